@@ -1,0 +1,510 @@
+//! The validated machine model.
+//!
+//! A [`Machine`] is what the loader (YAML, [`crate::load`]) and the `machine!`
+//! macro both produce, and what the derivation ([`crate::derive`]) consumes. By
+//! the time a `Machine` exists every rule of the machine-file contract has been
+//! checked: names resolve, the body graph is a tree with one root, every
+//! variable drives exactly one joint, every parameter an expression uses is
+//! declared. Every node keeps an [`Origin`] pointing back at the user's text so
+//! that later stages can still report located errors.
+
+use serde::Serialize;
+
+/// Where a node of the model came from: a byte span in the source text plus the
+/// key path (`bodies.x_slide.joint.axis`) that reaches it.
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
+pub struct Origin {
+    /// Byte offset of the first byte in the source text.
+    pub offset: usize,
+    /// Length in bytes (0 for a point location).
+    pub len: usize,
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column (in characters).
+    pub column: usize,
+    /// Dotted key path, e.g. `bodies.x_slide.joint.axis`.
+    pub key: String,
+}
+
+/// A coordinate axis of a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    /// The x axis.
+    X,
+    /// The y axis.
+    Y,
+    /// The z axis.
+    Z,
+}
+
+impl Axis {
+    /// 0 for x, 1 for y, 2 for z.
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        ["x", "y", "z"][self.index()]
+    }
+}
+
+/// A signed coordinate axis, as in `+x` or `-z`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct SignedAxis {
+    /// Which axis.
+    pub axis: Axis,
+    /// `false` for `+`, `true` for `-`.
+    pub negative: bool,
+}
+
+impl SignedAxis {
+    /// `+1.0` or `-1.0`.
+    pub fn sign(self) -> f64 {
+        if self.negative {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+}
+
+impl std::fmt::Display for SignedAxis {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}{}", if self.negative { "-" } else { "+" }, self.axis.name())
+    }
+}
+
+/// An arithmetic expression over numbers and parameters, as written in an
+/// offset, a tool point or a statistics entry.
+///
+/// Names are resolved at load time: [`Expr::Param`] holds the index into
+/// [`Machine::parameters`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub enum Expr {
+    /// A literal number.
+    Num(f64),
+    /// A parameter, by index into [`Machine::parameters`].
+    Param(usize),
+    /// Unary minus.
+    Neg(Box<Expr>),
+    /// Sum.
+    Add(Box<Expr>, Box<Expr>),
+    /// Difference.
+    Sub(Box<Expr>, Box<Expr>),
+    /// Product.
+    Mul(Box<Expr>, Box<Expr>),
+    /// Quotient. The divisor must not contain parameters (checked at load).
+    Div(Box<Expr>, Box<Expr>),
+    /// Integer power.
+    Pow(Box<Expr>, i32),
+}
+
+impl Expr {
+    /// Evaluates with the given parameter values (indexed like
+    /// [`Machine::parameters`]).
+    pub fn eval(&self, params: &[f64]) -> f64 {
+        match self {
+            Expr::Num(v) => *v,
+            Expr::Param(i) => params[*i],
+            Expr::Neg(a) => -a.eval(params),
+            Expr::Add(a, b) => a.eval(params) + b.eval(params),
+            Expr::Sub(a, b) => a.eval(params) - b.eval(params),
+            Expr::Mul(a, b) => a.eval(params) * b.eval(params),
+            Expr::Div(a, b) => a.eval(params) / b.eval(params),
+            Expr::Pow(a, n) => a.eval(params).powi(*n),
+        }
+    }
+
+    /// True if the expression is the literal zero.
+    pub fn is_zero(&self) -> bool {
+        matches!(self, Expr::Num(v) if *v == 0.0)
+    }
+}
+
+/// A named parameter of the machine (a structural length, say).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Parameter {
+    /// The name used in expressions.
+    pub name: String,
+    /// Its value, or `None` when it is symbolic and supplied at run time.
+    pub value: Option<f64>,
+    /// Where it was declared.
+    pub origin: Origin,
+}
+
+/// The kind of joint that moves a body relative to its parent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum JointKind {
+    /// Translation by `±q` along the axis.
+    Prismatic,
+    /// Rotation by `±q` (right-hand rule) about the axis.
+    Rotary,
+}
+
+/// An axis variable (the command of one joint).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Variable {
+    /// The variable's name (`x`, `A`, ...).
+    pub name: String,
+    /// The kind of the joint it drives.
+    pub kind: JointKind,
+    /// Index of the body whose joint it drives.
+    pub body: usize,
+    /// Where it was declared.
+    pub origin: Origin,
+}
+
+/// A joint: kind, signed axis and the variable that drives it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Joint {
+    /// Prismatic or rotary.
+    pub kind: JointKind,
+    /// Signed axis in the body frame.
+    pub axis: SignedAxis,
+    /// Index into [`Machine::variables`].
+    pub variable: usize,
+    /// Where it was declared.
+    pub origin: Origin,
+}
+
+/// A fixed elementary rotation of a body frame.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FixedRotation {
+    /// About which axis.
+    pub about: Axis,
+    /// Angle in radians.
+    pub angle: f64,
+    /// Where it was declared.
+    pub origin: Origin,
+}
+
+/// The six slots of a small-error transform `E(dx, dy, dz, ex, ey, ez)`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Slot {
+    /// Translation error along x.
+    Dx,
+    /// Translation error along y.
+    Dy,
+    /// Translation error along z.
+    Dz,
+    /// Rotation error about x.
+    Ex,
+    /// Rotation error about y.
+    Ey,
+    /// Rotation error about z.
+    Ez,
+}
+
+impl Slot {
+    /// All six slots in `dx, dy, dz, ex, ey, ez` order.
+    pub const ALL: [Slot; 6] = [Slot::Dx, Slot::Dy, Slot::Dz, Slot::Ex, Slot::Ey, Slot::Ez];
+
+    /// Position in `dx, dy, dz, ex, ey, ez` order.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The slot's key in a machine file.
+    pub fn name(self) -> &'static str {
+        ["dx", "dy", "dz", "ex", "ey", "ez"][self.index()]
+    }
+
+    /// True for `dx, dy, dz`.
+    pub fn is_linear(self) -> bool {
+        self.index() < 3
+    }
+}
+
+/// The error parameters assigned to the six slots of one small-error transform.
+/// A slot may hold several names (a motion error plus a squareness term); the
+/// slot's value is their sum.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct ErrorSlots {
+    /// Error indices (into [`Machine::errors`]) per slot, in `dx..ez` order.
+    pub slots: [Vec<usize>; 6],
+}
+
+impl ErrorSlots {
+    /// True if no slot holds an error.
+    pub fn is_empty(&self) -> bool {
+        self.slots.iter().all(Vec::is_empty)
+    }
+}
+
+/// What kind of quantity an error parameter is; sets its units (mm or rad) and
+/// how tolerances convert to standard deviations in allocation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ErrorKind {
+    /// A translation (`dx, dy, dz` slots): a length.
+    Linear,
+    /// A rotation (`ex, ey, ez` slots of `errors` or `location_errors`): an angle.
+    Angular,
+    /// A squareness term (`squareness` map): an angle.
+    Squareness,
+}
+
+/// One error parameter (one random variable), however many places use it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ErrorParam {
+    /// Its name.
+    pub name: String,
+    /// Linear, angular or squareness.
+    pub kind: ErrorKind,
+    /// Where it was first used.
+    pub origin: Origin,
+}
+
+/// A body of the machine: a rigid frame placed in its parent's frame by
+/// `Trans(offset) * Rot(rotation) * E(location_errors) * J(q) * E(errors + squareness)`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Body {
+    /// The body's name.
+    pub name: String,
+    /// Index of the parent body; `None` for the root.
+    pub parent: Option<usize>,
+    /// Offset of the body frame in the parent frame.
+    pub offset: [Expr; 3],
+    /// Fixed rotations, applied in order.
+    pub rotation: Vec<FixedRotation>,
+    /// Position-independent (location) errors, applied before the joint.
+    pub location_errors: ErrorSlots,
+    /// The joint, if the body moves.
+    pub joint: Option<Joint>,
+    /// Motion errors and squareness terms, applied after the joint.
+    pub errors: ErrorSlots,
+    /// Where the body was declared.
+    pub origin: Origin,
+}
+
+/// Which frame the derived `p` and `o` are expressed in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Frame {
+    /// The workpiece frame (the default).
+    #[default]
+    Workpiece,
+    /// The tool frame: `R_wt(q,0)^T p`, `R_wt(q,0)^T o`.
+    Tool,
+}
+
+impl Frame {
+    /// `workpiece` or `tool`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Frame::Workpiece => "workpiece",
+            Frame::Tool => "tool",
+        }
+    }
+}
+
+/// The input distribution of one error parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "dist", rename_all = "lowercase")]
+pub enum Distribution {
+    /// Normal with mean and standard deviation (`std > 0`).
+    Normal {
+        /// Mean.
+        mean: f64,
+        /// Standard deviation.
+        std: f64,
+    },
+    /// Uniform on `[min, max]` (`min < max`).
+    Uniform {
+        /// Lower bound.
+        min: f64,
+        /// Upper bound.
+        max: f64,
+    },
+}
+
+impl Distribution {
+    /// The mean.
+    pub fn mean(&self) -> f64 {
+        match *self {
+            Distribution::Normal { mean, .. } => mean,
+            Distribution::Uniform { min, max } => 0.5 * (min + max),
+        }
+    }
+
+    /// The standard deviation.
+    pub fn std(&self) -> f64 {
+        match *self {
+            Distribution::Normal { std, .. } => std,
+            Distribution::Uniform { min, max } => (max - min) / 12f64.sqrt(),
+        }
+    }
+}
+
+/// The statistics entry of one error parameter.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Statistic {
+    /// Index into [`Machine::errors`].
+    pub error: usize,
+    /// Its distribution.
+    pub distribution: Distribution,
+    /// Weight in the allocation cost (default 1).
+    pub cost_weight: f64,
+    /// Allocation never makes the standard deviation smaller than this.
+    pub min_std: Option<f64>,
+    /// Where the entry was declared.
+    pub origin: Origin,
+}
+
+/// One of the six error components `px, py, pz, ox, oy, oz`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Component {
+    /// Position error along x.
+    Px,
+    /// Position error along y.
+    Py,
+    /// Position error along z.
+    Pz,
+    /// Orientation error about x.
+    Ox,
+    /// Orientation error about y.
+    Oy,
+    /// Orientation error about z.
+    Oz,
+}
+
+impl Component {
+    /// All six in `px, py, pz, ox, oy, oz` order.
+    pub const ALL: [Component; 6] = [
+        Component::Px,
+        Component::Py,
+        Component::Pz,
+        Component::Ox,
+        Component::Oy,
+        Component::Oz,
+    ];
+
+    /// Position in `px..oz` order.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// `px`, `py`, ...
+    pub fn name(self) -> &'static str {
+        ["px", "py", "pz", "ox", "oy", "oz"][self.index()]
+    }
+
+    /// Parses `px`, `py`, ...
+    pub fn from_name(name: &str) -> Option<Component> {
+        Component::ALL.into_iter().find(|c| c.name() == name)
+    }
+}
+
+/// How a tolerance bounds a component.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Sided {
+    /// `g = I - E` (the 2021 paper).
+    #[default]
+    Upper,
+    /// `|E| <= I`.
+    Two,
+}
+
+/// The `reliability` section of a machine file.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReliabilitySpec {
+    /// Allowable error per component (only the listed components are assessed).
+    pub tolerance: Vec<(Component, f64)>,
+    /// One- or two-sided limit state.
+    pub sided: Sided,
+    /// Grid values per axis variable (index into [`Machine::variables`]).
+    pub grid: Vec<(usize, Vec<f64>)>,
+    /// Required minimum and mean reliability over the grid.
+    pub requirement: Option<Requirement>,
+    /// Where the section was declared.
+    pub origin: Origin,
+}
+
+/// A reliability requirement over a grid.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Requirement {
+    /// Minimum reliability over the grid.
+    pub min: f64,
+    /// Mean reliability over the grid.
+    pub mean: f64,
+}
+
+/// A validated machine.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Machine {
+    /// Identifier (`machine:` key).
+    pub name: String,
+    /// Free text.
+    pub description: Option<String>,
+    /// The file it was loaded from (for diagnostics), if any.
+    pub file: Option<String>,
+    /// Parameters in declaration order.
+    pub parameters: Vec<Parameter>,
+    /// Axis variables in body (tree pre-order) order.
+    pub variables: Vec<Variable>,
+    /// Error parameters in order of first use along the bodies.
+    pub errors: Vec<ErrorParam>,
+    /// Bodies, parents before children; index 0 is the root.
+    pub bodies: Vec<Body>,
+    /// Index of the workpiece body.
+    pub workpiece: usize,
+    /// Index of the tool body.
+    pub tool: usize,
+    /// Tool point in the tool frame.
+    pub tool_point: [Expr; 3],
+    /// Frame of the derived `p`, `o`.
+    pub frame: Frame,
+    /// Statistics entries (at most one per error), in file order.
+    pub statistics: Vec<Statistic>,
+    /// The reliability section, if any.
+    pub reliability: Option<ReliabilitySpec>,
+}
+
+impl Machine {
+    /// Index of the body with this name.
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
+    /// Index of the error parameter with this name.
+    pub fn error_index(&self, name: &str) -> Option<usize> {
+        self.errors.iter().position(|e| e.name == name)
+    }
+
+    /// Index of the variable with this name.
+    pub fn variable_index(&self, name: &str) -> Option<usize> {
+        self.variables.iter().position(|v| v.name == name)
+    }
+
+    /// Index of the parameter with this name.
+    pub fn parameter_index(&self, name: &str) -> Option<usize> {
+        self.parameters.iter().position(|p| p.name == name)
+    }
+
+    /// The chain of body indices from the root to `body`, root first.
+    pub fn path_from_root(&self, body: usize) -> Vec<usize> {
+        let mut path = vec![body];
+        let mut b = body;
+        while let Some(p) = self.bodies[b].parent {
+            path.push(p);
+            b = p;
+        }
+        path.reverse();
+        path
+    }
+
+    /// The statistics entry of an error, if any.
+    pub fn statistic(&self, error: usize) -> Option<&Statistic> {
+        self.statistics.iter().find(|s| s.error == error)
+    }
+}

@@ -1,0 +1,32 @@
+//! Subcommands of the `chain` binary: one file per subcommand, each a thin
+//! `exec` over the libraries.
+
+pub mod compensate;
+pub mod derive;
+
+use clap::{Parser, Subcommand};
+
+/// Geometric-error models, machining-accuracy reliability and precision
+/// allocation for machine tools.
+#[derive(Debug, Parser)]
+#[command(name = "chain", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Derive the exact first-order error model of a machine file.
+    Derive(derive::DeriveArgs),
+    /// Identify and compensate a swing-angle error from tool-tip heights (seed 003).
+    Compensate(compensate::CompensateArgs),
+}
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> miette::Result<()> {
+    match cli.command {
+        Command::Derive(args) => derive::exec(args),
+        Command::Compensate(args) => compensate::exec(args),
+    }
+}

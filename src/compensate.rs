@@ -1,0 +1,1 @@
+//! Swing-angle error identification and compensation (seed 003).

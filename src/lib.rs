@@ -1,0 +1,14 @@
+//! `chain`: geometric-error models, machining-accuracy reliability and
+//! precision allocation for machine tools.
+//!
+//! This facade re-exports the workspace crates:
+//! - [`core`] (`chain-core`): machine model, symbolic derivation, emission, runtime evaluation;
+//! - [`reliability`]: FORM, importance sampling, Monte Carlo, sensitivity;
+//!
+//! and holds the paper workflows that are not part of either
+//! ([`compensate`]: swing-angle error identification and compensation).
+
+pub use chain_core as core;
+pub use reliability;
+
+pub mod compensate;
