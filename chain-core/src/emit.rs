@@ -1,0 +1,497 @@
+//! Rust code emission: a [`SymbolicModel`] → straight-line Rust.
+//!
+//! One emitter serves both the `machine!` macro and `chain derive --format
+//! rust`. The generated type has the name lists, named index constants,
+//! `error`, `sensitivity` and `nominal` as inherent functions over fixed-size
+//! arrays (no heap, no panics), and an implementation of
+//! `chain::core::ErrorModel` so it is interchangeable with a runtime model.
+//! `sin`/`cos` of each rotary variable are computed once, every monomial of
+//! two or more factors is hoisted into a local, and coefficient expressions
+//! that occur more than once are computed once.
+
+use std::collections::HashMap;
+
+use proc_macro2::{Ident, Literal, Span, TokenStream};
+use quote::{format_ident, quote};
+
+use crate::algebra::{Monomial, Poly, Symbol};
+use crate::derive::SymbolicModel;
+use crate::model::{Component, JointKind};
+
+/// How to emit a model.
+#[derive(Debug, Clone)]
+pub struct EmitOptions {
+    /// Name of the generated type.
+    pub type_name: String,
+    /// Whether the type is `pub`.
+    pub public: bool,
+    /// Path of the `chain` facade crate in the generated code (default `::chain`).
+    pub crate_path: TokenStream,
+}
+
+impl EmitOptions {
+    /// Public type named after the machine (`gantry_grinder` → `GantryGrinder`)
+    /// with `::chain` as the crate path.
+    pub fn for_model(model: &SymbolicModel) -> EmitOptions {
+        EmitOptions {
+            type_name: type_name_for(&model.machine),
+            public: true,
+            crate_path: quote!(::chain),
+        }
+    }
+}
+
+/// `gantry_grinder` → `GantryGrinder`; non-identifier characters split words.
+pub fn type_name_for(machine: &str) -> String {
+    let mut out = String::new();
+    for word in machine.split(|c: char| !c.is_ascii_alphanumeric()) {
+        let mut chars = word.chars();
+        if let Some(first) = chars.next() {
+            out.extend(first.to_uppercase());
+            out.push_str(chars.as_str());
+        }
+    }
+    if out.is_empty() || out.starts_with(|c: char| c.is_ascii_digit()) {
+        out.insert_str(0, "Machine");
+    }
+    out
+}
+
+/// An upper-case constant name for an identifier (`ez_x2` → `EZ_X2`).
+fn const_name(prefix: &str, name: &str) -> String {
+    let body: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_uppercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("{prefix}{body}")
+}
+
+/// Emits the generated type as tokens.
+pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
+    let ty = Ident::new(&options.type_name, Span::call_site());
+    let krate = &options.crate_path;
+    let vis = if options.public { quote!(pub) } else { quote!() };
+    let v = model.variables.len();
+    let p = model.parameters.len();
+    let n = model.errors.len();
+    let var_names: Vec<&str> = model.variables.iter().map(|x| x.0.as_str()).collect();
+    let param_names: Vec<&str> = model.parameters.iter().map(|x| x.0.as_str()).collect();
+    let error_names: Vec<&str> = model.errors.iter().map(String::as_str).collect();
+    let param_values: Vec<TokenStream> = model
+        .parameters
+        .iter()
+        .map(|(_, value)| match value {
+            Some(x) if x.is_finite() => {
+                let lit = Literal::f64_unsuffixed(*x);
+                quote!(::core::option::Option::Some(#lit))
+            }
+            _ => quote!(::core::option::Option::None),
+        })
+        .collect();
+
+    let index_consts = index_constants(model);
+
+    // Sensitivity: every non-zero coefficient.
+    let sens_polys: Vec<(usize, usize, &Poly)> = model
+        .components
+        .iter()
+        .enumerate()
+        .flat_map(|(c, entries)| entries.iter().map(move |(j, poly)| (c, *j, poly)))
+        .collect();
+    let mut sens = Body::new(model);
+    let sens_assign: Vec<TokenStream> = sens_polys
+        .iter()
+        .map(|(c, j, poly)| {
+            let e = sens.expr(poly);
+            quote!(s[#c][#j] = #e;)
+        })
+        .collect();
+    let sens_prelude = sens.prelude();
+
+    let mut err = Body::new(model);
+    let err_rows: Vec<TokenStream> = Component::ALL
+        .iter()
+        .map(|c| {
+            let terms: Vec<TokenStream> = model.components[c.index()]
+                .iter()
+                .map(|(j, poly)| {
+                    let ex = err.expr(poly);
+                    quote!((#ex) * e[#j])
+                })
+                .collect();
+            if terms.is_empty() {
+                quote!(0.0)
+            } else {
+                quote!(#(#terms)+*)
+            }
+        })
+        .collect();
+    let err_prelude = err.prelude();
+
+    let mut nom = Body::new(model);
+    let rot: Vec<TokenStream> = model
+        .nominal_rotation
+        .iter()
+        .map(|row| {
+            let cells: Vec<TokenStream> = row.iter().map(|x| nom.expr(x)).collect();
+            quote!([#(#cells),*])
+        })
+        .collect();
+    let pos: Vec<TokenStream> = model
+        .nominal_position
+        .iter()
+        .map(|x| nom.expr(x))
+        .collect();
+    let nom_prelude = nom.prelude();
+
+    let text = |poly: &Poly| poly.to_text(&|s| model.symbol_name(s));
+    let component_docs: Vec<String> = Component::ALL
+        .iter()
+        .map(|c| {
+            let terms: Vec<String> = model.components[c.index()]
+                .iter()
+                .map(|(j, poly)| format!("({})*{}", text(poly), model.errors[*j]))
+                .collect();
+            let rhs = if terms.is_empty() {
+                "0".to_string()
+            } else {
+                terms.join(" + ")
+            };
+            format!(" - `{} = {}`", c.name(), rhs)
+        })
+        .collect();
+    let nominal_doc: Vec<String> = model
+        .nominal_rotation
+        .iter()
+        .map(|row| {
+            let cells: Vec<String> = row.iter().map(&text).collect();
+            format!(" - `R` row: `[{}]`", cells.join(", "))
+        })
+        .chain(std::iter::once(format!(
+            " - position: `[{}]`",
+            model
+                .nominal_position
+                .iter()
+                .map(&text)
+                .collect::<Vec<_>>()
+                .join(", ")
+        )))
+        .collect();
+    let type_doc = format!(
+        " First-order error model of machine `{}` (frame: {}), generated by `chain`.",
+        model.machine,
+        model.frame.name()
+    );
+    let vars_doc = format!(" Axis variables, in `q` order: {}.", var_names.join(", "));
+
+    quote! {
+        #[doc = #type_doc]
+        #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+        #vis struct #ty;
+
+        #[allow(clippy::all, clippy::pedantic, unused_parens, unused_variables)]
+        impl #ty {
+            #[doc = #vars_doc]
+            pub const VARIABLES: [&'static str; #v] = [#(#var_names),*];
+            /// Parameter names, in `p` order.
+            pub const PARAMETERS: [&'static str; #p] = [#(#param_names),*];
+            /// Error parameter names, in `e` order.
+            pub const ERRORS: [&'static str; #n] = [#(#error_names),*];
+            /// Parameter values given with the machine (`None`: supplied at run time).
+            pub const PARAMETER_VALUES: [::core::option::Option<f64>; #p] = [#(#param_values),*];
+            #(#index_consts)*
+
+            /// The error vector `[px, py, pz, ox, oy, oz]`:
+            ///
+            #(#[doc = #component_docs])*
+            #[inline]
+            #[must_use]
+            pub fn error(q: &[f64; #v], p: &[f64; #p], e: &[f64; #n]) -> [f64; 6] {
+                #err_prelude
+                [#(#err_rows),*]
+            }
+
+            /// The sensitivity matrix `s[c][j] = ∂E_c/∂e_j` (rows `px, py, pz, ox, oy, oz`):
+            ///
+            #(#[doc = #component_docs])*
+            #[inline]
+            #[must_use]
+            pub fn sensitivity(q: &[f64; #v], p: &[f64; #p]) -> [[f64; #n]; 6] {
+                #sens_prelude
+                let mut s = [[0.0f64; #n]; 6];
+                #(#sens_assign)*
+                s
+            }
+
+            /// The nominal pose `R_wt(q, 0)` and `T_wt(q, 0)·tool_point`:
+            ///
+            #(#[doc = #nominal_doc])*
+            #[inline]
+            #[must_use]
+            pub fn nominal(q: &[f64; #v], p: &[f64; #p]) -> ([[f64; 3]; 3], [f64; 3]) {
+                #nom_prelude
+                ([#(#rot),*], [#(#pos),*])
+            }
+        }
+
+        impl #krate::core::ErrorModel for #ty {
+            fn variables(&self) -> &[&str] {
+                &Self::VARIABLES
+            }
+            fn parameters(&self) -> &[&str] {
+                &Self::PARAMETERS
+            }
+            fn errors(&self) -> &[&str] {
+                &Self::ERRORS
+            }
+            fn error(&self, q: &[f64], p: &[f64], e: &[f64], out: &mut [f64; 6]) {
+                *out = match (
+                    <&[f64; #v]>::try_from(q),
+                    <&[f64; #p]>::try_from(p),
+                    <&[f64; #n]>::try_from(e),
+                ) {
+                    (Ok(q), Ok(p), Ok(e)) => Self::error(q, p, e),
+                    _ => [f64::NAN; 6],
+                };
+            }
+            fn sensitivity(&self, q: &[f64], p: &[f64], out: &mut [f64]) {
+                match (<&[f64; #v]>::try_from(q), <&[f64; #p]>::try_from(p)) {
+                    (Ok(q), Ok(p)) => {
+                        let s = Self::sensitivity(q, p);
+                        for (slot, value) in out.iter_mut().zip(s.iter().flatten()) {
+                            *slot = *value;
+                        }
+                    }
+                    _ => out.iter_mut().for_each(|slot| *slot = f64::NAN),
+                }
+            }
+            fn nominal(&self, q: &[f64], p: &[f64]) -> #krate::core::Pose {
+                match (<&[f64; #v]>::try_from(q), <&[f64; #p]>::try_from(p)) {
+                    (Ok(q), Ok(p)) => {
+                        let (rotation, position) = Self::nominal(q, p);
+                        #krate::core::Pose { rotation, position }
+                    }
+                    _ => #krate::core::Pose {
+                        rotation: [[f64::NAN; 3]; 3],
+                        position: [f64::NAN; 3],
+                    },
+                }
+            }
+        }
+    }
+}
+
+/// Emits the generated type as formatted Rust source (prettyplease).
+pub fn emit_pretty(model: &SymbolicModel, options: &EmitOptions) -> String {
+    let tokens = emit(model, options);
+    match syn::parse2::<syn::File>(tokens.clone()) {
+        Ok(file) => prettyplease::unparse(&file),
+        Err(_) => tokens.to_string(),
+    }
+}
+
+fn index_constants(model: &SymbolicModel) -> Vec<TokenStream> {
+    let mut seen: HashMap<String, usize> = HashMap::new();
+    let mut out = Vec::new();
+    let groups: [(&str, Vec<&str>, &str); 3] = [
+        (
+            "VAR_",
+            model.variables.iter().map(|v| v.0.as_str()).collect(),
+            "axis variable",
+        ),
+        (
+            "PARAM_",
+            model.parameters.iter().map(|v| v.0.as_str()).collect(),
+            "parameter",
+        ),
+        (
+            "ERR_",
+            model.errors.iter().map(String::as_str).collect(),
+            "error parameter",
+        ),
+    ];
+    for (prefix, names, what) in groups {
+        for (i, name) in names.iter().enumerate() {
+            let mut c = const_name(prefix, name);
+            let count = seen.entry(c.clone()).or_insert(0);
+            *count += 1;
+            if *count > 1 {
+                c = format!("{c}_{i}");
+            }
+            let ident = Ident::new(&c, Span::call_site());
+            let doc = format!(" Index of the {what} `{name}`.");
+            out.push(quote! {
+                #[doc = #doc]
+                pub const #ident: usize = #i;
+            });
+        }
+    }
+    out
+}
+
+/// Collects the hoisted locals of one generated function body.
+struct Body<'a> {
+    model: &'a SymbolicModel,
+    symbols: Vec<Symbol>,
+    monomials: Vec<(Monomial, Ident, TokenStream)>,
+    monomial_index: HashMap<Monomial, Ident>,
+    shared: HashMap<String, (Ident, TokenStream, usize)>,
+    shared_order: Vec<String>,
+}
+
+impl<'a> Body<'a> {
+    fn new(model: &'a SymbolicModel) -> Body<'a> {
+        Body {
+            model,
+            symbols: Vec::new(),
+            monomials: Vec::new(),
+            monomial_index: HashMap::new(),
+            shared: HashMap::new(),
+            shared_order: Vec::new(),
+        }
+    }
+
+    fn symbol(&mut self, s: Symbol) -> Ident {
+        if !self.symbols.contains(&s) {
+            self.symbols.push(s);
+        }
+        symbol_ident(s)
+    }
+
+    fn monomial(&mut self, m: &Monomial) -> TokenStream {
+        if m.0.len() == 1 && m.0[0].1 == 1 {
+            let id = self.symbol(m.0[0].0);
+            return quote!(#id);
+        }
+        if let Some(id) = self.monomial_index.get(m) {
+            return quote!(#id);
+        }
+        let mut parent = m.0.clone();
+        let last = parent.len() - 1;
+        let sym = parent[last].0;
+        if parent[last].1 == 1 {
+            parent.pop();
+        } else {
+            parent[last].1 -= 1;
+        }
+        let a = self.monomial(&Monomial(parent));
+        let b = self.symbol(sym);
+        let id = format_ident!("m{}", self.monomials.len());
+        self.monomials.push((m.clone(), id.clone(), quote!(#a * #b)));
+        self.monomial_index.insert(m.clone(), id.clone());
+        quote!(#id)
+    }
+
+    fn poly_tokens(&mut self, poly: &Poly) -> TokenStream {
+        if poly.is_zero() {
+            return quote!(0.0);
+        }
+        let mut out = TokenStream::new();
+        for (k, (m, c)) in poly.terms().iter().enumerate() {
+            let negative = *c < 0.0;
+            let mag = c.abs();
+            let sign = match (k, negative) {
+                (0, true) => quote!(-),
+                (0, false) => quote!(),
+                (_, true) => quote!(-),
+                (_, false) => quote!(+),
+            };
+            let term = if m.is_one() {
+                let lit = Literal::f64_unsuffixed(mag);
+                quote!(#lit)
+            } else {
+                let mono = self.monomial(m);
+                if mag == 1.0 {
+                    mono
+                } else {
+                    let lit = Literal::f64_unsuffixed(mag);
+                    quote!(#lit * #mono)
+                }
+            };
+            out.extend(quote!(#sign #term));
+        }
+        out
+    }
+
+    /// The expression of a polynomial; repeated multi-term polynomials are
+    /// hoisted into a shared local.
+    fn expr(&mut self, poly: &Poly) -> TokenStream {
+        let single = poly.terms().len() <= 1;
+        let body = self.poly_tokens(poly);
+        if single {
+            return quote!((#body));
+        }
+        let key = poly.to_text(&|s| self.model.symbol_name(s));
+        if let Some((id, _, uses)) = self.shared.get_mut(&key) {
+            *uses += 1;
+            let id = id.clone();
+            return quote!(#id);
+        }
+        let id = format_ident!("k{}", self.shared_order.len());
+        self.shared.insert(key.clone(), (id.clone(), body, 1));
+        self.shared_order.push(key);
+        quote!(#id)
+    }
+
+    /// The `let` statements: symbols, monomials, shared coefficients.
+    fn prelude(&self) -> TokenStream {
+        let mut out = TokenStream::new();
+        let mut symbols = self.symbols.clone();
+        symbols.sort();
+        let mut done_rotary = Vec::new();
+        for s in symbols {
+            match s {
+                Symbol::Var(i) => {
+                    let id = symbol_ident(s);
+                    let i = usize::from(i);
+                    out.extend(quote!(let #id = q[#i];));
+                }
+                Symbol::Param(i) => {
+                    let id = symbol_ident(s);
+                    let i = usize::from(i);
+                    out.extend(quote!(let #id = p[#i];));
+                }
+                Symbol::Cos(i) | Symbol::Sin(i) => {
+                    if done_rotary.contains(&i) {
+                        continue;
+                    }
+                    done_rotary.push(i);
+                    let (sn, cs) = (symbol_ident(Symbol::Sin(i)), symbol_ident(Symbol::Cos(i)));
+                    let k = usize::from(i);
+                    let is_rotary = self
+                        .model
+                        .variables
+                        .get(k)
+                        .is_some_and(|v| v.1 == JointKind::Rotary);
+                    if is_rotary {
+                        out.extend(quote!(let (#sn, #cs) = q[#k].sin_cos();));
+                    }
+                }
+            }
+        }
+        for (_, id, expr) in &self.monomials {
+            out.extend(quote!(let #id = #expr;));
+        }
+        for key in &self.shared_order {
+            if let Some((id, body, _)) = self.shared.get(key) {
+                out.extend(quote!(let #id = #body;));
+            }
+        }
+        out
+    }
+}
+
+fn symbol_ident(s: Symbol) -> Ident {
+    match s {
+        Symbol::Var(i) => format_ident!("q{}", i),
+        Symbol::Param(i) => format_ident!("p{}", i),
+        Symbol::Cos(i) => format_ident!("c{}", i),
+        Symbol::Sin(i) => format_ident!("s{}", i),
+    }
+}

@@ -1,0 +1,269 @@
+//! The runtime evaluator: a [`SymbolicModel`] flattened into a tape that
+//! evaluates the error vector, the full sensitivity matrix and the nominal
+//! pose at a point without re-deriving anything.
+//!
+//! Registers hold `1`, then one slot per symbol (`x`, `cos A`, `sin A`, `L`,
+//! ...), then one slot per distinct monomial; each monomial is the product of a
+//! shorter monomial and one symbol, so shared sub-products are computed once.
+//! Every output is a short dot product of coefficients with monomial registers.
+
+use std::collections::{HashMap, HashSet};
+use std::sync::Mutex;
+
+use crate::algebra::{Monomial, Poly, Symbol};
+use crate::derive::SymbolicModel;
+use crate::model::{JointKind, Machine};
+use crate::model_trait::{ErrorModel, Pose};
+
+/// Registers kept on the stack; larger tapes use a heap buffer per call.
+const STACK_REGISTERS: usize = 256;
+
+/// A machine's error model compiled to a flat tape. Implements [`ErrorModel`].
+#[derive(Debug, Clone)]
+pub struct CompiledModel {
+    variables: Vec<&'static str>,
+    parameters: Vec<&'static str>,
+    errors: Vec<&'static str>,
+    parameter_values: Vec<Option<f64>>,
+    /// Register index and meaning of each symbol slot.
+    loads: Vec<(usize, Symbol)>,
+    /// `regs[dst] = regs[a] * regs[b]`, in order.
+    products: Vec<(u32, u32, u32)>,
+    register_count: usize,
+    /// Sensitivity outputs: `(row-major index c*N+j, terms range)`.
+    sensitivity: Vec<(u32, u32, u32)>,
+    /// Nominal outputs: `(0..9 rotation row-major, 9..12 position, terms range)`.
+    nominal: Vec<(u32, u32, u32)>,
+    /// `(coefficient, register)` terms of all outputs.
+    terms: Vec<(f64, u32)>,
+}
+
+/// Compiles a machine: derive, then flatten.
+pub fn compile(machine: &Machine) -> CompiledModel {
+    CompiledModel::new(&crate::derive(machine))
+}
+
+impl CompiledModel {
+    /// Flattens a symbolic model.
+    pub fn new(model: &SymbolicModel) -> CompiledModel {
+        let mut builder = TapeBuilder::default();
+        builder.registers = 1; // register 0 holds 1.0
+        for (i, (_, kind)) in model.variables.iter().enumerate() {
+            let i = crate::algebra::index_u16(i);
+            match kind {
+                JointKind::Prismatic => builder.load(Symbol::Var(i)),
+                JointKind::Rotary => {
+                    builder.load(Symbol::Cos(i));
+                    builder.load(Symbol::Sin(i));
+                }
+            }
+        }
+        for k in 0..model.parameters.len() {
+            builder.load(Symbol::Param(crate::algebra::index_u16(k)));
+        }
+        let n = model.errors.len();
+        let mut sensitivity = Vec::new();
+        for (c, entries) in model.components.iter().enumerate() {
+            for (j, poly) in entries {
+                let range = builder.poly(poly);
+                sensitivity.push((to_u32(c * n + j), range.0, range.1));
+            }
+        }
+        let mut nominal = Vec::new();
+        for i in 0..3 {
+            for j in 0..3 {
+                let poly = &model.nominal_rotation[i][j];
+                if !poly.is_zero() {
+                    let range = builder.poly(poly);
+                    nominal.push((to_u32(3 * i + j), range.0, range.1));
+                }
+            }
+        }
+        for i in 0..3 {
+            let poly = &model.nominal_position[i];
+            if !poly.is_zero() {
+                let range = builder.poly(poly);
+                nominal.push((to_u32(9 + i), range.0, range.1));
+            }
+        }
+        CompiledModel {
+            variables: model.variables.iter().map(|v| intern(&v.0)).collect(),
+            parameters: model.parameters.iter().map(|p| intern(&p.0)).collect(),
+            errors: model.errors.iter().map(|e| intern(e)).collect(),
+            parameter_values: model.parameters.iter().map(|p| p.1).collect(),
+            loads: builder.loads,
+            products: builder.products,
+            register_count: builder.registers,
+            sensitivity,
+            nominal,
+            terms: builder.terms,
+        }
+    }
+
+    /// The parameter values given in the machine file (`None`: symbolic).
+    pub fn parameter_values(&self) -> &[Option<f64>] {
+        &self.parameter_values
+    }
+
+    /// Number of tape instructions (products) and output terms.
+    pub fn tape_size(&self) -> (usize, usize) {
+        (self.products.len(), self.terms.len())
+    }
+
+    fn with_registers<R>(&self, q: &[f64], p: &[f64], f: impl FnOnce(&[f64]) -> R) -> R {
+        let mut stack = [0.0f64; STACK_REGISTERS];
+        let mut heap = Vec::new();
+        let regs: &mut [f64] = if self.register_count <= STACK_REGISTERS {
+            &mut stack[..self.register_count]
+        } else {
+            heap.resize(self.register_count, 0.0);
+            &mut heap
+        };
+        regs[0] = 1.0;
+        for &(r, s) in &self.loads {
+            regs[r] = SymbolicModel::symbol_value(s, q, p);
+        }
+        for &(dst, a, b) in &self.products {
+            regs[dst as usize] = regs[a as usize] * regs[b as usize];
+        }
+        f(regs)
+    }
+
+    #[inline]
+    fn dot(&self, regs: &[f64], start: u32, end: u32) -> f64 {
+        self.terms[start as usize..end as usize]
+            .iter()
+            .map(|&(c, r)| c * regs[r as usize])
+            .sum()
+    }
+}
+
+impl ErrorModel for CompiledModel {
+    fn variables(&self) -> &[&str] {
+        &self.variables
+    }
+
+    fn parameters(&self) -> &[&str] {
+        &self.parameters
+    }
+
+    fn errors(&self) -> &[&str] {
+        &self.errors
+    }
+
+    fn error(&self, q: &[f64], p: &[f64], e: &[f64], out: &mut [f64; 6]) {
+        let n = self.errors.len();
+        *out = [0.0; 6];
+        self.with_registers(q, p, |regs| {
+            for &(idx, start, end) in &self.sensitivity {
+                let idx = idx as usize;
+                let (c, j) = (idx / n, idx % n);
+                out[c] += self.dot(regs, start, end) * e.get(j).copied().unwrap_or(0.0);
+            }
+        });
+    }
+
+    fn sensitivity(&self, q: &[f64], p: &[f64], out: &mut [f64]) {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        self.with_registers(q, p, |regs| {
+            for &(idx, start, end) in &self.sensitivity {
+                if let Some(slot) = out.get_mut(idx as usize) {
+                    *slot = self.dot(regs, start, end);
+                }
+            }
+        });
+    }
+
+    fn nominal(&self, q: &[f64], p: &[f64]) -> Pose {
+        let mut flat = [0.0; 12];
+        self.with_registers(q, p, |regs| {
+            for &(idx, start, end) in &self.nominal {
+                flat[idx as usize] = self.dot(regs, start, end);
+            }
+        });
+        Pose {
+            rotation: [
+                [flat[0], flat[1], flat[2]],
+                [flat[3], flat[4], flat[5]],
+                [flat[6], flat[7], flat[8]],
+            ],
+            position: [flat[9], flat[10], flat[11]],
+        }
+    }
+}
+
+fn to_u32(i: usize) -> u32 {
+    u32::try_from(i).unwrap_or(u32::MAX)
+}
+
+#[derive(Default)]
+struct TapeBuilder {
+    registers: usize,
+    loads: Vec<(usize, Symbol)>,
+    symbol_reg: HashMap<Symbol, u32>,
+    monomial_reg: HashMap<Monomial, u32>,
+    products: Vec<(u32, u32, u32)>,
+    terms: Vec<(f64, u32)>,
+}
+
+impl TapeBuilder {
+    fn load(&mut self, s: Symbol) {
+        let r = self.registers;
+        self.registers += 1;
+        self.loads.push((r, s));
+        self.symbol_reg.insert(s, to_u32(r));
+        self.monomial_reg.insert(Monomial::symbol(s), to_u32(r));
+    }
+
+    fn monomial(&mut self, m: &Monomial) -> u32 {
+        if m.is_one() {
+            return 0;
+        }
+        if let Some(&r) = self.monomial_reg.get(m) {
+            return r;
+        }
+        // m = parent * last symbol
+        let mut parent = m.0.clone();
+        let last = parent.len() - 1;
+        let sym = parent[last].0;
+        if parent[last].1 == 1 {
+            parent.pop();
+        } else {
+            parent[last].1 -= 1;
+        }
+        let a = self.monomial(&Monomial(parent));
+        let b = self.symbol_reg.get(&sym).copied().unwrap_or(0);
+        let dst = to_u32(self.registers);
+        self.registers += 1;
+        self.products.push((dst, a, b));
+        self.monomial_reg.insert(m.clone(), dst);
+        dst
+    }
+
+    fn poly(&mut self, p: &Poly) -> (u32, u32) {
+        let start = to_u32(self.terms.len());
+        for (m, c) in p.terms() {
+            let r = self.monomial(m);
+            self.terms.push((*c, r));
+        }
+        (start, to_u32(self.terms.len()))
+    }
+}
+
+/// Interns a name as a `&'static str`, so that runtime models can hand out
+/// `&[&str]` like generated ones. Each distinct name is stored once per
+/// process.
+fn intern(name: &str) -> &'static str {
+    static NAMES: Mutex<Option<HashSet<&'static str>>> = Mutex::new(None);
+    let mut guard = match NAMES.lock() {
+        Ok(g) => g,
+        Err(poisoned) => poisoned.into_inner(),
+    };
+    let set = guard.get_or_insert_with(HashSet::new);
+    if let Some(&s) = set.get(name) {
+        return s;
+    }
+    let leaked: &'static str = Box::leak(name.to_string().into_boxed_str());
+    set.insert(leaked);
+    leaked
+}
