@@ -247,3 +247,123 @@ pub(crate) fn body_transform(machine: &Machine, b: usize) -> Transform {
             Factor::Error(slots) => acc.mul(&error_transform(slots)),
         })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{
+        Body, ErrorKind, ErrorParam, Expr, Joint, Origin, Parameter, SignedAxis, Variable,
+    };
+
+    /// A rotary table (about +z, variable `C`) carrying the workpiece, and a
+    /// fixed tool at `[L, 0, 0]` from the bed; the table has an `ez` motion
+    /// error `ezc` and a `dx` motion error `dxc`.
+    fn rotary_table() -> Machine {
+        let o = Origin::default;
+        let slots = |pairs: &[(usize, usize)]| {
+            let mut s = ErrorSlots::default();
+            for &(slot, err) in pairs {
+                s.slots[slot].push(err);
+            }
+            s
+        };
+        Machine {
+            name: "rot".into(),
+            description: None,
+            file: None,
+            parameters: vec![Parameter {
+                name: "L".into(),
+                value: Some(100.0),
+                origin: o(),
+            }],
+            variables: vec![Variable {
+                name: "C".into(),
+                kind: JointKind::Rotary,
+                body: 1,
+                origin: o(),
+            }],
+            errors: vec![
+                ErrorParam {
+                    name: "dxc".into(),
+                    kind: ErrorKind::Linear,
+                    origin: o(),
+                },
+                ErrorParam {
+                    name: "ezc".into(),
+                    kind: ErrorKind::Angular,
+                    origin: o(),
+                },
+            ],
+            bodies: vec![
+                Body {
+                    name: "bed".into(),
+                    parent: None,
+                    offset: [Expr::Num(0.0), Expr::Num(0.0), Expr::Num(0.0)],
+                    rotation: vec![],
+                    location_errors: ErrorSlots::default(),
+                    joint: None,
+                    errors: ErrorSlots::default(),
+                    origin: o(),
+                },
+                Body {
+                    name: "table".into(),
+                    parent: Some(0),
+                    offset: [Expr::Num(0.0), Expr::Num(0.0), Expr::Num(0.0)],
+                    rotation: vec![],
+                    location_errors: ErrorSlots::default(),
+                    joint: Some(Joint {
+                        kind: JointKind::Rotary,
+                        axis: SignedAxis {
+                            axis: crate::model::Axis::Z,
+                            negative: false,
+                        },
+                        variable: 0,
+                        origin: o(),
+                    }),
+                    errors: slots(&[(0, 0), (5, 1)]),
+                    origin: o(),
+                },
+                Body {
+                    name: "tool".into(),
+                    parent: Some(0),
+                    offset: [Expr::Param(0), Expr::Num(0.0), Expr::Num(0.0)],
+                    rotation: vec![],
+                    location_errors: ErrorSlots::default(),
+                    joint: None,
+                    errors: ErrorSlots::default(),
+                    origin: o(),
+                },
+            ],
+            workpiece: 1,
+            tool: 2,
+            tool_point: [Expr::Num(0.0), Expr::Num(0.0), Expr::Num(0.0)],
+            frame: Frame::Workpiece,
+            statistics: vec![],
+            reliability: None,
+        }
+    }
+
+    #[test]
+    fn rotary_table_by_hand() {
+        // T_wt = inv(Rz(C) E) Trans(L): the tool sits at Rz(-C)(L,0,0) in the
+        // table frame. A table error E(dx=dxc, ez=ezc) moves the workpiece, so
+        // the tool moves by -E relative to it: p = -(dxc, 0, 0) - ezc × p0.
+        let m = rotary_table();
+        let model = derive(&m);
+        let name = |p: &Poly| p.to_text(&|s| model.symbol_name(s));
+        assert_eq!(name(&model.nominal_position[0]), "L*cos(C)");
+        assert_eq!(name(&model.nominal_position[1]), "-L*sin(C)");
+        assert_eq!(name(&model.coefficient(Component::Px, 0)), "-1");
+        assert_eq!(name(&model.coefficient(Component::Py, 0)), "0");
+        // -ezc × (L cos C, -L sin C, 0) = ezc (-L sin C, -L cos C, 0)·(-1)...
+        assert_eq!(name(&model.coefficient(Component::Px, 1)), "-L*sin(C)");
+        assert_eq!(name(&model.coefficient(Component::Py, 1)), "-L*cos(C)");
+        assert_eq!(name(&model.coefficient(Component::Oz, 1)), "-1");
+        // The DMM route agrees in both frames.
+        for frame in [Frame::Workpiece, Frame::Tool] {
+            let a = derive_in(&m, frame).components;
+            let b = crate::dmm::derive_dmm(&m, frame);
+            assert_eq!(a, b, "{frame:?}");
+        }
+    }
+}

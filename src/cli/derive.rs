@@ -1,13 +1,66 @@
-//! `chain derive`.
+//! `chain derive FILE [--frame tool|workpiece] [--format text|json|latex|rust]`.
+
+use std::path::PathBuf;
+
+use chain_core::emit::{emit_pretty, EmitOptions};
+use chain_core::export;
+use chain_core::model::Frame;
+
+/// Output formats of `chain derive`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DeriveFormat {
+    /// A readable report.
+    Text,
+    /// The spec's JSON document.
+    Json,
+    /// LaTeX (`align*`).
+    Latex,
+    /// Rust source, exactly what `machine!` emits for the file.
+    Rust,
+}
+
+/// The frame override of `--frame`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FrameArg {
+    /// The tool frame.
+    Tool,
+    /// The workpiece frame.
+    Workpiece,
+}
 
 /// Arguments of `chain derive`.
 #[derive(Debug, clap::Args)]
 pub struct DeriveArgs {
     /// Machine file (YAML).
-    pub file: std::path::PathBuf,
+    pub file: PathBuf,
+    /// Frame of `p` and `o` (default: the file's `frame`).
+    #[arg(long, value_enum)]
+    pub frame: Option<FrameArg>,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: DeriveFormat,
 }
 
 /// Runs `chain derive`.
-pub fn exec(_args: DeriveArgs) -> miette::Result<()> {
-    Err(miette::miette!("derive: under construction"))
+pub fn exec(args: DeriveArgs) -> miette::Result<()> {
+    let machine = chain_core::load_file(&args.file)?;
+    let frame = match args.frame {
+        Some(FrameArg::Tool) => Frame::Tool,
+        Some(FrameArg::Workpiece) => Frame::Workpiece,
+        None => machine.frame,
+    };
+    let model = chain_core::derive_in(&machine, frame);
+    let out = match args.format {
+        DeriveFormat::Text => export::to_text(&model),
+        DeriveFormat::Latex => export::to_latex(&model),
+        DeriveFormat::Json => {
+            let mut s = serde_json::to_string_pretty(&export::to_json(&model))
+                .map_err(|e| miette::miette!("cannot serialise the model: {e}"))?;
+            s.push('\n');
+            s
+        }
+        DeriveFormat::Rust => emit_pretty(&model, &EmitOptions::for_model(&model)),
+    };
+    print!("{out}");
+    Ok(())
 }

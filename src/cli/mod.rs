@@ -3,6 +3,8 @@
 
 pub mod compensate;
 pub mod derive;
+pub mod reliability;
+pub mod sensitivity;
 
 use clap::{Parser, Subcommand};
 
@@ -19,6 +21,10 @@ pub struct Cli {
 enum Command {
     /// Derive the exact first-order error model of a machine file.
     Derive(derive::DeriveArgs),
+    /// Machining-accuracy reliability over the workspace grid (FORM, importance sampling, Monte Carlo).
+    Reliability(reliability::ReliabilityArgs),
+    /// Reliability sensitivity to each error's mean and standard deviation.
+    Sensitivity(sensitivity::SensitivityArgs),
     /// Identify and compensate a swing-angle error from tool-tip heights (seed 003).
     Compensate(compensate::CompensateArgs),
 }
@@ -27,6 +33,8 @@ enum Command {
 pub fn run(cli: Cli) -> miette::Result<()> {
     match cli.command {
         Command::Derive(args) => derive::exec(args),
+        Command::Reliability(args) => reliability::exec(args),
+        Command::Sensitivity(args) => sensitivity::exec(args),
         Command::Compensate(args) => compensate::exec(args),
     }
 }

@@ -399,8 +399,8 @@ mod tests {
         let x = Poly::symbol(Symbol::Var(0));
         let c = Poly::symbol(Symbol::Cos(0));
         let p = x.mul(&x).scale(2.0).sub(&c.mul(&Poly::symbol(Symbol::Param(0))));
-        assert_eq!(p.to_text(&names), "2*x^2 - L*cos(A)");
-        assert_eq!(p.to_latex(&names), "2 x^{2} - L cos(A)");
+        assert_eq!(p.to_text(&names), "-L*cos(A) + 2*x^2");
+        assert_eq!(p.to_latex(&names), "-L cos(A) + 2 x^{2}");
     }
 
     #[test]
