@@ -12,3 +12,4 @@ pub use chain_core as core;
 pub use reliability;
 
 pub mod compensate;
+pub mod plot;

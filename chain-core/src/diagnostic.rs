@@ -396,7 +396,7 @@ impl Problem {
                 format!("`{key}` does not apply to a {dist} distribution")
             }
             Problem::UnknownError { name, .. } => {
-                format!("statistics for `{name}`, which is not an error parameter of this machine")
+                format!("statistics for `{name}`, but no body uses an error parameter of that name")
             }
             Problem::ErrorKindConflict {
                 name,
@@ -592,28 +592,39 @@ impl fmt::Display for Problem {
 /// The closest candidate to `name` by edit distance, if it is close enough to
 /// be a plausible typo (at most a third of the longer name's length, and at
 /// least one edit is always allowed; a case-only difference always matches).
+/// Failing that, a candidate of at least three characters that is a prefix of
+/// `name` (`minimum` → `min`) or that `name` is a prefix of.
 pub fn closest<'a, I>(name: &str, candidates: I) -> Option<&'a str>
 where
     I: IntoIterator<Item = &'a str>,
 {
     let lower = name.to_lowercase();
     let mut best: Option<(usize, &'a str)> = None;
+    let mut prefixed: Option<&'a str> = None;
     for cand in candidates {
         if cand == name {
             continue;
         }
-        let d = if cand.to_lowercase() == lower {
+        let cl = cand.to_lowercase();
+        let d = if cl == lower {
             0
         } else {
-            edit_distance(&lower, &cand.to_lowercase())
+            edit_distance(&lower, &cl)
         };
         let longest = name.chars().count().max(cand.chars().count());
         let allowed = (longest / 3).max(1);
         if d <= allowed && best.is_none_or(|(bd, _)| d < bd) {
             best = Some((d, cand));
         }
+        let shortest = name.chars().count().min(cand.chars().count());
+        if prefixed.is_none()
+            && shortest >= 3
+            && (lower.starts_with(&cl) || cl.starts_with(&lower))
+        {
+            prefixed = Some(cand);
+        }
     }
-    best.map(|(_, c)| c)
+    best.map(|(_, c)| c).or(prefixed)
 }
 
 /// Optimal-string-alignment distance (Levenshtein plus adjacent transpositions).
@@ -755,6 +766,11 @@ impl miette::Diagnostic for Related {
 /// error, one per line. As a [`miette::Diagnostic`] it renders the first error
 /// with a labelled snippet of the file and the others as related diagnostics.
 pub struct Diagnostics {
+    // Boxed so that `Result<Machine, Diagnostics>` stays small.
+    inner: Box<Inner>,
+}
+
+struct Inner {
     source: NamedSource<String>,
     source_len: usize,
     errors: Vec<LoadError>,
@@ -764,7 +780,7 @@ pub struct Diagnostics {
 impl fmt::Debug for Diagnostics {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("Diagnostics")
-            .field("errors", &self.errors)
+            .field("errors", &self.inner.errors)
             .finish_non_exhaustive()
     }
 }
@@ -794,10 +810,12 @@ impl Diagnostics {
             })
             .collect();
         Some(Diagnostics {
-            source: NamedSource::new(file, source).with_language("yaml"),
-            source_len,
-            errors,
-            related,
+            inner: Box::new(Inner {
+                source: NamedSource::new(file, source).with_language("yaml"),
+                source_len,
+                errors,
+                related,
+            }),
         })
     }
 
@@ -813,42 +831,44 @@ impl Diagnostics {
         let source = source.into();
         let source_len = source.len();
         Diagnostics {
-            source: NamedSource::new(file, source).with_language("yaml"),
-            source_len,
-            errors: vec![error],
-            related: Vec::new(),
+            inner: Box::new(Inner {
+                source: NamedSource::new(file, source).with_language("yaml"),
+                source_len,
+                errors: vec![error],
+                related: Vec::new(),
+            }),
         }
     }
 
     /// The file name.
     pub fn file(&self) -> &str {
-        self.source.name()
+        self.inner.source.name()
     }
 
     /// The errors, in source order.
     pub fn errors(&self) -> &[LoadError] {
-        &self.errors
+        &self.inner.errors
     }
 
     /// Iterates over the errors in source order.
     pub fn iter(&self) -> std::slice::Iter<'_, LoadError> {
-        self.errors.iter()
+        self.inner.errors.iter()
     }
 
     /// The first error.
     pub fn first(&self) -> &LoadError {
         // `errors` is never empty by construction; fall back defensively.
-        &self.errors[0]
+        &self.inner.errors[0]
     }
 
     /// The number of errors (at least 1).
     pub fn len(&self) -> usize {
-        self.errors.len()
+        self.inner.errors.len()
     }
 
     /// Always false: a `Diagnostics` holds at least one error.
     pub fn is_empty(&self) -> bool {
-        self.errors.is_empty()
+        self.inner.errors.is_empty()
     }
 }
 
@@ -857,14 +877,14 @@ impl<'a> IntoIterator for &'a Diagnostics {
     type IntoIter = std::slice::Iter<'a, LoadError>;
 
     fn into_iter(self) -> Self::IntoIter {
-        self.errors.iter()
+        self.inner.errors.iter()
     }
 }
 
 impl fmt::Display for Diagnostics {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         if f.alternate() {
-            for (i, e) in self.errors.iter().enumerate() {
+            for (i, e) in self.inner.errors.iter().enumerate() {
                 if i > 0 {
                     writeln!(f)?;
                 }
@@ -873,7 +893,7 @@ impl fmt::Display for Diagnostics {
             return Ok(());
         }
         write!(f, "{}", self.first())?;
-        match self.errors.len() {
+        match self.inner.errors.len() {
             0 | 1 => Ok(()),
             2 => write!(f, " (and 1 more error)"),
             n => write!(f, " (and {} more errors)", n - 1),
@@ -893,28 +913,28 @@ impl miette::Diagnostic for Diagnostics {
     }
 
     fn source_code(&self) -> Option<&dyn SourceCode> {
-        if self.source_len == 0 {
+        if self.inner.source_len == 0 {
             None
         } else {
-            Some(&self.source)
+            Some(&self.inner.source)
         }
     }
 
     fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
-        if self.source_len == 0 {
+        if self.inner.source_len == 0 {
             return None;
         }
         self.first()
-            .label(self.source_len)
+            .label(self.inner.source_len)
             .map(|l| Box::new(std::iter::once(l)) as Box<dyn Iterator<Item = LabeledSpan>>)
     }
 
     fn related<'a>(&'a self) -> Option<Box<dyn Iterator<Item = &'a dyn miette::Diagnostic> + 'a>> {
-        if self.related.is_empty() {
+        if self.inner.related.is_empty() {
             return None;
         }
         Some(Box::new(
-            self.related.iter().map(|r| r as &dyn miette::Diagnostic),
+            self.inner.related.iter().map(|r| r as &dyn miette::Diagnostic),
         ))
     }
 }

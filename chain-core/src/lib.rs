@@ -8,14 +8,20 @@
 
 pub mod algebra;
 pub mod derive;
+pub mod diagnostic;
 pub mod dmm;
 pub mod emit;
 pub mod export;
+pub mod expr;
 pub mod eval;
+pub mod load;
 pub mod model;
 mod model_trait;
+pub mod yaml;
 
 pub use derive::{derive, derive_in, SymbolicModel};
+pub use diagnostic::Diagnostics;
 pub use eval::{compile, CompiledModel};
+pub use load::{load_bytes, load_file, load_str};
 pub use model::Machine;
 pub use model_trait::{ErrorModel, Pose};

@@ -384,10 +384,11 @@ impl<'t> Builder<'t> {
                 }
                 Err(e) => {
                     let span = self.span(e.marker());
+                    let path = self.path();
                     self.root = None;
                     self.errors.push((
                         span,
-                        String::new(),
+                        path,
                         Problem::Syntax {
                             message: e.info().to_string(),
                         },

@@ -1,0 +1,755 @@
+//! The machine-file loader: YAML text → validated [`Machine`].
+//!
+//! [`load_str`], [`load_bytes`] and [`load_file`] parse a machine file
+//! (contract: `docs/yaml.md` and the machine-format spec, section 2), check
+//! every rule of the contract and either return the [`Machine`] or *all* the
+//! errors found as [`Diagnostics`], each naming file, line, column and key.
+//! One mistake gives one message: a body with an unknown parent is not also
+//! reported as unreachable, statistics for an error whose slot was misspelt
+//! are not also reported as unknown, and so on.
+//!
+//! The validation works on the located tree of [`crate::yaml`] and is exposed
+//! as [`from_tree`], so another front end that builds such a tree can reuse it.
+//!
+//! Orders of the produced machine:
+//! - bodies in tree pre-order from the root, children in file order (index 0
+//!   is the root, parents come before children);
+//! - variables in that body order;
+//! - errors in order of first use, walking the bodies in that order and,
+//!   within a body, `location_errors` (`dx..ez`), then `errors` (`dx..ez`),
+//!   then `squareness` (`ex, ey, ez`);
+//! - parameters, statistics, reliability tolerances and grid axes in file
+//!   order.
+
+mod bodies;
+mod sections;
+
+use std::collections::HashSet;
+use std::io::Read;
+use std::path::Path;
+
+use crate::diagnostic::{closest, Diagnostics, LoadError, Problem};
+use crate::expr;
+use crate::model::{Expr, Frame, Machine, Origin, Parameter};
+use crate::yaml::{self, Node, Span};
+
+/// Files larger than this many bytes are refused by [`load_file`].
+pub const MAX_FILE_BYTES: usize = 16 * 1024 * 1024;
+
+/// Keys allowed at the top level of a machine file.
+pub const TOP_KEYS: &[&str] = &[
+    "machine",
+    "description",
+    "parameters",
+    "bodies",
+    "workpiece",
+    "tool",
+    "tool_point",
+    "frame",
+    "statistics",
+    "reliability",
+];
+
+/// Names the expression language reserves.
+pub const RESERVED: &[&str] = &["pi", "sin", "cos"];
+
+/// Loads a machine from YAML text. `file` names the text in diagnostics.
+pub fn load_str(text: &str, file: &str) -> Result<Machine, Diagnostics> {
+    if let Some(offset) = text.find('\0') {
+        return Err(binary(text.as_bytes(), offset, file));
+    }
+    let parsed = yaml::parse(text);
+    let mut errors: Vec<LoadError> = parsed
+        .errors
+        .into_iter()
+        .map(|(span, key, problem)| LoadError::new(file, span.origin(key), problem))
+        .collect();
+    let machine = match &parsed.root {
+        None => {
+            if errors.is_empty() {
+                errors.push(LoadError::new(file, start_origin(), Problem::Empty));
+            }
+            None
+        }
+        Some(root) => match from_tree(root) {
+            Ok(m) => Some(m),
+            Err(found) => {
+                errors.extend(
+                    found
+                        .into_iter()
+                        .map(|(origin, problem)| LoadError::new(file, origin, problem)),
+                );
+                None
+            }
+        },
+    };
+    match (machine, Diagnostics::new(file, text, errors)) {
+        (_, Some(d)) => Err(d),
+        (Some(mut m), None) => {
+            m.file = Some(file.to_string());
+            Ok(m)
+        }
+        (None, None) => Err(Diagnostics::single(
+            file,
+            text,
+            start_origin(),
+            Problem::Empty,
+        )),
+    }
+}
+
+/// Loads a machine from the bytes of a file: a NUL byte (binary file) or
+/// invalid UTF-8 is a diagnostic, like every other problem.
+pub fn load_bytes(bytes: &[u8], file: &str) -> Result<Machine, Diagnostics> {
+    if let Some(offset) = bytes.iter().position(|&b| b == 0) {
+        return Err(binary(bytes, offset, file));
+    }
+    match std::str::from_utf8(bytes) {
+        Ok(text) => load_str(text, file),
+        Err(e) => {
+            let offset = e.valid_up_to();
+            let lossy = String::from_utf8_lossy(bytes).into_owned();
+            Err(Diagnostics::single(
+                file,
+                lossy,
+                byte_origin(bytes, offset, 1),
+                Problem::InvalidUtf8 { offset },
+            ))
+        }
+    }
+}
+
+/// Loads a machine file. A file that cannot be read (missing, a directory,
+/// larger than [`MAX_FILE_BYTES`]) is a diagnostic too.
+pub fn load_file(path: &Path) -> Result<Machine, Diagnostics> {
+    let file = path.display().to_string();
+    let io_error = |message: String| {
+        Diagnostics::single(
+            file.clone(),
+            String::new(),
+            Origin::default(),
+            Problem::Io { message },
+        )
+    };
+    let handle = std::fs::File::open(path).map_err(|e| io_error(e.to_string()))?;
+    let mut bytes = Vec::new();
+    handle
+        .take(MAX_FILE_BYTES as u64 + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| io_error(e.to_string()))?;
+    if bytes.len() > MAX_FILE_BYTES {
+        return Err(Diagnostics::single(
+            file,
+            String::new(),
+            Origin::default(),
+            Problem::TooLarge {
+                limit: MAX_FILE_BYTES,
+            },
+        ));
+    }
+    load_bytes(&bytes, &file)
+}
+
+fn start_origin() -> Origin {
+    Origin {
+        offset: 0,
+        len: 0,
+        line: 1,
+        column: 1,
+        key: String::new(),
+    }
+}
+
+/// The origin of byte `offset` of raw bytes (line and column counted on the
+/// lossily decoded prefix).
+fn byte_origin(bytes: &[u8], offset: usize, len: usize) -> Origin {
+    let prefix = bytes.get(..offset).unwrap_or(bytes);
+    let line_start = prefix
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |p| p + 1);
+    let line = prefix.iter().filter(|&&b| b == b'\n').count() + 1;
+    let column = String::from_utf8_lossy(prefix.get(line_start..).unwrap_or(&[]))
+        .chars()
+        .count()
+        + 1;
+    Origin {
+        offset,
+        len,
+        line,
+        column,
+        key: String::new(),
+    }
+}
+
+fn binary(bytes: &[u8], offset: usize, file: &str) -> Diagnostics {
+    Diagnostics::single(
+        file,
+        String::new(),
+        byte_origin(bytes, offset, 1),
+        Problem::Binary { offset },
+    )
+}
+
+/// Validates a located YAML tree (the document root) and builds the machine.
+/// Returns every problem found, each with its origin. `Machine::file` is left
+/// `None`.
+pub fn from_tree(root: &Node) -> Result<Machine, Vec<(Origin, Problem)>> {
+    let mut l = Loader::default();
+    let machine = l.machine(root);
+    match machine {
+        Some(m) if l.errors.is_empty() => Ok(m),
+        _ => {
+            if l.errors.is_empty() {
+                // Defensive: a rule failed without saying why.
+                l.errors.push((
+                    root.span.origin(""),
+                    Problem::WrongType {
+                        expected: "a valid machine",
+                        found: root.describe(),
+                    },
+                ));
+            }
+            Err(l.errors)
+        }
+    }
+}
+
+/// Dotted key path.
+fn join(path: &str, key: &str) -> String {
+    if path.is_empty() {
+        key.to_string()
+    } else {
+        format!("{path}.{key}")
+    }
+}
+
+fn index(path: &str, i: usize) -> String {
+    format!("{path}[{i}]")
+}
+
+/// True for `[A-Za-z_][A-Za-z0-9_]*`.
+pub fn is_identifier(name: &str) -> bool {
+    let mut chars = name.chars();
+    chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+/// The known entries of a mapping, with their key nodes.
+struct Fields<'n> {
+    /// `(key, key node, value node)` for keys in the allowed set.
+    known: Vec<(&'n str, &'n Node, &'n Node)>,
+    /// Entries with keys outside the allowed set (already reported).
+    unknown: Vec<(&'n Node, &'n Node)>,
+    /// The valid keys suggested for the unknown ones: a missing key that was
+    /// suggested is probably misspelt, so it is not reported again.
+    suggested: Vec<&'static str>,
+    /// Where to report a missing key: the key that owns this mapping.
+    owner: Span,
+    /// The mapping's key path.
+    path: String,
+}
+
+impl<'n> Fields<'n> {
+    /// The value of `key`, unless absent or null.
+    fn get(&self, key: &str) -> Option<&'n Node> {
+        self.entry(key).map(|(_, v)| v)
+    }
+
+    /// The key node and value of `key`, unless absent or null.
+    fn entry(&self, key: &str) -> Option<(&'n Node, &'n Node)> {
+        self.known
+            .iter()
+            .find(|(k, _, v)| *k == key && !v.is_null())
+            .map(|(_, k, v)| (*k, *v))
+    }
+
+    /// The key path of `key` in this mapping.
+    fn path(&self, key: &str) -> String {
+        join(&self.path, key)
+    }
+}
+
+/// Validation state: problems found and what is known so far.
+#[derive(Default)]
+struct Loader {
+    errors: Vec<(Origin, Problem)>,
+    parameters: Vec<Parameter>,
+    /// Variable names seen in any joint, valid or not (no-cascade checks).
+    seen_variables: HashSet<String>,
+    /// Error names seen in any slot, valid or not (no-cascade checks).
+    seen_errors: HashSet<String>,
+}
+
+impl Loader {
+    fn report(&mut self, span: Span, key: impl Into<String>, problem: Problem) {
+        self.errors.push((span.origin(key), problem));
+    }
+
+    /// The entries of a mapping whose keys must be in `allowed` (`null` is an
+    /// empty mapping). Unknown keys are reported with the closest valid key.
+    fn fields<'n>(
+        &mut self,
+        node: &'n Node,
+        owner: Span,
+        path: &str,
+        allowed: &'static [&'static str],
+    ) -> Option<Fields<'n>> {
+        let mut f = Fields {
+            known: Vec::new(),
+            unknown: Vec::new(),
+            suggested: Vec::new(),
+            owner,
+            path: path.to_string(),
+        };
+        if node.is_null() {
+            return Some(f);
+        }
+        let Some(entries) = node.as_mapping() else {
+            self.report(
+                node.span,
+                path,
+                Problem::WrongType {
+                    expected: "a mapping",
+                    found: node.describe(),
+                },
+            );
+            return None;
+        };
+        for (k, v) in entries {
+            let key = k.as_str().unwrap_or("");
+            if let Some(&known) = allowed.iter().find(|a| **a == key) {
+                f.known.push((known, k, v));
+            } else {
+                let suggested = closest(key, allowed.iter().copied());
+                f.suggested.extend(suggested);
+                let suggestion = suggested.map(str::to_string);
+                self.report(
+                    k.span,
+                    join(path, key),
+                    Problem::UnknownKey {
+                        key: key.to_string(),
+                        expected: allowed,
+                        suggestion,
+                    },
+                );
+                f.unknown.push((k, v));
+            }
+        }
+        Some(f)
+    }
+
+    /// The entries of a free-form mapping (names as keys); `null` is empty.
+    fn entries<'n>(&mut self, node: &'n Node, path: &str) -> Option<&'n [(Node, Node)]> {
+        if node.is_null() {
+            return Some(&[]);
+        }
+        match node.as_mapping() {
+            Some(m) => Some(m),
+            None => {
+                self.report(
+                    node.span,
+                    path,
+                    Problem::WrongType {
+                        expected: "a mapping",
+                        found: node.describe(),
+                    },
+                );
+                None
+            }
+        }
+    }
+
+    /// Reports a missing key, unless an unknown key looked like it.
+    fn missing(&mut self, fields: &Fields<'_>, key: &'static str) {
+        if fields.suggested.contains(&key) {
+            return;
+        }
+        self.report(fields.owner, fields.path.clone(), Problem::MissingKey { key });
+    }
+
+    /// A non-empty string scalar.
+    fn name(&mut self, node: &Node, path: &str, expected: &'static str) -> Option<String> {
+        match node.as_scalar() {
+            Some(s) if !s.is_null() && !s.text.is_empty() => Some(s.text.clone()),
+            _ => {
+                self.report(
+                    node.span,
+                    path,
+                    Problem::WrongType {
+                        expected,
+                        found: node.describe(),
+                    },
+                );
+                None
+            }
+        }
+    }
+
+    /// A name usable in expressions: an identifier, not reserved.
+    fn ident(&mut self, node: &Node, path: &str, what: &'static str) -> Option<String> {
+        let name = self.name(node, path, "a name")?;
+        if !is_identifier(&name) {
+            self.report(node.span, path, Problem::InvalidName { name, what });
+            return None;
+        }
+        if RESERVED.contains(&name.as_str()) {
+            self.report(node.span, path, Problem::ReservedName { name });
+            return None;
+        }
+        Some(name)
+    }
+
+    /// One of a fixed set of keywords.
+    fn keyword(
+        &mut self,
+        node: &Node,
+        path: &str,
+        what: &'static str,
+        expected: &'static [&'static str],
+    ) -> Option<&'static str> {
+        let text = self.name(node, path, "a name")?;
+        if let Some(&k) = expected.iter().find(|e| **e == text) {
+            return Some(k);
+        }
+        let suggestion = closest(&text, expected.iter().copied()).map(str::to_string);
+        self.report(
+            node.span,
+            path,
+            Problem::UnknownValue {
+                what,
+                found: text,
+                expected,
+                suggestion,
+            },
+        );
+        None
+    }
+
+    /// Reports an expression syntax error inside `node`.
+    fn expr_error(&mut self, node: &Node, path: &str, e: expr::ExprError) {
+        self.report(
+            node.span_at(e.offset),
+            path,
+            Problem::Expression { message: e.message },
+        );
+    }
+
+    /// A number: a numeric scalar or an arithmetic string of numbers
+    /// (`0.05/6`, `pi/2`); YAML's `.inf` and `.nan` are read as such so that
+    /// range checks can name them.
+    fn number(&mut self, node: &Node, path: &str) -> Option<f64> {
+        let text = match node.as_scalar() {
+            Some(s) if !s.is_null() => s.text.as_str(),
+            _ => {
+                self.report(
+                    node.span,
+                    path,
+                    Problem::WrongType {
+                        expected: "a number",
+                        found: node.describe(),
+                    },
+                );
+                return None;
+            }
+        };
+        let t = text.trim();
+        let special = match t.trim_start_matches(['+', '-']) {
+            ".inf" | ".Inf" | ".INF" | "inf" | "infinity" | "Infinity" => Some(f64::INFINITY),
+            ".nan" | ".NaN" | ".NAN" | "nan" | "NaN" => Some(f64::NAN),
+            _ => None,
+        };
+        if let Some(v) = special {
+            return Some(if t.starts_with('-') { -v } else { v });
+        }
+        let text = text.to_string();
+        self.number_in(node, &text, path)
+    }
+
+    /// Evaluates `text`, a prefix of `node`'s text, as a numbers-only
+    /// expression; errors point into `node`.
+    fn number_in(&mut self, node: &Node, text: &str, path: &str) -> Option<f64> {
+        let ast = match expr::parse(text) {
+            Ok(a) => a,
+            Err(e) => {
+                self.expr_error(node, path, e);
+                return None;
+            }
+        };
+        match expr::eval_const(&ast) {
+            Ok(v) => Some(v),
+            Err(errs) => {
+                for (offset, p) in errs {
+                    self.report(node.span_at(offset), path, p);
+                }
+                None
+            }
+        }
+    }
+
+    /// A positive, finite number.
+    fn positive(&mut self, node: &Node, path: &str, what: &'static str) -> Option<f64> {
+        let v = self.number(node, path)?;
+        if v > 0.0 && v.is_finite() {
+            Some(v)
+        } else {
+            self.report(node.span, path, Problem::NotPositive { what, value: v });
+            None
+        }
+    }
+
+    /// A finite number.
+    fn finite(&mut self, node: &Node, path: &str, what: &'static str) -> Option<f64> {
+        let v = self.number(node, path)?;
+        if v.is_finite() {
+            Some(v)
+        } else {
+            self.report(node.span, path, Problem::NotFinite { what });
+            None
+        }
+    }
+
+    /// An expression over numbers and parameters.
+    fn expr(&mut self, node: &Node, path: &str) -> Option<Expr> {
+        let text = match node.as_scalar() {
+            Some(s) if !s.is_null() => s.text.clone(),
+            _ => {
+                self.report(
+                    node.span,
+                    path,
+                    Problem::WrongType {
+                        expected: "a number or an expression",
+                        found: node.describe(),
+                    },
+                );
+                return None;
+            }
+        };
+        let ast = match expr::parse(&text) {
+            Ok(a) => a,
+            Err(e) => {
+                self.expr_error(node, path, e);
+                return None;
+            }
+        };
+        let params = &self.parameters;
+        let seen_errors = &self.seen_errors;
+        let variables = &self.seen_variables;
+        let resolved = expr::resolve(&ast, |name| {
+            if let Some(i) = params.iter().position(|p| p.name == name) {
+                return Ok(Some(i));
+            }
+            let hint = if variables.contains(name) {
+                Some(format!(
+                    "`{name}` is an axis variable; offsets and the tool point cannot depend on axis variables"
+                ))
+            } else if seen_errors.contains(name) {
+                Some(format!(
+                    "`{name}` is an error parameter; errors go in `errors`, not in expressions"
+                ))
+            } else {
+                closest(name, params.iter().map(|p| p.name.as_str()))
+                    .map(|s| format!("did you mean `{s}`?"))
+            };
+            Err(Problem::UnknownName {
+                name: name.to_string(),
+                hint,
+            })
+        });
+        match resolved {
+            Ok(e) => {
+                if let Expr::Num(v) = e {
+                    if !v.is_finite() {
+                        self.report(node.span, path, Problem::NotFinite { what: "the value" });
+                        return None;
+                    }
+                }
+                Some(e)
+            }
+            Err(errs) => {
+                for (offset, p) in errs {
+                    self.report(node.span_at(offset), path, p);
+                }
+                None
+            }
+        }
+    }
+
+    /// A list of three expressions (`offset`, `tool_point`); absent is zero.
+    fn vec3(&mut self, node: Option<&Node>, path: &str) -> Option<[Expr; 3]> {
+        let Some(node) = node else {
+            return Some([Expr::Num(0.0), Expr::Num(0.0), Expr::Num(0.0)]);
+        };
+        let Some(items) = node.as_sequence() else {
+            self.report(
+                node.span,
+                path,
+                Problem::WrongType {
+                    expected: "a list of 3 numbers or expressions",
+                    found: node.describe(),
+                },
+            );
+            return None;
+        };
+        let [a, b, c] = items else {
+            self.report(
+                node.span,
+                path,
+                Problem::WrongLength {
+                    expected: 3,
+                    found: items.len(),
+                },
+            );
+            return None;
+        };
+        let x = self.expr(a, &index(path, 0));
+        let y = self.expr(b, &index(path, 1));
+        let z = self.expr(c, &index(path, 2));
+        Some([x?, y?, z?])
+    }
+
+    /// The whole machine.
+    fn machine(&mut self, root: &Node) -> Option<Machine> {
+        if root.as_mapping().is_none() {
+            self.report(
+                root.span,
+                "",
+                Problem::TopLevelNotMapping {
+                    found: root.describe(),
+                },
+            );
+            return None;
+        }
+        let top = self.fields(root, start_span(), "", TOP_KEYS)?;
+
+        let name = match top.get("machine") {
+            Some(n) => self.name(n, "machine", "a name"),
+            None => {
+                self.missing(&top, "machine");
+                None
+            }
+        };
+        let description = match top.get("description") {
+            Some(n) => match n.as_str() {
+                Some(s) => Some(s.to_string()),
+                None => {
+                    self.report(
+                        n.span,
+                        "description",
+                        Problem::WrongType {
+                            expected: "a string",
+                            found: n.describe(),
+                        },
+                    );
+                    None
+                }
+            },
+            None => None,
+        };
+
+        if let Some(p) = top.get("parameters") {
+            self.parameters_section(p);
+        }
+
+        let tree = match top.entry("bodies") {
+            Some((k, v)) => self.bodies_section(k, v),
+            None => {
+                self.missing(&top, "bodies");
+                None
+            }
+        };
+        let workpiece = self.body_ref(&top, "workpiece", tree.as_ref());
+        let tool = self.body_ref(&top, "tool", tree.as_ref());
+        if let (Some(w), Some(t)) = (&workpiece, &tool) {
+            if w == t {
+                let node = top.get("tool").map_or(top.owner, |n| n.span);
+                self.report(node, "tool", Problem::WorkpieceIsTool { name: t.clone() });
+            }
+        }
+
+        let tool_point = self.vec3(top.get("tool_point"), "tool_point");
+        let frame = match top.get("frame") {
+            Some(n) => match self.keyword(n, "frame", "frame", &["workpiece", "tool"]) {
+                Some("tool") => Some(Frame::Tool),
+                Some(_) => Some(Frame::Workpiece),
+                None => None,
+            },
+            None => Some(Frame::Workpiece),
+        };
+
+        let statistics = match top.get("statistics") {
+            Some(n) => self.statistics_section(n, tree.as_ref()),
+            None => Some(Vec::new()),
+        };
+        let reliability = match top.entry("reliability") {
+            Some((k, v)) => self.reliability_section(k, v, tree.as_ref()).map(Some),
+            None => Some(None),
+        };
+
+        let tree = tree.filter(|t| t.ok)?;
+        let workpiece = tree.index_of(&workpiece?)?;
+        let tool = tree.index_of(&tool?)?;
+        Some(Machine {
+            name: name?,
+            description,
+            file: None,
+            parameters: std::mem::take(&mut self.parameters),
+            variables: tree.variables,
+            errors: tree.errors,
+            bodies: tree.bodies,
+            workpiece,
+            tool,
+            tool_point: tool_point?,
+            frame: frame?,
+            statistics: statistics?,
+            reliability: reliability?,
+        })
+    }
+
+    /// `workpiece` / `tool`: the body name, if given and a body of the
+    /// machine (or if the bodies could not be checked).
+    fn body_ref(
+        &mut self,
+        top: &Fields<'_>,
+        key: &'static str,
+        tree: Option<&bodies::Tree>,
+    ) -> Option<String> {
+        let Some(node) = top.get(key) else {
+            self.missing(top, key);
+            return None;
+        };
+        let name = self.name(node, key, "a body name")?;
+        let Some(tree) = tree else {
+            return Some(name);
+        };
+        if tree.all_names.contains(&name) {
+            return Some(name);
+        }
+        let suggestion =
+            closest(&name, tree.all_names.iter().map(String::as_str)).map(str::to_string);
+        self.report(
+            node.span,
+            key,
+            Problem::UnknownBody {
+                role: key,
+                name,
+                suggestion,
+            },
+        );
+        None
+    }
+}
+
+fn start_span() -> Span {
+    Span {
+        offset: 0,
+        len: 0,
+        line: 1,
+        column: 1,
+    }
+}
+
+#[cfg(test)]
+mod tests;

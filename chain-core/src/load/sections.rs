@@ -1,0 +1,404 @@
+//! The `parameters`, `statistics` and `reliability` sections.
+
+use super::bodies::Tree;
+use super::{join, Fields, Loader};
+use crate::diagnostic::{closest, Problem};
+use crate::model::{
+    Component, Distribution, Parameter, Requirement, ReliabilitySpec, Sided, Statistic,
+};
+use crate::yaml::Node;
+
+/// Keys of a statistics entry.
+pub const STATISTICS_KEYS: &[&str] = &[
+    "dist",
+    "mean",
+    "std",
+    "tolerance",
+    "sigma_rule",
+    "min",
+    "max",
+    "cost_weight",
+    "min_std",
+];
+/// Distributions.
+pub const DISTRIBUTIONS: &[&str] = &["normal", "uniform"];
+/// Keys of the reliability section.
+pub const RELIABILITY_KEYS: &[&str] = &["tolerance", "sided", "grid", "requirement"];
+/// Keys of a reliability requirement.
+pub const REQUIREMENT_KEYS: &[&str] = &["min", "mean"];
+/// Component names.
+pub const COMPONENTS: &[&str] = &["px", "py", "pz", "ox", "oy", "oz"];
+/// Values of `sided`.
+pub const SIDED: &[&str] = &["upper", "two"];
+
+/// `sigma_rule` when `tolerance` is given without it.
+pub const DEFAULT_SIGMA_RULE: f64 = 6.0;
+
+impl Loader {
+    /// `parameters: {name: value | null}`.
+    pub(super) fn parameters_section(&mut self, node: &Node) {
+        let Some(entries) = self.entries(node, "parameters") else {
+            return;
+        };
+        for (k, v) in entries {
+            let path = join("parameters", k.as_str().unwrap_or(""));
+            let Some(name) = self.ident(k, &path, "parameter") else {
+                continue;
+            };
+            let value = if v.is_null() {
+                None
+            } else {
+                self.finite(v, &path, "a parameter value")
+            };
+            self.parameters.push(Parameter {
+                name,
+                value,
+                origin: k.span.origin(path),
+            });
+        }
+    }
+
+    /// `statistics: {error: {dist, ...}}`. `None` if any entry is invalid.
+    pub(super) fn statistics_section(
+        &mut self,
+        node: &Node,
+        tree: Option<&Tree>,
+    ) -> Option<Vec<Statistic>> {
+        let entries = self.entries(node, "statistics")?;
+        let mut out = Vec::new();
+        let mut complete = true;
+        for (k, v) in entries {
+            let name = k.as_str().unwrap_or("");
+            let path = join("statistics", name);
+            let error = tree.and_then(|t| t.errors.iter().position(|e| e.name == name));
+            if let Some(t) = tree {
+                if error.is_none() && !self.seen_errors.contains(name) {
+                    let suggestion = closest(name, t.errors.iter().map(|e| e.name.as_str()))
+                        .map(str::to_string);
+                    self.report(
+                        k.span,
+                        path.clone(),
+                        Problem::UnknownError {
+                            name: name.to_string(),
+                            suggestion,
+                        },
+                    );
+                }
+            }
+            let entry = self.statistic(k, v, &path);
+            match (error, entry) {
+                (Some(error), Some((distribution, cost_weight, min_std))) => out.push(Statistic {
+                    error,
+                    distribution,
+                    cost_weight,
+                    min_std,
+                    origin: k.span.origin(path),
+                }),
+                _ => complete = false,
+            }
+        }
+        complete.then_some(out)
+    }
+
+    /// An optional number-valued key: `None` if absent, `Some(None)` if
+    /// invalid (reported).
+    fn opt_num(
+        &mut self,
+        f: &Fields<'_>,
+        key: &'static str,
+        positive: bool,
+    ) -> Option<Option<f64>> {
+        let node = f.get(key)?;
+        let path = f.path(key);
+        Some(if positive {
+            self.positive(node, &path, key)
+        } else {
+            self.finite(node, &path, key)
+        })
+    }
+
+    /// The key node of `key` (for locating conflicts), or the owner.
+    fn key_span(f: &Fields<'_>, key: &str) -> crate::yaml::Span {
+        f.entry(key).map_or(f.owner, |(k, _)| k.span)
+    }
+
+    /// One statistics entry: distribution, cost weight, min_std.
+    fn statistic(
+        &mut self,
+        key: &Node,
+        value: &Node,
+        path: &str,
+    ) -> Option<(Distribution, f64, Option<f64>)> {
+        let before = self.errors.len();
+        let f = self.fields(value, key.span, path, STATISTICS_KEYS)?;
+        let dist = match f.get("dist") {
+            Some(n) => self.keyword(n, &f.path("dist"), "distribution", DISTRIBUTIONS),
+            None => Some("normal"),
+        };
+        let mean = self.opt_num(&f, "mean", false);
+        let std = self.opt_num(&f, "std", true);
+        let tolerance = self.opt_num(&f, "tolerance", true);
+        let sigma_rule = self.opt_num(&f, "sigma_rule", true);
+        let min = self.opt_num(&f, "min", false);
+        let max = self.opt_num(&f, "max", false);
+        let cost_weight = self.opt_num(&f, "cost_weight", true);
+        let min_std = self.opt_num(&f, "min_std", true);
+
+        let conflict = |l: &mut Loader, first: &'static str, second: &'static str| {
+            let span = Self::key_span(&f, second);
+            l.report(span, f.path(second), Problem::Conflict { first, second });
+        };
+        if std.is_some() && tolerance.is_some() {
+            conflict(self, "std", "tolerance");
+        } else if std.is_some() && sigma_rule.is_some() {
+            conflict(self, "std", "sigma_rule");
+        }
+        // The spread, from std or tolerance / sigma_rule.
+        let spread = match (std, tolerance) {
+            (Some(s), None) => Some(s),
+            (None, Some(t)) => Some(match (t, sigma_rule) {
+                (Some(t), None) => Some(t / DEFAULT_SIGMA_RULE),
+                (Some(t), Some(Some(r))) => Some(t / r),
+                _ => None,
+            }),
+            (None, None) => None,
+            (Some(_), Some(_)) => Some(None),
+        };
+
+        let misspelt_spread = ["std", "tolerance", "min", "max"]
+            .iter()
+            .any(|k| f.suggested.contains(k));
+        let distribution = match dist {
+            Some("uniform") => {
+                let bounds = min.is_some() || max.is_some();
+                if bounds && spread.is_some() {
+                    let first = if min.is_some() { "min" } else { "max" };
+                    let second = if std.is_some() { "std" } else { "tolerance" };
+                    conflict(self, first, second);
+                    None
+                } else if bounds && mean.is_some() {
+                    conflict(self, if min.is_some() { "min" } else { "max" }, "mean");
+                    None
+                } else if bounds {
+                    if min.is_none() {
+                        self.missing(&f, "min");
+                    }
+                    if max.is_none() {
+                        self.missing(&f, "max");
+                    }
+                    match (min.flatten(), max.flatten()) {
+                        (Some(lo), Some(hi)) if lo < hi => {
+                            Some(Distribution::Uniform { min: lo, max: hi })
+                        }
+                        (Some(lo), Some(hi)) => {
+                            let span = f.get("max").map_or(f.owner, |n| n.span);
+                            self.report(
+                                span,
+                                f.path("max"),
+                                Problem::UniformBounds { min: lo, max: hi },
+                            );
+                            None
+                        }
+                        _ => None,
+                    }
+                } else if let Some(s) = spread {
+                    let m = mean.unwrap_or(Some(0.0));
+                    match (m, s) {
+                        (Some(m), Some(s)) => {
+                            let half = 3f64.sqrt() * s;
+                            Some(Distribution::Uniform {
+                                min: m - half,
+                                max: m + half,
+                            })
+                        }
+                        _ => None,
+                    }
+                } else {
+                    if !misspelt_spread {
+                        self.report(f.owner, path, Problem::MissingSpread { dist: "uniform" });
+                    }
+                    None
+                }
+            }
+            Some(_) => {
+                for key in ["min", "max"] {
+                    if let Some((k, _)) = f.entry(key) {
+                        let key = if key == "min" { "min" } else { "max" };
+                        self.report(
+                            k.span,
+                            f.path(key),
+                            Problem::KeyNotForDistribution {
+                                key,
+                                dist: "normal",
+                            },
+                        );
+                    }
+                }
+                match (spread, mean.unwrap_or(Some(0.0))) {
+                    (None, _) => {
+                        if !misspelt_spread {
+                            self.report(f.owner, path, Problem::MissingSpread { dist: "normal" });
+                        }
+                        None
+                    }
+                    (Some(Some(std)), Some(mean)) => Some(Distribution::Normal { mean, std }),
+                    _ => None,
+                }
+            }
+            None => None,
+        };
+        let cost_weight = cost_weight.unwrap_or(Some(1.0));
+        let min_std = min_std.unwrap_or(Some(f64::NAN));
+        if self.errors.len() != before {
+            return None;
+        }
+        let min_std = min_std.filter(|v| !v.is_nan());
+        Some((distribution?, cost_weight?, min_std))
+    }
+
+    /// `reliability: {tolerance, sided, grid, requirement}`.
+    pub(super) fn reliability_section(
+        &mut self,
+        key: &Node,
+        value: &Node,
+        tree: Option<&Tree>,
+    ) -> Option<ReliabilitySpec> {
+        let before = self.errors.len();
+        let f = self.fields(value, key.span, "reliability", RELIABILITY_KEYS)?;
+
+        let mut tolerance = Vec::new();
+        match f.entry("tolerance") {
+            Some((k, v)) => {
+                let path = f.path("tolerance");
+                if let Some(entries) = self.entries(v, &path) {
+                    if entries.is_empty() {
+                        self.report(
+                            k.span,
+                            path.clone(),
+                            Problem::EmptyList {
+                                what: "the reliability tolerance",
+                            },
+                        );
+                    }
+                    for (ck, cv) in entries {
+                        let cpath = join(&path, ck.as_str().unwrap_or(""));
+                        let comp = self
+                            .keyword(ck, &cpath, "component", COMPONENTS)
+                            .and_then(Component::from_name);
+                        let val = self.positive(cv, &cpath, "a tolerance");
+                        if let (Some(c), Some(v)) = (comp, val) {
+                            tolerance.push((c, v));
+                        }
+                    }
+                }
+            }
+            None => self.missing(&f, "tolerance"),
+        }
+
+        let sided = match f.get("sided") {
+            Some(n) => match self.keyword(n, &f.path("sided"), "`sided` value", SIDED) {
+                Some("two") => Sided::Two,
+                _ => Sided::Upper,
+            },
+            None => Sided::Upper,
+        };
+
+        let mut grid = Vec::new();
+        if let Some(g) = f.get("grid") {
+            let path = f.path("grid");
+            for (gk, gv) in self.entries(g, &path).unwrap_or(&[]) {
+                let name = gk.as_str().unwrap_or("");
+                let gpath = join(&path, name);
+                let var = tree.and_then(|t| t.variables.iter().position(|v| v.name == name));
+                if let Some(t) = tree {
+                    if var.is_none() && !self.seen_variables.contains(name) {
+                        let suggestion =
+                            closest(name, t.variables.iter().map(|v| v.name.as_str()))
+                                .map(str::to_string);
+                        self.report(
+                            gk.span,
+                            gpath.clone(),
+                            Problem::UnknownVariable {
+                                name: name.to_string(),
+                                suggestion,
+                            },
+                        );
+                    }
+                }
+                let Some(items) = gv.as_sequence() else {
+                    self.report(
+                        gv.span,
+                        gpath,
+                        Problem::WrongType {
+                            expected: "a list of numbers",
+                            found: gv.describe(),
+                        },
+                    );
+                    continue;
+                };
+                if items.is_empty() {
+                    self.report(gv.span, gpath.clone(), Problem::EmptyList { what: "a grid" });
+                }
+                let values: Vec<Option<f64>> = items
+                    .iter()
+                    .enumerate()
+                    .map(|(i, n)| self.finite(n, &super::index(&gpath, i), "a grid value"))
+                    .collect();
+                if let (Some(var), Some(values)) = (var, values.into_iter().collect()) {
+                    grid.push((var, values));
+                }
+            }
+        }
+
+        let requirement = match f.entry("requirement") {
+            Some((k, v)) => {
+                let path = f.path("requirement");
+                self.fields(v, k.span, &path, REQUIREMENT_KEYS)
+                    .and_then(|rf| {
+                        let get = |l: &mut Loader, key: &'static str| match rf.get(key) {
+                            Some(n) => {
+                                let p = rf.path(key);
+                                let v = l.number(n, &p)?;
+                                if v > 0.0 && v <= 1.0 {
+                                    Some(v)
+                                } else {
+                                    l.report(
+                                        n.span,
+                                        p,
+                                        Problem::OutOfRange {
+                                            what: "a required reliability",
+                                            value: v,
+                                            range: "(0, 1]",
+                                        },
+                                    );
+                                    None
+                                }
+                            }
+                            None => {
+                                l.missing(&rf, key);
+                                None
+                            }
+                        };
+                        let min = get(self, "min");
+                        let mean = get(self, "mean");
+                        Some(Requirement {
+                            min: min?,
+                            mean: mean?,
+                        })
+                    })
+            }
+            None => None,
+        };
+
+        if self.errors.len() != before {
+            return None;
+        }
+        Some(ReliabilitySpec {
+            tolerance,
+            sided,
+            grid,
+            requirement,
+            origin: key.span.origin("reliability"),
+        })
+    }
+}

@@ -1,0 +1,77 @@
+//! The errors of the reliability engine.
+
+use chain_core::model::Origin;
+
+/// Everything that can go wrong between a machine and a reliability result.
+///
+/// Variants that come from a machine file carry the [`Origin`] of the node
+/// concerned so that the CLI can point at the file, line and key.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReliabilityError {
+    /// The machine has no `reliability` section.
+    #[error("the machine has no `reliability` section (tolerance, sided, grid)")]
+    NoReliabilitySection,
+    /// An error parameter used by the model has no `statistics` entry.
+    #[error("error parameter `{name}` has no `statistics` entry")]
+    MissingStatistic {
+        /// The error parameter.
+        name: String,
+        /// Where it is first used.
+        origin: Origin,
+    },
+    /// A parameter is symbolic (`null`) and no value was supplied.
+    #[error("parameter `{name}` is symbolic (null) and has no value")]
+    SymbolicParameter {
+        /// The parameter.
+        name: String,
+        /// Where it is declared.
+        origin: Origin,
+    },
+    /// A distribution's numbers are out of range.
+    #[error("invalid distribution: {0}")]
+    InvalidDistribution(String),
+    /// A tolerance is not a positive finite number.
+    #[error("tolerance of `{component}` must be positive and finite (found {value})")]
+    InvalidTolerance {
+        /// The component or system.
+        component: String,
+        /// The offending value.
+        value: f64,
+    },
+    /// Sizes that must agree do not.
+    #[error("{what}: expected {expected}, found {found}")]
+    Dimension {
+        /// What was being sized.
+        what: &'static str,
+        /// The expected size.
+        expected: usize,
+        /// The size found.
+        found: usize,
+    },
+    /// A name (variable, error, parameter) is unknown.
+    #[error("unknown {kind} `{name}`{}", hint.as_ref().map(|h| format!(" (did you mean `{h}`?)")).unwrap_or_default())]
+    UnknownName {
+        /// `variable`, `error`, `parameter` or `component`.
+        kind: &'static str,
+        /// The name given.
+        name: String,
+        /// A close known name.
+        hint: Option<String>,
+    },
+    /// The reliability grid has no point, or an axis has no value.
+    #[error("the reliability grid is empty: {0}")]
+    EmptyGrid(String),
+    /// A point misses a value for an axis variable.
+    #[error("no value for axis variable `{0}`")]
+    MissingCoordinate(String),
+    /// A computation produced a non-finite number.
+    #[error("non-finite value in {0}")]
+    NonFinite(&'static str),
+    /// An error of the model has no input distribution.
+    #[error("no input distribution for error `{0}`")]
+    MissingInput(String),
+    /// A sampler was asked for no samples.
+    #[error("the number of samples must be at least 1")]
+    NoSamples,
+}

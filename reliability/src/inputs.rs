@@ -1,0 +1,282 @@
+//! The random inputs of an event: one marginal distribution per error
+//! parameter and the transformation to independent standard normal space.
+//!
+//! FORM, the importance sampling and the sensitivities all work in the
+//! standard normal space `U` of the paper's Section 3.1 ("transforming basic
+//! random variable X space into independent standard normal random variable Y
+//! space"). [`Inputs`] owns that transformation `x = T(u)`: callers only use
+//! [`Inputs::to_physical`], [`Inputs::jacobian`] and the parameter
+//! derivatives, so adding marginals (lognormal, truncated normal) or a
+//! correlation (Nataf: `u → L·u → Φ → F⁻¹`) changes this file only.
+
+use serde::Serialize;
+
+use crate::error::ReliabilityError;
+use crate::normal;
+use crate::rng::CaseRng;
+
+/// `√3`: half-width of a uniform law over its standard deviation.
+const SQRT_3: f64 = 1.732_050_807_568_877_2;
+
+/// The marginal distribution of one input.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "dist", rename_all = "lowercase")]
+#[non_exhaustive]
+pub enum Marginal {
+    /// Normal with mean and standard deviation: `x = μ + σ·u`.
+    Normal {
+        /// Mean `μ`.
+        mean: f64,
+        /// Standard deviation `σ > 0`.
+        std: f64,
+    },
+    /// Uniform on `[min, max]`: `x = min + (max − min)·Φ(u)`.
+    Uniform {
+        /// Lower bound.
+        min: f64,
+        /// Upper bound (`> min`).
+        max: f64,
+    },
+}
+
+impl Marginal {
+    /// A validated normal marginal.
+    pub fn normal(mean: f64, std: f64) -> Result<Marginal, ReliabilityError> {
+        if !mean.is_finite() || !std.is_finite() || std <= 0.0 {
+            return Err(ReliabilityError::InvalidDistribution(format!(
+                "normal(mean {mean}, std {std}): the mean must be finite and the std positive"
+            )));
+        }
+        Ok(Marginal::Normal { mean, std })
+    }
+
+    /// A validated uniform marginal.
+    pub fn uniform(min: f64, max: f64) -> Result<Marginal, ReliabilityError> {
+        if !min.is_finite() || !max.is_finite() || min >= max {
+            return Err(ReliabilityError::InvalidDistribution(format!(
+                "uniform(min {min}, max {max}): the bounds must be finite with min < max"
+            )));
+        }
+        Ok(Marginal::Uniform { min, max })
+    }
+
+    /// The mean.
+    pub fn mean(&self) -> f64 {
+        match *self {
+            Marginal::Normal { mean, .. } => mean,
+            Marginal::Uniform { min, max } => 0.5 * (min + max),
+        }
+    }
+
+    /// The standard deviation.
+    pub fn std(&self) -> f64 {
+        match *self {
+            Marginal::Normal { std, .. } => std,
+            Marginal::Uniform { min, max } => (max - min) / (2.0 * SQRT_3),
+        }
+    }
+
+    /// True for a normal marginal (its transformation is affine).
+    pub fn is_normal(&self) -> bool {
+        matches!(self, Marginal::Normal { .. })
+    }
+
+    /// The same family with another mean and standard deviation.
+    pub fn with_moments(&self, mean: f64, std: f64) -> Result<Marginal, ReliabilityError> {
+        match self {
+            Marginal::Normal { .. } => Marginal::normal(mean, std),
+            Marginal::Uniform { .. } => Marginal::uniform(mean - SQRT_3 * std, mean + SQRT_3 * std),
+        }
+    }
+
+    /// `x = T(u)`, the physical value of a standard normal coordinate.
+    #[inline]
+    pub fn to_physical(&self, u: f64) -> f64 {
+        match *self {
+            Marginal::Normal { mean, std } => mean + std * u,
+            Marginal::Uniform { min, max } => min + (max - min) * normal::cdf(u),
+        }
+    }
+
+    /// `u = T⁻¹(x)`.
+    pub fn to_standard(&self, x: f64) -> f64 {
+        match *self {
+            Marginal::Normal { mean, std } => (x - mean) / std,
+            Marginal::Uniform { min, max } => normal::inverse_cdf((x - min) / (max - min)),
+        }
+    }
+
+    /// `dx/du` at `u`.
+    #[inline]
+    pub fn dx_du(&self, u: f64) -> f64 {
+        match *self {
+            Marginal::Normal { std, .. } => std,
+            Marginal::Uniform { min, max } => (max - min) * normal::pdf(u),
+        }
+    }
+
+    /// `∂x/∂μ` at fixed `u` (the marginal parametrised by mean and std).
+    pub fn dx_dmean(&self, _u: f64) -> f64 {
+        1.0
+    }
+
+    /// `∂x/∂σ` at fixed `u` (the marginal parametrised by mean and std):
+    /// `u` for a normal, `√3·(2Φ(u) − 1)` for a uniform.
+    pub fn dx_dstd(&self, u: f64) -> f64 {
+        match self {
+            Marginal::Normal { .. } => u,
+            Marginal::Uniform { .. } => SQRT_3 * (2.0 * normal::cdf(u) - 1.0),
+        }
+    }
+
+    /// One physical sample.
+    #[inline]
+    pub fn sample(&self, rng: &mut CaseRng) -> f64 {
+        match *self {
+            Marginal::Normal { mean, std } => mean + std * rng.normal(),
+            Marginal::Uniform { min, max } => min + (max - min) * rng.uniform(),
+        }
+    }
+}
+
+/// The joint distribution of the inputs: independent marginals, named.
+///
+/// ```
+/// use reliability::{Inputs, Marginal};
+/// let inputs = Inputs::new(
+///     vec!["a".into(), "b".into()],
+///     vec![Marginal::normal(0.0, 2.0).unwrap(), Marginal::uniform(-1.0, 1.0).unwrap()],
+/// ).unwrap();
+/// let mut x = [0.0; 2];
+/// inputs.to_physical(&[1.0, 0.0], &mut x);
+/// assert_eq!(x, [2.0, 0.0]);
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Inputs {
+    names: Vec<String>,
+    marginals: Vec<Marginal>,
+    all_normal: bool,
+}
+
+impl Inputs {
+    /// Independent inputs with the given names and marginals.
+    pub fn new(names: Vec<String>, marginals: Vec<Marginal>) -> Result<Inputs, ReliabilityError> {
+        if names.len() != marginals.len() {
+            return Err(ReliabilityError::Dimension {
+                what: "input names",
+                expected: marginals.len(),
+                found: names.len(),
+            });
+        }
+        for m in &marginals {
+            // Re-validate: the enum's fields are public.
+            match *m {
+                Marginal::Normal { mean, std } => {
+                    Marginal::normal(mean, std)?;
+                }
+                Marginal::Uniform { min, max } => {
+                    Marginal::uniform(min, max)?;
+                }
+            }
+        }
+        let all_normal = marginals.iter().all(Marginal::is_normal);
+        Ok(Inputs {
+            names,
+            marginals,
+            all_normal,
+        })
+    }
+
+    /// Number of inputs.
+    pub fn len(&self) -> usize {
+        self.marginals.len()
+    }
+
+    /// True when there are no inputs.
+    pub fn is_empty(&self) -> bool {
+        self.marginals.is_empty()
+    }
+
+    /// The names, in input order.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// The marginals, in input order.
+    pub fn marginals(&self) -> &[Marginal] {
+        &self.marginals
+    }
+
+    /// Index of a named input.
+    pub fn index(&self, name: &str) -> Option<usize> {
+        self.names.iter().position(|n| n == name)
+    }
+
+    /// True when the map `u → x` is affine (every marginal normal, no
+    /// correlation), so that straight lines in `U` stay straight in `X`.
+    pub fn is_affine(&self) -> bool {
+        self.all_normal
+    }
+
+    /// The means.
+    pub fn means(&self) -> Vec<f64> {
+        self.marginals.iter().map(Marginal::mean).collect()
+    }
+
+    /// The standard deviations.
+    pub fn stds(&self) -> Vec<f64> {
+        self.marginals.iter().map(Marginal::std).collect()
+    }
+
+    /// A copy with input `j`'s mean and standard deviation replaced.
+    pub fn with_moments(&self, j: usize, mean: f64, std: f64) -> Result<Inputs, ReliabilityError> {
+        let mut out = self.clone();
+        let m = out.marginals.get_mut(j).ok_or(ReliabilityError::Dimension {
+            what: "input index",
+            expected: self.len(),
+            found: j,
+        })?;
+        *m = m.with_moments(mean, std)?;
+        Ok(out)
+    }
+
+    /// `x = T(u)`.
+    #[inline]
+    pub fn to_physical(&self, u: &[f64], x: &mut [f64]) {
+        for ((x, u), m) in x.iter_mut().zip(u).zip(&self.marginals) {
+            *x = m.to_physical(*u);
+        }
+    }
+
+    /// `u = T⁻¹(x)`.
+    pub fn to_standard(&self, x: &[f64], u: &mut [f64]) {
+        for ((u, x), m) in u.iter_mut().zip(x).zip(&self.marginals) {
+            *u = m.to_standard(*x);
+        }
+    }
+
+    /// The diagonal Jacobian `dx_j/du_j` at `u`.
+    #[inline]
+    pub fn jacobian(&self, u: &[f64], out: &mut [f64]) {
+        for ((o, u), m) in out.iter_mut().zip(u).zip(&self.marginals) {
+            *o = m.dx_du(*u);
+        }
+    }
+
+    /// One physical sample of every input.
+    #[inline]
+    pub fn sample(&self, rng: &mut CaseRng, x: &mut [f64]) {
+        if self.all_normal {
+            rng.fill_normal(x);
+            for (x, m) in x.iter_mut().zip(&self.marginals) {
+                if let Marginal::Normal { mean, std } = *m {
+                    *x = mean + std * *x;
+                }
+            }
+        } else {
+            for (x, m) in x.iter_mut().zip(&self.marginals) {
+                *x = m.sample(rng);
+            }
+        }
+    }
+}

@@ -1,0 +1,287 @@
+//! Reproducible random streams for the samplers.
+//!
+//! Every block of samples of every case draws from its own ChaCha8 stream:
+//! the generator is seeded from the user's seed and the 64-bit stream
+//! identifier is `case << 32 | block`. Which thread runs a block therefore
+//! never changes what it draws, so results are bit-identical for a given seed
+//! whatever the number of threads.
+//!
+//! Standard normal variates come from a 256-layer ziggurat (Marsaglia & Tsang
+//! 2000) that takes 32 random bits per variate on its fast path (two variates
+//! per 64-bit word); the rare wedge and tail steps use fresh 53-bit uniforms.
+
+use std::sync::OnceLock;
+
+use rand_chacha::rand_core::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Words per refill of the buffer (8 ChaCha blocks).
+const BUFFER_WORDS: usize = 64;
+
+/// A buffered ChaCha8 stream with fast standard-normal and uniform variates.
+///
+/// ```
+/// use reliability::rng::CaseRng;
+/// let mut a = CaseRng::new(42, 7, 0);
+/// let mut b = CaseRng::new(42, 7, 0);
+/// let (mut x, mut y) = ([0.0; 5], [0.0; 5]);
+/// a.fill_normal(&mut x);
+/// b.fill_normal(&mut y);
+/// assert_eq!(x, y);
+/// ```
+#[derive(Debug, Clone)]
+pub struct CaseRng {
+    inner: ChaCha8Rng,
+    buffer: [u64; BUFFER_WORDS],
+    position: usize,
+    tables: &'static Ziggurat,
+}
+
+impl CaseRng {
+    /// The stream of block `block` of case `case` for the user's `seed`.
+    pub fn new(seed: u64, case: u32, block: u32) -> CaseRng {
+        let mut inner = ChaCha8Rng::seed_from_u64(seed);
+        inner.set_stream((u64::from(case) << 32) | u64::from(block));
+        CaseRng {
+            inner,
+            buffer: [0; BUFFER_WORDS],
+            position: BUFFER_WORDS,
+            tables: ziggurat(),
+        }
+    }
+
+    /// The next 64 random bits.
+    #[inline(always)]
+    pub fn next_u64(&mut self) -> u64 {
+        if self.position == BUFFER_WORDS {
+            self.refill();
+        }
+        let w = self.buffer[self.position];
+        self.position += 1;
+        w
+    }
+
+    #[inline(never)]
+    fn refill(&mut self) {
+        let mut bytes = [0u8; BUFFER_WORDS * 8];
+        self.inner.fill_bytes(&mut bytes);
+        for (w, chunk) in self.buffer.iter_mut().zip(bytes.chunks_exact(8)) {
+            let mut b = [0u8; 8];
+            b.copy_from_slice(chunk);
+            *w = u64::from_le_bytes(b);
+        }
+        self.position = 0;
+    }
+
+    /// A uniform variate on `[0, 1)` with 53 random bits.
+    #[inline(always)]
+    pub fn uniform(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    /// A uniform variate on `(0, 1]` (safe under `ln`).
+    #[inline(always)]
+    fn uniform_open0(&mut self) -> f64 {
+        1.0 - self.uniform()
+    }
+
+    /// One standard normal variate.
+    #[inline]
+    pub fn normal(&mut self) -> f64 {
+        let w = self.next_u64();
+        self.normal_from_bits(w as u32)
+    }
+
+    /// Fills `out` with independent standard normal variates, two per 64-bit
+    /// word on the ziggurat's fast path. For odd lengths the last word's upper
+    /// half is discarded, so the stream consumed per call depends only on
+    /// `out.len()` and the draws.
+    #[inline]
+    pub fn fill_normal(&mut self, out: &mut [f64]) {
+        let mut pairs = out.chunks_exact_mut(2);
+        for pair in &mut pairs {
+            let w = self.next_u64();
+            pair[0] = self.normal_from_bits(w as u32);
+            pair[1] = self.normal_from_bits((w >> 32) as u32);
+        }
+        if let [last] = pairs.into_remainder() {
+            let w = self.next_u64();
+            *last = self.normal_from_bits(w as u32);
+        }
+    }
+
+    /// The ziggurat step on 32 bits: 8 for the layer, 1 for the sign, 23 for
+    /// the abscissa.
+    #[inline(always)]
+    fn normal_from_bits(&mut self, bits: u32) -> f64 {
+        let t = self.tables;
+        let layer = (bits & 0xff) as usize;
+        let negative = bits & 0x100 != 0;
+        let m = bits >> 9;
+        if m < t.k[layer] {
+            let x = (f64::from(m) + 0.5) * t.w[layer];
+            return if negative { -x } else { x };
+        }
+        self.normal_slow(layer, negative, m)
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn normal_slow(&mut self, mut layer: usize, mut negative: bool, mut m: u32) -> f64 {
+        let t = self.tables;
+        loop {
+            let x = (f64::from(m) + 0.5) * t.w[layer];
+            if x < t.x[layer + 1] {
+                return if negative { -x } else { x };
+            }
+            if layer == 0 {
+                // Tail beyond r (Marsaglia 1964).
+                let r = t.x[1];
+                let x = loop {
+                    let a = -self.uniform_open0().ln() / r;
+                    let b = -self.uniform_open0().ln();
+                    if 2.0 * b >= a * a {
+                        break r + a;
+                    }
+                };
+                return if negative { -x } else { x };
+            }
+            // Wedge between layers: accept under the density.
+            let f_hi = t.f[layer + 1];
+            let f_lo = t.f[layer];
+            if f_lo + self.uniform() * (f_hi - f_lo) < (-0.5 * x * x).exp() {
+                return if negative { -x } else { x };
+            }
+            let bits = self.next_u64() as u32;
+            layer = (bits & 0xff) as usize;
+            negative = bits & 0x100 != 0;
+            m = bits >> 9;
+            if m < t.k[layer] {
+                let x = (f64::from(m) + 0.5) * t.w[layer];
+                return if negative { -x } else { x };
+            }
+        }
+    }
+}
+
+/// Ziggurat tables: layer right edges `x[i]` (`x[0] = v/f(r)`, `x[1] = r`,
+/// `x[256] = 0`), densities `f[i] = exp(−x[i]²/2)`, the abscissa scale
+/// `w[i] = x[i]/2²³` and the fast-accept thresholds `k[i] = ⌊2²³·x[i+1]/x[i]⌋`.
+#[derive(Debug)]
+struct Ziggurat {
+    x: [f64; 257],
+    f: [f64; 257],
+    w: [f64; 256],
+    k: [u32; 256],
+}
+
+fn ziggurat() -> &'static Ziggurat {
+    static TABLES: OnceLock<Ziggurat> = OnceLock::new();
+    TABLES.get_or_init(|| {
+        // Marsaglia & Tsang (2000), 256 layers of area v.
+        const R: f64 = 3.654_152_885_361_009;
+        const V: f64 = 4.928_673_233_99e-3;
+        let f = |x: f64| (-0.5 * x * x).exp();
+        let mut x = [0.0; 257];
+        x[0] = V / f(R);
+        x[1] = R;
+        for i in 2..256 {
+            x[i] = (-2.0 * (V / x[i - 1] + f(x[i - 1])).ln()).sqrt();
+        }
+        x[256] = 0.0;
+        let mut fx = [0.0; 257];
+        for i in 0..257 {
+            fx[i] = f(x[i]);
+        }
+        // The base layer's pseudo-density is f(r) (its tail is handled apart).
+        fx[0] = f(R);
+        let scale = (1u64 << 23) as f64;
+        let mut w = [0.0; 256];
+        let mut k = [0u32; 256];
+        for i in 0..256 {
+            w[i] = x[i] / scale;
+            // m < k[i] ⇔ (m + 0.5)·w[i] < x[i+1] for every integer m.
+            k[i] = (x[i + 1] / x[i] * scale - 0.5).floor().max(0.0) as u32;
+        }
+        Ziggurat { x, f: fx, w, k }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::normal;
+
+    #[test]
+    fn tables_close_at_the_top() {
+        let t = ziggurat();
+        // The recursion ends at the mode: f(x[255]) + v/x[255] ≈ 1.
+        let v = 4.928_673_233_99e-3;
+        assert!((t.f[255] + v / t.x[255] - 1.0).abs() < 1e-6);
+        for i in 0..256 {
+            assert!(t.x[i + 1] < t.x[i]);
+        }
+    }
+
+    #[test]
+    fn moments_and_tails() {
+        let mut rng = CaseRng::new(1, 0, 0);
+        let n = 2_000_000;
+        let mut buf = [0.0; 10];
+        let (mut s1, mut s2, mut s4) = (0.0, 0.0, 0.0);
+        let mut tail2 = 0u64;
+        let mut tail3 = 0u64;
+        for _ in 0..n / 10 {
+            rng.fill_normal(&mut buf);
+            for &z in &buf {
+                s1 += z;
+                s2 += z * z;
+                s4 += z * z * z * z;
+                if z.abs() > 2.0 {
+                    tail2 += 1;
+                }
+                if z < -3.7 {
+                    tail3 += 1;
+                }
+            }
+        }
+        let nf = n as f64;
+        assert!((s1 / nf).abs() < 5.0 * (1.0 / nf).sqrt());
+        assert!((s2 / nf - 1.0).abs() < 5.0 * (2.0 / nf).sqrt());
+        assert!((s4 / nf - 3.0).abs() < 5.0 * (96.0 / nf).sqrt());
+        let p2 = 2.0 * normal::sf(2.0);
+        let e2 = tail2 as f64 / nf;
+        assert!((e2 - p2).abs() < 5.0 * (p2 * (1.0 - p2) / nf).sqrt());
+        // Beyond r = 3.654: exercises the tail algorithm.
+        let p3 = normal::sf(3.7);
+        let e3 = tail3 as f64 / nf;
+        assert!((e3 - p3).abs() < 5.0 * (p3 / nf).sqrt(), "{e3} vs {p3}");
+    }
+
+    #[test]
+    fn kolmogorov_smirnov() {
+        let mut rng = CaseRng::new(9, 3, 1);
+        let mut z: Vec<f64> = (0..200_000).map(|_| rng.normal()).collect();
+        z.sort_by(f64::total_cmp);
+        let n = z.len() as f64;
+        let d = z
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| {
+                let c = normal::cdf(x);
+                (c - i as f64 / n).abs().max(((i + 1) as f64 / n - c).abs())
+            })
+            .fold(0.0, f64::max);
+        // 1 % critical value 1.63/√n.
+        assert!(d < 1.63 / n.sqrt(), "KS distance {d}");
+    }
+
+    #[test]
+    fn streams_differ() {
+        let mut a = CaseRng::new(5, 0, 0);
+        let mut b = CaseRng::new(5, 0, 1);
+        let mut c = CaseRng::new(5, 1, 0);
+        let (x, y, z) = (a.next_u64(), b.next_u64(), c.next_u64());
+        assert!(x != y && y != z && x != z);
+    }
+}

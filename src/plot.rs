@@ -1,0 +1,446 @@
+//! A small plotting layer over [`plotters`]: charts described as data, drawn
+//! to PNG and SVG.
+//!
+//! Text is rendered with DejaVu Sans, embedded in the binary (the `dejavu`
+//! crate) and registered with plotters' `ab_glyph` renderer, so no system
+//! font or fontconfig is needed.
+//!
+//! ```no_run
+//! use chain::plot::{Series, XyChart};
+//! let chart = XyChart::new("Δθ", "θ (°)", "Δθ (°)")
+//!     .series(Series::points("measured", vec![(1.0, 0.1), (2.0, 0.2)]))
+//!     .series(Series::line("fit", vec![(1.0, 0.1), (2.0, 0.2)]))
+//!     .hline(0.0);
+//! let files = chart.write(std::path::Path::new("plots"), "delta_theta")?;
+//! # Ok::<(), chain::plot::PlotError>(())
+//! ```
+
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+pub use plotters::style::RGBColor;
+
+/// Neutral grey for measured data.
+pub const GREY: RGBColor = RGBColor(90, 90, 90);
+
+/// The Okabe-Ito colour-blind-safe palette (without its yellow, which is
+/// unreadable on white), used in turn by [`color`].
+pub const PALETTE: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
+];
+
+/// The `i`-th colour of [`PALETTE`], cycling.
+pub fn color(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
+/// Errors of drawing a chart.
+#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+#[non_exhaustive]
+pub enum PlotError {
+    /// The output directory could not be created.
+    #[error("{path}: cannot create the plot directory: {source}")]
+    #[diagnostic(code(chain::plot::io))]
+    Io {
+        /// The directory.
+        path: String,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Drawing or writing the image failed.
+    #[error("{path}: cannot draw the chart: {message}")]
+    #[diagnostic(code(chain::plot::draw))]
+    Draw {
+        /// The image file.
+        path: String,
+        /// What the backend said.
+        message: String,
+    },
+    /// No series has a finite point.
+    #[error("chart `{title}` has no finite data to draw")]
+    #[diagnostic(code(chain::plot::no_data))]
+    NoData {
+        /// The chart's title.
+        title: String,
+    },
+}
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mark {
+    /// A polyline through the points.
+    Line,
+    /// A filled circle at each point.
+    Points,
+    /// A polyline with a circle at each point.
+    LinePoints,
+}
+
+/// One data series of an [`XyChart`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// Legend text (`None`: not in the legend).
+    pub label: Option<String>,
+    /// The points; non-finite ones are skipped.
+    pub points: Vec<(f64, f64)>,
+    /// How the series is drawn.
+    pub mark: Mark,
+    /// Colour (`None`: the palette colour of the series' index).
+    pub color: Option<RGBColor>,
+    /// Line width in pixels.
+    pub width: u32,
+}
+
+impl Series {
+    fn new(label: impl Into<String>, points: Vec<(f64, f64)>, mark: Mark) -> Series {
+        let label = label.into();
+        Series {
+            label: (!label.is_empty()).then_some(label),
+            points,
+            mark,
+            color: None,
+            width: 2,
+        }
+    }
+
+    /// A line series (an empty label keeps it out of the legend).
+    pub fn line(label: impl Into<String>, points: Vec<(f64, f64)>) -> Series {
+        Series::new(label, points, Mark::Line)
+    }
+
+    /// A scatter series.
+    pub fn points(label: impl Into<String>, points: Vec<(f64, f64)>) -> Series {
+        Series::new(label, points, Mark::Points)
+    }
+
+    /// A line with a marker at each point.
+    pub fn line_points(label: impl Into<String>, points: Vec<(f64, f64)>) -> Series {
+        Series::new(label, points, Mark::LinePoints)
+    }
+
+    /// Sets the colour.
+    pub fn color(mut self, color: RGBColor) -> Series {
+        self.color = Some(color);
+        self
+    }
+
+    /// Sets the line width (pixels).
+    pub fn width(mut self, width: u32) -> Series {
+        self.width = width.max(1);
+        self
+    }
+}
+
+/// Where the legend goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Legend {
+    /// Inside the plot, upper right.
+    #[default]
+    UpperRight,
+    /// Inside the plot, upper left.
+    UpperLeft,
+    /// Inside the plot, lower right.
+    LowerRight,
+    /// Inside the plot, lower left.
+    LowerLeft,
+    /// No legend.
+    Hidden,
+}
+
+/// A 2-D chart of line and scatter series on linear axes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct XyChart {
+    /// Caption above the plot.
+    pub title: String,
+    /// Horizontal axis description.
+    pub x_label: String,
+    /// Vertical axis description.
+    pub y_label: String,
+    /// The series, drawn in order.
+    pub series: Vec<Series>,
+    /// Horizontal reference lines (e.g. zero).
+    pub hlines: Vec<f64>,
+    /// Explicit x range (`None`: fitted to the data).
+    pub x_range: Option<(f64, f64)>,
+    /// Explicit y range (`None`: fitted to the data and reference lines).
+    pub y_range: Option<(f64, f64)>,
+    /// Legend placement.
+    pub legend: Legend,
+    /// Image size in pixels (SVG user units).
+    pub size: (u32, u32),
+}
+
+impl XyChart {
+    /// An empty 1000 × 640 chart.
+    pub fn new(
+        title: impl Into<String>,
+        x_label: impl Into<String>,
+        y_label: impl Into<String>,
+    ) -> XyChart {
+        XyChart {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            series: Vec::new(),
+            hlines: Vec::new(),
+            x_range: None,
+            y_range: None,
+            legend: Legend::default(),
+            size: (1000, 640),
+        }
+    }
+
+    /// Adds a series.
+    pub fn series(mut self, series: Series) -> XyChart {
+        self.series.push(series);
+        self
+    }
+
+    /// Adds a horizontal reference line at `y`.
+    pub fn hline(mut self, y: f64) -> XyChart {
+        self.hlines.push(y);
+        self
+    }
+
+    /// Fixes the x range.
+    pub fn x_range(mut self, lo: f64, hi: f64) -> XyChart {
+        self.x_range = Some((lo, hi));
+        self
+    }
+
+    /// Fixes the y range.
+    pub fn y_range(mut self, lo: f64, hi: f64) -> XyChart {
+        self.y_range = Some((lo, hi));
+        self
+    }
+
+    /// Sets the legend placement.
+    pub fn legend(mut self, legend: Legend) -> XyChart {
+        self.legend = legend;
+        self
+    }
+
+    /// Sets the image size in pixels.
+    pub fn size(mut self, width: u32, height: u32) -> XyChart {
+        self.size = (width.max(200), height.max(150));
+        self
+    }
+
+    /// Writes `dir/stem.png` and `dir/stem.svg` (creating `dir`) and returns
+    /// both paths.
+    pub fn write(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, PlotError> {
+        std::fs::create_dir_all(dir).map_err(|source| PlotError::Io {
+            path: dir.display().to_string(),
+            source,
+        })?;
+        let png = dir.join(format!("{stem}.png"));
+        let svg = dir.join(format!("{stem}.svg"));
+        self.write_png(&png)?;
+        self.write_svg(&svg)?;
+        Ok(vec![png, svg])
+    }
+
+    /// Draws the chart into a PNG file.
+    pub fn write_png(&self, path: &Path) -> Result<(), PlotError> {
+        let ranges = self.ranges()?;
+        ensure_fonts();
+        let root = BitMapBackend::new(path, self.size).into_drawing_area();
+        self.draw(root, ranges).map_err(|message| PlotError::Draw {
+            path: path.display().to_string(),
+            message,
+        })
+    }
+
+    /// Draws the chart into an SVG file.
+    pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
+        let ranges = self.ranges()?;
+        ensure_fonts();
+        let root = SVGBackend::new(path, self.size).into_drawing_area();
+        self.draw(root, ranges).map_err(|message| PlotError::Draw {
+            path: path.display().to_string(),
+            message,
+        })
+    }
+
+    /// Axis ranges: the explicit ones, or the finite data padded by 3 % (x)
+    /// and 8 % (y).
+    fn ranges(&self) -> Result<((f64, f64), (f64, f64)), PlotError> {
+        let finite = || {
+            self.series
+                .iter()
+                .flat_map(|s| s.points.iter())
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+        };
+        if finite().next().is_none() {
+            return Err(PlotError::NoData {
+                title: self.title.clone(),
+            });
+        }
+        let span = |values: &mut dyn Iterator<Item = f64>, pad: f64| -> (f64, f64) {
+            let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            });
+            let width = hi - lo;
+            if width > 0.0 {
+                (lo - pad * width, hi + pad * width)
+            } else {
+                let half = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
+                (lo - half, hi + half)
+            }
+        };
+        let x = self
+            .x_range
+            .filter(|(a, b)| a.is_finite() && b.is_finite() && a < b)
+            .unwrap_or_else(|| span(&mut finite().map(|p| p.0), 0.03));
+        let y = self
+            .y_range
+            .filter(|(a, b)| a.is_finite() && b.is_finite() && a < b)
+            .unwrap_or_else(|| {
+                span(
+                    &mut finite()
+                        .map(|p| p.1)
+                        .chain(self.hlines.iter().copied().filter(|v| v.is_finite())),
+                    0.08,
+                )
+            });
+        Ok((x, y))
+    }
+
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: DrawingArea<DB, Shift>,
+        ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
+    ) -> Result<(), String> {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(&self.title, ("sans-serif", 24).into_font())
+            .margin(16)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc(self.x_label.as_str())
+            .y_desc(self.y_label.as_str())
+            .label_style(("sans-serif", 15))
+            .axis_desc_style(("sans-serif", 17))
+            .light_line_style(RGBColor(235, 235, 235))
+            .bold_line_style(RGBColor(210, 210, 210))
+            .draw()
+            .map_err(err)?;
+        for &y in self
+            .hlines
+            .iter()
+            .filter(|y| y.is_finite() && **y >= y0 && **y <= y1)
+        {
+            chart
+                .draw_series(LineSeries::new(
+                    [(x0, y), (x1, y)],
+                    BLACK.mix(0.55).stroke_width(1),
+                ))
+                .map_err(err)?;
+        }
+        let mut labelled = false;
+        for (i, s) in self.series.iter().enumerate() {
+            let colour = s.color.unwrap_or_else(|| color(i));
+            let points: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .copied()
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .collect();
+            let line_style = colour.stroke_width(s.width);
+            let radius = (s.width + 2).min(6) as i32;
+            let anno = match s.mark {
+                Mark::Line => chart
+                    .draw_series(LineSeries::new(points, line_style))
+                    .map_err(err)?,
+                Mark::Points => chart
+                    .draw_series(
+                        points
+                            .into_iter()
+                            .map(|p| Circle::new(p, radius, colour.filled())),
+                    )
+                    .map_err(err)?,
+                Mark::LinePoints => {
+                    chart
+                        .draw_series(LineSeries::new(points.iter().copied(), line_style))
+                        .map_err(err)?;
+                    chart
+                        .draw_series(
+                            points
+                                .into_iter()
+                                .map(|p| Circle::new(p, radius, colour.filled())),
+                        )
+                        .map_err(err)?
+                }
+            };
+            if let Some(label) = &s.label {
+                labelled = true;
+                let mark = s.mark;
+                anno.label(label.as_str()).legend(move |(x, y)| {
+                    let line = PathElement::new(
+                        vec![(x, y), (x + 24, y)],
+                        match mark {
+                            Mark::Points => colour.mix(0.0).stroke_width(1),
+                            _ => colour.stroke_width(3),
+                        },
+                    );
+                    let dot = Circle::new(
+                        (x + 12, y),
+                        if mark == Mark::Line { 0 } else { 4 },
+                        colour.filled(),
+                    );
+                    EmptyElement::at((0, 0)) + line + dot
+                });
+            }
+        }
+        let position = match self.legend {
+            Legend::UpperRight => Some(SeriesLabelPosition::UpperRight),
+            Legend::UpperLeft => Some(SeriesLabelPosition::UpperLeft),
+            Legend::LowerRight => Some(SeriesLabelPosition::LowerRight),
+            Legend::LowerLeft => Some(SeriesLabelPosition::LowerLeft),
+            Legend::Hidden => None,
+        };
+        if let (true, Some(position)) = (labelled, position) {
+            chart
+                .configure_series_labels()
+                .position(position)
+                .background_style(WHITE.mix(0.9))
+                .border_style(RGBColor(160, 160, 160))
+                .label_font(("sans-serif", 15))
+                .draw()
+                .map_err(err)?;
+        }
+        root.present().map_err(err)?;
+        Ok(())
+    }
+}
+
+/// Registers the embedded DejaVu Sans under the generic family names plotters
+/// uses (`sans-serif`, `serif`, `monospace`). Idempotent; the drawing
+/// functions call it.
+pub fn ensure_fonts() {
+    static FONTS: Once = Once::new();
+    FONTS.call_once(|| {
+        for family in ["sans-serif", "serif", "monospace"] {
+            // The embedded font is a valid TrueType file; a failure here would
+            // only mean that text is missing from the charts.
+            let _ =
+                plotters::style::register_font(family, FontStyle::Normal, dejavu::sans::regular());
+            let _ = plotters::style::register_font(family, FontStyle::Bold, dejavu::sans::bold());
+        }
+    });
+}

@@ -1,0 +1,600 @@
+//! An independent, purely numeric implementation of the kinematic semantics of
+//! `shared/spec/machine-format.md` section 1, used to check the symbolic engine.
+//!
+//! Nothing here is linearised: every body transform is the full 4×4 product
+//!
+//! ```text
+//! T(parent -> body) = Trans(offset) · Rot(rotation) · E(location_errors) · J(q) · E(errors + squareness)
+//! ```
+//!
+//! with `E(d, ε)` the exact rigid transform whose rotation is `exp([ε×])`
+//! (Rodrigues) and whose translation is `d`; to first order this is the spec's
+//! `[[1, -ez, ey, dx], [ez, 1, -ex, dy], [-ey, ex, 1, dz], [0, 0, 0, 1]]`.
+//! `T_wt = inv(P(workpiece)) · P(tool)`, `p = T_wt(q, e)·tp - T_wt(q, 0)·tp`,
+//! `o = vee(skew(R_wt(q, e) · R_wt(q, 0)ᵀ))`, rotated by `R_wt(q, 0)ᵀ` for
+//! `frame: tool`. The first-order model is the derivative of these at `e = 0`,
+//! which [`Exact::fd_sensitivity`] estimates by a 5-point central difference.
+//!
+//! It reads the validated [`Machine`] directly and shares no code with
+//! `chain-core`'s derivation (only `Expr::eval` for offsets and tool points).
+//!
+//! Index conventions inside this module: `q` is indexed like
+//! `machine.variables`, `p` like `machine.parameters`, `e` like
+//! `machine.errors`. The model under test has its own name lists; the helpers
+//! [`by_names`] and [`Exact::model_sensitivity`] translate by name.
+// Matrix code reads best with explicit indices.
+#![allow(dead_code, clippy::needless_range_loop)]
+
+use chain_core::model::{ErrorSlots, Frame, JointKind, Machine};
+use chain_core::ErrorModel;
+
+/// Row-major 3×3 matrix.
+pub type Mat3 = [[f64; 3]; 3];
+/// Row-major homogeneous 4×4 matrix.
+pub type Mat4 = [[f64; 4]; 4];
+
+/// The 4×4 identity.
+pub fn identity4() -> Mat4 {
+    let mut m = [[0.0; 4]; 4];
+    for (i, row) in m.iter_mut().enumerate() {
+        row[i] = 1.0;
+    }
+    m
+}
+
+/// `a · b` for 4×4 matrices.
+pub fn mul4(a: &Mat4, b: &Mat4) -> Mat4 {
+    let mut m = [[0.0; 4]; 4];
+    for i in 0..4 {
+        for j in 0..4 {
+            m[i][j] = (0..4).map(|k| a[i][k] * b[k][j]).sum();
+        }
+    }
+    m
+}
+
+/// `a · b` for 3×3 matrices.
+pub fn mul3(a: &Mat3, b: &Mat3) -> Mat3 {
+    let mut m = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
+        }
+    }
+    m
+}
+
+/// `aᵀ`.
+pub fn transpose3(a: &Mat3) -> Mat3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| a[j][i]))
+}
+
+/// `a · v`.
+pub fn apply3(a: &Mat3, v: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| (0..3).map(|k| a[i][k] * v[k]).sum())
+}
+
+/// The homogeneous transform with rotation `r` and translation `t`.
+pub fn rigid(r: &Mat3, t: [f64; 3]) -> Mat4 {
+    let mut m = identity4();
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i][j] = r[i][j];
+        }
+        m[i][3] = t[i];
+    }
+    m
+}
+
+/// Rotation block of a homogeneous transform.
+pub fn rotation(m: &Mat4) -> Mat3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| m[i][j]))
+}
+
+/// Translation column of a homogeneous transform.
+pub fn translation(m: &Mat4) -> [f64; 3] {
+    [m[0][3], m[1][3], m[2][3]]
+}
+
+/// `m · (v, 1)`.
+pub fn transform_point(m: &Mat4, v: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2] + m[i][3])
+}
+
+/// Inverse of a rigid transform: `[Rᵀ, -Rᵀ t]`.
+pub fn rigid_inverse(m: &Mat4) -> Mat4 {
+    let rt = transpose3(&rotation(m));
+    let t = apply3(&rt, translation(m));
+    rigid(&rt, [-t[0], -t[1], -t[2]])
+}
+
+/// The elementary rotation by `angle` (right-hand rule) about axis `k`
+/// (0 = x, 1 = y, 2 = z).
+pub fn rot_axis(k: usize, angle: f64) -> Mat3 {
+    let (s, c) = angle.sin_cos();
+    match k {
+        0 => [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]],
+        1 => [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]],
+        _ => [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]],
+    }
+}
+
+/// `exp([w×])` by Rodrigues' formula (series for tiny angles).
+pub fn exp_so3(w: [f64; 3]) -> Mat3 {
+    let theta2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    let theta = theta2.sqrt();
+    let (a, b) = if theta < 1e-6 {
+        (1.0 - theta2 / 6.0, 0.5 - theta2 / 24.0)
+    } else {
+        (theta.sin() / theta, (1.0 - theta.cos()) / theta2)
+    };
+    let k = [[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]];
+    let k2 = mul3(&k, &k);
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| f64::from(u8::from(i == j)) + a * k[i][j] + b * k2[i][j])
+    })
+}
+
+/// The exact small-error transform `E(dx, dy, dz, ex, ey, ez)`: rotation
+/// `exp([ε×])`, translation `d`.
+pub fn error_transform(v: [f64; 6]) -> Mat4 {
+    rigid(&exp_so3([v[3], v[4], v[5]]), [v[0], v[1], v[2]])
+}
+
+/// `vee(skew(m))`: the `o` with `skew(m) = [o×]`.
+pub fn vee_skew(m: &Mat3) -> [f64; 3] {
+    [
+        0.5 * (m[2][1] - m[1][2]),
+        0.5 * (m[0][2] - m[2][0]),
+        0.5 * (m[1][0] - m[0][1]),
+    ]
+}
+
+/// A small deterministic generator (SplitMix64) for random test points.
+#[derive(Debug, Clone)]
+pub struct Rng(u64);
+
+impl Rng {
+    /// A generator from a seed.
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed)
+    }
+
+    /// Next raw 64-bit value.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in `[0, 1)`.
+    pub fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform in `[lo, hi)`.
+    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+}
+
+/// Values for the names of `names` (a model's variable, parameter or error
+/// list), looked up by name.
+pub fn by_names(names: &[&str], value: impl Fn(&str) -> f64) -> Vec<f64> {
+    names.iter().map(|n| value(n)).collect()
+}
+
+/// The exact numeric machine.
+pub struct Exact<'m> {
+    /// The validated machine.
+    pub machine: &'m Machine,
+}
+
+impl<'m> Exact<'m> {
+    /// Wraps a machine.
+    pub fn new(machine: &'m Machine) -> Exact<'m> {
+        Exact { machine }
+    }
+
+    /// Parameter values from the file (`NaN` for symbolic ones), in
+    /// `machine.parameters` order.
+    pub fn file_parameters(&self) -> Vec<f64> {
+        self.machine
+            .parameters
+            .iter()
+            .map(|p| p.value.unwrap_or(f64::NAN))
+            .collect()
+    }
+
+    /// Summed slot values of an error-slot set.
+    fn slot_values(slots: &ErrorSlots, e: &[f64]) -> [f64; 6] {
+        std::array::from_fn(|s| slots.slots[s].iter().map(|&j| e[j]).sum())
+    }
+
+    /// `T(parent -> body)`, exact.
+    pub fn body_transform(&self, b: usize, q: &[f64], p: &[f64], e: &[f64]) -> Mat4 {
+        let body = &self.machine.bodies[b];
+        let offset: [f64; 3] = std::array::from_fn(|i| body.offset[i].eval(p));
+        let mut t = rigid(&rot_axis(0, 0.0), offset);
+        for r in &body.rotation {
+            t = mul4(&t, &rigid(&rot_axis(r.about.index(), r.angle), [0.0; 3]));
+        }
+        t = mul4(
+            &t,
+            &error_transform(Self::slot_values(&body.location_errors, e)),
+        );
+        if let Some(joint) = &body.joint {
+            let k = joint.axis.axis.index();
+            let v = joint.axis.sign() * q[joint.variable];
+            let j = match joint.kind {
+                JointKind::Prismatic => {
+                    let mut d = [0.0; 3];
+                    d[k] = v;
+                    rigid(&rot_axis(0, 0.0), d)
+                }
+                JointKind::Rotary => rigid(&rot_axis(k, v), [0.0; 3]),
+            };
+            t = mul4(&t, &j);
+        }
+        mul4(&t, &error_transform(Self::slot_values(&body.errors, e)))
+    }
+
+    /// `P(b)`: the product of the body transforms from the root to `b`
+    /// (the root's own transform included; it cancels in `T_wt`).
+    pub fn pose(&self, b: usize, q: &[f64], p: &[f64], e: &[f64]) -> Mat4 {
+        self.machine
+            .path_from_root(b)
+            .into_iter()
+            .fold(identity4(), |acc, k| {
+                mul4(&acc, &self.body_transform(k, q, p, e))
+            })
+    }
+
+    /// `T_wt(q, e) = inv(P(workpiece)) · P(tool)`.
+    pub fn t_wt(&self, q: &[f64], p: &[f64], e: &[f64]) -> Mat4 {
+        let w = self.pose(self.machine.workpiece, q, p, e);
+        let t = self.pose(self.machine.tool, q, p, e);
+        mul4(&rigid_inverse(&w), &t)
+    }
+
+    /// The tool point in the tool frame.
+    pub fn tool_point(&self, p: &[f64]) -> [f64; 3] {
+        std::array::from_fn(|i| self.machine.tool_point[i].eval(p))
+    }
+
+    /// `R_wt(q, 0)` and `T_wt(q, 0) · tool_point`.
+    pub fn nominal(&self, q: &[f64], p: &[f64]) -> (Mat3, [f64; 3]) {
+        let zero = vec![0.0; self.machine.errors.len()];
+        let t = self.t_wt(q, p, &zero);
+        (rotation(&t), transform_point(&t, self.tool_point(p)))
+    }
+
+    /// The full (non-linearised) error `[px, py, pz, ox, oy, oz]` at error
+    /// values `e`, in the machine's frame.
+    pub fn exact_error(&self, q: &[f64], p: &[f64], e: &[f64]) -> [f64; 6] {
+        self.exact_error_in(self.machine.frame, q, p, e)
+    }
+
+    /// The full error in a given frame.
+    pub fn exact_error_in(&self, frame: Frame, q: &[f64], p: &[f64], e: &[f64]) -> [f64; 6] {
+        let zero = vec![0.0; self.machine.errors.len()];
+        let t0 = self.t_wt(q, p, &zero);
+        let te = self.t_wt(q, p, e);
+        let tp = self.tool_point(p);
+        let a = transform_point(&te, tp);
+        let b = transform_point(&t0, tp);
+        let pos = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        let r0 = rotation(&t0);
+        let ori = vee_skew(&mul3(&rotation(&te), &transpose3(&r0)));
+        let (pos, ori) = match frame {
+            Frame::Workpiece => (pos, ori),
+            Frame::Tool => {
+                let r0t = transpose3(&r0);
+                (apply3(&r0t, pos), apply3(&r0t, ori))
+            }
+        };
+        [pos[0], pos[1], pos[2], ori[0], ori[1], ori[2]]
+    }
+
+    /// The 6×N sensitivity (row-major, `machine.errors` order) by a 5-point
+    /// central difference of [`Exact::exact_error`] at `e = 0` with step `h`
+    /// (truncation `O(h⁴)`).
+    pub fn fd_sensitivity(&self, q: &[f64], p: &[f64], h: f64) -> Vec<f64> {
+        self.fd_sensitivity_in(self.machine.frame, q, p, h)
+    }
+
+    /// [`Exact::fd_sensitivity`] in a given frame.
+    pub fn fd_sensitivity_in(&self, frame: Frame, q: &[f64], p: &[f64], h: f64) -> Vec<f64> {
+        let n = self.machine.errors.len();
+        let mut out = vec![0.0; 6 * n];
+        let mut e = vec![0.0; n];
+        for j in 0..n {
+            let mut at = |s: f64| {
+                e[j] = s * h;
+                let v = self.exact_error_in(frame, q, p, &e);
+                e[j] = 0.0;
+                v
+            };
+            let (m2, m1, p1, p2) = (at(-2.0), at(-1.0), at(1.0), at(2.0));
+            for c in 0..6 {
+                out[c * n + j] = (m2[c] - 8.0 * m1[c] + 8.0 * p1[c] - p2[c]) / (12.0 * h);
+            }
+        }
+        out
+    }
+
+    /// A length scale of the machine at a point: 1 + the sum of the absolute
+    /// offsets, tool point and prismatic axis values. Used for absolute
+    /// tolerance floors.
+    pub fn length_scale(&self, q: &[f64], p: &[f64]) -> f64 {
+        let mut s = 1.0;
+        for b in &self.machine.bodies {
+            s += b.offset.iter().map(|x| x.eval(p).abs()).sum::<f64>();
+            if let Some(j) = &b.joint {
+                if j.kind == JointKind::Prismatic {
+                    s += q[j.variable].abs();
+                }
+            }
+        }
+        s + self.tool_point(p).iter().map(|v| v.abs()).sum::<f64>()
+    }
+
+    /// `q` in the model's variable order from machine-ordered values.
+    pub fn q_for<M: ErrorModel + ?Sized>(&self, model: &M, q: &[f64]) -> Vec<f64> {
+        by_names(model.variables(), |n| {
+            self.machine.variable_index(n).map_or(f64::NAN, |i| q[i])
+        })
+    }
+
+    /// `p` in the model's parameter order from machine-ordered values.
+    pub fn p_for<M: ErrorModel + ?Sized>(&self, model: &M, p: &[f64]) -> Vec<f64> {
+        by_names(model.parameters(), |n| {
+            self.machine.parameter_index(n).map_or(f64::NAN, |i| p[i])
+        })
+    }
+
+    /// `e` in the model's error order from machine-ordered values.
+    pub fn e_for<M: ErrorModel + ?Sized>(&self, model: &M, e: &[f64]) -> Vec<f64> {
+        by_names(model.errors(), |n| {
+            self.machine.error_index(n).map_or(f64::NAN, |i| e[i])
+        })
+    }
+
+    /// The model's sensitivity at machine-ordered `q`, `p`, re-indexed to
+    /// `machine.errors` order (row-major 6×N). Panics if the model's error
+    /// names are not exactly the machine's.
+    pub fn model_sensitivity<M: ErrorModel + ?Sized>(
+        &self,
+        model: &M,
+        q: &[f64],
+        p: &[f64],
+    ) -> Vec<f64> {
+        let names = model.errors();
+        let n = self.machine.errors.len();
+        assert_eq!(names.len(), n, "model and machine error counts differ");
+        let mut s = vec![0.0; 6 * n];
+        model.sensitivity(&self.q_for(model, q), &self.p_for(model, p), &mut s);
+        let mut out = vec![0.0; 6 * n];
+        for (k, name) in names.iter().enumerate() {
+            let j = self
+                .machine
+                .error_index(name)
+                .unwrap_or_else(|| panic!("model error {name} not in the machine"));
+            for c in 0..6 {
+                out[c * n + j] = s[c * n + k];
+            }
+        }
+        out
+    }
+
+    /// Compares the model's sensitivity with the finite difference of the exact
+    /// product: `|model - fd| <= rel · max(|model|, |fd|) + floor · scale`.
+    /// Returns a description of the first mismatch.
+    pub fn check_sensitivity<M: ErrorModel + ?Sized>(
+        &self,
+        model: &M,
+        q: &[f64],
+        p: &[f64],
+        rel: f64,
+        floor: f64,
+    ) -> Result<(), String> {
+        let n = self.machine.errors.len();
+        let s = self.model_sensitivity(model, q, p);
+        let fd = self.fd_sensitivity(q, p, 1e-3);
+        let scale = self.length_scale(q, p);
+        for c in 0..6 {
+            for j in 0..n {
+                let (a, b) = (s[c * n + j], fd[c * n + j]);
+                let tol = rel * a.abs().max(b.abs()) + floor * scale;
+                if !within(a - b, tol) {
+                    return Err(format!(
+                        "d{}/d{} at q = {q:?}, p = {p:?}: model {a}, finite difference {b} (tol {tol})",
+                        ["px", "py", "pz", "ox", "oy", "oz"][c],
+                        self.machine.errors[j].name
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks `error(q, p, e) = sensitivity(q, p) · e` (to `rel` of the sum of
+    /// the absolute terms) and `nominal()` against the exact product (to `rel`
+    /// of the length scale).
+    pub fn check_error_and_nominal<M: ErrorModel + ?Sized>(
+        &self,
+        model: &M,
+        q: &[f64],
+        p: &[f64],
+        e: &[f64],
+        rel: f64,
+    ) -> Result<(), String> {
+        let n = self.machine.errors.len();
+        let s = self.model_sensitivity(model, q, p);
+        let mut out = [0.0; 6];
+        model.error(
+            &self.q_for(model, q),
+            &self.p_for(model, p),
+            &self.e_for(model, e),
+            &mut out,
+        );
+        for c in 0..6 {
+            let expect: f64 = (0..n).map(|j| s[c * n + j] * e[j]).sum();
+            let mag: f64 = (0..n).map(|j| (s[c * n + j] * e[j]).abs()).sum();
+            if !within(out[c] - expect, rel * mag + 1e-300) {
+                return Err(format!(
+                    "error()[{c}] = {} but sensitivity · e = {expect} at q = {q:?}",
+                    out[c]
+                ));
+            }
+        }
+        let pose = model.nominal(&self.q_for(model, q), &self.p_for(model, p));
+        let (r, pos) = self.nominal(q, p);
+        let scale = self.length_scale(q, p);
+        for i in 0..3 {
+            for j in 0..3 {
+                if !within(pose.rotation[i][j] - r[i][j], rel) {
+                    return Err(format!(
+                        "nominal rotation[{i}][{j}] = {} but the exact product gives {} at q = {q:?}",
+                        pose.rotation[i][j], r[i][j]
+                    ));
+                }
+            }
+            if !within(pose.position[i] - pos[i], rel * scale) {
+                return Err(format!(
+                    "nominal position[{i}] = {} but the exact product gives {} at q = {q:?}",
+                    pose.position[i], pos[i]
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Standard normal CDF `Φ(x) = erfc(-x/√2)/2`, with `erfc` from W. J. Cody's
+/// rational Chebyshev approximations (relative error below 1e-14).
+pub fn normal_cdf(x: f64) -> f64 {
+    0.5 * erfc(-x / std::f64::consts::SQRT_2)
+}
+
+/// Complementary error function (Cody 1969).
+pub fn erfc(x: f64) -> f64 {
+    let ax = x.abs();
+    let r = if ax < 0.5 {
+        // erf for small |x|
+        const A: [f64; 5] = [
+            3.161_123_743_870_565_6,
+            113.864_154_151_050_16,
+            377.485_237_685_302,
+            3_209.377_589_138_469_4,
+            0.185_777_706_184_603_15,
+        ];
+        const B: [f64; 4] = [
+            23.601_290_952_344_122,
+            244.024_637_934_444_17,
+            1_282.616_526_077_372_3,
+            2_844.236_833_439_171,
+        ];
+        let y = x * x;
+        let mut num = A[4] * y;
+        let mut den = y;
+        for i in 0..3 {
+            num = (num + A[i]) * y;
+            den = (den + B[i]) * y;
+        }
+        return 1.0 - x * (num + A[3]) / (den + B[3]);
+    } else if ax <= 4.0 {
+        const C: [f64; 9] = [
+            0.564_188_496_988_670_1,
+            8.883_149_794_388_376,
+            66.119_190_637_141_63,
+            298.635_138_197_400_1,
+            881.952_221_241_769,
+            1_712.047_612_634_070_7,
+            2_051.078_377_826_071_6,
+            1_230.339_354_797_997_2,
+            2.153_115_354_744_038_5e-8,
+        ];
+        const D: [f64; 8] = [
+            15.744_926_110_709_835,
+            117.693_950_891_312_5,
+            537.181_101_862_009_9,
+            1_621.389_574_566_690_3,
+            3_290.799_235_733_459_7,
+            4_362.619_090_143_247,
+            3_439.367_674_143_721_6,
+            1_230.339_354_803_749_5,
+        ];
+        let mut num = C[8] * ax;
+        let mut den = ax;
+        for i in 0..7 {
+            num = (num + C[i]) * ax;
+            den = (den + D[i]) * ax;
+        }
+        let r = (num + C[7]) / (den + D[7]);
+        let ysq = (ax * 16.0).trunc() / 16.0;
+        let del = (ax - ysq) * (ax + ysq);
+        (-ysq * ysq).exp() * (-del).exp() * r
+    } else {
+        const P: [f64; 6] = [
+            0.305_326_634_961_232_36,
+            0.360_344_899_949_804_45,
+            0.125_781_726_111_229_25,
+            0.016_083_785_148_742_275,
+            6.587_491_615_298_378e-4,
+            0.016_315_387_137_302_097,
+        ];
+        const Q: [f64; 5] = [
+            2.568_520_192_289_822,
+            1.872_952_849_923_460_4,
+            0.527_905_102_951_428_4,
+            0.060_518_341_312_441_32,
+            0.002_335_204_976_268_691_8,
+        ];
+        let y = 1.0 / (ax * ax);
+        let mut num = P[5] * y;
+        let mut den = y;
+        for i in 0..4 {
+            num = (num + P[i]) * y;
+            den = (den + Q[i]) * y;
+        }
+        let r = y * (num + P[4]) / (den + Q[4]);
+        let r = (1.0 / std::f64::consts::PI.sqrt() - r) / ax;
+        let ysq = (ax * 16.0).trunc() / 16.0;
+        let del = (ax - ysq) * (ax + ysq);
+        (-ysq * ysq).exp() * (-del).exp() * r
+    };
+    if x < 0.0 {
+        2.0 - r
+    } else {
+        r
+    }
+}
+
+/// Path of an example machine file, `examples/machines/<file>`.
+pub fn example_path(file: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples")
+        .join("machines")
+        .join(file)
+}
+
+/// Loads an example machine file, panicking with the rendered diagnostics.
+pub fn load_example(file: &str) -> Machine {
+    match chain_core::load_file(&example_path(file)) {
+        Ok(m) => m,
+        Err(d) => panic!("{file} does not load:\n{d}"),
+    }
+}
+
+/// `|d| <= tol`, false for NaN.
+pub fn within(d: f64, tol: f64) -> bool {
+    d.abs() <= tol
+}
+
+/// `|a - b| <= rel · max(|a|, |b|) + abs` (false if either is NaN).
+pub fn close(a: f64, b: f64, rel: f64, abs: f64) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()) + abs
+}
