@@ -148,7 +148,7 @@ pub enum CompensateError {
         theta_deg: f64,
     },
     /// `cos θ − ΔZ/L` is outside `[-1, 1]`, so Eq. 5 has no solution.
-    #[error("{file}, line {line}: cos θ − ΔZ/L = {argument} is outside [−1, 1] (θ = {theta_deg}°, z1 − z3 = {drop} mm, L = {length} mm); the measured drop z1 − z3 must lie in [0, 2L]")]
+    #[error("{file}, line {line}: cos θ − ΔZ/L = {argument:.9} is outside [−1, 1] (θ = {theta_deg}°, z1 − z3 = {drop:.6} mm, L = {length} mm); the measured drop z1 − z3 must lie in [0, 2L]")]
     #[diagnostic(
         code(chain::compensate::acos_domain),
         help("check the sign convention (z3 is the measured tip height, below z1 for θ > 0) and --length")
@@ -368,7 +368,7 @@ pub fn parse_csv(file: &str, data: &[u8]) -> Result<Measurements, CompensateErro
         }
         Some(h) => h.map_err(csv_error)?,
     };
-    let header_line = header.position().map_or(1, csv::Position::line);
+    let header_line = header.position().map_or(1, |p| record_line(data, p));
     let names: Vec<String> = header.iter().map(str::to_ascii_lowercase).collect();
     let find = |column: &'static str| -> Result<Option<usize>, CompensateError> {
         let mut hits = names.iter().enumerate().filter(|(_, n)| *n == column);
@@ -402,7 +402,7 @@ pub fn parse_csv(file: &str, data: &[u8]) -> Result<Measurements, CompensateErro
     let mut records = Vec::new();
     for row in rows {
         let row = row.map_err(csv_error)?;
-        let line = row.position().map_or(0, csv::Position::line);
+        let line = row.position().map_or(0, |p| record_line(data, p));
         if row.len() != header.len() {
             return Err(CompensateError::Malformed {
                 file: file.to_string(),
@@ -463,6 +463,37 @@ pub fn parse_csv(file: &str, data: &[u8]) -> Result<Measurements, CompensateErro
         header_line,
         records,
     })
+}
+
+/// The line a record starts on. The reader reports where it started reading,
+/// which is before any comment or blank lines it skipped; skip them here too.
+fn record_line(data: &[u8], pos: &csv::Position) -> u64 {
+    let mut line = pos.line();
+    let mut i = usize::try_from(pos.byte()).unwrap_or(usize::MAX);
+    while let Some(&b) = data.get(i) {
+        match b {
+            b'#' => match data[i..].iter().position(|&c| c == b'\n') {
+                Some(end) => {
+                    i += end + 1;
+                    line += 1;
+                }
+                None => break,
+            },
+            b'\n' => {
+                i += 1;
+                line += 1;
+            }
+            b'\r' => {
+                i += 1;
+                if data.get(i) == Some(&b'\n') {
+                    i += 1;
+                }
+                line += 1;
+            }
+            _ => break,
+        }
+    }
+    line
 }
 
 fn csv_error_message(e: &csv::Error) -> String {

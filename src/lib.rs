@@ -11,5 +11,8 @@
 pub use chain_core as core;
 pub use reliability;
 
+/// Declares a machine and generates its error model at compile time (see `docs/macro.md`).
+pub use chain_macro::machine;
+
 pub mod compensate;
 pub mod plot;

@@ -75,6 +75,9 @@ pub enum PlotError {
     },
 }
 
+/// `((x_min, x_max), (y_min, y_max))` of a chart's axes.
+type Ranges = ((f64, f64), (f64, f64));
+
 /// How a series is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mark {
@@ -274,7 +277,7 @@ impl XyChart {
 
     /// Axis ranges: the explicit ones, or the finite data padded by 3 % (x)
     /// and 8 % (y).
-    fn ranges(&self) -> Result<((f64, f64), (f64, f64)), PlotError> {
+    fn ranges(&self) -> Result<Ranges, PlotError> {
         let finite = || {
             self.series
                 .iter()
@@ -319,7 +322,7 @@ impl XyChart {
     fn draw<DB: DrawingBackend>(
         &self,
         root: DrawingArea<DB, Shift>,
-        ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
+        ((x0, x1), (y0, y1)): Ranges,
     ) -> Result<(), String> {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
         root.fill(&WHITE).map_err(err)?;
@@ -336,6 +339,8 @@ impl XyChart {
             .y_desc(self.y_label.as_str())
             .label_style(("sans-serif", 15))
             .axis_desc_style(("sans-serif", 17))
+            .x_label_formatter(&|v| tick_label(*v, x0, x1))
+            .y_label_formatter(&|v| tick_label(*v, y0, y1))
             .light_line_style(RGBColor(235, 235, 235))
             .bold_line_style(RGBColor(210, 210, 210))
             .draw()
@@ -427,6 +432,16 @@ impl XyChart {
         root.present().map_err(err)?;
         Ok(())
     }
+}
+
+/// A tick label without float noise or trailing zeros: `5`, `0.25`, `0`
+/// (never `-0.0`), rounded to 10 significant digits.
+fn tick_label(v: f64, lo: f64, hi: f64) -> String {
+    if v.abs() <= 1e-9 * lo.abs().max(hi.abs()) {
+        return "0".to_string();
+    }
+    let rounded: f64 = format!("{v:.9e}").parse().unwrap_or(v);
+    format!("{rounded}")
 }
 
 /// Registers the embedded DejaVu Sans under the generic family names plotters

@@ -220,7 +220,7 @@ fn fourth_order_law_against_the_printed_one() {
         0.180_764_893_082_782_57,
         -0.029_515_046_484_958_28,
         0.002_311_015_760_093_760_5,
-        -7.154_722_336_169_159e-5,
+        -7.154_722_336_169_16e-5,
         7.626_218_020_069_122e-7,
     ];
     for (k, (ours, theirs)) in c.iter().zip(numpy).enumerate() {
@@ -700,7 +700,7 @@ fn cli_table_format_and_table_out() {
         "--table-out",
         table.to_str().unwrap(),
         "--grid",
-        "0:1:45",
+        "0.5:0.5:45",
     ]);
     assert!(!out.status.success());
     assert!(out.stdout.is_empty());

@@ -426,8 +426,8 @@ impl Problem {
                 expected,
                 suggestion,
                 ..
-            } => Some(did_you_mean(suggestion).unwrap_or_else(|| one_of(expected))),
-            Problem::UnknownValue {
+            }
+            | Problem::UnknownValue {
                 expected,
                 suggestion,
                 ..

@@ -23,8 +23,8 @@ use crate::model::{Component, JointKind};
 pub struct EmitOptions {
     /// Name of the generated type.
     pub type_name: String,
-    /// Whether the type is `pub`.
-    pub public: bool,
+    /// Visibility of the type (`pub`, `pub(crate)` or empty).
+    pub visibility: TokenStream,
     /// Path of the `chain` facade crate in the generated code (default `::chain`).
     pub crate_path: TokenStream,
 }
@@ -35,7 +35,7 @@ impl EmitOptions {
     pub fn for_model(model: &SymbolicModel) -> EmitOptions {
         EmitOptions {
             type_name: type_name_for(&model.machine),
-            public: true,
+            visibility: quote!(pub),
             crate_path: quote!(::chain),
         }
     }
@@ -76,10 +76,10 @@ fn const_name(prefix: &str, name: &str) -> String {
 pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
     let ty = Ident::new(&options.type_name, Span::call_site());
     let krate = &options.crate_path;
-    let vis = if options.public { quote!(pub) } else { quote!() };
-    let v = model.variables.len();
-    let p = model.parameters.len();
-    let n = model.errors.len();
+    let vis = &options.visibility;
+    let v = lit(model.variables.len());
+    let p = lit(model.parameters.len());
+    let n = lit(model.errors.len());
     let var_names: Vec<&str> = model.variables.iter().map(|x| x.0.as_str()).collect();
     let param_names: Vec<&str> = model.parameters.iter().map(|x| x.0.as_str()).collect();
     let error_names: Vec<&str> = model.errors.iter().map(String::as_str).collect();
@@ -108,8 +108,13 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
     let sens_assign: Vec<TokenStream> = sens_polys
         .iter()
         .map(|(c, j, poly)| {
-            let e = sens.expr(poly);
-            quote!(s[#c][#j] = #e;)
+            let (negative, e) = sens.signed(poly);
+            let (c, j) = (lit(*c), lit(*j));
+            if negative {
+                quote!(s[#c][#j] = -#e;)
+            } else {
+                quote!(s[#c][#j] = #e;)
+            }
         })
         .collect();
     let sens_prelude = sens.prelude();
@@ -118,17 +123,26 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
     let err_rows: Vec<TokenStream> = Component::ALL
         .iter()
         .map(|c| {
-            let terms: Vec<TokenStream> = model.components[c.index()]
-                .iter()
-                .map(|(j, poly)| {
-                    let ex = err.expr(poly);
-                    quote!((#ex) * e[#j])
-                })
-                .collect();
-            if terms.is_empty() {
+            let mut row = TokenStream::new();
+            for (k, (j, poly)) in model.components[c.index()].iter().enumerate() {
+                let (negative, ex) = err.signed(poly);
+                let j = lit(*j);
+                let factor = if ex.to_string() == "1.0" {
+                    quote!(e[#j])
+                } else {
+                    quote!(#ex * e[#j])
+                };
+                row.extend(match (k, negative) {
+                    (0, false) => quote!(#factor),
+                    (0, true) => quote!(-#factor),
+                    (_, false) => quote!(+ #factor),
+                    (_, true) => quote!(- #factor),
+                });
+            }
+            if row.is_empty() {
                 quote!(0.0)
             } else {
-                quote!(#(#terms)+*)
+                row
             }
         })
         .collect();
@@ -154,15 +168,11 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
     let component_docs: Vec<String> = Component::ALL
         .iter()
         .map(|c| {
-            let terms: Vec<String> = model.components[c.index()]
+            let terms: Vec<(bool, String)> = model.components[c.index()]
                 .iter()
-                .map(|(j, poly)| format!("({})*{}", text(poly), model.errors[*j]))
+                .map(|(j, poly)| crate::export::term(&text(poly), &model.errors[*j]))
                 .collect();
-            let rhs = if terms.is_empty() {
-                "0".to_string()
-            } else {
-                terms.join(" + ")
-            };
+            let rhs = crate::export::join_terms(&terms, (" + ", " - "));
             format!(" - `{} = {}`", c.name(), rhs)
         })
         .collect();
@@ -195,7 +205,7 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
         #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
         #vis struct #ty;
 
-        #[allow(clippy::all, clippy::pedantic, unused_parens, unused_variables)]
+        #[allow(clippy::all, clippy::pedantic, unused_parens, unused_variables, non_snake_case)]
         impl #ty {
             #[doc = #vars_doc]
             pub const VARIABLES: [&'static str; #v] = [#(#var_names),*];
@@ -326,6 +336,7 @@ fn index_constants(model: &SymbolicModel) -> Vec<TokenStream> {
             }
             let ident = Ident::new(&c, Span::call_site());
             let doc = format!(" Index of the {what} `{name}`.");
+            let i = lit(i);
             out.push(quote! {
                 #[doc = #doc]
                 pub const #ident: usize = #i;
@@ -361,7 +372,7 @@ impl<'a> Body<'a> {
         if !self.symbols.contains(&s) {
             self.symbols.push(s);
         }
-        symbol_ident(s)
+        symbol_ident_in(self.model, s)
     }
 
     fn monomial(&mut self, m: &Monomial) -> TokenStream {
@@ -419,13 +430,23 @@ impl<'a> Body<'a> {
         out
     }
 
+    /// The expression of a polynomial with a leading minus split off, so that
+    /// `-y` emits as `-v_y` and `-1` as a negated unit.
+    fn signed(&mut self, poly: &Poly) -> (bool, TokenStream) {
+        if let [(m, c)] = poly.terms() {
+            let single = Poly::from_terms(vec![(m.clone(), c.abs())]);
+            return (*c < 0.0, self.poly_tokens(&single));
+        }
+        (false, self.expr(poly))
+    }
+
     /// The expression of a polynomial; repeated multi-term polynomials are
     /// hoisted into a shared local.
     fn expr(&mut self, poly: &Poly) -> TokenStream {
         let single = poly.terms().len() <= 1;
         let body = self.poly_tokens(poly);
         if single {
-            return quote!((#body));
+            return body;
         }
         let key = poly.to_text(&|s| self.model.symbol_name(s));
         if let Some((id, _, uses)) = self.shared.get_mut(&key) {
@@ -448,13 +469,13 @@ impl<'a> Body<'a> {
         for s in symbols {
             match s {
                 Symbol::Var(i) => {
-                    let id = symbol_ident(s);
-                    let i = usize::from(i);
+                    let id = symbol_ident_in(self.model, s);
+                    let i = lit(usize::from(i));
                     out.extend(quote!(let #id = q[#i];));
                 }
                 Symbol::Param(i) => {
-                    let id = symbol_ident(s);
-                    let i = usize::from(i);
+                    let id = symbol_ident_in(self.model, s);
+                    let i = lit(usize::from(i));
                     out.extend(quote!(let #id = p[#i];));
                 }
                 Symbol::Cos(i) | Symbol::Sin(i) => {
@@ -462,7 +483,10 @@ impl<'a> Body<'a> {
                         continue;
                     }
                     done_rotary.push(i);
-                    let (sn, cs) = (symbol_ident(Symbol::Sin(i)), symbol_ident(Symbol::Cos(i)));
+                    let (sn, cs) = (
+                        symbol_ident_in(self.model, Symbol::Sin(i)),
+                        symbol_ident_in(self.model, Symbol::Cos(i)),
+                    );
                     let k = usize::from(i);
                     let is_rotary = self
                         .model
@@ -470,6 +494,7 @@ impl<'a> Body<'a> {
                         .get(k)
                         .is_some_and(|v| v.1 == JointKind::Rotary);
                     if is_rotary {
+                        let k = lit(k);
                         out.extend(quote!(let (#sn, #cs) = q[#k].sin_cos();));
                     }
                 }
@@ -487,11 +512,40 @@ impl<'a> Body<'a> {
     }
 }
 
-fn symbol_ident(s: Symbol) -> Ident {
+/// An unsuffixed integer literal (`3`, not `3usize`).
+fn lit(i: usize) -> Literal {
+    Literal::usize_unsuffixed(i)
+}
+
+/// The local of a symbol in generated code, named after the user's names:
+/// `v_x`, `p_L`, `cos_A`, `sin_A`.
+fn symbol_ident_in(model: &SymbolicModel, s: Symbol) -> Ident {
+    let var = |i: u16| {
+        sanitize(
+            model
+                .variables
+                .get(usize::from(i))
+                .map_or("_", |v| v.0.as_str()),
+        )
+    };
     match s {
-        Symbol::Var(i) => format_ident!("q{}", i),
-        Symbol::Param(i) => format_ident!("p{}", i),
-        Symbol::Cos(i) => format_ident!("c{}", i),
-        Symbol::Sin(i) => format_ident!("s{}", i),
+        Symbol::Var(i) => format_ident!("v_{}", var(i)),
+        Symbol::Param(i) => format_ident!(
+            "p_{}",
+            sanitize(
+                model
+                    .parameters
+                    .get(usize::from(i))
+                    .map_or("_", |p| p.0.as_str())
+            )
+        ),
+        Symbol::Cos(i) => format_ident!("cos_{}", var(i)),
+        Symbol::Sin(i) => format_ident!("sin_{}", var(i)),
     }
+}
+
+fn sanitize(name: &str) -> String {
+    name.chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' })
+        .collect()
 }

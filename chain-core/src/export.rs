@@ -81,7 +81,7 @@ pub fn to_json(model: &SymbolicModel) -> DeriveJson {
 
 /// `coefficient · name` as a readable term of a sum, with its sign split off:
 /// `(negative, "z*eyx")`.
-fn term(coefficient: &str, name: &str) -> (bool, String) {
+pub(crate) fn term(coefficient: &str, name: &str) -> (bool, String) {
     let (negative, body) = match coefficient.strip_prefix('-') {
         Some(rest) if !rest.contains(" + ") && !rest.contains(" - ") => (true, rest),
         _ => (false, coefficient),
@@ -97,7 +97,7 @@ fn term(coefficient: &str, name: &str) -> (bool, String) {
 }
 
 /// Joins signed terms into `a - b + c`.
-fn join_terms(terms: &[(bool, String)], separator: (&str, &str)) -> String {
+pub(crate) fn join_terms(terms: &[(bool, String)], separator: (&str, &str)) -> String {
     if terms.is_empty() {
         return "0".to_string();
     }

@@ -272,6 +272,8 @@ struct Builder<'t> {
     text: &'t str,
     base: usize,
     char_bytes: Option<Vec<usize>>,
+    /// Byte offset of the start of each line.
+    line_starts: Vec<usize>,
     frames: Vec<Frame>,
     anchors: HashMap<usize, Anchored>,
     nodes: usize,
@@ -287,10 +289,14 @@ impl<'t> Builder<'t> {
         } else {
             Some(text.char_indices().map(|(i, _)| i).collect())
         };
+        let line_starts = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
         Builder {
             text,
             base,
             char_bytes,
+            line_starts,
             frames: Vec::new(),
             anchors: HashMap::new(),
             nodes: 0,
@@ -316,12 +322,24 @@ impl<'t> Builder<'t> {
         }
     }
 
+    /// The span (length 0) of a marker. Line and column are computed from
+    /// the byte offset (the scanner's own line is one too far at the end of
+    /// a file without a final newline).
     fn span(&self, m: &Marker) -> Span {
+        let byte = self.byte(m);
+        let line = self.line_starts.partition_point(|&s| s <= byte).max(1);
+        let start = self.line_starts.get(line - 1).copied().unwrap_or(0);
+        let column = match &self.char_bytes {
+            None => byte - start.min(byte),
+            Some(t) => {
+                t.partition_point(|&b| b < byte) - t.partition_point(|&b| b < start)
+            }
+        } + 1;
         Span {
-            offset: self.base + self.byte(m),
+            offset: self.base + byte,
             len: 0,
-            line: m.line().max(1),
-            column: m.col() + 1,
+            line,
+            column,
         }
     }
 

@@ -40,7 +40,13 @@ impl From<Select> for SelectionRule {
     }
 }
 
-/// Arguments of `chain compensate`.
+/// Identify a swing-angle error from tool-tip heights measured at commanded
+/// angles and derive its compensation law (seed 003).
+///
+/// Δθ = acos(cos θ − ΔZ/L) − θ per point, least-squares polynomial fits of
+/// every order from --min-order to --max-order with R², the order selected by
+/// --select, the law θa = θt + Δθ(θt) and the residual predicted after
+/// compensation.
 #[derive(Debug, clap::Args)]
 pub struct CompensateArgs {
     /// Measurement CSV with header `theta_deg,z1,z3` (an optional `z2` column
@@ -118,16 +124,11 @@ pub fn exec(args: CompensateArgs) -> miette::Result<()> {
 
     let text = match args.format {
         Format::Json => {
-            let mut value = serde_json::to_value(&analysis).into_diagnostic()?;
-            if !files.is_empty() {
-                if let Some(object) = value.as_object_mut() {
-                    object.insert(
-                        "written".to_string(),
-                        files.iter().map(|p| p.display().to_string()).collect(),
-                    );
-                }
-            }
-            let mut s = serde_json::to_string_pretty(&value).into_diagnostic()?;
+            let document = JsonDocument {
+                analysis: &analysis,
+                written: files.iter().map(|p| p.display().to_string()).collect(),
+            };
+            let mut s = serde_json::to_string_pretty(&document).into_diagnostic()?;
             s.push('\n');
             s
         }
@@ -140,6 +141,16 @@ pub fn exec(args: CompensateArgs) -> miette::Result<()> {
         .write_all(text.as_bytes())
         .and_then(|()| stdout.flush());
     Ok(())
+}
+
+/// The `--format json` document: the analysis (spec fields first, in struct
+/// order) and the files written, if any.
+#[derive(serde::Serialize)]
+struct JsonDocument<'a> {
+    #[serde(flatten)]
+    analysis: &'a Analysis,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    written: Vec<String>,
 }
 
 /// The `--format table` report.
