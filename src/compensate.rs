@@ -573,7 +573,8 @@ pub fn swing_angle_error_from_delta_z_deg(
 pub struct PolyFit {
     /// Polynomial order `p`.
     pub order: usize,
-    /// Coefficient of determination `R² = 1 − RSS/TSS` (1 when `TSS = 0`).
+    /// Coefficient of determination `R² = 1 − RSS/TSS` (1 when `TSS = 0`;
+    /// sums of squares at the rounding-noise level of `y` count as 0).
     pub r2: f64,
     /// Coefficients `c_0 … c_p` in ascending powers of `x`.
     pub coefficients: Vec<f64>,
@@ -593,7 +594,7 @@ pub struct PolyFit {
     /// Bayesian information criterion (Gaussian errors, `k = p + 2`).
     pub bic: f64,
     /// p-value of the overall F-test of this fit against the constant model
-    /// (`None` for order 0).
+    /// (`None` for order 0 and for data without variance).
     pub f_test_p: Option<f64>,
     /// Number of points.
     pub n: usize,
@@ -677,9 +678,14 @@ pub fn fit_polynomial(x: &[f64], y: &[f64], order: usize) -> Result<PolyFit, Fit
         .ok_or(FitError::RankDeficient { order })?;
     let fitted = &q * &qty;
     let residual = &yv - &fitted;
-    let rss: f64 = residual.iter().map(|e| e * e).sum();
+    // Sums of squares at the level of rounding noise of y are zero: a fit of
+    // exact (or constant) data must not rank orders by noise.
+    let y_max = y.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let noise_floor = n as f64 * (1e3 * f64::EPSILON * y_max).powi(2);
+    let denoise = |ss: f64| if ss <= noise_floor { 0.0 } else { ss };
+    let rss = denoise(residual.iter().map(|e| e * e).sum());
     let mean = y.iter().sum::<f64>() / n as f64;
-    let tss: f64 = y.iter().map(|v| (v - mean) * (v - mean)).sum();
+    let tss = denoise(y.iter().map(|v| (v - mean) * (v - mean)).sum());
     let r2 = if tss > 0.0 { 1.0 - rss / tss } else { 1.0 };
     let nf = n as f64;
     let dof = (n - cols) as f64;
@@ -693,13 +699,16 @@ pub fn fit_polynomial(x: &[f64], y: &[f64], order: usize) -> Result<PolyFit, Fit
         }
         press += (residual[i] / denominator).powi(2);
     }
+    let press = if rss == 0.0 { 0.0 } else { press };
     let k = (order + 2) as f64;
     let log_likelihood_term = nf * (rss.max(f64::MIN_POSITIVE) / nf).ln();
     let aicc = (nf > k + 1.0)
         .then(|| log_likelihood_term + 2.0 * k + 2.0 * k * (k + 1.0) / (nf - k - 1.0));
     let bic = log_likelihood_term + k * nf.ln();
-    let f_test_p = (order > 0).then(|| {
-        if r2 >= 1.0 {
+    // The overall F-test needs variance to explain; an exact fit of varying
+    // data has p = 0.
+    let f_test_p = (order > 0 && tss > 0.0).then(|| {
+        if rss == 0.0 {
             0.0
         } else {
             let d1 = order as f64;

@@ -285,6 +285,24 @@ fn fit_rejects_what_it_cannot_fit() {
 }
 
 #[test]
+fn constant_data_fit_exactly_and_select_the_lowest_order() {
+    let x: Vec<f64> = (1..=10).map(f64::from).collect();
+    let y = vec![0.0674; 10];
+    let fits: Vec<_> = (0..=3)
+        .map(|p| fit_polynomial(&x, &y, p).unwrap())
+        .collect();
+    for f in &fits {
+        assert_eq!(f.r2, 1.0);
+        assert_eq!(f.press, 0.0);
+        assert!(f.f_test_p.is_none());
+        assert!((f.eval(5.5) - 0.0674).abs() < 1e-15);
+    }
+    for rule in SelectionRule::ALL {
+        assert_eq!(rule.select(&fits), Some(0), "{rule}");
+    }
+}
+
+#[test]
 fn f_test_p_values_match_scipy() {
     // scipy.stats.f.sf(1, 7, 7) = 0.5 (symmetry); f.sf(2.5, 3, 20) = 0.08884375193768917.
     assert!((f_survival(1.0, 7.0, 7.0) - 0.5).abs() < 1e-12);

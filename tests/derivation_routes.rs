@@ -21,7 +21,10 @@ fn example_machines() -> Vec<std::path::PathBuf> {
 #[test]
 fn dmm_route_equals_matrix_route_on_every_example() {
     let files = example_machines();
-    assert!(files.len() >= 3, "expected the three paper machines, got {files:?}");
+    assert!(
+        files.len() >= 3,
+        "expected the three paper machines, got {files:?}"
+    );
     for path in files {
         let machine = chain_core::load_file(&path).unwrap_or_else(|e| panic!("{e}"));
         for frame in [Frame::Tool, Frame::Workpiece] {
@@ -32,10 +35,23 @@ fn dmm_route_equals_matrix_route_on_every_example() {
                 let b = &dmm[c.index()];
                 let names = |v: &Vec<(usize, chain_core::algebra::Poly)>| {
                     v.iter()
-                        .map(|(j, p)| format!("{}: {}", machine.errors[*j].name, p.to_text(&|s| model.symbol_name(s))))
+                        .map(|(j, p)| {
+                            format!(
+                                "{}: {}",
+                                machine.errors[*j].name,
+                                p.to_text(&|s| model.symbol_name(s))
+                            )
+                        })
                         .collect::<Vec<_>>()
                 };
-                assert_eq!(names(a), names(b), "{} {:?} {}", path.display(), frame, c.name());
+                assert_eq!(
+                    names(a),
+                    names(b),
+                    "{} {:?} {}",
+                    path.display(),
+                    frame,
+                    c.name()
+                );
             }
             assert!(model.nonzero_count() > 0, "{}: empty model", path.display());
         }
@@ -51,7 +67,10 @@ fn spec_example_json_excerpt() {
     let model = chain_core::derive(&machine);
     let json = chain_core::export::to_json(&model);
     assert_eq!(json.frame, "tool");
-    assert_eq!(json.nominal.position, ["-x".to_string(), "y".into(), "z".into()]);
+    assert_eq!(
+        json.nominal.position,
+        ["-x".to_string(), "y".into(), "z".into()]
+    );
     let px = json.components["px"].as_object().expect("px is an object");
     assert_eq!(px["dxx"], "-1");
     assert_eq!(px["eyx"], "-z");

@@ -63,10 +63,20 @@ fn inline_and_file_forms_generate_identical_functions() {
     assert_eq!(GantryFile::VARIABLES, GantryInline::VARIABLES);
     let mut rng = Rng(7);
     for _ in 0..1000 {
-        let q = [rng.uniform(0.0, 1000.0), rng.uniform(600.0, 1400.0), rng.uniform(-1500.0, 1500.0)];
+        let q = [
+            rng.uniform(0.0, 1000.0),
+            rng.uniform(600.0, 1400.0),
+            rng.uniform(-1500.0, 1500.0),
+        ];
         let e: [f64; 21] = std::array::from_fn(|_| rng.uniform(-1e-3, 1e-3));
-        assert_eq!(GantryFile::sensitivity(&q, &[]), GantryInline::sensitivity(&q, &[]));
-        assert_eq!(GantryFile::error(&q, &[], &e), GantryInline::error(&q, &[], &e));
+        assert_eq!(
+            GantryFile::sensitivity(&q, &[]),
+            GantryInline::sensitivity(&q, &[])
+        );
+        assert_eq!(
+            GantryFile::error(&q, &[], &e),
+            GantryInline::error(&q, &[], &e)
+        );
     }
 }
 
@@ -87,10 +97,24 @@ fn eq18_corrected(x: f64, y: f64, z: f64, e: &dyn Fn(&str) -> f64) -> [f64; 6] {
 #[test]
 fn generated_gantry_equals_corrected_eq18_at_10000_points() {
     let mut rng = Rng(11);
-    let idx = |name: &str| GantryFile::ERRORS.iter().position(|n| *n == name).expect(name);
-    let var = |name: &str| GantryFile::VARIABLES.iter().position(|n| *n == name).expect(name);
+    let idx = |name: &str| {
+        GantryFile::ERRORS
+            .iter()
+            .position(|n| *n == name)
+            .expect(name)
+    };
+    let var = |name: &str| {
+        GantryFile::VARIABLES
+            .iter()
+            .position(|n| *n == name)
+            .expect(name)
+    };
     for _ in 0..10_000 {
-        let (x, y, z) = (rng.uniform(0.0, 1000.0), rng.uniform(-1500.0, 1500.0), rng.uniform(600.0, 1400.0));
+        let (x, y, z) = (
+            rng.uniform(0.0, 1000.0),
+            rng.uniform(-1500.0, 1500.0),
+            rng.uniform(600.0, 1400.0),
+        );
         let mut q = [0.0; 3];
         q[var("x")] = x;
         q[var("y")] = y;
@@ -99,7 +123,12 @@ fn generated_gantry_equals_corrected_eq18_at_10000_points() {
         let expected = eq18_corrected(x, y, z, &|n| e[idx(n)]);
         let got = GantryFile::error(&q, &[], &e);
         for c in 0..6 {
-            assert!(close(got[c], expected[c], 1e-12), "component {c}: {} vs {}", got[c], expected[c]);
+            assert!(
+                close(got[c], expected[c], 1e-12),
+                "component {c}: {} vs {}",
+                got[c],
+                expected[c]
+            );
         }
         // Sensitivity: the coefficient of each error is Eq. 18 at a unit error.
         let s = GantryFile::sensitivity(&q, &[]);
@@ -120,16 +149,27 @@ fn compare_with_runtime(generated: &dyn ErrorModel, file: &str, seed: u64) {
     assert_eq!(generated.variables(), runtime.variables());
     assert_eq!(generated.parameters(), runtime.parameters());
     let n = runtime.errors().len();
-    let p: Vec<f64> = machine.parameters.iter().map(|p| p.value.unwrap_or(50.0)).collect();
+    let p: Vec<f64> = machine
+        .parameters
+        .iter()
+        .map(|p| p.value.unwrap_or(50.0))
+        .collect();
     let mut rng = Rng(seed);
     let (mut a, mut b) = (vec![0.0; 6 * n], vec![0.0; 6 * n]);
     for _ in 0..2000 {
-        let q: Vec<f64> = (0..runtime.variables().len()).map(|_| rng.uniform(-3.0, 3.0) * 100.0).collect();
+        let q: Vec<f64> = (0..runtime.variables().len())
+            .map(|_| rng.uniform(-3.0, 3.0) * 100.0)
+            .collect();
         let e: Vec<f64> = (0..n).map(|_| rng.uniform(-1e-3, 1e-3)).collect();
         generated.sensitivity(&q, &p, &mut a);
         runtime.sensitivity(&q, &p, &mut b);
         for k in 0..6 * n {
-            assert!(close(a[k], b[k], 1e-12), "{file}: entry {k}: {} vs {}", a[k], b[k]);
+            assert!(
+                close(a[k], b[k], 1e-12),
+                "{file}: entry {k}: {} vs {}",
+                a[k],
+                b[k]
+            );
         }
         let (mut ea, mut eb) = ([0.0; 6], [0.0; 6]);
         generated.error(&q, &p, &e, &mut ea);
@@ -150,7 +190,11 @@ fn compare_with_runtime(generated: &dyn ErrorModel, file: &str, seed: u64) {
 #[test]
 fn generated_code_equals_runtime_evaluator_on_every_example() {
     compare_with_runtime(&GantryFile, "examples/machines/gantry_grinder.yaml", 1);
-    compare_with_runtime(&InternalGrinder, "examples/machines/internal_grinder.yaml", 2);
+    compare_with_runtime(
+        &InternalGrinder,
+        "examples/machines/internal_grinder.yaml",
+        2,
+    );
     compare_with_runtime(&Cnc5Bevel, "examples/machines/cnc5_bevel.yaml", 3);
 }
 

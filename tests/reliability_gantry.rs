@@ -59,15 +59,35 @@ const TABLE4: [[f64; 5]; 5] = [
 
 /// Index of the grid point (x, y, z) in the study (x slowest, as in the file).
 fn point(study: &Study, x: f64, y: f64, z: f64) -> usize {
+    let [ix, iy, iz] = xyz(study);
     study
         .points()
         .iter()
-        .position(|p| p[0] == x && p[1] == y && p[2] == z)
+        .position(|p| p[ix] == x && p[iy] == y && p[iz] == z)
         .expect("grid point")
 }
 
+/// Positions of x, y and z in the model's variable order (bodies in tree
+/// pre-order: x, z, y for this machine).
+fn xyz(study: &Study) -> [usize; 3] {
+    ["x", "y", "z"].map(|v| {
+        study
+            .variables()
+            .iter()
+            .position(|n| n == v)
+            .expect("variable")
+    })
+}
+
 /// Reliability (%) of component `c` at (x, y, z) from a study result.
-fn percent(study: &Study, r: &reliability::StudyResult, c: Component, x: f64, y: f64, z: f64) -> f64 {
+fn percent(
+    study: &Study,
+    r: &reliability::StudyResult,
+    c: Component,
+    x: f64,
+    y: f64,
+    z: f64,
+) -> f64 {
     let np = study.points().len();
     let t = study
         .targets()
@@ -91,7 +111,11 @@ fn form_reproduces_tables_2_to_4() {
                 let v = percent(&study, &r, Component::Px, x, b, a);
                 let d = (v - TABLE2[i][j]).abs();
                 // Table 2, within 0.25 percentage points.
-                assert!(d <= 0.25, "px at (y {b}, z {a}): {v:.3} vs Table 2 {}", TABLE2[i][j]);
+                assert!(
+                    d <= 0.25,
+                    "px at (y {b}, z {a}): {v:.3} vs Table 2 {}",
+                    TABLE2[i][j]
+                );
                 dx = dx.max(d);
             }
         }
@@ -102,7 +126,11 @@ fn form_reproduces_tables_2_to_4() {
                 let v = percent(&study, &r, Component::Py, a, y, b);
                 let d = (v - TABLE3[i][j]).abs();
                 // Table 3, within 0.45 percentage points.
-                assert!(d <= 0.45, "py at (x {a}, z {b}): {v:.3} vs Table 3 {}", TABLE3[i][j]);
+                assert!(
+                    d <= 0.45,
+                    "py at (x {a}, z {b}): {v:.3} vs Table 3 {}",
+                    TABLE3[i][j]
+                );
                 dy = dy.max(d);
             }
         }
@@ -121,7 +149,11 @@ fn form_reproduces_tables_2_to_4() {
                     continue;
                 }
                 // Table 4, within 0.25 percentage points.
-                assert!(d <= 0.25, "pz at (x {a}, y {b}): {v:.3} vs Table 4 {}", TABLE4[i][j]);
+                assert!(
+                    d <= 0.25,
+                    "pz at (x {a}, y {b}): {v:.3} vs Table 4 {}",
+                    TABLE4[i][j]
+                );
                 dz = dz.max(d);
             }
         }
@@ -135,16 +167,28 @@ fn summaries_match_the_text_of_section_3_3() {
     let r = study.form(&Form::default()).expect("form");
     // Section 3.3: "minimum ... 86.07 %, average ... 92.16 %" (x), 93.45/96.75
     // (y), 91.21/95.08 (z); each within 0.35 percentage points.
-    let paper = [("px", 86.07, 92.16), ("py", 93.45, 96.75), ("pz", 91.21, 95.08)];
+    let paper = [
+        ("px", 86.07, 92.16),
+        ("py", 93.45, 96.75),
+        ("pz", 91.21, 95.08),
+    ];
     for (name, min, mean) in paper {
-        let s = r.summaries.iter().find(|s| s.target == name).expect("summary");
+        let s = r
+            .summaries
+            .iter()
+            .find(|s| s.target == name)
+            .expect("summary");
         eprintln!(
             "{name}: min {:.3} (paper {min}), mean {:.3} (paper {mean})",
             100.0 * s.min,
             100.0 * s.mean
         );
         assert!((100.0 * s.min - min).abs() <= 0.35, "{name} min {}", s.min);
-        assert!((100.0 * s.mean - mean).abs() <= 0.35, "{name} mean {}", s.mean);
+        assert!(
+            (100.0 * s.mean - mean).abs() <= 0.35,
+            "{name} mean {}",
+            s.mean
+        );
         // "The minimum and mean values of reliability in all directions do
         // not meet the design requirements" (95 % / 97 %).
         assert_eq!(s.met, Some(false));
@@ -159,11 +203,34 @@ fn sigma_e(c: usize, x: f64, y: f64, z: f64) -> f64 {
     let sq = |t: f64| t / 3000.0;
     let terms: Vec<f64> = match c {
         // px = -δxx - z εyx + y εzx + δxz + δxy + y Sxy - y εzz
-        0 => vec![lin(0.05), z * ang(0.06), y * ang(0.05), lin(0.03), lin(0.04), y * sq(0.03), y * ang(0.03)],
+        0 => vec![
+            lin(0.05),
+            z * ang(0.06),
+            y * ang(0.05),
+            lin(0.03),
+            lin(0.04),
+            y * sq(0.03),
+            y * ang(0.03),
+        ],
         // py = -δyx + z εxx + x εzx + δyz + δyy + x Sxy
-        1 => vec![lin(0.05), z * ang(0.03), x * ang(0.05), lin(0.03), lin(0.05), x * sq(0.03)],
+        1 => vec![
+            lin(0.05),
+            z * ang(0.03),
+            x * ang(0.05),
+            lin(0.03),
+            lin(0.05),
+            x * sq(0.03),
+        ],
         // pz = -δzx - y εxx - x εyx + δzz + y εxz + δzy + y Syz
-        _ => vec![lin(0.05), y * ang(0.03), x * ang(0.06), lin(0.05), y * ang(0.03), lin(0.04), y * sq(0.02)],
+        _ => vec![
+            lin(0.05),
+            y * ang(0.03),
+            x * ang(0.06),
+            lin(0.05),
+            y * ang(0.03),
+            lin(0.04),
+            y * sq(0.02),
+        ],
     };
     terms.iter().map(|t| t * t).sum::<f64>().sqrt()
 }
@@ -183,11 +250,16 @@ fn form_equals_the_closed_form_and_is_has_zero_variance() {
         )
         .expect("is");
     let np = study.points().len();
+    let [ix, iy, iz] = xyz(&study);
     for (i, (f, s)) in form.cases.iter().zip(&is.cases).enumerate() {
         let p = &f.point;
         // Eq. 21/31 for Z = I − E with zero means: R = Φ(I/σ_E).
-        let exact = normal::cdf(0.03 / sigma_e(i / np, p[0], p[1], p[2]));
-        assert!((f.reliability - exact).abs() < 1e-9, "case {i}: {} vs {exact}", f.reliability);
+        let exact = normal::cdf(0.03 / sigma_e(i / np, p[ix], p[iy], p[iz]));
+        assert!(
+            (f.reliability - exact).abs() < 1e-9,
+            "case {i}: {} vs {exact}",
+            f.reliability
+        );
         // Eq. 23-28 on a linear limit state in normal inputs: every sample
         // gives h = β, so the estimate is FORM's with zero variance.
         assert!((s.reliability - f.reliability).abs() < 1e-9, "case {i}");
@@ -217,7 +289,14 @@ fn monte_carlo_agrees_within_four_standard_errors() {
         worst = worst.max(z);
         // Tables 2-4 by crude Monte Carlo: within 4 standard errors of FORM
         // (exact here).
-        assert!(z < 4.0, "{} at {:?}: mc {} form {} se {se}", f.target, f.point, m.pf, f.pf);
+        assert!(
+            z < 4.0,
+            "{} at {:?}: mc {} form {} se {se}",
+            f.target,
+            f.point,
+            m.pf,
+            f.pf
+        );
     }
     eprintln!("Monte Carlo vs FORM over 375 cases: worst {worst:.2} standard errors");
 }
@@ -231,7 +310,8 @@ fn nonlinear_limit_states_importance_sampling_vs_ten_million_monte_carlo() {
     let volumetric = study.event(Target::Volumetric, p).expect("event");
     let two_sided = Event::new(
         study.inputs(),
-        ToleranceLimitState::component(study.row(p, Component::Px).to_vec(), 0.03, Sided::Two).expect("ls"),
+        ToleranceLimitState::component(study.row(p, Component::Px).to_vec(), 0.03, Sided::Two)
+            .expect("ls"),
     )
     .expect("event");
     let mut rows = Vec::new();
@@ -257,7 +337,11 @@ fn nonlinear_limit_states_importance_sampling_vs_ten_million_monte_carlo() {
     }
     .run_cases(&events, &())
     .expect("is");
-    for ((name, m), s) in ["volumetric", "two-sided px", "series two-sided"].iter().zip(&mc).zip(&is) {
+    for ((name, m), s) in ["volumetric", "two-sided px", "series two-sided"]
+        .iter()
+        .zip(&mc)
+        .zip(&is)
+    {
         let form = s.form.as_ref().expect("form");
         let se = (m.std_error.powi(2) + s.std_error.powi(2)).sqrt();
         eprintln!(
@@ -266,10 +350,20 @@ fn nonlinear_limit_states_importance_sampling_vs_ten_million_monte_carlo() {
         );
         assert_eq!(m.samples, 10_000_000);
         // The importance sampling inside 3 standard errors of 10⁷ Monte Carlo.
-        assert!((s.pf - m.pf).abs() < 3.0 * se, "{name}: IS {} MC {} se {se}", s.pf, m.pf);
+        assert!(
+            (s.pf - m.pf).abs() < 3.0 * se,
+            "{name}: IS {} MC {} se {se}",
+            s.pf,
+            m.pf
+        );
         // FORM is not exact here: it misses the far side / the other components.
         assert!(!form.exact);
-        assert!((form.pf - m.pf).abs() > 10.0 * m.std_error, "{name}: FORM {} MC {}", form.pf, m.pf);
+        assert!(
+            (form.pf - m.pf).abs() > 10.0 * m.std_error,
+            "{name}: FORM {} MC {}",
+            form.pf,
+            m.pf
+        );
     }
     // Two-sided px is still linear: IS along α is exact, 2·Φ(−β) at zero mean.
     let exact = events[1].exact_pf().expect("closed form");
@@ -300,7 +394,8 @@ fn non_normal_inputs_use_the_root_finder() {
     let inputs = Inputs::new(base.names().to_vec(), marginals).expect("inputs");
     let event = Event::new(
         &inputs,
-        ToleranceLimitState::component(study.row(p, Component::Px).to_vec(), 0.03, Sided::Upper).expect("ls"),
+        ToleranceLimitState::component(study.row(p, Component::Px).to_vec(), 0.03, Sided::Upper)
+            .expect("ls"),
     )
     .expect("event");
     let form = Form::default().run(&event).expect("form");
@@ -319,14 +414,24 @@ fn non_normal_inputs_use_the_root_finder() {
     .run(&event)
     .expect("mc");
     let se = (is.std_error.powi(2) + mc.std_error.powi(2)).sqrt();
-    eprintln!("uniform angular errors, px at the corner: FORM {:.5} IS {:.5} ± {:.1e} MC {:.5} ± {:.1e}", form.pf, is.pf, is.std_error, mc.pf, mc.std_error);
-    assert!((is.pf - mc.pf).abs() < 4.0 * se, "IS {} MC {} se {se}", is.pf, mc.pf);
+    eprintln!(
+        "uniform angular errors, px at the corner: FORM {:.5} IS {:.5} ± {:.1e} MC {:.5} ± {:.1e}",
+        form.pf, is.pf, is.std_error, mc.pf, mc.std_error
+    );
+    assert!(
+        (is.pf - mc.pf).abs() < 4.0 * se,
+        "IS {} MC {} se {se}",
+        is.pf,
+        mc.pf
+    );
 }
 
 #[test]
 fn sensitive_sets_of_figures_6_to_8() {
     let (_, _, study) = study(None);
-    let sens = study.sensitivity_mean(&Form::default()).expect("sensitivity");
+    let sens = study
+        .sensitivity_mean(&Form::default())
+        .expect("sensitivity");
     // Figures 6-8 (Section 3.3): the errors whose variance the reliability is
     // sensitive to.
     let paper: [(&str, &[&str]); 3] = [
@@ -363,7 +468,11 @@ fn analytic_sensitivities_equal_central_differences() {
     let (_, _, study) = study(None);
     let form = Form::default();
     let reliability_of = |inputs: &Inputs, row: &[f64], sided: Sided| -> f64 {
-        let e = Event::new(inputs, ToleranceLimitState::component(row.to_vec(), 0.03, sided).unwrap()).unwrap();
+        let e = Event::new(
+            inputs,
+            ToleranceLimitState::component(row.to_vec(), 0.03, sided).unwrap(),
+        )
+        .unwrap();
         1.0 - e.exact_pf().unwrap()
     };
     let mut checked = 0;
@@ -381,22 +490,35 @@ fn analytic_sensitivities_equal_central_differences() {
             .and_then(|i| i.with_moments(4, 2e-6, i.stds()[4]))
             .expect("inputs");
         for sided in [Sided::Upper, Sided::Two] {
-            let e = Event::new(&base, ToleranceLimitState::component(row.clone(), 0.03, sided).unwrap()).unwrap();
+            let e = Event::new(
+                &base,
+                ToleranceLimitState::component(row.clone(), 0.03, sided).unwrap(),
+            )
+            .unwrap();
             let s = sensitivity(&e, &form.run(&e).unwrap()).unwrap();
             assert_eq!(s.method, SensitivityMethod::Exact);
-            let scale = s.inputs.iter().map(|v| v.dr_dstd.abs().max(v.dr_dmean.abs())).fold(0.0, f64::max);
+            let scale = s
+                .inputs
+                .iter()
+                .map(|v| v.dr_dstd.abs().max(v.dr_dmean.abs()))
+                .fold(0.0, f64::max);
             for j in 0..base.len() {
                 let (mu, sd) = (base.means()[j], base.stds()[j]);
                 let h = 1e-4 * sd;
-                let fd_std = (reliability_of(&base.with_moments(j, mu, sd + h).unwrap(), &row, sided)
-                    - reliability_of(&base.with_moments(j, mu, sd - h).unwrap(), &row, sided))
-                    / (2.0 * h);
-                let fd_mean = (reliability_of(&base.with_moments(j, mu + h, sd).unwrap(), &row, sided)
-                    - reliability_of(&base.with_moments(j, mu - h, sd).unwrap(), &row, sided))
-                    / (2.0 * h);
+                let fd_std =
+                    (reliability_of(&base.with_moments(j, mu, sd + h).unwrap(), &row, sided)
+                        - reliability_of(&base.with_moments(j, mu, sd - h).unwrap(), &row, sided))
+                        / (2.0 * h);
+                let fd_mean =
+                    (reliability_of(&base.with_moments(j, mu + h, sd).unwrap(), &row, sided)
+                        - reliability_of(&base.with_moments(j, mu - h, sd).unwrap(), &row, sided))
+                        / (2.0 * h);
                 // Eq. 32-33 against central differences of R: 1e-6 relative
                 // (absolute 1e-9 of the largest derivative for those that vanish).
-                for (a, fd) in [(s.inputs[j].dr_dstd, fd_std), (s.inputs[j].dr_dmean, fd_mean)] {
+                for (a, fd) in [
+                    (s.inputs[j].dr_dstd, fd_std),
+                    (s.inputs[j].dr_dmean, fd_mean),
+                ] {
                     assert!(
                         (a - fd).abs() <= 1e-6 * fd.abs() + 1e-9 * scale,
                         "{c:?} {sided:?} input {j}: analytic {a} vs fd {fd}"
@@ -418,7 +540,15 @@ fn results_are_reproducible_whatever_the_thread_count() {
             .build()
             .expect("pool")
             .install(|| {
-                let mc = study.monte_carlo(&MonteCarlo { samples: 3_000, seed: 3 }, &()).expect("mc");
+                let mc = study
+                    .monte_carlo(
+                        &MonteCarlo {
+                            samples: 3_000,
+                            seed: 3,
+                        },
+                        &(),
+                    )
+                    .expect("mc");
                 let is = study
                     .importance_sampling(
                         &ImportanceSampling {

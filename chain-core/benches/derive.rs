@@ -15,7 +15,11 @@ fn machine_text(name: &str) -> String {
 }
 
 fn derive_from_text(c: &mut Criterion) {
-    for name in ["gantry_grinder.yaml", "cnc5_bevel.yaml", "internal_grinder.yaml"] {
+    for name in [
+        "gantry_grinder.yaml",
+        "cnc5_bevel.yaml",
+        "internal_grinder.yaml",
+    ] {
         let text = machine_text(name);
         c.bench_function(&format!("yaml_to_model/{name}"), |b| {
             b.iter(|| {
@@ -56,7 +60,9 @@ fn evaluator(c: &mut Criterion) {
         .map(|p| p.value.unwrap_or(100.0))
         .collect();
     let model = chain_core::compile(&machine);
-    let q: Vec<f64> = (0..model.variables().len()).map(|i| 0.3 + i as f64).collect();
+    let q: Vec<f64> = (0..model.variables().len())
+        .map(|i| 0.3 + i as f64)
+        .collect();
     let mut out = vec![0.0; 6 * model.errors().len()];
     c.bench_function("compiled/cnc5_bevel_sensitivity", |b| {
         b.iter(|| {

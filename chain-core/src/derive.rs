@@ -106,13 +106,15 @@ pub fn derive_in(machine: &Machine, frame: Frame) -> SymbolicModel {
         std::array::from_fn(|i| Dual::nominal(expr_to_poly(&machine.tool_point[i])));
     let position = t_wt.apply(&tool_point);
 
-    let r0: [[Poly; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| t_wt.r[i][j].value.clone()));
+    let r0: [[Poly; 3]; 3] =
+        std::array::from_fn(|i| std::array::from_fn(|j| t_wt.r[i][j].value.clone()));
     let n = machine.errors.len();
     let mut components: [Vec<(usize, Poly)>; 6] = Default::default();
     for j in 0..n {
         let p: [Poly; 3] = std::array::from_fn(|i| position[i].slope(j));
         // R_wt(q,e) R_wt(q,0)^T = I + [o x]: o = vee(R_j R0^T).
-        let rj: [[Poly; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|b| t_wt.r[a][b].slope(j)));
+        let rj: [[Poly; 3]; 3] =
+            std::array::from_fn(|a| std::array::from_fn(|b| t_wt.r[a][b].slope(j)));
         let m = |a: usize, b: usize| -> Poly {
             let mut s = Poly::zero();
             for k in 0..3 {
@@ -188,7 +190,7 @@ pub(crate) fn branches(machine: &Machine) -> (Vec<usize>, Vec<usize>) {
 /// small-error transform.
 pub(crate) enum Factor {
     /// A nominal (error-free) transform.
-    Nominal(Transform),
+    Nominal(Box<Transform>),
     /// A small-error transform `E(d, e)` with its error slots.
     Error(ErrorSlots),
 }
@@ -198,12 +200,12 @@ pub(crate) fn body_factors(machine: &Machine, b: usize) -> Vec<Factor> {
     let body = &machine.bodies[b];
     let mut f = Vec::new();
     if !body.offset.iter().all(|e| e.is_zero()) {
-        f.push(Factor::Nominal(Transform::translation(std::array::from_fn(|i| {
-            Dual::nominal(expr_to_poly(&body.offset[i]))
-        }))));
+        f.push(Factor::Nominal(Box::new(Transform::translation(
+            std::array::from_fn(|i| Dual::nominal(expr_to_poly(&body.offset[i]))),
+        ))));
     }
     for rot in &body.rotation {
-        f.push(Factor::Nominal(fixed_rotation(rot)));
+        f.push(Factor::Nominal(Box::new(fixed_rotation(rot))));
     }
     if !body.location_errors.is_empty() {
         f.push(Factor::Error(body.location_errors.clone()));
@@ -224,7 +226,7 @@ pub(crate) fn body_factors(machine: &Machine, b: usize) -> Vec<Factor> {
                 Dual::nominal(Poly::symbol(Symbol::Sin(v)).scale(sign)),
             ),
         };
-        f.push(Factor::Nominal(t));
+        f.push(Factor::Nominal(Box::new(t)));
     }
     if !body.errors.is_empty() {
         f.push(Factor::Error(body.errors.clone()));

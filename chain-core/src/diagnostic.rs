@@ -61,7 +61,8 @@ pub enum Problem {
         /// The nesting limit.
         limit: usize,
     },
-    /// Aliases expand to more nodes than the loader accepts (an alias bomb).
+    /// The file expands to more nodes than the loader accepts; alias uses
+    /// count their whole anchor, so an alias bomb stops here.
     AliasLimit {
         /// The node limit.
         limit: usize,
@@ -322,7 +323,7 @@ impl Problem {
             Problem::MultipleDocuments => "more than one YAML document in the file".into(),
             Problem::TooDeep { limit } => format!("nested more than {limit} levels deep"),
             Problem::AliasLimit { limit } => {
-                format!("YAML aliases expand to more than {limit} nodes")
+                format!("the file expands to more than {limit} YAML nodes")
             }
             Problem::RecursiveAlias => "an alias refers to a collection that contains it".into(),
             Problem::NonScalarKey => "a mapping key must be a plain name".into(),
@@ -355,9 +356,9 @@ impl Problem {
             Problem::WorkpieceIsTool { name } => {
                 format!("the workpiece and the tool are the same body `{name}`")
             }
-            Problem::DuplicateVariable { name, body } => format!(
-                "variable `{name}` already drives the joint of body `{body}`"
-            ),
+            Problem::DuplicateVariable { name, body } => {
+                format!("variable `{name}` already drives the joint of body `{body}`")
+            }
             Problem::NameCollision { name, what, other } => {
                 format!("{what} `{name}` has the same name as a {other}")
             }
@@ -446,9 +447,13 @@ impl Problem {
             Problem::ParameterInDivisor { .. } | Problem::NegativePowerOfParameter { .. } => {
                 Some("the derivation needs polynomials in the parameters".into())
             }
-            Problem::AliasLimit { .. } => Some("an alias bomb?".into()),
+            Problem::AliasLimit { .. } => {
+                Some("each use of an alias counts its whole anchor; an alias bomb?".into())
+            }
             Problem::MultipleDocuments => Some("a machine file holds exactly one".into()),
-            Problem::Empty => Some("expected a mapping with at least `machine` and `bodies`".into()),
+            Problem::Empty => {
+                Some("expected a mapping with at least `machine` and `bodies`".into())
+            }
             _ => None,
         }
     }
@@ -456,9 +461,6 @@ impl Problem {
     /// A longer hint for the reader, if one helps.
     pub fn help(&self) -> Option<String> {
         match self {
-            Problem::UnknownKey { expected, .. } => {
-                Some(format!("valid keys here: {}", expected.join(", ")))
-            }
             Problem::SecondRoot { second, .. } => Some(format!(
                 "give `{second}` a `parent`; exactly one body (the bed) has none"
             )),
@@ -617,9 +619,7 @@ where
             best = Some((d, cand));
         }
         let shortest = name.chars().count().min(cand.chars().count());
-        if prefixed.is_none()
-            && shortest >= 3
-            && (lower.starts_with(&cl) || cl.starts_with(&lower))
+        if prefixed.is_none() && shortest >= 3 && (lower.starts_with(&cl) || cl.starts_with(&lower))
         {
             prefixed = Some(cand);
         }
@@ -934,7 +934,10 @@ impl miette::Diagnostic for Diagnostics {
             return None;
         }
         Some(Box::new(
-            self.inner.related.iter().map(|r| r as &dyn miette::Diagnostic),
+            self.inner
+                .related
+                .iter()
+                .map(|r| r as &dyn miette::Diagnostic),
         ))
     }
 }

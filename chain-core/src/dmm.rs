@@ -24,7 +24,7 @@ use crate::model::{ErrorSlots, Frame, Machine};
 pub fn derive_dmm(machine: &Machine, frame: Frame) -> [Vec<(usize, Poly)>; 6] {
     // Flatten T_wt into signed factors.
     enum Signed {
-        Nominal(Transform),
+        Nominal(Box<Transform>),
         Error(ErrorSlots, f64),
     }
     let (wp_path, tool_path) = branches(machine);
@@ -32,7 +32,7 @@ pub fn derive_dmm(machine: &Machine, frame: Frame) -> [Vec<(usize, Poly)>; 6] {
     for &b in wp_path.iter().rev() {
         for f in body_factors(machine, b).into_iter().rev() {
             factors.push(match f {
-                Factor::Nominal(t) => Signed::Nominal(t.inverse()),
+                Factor::Nominal(t) => Signed::Nominal(Box::new(t.inverse())),
                 Factor::Error(s) => Signed::Error(s, -1.0),
             });
         }
@@ -53,7 +53,8 @@ pub fn derive_dmm(machine: &Machine, frame: Frame) -> [Vec<(usize, Poly)>; 6] {
         match f {
             Signed::Nominal(t) => after = t.mul(&after),
             Signed::Error(slots, sign) => {
-                let local: [Dual; 6] = std::array::from_fn(|i| Dual::errors(&slots.slots[i], *sign));
+                let local: [Dual; 6] =
+                    std::array::from_fn(|i| Dual::errors(&slots.slots[i], *sign));
                 let dj = differential_motion_matrix(&after);
                 for (i, row) in dj.iter().enumerate() {
                     for (k, entry) in row.iter().enumerate() {
@@ -65,11 +66,14 @@ pub fn derive_dmm(machine: &Machine, frame: Frame) -> [Vec<(usize, Poly)>; 6] {
             }
         }
     }
-    let total = factors.iter().fold(Transform::identity(), |acc, f| match f {
-        Signed::Nominal(t) => acc.mul(t),
-        Signed::Error(..) => acc,
-    });
-    let r0: [[Poly; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| total.r[i][j].value.clone()));
+    let total = factors
+        .iter()
+        .fold(Transform::identity(), |acc, f| match f {
+            Signed::Nominal(t) => acc.mul(t),
+            Signed::Error(..) => acc,
+        });
+    let r0: [[Poly; 3]; 3] =
+        std::array::from_fn(|i| std::array::from_fn(|j| total.r[i][j].value.clone()));
     let tp: [Poly; 3] = std::array::from_fn(|i| expr_to_poly(&machine.tool_point[i]));
 
     let mut components: [Vec<(usize, Poly)>; 6] = Default::default();
@@ -98,7 +102,8 @@ pub fn derive_dmm(machine: &Machine, frame: Frame) -> [Vec<(usize, Poly)>; 6] {
 
 /// `DJ[T]` of seed 000 Eq. 3 for a nominal transform `T = [R P; 0 1]`.
 pub fn differential_motion_matrix(t: &Transform) -> [[Poly; 6]; 6] {
-    let r: [[Poly; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| t.r[i][j].value.clone()));
+    let r: [[Poly; 3]; 3] =
+        std::array::from_fn(|i| std::array::from_fn(|j| t.r[i][j].value.clone()));
     let p: [Poly; 3] = std::array::from_fn(|i| t.t[i].value.clone());
     let mut dj: [[Poly; 6]; 6] = Default::default();
     // Columns n, o, a of R; row i of the upper blocks uses column i.
@@ -110,11 +115,9 @@ pub fn differential_motion_matrix(t: &Transform) -> [[Poly; 6]; 6] {
             p[2].mul(&col[0]).sub(&p[0].mul(&col[2])),
             p[0].mul(&col[1]).sub(&p[1].mul(&col[0])),
         ];
-        for k in 0..3 {
-            dj[i][k] = col[k].clone();
-            dj[i][k + 3] = pc[k].clone();
-            dj[i + 3][k + 3] = col[k].clone();
-        }
+        dj[i][..3].clone_from_slice(&col);
+        dj[i][3..].clone_from_slice(&pc);
+        dj[i + 3][3..].clone_from_slice(&col);
     }
     dj
 }

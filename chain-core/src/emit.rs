@@ -157,11 +157,7 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
             quote!([#(#cells),*])
         })
         .collect();
-    let pos: Vec<TokenStream> = model
-        .nominal_position
-        .iter()
-        .map(|x| nom.expr(x))
-        .collect();
+    let pos: Vec<TokenStream> = model.nominal_position.iter().map(|x| nom.expr(x)).collect();
     let nom_prelude = nom.prelude();
 
     let text = |poly: &Poly| poly.to_text(&|s| model.symbol_name(s));
@@ -394,7 +390,8 @@ impl<'a> Body<'a> {
         let a = self.monomial(&Monomial(parent));
         let b = self.symbol(sym);
         let id = format_ident!("m{}", self.monomials.len());
-        self.monomials.push((m.clone(), id.clone(), quote!(#a * #b)));
+        self.monomials
+            .push((m.clone(), id.clone(), quote!(#a * #b)));
         self.monomial_index.insert(m.clone(), id.clone());
         quote!(#id)
     }
@@ -546,6 +543,12 @@ fn symbol_ident_in(model: &SymbolicModel, s: Symbol) -> Ident {
 
 fn sanitize(name: &str) -> String {
     name.chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect()
 }

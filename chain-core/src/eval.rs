@@ -46,8 +46,11 @@ pub fn compile(machine: &Machine) -> CompiledModel {
 impl CompiledModel {
     /// Flattens a symbolic model.
     pub fn new(model: &SymbolicModel) -> CompiledModel {
-        let mut builder = TapeBuilder::default();
-        builder.registers = 1; // register 0 holds 1.0
+        // Register 0 holds 1.0.
+        let mut builder = TapeBuilder {
+            registers: 1,
+            ..TapeBuilder::default()
+        };
         for (i, (_, kind)) in model.variables.iter().enumerate() {
             let i = crate::algebra::index_u16(i);
             match kind {

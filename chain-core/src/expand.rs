@@ -73,7 +73,11 @@ pub fn expand(input: TokenStream) -> TokenStream {
     let stub = quote!(#vis struct #name;);
     let (machine, tracking) = match &parsed.source {
         Source::File(lit) => {
-            let dir = std::env::var("CARGO_MANIFEST_DIR").unwrap_or_else(|_| ".".into());
+            // `CHAIN_MACRO_MANIFEST_DIR` overrides the base directory (compile-fail
+            // tests run the macro from a generated crate elsewhere).
+            let dir = std::env::var("CHAIN_MACRO_MANIFEST_DIR")
+                .or_else(|_| std::env::var("CARGO_MANIFEST_DIR"))
+                .unwrap_or_else(|_| ".".into());
             let path = std::path::Path::new(&dir).join(lit.value());
             let bytes = match std::fs::read(&path) {
                 Ok(b) => b,
@@ -97,7 +101,12 @@ pub fn expand(input: TokenStream) -> TokenStream {
                 }
             };
             let abs = path.to_string_lossy().into_owned();
-            (machine, quote!(const _: &[u8] = include_bytes!(#abs);))
+            (
+                machine,
+                quote!(
+                    const _: &[u8] = include_bytes!(#abs);
+                ),
+            )
         }
         Source::Inline(group) => {
             let mut conv = Converter::default();

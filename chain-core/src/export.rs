@@ -167,7 +167,11 @@ pub fn to_text(model: &SymbolicModel) -> String {
             .iter()
             .map(|(j, poly)| term(&text(poly), &model.errors[*j]))
             .collect();
-        out.push_str(&format!("{} = {}\n", c.name(), join_terms(&terms, (" + ", " - "))));
+        out.push_str(&format!(
+            "{} = {}\n",
+            c.name(),
+            join_terms(&terms, (" + ", " - "))
+        ));
     }
     out
 }

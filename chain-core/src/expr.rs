@@ -98,7 +98,10 @@ fn lex(text: &str) -> Result<Vec<(Tok, usize)>, ExprError> {
     let mut i = 0;
     while let Some(&b) = bytes.get(i) {
         if toks.len() > MAX_TOKENS {
-            return Err(err(i, format!("expression too long (more than {MAX_TOKENS} tokens)")));
+            return Err(err(
+                i,
+                format!("expression too long (more than {MAX_TOKENS} tokens)"),
+            ));
         }
         let start = i;
         match b {
@@ -152,7 +155,10 @@ fn lex(text: &str) -> Result<Vec<(Tok, usize)>, ExprError> {
                 toks.push((Tok::Name(text.get(start..i).unwrap_or("").into()), start));
             }
             _ => {
-                let c = text.get(start..).and_then(|r| r.chars().next()).unwrap_or('?');
+                let c = text
+                    .get(start..)
+                    .and_then(|r| r.chars().next())
+                    .unwrap_or('?');
                 return Err(err(start, format!("unexpected character `{c}`")));
             }
         }
@@ -238,7 +244,11 @@ impl P {
             self.enter()?;
             let inner = self.unary()?;
             self.depth -= 1;
-            return Ok(if neg { Ast::Neg(Box::new(inner)) } else { inner });
+            return Ok(if neg {
+                Ast::Neg(Box::new(inner))
+            } else {
+                inner
+            });
         }
         self.power()
     }
@@ -266,7 +276,10 @@ impl P {
                 }
             }
             Tok::Num(_, true) => {
-                return Err(err(off, format!("exponent too large (at most {MAX_EXPONENT})")))
+                return Err(err(
+                    off,
+                    format!("exponent too large (at most {MAX_EXPONENT})"),
+                ))
             }
             _ => {
                 return Err(err(
@@ -292,7 +305,10 @@ impl P {
             Tok::Name(name) => {
                 self.bump();
                 if self.is_op('(') {
-                    return Err(err(off, format!("functions such as `{name}(…)` are not supported")));
+                    return Err(err(
+                        off,
+                        format!("functions such as `{name}(…)` are not supported"),
+                    ));
                 }
                 Ok(Ast::Name { name, offset: off })
             }
@@ -334,7 +350,10 @@ pub fn parse(text: &str) -> Result<Ast, ExprError> {
     match t {
         Tok::End => Ok(ast),
         Tok::Op(')') => Err(err(o, "unmatched `)`")),
-        t => Err(err(o, format!("expected an operator, found {}", describe(t)))),
+        t => Err(err(
+            o,
+            format!("expected an operator, found {}", describe(t)),
+        )),
     }
 }
 
@@ -506,7 +525,10 @@ mod tests {
         assert!(matches!(errs[0].1, Problem::ParameterInDivisor { .. }));
         let ast = parse("L^-2").unwrap();
         let errs = resolve(&ast, |_| Ok(Some(0))).unwrap_err();
-        assert!(matches!(errs[0].1, Problem::NegativePowerOfParameter { .. }));
+        assert!(matches!(
+            errs[0].1,
+            Problem::NegativePowerOfParameter { .. }
+        ));
     }
 
     #[test]

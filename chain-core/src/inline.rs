@@ -95,13 +95,17 @@ impl Converter {
                 Some(other) => {
                     return Err(SyntaxError {
                         span: other.span(),
-                        message: format!("expected `:` or `{{` after key `{key_text}`, found `{other}`"),
+                        message: format!(
+                            "expected `:` or `{{` after key `{key_text}`, found `{other}`"
+                        ),
                     })
                 }
                 None => {
                     return Err(SyntaxError {
                         span: key_token.span(),
-                        message: format!("key `{key_text}` has no value: write `{key_text}: value`"),
+                        message: format!(
+                            "key `{key_text}` has no value: write `{key_text}: value`"
+                        ),
                     })
                 }
             };
@@ -114,7 +118,9 @@ impl Converter {
                 Some(other) => {
                     return Err(SyntaxError {
                         span: other.span(),
-                        message: format!("expected `,` after the value of `{key_text}`, found `{other}`"),
+                        message: format!(
+                            "expected `,` after the value of `{key_text}`, found `{other}`"
+                        ),
                     })
                 }
             }

@@ -76,7 +76,12 @@ impl SignedAxis {
 
 impl std::fmt::Display for SignedAxis {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}{}", if self.negative { "-" } else { "+" }, self.axis.name())
+        write!(
+            f,
+            "{}{}",
+            if self.negative { "-" } else { "+" },
+            self.axis.name()
+        )
     }
 }
 

@@ -331,9 +331,7 @@ impl<'t> Builder<'t> {
         let start = self.line_starts.get(line - 1).copied().unwrap_or(0);
         let column = match &self.char_bytes {
             None => byte - start.min(byte),
-            Some(t) => {
-                t.partition_point(|&b| b < byte) - t.partition_point(|&b| b < start)
-            }
+            Some(t) => t.partition_point(|&b| b < byte) - t.partition_point(|&b| b < start),
         } + 1;
         Span {
             offset: self.base + byte,
@@ -614,7 +612,10 @@ fn measure(node: &Node) -> (usize, usize) {
         }),
         NodeKind::Mapping(entries) => entries.iter().fold((1, 1), |(n, h), (k, v)| {
             let (vn, vh) = measure(v);
-            (n.saturating_add(vn).saturating_add(measure(k).0), h.max(vh + 1))
+            (
+                n.saturating_add(vn).saturating_add(measure(k).0),
+                h.max(vh + 1),
+            )
         }),
     }
 }
@@ -668,7 +669,10 @@ mod tests {
         assert_eq!(p.errors.len(), 1);
         let (span, _, problem) = &p.errors[0];
         assert_eq!(span.line, 3);
-        assert!(matches!(problem, Problem::DuplicateKey { first_line: 1, .. }));
+        assert!(matches!(
+            problem,
+            Problem::DuplicateKey { first_line: 1, .. }
+        ));
         let r = p.root.unwrap();
         assert_eq!(r.as_mapping().unwrap()[0].1.as_str(), Some("1"));
     }

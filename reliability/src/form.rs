@@ -143,7 +143,10 @@ impl Form {
         let affine = event.affine();
         let mut branches = Vec::with_capacity(nb);
         for b in 0..nb {
-            let branch = match (&affine, event.limit_state.structure().map(|s| s.criterion())) {
+            let branch = match (
+                &affine,
+                event.limit_state.structure().map(|s| s.criterion()),
+            ) {
                 (Some(a), Some(Criterion::Each(sided))) => {
                     let (c, sign) = match sided {
                         Sided::Upper => (b, 1.0),
@@ -156,10 +159,13 @@ impl Form {
             branches.push(branch);
         }
         // The nearest branch (smallest β; ties keep the first).
-        let best = branches
-            .iter()
-            .enumerate()
-            .fold(0, |best, (i, br)| if br.beta < branches[best].beta { i } else { best });
+        let best = branches.iter().enumerate().fold(0, |best, (i, br)| {
+            if br.beta < branches[best].beta {
+                i
+            } else {
+                best
+            }
+        });
         let Branch {
             beta,
             u,
@@ -366,12 +372,16 @@ impl Work {
     }
 
     /// `g_b(T(u))` and `∇_u g_b = ∇_x g_b ∘ dx/du` (into `grad_u`).
-    fn eval<L: LimitState>(&mut self, event: &Event<'_, L>, b: usize, u: &[f64], calls: &mut Calls) -> f64 {
+    fn eval<L: LimitState>(
+        &mut self,
+        event: &Event<'_, L>,
+        b: usize,
+        u: &[f64],
+        calls: &mut Calls,
+    ) -> f64 {
         event.inputs.to_physical(u, &mut self.x);
         event.inputs.jacobian(u, &mut self.jac);
-        let g = event
-            .limit_state
-            .branch(b, &self.x, Some(&mut self.grad_x));
+        let g = event.limit_state.branch(b, &self.x, Some(&mut self.grad_x));
         calls.values += 1;
         calls.gradients += 1;
         for ((gu, gx), j) in self.grad_u.iter_mut().zip(&self.grad_x).zip(&self.jac) {
@@ -380,7 +390,6 @@ impl Work {
         g
     }
 }
-
 
 #[cfg(test)]
 mod tests {
@@ -391,7 +400,9 @@ mod tests {
     fn inputs(stds: &[f64]) -> Inputs {
         Inputs::new(
             (0..stds.len()).map(|i| format!("e{i}")).collect(),
-            stds.iter().map(|&s| Marginal::normal(0.0, s).unwrap()).collect(),
+            stds.iter()
+                .map(|&s| Marginal::normal(0.0, s).unwrap())
+                .collect(),
         )
         .unwrap()
     }
@@ -409,9 +420,14 @@ mod tests {
             }
         }
         let inp = inputs(&[0.01, 0.02, 1e-5]);
-        let ls = ToleranceLimitState::component(vec![-1.0, 1.0, 1200.0], 0.03, Sided::Upper).unwrap();
-        let exact = Form::default().run(&Event::new(&inp, ls.clone()).unwrap()).unwrap();
-        let it = Form::default().run(&Event::new(&inp, Linear(ls)).unwrap()).unwrap();
+        let ls =
+            ToleranceLimitState::component(vec![-1.0, 1.0, 1200.0], 0.03, Sided::Upper).unwrap();
+        let exact = Form::default()
+            .run(&Event::new(&inp, ls.clone()).unwrap())
+            .unwrap();
+        let it = Form::default()
+            .run(&Event::new(&inp, Linear(ls)).unwrap())
+            .unwrap();
         assert_eq!(exact.termination, Termination::ClosedForm);
         assert_eq!(it.termination, Termination::Converged);
         assert!((exact.beta - it.beta).abs() < 1e-12);
@@ -425,7 +441,8 @@ mod tests {
     fn volumetric_design_point_is_the_top_singular_direction() {
         // E = (u0, 2·u1) with σ = 1: ‖E‖ ≤ 3 first fails along u1 at β = 1.5.
         let inp = inputs(&[1.0, 1.0]);
-        let ls = ToleranceLimitState::new(2, vec![1.0, 0.0, 0.0, 2.0], vec![3.0], Criterion::Norm).unwrap();
+        let ls = ToleranceLimitState::new(2, vec![1.0, 0.0, 0.0, 2.0], vec![3.0], Criterion::Norm)
+            .unwrap();
         let r = Form::default().run(&Event::new(&inp, ls).unwrap()).unwrap();
         assert!((r.beta - 1.5).abs() < 1e-9, "{r:?}");
         assert!(r.alpha[1].abs() > 0.999_999);
@@ -436,7 +453,10 @@ mod tests {
     fn uniform_inputs_converge() {
         let inp = Inputs::new(
             vec!["a".into(), "b".into()],
-            vec![Marginal::uniform(-1.0, 1.0).unwrap(), Marginal::normal(0.0, 0.5).unwrap()],
+            vec![
+                Marginal::uniform(-1.0, 1.0).unwrap(),
+                Marginal::normal(0.0, 0.5).unwrap(),
+            ],
         )
         .unwrap();
         let ls = ToleranceLimitState::component(vec![1.0, 1.0], 1.5, Sided::Two).unwrap();

@@ -231,11 +231,14 @@ impl Inputs {
     /// A copy with input `j`'s mean and standard deviation replaced.
     pub fn with_moments(&self, j: usize, mean: f64, std: f64) -> Result<Inputs, ReliabilityError> {
         let mut out = self.clone();
-        let m = out.marginals.get_mut(j).ok_or(ReliabilityError::Dimension {
-            what: "input index",
-            expected: self.len(),
-            found: j,
-        })?;
+        let m = out
+            .marginals
+            .get_mut(j)
+            .ok_or(ReliabilityError::Dimension {
+                what: "input index",
+                expected: self.len(),
+                found: j,
+            })?;
         *m = m.with_moments(mean, std)?;
         Ok(out)
     }

@@ -42,14 +42,20 @@ pub fn inputs(machine: &Machine) -> Result<Inputs, ReliabilityError> {
 /// The parameter values: the file's, overridden by `overrides` (name, value).
 /// A symbolic parameter without an override is a
 /// [`ReliabilityError::SymbolicParameter`].
-pub fn parameters(machine: &Machine, overrides: &[(String, f64)]) -> Result<Vec<f64>, ReliabilityError> {
+pub fn parameters(
+    machine: &Machine,
+    overrides: &[(String, f64)],
+) -> Result<Vec<f64>, ReliabilityError> {
     for (name, _) in overrides {
         if machine.parameter_index(name).is_none() {
             return Err(ReliabilityError::UnknownName {
                 kind: "parameter",
                 name: name.clone(),
-                hint: chain_core::diagnostic::closest(name, machine.parameters.iter().map(|p| p.name.as_str()))
-                    .map(str::to_string),
+                hint: chain_core::diagnostic::closest(
+                    name,
+                    machine.parameters.iter().map(|p| p.name.as_str()),
+                )
+                .map(str::to_string),
             });
         }
     }
@@ -81,15 +87,13 @@ pub fn spec(machine: &Machine, system: Option<System>) -> Result<StudySpec, Reli
         .grid
         .iter()
         .map(|(v, values)| {
-            let name = machine
-                .variables
-                .get(*v)
-                .map(|x| x.name.clone())
-                .ok_or(ReliabilityError::Dimension {
+            let name = machine.variables.get(*v).map(|x| x.name.clone()).ok_or(
+                ReliabilityError::Dimension {
                     what: "grid variable index",
                     expected: machine.variables.len(),
                     found: *v,
-                })?;
+                },
+            )?;
             Ok((name, values.clone()))
         })
         .collect::<Result<Vec<_>, ReliabilityError>>()?;

@@ -149,7 +149,11 @@ pub fn sensitivity<L: LimitState>(
             .branch(form.branch, &form.design_point_x, Some(&mut grad));
     }
     let phi = if usable { normal::pdf(beta) } else { 0.0 };
-    let scale = if usable { phi / form.gradient_norm } else { 0.0 };
+    let scale = if usable {
+        phi / form.gradient_norm
+    } else {
+        0.0
+    };
     let inputs = event
         .inputs
         .marginals()

@@ -119,7 +119,10 @@ impl MonteCarlo {
     /// let r = MonteCarlo { samples: 100_000, seed: 1 }.run(&Event::new(&inputs, g).unwrap()).unwrap();
     /// assert!((r.pf - 0.158_655).abs() < 4.0 * r.std_error);
     /// ```
-    pub fn run<L: LimitState>(&self, event: &Event<'_, L>) -> Result<SimulationResult, ReliabilityError> {
+    pub fn run<L: LimitState>(
+        &self,
+        event: &Event<'_, L>,
+    ) -> Result<SimulationResult, ReliabilityError> {
         let mut out = self.run_cases(std::slice::from_ref(event), &())?;
         Ok(out.remove(0))
     }
@@ -134,24 +137,30 @@ impl MonteCarlo {
             return Err(ReliabilityError::NoSamples);
         }
         let width = events.iter().map(|e| e.inputs.len()).max().unwrap_or(0);
-        let sums = drive(events.len(), self.samples, width, progress, |case, block, count, x| {
-            let event = &events[case];
-            let x = &mut x[..event.inputs.len()];
-            let mut rng = CaseRng::new(self.seed, case_id(case), block);
-            let mut fails = 0u64;
-            for _ in 0..count {
-                event.inputs.sample(&mut rng, x);
-                if event.limit_state.value(x) <= 0.0 {
-                    fails += 1;
+        let sums = drive(
+            events.len(),
+            self.samples,
+            width,
+            progress,
+            |case, block, count, x| {
+                let event = &events[case];
+                let x = &mut x[..event.inputs.len()];
+                let mut rng = CaseRng::new(self.seed, case_id(case), block);
+                let mut fails = 0u64;
+                for _ in 0..count {
+                    event.inputs.sample(&mut rng, x);
+                    if event.limit_state.value(x) <= 0.0 {
+                        fails += 1;
+                    }
                 }
-            }
-            let f = fails as f64;
-            Sums {
-                s1: f,
-                s2: f,
-                calls: count,
-            }
-        });
+                let f = fails as f64;
+                Sums {
+                    s1: f,
+                    s2: f,
+                    calls: count,
+                }
+            },
+        );
         Ok(sums
             .into_iter()
             .map(|s| {
@@ -162,7 +171,14 @@ impl MonteCarlo {
                 } else {
                     0.0
                 };
-                finish("monte_carlo", pf, (var / n).sqrt(), self.samples, s.calls, None)
+                finish(
+                    "monte_carlo",
+                    pf,
+                    (var / n).sqrt(),
+                    self.samples,
+                    s.calls,
+                    None,
+                )
             })
             .collect())
     }
@@ -170,7 +186,10 @@ impl MonteCarlo {
 
 impl ImportanceSampling {
     /// Runs one event (on stream case 0).
-    pub fn run<L: LimitState>(&self, event: &Event<'_, L>) -> Result<SimulationResult, ReliabilityError> {
+    pub fn run<L: LimitState>(
+        &self,
+        event: &Event<'_, L>,
+    ) -> Result<SimulationResult, ReliabilityError> {
         let mut out = self.run_cases(std::slice::from_ref(event), &())?;
         Ok(out.remove(0))
     }
@@ -211,10 +230,16 @@ impl ImportanceSampling {
             .map(|(e, f)| Kernel::new(e, f))
             .collect();
         let width = kernels.iter().map(Kernel::scratch).max().unwrap_or(0);
-        let sums = drive(events.len(), self.samples, width, progress, |case, block, count, scratch| {
-            let mut rng = CaseRng::new(self.seed, case_id(case), block);
-            kernels[case].block(&events[case], &mut rng, count, scratch)
-        });
+        let sums = drive(
+            events.len(),
+            self.samples,
+            width,
+            progress,
+            |case, block, count, scratch| {
+                let mut rng = CaseRng::new(self.seed, case_id(case), block);
+                kernels[case].block(&events[case], &mut rng, count, scratch)
+            },
+        );
         Ok(sums
             .into_iter()
             .zip(kernels)
@@ -303,8 +328,8 @@ where
 
 /// What one case of the importance sampling needs, prepared once.
 struct Kernel {
-    /// The FORM estimate: samples accumulate `v − shift` (exact zero variance
-    /// stays zero).
+    /// The conditional `p_f` of the central line: samples accumulate
+    /// `v − shift`, so an exact zero variance stays zero.
     shift: f64,
     kind: KernelKind,
 }
@@ -338,8 +363,10 @@ impl Kernel {
         let n = event.inputs.len();
         let ls = &event.limit_state;
         let active: Vec<usize> = (0..n).filter(|&j| ls.depends_on(j)).collect();
-        let shift = form.pf;
-        if form.termination == Termination::Degenerate || active.is_empty() || !form.beta.is_finite() {
+        if form.termination == Termination::Degenerate
+            || active.is_empty()
+            || !form.beta.is_finite()
+        {
             // No usable direction: g does not depend on the inputs (or the
             // design point is at infinity), so p_f is 0 or 1.
             let u = vec![0.0; n];
@@ -375,12 +402,35 @@ impl Kernel {
                 d[c] = dot(&alpha, &a);
             }
             if dim == 0 {
-                let p = line_pf_affine(&aff.mean, &[], &d, &[], lsx.tolerances(), lsx.criterion(), 0, k);
+                let p = line_pf_affine(
+                    &aff.mean,
+                    &[],
+                    &d,
+                    &[],
+                    lsx.tolerances(),
+                    lsx.criterion(),
+                    0,
+                    k,
+                );
                 return Kernel {
                     shift: p,
                     kind: KernelKind::Constant(p),
                 };
             }
+            // Centre the sums on the conditional p_f of the central line
+            // (p̃ = 0): exact for a linear limit state, so its zero variance
+            // is not spoilt by rounding.
+            let zeros = vec![0.0; dim];
+            let shift = line_pf_affine(
+                &aff.mean,
+                &w,
+                &d,
+                &zeros,
+                lsx.tolerances(),
+                lsx.criterion(),
+                dim,
+                k,
+            );
             return Kernel {
                 shift,
                 kind: KernelKind::Affine {
@@ -394,6 +444,19 @@ impl Kernel {
                 },
             };
         }
+        // Centre on the central line's conditional p_f, as above.
+        let shift = {
+            let mut u = vec![0.0; n];
+            let mut x = vec![0.0; n];
+            let mut line = |t: f64| {
+                for (i, &j) in active.iter().enumerate() {
+                    u[j] = t * alpha[i];
+                }
+                event.inputs.to_physical(&u, &mut x);
+                ls.value(&x)
+            };
+            line_pf_scan(&mut line, form.beta)
+        };
         Kernel {
             shift,
             kind: KernelKind::General {
@@ -416,7 +479,13 @@ impl Kernel {
         }
     }
 
-    fn block<L: LimitState>(&self, event: &Event<'_, L>, rng: &mut CaseRng, count: u64, scratch: &mut [f64]) -> Sums {
+    fn block<L: LimitState>(
+        &self,
+        event: &Event<'_, L>,
+        rng: &mut CaseRng,
+        count: u64,
+        scratch: &mut [f64],
+    ) -> Sums {
         let mut s1 = 0.0;
         let mut s2 = 0.0;
         let mut calls = 0u64;
@@ -504,7 +573,13 @@ fn line_pf_affine(
 ) -> f64 {
     let mut lo = f64::NEG_INFINITY;
     let mut hi = f64::INFINITY;
-    let offset = |c: usize| m[c] + if dim > 0 { dot(&w[c * dim..(c + 1) * dim], z) } else { 0.0 };
+    let offset = |c: usize| {
+        m[c] + if dim > 0 {
+            dot(&w[c * dim..(c + 1) * dim], z)
+        } else {
+            0.0
+        }
+    };
     match criterion {
         Criterion::Each(sided) => {
             for c in 0..k {
@@ -548,7 +623,11 @@ fn line_pf_affine(
             let r = disc.sqrt();
             // Stable roots: q = −(B + sign(B)·r), t = q/A and C/q.
             let q = -(b2 + if b2 >= 0.0 { r } else { -r });
-            let (t1, t2) = if q != 0.0 { (q / a2, c2 / q) } else { (0.0, 0.0) };
+            let (t1, t2) = if q != 0.0 {
+                (q / a2, c2 / q)
+            } else {
+                (0.0, 0.0)
+            };
             lo = t1.min(t2);
             hi = t1.max(t2);
         }
@@ -556,8 +635,16 @@ fn line_pf_affine(
     if lo >= hi {
         return 1.0;
     }
-    let left = if lo == f64::NEG_INFINITY { 0.0 } else { normal::cdf(lo) };
-    let right = if hi == f64::INFINITY { 0.0 } else { normal::sf(hi) };
+    let left = if lo == f64::NEG_INFINITY {
+        0.0
+    } else {
+        normal::cdf(lo)
+    };
+    let right = if hi == f64::INFINITY {
+        0.0
+    } else {
+        normal::sf(hi)
+    };
     left + right
 }
 
@@ -598,7 +685,13 @@ fn line_pf_scan(f: &mut impl FnMut(f64) -> f64, beta: f64) -> f64 {
 
 /// A root of `f` in `[a, b]` with `f(a)·f(b) < 0`: regula falsi with the
 /// Illinois modification (the bracket is kept, so it cannot escape).
-fn illinois(f: &mut impl FnMut(f64) -> f64, mut a: f64, mut fa: f64, mut b: f64, mut fb: f64) -> f64 {
+fn illinois(
+    f: &mut impl FnMut(f64) -> f64,
+    mut a: f64,
+    mut fa: f64,
+    mut b: f64,
+    mut fb: f64,
+) -> f64 {
     let mut side = 0;
     for _ in 0..100 {
         let c = (a * fb - b * fa) / (fb - fa);
@@ -678,7 +771,10 @@ mod tests {
     fn uniform_inputs_agree_with_monte_carlo() {
         let inputs = Inputs::new(
             vec!["a".into(), "b".into()],
-            vec![Marginal::uniform(-1.0, 1.0).unwrap(), Marginal::normal(0.0, 0.5).unwrap()],
+            vec![
+                Marginal::uniform(-1.0, 1.0).unwrap(),
+                Marginal::normal(0.0, 0.5).unwrap(),
+            ],
         )
         .unwrap();
         let ls = ToleranceLimitState::component(vec![1.0, 1.0], 1.4, Sided::Two).unwrap();
@@ -705,10 +801,14 @@ mod tests {
     fn thread_count_does_not_change_results() {
         let inputs = Inputs::new(
             vec!["a".into(), "b".into()],
-            vec![Marginal::normal(0.0, 1.0).unwrap(), Marginal::normal(0.0, 1.0).unwrap()],
+            vec![
+                Marginal::normal(0.0, 1.0).unwrap(),
+                Marginal::normal(0.0, 1.0).unwrap(),
+            ],
         )
         .unwrap();
-        let ls = ToleranceLimitState::new(2, vec![1.0, 0.2, -0.3, 1.0], vec![2.5], Criterion::Norm).unwrap();
+        let ls = ToleranceLimitState::new(2, vec![1.0, 0.2, -0.3, 1.0], vec![2.5], Criterion::Norm)
+            .unwrap();
         let event = Event::new(&inputs, ls).unwrap();
         let run = |threads| {
             rayon::ThreadPoolBuilder::new()

@@ -242,7 +242,9 @@ impl Study {
                 }
             })?;
             if values.is_empty() {
-                return Err(ReliabilityError::EmptyGrid(format!("axis `{name}` has no value")));
+                return Err(ReliabilityError::EmptyGrid(format!(
+                    "axis `{name}` has no value"
+                )));
             }
             if values.iter().any(|x| !x.is_finite()) {
                 return Err(ReliabilityError::NonFinite("the grid"));
@@ -354,24 +356,29 @@ impl Study {
     }
 
     /// The limit state of `target` at point `p`.
-    pub fn limit_state(&self, target: Target, p: usize) -> Result<ToleranceLimitState, ReliabilityError> {
+    pub fn limit_state(
+        &self,
+        target: Target,
+        p: usize,
+    ) -> Result<ToleranceLimitState, ReliabilityError> {
         let n = self.inputs.len();
         let tol = &self.spec.tolerances;
         match target {
             Target::Component(c) => {
-                let i = tol
-                    .iter()
-                    .find(|(x, _)| *x == c)
-                    .map(|(_, t)| *t)
-                    .ok_or(ReliabilityError::UnknownName {
+                let i = tol.iter().find(|(x, _)| *x == c).map(|(_, t)| *t).ok_or(
+                    ReliabilityError::UnknownName {
                         kind: "component",
                         name: c.name().into(),
                         hint: None,
-                    })?;
+                    },
+                )?;
                 ToleranceLimitState::component(self.row(p, c).to_vec(), i, self.spec.sided)
             }
             Target::Series => {
-                let rows = tol.iter().flat_map(|(c, _)| self.row(p, *c).to_vec()).collect();
+                let rows = tol
+                    .iter()
+                    .flat_map(|(c, _)| self.row(p, *c).to_vec())
+                    .collect();
                 let t = tol.iter().map(|(_, t)| *t).collect();
                 ToleranceLimitState::new(n, rows, t, Criterion::Each(self.spec.sided))
             }
@@ -431,13 +438,21 @@ impl Study {
     }
 
     /// Crude Monte Carlo on every case.
-    pub fn monte_carlo(&self, mc: &MonteCarlo, progress: &dyn Progress) -> Result<StudyResult, ReliabilityError> {
+    pub fn monte_carlo(
+        &self,
+        mc: &MonteCarlo,
+        progress: &dyn Progress,
+    ) -> Result<StudyResult, ReliabilityError> {
         let events = self.events()?;
         let results = mc.run_cases(&events, progress)?;
         Ok(self.finish("mc", self.sampled(&results)))
     }
 
-    fn run_form(&self, events: &[Event<'_>], form: &Form) -> Result<Vec<FormResult>, ReliabilityError> {
+    fn run_form(
+        &self,
+        events: &[Event<'_>],
+        form: &Form,
+    ) -> Result<Vec<FormResult>, ReliabilityError> {
         if events.len() < 64 {
             events.iter().map(|e| form.run(e)).collect()
         } else {
@@ -480,7 +495,10 @@ impl Study {
             .iter()
             .enumerate()
             .map(|(t, target)| {
-                let rs: Vec<f64> = cases[t * np..(t + 1) * np].iter().map(|c| c.reliability).collect();
+                let rs: Vec<f64> = cases[t * np..(t + 1) * np]
+                    .iter()
+                    .map(|c| c.reliability)
+                    .collect();
                 let mean = rs.iter().sum::<f64>() / rs.len().max(1) as f64;
                 let min = rs.iter().copied().fold(f64::INFINITY, f64::min);
                 let max = rs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
@@ -489,7 +507,10 @@ impl Study {
                     mean,
                     min,
                     max,
-                    met: self.spec.requirement.map(|r| min >= r.min && mean >= r.mean),
+                    met: self
+                        .spec
+                        .requirement
+                        .map(|r| min >= r.min && mean >= r.mean),
                 }
             })
             .collect();
@@ -520,7 +541,10 @@ impl Study {
 
     /// The sensitivities of every target, averaged over the grid (the
     /// paper's Figures 6-8), each list sorted by `|∂R/∂σ|`, largest first.
-    pub fn sensitivity_mean(&self, form: &Form) -> Result<Vec<TargetSensitivity>, ReliabilityError> {
+    pub fn sensitivity_mean(
+        &self,
+        form: &Form,
+    ) -> Result<Vec<TargetSensitivity>, ReliabilityError> {
         let per_point: Vec<Vec<(Target, SensitivityResult)>> = (0..self.points.len())
             .into_par_iter()
             .map(|p| self.sensitivity_at(p, form))

@@ -1,13 +1,741 @@
-//! `chain reliability`.
+//! `chain reliability FILE [--method form|is|mc] [--samples N] [--seed S]
+//! [--format table|json|csv] [--plot DIR]`.
+//!
+//! Machining-accuracy reliability of every listed component (and optionally
+//! a series or volumetric system) over the file's grid, like Tables 2-4 of
+//! seed 000. The helpers shared with `chain sensitivity` (loading, building
+//! the study, rendering errors against the file) live here too.
+
+#[path = "reliability_plot.rs"]
+mod reliability_plot;
+
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+
+use chain_core::model::{Machine, Origin, Sided};
+use miette::{LabeledSpan, MietteDiagnostic, NamedSource, Report};
+use reliability::{
+    machine, Form, ImportanceSampling, MonteCarlo, ReliabilityError, Study, StudyResult, System,
+};
+use serde_json::{json, Map, Value};
+
+/// Algorithms of `--method`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    /// FORM / improved first-order second-moment (Eq. 19-22, 31).
+    Form,
+    /// The advanced importance sampling (Eq. 23-28), centred by FORM.
+    Is,
+    /// Crude Monte Carlo.
+    Mc,
+}
+
+/// Output formats of `chain reliability`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ReliabilityFormat {
+    /// Maps like the paper's Tables 2-4 and a summary.
+    Table,
+    /// The spec's JSON document.
+    Json,
+    /// One row per (target, point).
+    Csv,
+}
+
+/// `--sided` override.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SidedArg {
+    /// `g = I − E`.
+    Upper,
+    /// `|E| ≤ I`.
+    Two,
+}
+
+/// `--system`: an extra system target.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SystemArg {
+    /// All listed components within tolerance at once.
+    Series,
+    /// `√(px² + py² + pz²) ≤ I` (`--system-tolerance`, default the smallest
+    /// position tolerance).
+    Volumetric,
+}
 
 /// Arguments of `chain reliability`.
 #[derive(Debug, clap::Args)]
 pub struct ReliabilityArgs {
-    /// Machine file (YAML).
-    pub file: std::path::PathBuf,
+    /// Machine file (YAML) with `statistics` and `reliability` sections.
+    pub file: PathBuf,
+    /// Algorithm.
+    #[arg(long, value_enum, default_value = "form")]
+    pub method: MethodArg,
+    /// Samples per case (is: 10000, mc: 100000 by default).
+    #[arg(long)]
+    pub samples: Option<u64>,
+    /// Seed of the random streams (results do not depend on the thread count).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "table")]
+    pub format: ReliabilityFormat,
+    /// Write heat maps and sensitivity bar charts (PNG and SVG) into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+    /// Value of a parameter, `NAME=VALUE` (repeatable; required for symbolic ones).
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_assignment)]
+    pub params: Vec<(String, f64)>,
+    /// Replace the grid values of one axis, `VAR=v1,v2,...` (repeatable).
+    #[arg(long = "grid", value_name = "VAR=V1,V2,...", value_parser = parse_axis)]
+    pub grid: Vec<(String, Vec<f64>)>,
+    /// Override the file's `sided`.
+    #[arg(long, value_enum)]
+    pub sided: Option<SidedArg>,
+    /// Also assess a system limit state.
+    #[arg(long, value_enum)]
+    pub system: Option<SystemArg>,
+    /// Allowable volumetric error for `--system volumetric`.
+    #[arg(long, value_name = "I")]
+    pub system_tolerance: Option<f64>,
 }
 
 /// Runs `chain reliability`.
-pub fn exec(_args: ReliabilityArgs) -> miette::Result<()> {
-    Err(miette::miette!("reliability: under construction"))
+pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
+    let loaded = Loaded::new(&args.file)?;
+    let system = system_of(&loaded.machine, args.system, args.system_tolerance)
+        .map_err(|e| loaded.report(e))?;
+    let (study, _model) = loaded.study(&args.params, &args.grid, args.sided, system)?;
+    let result = match args.method {
+        MethodArg::Form => study.form(&Form::default()),
+        MethodArg::Is => {
+            let samples = args.samples.unwrap_or(10_000);
+            let bar = ProgressBar::new(samples, study_cases(&study), args.format);
+            let r = study.importance_sampling(
+                &ImportanceSampling {
+                    samples,
+                    seed: args.seed,
+                    form: Form::default(),
+                },
+                &|n| bar.inc(n),
+            );
+            bar.finish();
+            r
+        }
+        MethodArg::Mc => {
+            let samples = args.samples.unwrap_or(100_000);
+            let bar = ProgressBar::new(samples, study_cases(&study), args.format);
+            let r = study.monte_carlo(
+                &MonteCarlo {
+                    samples,
+                    seed: args.seed,
+                },
+                &|n| bar.inc(n),
+            );
+            bar.finish();
+            r
+        }
+    }
+    .map_err(|e| loaded.report(e))?;
+    if args.method == MethodArg::Form {
+        note_form_limits(&study);
+    }
+    if let Some(dir) = &args.plot {
+        let sens = study
+            .sensitivity_mean(&Form::default())
+            .map_err(|e| loaded.report(e))?;
+        let files = reliability_plot::write_all(dir, &loaded.machine.name, &study, &result, &sens)?;
+        for f in files {
+            eprintln!("wrote {}", f.display());
+        }
+    }
+    let text = match args.format {
+        ReliabilityFormat::Json => {
+            let mut s = serde_json::to_string_pretty(&to_json(&loaded.machine, &study, &result))
+                .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
+            s.push('\n');
+            s
+        }
+        ReliabilityFormat::Csv => to_csv(&study, &result)?,
+        ReliabilityFormat::Table => to_table(&loaded.machine, &study, &result),
+    };
+    write_stdout(&text)
+}
+
+/// Writes to stdout; a closed pipe (`| head`) is not an error.
+pub(crate) fn write_stdout(text: &str) -> miette::Result<()> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(miette::miette!("cannot write the output: {e}")),
+    }
+}
+
+fn study_cases(study: &Study) -> u64 {
+    (study.targets().len() * study.points().len()) as u64
+}
+
+/// FORM is exact only for one-sided components in normal inputs; say so on
+/// stderr when it is not.
+fn note_form_limits(study: &Study) {
+    let spec = study.spec();
+    let non_normal = !study.inputs().is_affine();
+    let two = spec.sided == Sided::Two;
+    let system = spec.system.is_some();
+    if non_normal || two || system {
+        let why = [
+            (two, "two-sided tolerances (the far side is not counted)"),
+            (system, "a system limit state"),
+            (non_normal, "non-normal inputs"),
+        ]
+        .iter()
+        .filter(|(on, _)| *on)
+        .map(|(_, w)| *w)
+        .collect::<Vec<_>>()
+        .join(", ");
+        eprintln!(
+            "note: FORM is a first-order approximation here ({why}); `--method is` corrects it"
+        );
+    }
+}
+
+/// A progress bar on stderr, only when stderr is a terminal and the output is
+/// not JSON.
+struct ProgressBar(Option<indicatif::ProgressBar>);
+
+impl ProgressBar {
+    fn new(samples: u64, cases: u64, format: ReliabilityFormat) -> ProgressBar {
+        if format == ReliabilityFormat::Json || !std::io::stderr().is_terminal() {
+            return ProgressBar(None);
+        }
+        let bar = indicatif::ProgressBar::with_draw_target(
+            Some(samples.saturating_mul(cases)),
+            indicatif::ProgressDrawTarget::stderr(),
+        );
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{spinner} sampling [{bar:40}] {percent:>3}% {human_pos}/{human_len} samples, eta {eta}",
+        ) {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        ProgressBar(Some(bar))
+    }
+
+    fn inc(&self, n: u64) {
+        if let Some(b) = &self.0 {
+            b.inc(n);
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(b) = &self.0 {
+            b.finish_and_clear();
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Shared with `chain sensitivity`.
+
+/// A loaded machine with its source text (for diagnostics).
+pub(crate) struct Loaded {
+    pub(crate) machine: Machine,
+    file: String,
+    source: String,
+}
+
+impl Loaded {
+    /// Loads and validates a machine file.
+    pub(crate) fn new(path: &Path) -> miette::Result<Loaded> {
+        let machine = chain_core::load_file(path)?;
+        let source = std::fs::read_to_string(path).unwrap_or_default();
+        let file = machine
+            .file
+            .clone()
+            .unwrap_or_else(|| path.display().to_string());
+        Ok(Loaded {
+            machine,
+            file,
+            source,
+        })
+    }
+
+    /// The study of the machine's reliability section, with command-line
+    /// parameter values, grid axes and `sided`.
+    pub(crate) fn study(
+        &self,
+        params: &[(String, f64)],
+        grid: &[(String, Vec<f64>)],
+        sided: Option<SidedArg>,
+        system: Option<System>,
+    ) -> miette::Result<(Study, chain_core::CompiledModel)> {
+        let m = &self.machine;
+        let mut spec = machine::spec(m, system).map_err(|e| self.report(e))?;
+        if let Some(s) = sided {
+            spec.sided = match s {
+                SidedArg::Upper => Sided::Upper,
+                SidedArg::Two => Sided::Two,
+            };
+        }
+        for (name, values) in grid {
+            if m.variable_index(name).is_none() {
+                return Err(self.report(ReliabilityError::UnknownName {
+                    kind: "axis variable",
+                    name: name.clone(),
+                    hint: chain_core::diagnostic::closest(
+                        name,
+                        m.variables.iter().map(|v| v.name.as_str()),
+                    )
+                    .map(str::to_string),
+                }));
+            }
+            match spec.grid.axes.iter_mut().find(|(n, _)| n == name) {
+                Some(axis) => axis.1 = values.clone(),
+                None => spec.grid.axes.push((name.clone(), values.clone())),
+            }
+        }
+        let inputs = machine::inputs(m).map_err(|e| self.report(e))?;
+        let values = machine::parameters(m, params).map_err(|e| self.report(e))?;
+        let model = chain_core::compile(m);
+        let study = Study::new(&model, &values, inputs, spec).map_err(|e| self.report(e))?;
+        Ok((study, model))
+    }
+
+    /// A located, rendered diagnostic for a reliability error.
+    pub(crate) fn report(&self, err: ReliabilityError) -> Report {
+        let file = &self.file;
+        let (message, origin, label, help): (String, Option<&Origin>, &str, String) = match &err {
+            ReliabilityError::MissingStatistic { name, origin } => (
+                format!(
+                    "{file}{}: missing key `statistics.{name}`: error parameter `{name}` has no statistics entry",
+                    at(origin)
+                ),
+                Some(origin),
+                "used here",
+                format!(
+                    "every error needs a distribution for reliability, e.g.\nstatistics:\n  {name}: {{dist: normal, mean: 0, std: 0.01}}"
+                ),
+            ),
+            ReliabilityError::NoReliabilitySection => (
+                format!("{file}: missing key `reliability`: the machine has no reliability section"),
+                None,
+                "",
+                "add, e.g.\nreliability:\n  tolerance: {px: 0.03, py: 0.03, pz: 0.03}\n  sided: upper\n  grid: {x: [0, 500, 1000]}"
+                    .to_string(),
+            ),
+            ReliabilityError::SymbolicParameter { name, origin } => (
+                format!(
+                    "{file}{}: parameter `{name}` is symbolic (null) and has no value",
+                    at(origin)
+                ),
+                Some(origin),
+                "declared without a value",
+                format!("give it one on the command line: --param {name}=VALUE"),
+            ),
+            ReliabilityError::MissingCoordinate(v) => (
+                format!("{file}: the reliability grid has no values for axis variable `{v}` (key `reliability.grid.{v}`)"),
+                None,
+                "",
+                format!("add `{v}: [...]` to reliability.grid, or pass --grid {v}=VALUE"),
+            ),
+            other => (format!("{file}: {other}"), None, "", String::new()),
+        };
+        let mut diag =
+            MietteDiagnostic::new(message).with_code(format!("chain::reliability::{}", code(&err)));
+        if !help.is_empty() {
+            diag = diag.with_help(help);
+        }
+        if let Some(o) = origin.filter(|o| o.line > 0 && o.offset <= self.source.len()) {
+            let len = o.len.min(self.source.len() - o.offset);
+            diag = diag.with_label(LabeledSpan::at(o.offset..o.offset + len, label));
+            return Report::new(diag).with_source_code(
+                NamedSource::new(file.clone(), self.source.clone()).with_language("yaml"),
+            );
+        }
+        Report::new(diag)
+    }
+}
+
+fn at(origin: &Origin) -> String {
+    if origin.line > 0 {
+        format!(":{}:{}", origin.line, origin.column)
+    } else {
+        String::new()
+    }
+}
+
+fn code(err: &ReliabilityError) -> &'static str {
+    match err {
+        ReliabilityError::NoReliabilitySection => "no_reliability",
+        ReliabilityError::MissingStatistic { .. } => "missing_statistic",
+        ReliabilityError::SymbolicParameter { .. } => "symbolic_parameter",
+        ReliabilityError::InvalidDistribution(_) => "invalid_distribution",
+        ReliabilityError::InvalidTolerance { .. } => "invalid_tolerance",
+        ReliabilityError::UnknownName { .. } => "unknown_name",
+        ReliabilityError::EmptyGrid(_) => "empty_grid",
+        ReliabilityError::MissingCoordinate(_) => "missing_coordinate",
+        ReliabilityError::NonFinite(_) => "non_finite",
+        ReliabilityError::NoSamples => "no_samples",
+        _ => "error",
+    }
+}
+
+fn system_of(
+    machine: &Machine,
+    system: Option<SystemArg>,
+    tolerance: Option<f64>,
+) -> Result<Option<System>, ReliabilityError> {
+    Ok(match system {
+        None => None,
+        Some(SystemArg::Series) => Some(System::Series),
+        Some(SystemArg::Volumetric) => {
+            let t = match tolerance {
+                Some(t) => t,
+                None => machine
+                    .reliability
+                    .as_ref()
+                    .ok_or(ReliabilityError::NoReliabilitySection)?
+                    .tolerance
+                    .iter()
+                    .filter(|(c, _)| c.index() < 3)
+                    .map(|(_, t)| *t)
+                    .fold(f64::INFINITY, f64::min),
+            };
+            Some(System::Volumetric { tolerance: t })
+        }
+    })
+}
+
+/// Parses `NAME=VALUE`.
+pub(crate) fn parse_assignment(s: &str) -> Result<(String, f64), String> {
+    let (name, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=VALUE, found `{s}`"))?;
+    let v: f64 = value
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{value}` is not a number"))?;
+    if !v.is_finite() {
+        return Err(format!("`{value}` is not finite"));
+    }
+    Ok((name.trim().to_string(), v))
+}
+
+/// Parses `VAR=v1,v2,...`.
+fn parse_axis(s: &str) -> Result<(String, Vec<f64>), String> {
+    let (name, values) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected VAR=V1,V2,..., found `{s}`"))?;
+    let values = values
+        .split(',')
+        .map(|v| {
+            v.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| format!("`{v}` is not a finite number"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    if values.is_empty() {
+        return Err(format!("axis `{name}` has no value"));
+    }
+    Ok((name.trim().to_string(), values))
+}
+
+// ---------------------------------------------------------------------------
+// Output.
+
+/// The grid axes in file order, as (name, index in the model's variables).
+pub(crate) fn axes(study: &Study) -> Vec<(String, usize)> {
+    study
+        .spec()
+        .grid
+        .axes
+        .iter()
+        .filter_map(|(n, _)| {
+            study
+                .variables()
+                .iter()
+                .position(|v| v == n)
+                .map(|i| (n.clone(), i))
+        })
+        .collect()
+}
+
+fn point_json(study: &Study, point: &[f64]) -> Value {
+    let mut m = Map::new();
+    for (name, i) in axes(study) {
+        m.insert(name, json!(point[i]));
+    }
+    Value::Object(m)
+}
+
+fn to_json(machine: &Machine, study: &Study, r: &StudyResult) -> Value {
+    let results: Vec<Value> = r
+        .cases
+        .iter()
+        .map(|c| {
+            let mut o = Map::new();
+            o.insert("component".into(), json!(c.target));
+            o.insert("point".into(), point_json(study, &c.point));
+            o.insert("reliability".into(), json!(c.reliability));
+            o.insert("pf".into(), json!(c.pf));
+            o.insert("beta".into(), finite(c.beta));
+            if let Some(se) = c.std_error {
+                o.insert("std_error".into(), json!(se));
+            }
+            if let Some(n) = c.samples {
+                o.insert("samples".into(), json!(n));
+            }
+            if let Some(cov) = c.cov {
+                o.insert("cov".into(), json!(cov));
+            }
+            Value::Object(o)
+        })
+        .collect();
+    let mut summary = Map::new();
+    for s in &r.summaries {
+        let mut o = Map::new();
+        o.insert("mean".into(), json!(s.mean));
+        o.insert("min".into(), json!(s.min));
+        o.insert("max".into(), json!(s.max));
+        if let Some(met) = s.met {
+            o.insert("met".into(), json!(met));
+        }
+        summary.insert(s.target.into(), Value::Object(o));
+    }
+    let mut doc = Map::new();
+    doc.insert("machine".into(), json!(machine.name));
+    doc.insert("method".into(), json!(r.method));
+    doc.insert(
+        "sided".into(),
+        json!(match study.spec().sided {
+            Sided::Upper => "upper",
+            Sided::Two => "two",
+        }),
+    );
+    doc.insert("results".into(), Value::Array(results));
+    doc.insert("summary".into(), Value::Object(summary));
+    if let Some(req) = r.requirement {
+        doc.insert(
+            "requirement".into(),
+            json!({"min": req.min, "mean": req.mean, "met": r.summaries.iter().all(|s| s.met != Some(false))}),
+        );
+    }
+    Value::Object(doc)
+}
+
+/// JSON has no infinities: an infinite β (a component the errors do not
+/// reach) is written as null.
+fn finite(v: f64) -> Value {
+    if v.is_finite() {
+        json!(v)
+    } else {
+        Value::Null
+    }
+}
+
+fn to_csv(study: &Study, r: &StudyResult) -> miette::Result<String> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let ax = axes(study);
+    let sampled = r.cases.first().is_some_and(|c| c.samples.is_some());
+    let mut header = vec!["component".to_string()];
+    header.extend(ax.iter().map(|(n, _)| n.clone()));
+    header.extend(["reliability", "pf", "beta"].map(String::from));
+    if sampled {
+        header.extend(["std_error", "cov", "samples"].map(String::from));
+    }
+    let err = |e: csv::Error| miette::miette!("cannot write CSV: {e}");
+    w.write_record(&header).map_err(err)?;
+    for c in &r.cases {
+        let mut row = vec![c.target.to_string()];
+        row.extend(ax.iter().map(|(_, i)| fmt_num(c.point[*i])));
+        row.extend([c.reliability, c.pf, c.beta].map(|v| format!("{v:?}")));
+        if sampled {
+            row.push(format!("{:?}", c.std_error.unwrap_or(0.0)));
+            row.push(format!("{:?}", c.cov.unwrap_or(0.0)));
+            row.push(c.samples.unwrap_or(0).to_string());
+        }
+        w.write_record(&row).map_err(err)?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| miette::miette!("cannot write CSV: {e}"))?;
+    String::from_utf8(bytes).map_err(|e| miette::miette!("cannot write CSV: {e}"))
+}
+
+/// One target's reliabilities as maps over the two grid axes it varies along
+/// (further varying axes give one map per value), like Tables 2-4.
+pub(crate) struct TargetMap {
+    /// Row axis (name, values) and column axis, if the target varies along them.
+    pub(crate) rows: Option<(String, Vec<f64>)>,
+    pub(crate) cols: Option<(String, Vec<f64>)>,
+    /// One map per combination of the other varying axes: (label, values[row][col]).
+    pub(crate) maps: Vec<(String, Vec<Vec<f64>>)>,
+}
+
+/// Builds the maps of target `t` from a study result.
+pub(crate) fn target_map(study: &Study, r: &StudyResult, t: usize) -> TargetMap {
+    let grid = &study.spec().grid;
+    let np = study.points().len();
+    let values: Vec<f64> = r.cases[t * np..(t + 1) * np]
+        .iter()
+        .map(|c| c.reliability)
+        .collect();
+    let dims: Vec<usize> = grid.axes.iter().map(|(_, v)| v.len()).collect();
+    // Axes along which the limit state changes (decided on the model, not on
+    // sampled values, which are noisy).
+    let target = study.targets()[t];
+    let varying: Vec<usize> = (0..dims.len())
+        .filter(|&a| {
+            (0..np).any(|p| {
+                let mut idx = grid.index(p);
+                if idx[a] == 0 {
+                    return false;
+                }
+                idx[a] = 0;
+                let q = flat(&idx, &dims);
+                match (study.limit_state(target, p), study.limit_state(target, q)) {
+                    (Ok(g1), Ok(g2)) => g1 != g2,
+                    _ => true,
+                }
+            })
+        })
+        .collect();
+    let row_axis = varying.first().copied();
+    let col_axis = varying.get(1).copied();
+    let others: Vec<usize> = varying.iter().skip(2).copied().collect();
+    let len = |a: Option<usize>| a.map_or(1, |a| dims[a]);
+    let other_count: usize = others.iter().map(|&a| dims[a]).product();
+    let mut maps = Vec::new();
+    for o in 0..other_count.max(1) {
+        let mut idx = vec![0; dims.len()];
+        let mut rest = o;
+        let mut label = Vec::new();
+        for &a in others.iter().rev() {
+            idx[a] = rest % dims[a];
+            rest /= dims[a];
+        }
+        for &a in &others {
+            label.push(format!("{} = {}", grid.axes[a].0, grid.axes[a].1[idx[a]]));
+        }
+        let mut m = vec![vec![0.0; len(col_axis)]; len(row_axis)];
+        for (i, row) in m.iter_mut().enumerate() {
+            for (j, cell) in row.iter_mut().enumerate() {
+                if let Some(a) = row_axis {
+                    idx[a] = i;
+                }
+                if let Some(a) = col_axis {
+                    idx[a] = j;
+                }
+                *cell = values[flat(&idx, &dims)];
+            }
+        }
+        maps.push((label.join(", "), m));
+    }
+    TargetMap {
+        rows: row_axis.map(|a| grid.axes[a].clone()),
+        cols: col_axis.map(|a| grid.axes[a].clone()),
+        maps,
+    }
+}
+
+fn flat(idx: &[usize], dims: &[usize]) -> usize {
+    idx.iter().zip(dims).fold(0, |acc, (i, d)| acc * d + i)
+}
+
+fn to_table(machine: &Machine, study: &Study, r: &StudyResult) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let method = match r.method {
+        "form" => "FORM",
+        "is" => "importance sampling",
+        _ => "Monte Carlo",
+    };
+    let sided = match study.spec().sided {
+        Sided::Upper => "upper",
+        Sided::Two => "two-sided",
+    };
+    let _ = writeln!(
+        out,
+        "{}: machining-accuracy reliability ({method}, {sided})",
+        machine.name
+    );
+    for (t, target) in study.targets().iter().enumerate() {
+        let map = target_map(study, r, t);
+        let over = match (&map.rows, &map.cols) {
+            (Some(a), Some(b)) => format!(" over ({}, {})", a.0, b.0),
+            (Some(a), None) => format!(" over {}", a.0),
+            _ => String::new(),
+        };
+        let _ = writeln!(out, "\n{}: reliability (%){over}", target.name());
+        for (label, m) in &map.maps {
+            if !label.is_empty() {
+                let _ = writeln!(out, "  at {label}");
+            }
+            let corner = match (&map.rows, &map.cols) {
+                (Some(a), Some(b)) => format!("{} \\ {}", a.0, b.0),
+                (Some(a), None) => a.0.clone(),
+                _ => String::new(),
+            };
+            let _ = write!(out, "  {corner:>10}");
+            match &map.cols {
+                Some((_, vals)) => vals.iter().for_each(|v| {
+                    let _ = write!(out, " {:>9}", fmt_num(*v));
+                }),
+                None => {
+                    let _ = write!(out, " {:>9}", "");
+                }
+            }
+            out.push('\n');
+            for (i, row) in m.iter().enumerate() {
+                let head = map
+                    .rows
+                    .as_ref()
+                    .map_or(String::new(), |(_, v)| fmt_num(v[i]));
+                let _ = write!(out, "  {head:>10}");
+                for v in row {
+                    let _ = write!(out, " {:>9.2}", 100.0 * v);
+                }
+                out.push('\n');
+            }
+        }
+        if let Some(s) = r.summaries.get(t) {
+            let _ = write!(
+                out,
+                "  summary: mean {:.2} %, min {:.2} %, max {:.2} %",
+                100.0 * s.mean,
+                100.0 * s.min,
+                100.0 * s.max
+            );
+            if let (Some(req), Some(met)) = (r.requirement, s.met) {
+                let _ = write!(
+                    out,
+                    "; requirement min {:.2} %, mean {:.2} %: {}",
+                    100.0 * req.min,
+                    100.0 * req.mean,
+                    if met { "met" } else { "NOT met" }
+                );
+            }
+            out.push('\n');
+        }
+        let np = study.points().len();
+        let se = r.cases[t * np..(t + 1) * np]
+            .iter()
+            .filter_map(|c| c.std_error)
+            .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))));
+        if let (Some(se), Some(n)) = (se, r.cases[t * np].samples) {
+            let _ = writeln!(
+                out,
+                "  sampling: {n} samples per point, largest standard error {:.2e}",
+                se
+            );
+        }
+    }
+    out
+}
+
+fn fmt_num(v: f64) -> String {
+    if v == v.trunc() && v.abs() < 1e15 {
+        format!("{}", v as i64)
+    } else {
+        format!("{v}")
+    }
 }

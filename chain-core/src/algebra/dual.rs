@@ -5,6 +5,9 @@
 //! `e_i · e_j`, so a matrix product over duals is the exact first-order
 //! expansion in the errors, and the slopes are the exact partial derivatives.
 
+// Index loops read like the matrix formulas they implement.
+#![allow(clippy::needless_range_loop)]
+
 use super::poly::Poly;
 
 /// `value + Σ slope_j e_j`, with the slopes sparse and sorted by error index.

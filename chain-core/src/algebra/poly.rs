@@ -290,18 +290,17 @@ impl Poly {
             } else {
                 out.push_str(if negative { " - " } else { " + " });
             }
-            let factors: Vec<String> = m
-                .0
-                .iter()
-                .map(|&(s, e)| {
-                    let base = names(s);
-                    if e == 1 {
-                        base
-                    } else {
-                        (style.power)(&base, e)
-                    }
-                })
-                .collect();
+            let factors: Vec<String> =
+                m.0.iter()
+                    .map(|&(s, e)| {
+                        let base = names(s);
+                        if e == 1 {
+                            base
+                        } else {
+                            (style.power)(&base, e)
+                        }
+                    })
+                    .collect();
             if factors.is_empty() {
                 out.push_str(&format_number(mag));
             } else {
@@ -349,7 +348,10 @@ pub fn format_number(v: f64) -> String {
 /// Appends `c·m` to `out` with every `sin^k` (k ≥ 2) rewritten through
 /// `sin² = 1 − cos²`. The third field carries `|c|` for cancellation tests.
 fn fold_sin(m: Monomial, c: f64, out: &mut Vec<(Monomial, f64, f64)>) {
-    let Some(pos) = m.0.iter().position(|&(s, e)| matches!(s, Symbol::Sin(_)) && e >= 2) else {
+    let Some(pos) =
+        m.0.iter()
+            .position(|&(s, e)| matches!(s, Symbol::Sin(_)) && e >= 2)
+    else {
         out.push((m, c, c.abs()));
         return;
     };
@@ -398,7 +400,10 @@ mod tests {
         };
         let x = Poly::symbol(Symbol::Var(0));
         let c = Poly::symbol(Symbol::Cos(0));
-        let p = x.mul(&x).scale(2.0).sub(&c.mul(&Poly::symbol(Symbol::Param(0))));
+        let p = x
+            .mul(&x)
+            .scale(2.0)
+            .sub(&c.mul(&Poly::symbol(Symbol::Param(0))));
         assert_eq!(p.to_text(&names), "-L*cos(A) + 2*x^2");
         assert_eq!(p.to_latex(&names), "-L cos(A) + 2 x^{2}");
     }

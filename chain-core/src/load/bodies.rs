@@ -2,7 +2,7 @@
 //! cycles, roots), the variables and the error parameters, in the machine's
 //! orders.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use super::{index, join, Loader};
 use crate::diagnostic::{closest, Problem};
@@ -341,6 +341,9 @@ impl Loader {
         let Some(f) = self.fields(value, key.span, path, JOINT_KEYS) else {
             return j;
         };
+        for (_, node) in &f.unknown {
+            self.note_all_names(node);
+        }
         match f.get("type") {
             Some(n) => {
                 j.kind = match self.keyword(n, &f.path("type"), "joint type", JOINT_TYPES) {
@@ -630,7 +633,7 @@ impl Loader {
                 continue;
             }
             owner.insert(&u.name, &raw.name);
-            if self.parameters.iter().any(|p| p.name == u.name) {
+            if self.parameter_index.contains_key(&u.name) {
                 self.report(
                     u.span,
                     u.path.clone(),
@@ -674,7 +677,7 @@ impl Loader {
         raws: &[RawBody<'_>],
         order: &[usize],
     ) -> (Vec<ErrorParam>, Vec<(ErrorSlots, ErrorSlots)>) {
-        let variable_names: Vec<String> = raws
+        let variable_names: HashSet<String> = raws
             .iter()
             .filter_map(|r| r.joint.as_ref()?.variable.as_ref().map(|u| u.name.clone()))
             .collect();
@@ -696,7 +699,8 @@ impl Loader {
                         ErrorKind::Angular
                     };
                     for u in uses {
-                        let Some(i) = self.error_use(u, kind, &mut errors, &mut by_name, &variable_names)
+                        let Some(i) =
+                            self.error_use(u, kind, &mut errors, &mut by_name, &variable_names)
                         else {
                             continue;
                         };
@@ -721,7 +725,7 @@ impl Loader {
         kind: ErrorKind,
         errors: &mut Vec<ErrorParam>,
         by_name: &mut HashMap<String, usize>,
-        variable_names: &[String],
+        variable_names: &HashSet<String>,
     ) -> Option<usize> {
         if let Some(&i) = by_name.get(&u.name) {
             let e = errors.get_mut(i)?;
@@ -741,7 +745,7 @@ impl Loader {
             }
             return Some(i);
         }
-        if self.parameters.iter().any(|p| p.name == u.name) {
+        if self.parameter_index.contains_key(&u.name) {
             self.report(
                 u.span,
                 u.path.clone(),

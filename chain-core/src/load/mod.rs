@@ -24,7 +24,7 @@
 mod bodies;
 mod sections;
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::io::Read;
 use std::path::Path;
 
@@ -277,6 +277,8 @@ impl<'n> Fields<'n> {
 struct Loader {
     errors: Vec<(Origin, Problem)>,
     parameters: Vec<Parameter>,
+    /// Parameter name → index into `parameters`.
+    parameter_index: HashMap<String, usize>,
     /// Variable names seen in any joint, valid or not (no-cascade checks).
     seen_variables: HashSet<String>,
     /// Error names seen in any slot, valid or not (no-cascade checks).
@@ -367,7 +369,11 @@ impl Loader {
         if fields.suggested.contains(&key) {
             return;
         }
-        self.report(fields.owner, fields.path.clone(), Problem::MissingKey { key });
+        self.report(
+            fields.owner,
+            fields.path.clone(),
+            Problem::MissingKey { key },
+        );
     }
 
     /// A non-empty string scalar.
@@ -535,10 +541,11 @@ impl Loader {
             }
         };
         let params = &self.parameters;
+        let index = &self.parameter_index;
         let seen_errors = &self.seen_errors;
         let variables = &self.seen_variables;
         let resolved = expr::resolve(&ast, |name| {
-            if let Some(i) = params.iter().position(|p| p.name == name) {
+            if let Some(&i) = index.get(name) {
                 return Ok(Some(i));
             }
             let hint = if variables.contains(name) {

@@ -1,10 +1,12 @@
 //! The `parameters`, `statistics` and `reliability` sections.
 
+use std::collections::HashMap;
+
 use super::bodies::Tree;
 use super::{join, Fields, Loader};
 use crate::diagnostic::{closest, Problem};
 use crate::model::{
-    Component, Distribution, Parameter, Requirement, ReliabilitySpec, Sided, Statistic,
+    Component, Distribution, Parameter, ReliabilitySpec, Requirement, Sided, Statistic,
 };
 use crate::yaml::Node;
 
@@ -50,6 +52,9 @@ impl Loader {
             } else {
                 self.finite(v, &path, "a parameter value")
             };
+            self.parameter_index
+                .entry(name.clone())
+                .or_insert(self.parameters.len());
             self.parameters.push(Parameter {
                 name,
                 value,
@@ -67,14 +72,23 @@ impl Loader {
         let entries = self.entries(node, "statistics")?;
         let mut out = Vec::new();
         let mut complete = true;
+        let error_index: HashMap<&str, usize> = tree
+            .map(|t| {
+                t.errors
+                    .iter()
+                    .enumerate()
+                    .map(|(i, e)| (e.name.as_str(), i))
+                    .collect()
+            })
+            .unwrap_or_default();
         for (k, v) in entries {
             let name = k.as_str().unwrap_or("");
             let path = join("statistics", name);
-            let error = tree.and_then(|t| t.errors.iter().position(|e| e.name == name));
+            let error = error_index.get(name).copied();
             if let Some(t) = tree {
                 if error.is_none() && !self.seen_errors.contains(name) {
-                    let suggestion = closest(name, t.errors.iter().map(|e| e.name.as_str()))
-                        .map(str::to_string);
+                    let suggestion =
+                        closest(name, t.errors.iter().map(|e| e.name.as_str())).map(str::to_string);
                     self.report(
                         k.span,
                         path.clone(),
@@ -312,9 +326,8 @@ impl Loader {
                 let var = tree.and_then(|t| t.variables.iter().position(|v| v.name == name));
                 if let Some(t) = tree {
                     if var.is_none() && !self.seen_variables.contains(name) {
-                        let suggestion =
-                            closest(name, t.variables.iter().map(|v| v.name.as_str()))
-                                .map(str::to_string);
+                        let suggestion = closest(name, t.variables.iter().map(|v| v.name.as_str()))
+                            .map(str::to_string);
                         self.report(
                             gk.span,
                             gpath.clone(),
@@ -337,7 +350,11 @@ impl Loader {
                     continue;
                 };
                 if items.is_empty() {
-                    self.report(gv.span, gpath.clone(), Problem::EmptyList { what: "a grid" });
+                    self.report(
+                        gv.span,
+                        gpath.clone(),
+                        Problem::EmptyList { what: "a grid" },
+                    );
                 }
                 let values: Vec<Option<f64>> = items
                     .iter()

@@ -46,7 +46,10 @@ fn spec_example_loads() {
     assert_eq!(m.name, "gantry_grinder");
     assert_eq!(m.file.as_deref(), Some("gantry.yaml"));
     let names: Vec<&str> = m.bodies.iter().map(|b| b.name.as_str()).collect();
-    assert_eq!(names, ["bed", "x_slide", "table", "z_slide", "y_slide", "tool"]);
+    assert_eq!(
+        names,
+        ["bed", "x_slide", "table", "z_slide", "y_slide", "tool"]
+    );
     let vars: Vec<&str> = m.variables.iter().map(|v| v.name.as_str()).collect();
     assert_eq!(vars, ["x", "z", "y"]);
     assert_eq!(m.variables[2].body, 4);

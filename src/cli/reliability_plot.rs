@@ -1,0 +1,322 @@
+//! `--plot DIR` of `chain reliability`: a heat map of each target's
+//! reliability over the grid (like Tables 2-4 of seed 000) and a bar chart of
+//! the grid-mean reliability sensitivities `|∂R/∂σ|` (like Figures 6-8), each
+//! as PNG and SVG.
+
+use std::path::{Path, PathBuf};
+
+use plotters::coord::ranged1d::SegmentValue;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use reliability::{Study, StudyResult, TargetSensitivity};
+
+use super::target_map;
+
+const HEAT_SIZE: (u32, u32) = (900, 700);
+const BAR_SIZE: (u32, u32) = (1100, 600);
+
+/// A heat map to draw.
+struct Heat {
+    title: String,
+    rows: (String, Vec<String>),
+    cols: (String, Vec<String>),
+    /// Reliability in [0, 1], `values[row][col]`.
+    values: Vec<Vec<f64>>,
+}
+
+/// A bar chart to draw.
+struct Bars {
+    title: String,
+    labels: Vec<String>,
+    values: Vec<f64>,
+}
+
+/// Writes every chart into `dir`; returns the files written.
+pub(super) fn write_all(
+    dir: &Path,
+    machine: &str,
+    study: &Study,
+    result: &StudyResult,
+    sens: &[TargetSensitivity],
+) -> miette::Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| miette::miette!("{}: cannot create the plot directory: {e}", dir.display()))?;
+    chain::plot::ensure_fonts();
+    let method = match result.method {
+        "form" => "FORM",
+        "is" => "importance sampling",
+        _ => "Monte Carlo",
+    };
+    let mut files = Vec::new();
+    for (t, target) in study.targets().iter().enumerate() {
+        let map = target_map(study, result, t);
+        let labels = |axis: &Option<(String, Vec<f64>)>| match axis {
+            Some((name, v)) => (name.clone(), v.iter().map(|x| format!("{x}")).collect()),
+            None => (String::new(), vec![String::new()]),
+        };
+        let several = map.maps.len() > 1;
+        for (k, (label, values)) in map.maps.iter().enumerate() {
+            let heat = Heat {
+                title: format!(
+                    "{machine}: {} reliability (%), {method}{}",
+                    target.name(),
+                    if label.is_empty() {
+                        String::new()
+                    } else {
+                        format!(", {label}")
+                    }
+                ),
+                rows: labels(&map.rows),
+                cols: labels(&map.cols),
+                values: values.clone(),
+            };
+            let stem = if several {
+                format!("reliability_{}_{}", target.name(), k + 1)
+            } else {
+                format!("reliability_{}", target.name())
+            };
+            files.extend(write_both(dir, &stem, HEAT_SIZE, |root| {
+                draw_heat(root, &heat)
+            })?);
+        }
+    }
+    for s in sens {
+        // The model's error order (errors 1..N as in Table 1), like Figures 6-8.
+        let order = study.inputs().names();
+        let values: Vec<f64> = order
+            .iter()
+            .map(|n| {
+                s.errors
+                    .iter()
+                    .find(|e| &e.error == n)
+                    .map_or(0.0, |e| e.mean_abs_dr_dstd)
+            })
+            .collect();
+        let bars = Bars {
+            title: format!(
+                "{machine}: {} reliability sensitivity |∂R/∂σ| (grid mean)",
+                s.target
+            ),
+            labels: order.to_vec(),
+            values,
+        };
+        let stem = format!("sensitivity_{}", s.target);
+        files.extend(write_both(dir, &stem, BAR_SIZE, |root| {
+            draw_bars(root, &bars)
+        })?);
+    }
+    Ok(files)
+}
+
+/// Draws one chart as `stem.png` and `stem.svg`.
+fn write_both(
+    dir: &Path,
+    stem: &str,
+    size: (u32, u32),
+    draw: impl Fn(Area<'_>) -> Result<(), String>,
+) -> miette::Result<Vec<PathBuf>> {
+    let png = dir.join(format!("{stem}.png"));
+    let svg = dir.join(format!("{stem}.svg"));
+    let fail = |p: &Path, e: String| miette::miette!("{}: cannot draw the chart: {e}", p.display());
+    {
+        let root = BitMapBackend::new(&png, size).into_drawing_area();
+        draw(Area::Bitmap(root)).map_err(|e| fail(&png, e))?;
+    }
+    {
+        let root = SVGBackend::new(&svg, size).into_drawing_area();
+        draw(Area::Svg(root)).map_err(|e| fail(&svg, e))?;
+    }
+    Ok(vec![png, svg])
+}
+
+/// The two backends behind one type, so each chart is written once.
+enum Area<'a> {
+    Bitmap(DrawingArea<BitMapBackend<'a>, Shift>),
+    Svg(DrawingArea<SVGBackend<'a>, Shift>),
+}
+
+fn draw_heat(area: Area<'_>, heat: &Heat) -> Result<(), String> {
+    match area {
+        Area::Bitmap(a) => heat_on(a, heat),
+        Area::Svg(a) => heat_on(a, heat),
+    }
+}
+
+fn draw_bars(area: Area<'_>, bars: &Bars) -> Result<(), String> {
+    match area {
+        Area::Bitmap(a) => bars_on(a, bars),
+        Area::Svg(a) => bars_on(a, bars),
+    }
+}
+
+fn err<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+/// Viridis, five stops, linearly interpolated.
+fn viridis(t: f64) -> RGBColor {
+    const STOPS: [(f64, f64, f64); 5] = [
+        (68.0, 1.0, 84.0),
+        (59.0, 82.0, 139.0),
+        (33.0, 145.0, 140.0),
+        (94.0, 201.0, 98.0),
+        (253.0, 231.0, 37.0),
+    ];
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = t * 4.0;
+    let i = (x.floor() as usize).min(3);
+    let f = x - i as f64;
+    let (a, b) = (STOPS[i], STOPS[i + 1]);
+    let mix = |p: f64, q: f64| (p + (q - p) * f).round().clamp(0.0, 255.0) as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+fn heat_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, heat: &Heat) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let nr = heat.values.len().max(1);
+    let nc = heat.values.first().map_or(1, |r| r.len().max(1));
+    let lo = heat
+        .values
+        .iter()
+        .flatten()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let hi = heat
+        .values
+        .iter()
+        .flatten()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max);
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let mut chart = ChartBuilder::on(&root)
+        .caption(&heat.title, ("sans-serif", 22))
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(80)
+        .build_cartesian_2d((0..nc - 1).into_segmented(), (0..nr - 1).into_segmented())
+        .map_err(err)?;
+    let col_label = |v: &SegmentValue<usize>| match v {
+        SegmentValue::CenterOf(j) => heat.cols.1.get(*j).cloned().unwrap_or_default(),
+        _ => String::new(),
+    };
+    let row_label = |v: &SegmentValue<usize>| match v {
+        SegmentValue::CenterOf(i) => heat.rows.1.get(*i).cloned().unwrap_or_default(),
+        _ => String::new(),
+    };
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(heat.cols.0.as_str())
+        .y_desc(heat.rows.0.as_str())
+        .x_labels(nc)
+        .y_labels(nr)
+        .x_label_formatter(&col_label)
+        .y_label_formatter(&row_label)
+        .label_style(("sans-serif", 16))
+        .axis_desc_style(("sans-serif", 18))
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(heat.values.iter().enumerate().flat_map(|(i, row)| {
+            row.iter().enumerate().map(move |(j, &v)| {
+                Rectangle::new(
+                    [
+                        (SegmentValue::Exact(j), SegmentValue::Exact(i)),
+                        (SegmentValue::Exact(j + 1), SegmentValue::Exact(i + 1)),
+                    ],
+                    viridis((v - lo) / span).filled(),
+                )
+            })
+        }))
+        .map_err(err)?;
+    chart
+        .draw_series(heat.values.iter().enumerate().flat_map(|(i, row)| {
+            row.iter().enumerate().map(move |(j, &v)| {
+                let t = (v - lo) / span;
+                let color = if t > 0.6 { BLACK } else { WHITE };
+                Text::new(
+                    format!("{:.2}", 100.0 * v),
+                    (SegmentValue::CenterOf(j), SegmentValue::CenterOf(i)),
+                    ("sans-serif", 16)
+                        .into_font()
+                        .color(&color)
+                        .pos(Pos::new(HPos::Center, VPos::Center)),
+                )
+            })
+        }))
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+fn bars_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, bars: &Bars) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let n = bars.values.len().max(1);
+    let top = bars.values.iter().copied().fold(0.0f64, f64::max);
+    let top = if top > 0.0 { top * 1.1 } else { 1.0 };
+    let mut chart = ChartBuilder::on(&root)
+        .caption(&bars.title, ("sans-serif", 22))
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(80)
+        .build_cartesian_2d((0..n - 1).into_segmented(), 0.0..top)
+        .map_err(err)?;
+    let label = |v: &SegmentValue<usize>| match v {
+        SegmentValue::CenterOf(j) => bars.labels.get(*j).cloned().unwrap_or_default(),
+        _ => String::new(),
+    };
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(n)
+        .x_label_formatter(&label)
+        .x_desc("error parameter")
+        .y_desc("|∂R/∂σ| (per unit of the error)")
+        .label_style(("sans-serif", 13))
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(err)?;
+    let color = chain::plot::color(0);
+    chart
+        .draw_series(bars.values.iter().enumerate().map(|(j, &v)| {
+            Rectangle::new(
+                [
+                    (SegmentValue::Exact(j), 0.0),
+                    (SegmentValue::Exact(j + 1), v.max(0.0)),
+                ],
+                color.filled(),
+            )
+        }))
+        .map_err(err)?;
+    // White outlines keep neighbouring bars apart.
+    chart
+        .draw_series(
+            bars.values
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| **v > 0.0)
+                .map(|(j, &v)| {
+                    Rectangle::new(
+                        [
+                            (SegmentValue::Exact(j), 0.0),
+                            (SegmentValue::Exact(j + 1), v),
+                        ],
+                        WHITE.stroke_width(3),
+                    )
+                }),
+        )
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}

@@ -1,0 +1,2 @@
+chain::machine!(pub M = "tests/ui/bad_key.yaml");
+fn main() {}

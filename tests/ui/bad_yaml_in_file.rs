@@ -1,0 +1,2 @@
+chain::machine!(pub M = "tests/ui/bad_yaml.yaml");
+fn main() {}

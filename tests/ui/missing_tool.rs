@@ -1,0 +1,7 @@
+chain::machine! {
+    pub M {
+        bodies { bed {}, slide { parent: bed, joint: { type: prismatic, axis: +x, variable: x } } },
+        workpiece: bed,
+    }
+}
+fn main() {}

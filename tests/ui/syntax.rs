@@ -1,0 +1,8 @@
+chain::machine! {
+    pub M {
+        bodies: { bed {} },
+        workpiece bed,
+        tool: bed,
+    }
+}
+fn main() {}
