@@ -221,7 +221,7 @@ impl Form {
         let mut u = vec![0.0; n];
         let mut g = work.eval(event, b, &u, calls);
         let mut gn = norm(&work.grad_u);
-        if !(gn > 0.0) || !gn.is_finite() {
+        if !gn.is_finite() || gn <= 0.0 {
             // The origin can be a kink (the volumetric norm at zero mean):
             // start a little off it, the same way every time.
             u.iter_mut().for_each(|v| *v = 0.1 / (n as f64).sqrt());
@@ -231,7 +231,7 @@ impl Form {
         if !g.is_finite() {
             return Err(ReliabilityError::NonFinite("the limit state"));
         }
-        if !(gn > 0.0) || !gn.is_finite() {
+        if !gn.is_finite() || gn <= 0.0 {
             let beta = if g > 0.0 {
                 f64::INFINITY
             } else {
@@ -290,7 +290,7 @@ impl Form {
             g = g_new;
             grad.copy_from_slice(&grad_new);
             gn = norm(&grad);
-            if !(gn > 0.0) {
+            if !gn.is_finite() || gn <= 0.0 {
                 break;
             }
             // Convergence: on the surface, and u aligned with −∇g.
@@ -327,7 +327,7 @@ fn closed_form(a: &[f64], m: f64, tolerance: f64, sign: f64) -> Branch {
     let n = a.len();
     let sigma = norm(a);
     let mu_z = tolerance - sign * m;
-    if !(sigma > 0.0) {
+    if sigma.is_nan() || sigma <= 0.0 {
         return Branch {
             beta: if mu_z > 0.0 {
                 f64::INFINITY

@@ -156,6 +156,10 @@ pub struct Inputs {
     names: Vec<String>,
     marginals: Vec<Marginal>,
     all_normal: bool,
+    #[serde(skip)]
+    means: Vec<f64>,
+    #[serde(skip)]
+    stds: Vec<f64>,
 }
 
 impl Inputs {
@@ -180,10 +184,14 @@ impl Inputs {
             }
         }
         let all_normal = marginals.iter().all(Marginal::is_normal);
+        let means = marginals.iter().map(Marginal::mean).collect();
+        let stds = marginals.iter().map(Marginal::std).collect();
         Ok(Inputs {
             names,
             marginals,
             all_normal,
+            means,
+            stds,
         })
     }
 
@@ -219,28 +227,25 @@ impl Inputs {
     }
 
     /// The means.
-    pub fn means(&self) -> Vec<f64> {
-        self.marginals.iter().map(Marginal::mean).collect()
+    pub fn means(&self) -> &[f64] {
+        &self.means
     }
 
     /// The standard deviations.
-    pub fn stds(&self) -> Vec<f64> {
-        self.marginals.iter().map(Marginal::std).collect()
+    pub fn stds(&self) -> &[f64] {
+        &self.stds
     }
 
     /// A copy with input `j`'s mean and standard deviation replaced.
     pub fn with_moments(&self, j: usize, mean: f64, std: f64) -> Result<Inputs, ReliabilityError> {
-        let mut out = self.clone();
-        let m = out
-            .marginals
-            .get_mut(j)
-            .ok_or(ReliabilityError::Dimension {
-                what: "input index",
-                expected: self.len(),
-                found: j,
-            })?;
+        let mut marginals = self.marginals.clone();
+        let m = marginals.get_mut(j).ok_or(ReliabilityError::Dimension {
+            what: "input index",
+            expected: self.len(),
+            found: j,
+        })?;
         *m = m.with_moments(mean, std)?;
-        Ok(out)
+        Inputs::new(self.names.clone(), marginals)
     }
 
     /// `x = T(u)`.
@@ -271,10 +276,8 @@ impl Inputs {
     pub fn sample(&self, rng: &mut CaseRng, x: &mut [f64]) {
         if self.all_normal {
             rng.fill_normal(x);
-            for (x, m) in x.iter_mut().zip(&self.marginals) {
-                if let Marginal::Normal { mean, std } = *m {
-                    *x = mean + std * *x;
-                }
+            for ((x, m), s) in x.iter_mut().zip(&self.means).zip(&self.stds) {
+                *x = m + s * *x;
             }
         } else {
             for (x, m) in x.iter_mut().zip(&self.marginals) {

@@ -42,6 +42,8 @@
 //! assert!((is.pf - form.pf).abs() < 1e-12 && is.std_error < 1e-12);
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod error;
 pub mod form;
 pub mod inputs;

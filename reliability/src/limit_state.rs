@@ -167,6 +167,7 @@ impl ToleranceLimitState {
     }
 
     /// Row `c` of the sensitivities.
+    #[inline]
     pub fn row(&self, c: usize) -> &[f64] {
         &self.rows[c * self.n..(c + 1) * self.n]
     }
@@ -247,6 +248,14 @@ impl LimitState for ToleranceLimitState {
     #[inline]
     fn value(&self, x: &[f64]) -> f64 {
         let k = self.components();
+        if k == 1 {
+            // The common case (one component): no iterator machinery.
+            let e = crate::util::dot(&self.rows, x);
+            return match self.criterion {
+                Criterion::Each(Sided::Upper) => self.tolerances[0] - e,
+                Criterion::Each(Sided::Two) | Criterion::Norm => self.tolerances[0] - e.abs(),
+            };
+        }
         match self.criterion {
             Criterion::Each(Sided::Upper) => (0..k)
                 .map(|c| self.tolerances[c] - self.dot(c, x))

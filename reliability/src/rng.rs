@@ -116,13 +116,15 @@ impl CaseRng {
     fn normal_from_bits(&mut self, bits: u32) -> f64 {
         let t = self.tables;
         let layer = (bits & 0xff) as usize;
-        let negative = bits & 0x100 != 0;
         let m = bits >> 9;
         if m < t.k[layer] {
             let x = (f64::from(m) + 0.5) * t.w[layer];
-            return if negative { -x } else { x };
+            // Branch-free sign: bit 8 of `bits` becomes the sign bit (a
+            // data-dependent branch here would be mispredicted half the time).
+            let sign = u64::from(bits & 0x100) << 55;
+            return f64::from_bits(x.to_bits() ^ sign);
         }
-        self.normal_slow(layer, negative, m)
+        self.normal_slow(layer, bits & 0x100 != 0, m)
     }
 
     #[cold]

@@ -505,12 +505,35 @@ impl Kernel {
                 criterion,
             } => {
                 let z = &mut scratch[..*dim];
-                for _ in 0..count {
-                    rng.fill_normal(z);
-                    let p = line_pf_affine(m, w, d, z, tolerances, *criterion, *dim, *k);
-                    let v = p - self.shift;
-                    s1 += v;
-                    s2 += v * v;
+                if *k == 1 && *criterion == Criterion::Each(Sided::Upper) && d[0] > 0.0 {
+                    // One upper tolerance (Eq. 25-28 as printed): failure is
+                    // t ≥ h with h = (I − m − w·p̃)/d, and p = Φ(−h).
+                    // In batches, so that the Φ evaluations of independent
+                    // samples overlap in the pipeline.
+                    let (inv_d, top) = (1.0 / d[0], tolerances[0] - m[0]);
+                    let mut h = [0.0f64; 32];
+                    let mut left = count;
+                    while left > 0 {
+                        let nb = left.min(32) as usize;
+                        for hi in &mut h[..nb] {
+                            rng.fill_normal(z);
+                            *hi = (top - dot(w, z)) * inv_d;
+                        }
+                        for &hi in &h[..nb] {
+                            let v = normal::sf(hi) - self.shift;
+                            s1 += v;
+                            s2 += v * v;
+                        }
+                        left -= nb as u64;
+                    }
+                } else {
+                    for _ in 0..count {
+                        rng.fill_normal(z);
+                        let p = line_pf_affine(m, w, d, z, tolerances, *criterion, *dim, *k);
+                        let v = p - self.shift;
+                        s1 += v;
+                        s2 += v * v;
+                    }
                 }
                 calls = count;
             }
@@ -605,10 +628,10 @@ fn line_pf_affine(
         Criterion::Norm => {
             // |b + t·d|² ≤ I²  ⇔  A t² + 2B t + C ≤ 0.
             let (mut a2, mut b2, mut c2) = (0.0, 0.0, 0.0);
-            for c in 0..k {
+            for (c, &dc) in d.iter().enumerate().take(k) {
                 let b = offset(c);
-                a2 += d[c] * d[c];
-                b2 += b * d[c];
+                a2 += dc * dc;
+                b2 += b * dc;
                 c2 += b * b;
             }
             let i = tolerances[0];

@@ -30,7 +30,7 @@ pub struct SensitivityArgs {
     /// Evaluate at one point, e.g. `x=0,y=1500,z=600` (every axis variable);
     /// without it, the mean over the reliability grid.
     #[arg(long, value_name = "VAR=VALUE,...", value_parser = parse_point)]
-    pub at: Option<Vec<(String, f64)>>,
+    pub at: Option<AtPoint>,
     /// Output format.
     #[arg(long, value_enum, default_value = "table")]
     pub format: SensitivityFormat,
@@ -42,12 +42,17 @@ pub struct SensitivityArgs {
     pub sided: Option<SidedArg>,
 }
 
+/// The coordinates of `--at`, `(variable, value)` in the order given.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AtPoint(pub Vec<(String, f64)>);
+
 /// Parses `x=0,y=1500,z=600`.
-fn parse_point(s: &str) -> Result<Vec<(String, f64)>, String> {
+fn parse_point(s: &str) -> Result<AtPoint, String> {
     s.split(',')
         .filter(|p| !p.trim().is_empty())
         .map(parse_assignment)
-        .collect()
+        .collect::<Result<Vec<_>, _>>()
+        .map(AtPoint)
 }
 
 /// Runs `chain sensitivity`.
@@ -62,7 +67,7 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
                 .sensitivity_mean(&form)
                 .map_err(|e| loaded.report(e))?,
         ),
-        Some(coords) => {
+        Some(AtPoint(coords)) => {
             let vars = study.variables();
             for (name, _) in coords {
                 if !vars.iter().any(|v| v == name) {
@@ -104,7 +109,15 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
             let r = study
                 .sensitivity_point(&model, &values, &point, &form)
                 .map_err(|e| loaded.report(e))?;
-            let at: Vec<(String, f64)> = vars.iter().cloned().zip(point).collect();
+            // Report the point in the grid's axis order (x, y, z), then any other.
+            let mut order: Vec<usize> = super::reliability::axes(&study)
+                .iter()
+                .map(|(_, i)| *i)
+                .collect();
+            let rest: Vec<usize> = (0..vars.len()).filter(|i| !order.contains(i)).collect();
+            order.extend(rest);
+            let at: Vec<(String, f64)> =
+                order.iter().map(|&i| (vars[i].clone(), point[i])).collect();
             (Some(at), r)
         }
     };

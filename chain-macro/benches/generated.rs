@@ -1,0 +1,99 @@
+//! Generated code vs hand-written Rust vs the runtime tape (issue 7 targets;
+//! figures in docs/performance.md). Run with
+//! `cargo bench -p chain-macro --bench generated`.
+
+use std::hint::black_box;
+
+use chain::core::ErrorModel;
+use criterion::{criterion_group, criterion_main, Criterion};
+
+chain::machine!(GantryGrinder = "../examples/machines/gantry_grinder.yaml");
+chain::machine!(Cnc5Bevel = "../examples/machines/cnc5_bevel.yaml");
+
+/// Seed 000's corrected Eq. 18 sensitivity written by hand, in the generated
+/// type's error order (docs/errata.md for the two corrections).
+#[inline]
+fn hand_written(q: &[f64; 3]) -> [[f64; 21]; 6] {
+    let (x, z, y) = (q[0], q[1], q[2]);
+    use GantryGrinder as G;
+    let mut s = [[0.0; 21]; 6];
+    s[0][G::ERR_DXX] = -1.0;
+    s[0][G::ERR_EYX] = -z;
+    s[0][G::ERR_EZX] = y;
+    s[0][G::ERR_SXY] = y;
+    s[0][G::ERR_DXZ] = 1.0;
+    s[0][G::ERR_EZZ] = -y;
+    s[0][G::ERR_DXY] = 1.0;
+    s[1][G::ERR_DYX] = -1.0;
+    s[1][G::ERR_EXX] = z;
+    s[1][G::ERR_EZX] = x;
+    s[1][G::ERR_SXY] = x;
+    s[1][G::ERR_DYZ] = 1.0;
+    s[1][G::ERR_DYY] = 1.0;
+    s[2][G::ERR_DZX] = -1.0;
+    s[2][G::ERR_EXX] = -y;
+    s[2][G::ERR_EYX] = -x;
+    s[2][G::ERR_DZZ] = 1.0;
+    s[2][G::ERR_EXZ] = y;
+    s[2][G::ERR_SYZ] = y;
+    s[2][G::ERR_DZY] = 1.0;
+    s[3][G::ERR_EXX] = -1.0;
+    s[3][G::ERR_EXZ] = 1.0;
+    s[3][G::ERR_SYZ] = 1.0;
+    s[3][G::ERR_EXY] = 1.0;
+    s[4][G::ERR_EYX] = -1.0;
+    s[4][G::ERR_EYZ] = 1.0;
+    s[4][G::ERR_SXZ] = 1.0;
+    s[4][G::ERR_EYY] = 1.0;
+    s[5][G::ERR_EZX] = -1.0;
+    s[5][G::ERR_SXY] = -1.0;
+    s[5][G::ERR_EZZ] = 1.0;
+    s[5][G::ERR_EZY] = 1.0;
+    s
+}
+
+fn gantry(c: &mut Criterion) {
+    let q = [500.0, 1000.0, 750.0];
+    assert_eq!(hand_written(&q), GantryGrinder::sensitivity(&q, &[]));
+    c.bench_function("gantry_sensitivity/generated", |b| {
+        b.iter(|| black_box(GantryGrinder::sensitivity(black_box(&q), &[])))
+    });
+    c.bench_function("gantry_sensitivity/hand_written", |b| {
+        b.iter(|| black_box(hand_written(black_box(&q))))
+    });
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/machines/gantry_grinder.yaml");
+    let machine = chain::core::load_file(std::path::Path::new(path)).expect("valid machine");
+    let runtime = chain::core::compile(&machine);
+    let mut out = vec![0.0; 6 * 21];
+    c.bench_function("gantry_sensitivity/runtime_tape", |b| {
+        b.iter(|| {
+            runtime.sensitivity(black_box(&q), &[], &mut out);
+            black_box(&out);
+        })
+    });
+}
+
+fn five_axis(c: &mut Criterion) {
+    let p: Vec<f64> = Cnc5Bevel::PARAMETER_VALUES
+        .iter()
+        .map(|v| v.unwrap_or(100.0))
+        .collect();
+    let p: [f64; 1] = [p[0]];
+    let q = [120.0, -40.0, 0.3, 250.0, 0.5, -0.2];
+    c.bench_function("cnc5_bevel_sensitivity/generated", |b| {
+        b.iter(|| black_box(Cnc5Bevel::sensitivity(black_box(&q), black_box(&p))))
+    });
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/machines/cnc5_bevel.yaml");
+    let machine = chain::core::load_file(std::path::Path::new(path)).expect("valid machine");
+    let runtime = chain::core::compile(&machine);
+    let mut out = vec![0.0; 6 * runtime.errors().len()];
+    c.bench_function("cnc5_bevel_sensitivity/runtime_tape", |b| {
+        b.iter(|| {
+            runtime.sensitivity(black_box(&q), black_box(&p), &mut out);
+            black_box(&out);
+        })
+    });
+}
+
+criterion_group!(benches, gantry, five_axis);
+criterion_main!(benches);

@@ -1,0 +1,365 @@
+//! End-to-end tests of `chain reliability` and `chain sensitivity` on the
+//! gantry grinder of seed 000 (the CLI + JSON contract of
+//! shared/spec/machine-format.md, section 3).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn gantry() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/machines/gantry_grinder.yaml")
+}
+
+fn chain(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_chain"))
+        .args(args)
+        .output()
+        .expect("run chain")
+}
+
+fn ok_json(args: &[&str]) -> Value {
+    let out = chain(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Nothing but the JSON document on stdout.
+    serde_json::from_slice(&out.stdout).expect("stdout is one JSON document")
+}
+
+/// A scratch directory unique to this test process and name.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "chain-reliability-cli-{}-{name}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
+#[test]
+fn form_json_follows_the_contract_and_table_2() {
+    let file = gantry();
+    let doc = ok_json(&["reliability", file.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(doc["machine"], "gantry_grinder");
+    assert_eq!(doc["method"], "form");
+    let results = doc["results"].as_array().expect("results");
+    assert_eq!(results.len(), 375);
+    let first = &results[0];
+    assert_eq!(first["component"], "px");
+    assert_eq!(first["point"]["x"], 0.0);
+    assert_eq!(first["point"]["y"], -1500.0);
+    assert_eq!(first["point"]["z"], 600.0);
+    // Table 2 prints 88.83 % at (y, z) = (-1500, 600); the model gives 88.73 %.
+    let r = first["reliability"].as_f64().unwrap();
+    assert!((100.0 * r - 88.83).abs() < 0.25, "{r}");
+    assert!((first["pf"].as_f64().unwrap() - (1.0 - r)).abs() < 1e-12);
+    assert!((first["beta"].as_f64().unwrap() - 1.2123).abs() < 1e-3);
+    assert!(first.get("std_error").is_none());
+    // Section 3.3: px min 86.07 %, mean 92.16 %.
+    let px = &doc["summary"]["px"];
+    assert!((100.0 * px["min"].as_f64().unwrap() - 86.07).abs() < 0.35);
+    assert!((100.0 * px["mean"].as_f64().unwrap() - 92.16).abs() < 0.35);
+    assert_eq!(px["met"], false);
+    assert_eq!(doc["requirement"]["met"], false);
+}
+
+#[test]
+fn sampling_methods_add_std_error_and_samples_and_are_reproducible() {
+    let file = gantry();
+    let args = [
+        "reliability",
+        file.to_str().unwrap(),
+        "--method",
+        "mc",
+        "--samples",
+        "5000",
+        "--seed",
+        "42",
+        "--format",
+        "json",
+    ];
+    let a = chain(&args);
+    let b = chain(&args);
+    assert!(a.status.success());
+    assert_eq!(a.stdout, b.stdout, "same seed, same output");
+    let doc: Value = serde_json::from_slice(&a.stdout).unwrap();
+    assert_eq!(doc["method"], "mc");
+    let r = &doc["results"][0];
+    assert_eq!(r["samples"], 5000);
+    assert!(r["std_error"].as_f64().unwrap() > 0.0);
+    // No progress bar or note leaks into the output streams when not a terminal.
+    assert!(
+        a.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&a.stderr)
+    );
+
+    let doc = ok_json(&[
+        "reliability",
+        file.to_str().unwrap(),
+        "--method",
+        "is",
+        "--samples",
+        "500",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(doc["method"], "is");
+    // Linear limit state in normal inputs: zero variance (Eq. 28 with h = β).
+    for r in doc["results"].as_array().unwrap() {
+        assert!(r["std_error"].as_f64().unwrap() < 1e-12);
+        assert_eq!(r["samples"], 500);
+    }
+}
+
+#[test]
+fn csv_and_table_formats() {
+    let file = gantry();
+    let out = chain(&["reliability", file.to_str().unwrap(), "--format", "csv"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("component,x,y,z,reliability,pf,beta"));
+    assert_eq!(lines.count(), 375);
+    assert!(text.contains("\npx,0,-1500,600,0.88729"));
+
+    let out = chain(&["reliability", file.to_str().unwrap()]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    // The maps of Tables 2-4 and the summary lines.
+    assert!(text.contains("px: reliability (%) over (y, z)"));
+    assert!(text.contains("88.73"));
+    assert!(text.contains("summary: mean 92.18 %, min 85.98 %"));
+    assert!(text.contains("NOT met"));
+}
+
+#[test]
+fn system_targets_and_overrides() {
+    let file = gantry();
+    let doc = ok_json(&[
+        "reliability",
+        file.to_str().unwrap(),
+        "--method",
+        "is",
+        "--samples",
+        "2000",
+        "--system",
+        "volumetric",
+        "--system-tolerance",
+        "0.05",
+        "--grid",
+        "x=1000",
+        "--grid",
+        "y=1500",
+        "--grid",
+        "z=1400",
+        "--format",
+        "json",
+    ]);
+    let results = doc["results"].as_array().unwrap();
+    assert_eq!(results.len(), 4);
+    let vol = &results[3];
+    assert_eq!(vol["component"], "volumetric");
+    // Inside 4 standard errors of the 10⁷-sample Monte Carlo value 0.2069
+    // (tests/reliability_gantry.rs) at the corner (1000, 1500, 1400).
+    let pf = vol["pf"].as_f64().unwrap();
+    let se = vol["std_error"].as_f64().unwrap();
+    assert!((pf - 0.2069).abs() < 4.0 * se + 2e-4, "{pf} ± {se}");
+
+    let out = chain(&[
+        "reliability",
+        file.to_str().unwrap(),
+        "--sided",
+        "two",
+        "--format",
+        "json",
+    ]);
+    assert!(out.status.success());
+    // FORM is not exact for two-sided tolerances: a note on stderr, not stdout.
+    assert!(String::from_utf8_lossy(&out.stderr).contains("first-order approximation"));
+    let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["sided"], "two");
+}
+
+#[test]
+fn clear_errors_name_the_file_and_the_missing_key() {
+    let dir = scratch("errors");
+    let src = std::fs::read_to_string(gantry()).unwrap();
+    let nostat = dir.join("nostat.yaml");
+    std::fs::write(
+        &nostat,
+        src.replace("  eyx: {dist: normal, mean: 0, std: 0.06/6000}\n", ""),
+    )
+    .unwrap();
+    let norel = dir.join("norel.yaml");
+    std::fs::write(
+        &norel,
+        &src[..src.find("reliability:\n  tolerance").unwrap()],
+    )
+    .unwrap();
+    let symbolic = dir.join("symbolic.yaml");
+    std::fs::write(
+        &symbolic,
+        src.replace("parameters: {}", "parameters: {L: null}")
+            .replace("tool_point: [0, 0, 0]", "tool_point: [0, 0, -L]"),
+    )
+    .unwrap();
+    let cases: [(&Path, &str, &[&str]); 3] = [
+        (&nostat, "statistics.eyx", &["nostat.yaml"]),
+        (&norel, "`reliability`", &["norel.yaml"]),
+        (&symbolic, "--param L=", &["symbolic.yaml", "parameter `L`"]),
+    ];
+    for (file, key, more) in cases {
+        for cmd in ["reliability", "sensitivity"] {
+            let out = chain(&[cmd, file.to_str().unwrap(), "--format", "json"]);
+            assert!(!out.status.success(), "{cmd} {}", file.display());
+            assert!(out.stdout.is_empty(), "nothing on stdout");
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(err.contains(key), "{cmd}: {err}");
+            for m in more {
+                assert!(err.contains(m), "{cmd}: {err}");
+            }
+            assert!(!err.contains("panicked"), "{err}");
+        }
+    }
+    // With a value the symbolic machine runs.
+    let out = chain(&[
+        "reliability",
+        symbolic.to_str().unwrap(),
+        "--param",
+        "L=100",
+        "--format",
+        "json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Bad command-line values are errors, not panics.
+    for args in [
+        vec!["reliability", "--grid", "x=a,b"],
+        vec!["reliability", "--grid", "w=1"],
+        vec!["reliability", "--method", "mc", "--samples", "0"],
+        vec!["sensitivity", "--at", "x=0,y=0"],
+    ] {
+        let mut full = vec![args[0], file_str(&gantry())];
+        full.extend_from_slice(&args[1..]);
+        let out = chain(&full);
+        assert!(!out.status.success(), "{full:?}");
+        assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+fn file_str(p: &Path) -> &'static str {
+    Box::leak(p.to_string_lossy().into_owned().into_boxed_str())
+}
+
+#[test]
+fn plots_are_valid_non_trivial_png_and_svg() {
+    let dir = scratch("plots");
+    let out = chain(&[
+        "reliability",
+        file_str(&gantry()),
+        "--plot",
+        dir.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice::<Value>(&out.stdout).expect("JSON only on stdout");
+    for stem in [
+        "reliability_px",
+        "reliability_py",
+        "reliability_pz",
+        "sensitivity_px",
+        "sensitivity_py",
+        "sensitivity_pz",
+    ] {
+        let png = dir.join(format!("{stem}.png"));
+        let bytes = std::fs::read(&png).unwrap_or_else(|_| panic!("{} exists", png.display()));
+        assert!(bytes.len() > 10_000, "{stem}.png is {} bytes", bytes.len());
+        let decoder = png::Decoder::new(std::io::Cursor::new(&bytes));
+        let mut reader = decoder.read_info().expect("valid PNG");
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).expect("PNG frame");
+        assert!(info.width >= 800 && info.height >= 500);
+        let px = info.color_type.samples();
+        let pixels = &buf[..info.buffer_size()];
+        let mut colours = std::collections::HashSet::new();
+        let mut non_white = 0usize;
+        for p in pixels.chunks_exact(px) {
+            colours.insert(p[..3].to_vec());
+            if p[..3] != [255, 255, 255] {
+                non_white += 1;
+            }
+        }
+        let total = (info.width * info.height) as usize;
+        // A heat map is mostly coloured cells; a bar chart has bars and text.
+        assert!(colours.len() >= 10, "{stem}: {} colours", colours.len());
+        assert!(
+            non_white * 20 > total,
+            "{stem}: {non_white} of {total} pixels drawn"
+        );
+
+        let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).expect("svg");
+        assert!(svg.len() > 5_000, "{stem}.svg is {} bytes", svg.len());
+        assert!(svg.contains("<svg") && svg.trim_end().ends_with("</svg>"));
+        assert!(svg.matches("<rect").count() >= 10, "{stem}.svg");
+        assert!(svg.contains("<text"), "{stem}.svg has text");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn sensitivity_json_is_sorted_and_finds_figures_6_to_8() {
+    let file = gantry();
+    let doc = ok_json(&["sensitivity", file.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(doc["machine"], "gantry_grinder");
+    assert!(doc["at"].is_null());
+    // Figure 6 (x-direction): eyx, ezx, ezz, Sxy are the sensitive errors.
+    let px = doc["components"]["px"].as_array().unwrap();
+    assert_eq!(px.len(), 21);
+    let mut top: Vec<&str> = px[..4]
+        .iter()
+        .map(|e| e["error"].as_str().unwrap())
+        .collect();
+    top.sort_unstable();
+    assert_eq!(top, ["Sxy", "eyx", "ezx", "ezz"]);
+    let abs: Vec<f64> = px
+        .iter()
+        .map(|e| e["dr_dstd"].as_f64().unwrap().abs())
+        .collect();
+    assert!(abs.windows(2).all(|w| w[0] >= w[1]), "sorted by |dr_dstd|");
+    let imp: f64 = px.iter().map(|e| e["importance"].as_f64().unwrap()).sum();
+    assert!((imp - 1.0).abs() < 1e-9);
+
+    let doc = ok_json(&[
+        "sensitivity",
+        file.to_str().unwrap(),
+        "--at",
+        "x=0,y=1500,z=600",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(doc["at"]["y"], 1500.0);
+    let px = doc["components"]["px"].as_array().unwrap();
+    // At (y, z) = (1500, 600): ∂R/∂σ = −φ(β)·β·S²σ/σ_E² (Eq. 32-33); the
+    // largest is Sxy (coefficient y = 1500, σ = 0.03/3000).
+    assert_eq!(px[0]["error"], "Sxy");
+    assert!(px[0]["dr_dstd"].as_f64().unwrap() < 0.0);
+
+    let out = chain(&["sensitivity", file.to_str().unwrap()]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("px (exact), sorted by |dR/dstd|"));
+}
