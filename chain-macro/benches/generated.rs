@@ -61,7 +61,10 @@ fn gantry(c: &mut Criterion) {
     c.bench_function("gantry_sensitivity/hand_written", |b| {
         b.iter(|| black_box(hand_written(black_box(&q))))
     });
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/machines/gantry_grinder.yaml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../examples/machines/gantry_grinder.yaml"
+    );
     let machine = chain::core::load_file(std::path::Path::new(path)).expect("valid machine");
     let runtime = chain::core::compile(&machine);
     let mut out = vec![0.0; 6 * 21];
@@ -83,7 +86,10 @@ fn five_axis(c: &mut Criterion) {
     c.bench_function("cnc5_bevel_sensitivity/generated", |b| {
         b.iter(|| black_box(Cnc5Bevel::sensitivity(black_box(&q), black_box(&p))))
     });
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/machines/cnc5_bevel.yaml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../examples/machines/cnc5_bevel.yaml"
+    );
     let machine = chain::core::load_file(std::path::Path::new(path)).expect("valid machine");
     let runtime = chain::core::compile(&machine);
     let mut out = vec![0.0; 6 * runtime.errors().len()];

@@ -213,8 +213,16 @@ mod tests {
             let fd_std = (r(mu, sd + h) - r(mu, sd - h)) / (2.0 * h);
             let fd_mean = (r(mu + h, sd) - r(mu - h, sd)) / (2.0 * h);
             let a = s.inputs[j];
-            assert!((a.dr_dstd - fd_std).abs() <= 1e-5 * fd_std.abs(), "{j}: {} vs {fd_std}", a.dr_dstd);
-            assert!((a.dr_dmean - fd_mean).abs() <= 1e-5 * fd_mean.abs(), "{j}: {} vs {fd_mean}", a.dr_dmean);
+            assert!(
+                (a.dr_dstd - fd_std).abs() <= 1e-5 * fd_std.abs(),
+                "{j}: {} vs {fd_std}",
+                a.dr_dstd
+            );
+            assert!(
+                (a.dr_dmean - fd_mean).abs() <= 1e-5 * fd_mean.abs(),
+                "{j}: {} vs {fd_mean}",
+                a.dr_dmean
+            );
         }
     }
 }

@@ -137,6 +137,10 @@ impl MonteCarlo {
             return Err(ReliabilityError::NoSamples);
         }
         let width = events.iter().map(|e| e.inputs.len()).max().unwrap_or(0);
+        // Tolerance limit states in normal inputs are evaluated on the
+        // standard normal draws directly, E_c = m_c + a_c·z: the same samples
+        // (all n inputs drawn) without the x = μ + σ·z pass.
+        let affine: Vec<Option<AffineMc>> = events.iter().map(AffineMc::new).collect();
         let sums = drive(
             events.len(),
             self.samples,
@@ -147,10 +151,17 @@ impl MonteCarlo {
                 let x = &mut x[..event.inputs.len()];
                 let mut rng = CaseRng::new(self.seed, case_id(case), block);
                 let mut fails = 0u64;
-                for _ in 0..count {
-                    event.inputs.sample(&mut rng, x);
-                    if event.limit_state.value(x) <= 0.0 {
-                        fails += 1;
+                if let Some(a) = &affine[case] {
+                    for _ in 0..count {
+                        rng.fill_normal(x);
+                        fails += u64::from(a.fails(x));
+                    }
+                } else {
+                    for _ in 0..count {
+                        event.inputs.sample(&mut rng, x);
+                        if event.limit_state.value(x) <= 0.0 {
+                            fails += 1;
+                        }
                     }
                 }
                 let f = fails as f64;
@@ -324,6 +335,46 @@ where
             })
         })
         .collect()
+}
+
+/// A tolerance limit state in normal inputs seen on standard normal draws:
+/// `E_c = m_c + a_c·z`.
+struct AffineMc {
+    k: usize,
+    n: usize,
+    m: Vec<f64>,
+    a: Vec<f64>,
+    tolerances: Vec<f64>,
+    criterion: Criterion,
+}
+
+impl AffineMc {
+    fn new<L: LimitState>(event: &Event<'_, L>) -> Option<AffineMc> {
+        let aff = event.affine()?;
+        let ls = aff.limit_state;
+        Some(AffineMc {
+            k: ls.components(),
+            n: event.inputs.len(),
+            m: aff.mean.clone(),
+            a: aff.a.clone(),
+            tolerances: ls.tolerances().to_vec(),
+            criterion: ls.criterion(),
+        })
+    }
+
+    /// Whether `g ≤ 0` at the draw `z`.
+    #[inline]
+    fn fails(&self, z: &[f64]) -> bool {
+        let e = |c: usize| self.m[c] + dot(&self.a[c * self.n..(c + 1) * self.n], z);
+        match self.criterion {
+            Criterion::Each(Sided::Upper) => (0..self.k).any(|c| e(c) >= self.tolerances[c]),
+            Criterion::Each(Sided::Two) => (0..self.k).any(|c| e(c).abs() >= self.tolerances[c]),
+            Criterion::Norm => {
+                let t = self.tolerances[0];
+                (0..self.k).map(|c| e(c).powi(2)).sum::<f64>() >= t * t
+            }
+        }
+    }
 }
 
 /// What one case of the importance sampling needs, prepared once.
