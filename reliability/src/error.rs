@@ -71,7 +71,12 @@ pub enum ReliabilityError {
     /// An error of the model has no input distribution.
     #[error("no input distribution for error `{0}`")]
     MissingInput(String),
-    /// A sampler was asked for no samples.
-    #[error("the number of samples must be at least 1")]
-    NoSamples,
+    /// A sampler was asked for no samples, or for too many.
+    #[error("the number of samples must be between 1 and {max} (found {found})")]
+    InvalidSamples {
+        /// The count asked for.
+        found: u64,
+        /// The largest allowed.
+        max: u64,
+    },
 }

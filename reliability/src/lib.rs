@@ -17,7 +17,7 @@
 //!   per component, series or volumetric ([`Criterion`]);
 //! - [`Event`]: a limit state with its inputs;
 //! - algorithms [`Form`], [`ImportanceSampling`], [`MonteCarlo`] and the
-//!   function [`sensitivity`], returning plain serialisable results
+//!   function [`sensitivity()`], returning plain serialisable results
 //!   ([`FormResult`], [`SimulationResult`], [`SensitivityResult`]);
 //! - [`Study`]: all of it over a workspace grid for any
 //!   [`chain_core::ErrorModel`] (runtime-compiled or `machine!`-generated),

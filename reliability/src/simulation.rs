@@ -39,6 +39,9 @@ use rayon::prelude::*;
 /// Samples per block (the unit of parallel work and of random streams).
 pub const BLOCK: u64 = 1 << 16;
 
+/// The largest number of samples per case (2³⁶ ≈ 6.9·10¹⁰).
+pub const MAX_SAMPLES: u64 = 1 << 36;
+
 /// A progress sink: told how many samples have been done, from any thread.
 pub trait Progress: Sync {
     /// `samples` more samples are done.
@@ -133,9 +136,7 @@ impl MonteCarlo {
         events: &[Event<'_, L>],
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
-        if self.samples == 0 {
-            return Err(ReliabilityError::NoSamples);
-        }
+        check_samples(self.samples)?;
         let width = events.iter().map(|e| e.inputs.len()).max().unwrap_or(0);
         // Tolerance limit states in normal inputs are evaluated on the
         // standard normal draws directly, E_c = m_c + a_c·z: the same samples
@@ -225,9 +226,7 @@ impl ImportanceSampling {
         forms: Vec<FormResult>,
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
-        if self.samples == 0 {
-            return Err(ReliabilityError::NoSamples);
-        }
+        check_samples(self.samples)?;
         if forms.len() != events.len() {
             return Err(ReliabilityError::Dimension {
                 what: "FORM results",
@@ -309,32 +308,43 @@ where
     F: Fn(usize, u32, u64, &mut [f64]) -> Sums + Sync,
 {
     let blocks = samples.div_ceil(BLOCK);
-    let tasks: Vec<(usize, u64)> = (0..cases)
-        .flat_map(|c| (0..blocks).map(move |b| (c, b)))
-        .collect();
-    let sums: Vec<Sums> = tasks
-        .par_iter()
-        .map_init(
-            || vec![0.0; width],
-            |scratch, &(case, block)| {
-                let count = BLOCK.min(samples - block * BLOCK);
-                let block_id = u32::try_from(block).unwrap_or(u32::MAX);
-                let s = run(case, block_id, count, scratch);
-                progress.advance(count);
-                s
-            },
-        )
-        .collect();
-    let per_case = usize::try_from(blocks).unwrap_or(usize::MAX);
-    sums.chunks(per_case.max(1))
-        .map(|chunk| {
-            chunk.iter().fold(Sums::default(), |a, b| Sums {
+    (0..cases)
+        .into_par_iter()
+        .map(|case| {
+            let sums: Vec<Sums> = (0..blocks)
+                .into_par_iter()
+                .map_init(
+                    // Padded by a cache line on each side: the scratch of two
+                    // workers must not share a line (false sharing).
+                    || vec![0.0; width + 16],
+                    |scratch, block| {
+                        let count = BLOCK.min(samples - block * BLOCK);
+                        let block_id = u32::try_from(block).unwrap_or(u32::MAX);
+                        let s = run(case, block_id, count, &mut scratch[8..8 + width]);
+                        progress.advance(count);
+                        s
+                    },
+                )
+                .collect();
+            // Block order, whatever thread ran which block.
+            sums.iter().fold(Sums::default(), |a, b| Sums {
                 s1: a.s1 + b.s1,
                 s2: a.s2 + b.s2,
                 calls: a.calls + b.calls,
             })
         })
         .collect()
+}
+
+/// Checks a sample count: at least 1, at most [`MAX_SAMPLES`].
+fn check_samples(samples: u64) -> Result<(), ReliabilityError> {
+    if samples == 0 || samples > MAX_SAMPLES {
+        return Err(ReliabilityError::InvalidSamples {
+            found: samples,
+            max: MAX_SAMPLES,
+        });
+    }
+    Ok(())
 }
 
 /// A tolerance limit state in normal inputs seen on standard normal draws:

@@ -372,7 +372,7 @@ fn code(err: &ReliabilityError) -> &'static str {
         ReliabilityError::EmptyGrid(_) => "empty_grid",
         ReliabilityError::MissingCoordinate(_) => "missing_coordinate",
         ReliabilityError::NonFinite(_) => "non_finite",
-        ReliabilityError::NoSamples => "no_samples",
+        ReliabilityError::InvalidSamples { .. } => "invalid_samples",
         _ => "error",
     }
 }
