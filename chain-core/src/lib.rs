@@ -15,6 +15,7 @@ pub mod eval;
 pub mod expand;
 pub mod export;
 pub mod expr;
+pub mod geometric;
 pub mod inline;
 pub mod load;
 pub mod model;

@@ -44,6 +44,7 @@
 
 #![warn(missing_docs)]
 
+pub mod allocate;
 pub mod error;
 pub mod form;
 pub mod inputs;
@@ -56,6 +57,7 @@ pub mod simulation;
 pub mod study;
 mod util;
 
+pub use allocate::{AllocateError, Allocation, ErrorBounds, Kkt, Optimal, Paper, Step};
 pub use chain_core::ErrorModel;
 pub use error::ReliabilityError;
 pub use form::{BranchResult, Calls, Form, FormResult, Termination};

@@ -1,6 +1,7 @@
 //! Subcommands of the `chain` binary: one file per subcommand, each a thin
 //! `exec` over the libraries.
 
+pub mod allocate;
 pub mod compensate;
 pub mod derive;
 pub mod reliability;
@@ -23,8 +24,10 @@ enum Command {
     Derive(derive::DeriveArgs),
     /// Machining-accuracy reliability over the workspace grid (FORM, importance sampling, Monte Carlo).
     Reliability(reliability::ReliabilityArgs),
-    /// Reliability sensitivity to each error's mean and standard deviation.
+    /// Reliability sensitivity (default) or geometric sensitivity coefficients (`--kind geometric`, seed 004).
     Sensitivity(sensitivity::SensitivityArgs),
+    /// Precision allocation: the paper's tightening or the least-cost tolerances.
+    Allocate(allocate::AllocateArgs),
     /// Identify and compensate a swing-angle error from tool-tip heights (seed 003).
     Compensate(compensate::CompensateArgs),
 }
@@ -35,6 +38,7 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Derive(args) => derive::exec(args),
         Command::Reliability(args) => reliability::exec(args),
         Command::Sensitivity(args) => sensitivity::exec(args),
+        Command::Allocate(args) => allocate::exec(args),
         Command::Compensate(args) => compensate::exec(args),
     }
 }

@@ -1,17 +1,38 @@
-//! `chain sensitivity FILE [--at x=..,y=..,z=..] [--format table|json]`.
+//! `chain sensitivity FILE [--kind reliability|geometric] [--at x=..,y=..,z=..]
+//! [--format table|json]`.
 //!
-//! The reliability sensitivity of each component to the mean and standard
+//! `--kind reliability` (the default): the reliability sensitivity of each component to the mean and standard
 //! deviation of every error parameter (seed 000, Eq. 32-33) and its FORM
 //! importance factor: at one point with `--at`, otherwise the mean over the
 //! file's reliability grid (the paper's Figures 6-8). Lists are sorted by
 //! `|∂R/∂σ|`, largest first.
+//!
+//! `--kind geometric`: the geometric error sensitivity coefficients of seed
+//! 004 (Eq. 4-6), `S = |∂E_u/∂e_v|` and `C = S·e / Σ S·e` per direction,
+//! at `--at` or averaged over the reliability grid (or `--grid`), with
+//! `--values` giving the nominal error sizes and `--plot DIR` bar charts like
+//! the paper's Figures 3-5 (see `docs/geometric_sensitivity.md`).
+
+#[path = "geometric_plot.rs"]
+mod geometric_plot;
 
 use std::path::PathBuf;
 
+use chain_core::geometric::{self, GeometricSensitivity, NominalSizes};
 use reliability::{machine, Form, ReliabilityError, SensitivityMethod, TargetSensitivity};
 use serde_json::{json, Map, Value};
 
 use super::reliability::{parse_assignment, write_stdout, Loaded, SidedArg};
+
+/// What `chain sensitivity` computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum SensitivityKind {
+    /// Reliability sensitivity to each error's mean and standard deviation.
+    #[default]
+    Reliability,
+    /// Geometric error sensitivity coefficients `S = |∂E/∂e|`, `C = S·e/ΣS·e` (seed 004).
+    Geometric,
+}
 
 /// Output formats of `chain sensitivity`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -40,6 +61,42 @@ pub struct SensitivityArgs {
     /// Override the file's `sided`.
     #[arg(long, value_enum)]
     pub sided: Option<SidedArg>,
+    /// What to compute.
+    #[arg(long, value_enum, default_value = "reliability")]
+    pub kind: SensitivityKind,
+    /// Nominal error sizes for `--kind geometric`: `linear=MM,angular=ANGLE[,squareness=ANGLE]`,
+    /// angles in radians or with a `deg` suffix (default `linear=0.001,angular=0.001deg`).
+    #[arg(long, value_name = "KIND=VALUE,...", value_parser = parse_values)]
+    pub values: Option<NominalSizes>,
+    /// Replace the grid values of one axis for the grid mean, `VAR=v1,v2,...` (repeatable).
+    #[arg(long = "grid", value_name = "VAR=V1,V2,...", value_parser = parse_axis)]
+    pub grid: Vec<(String, Vec<f64>)>,
+    /// Write bar charts of the coefficients (PNG and SVG) into DIR (`--kind geometric`).
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+}
+
+/// Parses `--values`.
+fn parse_values(s: &str) -> Result<NominalSizes, String> {
+    NominalSizes::default().parse(s)
+}
+
+/// Parses `VAR=v1,v2,...`.
+fn parse_axis(s: &str) -> Result<(String, Vec<f64>), String> {
+    let (name, values) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected VAR=V1,V2,..., found `{s}`"))?;
+    let values = values
+        .split(',')
+        .map(|v| {
+            v.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| format!("`{v}` is not a finite number"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((name.trim().to_string(), values))
 }
 
 /// The coordinates of `--at`, `(variable, value)` in the order given.
@@ -57,8 +114,23 @@ fn parse_point(s: &str) -> Result<AtPoint, String> {
 
 /// Runs `chain sensitivity`.
 pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
+    if args.kind == SensitivityKind::Geometric {
+        return exec_geometric(args);
+    }
+    if args.values.is_some() {
+        return Err(miette::miette!(
+            help = "add --kind geometric",
+            "--values applies only to --kind geometric"
+        ));
+    }
+    if args.plot.is_some() {
+        return Err(miette::miette!(
+            help = "`chain reliability --plot DIR` draws the reliability sensitivities; or add --kind geometric",
+            "--plot applies only to --kind geometric"
+        ));
+    }
     let loaded = Loaded::new(&args.file)?;
-    let (study, model) = loaded.study(&args.params, &[], args.sided, None)?;
+    let (study, model) = loaded.study(&args.params, &args.grid, args.sided, None)?;
     let form = Form::default();
     let (at, result) = match &args.at {
         None => (
@@ -211,4 +283,298 @@ fn to_table(machine: &str, at: Option<&[(String, f64)]>, result: &[TargetSensiti
         }
     }
     out
+}
+
+// ---------------------------------------------------------------------------
+// `--kind geometric` (seed 004, Eq. 4-6).
+
+/// Where the geometric coefficients were evaluated.
+enum Where {
+    /// One point, `(variable, value)` in the model's variable order.
+    At(Vec<(String, f64)>),
+    /// The mean over a grid, `(variable, values)` in the model's variable order.
+    Grid(Vec<(String, Vec<f64>)>),
+}
+
+fn unknown_variable(loaded: &Loaded, name: &str) -> miette::Report {
+    let m = &loaded.machine;
+    loaded.report(ReliabilityError::UnknownName {
+        kind: "axis variable",
+        name: name.to_string(),
+        hint: chain_core::diagnostic::closest(name, m.variables.iter().map(|v| v.name.as_str()))
+            .map(str::to_string),
+    })
+}
+
+fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {
+    let loaded = Loaded::new(&args.file)?;
+    let m = &loaded.machine;
+    let params = machine::parameters(m, &args.params).map_err(|e| loaded.report(e))?;
+    let model = chain_core::compile(m);
+    let nominal = args.values.unwrap_or_default();
+    let sizes = nominal.of(m);
+    let vars: Vec<&str> = m.variables.iter().map(|v| v.name.as_str()).collect();
+    let every = || {
+        vars.iter()
+            .map(|v| format!("{v}=…"))
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    let (where_, result) = match &args.at {
+        Some(AtPoint(coords)) => {
+            if !args.grid.is_empty() {
+                return Err(miette::miette!(
+                    help =
+                        "--at evaluates at one point, --grid sets the grid of the mean; give one",
+                    "--grid cannot be combined with --at"
+                ));
+            }
+            for (name, _) in coords {
+                if !vars.contains(&name.as_str()) {
+                    return Err(unknown_variable(&loaded, name));
+                }
+            }
+            let point = vars
+                .iter()
+                .map(|v| {
+                    coords
+                        .iter()
+                        .rev()
+                        .find(|(n, _)| n == v)
+                        .map(|(_, x)| *x)
+                        .ok_or_else(|| {
+                            miette::miette!(
+                                help = format!("give every axis variable: --at {}", every()),
+                                "--at has no value for axis variable `{v}`"
+                            )
+                        })
+                })
+                .collect::<miette::Result<Vec<f64>>>()?;
+            let r = geometric::at_point(&model, &point, &params, &sizes);
+            let at = vars
+                .iter()
+                .zip(&point)
+                .map(|(n, x)| (n.to_string(), *x))
+                .collect();
+            (Where::At(at), r)
+        }
+        None => {
+            let mut axes: Vec<(String, Vec<f64>)> = m
+                .reliability
+                .as_ref()
+                .map(|r| {
+                    r.grid
+                        .iter()
+                        .map(|(i, v)| (vars[*i].to_string(), v.clone()))
+                        .collect()
+                })
+                .unwrap_or_default();
+            for (name, values) in &args.grid {
+                if !vars.contains(&name.as_str()) {
+                    return Err(unknown_variable(&loaded, name));
+                }
+                match axes.iter_mut().find(|(n, _)| n == name) {
+                    Some(axis) => axis.1 = values.clone(),
+                    None => axes.push((name.clone(), values.clone())),
+                }
+            }
+            let ordered = vars
+                .iter()
+                .map(|v| {
+                    let values = axes.iter().find(|(n, _)| n == v).map(|(_, x)| x.clone());
+                    match values {
+                        Some(x) if !x.is_empty() => Ok((v.to_string(), x)),
+                        _ => Err(miette::miette!(
+                            help = format!(
+                                "evaluate at one point with --at {}, or give the grid with --grid {v}=V1,V2,...",
+                                every()
+                            ),
+                            "{}: no grid values for axis variable `{v}` (key `reliability.grid.{v}`)",
+                            loaded.machine.file.as_deref().unwrap_or("machine")
+                        )),
+                    }
+                })
+                .collect::<miette::Result<Vec<_>>>()?;
+            let values: Vec<Vec<f64>> = ordered.iter().map(|(_, x)| x.clone()).collect();
+            let points = geometric::grid_points(&values);
+            let r = geometric::mean_over(&model, points, &params, &sizes);
+            (Where::Grid(ordered), r)
+        }
+    };
+    if let Some(dir) = &args.plot {
+        let files = geometric_plot::write_all(dir, &m.name, &where_text(&where_), &result)?;
+        for f in files {
+            eprintln!("wrote {}", f.display());
+        }
+    }
+    let text = match args.format {
+        SensitivityFormat::Json => {
+            let mut s =
+                serde_json::to_string_pretty(&geometric_json(&m.name, &where_, &nominal, &result))
+                    .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
+            s.push('\n');
+            s
+        }
+        SensitivityFormat::Table => geometric_table(&m.name, &where_, &nominal, &result),
+    };
+    write_stdout(&text)
+}
+
+fn where_text(w: &Where) -> String {
+    match w {
+        Where::At(a) => format!(
+            "at {}",
+            a.iter()
+                .map(|(n, v)| format!("{n} = {v}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        Where::Grid(g) => format!(
+            "mean over {} grid points",
+            g.iter().map(|(_, v)| v.len()).product::<usize>()
+        ),
+    }
+}
+
+fn geometric_json(
+    machine: &str,
+    where_: &Where,
+    nominal: &NominalSizes,
+    r: &GeometricSensitivity,
+) -> Value {
+    let mut components = Map::new();
+    let mut totals = Map::new();
+    for c in &r.components {
+        let list: Vec<Value> = c
+            .ranked
+            .iter()
+            .map(|e| {
+                let mut o = Map::new();
+                o.insert("error".into(), json!(e.error));
+                o.insert("s".into(), json!(e.s));
+                o.insert("c".into(), json!(e.c));
+                o.insert("e".into(), json!(e.e));
+                if let Where::Grid(_) = where_ {
+                    o.insert("c_min".into(), json!(e.c_min));
+                    o.insert("c_max".into(), json!(e.c_max));
+                }
+                Value::Object(o)
+            })
+            .collect();
+        components.insert(c.component.name().into(), Value::Array(list));
+        totals.insert(c.component.name().into(), json!(c.total));
+    }
+    let (at, grid) = match where_ {
+        Where::At(a) => (
+            Value::Object(a.iter().map(|(n, v)| (n.clone(), json!(v))).collect()),
+            Value::Null,
+        ),
+        Where::Grid(g) => (
+            Value::Null,
+            Value::Object(g.iter().map(|(n, v)| (n.clone(), json!(v))).collect()),
+        ),
+    };
+    let mut doc = Map::new();
+    doc.insert("machine".into(), json!(machine));
+    doc.insert("kind".into(), json!("geometric"));
+    doc.insert("at".into(), at);
+    if !grid.is_null() {
+        doc.insert("grid".into(), grid);
+        doc.insert("points".into(), json!(r.points));
+    }
+    doc.insert("normalisation".into(), json!("c = s*e / sum(s*e)"));
+    doc.insert(
+        "values".into(),
+        json!({"linear": nominal.linear, "angular": nominal.angular, "squareness": nominal.squareness}),
+    );
+    doc.insert("totals".into(), Value::Object(totals));
+    doc.insert("components".into(), Value::Object(components));
+    Value::Object(doc)
+}
+
+fn geometric_table(
+    machine: &str,
+    where_: &Where,
+    nominal: &NominalSizes,
+    r: &GeometricSensitivity,
+) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{machine}: geometric error sensitivity (seed 004 Eq. 5-6), {}",
+        where_text(where_)
+    );
+    let _ = writeln!(
+        out,
+        "S = |dE/de|, C = S·e / sum(S·e); e = {} (linear), {:.6e} rad = {}° (angular), {:.6e} rad (squareness)",
+        nominal.linear,
+        nominal.angular,
+        round(nominal.angular.to_degrees()),
+        nominal.squareness
+    );
+    let grid = matches!(where_, Where::Grid(_));
+    for c in &r.components {
+        let shown: Vec<_> = c.ranked.iter().filter(|e| e.s > 0.0).collect();
+        if shown.is_empty() {
+            let _ = writeln!(
+                out,
+                "\n{}: no error acts in this direction",
+                c.component.name()
+            );
+            continue;
+        }
+        let _ = writeln!(
+            out,
+            "\n{} (sum of S·e = {:.6e}), sorted by C:",
+            c.component.name(),
+            c.total
+        );
+        if grid {
+            let _ = writeln!(
+                out,
+                "  {:>4} {:<10} {:>14} {:>9} {:>9} {:>9}",
+                "rank", "error", "S (mean)", "C %", "min %", "max %"
+            );
+        } else {
+            let _ = writeln!(
+                out,
+                "  {:>4} {:<10} {:>14} {:>9}",
+                "rank", "error", "S", "C %"
+            );
+        }
+        for (i, e) in shown.iter().enumerate() {
+            if grid {
+                let _ = writeln!(
+                    out,
+                    "  {:>4} {:<10} {:>14.6} {:>9.2} {:>9.2} {:>9.2}",
+                    i + 1,
+                    e.error,
+                    e.s,
+                    100.0 * e.c,
+                    100.0 * e.c_min,
+                    100.0 * e.c_max
+                );
+            } else {
+                let _ = writeln!(
+                    out,
+                    "  {:>4} {:<10} {:>14.6} {:>9.2}",
+                    i + 1,
+                    e.error,
+                    e.s,
+                    100.0 * e.c
+                );
+            }
+        }
+        let zero = c.ranked.len() - shown.len();
+        if zero > 0 {
+            let _ = writeln!(out, "  ({zero} errors with S = 0 not listed)");
+        }
+    }
+    out
+}
+
+/// Rounds to 10 significant digits (no float noise in printed degrees).
+fn round(x: f64) -> f64 {
+    format!("{x:.9e}").parse().unwrap_or(x)
 }

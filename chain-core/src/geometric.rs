@@ -1,0 +1,336 @@
+//! Geometric error sensitivity coefficients (seed 004, Fan et al. 2020,
+//! Eq. 4-6), for any error model.
+//!
+//! For each error component `u` (`px, py, pz, ox, oy, oz`) and error parameter
+//! `v`:
+//!
+//! - the sensitivity `S_uv = |∂E_u/∂e_v|` (Eq. 5), exact, from
+//!   [`ErrorModel::sensitivity`];
+//! - the normalised coefficient `C_uv = S_uv·e_v / Σ_w S_uw·e_w` (Eq. 6 with
+//!   each sensitivity weighted by the nominal size `e_v` of its error), so
+//!   that `C_uv` is the share of error `v` in the worst-case first-order sum
+//!   of direction `u`, and `Σ_v C_uv = 1` whenever the direction has any
+//!   error at all (otherwise every `C_uv = 0`).
+//!
+//! `e_v` is chosen by the error's kind ([`ErrorKind`]): a length for linear
+//! errors, an angle (radians) for angular and squareness errors
+//! ([`NominalSizes`]). With equal numbers for both (e.g. 0.001 mm and
+//! 0.001 rad) the weighting cancels and `C = S/ΣS`, Eq. 6 as printed; this is
+//! the normalisation the paper's Figures 3-5 imply (see
+//! `docs/geometric_sensitivity.md`).
+//!
+//! ```
+//! use chain_core::{geometric, load_str};
+//! let yaml = "machine: m\nbodies:\n  bed: {}\n  x_slide: {parent: bed, joint: {type: prismatic, axis: +x, variable: x}, errors: {dx: dxx, ez: ezx}}\nworkpiece: bed\ntool: x_slide\ntool_point: [0, 100, 0]\n";
+//! let machine = load_str(yaml, "m.yaml").unwrap();
+//! let model = chain_core::compile(&machine);
+//! let sizes = geometric::NominalSizes::default().of(&machine);
+//! let r = geometric::at_point(&model, &[0.0], &[], &sizes);
+//! // px = dxx - 100·ezx: S = (1, 100), S·e = (0.001, 100·0.001°).
+//! let px = &r.components[0];
+//! assert_eq!(px.ranked[0].error, "ezx");
+//! assert!((px.ranked[0].s - 100.0).abs() < 1e-12);
+//! assert!((px.ranked[0].c + px.ranked[1].c - 1.0).abs() < 1e-12);
+//! ```
+
+use serde::Serialize;
+
+use crate::model::{Component, ErrorKind, Machine};
+use crate::ErrorModel;
+
+/// One degree in radians.
+const DEG: f64 = std::f64::consts::PI / 180.0;
+
+/// The nominal size `e_v` of each kind of error.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct NominalSizes {
+    /// Linear errors, in the model's length unit (mm).
+    pub linear: f64,
+    /// Angular errors, in radians.
+    pub angular: f64,
+    /// Squareness errors, in radians.
+    pub squareness: f64,
+}
+
+impl Default for NominalSizes {
+    /// The paper's values: 0.001 mm and 0.001° (Section 5.2).
+    fn default() -> NominalSizes {
+        NominalSizes {
+            linear: 0.001,
+            angular: 0.001 * DEG,
+            squareness: 0.001 * DEG,
+        }
+    }
+}
+
+impl NominalSizes {
+    /// The size of one kind of error.
+    pub fn of_kind(&self, kind: ErrorKind) -> f64 {
+        match kind {
+            ErrorKind::Linear => self.linear,
+            ErrorKind::Angular => self.angular,
+            ErrorKind::Squareness => self.squareness,
+        }
+    }
+
+    /// `e_v` for every error of the machine, in `machine.errors` order (the
+    /// order of the compiled model's [`ErrorModel::errors`]).
+    pub fn of(&self, machine: &Machine) -> Vec<f64> {
+        machine
+            .errors
+            .iter()
+            .map(|e| self.of_kind(e.kind))
+            .collect()
+    }
+
+    /// Parses `linear=0.001,angular=0.001deg[,squareness=…]`: lengths as
+    /// plain numbers, angles in radians or with a `deg` (or `rad`) suffix.
+    /// Keys not given keep their value in `self`; `squareness` follows
+    /// `angular` unless given. Every value must be finite and positive.
+    pub fn parse(&self, text: &str) -> Result<NominalSizes, String> {
+        let mut out = *self;
+        let mut squareness = None;
+        let mut any = false;
+        for item in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            any = true;
+            let (key, value) = item.split_once('=').ok_or_else(|| {
+                format!("expected KIND=VALUE (linear=0.001,angular=0.001deg), found `{item}`")
+            })?;
+            let key = key.trim();
+            let value = value.trim();
+            let number = |v: &str, angle: bool| -> Result<f64, String> {
+                let (digits, scale) = match (angle, v.strip_suffix("deg"), v.strip_suffix("rad")) {
+                    (true, Some(d), _) => (d, DEG),
+                    (true, None, Some(r)) => (r, 1.0),
+                    _ => (v, 1.0),
+                };
+                let x: f64 = digits.trim().parse().map_err(|_| {
+                    if angle {
+                        format!(
+                            "`{v}` is not an angle (a number in radians, or with a `deg` suffix)"
+                        )
+                    } else {
+                        format!("`{v}` is not a length (a number, in the model's unit)")
+                    }
+                })?;
+                let x = x * scale;
+                if !x.is_finite() || x <= 0.0 {
+                    return Err(format!(
+                        "`{key}={v}`: the nominal error size must be positive and finite"
+                    ));
+                }
+                Ok(x)
+            };
+            match key {
+                "linear" => out.linear = number(value, false)?,
+                "angular" => out.angular = number(value, true)?,
+                "squareness" => squareness = Some(number(value, true)?),
+                other => {
+                    return Err(format!(
+                        "unknown error kind `{other}` (expected linear, angular or squareness)"
+                    ))
+                }
+            }
+        }
+        if !any {
+            return Err("no value given (expected e.g. linear=0.001,angular=0.001deg)".into());
+        }
+        out.squareness = squareness.unwrap_or(out.angular);
+        Ok(out)
+    }
+}
+
+/// One error's sensitivity in one direction.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Coefficient {
+    /// Error parameter name.
+    pub error: String,
+    /// Index in the model's error order.
+    pub index: usize,
+    /// `S_uv = |∂E_u/∂e_v|` (at a point) or its mean over the points.
+    pub s: f64,
+    /// The nominal size `e_v`.
+    pub e: f64,
+    /// `C_uv = S_uv·e_v / Σ_w S_uw·e_w` (at a point) or its mean over the points.
+    pub c: f64,
+    /// Smallest `C_uv` over the points (equal to `c` at one point).
+    pub c_min: f64,
+    /// Largest `C_uv` over the points (equal to `c` at one point).
+    pub c_max: f64,
+}
+
+/// The ranked coefficients of one direction.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ComponentSensitivity {
+    /// The direction.
+    pub component: Component,
+    /// `Σ_v S_uv·e_v`: the worst-case first-order error of this direction
+    /// with every error at its nominal size (mean over the points).
+    pub total: f64,
+    /// Every error of the model, sorted by `c`, largest first (ties in the
+    /// model's error order).
+    pub ranked: Vec<Coefficient>,
+}
+
+impl ComponentSensitivity {
+    /// The entry of one error, if the model has it.
+    pub fn get(&self, error: &str) -> Option<&Coefficient> {
+        self.ranked.iter().find(|c| c.error == error)
+    }
+}
+
+/// The coefficients of all six directions.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GeometricSensitivity {
+    /// Number of points averaged (1 for a single point).
+    pub points: usize,
+    /// `px, py, pz, ox, oy, oz`.
+    pub components: Vec<ComponentSensitivity>,
+}
+
+impl GeometricSensitivity {
+    /// The entry of one direction.
+    pub fn component(&self, c: Component) -> &ComponentSensitivity {
+        &self.components[c.index()]
+    }
+}
+
+/// Accumulates `S` and `C` over points.
+struct Accumulator {
+    n_errors: usize,
+    points: usize,
+    s: Vec<f64>,
+    c: Vec<f64>,
+    c_min: Vec<f64>,
+    c_max: Vec<f64>,
+    total: [f64; 6],
+    buf: Vec<f64>,
+}
+
+impl Accumulator {
+    fn new(n_errors: usize) -> Accumulator {
+        Accumulator {
+            n_errors,
+            points: 0,
+            s: vec![0.0; 6 * n_errors],
+            c: vec![0.0; 6 * n_errors],
+            c_min: vec![f64::INFINITY; 6 * n_errors],
+            c_max: vec![f64::NEG_INFINITY; 6 * n_errors],
+            total: [0.0; 6],
+            buf: vec![0.0; 6 * n_errors],
+        }
+    }
+
+    fn add<M: ErrorModel + ?Sized>(&mut self, model: &M, q: &[f64], p: &[f64], sizes: &[f64]) {
+        let n = self.n_errors;
+        model.sensitivity(q, p, &mut self.buf);
+        for u in 0..6 {
+            let row = &self.buf[u * n..(u + 1) * n];
+            let total: f64 = row.iter().zip(sizes).map(|(s, e)| s.abs() * e).sum();
+            self.total[u] += total;
+            for (v, (s, e)) in row.iter().zip(sizes).enumerate() {
+                let k = u * n + v;
+                let s = s.abs();
+                let c = if total > 0.0 { s * e / total } else { 0.0 };
+                self.s[k] += s;
+                self.c[k] += c;
+                self.c_min[k] = self.c_min[k].min(c);
+                self.c_max[k] = self.c_max[k].max(c);
+            }
+        }
+        self.points += 1;
+    }
+
+    fn finish<M: ErrorModel + ?Sized>(self, model: &M, sizes: &[f64]) -> GeometricSensitivity {
+        let n = self.n_errors;
+        let count = self.points.max(1) as f64;
+        let names = model.errors();
+        let components = Component::ALL
+            .iter()
+            .map(|&component| {
+                let u = component.index();
+                let mut ranked: Vec<Coefficient> = (0..n)
+                    .map(|v| {
+                        let k = u * n + v;
+                        let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
+                        Coefficient {
+                            error: names[v].to_string(),
+                            index: v,
+                            s: self.s[k] / count,
+                            e: sizes[v],
+                            c: self.c[k] / count,
+                            c_min: finite(self.c_min[k]),
+                            c_max: finite(self.c_max[k]),
+                        }
+                    })
+                    .collect();
+                ranked.sort_by(|a, b| b.c.total_cmp(&a.c).then(a.index.cmp(&b.index)));
+                ComponentSensitivity {
+                    component,
+                    total: self.total[u] / count,
+                    ranked,
+                }
+            })
+            .collect();
+        GeometricSensitivity {
+            points: self.points,
+            components,
+        }
+    }
+}
+
+/// `S` and `C` of every direction at axis values `q` and parameter values
+/// `p`, with nominal error sizes `sizes` (in the model's error order, e.g.
+/// [`NominalSizes::of`]).
+///
+/// # Panics
+///
+/// If `sizes` does not have one entry per error of the model.
+pub fn at_point<M: ErrorModel + ?Sized>(
+    model: &M,
+    q: &[f64],
+    p: &[f64],
+    sizes: &[f64],
+) -> GeometricSensitivity {
+    mean_over(model, std::iter::once(q.to_vec()), p, sizes)
+}
+
+/// The mean of `S` and of `C` over a set of points (each `C` is normalised
+/// at its own point, then averaged), with the range of `C` over them.
+///
+/// # Panics
+///
+/// If `sizes` does not have one entry per error of the model.
+pub fn mean_over<M: ErrorModel + ?Sized>(
+    model: &M,
+    points: impl IntoIterator<Item = Vec<f64>>,
+    p: &[f64],
+    sizes: &[f64],
+) -> GeometricSensitivity {
+    let n = model.errors().len();
+    assert_eq!(sizes.len(), n, "one nominal size per error");
+    let mut acc = Accumulator::new(n);
+    for q in points {
+        acc.add(model, &q, p, sizes);
+    }
+    acc.finish(model, sizes)
+}
+
+/// Every point of a full-factorial grid, `axes[i]` being the values of axis
+/// variable `i` (in the model's variable order), the last axis fastest.
+pub fn grid_points(axes: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let mut out = vec![Vec::with_capacity(axes.len())];
+    for values in axes {
+        out = out
+            .into_iter()
+            .flat_map(|prefix| {
+                values.iter().map(move |&x| {
+                    let mut p = prefix.clone();
+                    p.push(x);
+                    p
+                })
+            })
+            .collect();
+    }
+    out
+}
