@@ -215,7 +215,10 @@ fn min_std_bound_binds_and_is_reported() {
     let kkt = r.kkt.unwrap();
     assert!(kkt.residual() < 1e-10, "{kkt:?}");
     assert!((r.std[1].1 - 0.00012).abs() < 1e-15);
-    assert!(kkt.at_bound.iter().any(|(n, w, z)| n == "b" && *w == "min_std" && *z > 0.0));
+    assert!(kkt
+        .at_bound
+        .iter()
+        .any(|(n, w, z)| n == "b" && *w == "min_std" && *z > 0.0));
     let z = normal::inverse_cdf(0.99);
     let sa = ((0.03 / z).powi(2) - 1e4 * 0.00012f64.powi(2)).sqrt();
     assert!(((r.std[0].1 - sa) / sa).abs() < 1e-8);
@@ -302,4 +305,83 @@ fn cli_json_follows_the_contract() {
             assert!(doc["kkt"]["residual"].as_f64().unwrap() < 1e-6);
         }
     }
+}
+
+/// docs/errata.md 000-6 and 000-7: Table 5's fourth round and Table 7's
+/// rounds 2-3 against the model (from Table 1, one step a round).
+#[test]
+fn errata_000_6_and_000_7() {
+    let (m, model, study) = gantry();
+    let b = allocate::bounds(&m, &study).unwrap();
+    let with = |changes: &[(&str, f64)]| {
+        let mut s: Vec<f64> = b.iter().map(|x| x.std0).collect();
+        for (name, v) in changes {
+            let j = b.iter().position(|x| x.error == *name).unwrap();
+            s[j] = *v;
+        }
+        allocate::evaluate(&model, &[], &study, &s)
+            .unwrap()
+            .1
+            .summaries
+    };
+    let near = |s: &[Summary], c: &str, mean: f64, min: f64| {
+        let x = summary(s, c);
+        assert!(
+            (x.mean * 100.0 - mean).abs() < 0.006 && (x.min * 100.0 - min).abs() < 0.006,
+            "{c}: {:.3}/{:.3} vs {mean}/{min}",
+            x.mean * 100.0,
+            x.min * 100.0
+        );
+    };
+    // 000-6: Table 5 round 4 prints 97.76/96.52.
+    let s = with(&[
+        ("eyx", 0.04 / 6000.0),
+        ("ezx", 0.03 / 6000.0),
+        ("ezz", 0.01 / 6000.0),
+        ("Sxy", 0.01 / 3000.0),
+    ]);
+    near(&s, "px", 97.54, 95.49);
+    // 000-7: Table 7 from Table 1, k steps on exx, eyx, exz, Syz.
+    for (k, (mean, min)) in [(2, (97.16, 95.12)), (3, (97.79, 96.50))] {
+        let d = 0.005 * k as f64;
+        let s = with(&[
+            ("exx", (0.03 - d) / 6000.0),
+            ("eyx", (0.06 - d) / 6000.0),
+            ("exz", (0.03 - d) / 6000.0),
+            ("Syz", (0.02 - d) / 3000.0),
+        ]);
+        near(&s, "pz", mean, min);
+    }
+}
+
+#[test]
+fn cli_plot_writes_maps_and_the_tightening_chart() {
+    let dir = scratch("plot");
+    let file = gantry_path();
+    let o = chain(&[
+        "allocate",
+        file.to_str().unwrap(),
+        "--strategy",
+        "paper",
+        "--plot",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for stem in [
+        "allocate_px",
+        "allocate_py",
+        "allocate_pz",
+        "allocate_tightening",
+    ] {
+        for ext in ["png", "svg"] {
+            let f = dir.join(format!("{stem}.{ext}"));
+            assert!(
+                std::fs::metadata(&f)
+                    .map(|m| m.len() > 1000)
+                    .unwrap_or(false),
+                "{f:?}"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

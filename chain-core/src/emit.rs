@@ -379,15 +379,10 @@ impl<'a> Body<'a> {
         if let Some(id) = self.monomial_index.get(m) {
             return quote!(#id);
         }
-        let mut parent = m.0.clone();
-        let last = parent.len() - 1;
-        let sym = parent[last].0;
-        if parent[last].1 == 1 {
-            parent.pop();
-        } else {
-            parent[last].1 -= 1;
-        }
-        let a = self.monomial(&Monomial(parent));
+        let Some((parent, sym)) = m.split_last() else {
+            return quote!(1.0);
+        };
+        let a = self.monomial(&parent);
         let b = self.symbol(sym);
         let id = format_ident!("m{}", self.monomials.len());
         self.monomials

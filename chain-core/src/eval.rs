@@ -226,15 +226,10 @@ impl TapeBuilder {
             return r;
         }
         // m = parent * last symbol
-        let mut parent = m.0.clone();
-        let last = parent.len() - 1;
-        let sym = parent[last].0;
-        if parent[last].1 == 1 {
-            parent.pop();
-        } else {
-            parent[last].1 -= 1;
-        }
-        let a = self.monomial(&Monomial(parent));
+        let Some((parent, sym)) = m.split_last() else {
+            return 0;
+        };
+        let a = self.monomial(&parent);
         let b = self.symbol_reg.get(&sym).copied().unwrap_or(0);
         let dst = to_u32(self.registers);
         self.registers += 1;

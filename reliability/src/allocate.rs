@@ -28,6 +28,9 @@
 //! is [`AllocateError::Infeasible`] naming the component, the case and the
 //! bounds that bind.
 
+// Dense linear algebra over small index ranges reads best with indices.
+#![allow(clippy::needless_range_loop)]
+
 use chain_core::model::{Component, ErrorKind, Machine, Sided};
 use chain_core::ErrorModel;
 use serde::Serialize;
@@ -592,13 +595,36 @@ impl Problem {
 }
 
 fn point_name(study: &Study, p: usize) -> String {
-    study
-        .variables()
+    // In the grid's axis order (x, y, z), then any other variable.
+    let vars = study.variables();
+    let mut order: Vec<usize> = study
+        .spec()
+        .grid
+        .axes
         .iter()
-        .zip(&study.points()[p])
-        .map(|(v, x)| format!("{v}={x}"))
+        .filter_map(|(name, _)| vars.iter().position(|v| v == name))
+        .collect();
+    order.extend(
+        (0..vars.len())
+            .filter(|i| !order.contains(i))
+            .collect::<Vec<_>>(),
+    );
+    order
+        .iter()
+        .map(|&i| format!("{}={}", vars[i], study.points()[p][i]))
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// A short number: 6 significant digits, trailing zeros trimmed.
+fn short(x: f64) -> String {
+    let s = format!("{x:.5e}");
+    match s.split_once('e') {
+        Some((m, e)) if m.contains('.') => {
+            format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
+        }
+        _ => s,
+    }
 }
 
 /// Solves `A x = b` (dense, row-major `n × n`) by Gaussian elimination with
@@ -878,7 +904,9 @@ pub fn optimal<M: ErrorModel + ?Sized>(
             required,
             binding: contrib
                 .iter()
-                .map(|&(j, _)| format!("{} (min_std {:e})", bounds[j].error, bounds[j].min_std))
+                .map(|&(j, _)| {
+                    format!("{} (min_std {})", bounds[j].error, short(bounds[j].min_std))
+                })
                 .collect(),
         });
     }
@@ -1230,4 +1258,96 @@ pub fn components(study: &Study) -> Vec<Target> {
         .copied()
         .filter(|t| matches!(t, Target::Component(_)))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sensitivity::sensitivity;
+
+    const YAML: &str = "
+machine: m
+bodies:
+  bed: {}
+  xs: {parent: bed, joint: {type: prismatic, axis: +x, variable: x}, errors: {dx: a, ez: b}}
+  ys: {parent: xs, joint: {type: prismatic, axis: +y, variable: y}, errors: {dx: c}}
+workpiece: bed
+tool: ys
+statistics:
+  a: {dist: normal, mean: 0.001, std: 0.01}
+  b: {dist: normal, mean: 0, std: 0.00005}
+  c: {dist: normal, mean: -0.002, std: 0.008, min_std: 0.001}
+reliability:
+  tolerance: {px: 0.03}
+  sided: SIDED
+  grid: {x: [0], y: [100, 300, 500]}
+  requirement: {min: 0.9, mean: 0.95}
+";
+
+    fn setup(sided: &str) -> (chain_core::CompiledModel, Study, Vec<ErrorBounds>) {
+        let m = chain_core::load_str(&YAML.replace("SIDED", sided), "m.yaml").unwrap();
+        let model = chain_core::compile(&m);
+        let study = crate::machine::study(&m, &model, &[], None).unwrap();
+        let b = bounds(&m, &study).unwrap();
+        (model, study, b)
+    }
+
+    #[test]
+    fn case_derivatives_match_finite_differences_and_the_sensitivities() {
+        for sided in ["upper", "two"] {
+            let (_, study, b) = setup(sided);
+            let p = build(&study, &b).unwrap();
+            let n = p.n();
+            assert_eq!(n, 3);
+            let t = [0.3, 0.7, 0.2];
+            for k in 0..p.cases.len() {
+                let e = p.case(k, &t, true);
+                for j in 0..n {
+                    let h = 1e-6;
+                    let mut tp = t;
+                    let mut tm = t;
+                    tp[j] += h;
+                    tm[j] -= h;
+                    let (ep, em) = (p.case(k, &tp, true), p.case(k, &tm, true));
+                    let fd = (ep.r - em.r) / (2.0 * h);
+                    assert!((fd - e.grad[j]).abs() < 1e-7, "{sided} grad {k} {j}");
+                    for l in 0..n {
+                        let fd = (ep.grad[l] - em.grad[l]) / (2.0 * h);
+                        assert!((fd - e.hess[j * n + l]).abs() < 1e-6, "{sided} hess");
+                    }
+                }
+            }
+        }
+        // ∂R/∂t = −σ ∂R/∂σ with the engine's exact sensitivities (upper).
+        let (_, study, b) = setup("upper");
+        let p = build(&study, &b).unwrap();
+        let zero = [0.0; 3];
+        for (k, case) in p.cases.iter().enumerate() {
+            let ev = study
+                .event(Target::Component(Component::Px), case.point)
+                .unwrap();
+            let f = Form::default().run(&ev).unwrap();
+            let s = sensitivity(&ev, &f).unwrap();
+            let e = p.case(k, &zero, false);
+            assert!((e.r - f.reliability).abs() < 1e-12);
+            for (i, &j) in p.var.iter().enumerate() {
+                let want = -b[j].std0 * s.inputs[j].dr_dstd;
+                assert!((e.grad[i] - want).abs() < 1e-9 * (1.0 + want.abs()));
+            }
+        }
+    }
+
+    #[test]
+    fn optimum_is_kkt_and_bounds_hold_with_nonzero_means() {
+        for sided in ["upper", "two"] {
+            let (model, study, b) = setup(sided);
+            let r = optimal(&model, &[], &study, &b, &Optimal::default()).unwrap();
+            let k = r.kkt.as_ref().unwrap();
+            assert!(k.residual() < 1e-8, "{sided}: {k:?}");
+            for (bb, (_, s)) in b.iter().zip(&r.std) {
+                assert!(*s <= bb.std0 && *s >= bb.min_std);
+            }
+            assert!(r.cost > 0.0 && r.met);
+        }
+    }
 }

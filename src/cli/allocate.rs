@@ -69,6 +69,10 @@ pub struct AllocateArgs {
     /// Override the file's `sided`.
     #[arg(long, value_enum)]
     pub sided: Option<SidedArg>,
+    /// Write before/after reliability charts per component and a chart of
+    /// the tightening per error (PNG and SVG) into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
 }
 
 /// Runs `chain allocate`.
@@ -96,6 +100,27 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
         ),
     };
     let result = result.map_err(|e| report(&loaded, e))?;
+    if let Some(dir) = &args.plot {
+        let stds: Vec<f64> = result.std.iter().map(|(_, s)| *s).collect();
+        let before = study
+            .form(&reliability::Form::default())
+            .map_err(|e| loaded.report(e))?;
+        let (_, after) =
+            allocate::evaluate(&model, &values, &study, &stds).map_err(|e| loaded.report(e))?;
+        let files = plot(
+            dir,
+            &loaded.machine.name,
+            &study,
+            &bounds,
+            &result,
+            &before,
+            &after,
+        )
+        .map_err(|e| miette::miette!("{e}"))?;
+        for f in files {
+            eprintln!("wrote {}", f.display());
+        }
+    }
     let req = study.spec().requirement;
     let text = match args.format {
         AllocateFormat::Json => {
@@ -117,6 +142,86 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
     Ok(())
 }
 
+/// Before/after reliability over the grid per component, and the tightening
+/// `σ0/σ` per error (per round for the paper's procedure).
+fn plot(
+    dir: &std::path::Path,
+    machine: &str,
+    study: &reliability::Study,
+    bounds: &[ErrorBounds],
+    r: &Allocation,
+    before: &reliability::StudyResult,
+    after: &reliability::StudyResult,
+) -> Result<Vec<PathBuf>, chain::plot::PlotError> {
+    use chain::plot::{Legend, Series, XyChart};
+    let mut files = Vec::new();
+    let np = study.points().len();
+    let axes: Vec<&str> = study
+        .spec()
+        .grid
+        .axes
+        .iter()
+        .map(|(n, _)| n.as_str())
+        .collect();
+    let req = study.spec().requirement;
+    for (t, target) in study.targets().iter().enumerate() {
+        let pts = |res: &reliability::StudyResult| -> Vec<(f64, f64)> {
+            res.cases[t * np..(t + 1) * np]
+                .iter()
+                .enumerate()
+                .map(|(i, c)| ((i + 1) as f64, c.reliability * 100.0))
+                .collect()
+        };
+        let mut chart = XyChart::new(
+            format!(
+                "{machine}: {} reliability before and after allocation ({})",
+                target.name(),
+                r.strategy
+            ),
+            format!("grid point ({} order, first slowest)", axes.join(", ")),
+            "reliability (%)",
+        )
+        .series(Series::line_points("before", pts(before)))
+        .series(Series::line_points("after", pts(after)))
+        .legend(Legend::LowerRight);
+        if let Some(q) = req {
+            chart = chart.hline(q.min * 100.0);
+        }
+        files.extend(chart.write(dir, &format!("allocate_{}", target.name()))?);
+    }
+    let mut chart = XyChart::new(
+        format!("{machine}: tightening per error ({})", r.strategy),
+        if r.steps.is_empty() {
+            "initial (0) → allocated (1)"
+        } else {
+            "round"
+        },
+        "std0 / std",
+    )
+    .legend(Legend::UpperLeft);
+    for (j, b) in bounds.iter().enumerate() {
+        let last = r.std[j].1;
+        if (last - b.std0).abs() <= 1e-15 * b.std0 {
+            continue;
+        }
+        let mut points = vec![(0.0, 1.0)];
+        if r.steps.is_empty() {
+            points.push((1.0, b.std0 / last));
+        } else {
+            let mut s = b.std0;
+            for step in &r.steps {
+                if let Some((_, v)) = step.std.iter().find(|(n, _)| *n == b.error) {
+                    s = *v;
+                }
+                points.push((step.round as f64, b.std0 / s));
+            }
+        }
+        chart = chart.series(Series::line_points(b.error.clone(), points));
+    }
+    files.extend(chart.write(dir, "allocate_tightening")?);
+    Ok(files)
+}
+
 fn report(loaded: &Loaded, err: AllocateError) -> miette::Report {
     match err {
         AllocateError::Reliability(e) => loaded.report(e),
@@ -130,7 +235,9 @@ fn report(loaded: &Loaded, err: AllocateError) -> miette::Report {
         AllocateError::NoRequirement => miette::Report::new(
             MietteDiagnostic::new(format!("{}: {err}", loaded.machine.name))
                 .with_code("chain::allocate::no_requirement")
-                .with_help("add, e.g., `requirement: {min: 0.95, mean: 0.97}` to the reliability section"),
+                .with_help(
+                    "add, e.g., `requirement: {min: 0.95, mean: 0.97}` to the reliability section",
+                ),
         ),
         other => miette::Report::new(
             MietteDiagnostic::new(format!("{}: {other}", loaded.machine.name))
@@ -221,7 +328,11 @@ fn to_table(
     use std::fmt::Write as _;
     let mut out = String::new();
     let req_text = req.map_or("none".to_string(), |q| {
-        format!("min ≥ {:.2} %, mean ≥ {:.2} %", q.min * 100.0, q.mean * 100.0)
+        format!(
+            "min ≥ {:.2} %, mean ≥ {:.2} %",
+            q.min * 100.0,
+            q.mean * 100.0
+        )
     });
     let _ = writeln!(
         out,

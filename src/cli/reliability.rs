@@ -418,8 +418,8 @@ pub(crate) fn parse_assignment(s: &str) -> Result<(String, f64), String> {
     Ok((name.trim().to_string(), v))
 }
 
-/// Parses `VAR=v1,v2,...`.
-fn parse_axis(s: &str) -> Result<(String, Vec<f64>), String> {
+/// Parses `VAR=v1,v2,...` (a grid axis on the command line).
+pub(crate) fn parse_axis(s: &str) -> Result<(String, Vec<f64>), String> {
     let (name, values) = s
         .split_once('=')
         .ok_or_else(|| format!("expected VAR=V1,V2,..., found `{s}`"))?;

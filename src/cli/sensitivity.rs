@@ -22,7 +22,7 @@ use chain_core::geometric::{self, GeometricSensitivity, NominalSizes};
 use reliability::{machine, Form, ReliabilityError, SensitivityMethod, TargetSensitivity};
 use serde_json::{json, Map, Value};
 
-use super::reliability::{parse_assignment, write_stdout, Loaded, SidedArg};
+use super::reliability::{parse_assignment, parse_axis, write_stdout, Loaded, SidedArg};
 
 /// What `chain sensitivity` computes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -79,24 +79,6 @@ pub struct SensitivityArgs {
 /// Parses `--values`.
 fn parse_values(s: &str) -> Result<NominalSizes, String> {
     NominalSizes::default().parse(s)
-}
-
-/// Parses `VAR=v1,v2,...`.
-fn parse_axis(s: &str) -> Result<(String, Vec<f64>), String> {
-    let (name, values) = s
-        .split_once('=')
-        .ok_or_else(|| format!("expected VAR=V1,V2,..., found `{s}`"))?;
-    let values = values
-        .split(',')
-        .map(|v| {
-            v.trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| format!("`{v}` is not a finite number"))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok((name.trim().to_string(), values))
 }
 
 /// The coordinates of `--at`, `(variable, value)` in the order given.

@@ -48,6 +48,21 @@ impl Monomial {
         self.0.is_empty()
     }
 
+    /// Splits off one factor of the last symbol: `m = rest · s`. `None` for
+    /// the constant monomial. Builders of evaluation code use it to compute
+    /// each monomial from a shorter one with one multiplication.
+    pub fn split_last(&self) -> Option<(Monomial, Symbol)> {
+        let mut rest = self.0.clone();
+        let last = rest.last_mut()?;
+        let sym = last.0;
+        if last.1 == 1 {
+            rest.pop();
+        } else {
+            last.1 -= 1;
+        }
+        Some((Monomial(rest), sym))
+    }
+
     /// Total degree.
     pub fn degree(&self) -> u32 {
         self.0.iter().map(|&(_, e)| u32::from(e)).sum()
