@@ -96,6 +96,14 @@ fn cnc5_bevel_matches_the_exact_product() {
 }
 
 #[test]
+fn ac_trunnion_matches_the_exact_product() {
+    check_example("ac_trunnion.yaml", 100, |v| match v {
+        "x" | "y" | "z" => (-400.0, 400.0),
+        _ => (-std::f64::consts::PI, std::f64::consts::PI),
+    });
+}
+
+#[test]
 fn the_checks_can_fail() {
     // Guard against a comparison that cannot fail: the gantry's exact product
     // with ezz moved from the Z slide to the Y slide gives a different

@@ -8,6 +8,7 @@ use chain::core::ErrorModel;
 chain::machine!(pub GantryFile = "examples/machines/gantry_grinder.yaml");
 chain::machine!(pub InternalGrinder = "examples/machines/internal_grinder.yaml");
 chain::machine!(pub Cnc5Bevel = "examples/machines/cnc5_bevel.yaml");
+chain::machine!(pub AcTrunnion = "examples/machines/ac_trunnion.yaml");
 
 chain::machine! {
     pub GantryInline {
@@ -196,6 +197,7 @@ fn generated_code_equals_runtime_evaluator_on_every_example() {
         2,
     );
     compare_with_runtime(&Cnc5Bevel, "examples/machines/cnc5_bevel.yaml", 3);
+    compare_with_runtime(&AcTrunnion, "examples/machines/ac_trunnion.yaml", 4);
 }
 
 #[test]

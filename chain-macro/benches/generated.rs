@@ -9,6 +9,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 
 chain::machine!(GantryGrinder = "../examples/machines/gantry_grinder.yaml");
 chain::machine!(Cnc5Bevel = "../examples/machines/cnc5_bevel.yaml");
+chain::machine!(AcTrunnion = "../examples/machines/ac_trunnion.yaml");
 
 /// Seed 000's corrected Eq. 18 sensitivity written by hand, in the generated
 /// type's error order (docs/errata.md for the two corrections).
@@ -101,5 +102,15 @@ fn five_axis(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, gantry, five_axis);
+/// The "two rotary axes, 40+ errors" machine of the issue: an A/C trunnion
+/// with 41 errors (`examples/machines/ac_trunnion.yaml`).
+fn two_rotary_axes(c: &mut Criterion) {
+    let p = [150.0, 200.0];
+    let q = [-40.0, 0.5, -1.2, 120.0, 250.0];
+    c.bench_function("ac_trunnion_sensitivity/generated", |b| {
+        b.iter(|| black_box(AcTrunnion::sensitivity(black_box(&q), black_box(&p))))
+    });
+}
+
+criterion_group!(benches, gantry, five_axis, two_rotary_axes);
 criterion_main!(benches);
