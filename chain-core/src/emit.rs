@@ -395,8 +395,66 @@ impl<'a> Body<'a> {
         if poly.is_zero() {
             return quote!(0.0);
         }
+        self.horner(poly.terms().to_vec())
+    }
+
+    /// A sum of terms, factored greedily (multivariate Horner): the symbol
+    /// that occurs in the most terms is taken out, `s·(…) + (…)`, recursively.
+    /// Kinematic coefficients share `sin`/`cos` factors, so this saves most of
+    /// the multiplications of the expanded form.
+    fn horner(&mut self, terms: Vec<(Monomial, f64)>) -> TokenStream {
+        let mut counts: Vec<(Symbol, usize)> = Vec::new();
+        for (m, _) in &terms {
+            for &(s, _) in &m.0 {
+                match counts.iter_mut().find(|(t, _)| *t == s) {
+                    Some((_, n)) => *n += 1,
+                    None => counts.push((s, 1)),
+                }
+            }
+        }
+        let best = counts
+            .iter()
+            .filter(|(_, n)| *n >= 2)
+            .max_by_key(|(s, n)| (*n, std::cmp::Reverse(*s)))
+            .map(|(s, _)| *s);
+        let Some(sym) = best else {
+            return self.plain_sum(&terms);
+        };
+        let (with, without): (Vec<_>, Vec<_>) = terms
+            .into_iter()
+            .partition(|(m, _)| m.0.iter().any(|&(s, _)| s == sym));
+        let reduced: Vec<(Monomial, f64)> = with
+            .into_iter()
+            .map(|(m, c)| {
+                let rest: Vec<(Symbol, u16)> =
+                    m.0.iter()
+                        .filter_map(|&(s, e)| match (s == sym, e) {
+                            (true, 1) => None,
+                            (true, e) => Some((s, e - 1)),
+                            _ => Some((s, e)),
+                        })
+                        .collect();
+                (Monomial(rest), c)
+            })
+            .collect();
+        let id = self.symbol(sym);
+        let inner = self.horner(reduced);
+        if without.is_empty() {
+            quote!(#id * (#inner))
+        } else {
+            let rest = self.horner(without);
+            if rest.to_string().starts_with('-') {
+                quote!(#id * (#inner) #rest)
+            } else {
+                quote!(#id * (#inner) + #rest)
+            }
+        }
+    }
+
+    /// `c1·m1 ± c2·m2 …` without factoring, monomials hoisted.
+    fn plain_sum(&mut self, terms: &[(Monomial, f64)]) -> TokenStream {
         let mut out = TokenStream::new();
-        for (k, (m, c)) in poly.terms().iter().enumerate() {
+        for (k, (m, c)) in terms.iter().enumerate() {
             let negative = *c < 0.0;
             let mag = c.abs();
             let sign = match (k, negative) {
