@@ -459,3 +459,146 @@ pub fn ensure_fonts() {
         }
     });
 }
+
+/// A bar chart of named values (sensitivities, shares), bars in the given
+/// order, drawn to PNG and SVG like [`XyChart`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct BarChart {
+    /// Caption above the plot.
+    pub title: String,
+    /// Vertical axis description.
+    pub y_label: String,
+    /// One label per bar (the horizontal axis).
+    pub labels: Vec<String>,
+    /// One value per bar; negative and non-finite values draw no bar.
+    pub values: Vec<f64>,
+    /// Bar colour.
+    pub color: RGBColor,
+    /// Decimals of the value printed above each bar (`None`: no value labels).
+    pub value_decimals: Option<usize>,
+    /// Image size in pixels (SVG user units).
+    pub size: (u32, u32),
+}
+
+impl BarChart {
+    /// A 1000 × 600 chart in the first palette colour, without value labels.
+    pub fn new(
+        title: impl Into<String>,
+        y_label: impl Into<String>,
+        labels: Vec<String>,
+        values: Vec<f64>,
+    ) -> BarChart {
+        BarChart {
+            title: title.into(),
+            y_label: y_label.into(),
+            labels,
+            values,
+            color: color(0),
+            value_decimals: None,
+            size: (1000, 600),
+        }
+    }
+
+    /// Writes `dir/stem.png` and `dir/stem.svg` (creating `dir`) and returns
+    /// both paths.
+    pub fn write(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, PlotError> {
+        std::fs::create_dir_all(dir).map_err(|source| PlotError::Io {
+            path: dir.display().to_string(),
+            source,
+        })?;
+        ensure_fonts();
+        let png = dir.join(format!("{stem}.png"));
+        let svg = dir.join(format!("{stem}.svg"));
+        let fail = |path: &Path, message: String| PlotError::Draw {
+            path: path.display().to_string(),
+            message,
+        };
+        self.draw(BitMapBackend::new(&png, self.size).into_drawing_area())
+            .map_err(|m| fail(&png, m))?;
+        self.draw(SVGBackend::new(&svg, self.size).into_drawing_area())
+            .map_err(|m| fail(&svg, m))?;
+        Ok(vec![png, svg])
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        use plotters::coord::ranged1d::SegmentValue;
+        use plotters::style::text_anchor::{HPos, Pos, VPos};
+        let err = |e: &dyn std::fmt::Display| e.to_string();
+        root.fill(&WHITE).map_err(|e| err(&e))?;
+        let n = self.values.len().max(1);
+        let top = self
+            .values
+            .iter()
+            .copied()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, f64::max);
+        let top = if top > 0.0 { top * 1.1 } else { 1.0 };
+        let mut chart = ChartBuilder::on(&root)
+            .caption(&self.title, ("sans-serif", 22))
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d((0..n - 1).into_segmented(), 0.0..top)
+            .map_err(|e| err(&e))?;
+        let label = |v: &SegmentValue<usize>| match v {
+            SegmentValue::CenterOf(j) => self.labels.get(*j).cloned().unwrap_or_default(),
+            _ => String::new(),
+        };
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .x_labels(n)
+            .x_label_formatter(&label)
+            .x_desc("error parameter")
+            .y_desc(self.y_label.as_str())
+            .label_style(("sans-serif", 13))
+            .axis_desc_style(("sans-serif", 16))
+            .draw()
+            .map_err(|e| err(&e))?;
+        let bars: Vec<(usize, f64)> = self
+            .values
+            .iter()
+            .copied()
+            .enumerate()
+            .filter(|(_, v)| v.is_finite() && *v > 0.0)
+            .collect();
+        let rect = |j: usize, v: f64| {
+            [
+                (SegmentValue::Exact(j), 0.0),
+                (SegmentValue::Exact(j + 1), v),
+            ]
+        };
+        chart
+            .draw_series(
+                bars.iter()
+                    .map(|&(j, v)| Rectangle::new(rect(j, v), self.color.filled())),
+            )
+            .map_err(|e| err(&e))?;
+        // White outlines keep neighbouring bars apart.
+        chart
+            .draw_series(
+                bars.iter()
+                    .map(|&(j, v)| Rectangle::new(rect(j, v), WHITE.stroke_width(3))),
+            )
+            .map_err(|e| err(&e))?;
+        if let Some(decimals) = self.value_decimals {
+            chart
+                .draw_series(bars.iter().map(|&(j, v)| {
+                    Text::new(
+                        format!("{v:.decimals$}"),
+                        (SegmentValue::CenterOf(j), v + top * 0.01),
+                        ("sans-serif", 13)
+                            .into_font()
+                            .color(&BLACK)
+                            .pos(Pos::new(HPos::Center, VPos::Bottom)),
+                    )
+                }))
+                .map_err(|e| err(&e))?;
+        }
+        root.present().map_err(|e| err(&e))?;
+        Ok(())
+    }
+}

@@ -25,13 +25,6 @@ struct Heat {
     values: Vec<Vec<f64>>,
 }
 
-/// A bar chart to draw.
-struct Bars {
-    title: String,
-    labels: Vec<String>,
-    values: Vec<f64>,
-}
-
 /// Writes every chart into `dir`; returns the files written.
 pub(super) fn write_all(
     dir: &Path,
@@ -93,18 +86,19 @@ pub(super) fn write_all(
                     .map_or(0.0, |e| e.mean_abs_dr_dstd)
             })
             .collect();
-        let bars = Bars {
-            title: format!(
-                "{machine}: {} reliability sensitivity |∂R/∂σ| (grid mean)",
-                s.target
-            ),
-            labels: order.to_vec(),
-            values,
+        let chart = chain::plot::BarChart {
+            size: BAR_SIZE,
+            ..chain::plot::BarChart::new(
+                format!(
+                    "{machine}: {} reliability sensitivity |∂R/∂σ| (grid mean)",
+                    s.target
+                ),
+                "|∂R/∂σ| (per unit of the error)",
+                order.to_vec(),
+                values,
+            )
         };
-        let stem = format!("sensitivity_{}", s.target);
-        files.extend(write_both(dir, &stem, BAR_SIZE, |root| {
-            draw_bars(root, &bars)
-        })?);
+        files.extend(chart.write(dir, &format!("sensitivity_{}", s.target))?);
     }
     Ok(files)
 }
@@ -140,13 +134,6 @@ fn draw_heat(area: Area<'_>, heat: &Heat) -> Result<(), String> {
     match area {
         Area::Bitmap(a) => heat_on(a, heat),
         Area::Svg(a) => heat_on(a, heat),
-    }
-}
-
-fn draw_bars(area: Area<'_>, bars: &Bars) -> Result<(), String> {
-    match area {
-        Area::Bitmap(a) => bars_on(a, bars),
-        Area::Svg(a) => bars_on(a, bars),
     }
 }
 
@@ -252,70 +239,6 @@ where
                 )
             })
         }))
-        .map_err(err)?;
-    root.present().map_err(err)?;
-    Ok(())
-}
-
-fn bars_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, bars: &Bars) -> Result<(), String>
-where
-    DB::ErrorType: 'static,
-{
-    root.fill(&WHITE).map_err(err)?;
-    let n = bars.values.len().max(1);
-    let top = bars.values.iter().copied().fold(0.0f64, f64::max);
-    let top = if top > 0.0 { top * 1.1 } else { 1.0 };
-    let mut chart = ChartBuilder::on(&root)
-        .caption(&bars.title, ("sans-serif", 22))
-        .margin(20)
-        .x_label_area_size(50)
-        .y_label_area_size(80)
-        .build_cartesian_2d((0..n - 1).into_segmented(), 0.0..top)
-        .map_err(err)?;
-    let label = |v: &SegmentValue<usize>| match v {
-        SegmentValue::CenterOf(j) => bars.labels.get(*j).cloned().unwrap_or_default(),
-        _ => String::new(),
-    };
-    chart
-        .configure_mesh()
-        .disable_x_mesh()
-        .x_labels(n)
-        .x_label_formatter(&label)
-        .x_desc("error parameter")
-        .y_desc("|∂R/∂σ| (per unit of the error)")
-        .label_style(("sans-serif", 13))
-        .axis_desc_style(("sans-serif", 16))
-        .draw()
-        .map_err(err)?;
-    let color = chain::plot::color(0);
-    chart
-        .draw_series(bars.values.iter().enumerate().map(|(j, &v)| {
-            Rectangle::new(
-                [
-                    (SegmentValue::Exact(j), 0.0),
-                    (SegmentValue::Exact(j + 1), v.max(0.0)),
-                ],
-                color.filled(),
-            )
-        }))
-        .map_err(err)?;
-    // White outlines keep neighbouring bars apart.
-    chart
-        .draw_series(
-            bars.values
-                .iter()
-                .enumerate()
-                .filter(|(_, v)| **v > 0.0)
-                .map(|(j, &v)| {
-                    Rectangle::new(
-                        [
-                            (SegmentValue::Exact(j), 0.0),
-                            (SegmentValue::Exact(j + 1), v),
-                        ],
-                        WHITE.stroke_width(3),
-                    )
-                }),
-        )
         .map_err(err)?;
     root.present().map_err(err)?;
     Ok(())
