@@ -4,6 +4,7 @@
 pub mod allocate;
 pub mod compensate;
 pub mod derive;
+pub mod inverse;
 pub mod reliability;
 pub mod sensitivity;
 
@@ -30,6 +31,8 @@ enum Command {
     Allocate(allocate::AllocateArgs),
     /// Identify and compensate a swing-angle error from tool-tip heights (seed 003).
     Compensate(compensate::CompensateArgs),
+    /// Inverse kinematics: every axis solution of tool poses (point and axis) from a CSV.
+    Inverse(inverse::InverseArgs),
 }
 
 /// Runs the parsed command line.
@@ -40,5 +43,6 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Sensitivity(args) => sensitivity::exec(args),
         Command::Allocate(args) => allocate::exec(args),
         Command::Compensate(args) => compensate::exec(args),
+        Command::Inverse(args) => inverse::exec(args),
     }
 }

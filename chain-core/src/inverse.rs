@@ -1,0 +1,550 @@
+//! Inverse kinematics of a five-axis chain: the axis values that put the tool
+//! point at a target position with the tool axis (the tool frame's +z) along a
+//! target direction, both in the workpiece frame.
+//!
+//! The solver works on any machine whose free variables (after `fixed` ones are
+//! held) are two rotary and three prismatic, and whose nominal rotation has the
+//! product form `R(a, b) = Rot(u, a) · R0 · Rot(v, b)` (checked numerically:
+//! `u` is the outer rotary axis in the workpiece frame, `v` the inner one in the
+//! tool frame) and does not depend on the prismatic variables. Then:
+//!
+//! 1. the inner angle `b` from `u · R0 Rot(v, b) z = u · t` (a sinusoid in `b`:
+//!    two branches by `atan2` / `acos`),
+//! 2. the outer angle `a` as the rotation about `u` that maps `R0 Rot(v, b) z`
+//!    onto `t`,
+//! 3. the prismatic variables from the position, which is affine in them for
+//!    fixed angles (a 3×3 linear system built from `nominal()` at unit steps,
+//!    then one refinement step on the residual).
+//!
+//! Every solution is verified with `nominal()`; rotary angles are wrapped to
+//! (−π, π]. When the tool axis is along a rotary axis the free angle is held
+//! at the previous value and the row is `Singular`.
+
+#![allow(clippy::needless_range_loop)]
+
+use crate::model::JointKind;
+use crate::ErrorModel;
+
+type V3 = [f64; 3];
+
+/// Why a machine cannot be handled by [`Solver`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum InverseError {
+    /// The free variables are not two rotary and three prismatic ones.
+    #[error("inverse kinematics needs 2 free rotary and 3 free prismatic variables, found {rotary} rotary and {prismatic} prismatic (fix the others with --fix)")]
+    Shape {
+        /// Free rotary variables.
+        rotary: usize,
+        /// Free prismatic variables.
+        prismatic: usize,
+    },
+    /// The orientation is not of the form `Rot(u, a) R0 Rot(v, b)` or depends
+    /// on a prismatic variable.
+    #[error("the tool orientation of this machine is not a product of two fixed-axis rotations independent of the linear axes; the closed-form solver does not apply")]
+    NotClosedForm,
+    /// The linear axes cannot move the tool point in three independent directions.
+    #[error("the linear axes do not span three directions")]
+    DegenerateLinear,
+}
+
+/// Status of one solved pose.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// At least one verified solution, none singular.
+    Ok,
+    /// No axis values reproduce the pose.
+    Unreachable,
+    /// The tool axis lies along a rotary axis; the free angle was held.
+    Singular,
+}
+
+/// The solutions of one pose.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Solution {
+    /// Status of the pose.
+    pub status: Status,
+    /// Full variable vectors (in the model's variable order), nearest to the
+    /// previous values first.
+    pub solutions: Vec<Vec<f64>>,
+}
+
+/// A closed-form inverse-kinematics solver for one machine.
+pub struct Solver<'m, M: ErrorModel + ?Sized> {
+    model: &'m M,
+    params: Vec<f64>,
+    base: Vec<f64>,
+    rotary: Vec<bool>,
+    outer: usize,
+    inner: usize,
+    lin: [usize; 3],
+    u: V3,
+    v: V3,
+    r0: [[f64; 3]; 3],
+    /// Position model `p = Σ_αβ f_α(a) g_β(b) (offset[α][β] + gain[α][β]·l)`
+    /// with `f = (1, cos a, sin a)`, `g = (1, cos b, sin b)`.
+    offset: [[V3; 3]; 3],
+    gain: [[[[f64; 3]; 3]; 3]; 3],
+}
+
+const SING: f64 = 1e-9;
+
+impl<'m, M: ErrorModel + ?Sized> Solver<'m, M> {
+    /// Prepares the solver: `kinds` are the variables' joint kinds (model
+    /// order), `params` the parameter values, `fixed` the held variables
+    /// `(index, value)`.
+    pub fn new(
+        model: &'m M,
+        kinds: &[JointKind],
+        params: &[f64],
+        fixed: &[(usize, f64)],
+    ) -> Result<Self, InverseError> {
+        let n = kinds.len();
+        let mut base = vec![0.0; n];
+        let mut free = vec![true; n];
+        for &(i, v) in fixed {
+            base[i] = v;
+            free[i] = false;
+        }
+        let mut rot: Vec<usize> = (0..n)
+            .filter(|&i| free[i] && kinds[i] == JointKind::Rotary)
+            .collect();
+        if rot.len() > 2 {
+            // Variables that move neither the tool point nor the tool axis
+            // (a spindle's own rotation) are not determined by a pose: hold
+            // them at 0 (the spec's default for `--fix`).
+            let idle: Vec<usize> = rot
+                .iter()
+                .copied()
+                .filter(|&i| !moves_tool(model, params, &base, i))
+                .collect();
+            for &i in &idle {
+                free[i] = false;
+            }
+            rot.retain(|i| !idle.contains(i));
+        }
+        let lin: Vec<usize> = (0..n)
+            .filter(|&i| free[i] && kinds[i] == JointKind::Prismatic)
+            .collect();
+        if rot.len() != 2 || lin.len() != 3 {
+            return Err(InverseError::Shape {
+                rotary: rot.len(),
+                prismatic: lin.len(),
+            });
+        }
+        let lin = [lin[0], lin[1], lin[2]];
+        let rotary = kinds.iter().map(|k| *k == JointKind::Rotary).collect();
+        let mut s = Solver {
+            model,
+            params: params.to_vec(),
+            base,
+            rotary,
+            outer: rot[0],
+            inner: rot[1],
+            lin,
+            u: [0.0; 3],
+            v: [0.0; 3],
+            r0: [[0.0; 3]; 3],
+            offset: [[[0.0; 3]; 3]; 3],
+            gain: [[[[0.0; 3]; 3]; 3]; 3],
+        };
+        for (o, i) in [(rot[0], rot[1]), (rot[1], rot[0])] {
+            s.outer = o;
+            s.inner = i;
+            if s.fit() {
+                if !s.fit_position() {
+                    return Err(InverseError::NotClosedForm);
+                }
+                if det(&s.linear_model(0.3, -0.7).0).abs() < 1e-12 {
+                    return Err(InverseError::DegenerateLinear);
+                }
+                return Ok(s);
+            }
+        }
+        Err(InverseError::NotClosedForm)
+    }
+
+    /// Indices of the outer (workpiece-frame side, axis `u`) and inner
+    /// (tool-frame side, axis `v`) rotary variables.
+    pub fn rotary_variables(&self) -> (usize, usize) {
+        (self.outer, self.inner)
+    }
+
+    fn q(&self, a: f64, b: f64, l: V3) -> Vec<f64> {
+        let mut q = self.base.clone();
+        q[self.outer] = a;
+        q[self.inner] = b;
+        for k in 0..3 {
+            q[self.lin[k]] = l[k];
+        }
+        q
+    }
+
+    fn rot(&self, a: f64, b: f64, l: V3) -> [[f64; 3]; 3] {
+        self.model.nominal(&self.q(a, b, l), &self.params).rotation
+    }
+
+    /// Fits `u`, `R0`, `v` for the current outer/inner choice and checks the
+    /// product form at a few points.
+    fn fit(&mut self) -> bool {
+        let z = [0.0; 3];
+        let r0 = self.rot(0.0, 0.0, z);
+        let ra = self.rot(std::f64::consts::FRAC_PI_2, 0.0, z);
+        let rb = self.rot(0.0, std::f64::consts::FRAC_PI_2, z);
+        self.r0 = r0;
+        self.u = quarter_axis(&mul(&ra, &tr(&r0)));
+        self.v = quarter_axis(&mul(&tr(&r0), &rb));
+        if norm(self.u) < 0.5 || norm(self.v) < 0.5 {
+            return false;
+        }
+        let checks = [
+            (0.7, -1.3, [10.0, -20.0, 30.0]),
+            (-2.1, 2.9, [-50.0, 5.0, 1.0]),
+            (3.0, 0.4, [0.0, 100.0, -7.0]),
+        ];
+        checks.iter().all(|&(a, b, l)| {
+            let got = self.rot(a, b, l);
+            let want = mul(&mul(&rodrigues(self.u, a), &self.r0), &rodrigues(self.v, b));
+            (0..3).all(|i| (0..3).all(|j| (got[i][j] - want[i][j]).abs() < 1e-9))
+        })
+    }
+
+    fn position(&self, a: f64, b: f64, l: V3) -> V3 {
+        self.model.nominal(&self.q(a, b, l), &self.params).position
+    }
+
+    /// Fits the position model from `nominal()` at the quarter turns
+    /// `a, b ∈ {0, π/2, π}` and unit steps of the linear axes (36
+    /// evaluations), then checks it at three other configurations. The model
+    /// is exact for any serial chain: each rotary joint appears once, so the
+    /// position is linear in `(1, cos, sin)` of each angle and affine in the
+    /// linear variables.
+    fn fit_position(&mut self) -> bool {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let angles = [0.0, FRAC_PI_2, PI];
+        // Values at the three angles -> coefficients of (1, cos, sin):
+        // v(0) = c1 + cc, v(π/2) = c1 + cs, v(π) = c1 − cc.
+        let coefficients = |v: [f64; 3]| -> [f64; 3] {
+            let c1 = 0.5 * (v[0] + v[2]);
+            [c1, 0.5 * (v[0] - v[2]), v[1] - c1]
+        };
+        let mut values = [[[[0.0; 3]; 4]; 3]; 3]; // [ia][ib][step][row]
+        for (ia, &a) in angles.iter().enumerate() {
+            for (ib, &b) in angles.iter().enumerate() {
+                let p0 = self.position(a, b, [0.0; 3]);
+                values[ia][ib][0] = p0;
+                for k in 0..3 {
+                    let mut l = [0.0; 3];
+                    l[k] = 1.0;
+                    values[ia][ib][k + 1] = sub(self.position(a, b, l), p0);
+                }
+            }
+        }
+        for step in 0..4 {
+            for row in 0..3 {
+                // Coefficients in b for each a sample, then in a.
+                let mut in_b = [[0.0; 3]; 3]; // [ia][β]
+                for ia in 0..3 {
+                    in_b[ia] = coefficients([
+                        values[ia][0][step][row],
+                        values[ia][1][step][row],
+                        values[ia][2][step][row],
+                    ]);
+                }
+                for beta in 0..3 {
+                    let c = coefficients([in_b[0][beta], in_b[1][beta], in_b[2][beta]]);
+                    for alpha in 0..3 {
+                        if step == 0 {
+                            self.offset[alpha][beta][row] = c[alpha];
+                        } else {
+                            self.gain[alpha][beta][row][step - 1] = c[alpha];
+                        }
+                    }
+                }
+            }
+        }
+        let checks = [
+            (0.7, -1.3, [10.0, -20.0, 30.0]),
+            (-2.1, 2.9, [-50.0, 5.0, 1.0]),
+            (3.0, 0.4, [0.0, 100.0, -7.0]),
+        ];
+        checks.iter().all(|&(a, b, l)| {
+            let want = self.position(a, b, l);
+            let (m, p0) = self.linear_model(a, b);
+            let got = [
+                p0[0] + dot(m[0], l),
+                p0[1] + dot(m[1], l),
+                p0[2] + dot(m[2], l),
+            ];
+            norm(sub(got, want)) <= 1e-9 * 1.0f64.max(norm(want))
+        })
+    }
+
+    /// The position model at angles `(a, b)`: `p = p0 + m·l`.
+    fn linear_model(&self, a: f64, b: f64) -> ([[f64; 3]; 3], V3) {
+        let (sa, ca) = a.sin_cos();
+        let (sb, cb) = b.sin_cos();
+        self.linear_model_trig([1.0, ca, sa], [1.0, cb, sb])
+    }
+
+    fn linear_model_trig(&self, f: [f64; 3], g: [f64; 3]) -> ([[f64; 3]; 3], V3) {
+        let mut m = [[0.0; 3]; 3];
+        let mut p0 = [0.0; 3];
+        for alpha in 0..3 {
+            for beta in 0..3 {
+                let w = f[alpha] * g[beta];
+                let off = &self.offset[alpha][beta];
+                let gain = &self.gain[alpha][beta];
+                for row in 0..3 {
+                    p0[row] += w * off[row];
+                    for k in 0..3 {
+                        m[row][k] += w * gain[row][k];
+                    }
+                }
+            }
+        }
+        (m, p0)
+    }
+
+    /// All solutions for tool point `point` and tool axis `axis` (normalised
+    /// here); `prev` are the previous row's values (model order), used for the
+    /// branch order and the held angle of a singular pose.
+    pub fn solve(&self, point: V3, axis: V3, prev: &[f64]) -> Solution {
+        let unreachable = Solution {
+            status: Status::Unreachable,
+            solutions: Vec::new(),
+        };
+        let na = norm(axis);
+        if !(na.is_finite() && na > 0.0 && point.iter().all(|x| x.is_finite())) {
+            return unreachable;
+        }
+        let t = scale(axis, 1.0 / na);
+        let (u, v) = (self.u, self.v);
+        let ez = [0.0, 0.0, 1.0];
+        // u · R0 (z_par + cos b z_perp + sin b (v × z)) = u · t
+        let w = mul_t_vec(&self.r0, u); // R0^T u
+        let zpar = scale(v, dot(v, ez));
+        let zperp = sub(ez, zpar);
+        let alpha = dot(w, zperp);
+        let beta = dot(w, cross(v, ez));
+        let gamma = dot(w, zpar);
+        let rho = alpha.hypot(beta);
+        let rhs = dot(u, t) - gamma;
+        let mut singular = false;
+        let mut bs: Vec<f64> = Vec::new();
+        if rho < SING {
+            singular = true;
+            if rhs.abs() > 1e-9 {
+                return unreachable;
+            }
+            bs.push(prev[self.inner]);
+        } else {
+            let c = rhs / rho;
+            if c.abs() > 1.0 + 1e-9 {
+                return unreachable;
+            }
+            let phi = beta.atan2(alpha);
+            let d = c.clamp(-1.0, 1.0).acos();
+            bs.push(phi + d);
+            bs.push(phi - d);
+        }
+        let tperp = sub(t, scale(u, dot(u, t)));
+        let mut sols: Vec<Vec<f64>> = Vec::new();
+        for b in bs {
+            let b = wrap(b);
+            let q = mat_vec(&self.r0, rodrigues_vec(v, b, ez));
+            let qperp = sub(q, scale(u, dot(u, q)));
+            let a = if norm(tperp) < SING || norm(qperp) < SING {
+                singular = true;
+                prev[self.outer]
+            } else {
+                dot(u, cross(qperp, tperp)).atan2(dot(qperp, tperp))
+            };
+            let a = wrap(a);
+            if let Some(s) = self.linear(a, b, point, t) {
+                if !sols.iter().any(|o| close(o, &s, &self.rotary)) {
+                    sols.push(s);
+                }
+            }
+        }
+        if sols.is_empty() {
+            return unreachable;
+        }
+        let dist = |s: &Vec<f64>| -> f64 {
+            s.iter()
+                .zip(prev)
+                .zip(&self.rotary)
+                .map(|((x, p), r)| {
+                    let d = if *r { wrap(x - p) } else { x - p };
+                    d * d
+                })
+                .sum()
+        };
+        sols.sort_by(|x, y| dist(x).total_cmp(&dist(y)));
+        Solution {
+            status: if singular {
+                Status::Singular
+            } else {
+                Status::Ok
+            },
+            solutions: sols,
+        }
+    }
+
+    /// The prismatic values for angles `(a, b)`, verified against the pose
+    /// (the tool axis from the rotation model, the point from the position
+    /// model, both checked against `nominal()` when the solver was built).
+    fn linear(&self, a: f64, b: f64, point: V3, t: V3) -> Option<Vec<f64>> {
+        let (sa, ca) = a.sin_cos();
+        let (sb, cb) = b.sin_cos();
+        let (m, p0) = self.linear_model_trig([1.0, ca, sa], [1.0, cb, sb]);
+        let l = solve3(&m, sub(point, p0))?;
+        let axis = rodrigues_vec(
+            self.u,
+            a,
+            mat_vec(&self.r0, rodrigues_vec(self.v, b, [0.0, 0.0, 1.0])),
+        );
+        let reached = [
+            p0[0] + dot(m[0], l),
+            p0[1] + dot(m[1], l),
+            p0[2] + dot(m[2], l),
+        ];
+        let ok = norm(sub(reached, point)) <= 1e-9 * 1.0f64.max(norm(point))
+            && norm(sub(axis, t)) <= 1e-9
+            && l.iter().all(|x| x.is_finite());
+        ok.then(|| self.q(a, b, l))
+    }
+}
+
+/// Whether variable `i` changes the tool point or the tool axis (checked at
+/// two configurations).
+fn moves_tool<M: ErrorModel + ?Sized>(model: &M, params: &[f64], base: &[f64], i: usize) -> bool {
+    [0.37, -1.9].iter().any(|&s| {
+        let mut q: Vec<f64> = base
+            .iter()
+            .enumerate()
+            .map(|(k, b)| b + s * (k as f64 + 1.0) * 0.61)
+            .collect();
+        let p1 = model.nominal(&q, params);
+        q[i] += 0.9;
+        let p2 = model.nominal(&q, params);
+        let a1 = [p1.rotation[0][2], p1.rotation[1][2], p1.rotation[2][2]];
+        let a2 = [p2.rotation[0][2], p2.rotation[1][2], p2.rotation[2][2]];
+        norm(sub(a1, a2)) > 1e-12
+            || norm(sub(p1.position, p2.position)) > 1e-12 * 1.0f64.max(norm(p1.position))
+    })
+}
+
+/// Wraps an angle to (−π, π].
+pub fn wrap(x: f64) -> f64 {
+    use std::f64::consts::PI;
+    let mut y = x.rem_euclid(2.0 * PI);
+    if y > PI {
+        y -= 2.0 * PI;
+    }
+    if y <= -PI {
+        y += 2.0 * PI;
+    }
+    y
+}
+
+fn close(a: &[f64], b: &[f64], rotary: &[bool]) -> bool {
+    a.iter().zip(b).zip(rotary).all(|((x, y), r)| {
+        let d = if *r { wrap(x - y) } else { x - y };
+        d.abs() < 1e-9 * 1.0f64.max(x.abs())
+    })
+}
+
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn norm(a: V3) -> f64 {
+    dot(a, a).sqrt()
+}
+fn scale(a: V3, s: f64) -> V3 {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn mul(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let mut c = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            c[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
+        }
+    }
+    c
+}
+fn tr(a: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let mut c = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            c[i][j] = a[j][i];
+        }
+    }
+    c
+}
+fn mat_vec(a: &[[f64; 3]; 3], x: V3) -> V3 {
+    [dot(a[0], x), dot(a[1], x), dot(a[2], x)]
+}
+fn mul_t_vec(a: &[[f64; 3]; 3], x: V3) -> V3 {
+    mat_vec(&tr(a), x)
+}
+fn det(a: &[[f64; 3]; 3]) -> f64 {
+    dot(a[0], cross(a[1], a[2]))
+}
+/// Solves `a x = y` by Cramer's rule.
+fn solve3(a: &[[f64; 3]; 3], y: V3) -> Option<V3> {
+    let d = det(a);
+    if d.abs() < 1e-12 {
+        return None;
+    }
+    let c = [
+        [a[0][0], a[1][0], a[2][0]],
+        [a[0][1], a[1][1], a[2][1]],
+        [a[0][2], a[1][2], a[2][2]],
+    ];
+    Some([
+        dot(y, cross(c[1], c[2])) / d,
+        dot(c[0], cross(y, c[2])) / d,
+        dot(c[0], cross(c[1], y)) / d,
+    ])
+}
+/// The axis of a rotation by +π/2.
+fn quarter_axis(r: &[[f64; 3]; 3]) -> V3 {
+    [
+        (r[2][1] - r[1][2]) / 2.0,
+        (r[0][2] - r[2][0]) / 2.0,
+        (r[1][0] - r[0][1]) / 2.0,
+    ]
+}
+fn rodrigues(u: V3, a: f64) -> [[f64; 3]; 3] {
+    let mut r = [[0.0; 3]; 3];
+    for j in 0..3 {
+        let mut e = [0.0; 3];
+        e[j] = 1.0;
+        let c = rodrigues_vec(u, a, e);
+        for i in 0..3 {
+            r[i][j] = c[i];
+        }
+    }
+    r
+}
+fn rodrigues_vec(u: V3, a: f64, x: V3) -> V3 {
+    let (s, c) = a.sin_cos();
+    let ux = cross(u, x);
+    let ud = dot(u, x) * (1.0 - c);
+    [
+        x[0] * c + ux[0] * s + u[0] * ud,
+        x[1] * c + ux[1] * s + u[1] * ud,
+        x[2] * c + ux[2] * s + u[2] * ud,
+    ]
+}

@@ -1,0 +1,181 @@
+//! `chain inverse FILE --pose POSE.csv [--fix mu=0] [--param NAME=VALUE] [--format json|csv]`.
+//!
+//! Inverse kinematics of every pose of a CSV (`px,py,pz,i,j,k`: tool point and
+//! tool axis in the workpiece frame), printed as the spec's JSON document.
+
+use std::path::PathBuf;
+
+use chain_core::inverse::{Solver, Status};
+use serde_json::{json, Map, Value};
+
+use super::reliability::{parse_assignment, write_stdout, Loaded};
+
+/// Arguments of `chain inverse`.
+#[derive(Debug, clap::Args)]
+pub struct InverseArgs {
+    /// Machine file (YAML).
+    pub file: PathBuf,
+    /// Poses, CSV with header `px,py,pz,i,j,k`.
+    #[arg(long, value_name = "POSE.csv")]
+    pub pose: PathBuf,
+    /// Hold a variable the pose does not determine, `NAME=VALUE` (repeatable).
+    #[arg(long = "fix", value_name = "NAME=VALUE", value_parser = parse_assignment)]
+    pub fix: Vec<(String, f64)>,
+    /// Value of a parameter, `NAME=VALUE` (repeatable; required for symbolic ones).
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_assignment)]
+    pub params: Vec<(String, f64)>,
+    /// Output format: the spec's JSON document, or CSV with one line per
+    /// solution (`row,status,solution,<variables>`; an unreachable row has
+    /// one line with empty values).
+    #[arg(long, value_enum, default_value = "json")]
+    pub format: InverseFormat,
+}
+
+/// Output formats of `chain inverse`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum InverseFormat {
+    /// The spec's JSON document.
+    Json,
+    /// One line per solution.
+    Csv,
+}
+
+/// Runs `chain inverse`.
+pub fn exec(args: InverseArgs) -> miette::Result<()> {
+    let loaded = Loaded::new(&args.file)?;
+    let m = &loaded.machine;
+    let mut params = Vec::with_capacity(m.parameters.len());
+    for p in &m.parameters {
+        let cli = args.params.iter().rev().find(|(n, _)| *n == p.name);
+        match cli.map(|c| c.1).or(p.value) {
+            Some(v) => params.push(v),
+            None => miette::bail!(
+                "parameter `{}` has no value; give --param {}=VALUE",
+                p.name,
+                p.name
+            ),
+        }
+    }
+    for (n, _) in &args.params {
+        if !m.parameters.iter().any(|p| p.name == *n) {
+            miette::bail!("`{n}` is not a parameter of machine `{}`", m.name);
+        }
+    }
+    let mut fixed = Vec::new();
+    for (n, v) in &args.fix {
+        let Some(i) = m.variables.iter().position(|x| x.name == *n) else {
+            miette::bail!("--fix: `{n}` is not a variable of machine `{}`", m.name);
+        };
+        fixed.push((i, *v));
+    }
+    let poses = read_poses(&args.pose)?;
+    let model = chain_core::compile(m);
+    let kinds: Vec<_> = m.variables.iter().map(|v| v.kind).collect();
+    let solver = Solver::new(&model, &kinds, &params, &fixed)
+        .map_err(|e| miette::miette!("machine `{}`: {e}", m.name))?;
+    let mut prev = vec![0.0; kinds.len()];
+    for &(i, v) in &fixed {
+        prev[i] = v;
+    }
+    let mut rows = Vec::with_capacity(poses.len());
+    let mut csv_text = String::from("row,status,solution");
+    for v in &m.variables {
+        csv_text.push(',');
+        csv_text.push_str(&v.name);
+    }
+    csv_text.push('\n');
+    for (k, (p, a)) in poses.iter().enumerate() {
+        let s = solver.solve(*p, *a, &prev);
+        if let Some(first) = s.solutions.first() {
+            prev.clone_from(first);
+        }
+        let sols: Vec<Value> = s
+            .solutions
+            .iter()
+            .map(|q| {
+                let mut o = Map::new();
+                for (var, x) in m.variables.iter().zip(q) {
+                    o.insert(var.name.clone(), json!(x));
+                }
+                Value::Object(o)
+            })
+            .collect();
+        let status = match s.status {
+            Status::Ok => "ok",
+            Status::Unreachable => "unreachable",
+            Status::Singular => "singular",
+        };
+        if s.solutions.is_empty() {
+            csv_text.push_str(&format!("{},{status},", k + 1));
+            csv_text.push_str(&",".repeat(m.variables.len()));
+            csv_text.push('\n');
+        }
+        for (j, q) in s.solutions.iter().enumerate() {
+            csv_text.push_str(&format!("{},{status},{}", k + 1, j + 1));
+            for x in q {
+                csv_text.push_str(&format!(",{x}"));
+            }
+            csv_text.push('\n');
+        }
+        rows.push(json!({"row": k + 1, "status": status, "solutions": sols}));
+    }
+    if args.format == InverseFormat::Csv {
+        return write_stdout(&csv_text);
+    }
+    let doc = json!({
+        "machine": m.name,
+        "variables": m.variables.iter().map(|v| v.name.clone()).collect::<Vec<_>>(),
+        "rows": rows,
+    });
+    let mut text = serde_json::to_string_pretty(&doc)
+        .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
+    text.push('\n');
+    write_stdout(&text)
+}
+
+type Row = ([f64; 3], [f64; 3]);
+
+/// Reads the pose CSV; errors name the file and line.
+fn read_poses(path: &std::path::Path) -> miette::Result<Vec<Row>> {
+    let name = path.display();
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_path(path)
+        .map_err(|e| miette::miette!("cannot read {name}: {e}"))?;
+    let header = rdr
+        .headers()
+        .map_err(|e| miette::miette!("{name}:1: {e}"))?
+        .clone();
+    let want = ["px", "py", "pz", "i", "j", "k"];
+    let cols: Vec<&str> = header.iter().collect();
+    if cols != want {
+        miette::bail!(
+            "{name}:1: expected the header `px,py,pz,i,j,k`, found `{}`",
+            cols.join(",")
+        );
+    }
+    let mut out = Vec::new();
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| {
+            let line = e.position().map_or(0, |p| p.line());
+            miette::miette!("{name}:{line}: {e}")
+        })?;
+        let line = rec.position().map_or(0, |p| p.line());
+        let mut v = [0.0; 6];
+        for (k, field) in rec.iter().enumerate() {
+            let x: f64 = field.parse().map_err(|_| {
+                miette::miette!("{name}:{line}: `{field}` ({}) is not a number", want[k])
+            })?;
+            if !x.is_finite() {
+                miette::bail!("{name}:{line}: `{field}` ({}) is not finite", want[k]);
+            }
+            v[k] = x;
+        }
+        let n = (v[3] * v[3] + v[4] * v[4] + v[5] * v[5]).sqrt();
+        if n < 1e-12 {
+            miette::bail!("{name}:{line}: the tool axis (i, j, k) is zero");
+        }
+        out.push(([v[0], v[1], v[2]], [v[3], v[4], v[5]]));
+    }
+    Ok(out)
+}

@@ -1,0 +1,326 @@
+//! Inverse kinematics (issue 8 point 2): round trips forward(inverse(pose)) =
+//! pose on random reachable poses, a singular and an unreachable pose, and the
+//! `chain inverse` CLI (JSON shape, bad CSV).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use chain_core::inverse::{wrap, Solver, Status};
+use chain_core::model::{JointKind, Machine};
+use chain_core::{CompiledModel, ErrorModel};
+use serde_json::Value;
+
+fn machine_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("examples/machines/{name}.yaml"))
+}
+
+fn load(name: &str) -> (Machine, CompiledModel, Vec<JointKind>, Vec<f64>) {
+    let m = chain_core::load_file(&machine_path(name)).expect("load");
+    let model = chain_core::compile(&m);
+    let kinds = m.variables.iter().map(|v| v.kind).collect();
+    let params = m
+        .parameters
+        .iter()
+        .map(|p| p.value.expect("numeric"))
+        .collect();
+    (m, model, kinds, params)
+}
+
+/// A small deterministic generator (splitmix64), uniform in [0, 1).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next()
+    }
+}
+
+fn axis_of(r: &[[f64; 3]; 3]) -> [f64; 3] {
+    [r[0][2], r[1][2], r[2][2]]
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// Round trip on `n` random poses; returns the largest position and axis errors.
+fn round_trip(name: &str, fixed: &[(&str, f64)], n: usize, seed: u64) -> (f64, f64) {
+    let (m, model, kinds, params) = load(name);
+    let fixed: Vec<(usize, f64)> = fixed
+        .iter()
+        .map(|(v, x)| (m.variables.iter().position(|y| y.name == *v).unwrap(), *x))
+        .collect();
+    let solver = Solver::new(&model, &kinds, &params, &fixed).expect("closed form applies");
+    let mut rng = Rng(seed);
+    let (mut ep, mut ea) = (0.0f64, 0.0f64);
+    let mut prev = vec![0.0; kinds.len()];
+    for &(i, x) in &fixed {
+        prev[i] = x;
+    }
+    for _ in 0..n {
+        let mut q = prev.clone();
+        for (i, k) in kinds.iter().enumerate() {
+            if fixed.iter().any(|f| f.0 == i) {
+                continue;
+            }
+            q[i] = match k {
+                JointKind::Rotary => rng.range(-std::f64::consts::PI, std::f64::consts::PI),
+                JointKind::Prismatic => rng.range(-500.0, 500.0),
+            };
+        }
+        let pose = model.nominal(&q, &params);
+        let axis = axis_of(&pose.rotation);
+        let s = solver.solve(pose.position, axis, &prev);
+        assert_eq!(s.status, Status::Ok, "q = {q:?}");
+        assert!(!s.solutions.is_empty());
+        let mut found = false;
+        for sol in &s.solutions {
+            assert!(sol.iter().all(|x| x.is_finite()));
+            for (x, k) in sol.iter().zip(&kinds) {
+                if *k == JointKind::Rotary {
+                    assert!(*x > -std::f64::consts::PI && *x <= std::f64::consts::PI);
+                }
+            }
+            let back = model.nominal(sol, &params);
+            ep = ep.max(dist(back.position, pose.position));
+            ea = ea.max(dist(axis_of(&back.rotation), axis));
+            let same = sol.iter().zip(&q).zip(&kinds).all(|((a, b), k)| {
+                let d = if *k == JointKind::Rotary {
+                    wrap(a - b)
+                } else {
+                    a - b
+                };
+                d.abs() < 1e-7
+            });
+            found |= same;
+        }
+        assert!(found, "the generating axis values are among the solutions");
+        // Branch order: the first is the nearest to the previous row.
+        prev.clone_from(&s.solutions[0]);
+    }
+    (ep, ea)
+}
+
+#[test]
+fn round_trip_ac_trunnion() {
+    let (ep, ea) = round_trip("ac_trunnion", &[], 10_000, 1);
+    eprintln!("ac_trunnion: max position error {ep:e}, max axis error {ea:e}");
+    assert!(ep < 1e-10 && ea < 1e-10, "{ep:e} {ea:e}");
+}
+
+#[test]
+fn round_trip_cnc5_bevel() {
+    let (ep, ea) = round_trip("cnc5_bevel", &[("mu", 0.0)], 10_000, 2);
+    eprintln!("cnc5_bevel: max position error {ep:e}, max axis error {ea:e}");
+    assert!(ep < 1e-10 && ea < 1e-10, "{ep:e} {ea:e}");
+}
+
+#[test]
+fn round_trip_head_head_bc() {
+    let (ep, ea) = round_trip("head_head_bc", &[], 10_000, 3);
+    eprintln!("head_head_bc: max position error {ep:e}, max axis error {ea:e}");
+    assert!(ep < 1e-10 && ea < 1e-10, "{ep:e} {ea:e}");
+}
+
+#[test]
+fn singular_pose_holds_the_free_angle() {
+    let (m, model, kinds, params) = load("ac_trunnion");
+    let solver = Solver::new(&model, &kinds, &params, &[]).unwrap();
+    let c = m.variables.iter().position(|v| v.name == "C").unwrap();
+    let mut prev = vec![0.0; kinds.len()];
+    prev[c] = 0.75;
+    // Tool axis along the C axis (A = 0).
+    let s = solver.solve([10.0, 20.0, 30.0], [0.0, 0.0, 1.0], &prev);
+    assert_eq!(s.status, Status::Singular);
+    assert!(!s.solutions.is_empty());
+    for sol in &s.solutions {
+        assert!((sol[c] - 0.75).abs() < 1e-12);
+        let back = model.nominal(sol, &params);
+        assert!(dist(back.position, [10.0, 20.0, 30.0]) < 1e-10);
+        assert!(dist(axis_of(&back.rotation), [0.0, 0.0, 1.0]) < 1e-10);
+    }
+}
+
+#[test]
+fn unreachable_pose() {
+    // The A/C trunnion reaches every direction; cnc5_bevel with mu fixed does
+    // too, so build a machine whose axis cone is limited: a B head tilted
+    // 30 degrees from a vertical C axis reaches only axes within 60 degrees of z.
+    let yaml = "machine: cone\nparameters: {}\nbodies:\n  bed: {}\n  x_slide: {parent: bed, joint: {type: prismatic, axis: +x, variable: x}}\n  y_slide: {parent: x_slide, joint: {type: prismatic, axis: +y, variable: y}}\n  z_slide: {parent: y_slide, joint: {type: prismatic, axis: +z, variable: z}}\n  c_head: {parent: z_slide, joint: {type: rotary, axis: +z, variable: C}}\n  b_head: {parent: c_head, rotation: [{about: x, angle: 30deg}], joint: {type: rotary, axis: +z, variable: B}}\n  tool: {parent: b_head, rotation: [{about: x, angle: 30deg}]}\nworkpiece: bed\ntool: tool\n";
+    let m = match chain_core::load_str(yaml, "cone.yaml") {
+        Ok(m) => m,
+        Err(e) => panic!("{e:?}"),
+    };
+    let model = chain_core::compile(&m);
+    let kinds: Vec<JointKind> = m.variables.iter().map(|v| v.kind).collect();
+    let solver = Solver::new(&model, &kinds, &[], &[]).unwrap();
+    let prev = vec![0.0; kinds.len()];
+    let s = solver.solve([1.0, 2.0, 3.0], [0.0, 0.0, -1.0], &prev);
+    assert_eq!(s.status, Status::Unreachable);
+    assert!(s.solutions.is_empty());
+    // A reachable direction of the same machine still solves.
+    let s = solver.solve([1.0, 2.0, 3.0], [0.5, 0.0, 0.8660254037844386], &prev);
+    assert_ne!(s.status, Status::Unreachable);
+}
+
+fn chain(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_chain"))
+        .args(args)
+        .output()
+        .expect("run chain")
+}
+
+fn temp_csv(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("chain-inverse-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn cli_json_shape() {
+    let csv = temp_csv(
+        "poses.csv",
+        "px,py,pz,i,j,k\n10,20,30,0.6,0,0.8\n10,20,30,0,0,1\n",
+    );
+    let file = machine_path("cnc5_bevel");
+    let out = chain(&[
+        "inverse",
+        file.to_str().unwrap(),
+        "--pose",
+        csv.to_str().unwrap(),
+        "--fix",
+        "mu=0",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).expect("one JSON document");
+    assert_eq!(v["machine"], "cnc5_bevel");
+    let vars: Vec<&str> = v["variables"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap())
+        .collect();
+    assert_eq!(vars, ["x", "y", "mu", "z", "B", "A"]);
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    for (k, r) in rows.iter().enumerate() {
+        assert_eq!(r["row"], k + 1);
+        assert_eq!(r["status"], "ok");
+        let sols = r["solutions"].as_array().unwrap();
+        assert!(!sols.is_empty());
+        for s in sols {
+            let o = s.as_object().unwrap();
+            assert_eq!(o.keys().map(String::as_str).collect::<Vec<_>>(), vars);
+            assert!(o.values().all(|x| x.as_f64().is_some_and(f64::is_finite)));
+            assert_eq!(o["mu"], 0.0);
+        }
+    }
+}
+
+#[test]
+fn cli_bad_csv_names_the_line() {
+    let csv = temp_csv("bad.csv", "px,py,pz,i,j,k\n1,2,3,0,0,1\n1,2,oops,0,0,1\n");
+    let file = machine_path("ac_trunnion");
+    let out = chain(&[
+        "inverse",
+        file.to_str().unwrap(),
+        "--pose",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains(":3:") && err.contains("oops"), "{err}");
+
+    let csv = temp_csv("header.csv", "x,y,z,i,j,k\n1,2,3,0,0,1\n");
+    let out = chain(&[
+        "inverse",
+        file.to_str().unwrap(),
+        "--pose",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains(":1:") && err.contains("px,py,pz,i,j,k"),
+        "{err}"
+    );
+}
+
+#[test]
+fn branch_selection_follows_a_smooth_path() {
+    let (_, model, kinds, params) = load("ac_trunnion");
+    let solver = Solver::new(&model, &kinds, &params, &[]).unwrap();
+    // y, A, C, x, z along a path that crosses C = ±π, with A in [0.2, 1.2]
+    // (away from the singular A = 0).
+    let path = |t: f64| {
+        vec![
+            50.0 * t.sin(),
+            0.7 + 0.5 * (3.0 * t).sin(),
+            wrap(2.5 + 2.0 * t),
+            -30.0 + 10.0 * t,
+            20.0 * t.cos(),
+        ]
+    };
+    let mut prev = path(0.0);
+    for k in 0..=500 {
+        let q = path(k as f64 * 0.01);
+        let pose = model.nominal(&q, &params);
+        let s = solver.solve(pose.position, axis_of(&pose.rotation), &prev);
+        assert_eq!(s.status, Status::Ok);
+        let first = &s.solutions[0];
+        for ((a, b), kind) in first.iter().zip(&q).zip(&kinds) {
+            let d = if *kind == JointKind::Rotary {
+                wrap(a - b)
+            } else {
+                a - b
+            };
+            assert!(d.abs() < 1e-8, "step {k}: {first:?} vs {q:?}");
+        }
+        prev.clone_from(first);
+    }
+}
+
+#[test]
+fn undetermined_spin_defaults_to_zero() {
+    // Without --fix, the cutter spin mu (it moves neither the tool point nor
+    // the tool axis) is held at 0.
+    let (m, model, kinds, params) = load("cnc5_bevel");
+    let solver = Solver::new(&model, &kinds, &params, &[]).expect("mu is held");
+    let mu = m.variables.iter().position(|v| v.name == "mu").unwrap();
+    let s = solver.solve([10.0, 20.0, 30.0], [0.6, 0.0, 0.8], &vec![0.0; kinds.len()]);
+    assert_eq!(s.status, Status::Ok);
+    assert!(s.solutions.iter().all(|q| q[mu] == 0.0));
+}
+
+#[test]
+fn cli_csv_format() {
+    let csv = temp_csv("poses_csv.csv", "px,py,pz,i,j,k\n10,20,30,0.6,0,0.8\n");
+    let file = machine_path("ac_trunnion");
+    let out = chain(&[
+        "inverse",
+        file.to_str().unwrap(),
+        "--pose",
+        csv.to_str().unwrap(),
+        "--format",
+        "csv",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "row,status,solution,y,A,C,x,z");
+    assert_eq!(lines.len(), 3, "{text}");
+    assert!(lines[1].starts_with("1,ok,1,") && lines[2].starts_with("1,ok,2,"));
+}
