@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 
-use chain_core::inverse::{Solver, Status};
+use chain_core::inverse::{Inverse, Status};
 use serde_json::{json, Map, Value};
 
 use super::reliability::{parse_assignment, write_stdout, Loaded};
@@ -69,11 +69,9 @@ pub fn exec(args: InverseArgs) -> miette::Result<()> {
         fixed.push((i, *v));
     }
     let poses = read_poses(&args.pose)?;
-    let model = chain_core::compile(m);
-    let kinds: Vec<_> = m.variables.iter().map(|v| v.kind).collect();
-    let solver = Solver::new(&model, &kinds, &params, &fixed)
+    let solver = Inverse::for_machine(m, &params, &fixed)
         .map_err(|e| miette::miette!("machine `{}`: {e}", m.name))?;
-    let mut prev = vec![0.0; kinds.len()];
+    let mut prev = vec![0.0; m.variables.len()];
     for &(i, v) in &fixed {
         prev[i] = v;
     }
@@ -124,6 +122,7 @@ pub fn exec(args: InverseArgs) -> miette::Result<()> {
     }
     let doc = json!({
         "machine": m.name,
+        "method": solver.method(),
         "variables": m.variables.iter().map(|v| v.name.clone()).collect::<Vec<_>>(),
         "rows": rows,
     });

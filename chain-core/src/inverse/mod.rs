@@ -1,29 +1,39 @@
-//! Inverse kinematics of a five-axis chain: the axis values that put the tool
-//! point at a target position with the tool axis (the tool frame's +z) along a
-//! target direction, both in the workpiece frame.
+//! Inverse kinematics: the axis values that put the tool point at a target
+//! position with the tool axis (the tool frame's +z) along a target
+//! direction, both in the workpiece frame — every solution branch.
 //!
-//! The solver works on any machine whose free variables (after `fixed` ones are
-//! held) are two rotary and three prismatic, and whose nominal rotation has the
-//! product form `R(a, b) = Rot(u, a) · R0 · Rot(v, b)` (checked numerically:
-//! `u` is the outer rotary axis in the workpiece frame, `v` the inner one in the
-//! tool frame) and does not depend on the prismatic variables. Then:
+//! [`Inverse::for_machine`] picks the method: the closed form ([`Solver`])
+//! when the chain allows it, otherwise damped Newton with the exact Jacobian
+//! ([`NewtonSolver`]).
+//!
+//! The closed form works on any machine whose free variables (after `fixed`
+//! ones are held) are two rotary and three prismatic, and whose nominal
+//! rotation has the product form `R(a, b) = Rot(u, a) · R0 · Rot(v, b)`
+//! (checked numerically: `u` is the outer rotary axis in the workpiece frame,
+//! `v` the inner one in the tool frame) and does not depend on the prismatic
+//! variables. Then:
 //!
 //! 1. the inner angle `b` from `u · R0 Rot(v, b) z = u · t` (a sinusoid in `b`:
 //!    two branches by `atan2` / `acos`),
 //! 2. the outer angle `a` as the rotation about `u` that maps `R0 Rot(v, b) z`
 //!    onto `t`,
-//! 3. the prismatic variables from the position, which is affine in them for
-//!    fixed angles (a 3×3 linear system built from `nominal()` at unit steps,
-//!    then one refinement step on the residual).
+//! 3. the prismatic variables from the position, which is affine in them and
+//!    linear in `(1, cos, sin)` of each angle: a 3×3 linear system whose
+//!    coefficients are fitted once from `nominal()` and verified.
 //!
-//! Every solution is verified with `nominal()`; rotary angles are wrapped to
-//! (−π, π]. When the tool axis is along a rotary axis the free angle is held
-//! at the previous value and the row is `Singular`.
+//! Every solution is verified; rotary angles are wrapped to (−π, π]. When the
+//! tool axis is along a rotary axis the free angle is held at the previous
+//! value and the row is `Singular`.
 
 #![allow(clippy::needless_range_loop)]
 
-use crate::model::JointKind;
-use crate::ErrorModel;
+mod newton;
+
+pub use newton::NewtonSolver;
+
+use crate::kinematics::Kinematics;
+use crate::model::{JointKind, Machine};
+use crate::{CompiledModel, ErrorModel};
 
 type V3 = [f64; 3];
 
@@ -31,7 +41,7 @@ type V3 = [f64; 3];
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum InverseError {
     /// The free variables are not two rotary and three prismatic ones.
-    #[error("inverse kinematics needs 2 free rotary and 3 free prismatic variables, found {rotary} rotary and {prismatic} prismatic (fix the others with --fix)")]
+    #[error("the closed-form inverse needs 2 free rotary and 3 free prismatic variables, found {rotary} rotary and {prismatic} prismatic")]
     Shape {
         /// Free rotary variables.
         rotary: usize,
@@ -42,6 +52,9 @@ pub enum InverseError {
     /// on a prismatic variable.
     #[error("the tool orientation of this machine is not a product of two fixed-axis rotations independent of the linear axes; the closed-form solver does not apply")]
     NotClosedForm,
+    /// No free variable moves the tool.
+    #[error("no free axis variable moves the tool point or the tool axis")]
+    NoFreeVariable,
     /// The linear axes cannot move the tool point in three independent directions.
     #[error("the linear axes do not span three directions")]
     DegenerateLinear,
@@ -69,9 +82,56 @@ pub struct Solution {
     pub solutions: Vec<Vec<f64>>,
 }
 
+/// The inverse kinematics of one machine, by the best method that applies.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Inverse {
+    /// The closed form (two rotary and three prismatic free variables,
+    /// product-form orientation).
+    ClosedForm(Box<Solver>),
+    /// Damped Newton with the exact Jacobian, for every other chain.
+    Newton(Box<NewtonSolver>),
+}
+
+impl Inverse {
+    /// Derives the machine and prepares its solver: the closed form if the
+    /// chain allows it, damped Newton otherwise. `params` are the parameter
+    /// values, `fixed` the held variables `(index, value)`.
+    pub fn for_machine(
+        machine: &Machine,
+        params: &[f64],
+        fixed: &[(usize, f64)],
+    ) -> Result<Inverse, InverseError> {
+        let symbolic = crate::derive(machine);
+        let model = CompiledModel::new(&symbolic);
+        let kinds: Vec<JointKind> = machine.variables.iter().map(|v| v.kind).collect();
+        match Solver::new(&model, &kinds, params, fixed) {
+            Ok(solver) => Ok(Inverse::ClosedForm(Box::new(solver))),
+            Err(_) => NewtonSolver::new(Kinematics::new(&symbolic), params, fixed)
+                .map(|s| Inverse::Newton(Box::new(s))),
+        }
+    }
+
+    /// `closed-form` or `newton`.
+    pub fn method(&self) -> &'static str {
+        match self {
+            Inverse::ClosedForm(_) => "closed-form",
+            Inverse::Newton(_) => "newton",
+        }
+    }
+
+    /// All solutions for tool point `point` and tool axis `axis`; `prev` are
+    /// the previous row's values (model order).
+    pub fn solve(&self, point: V3, axis: V3, prev: &[f64]) -> Solution {
+        match self {
+            Inverse::ClosedForm(s) => s.solve(point, axis, prev),
+            Inverse::Newton(s) => s.solve(point, axis, prev),
+        }
+    }
+}
+
 /// A closed-form inverse-kinematics solver for one machine.
-pub struct Solver<'m, M: ErrorModel + ?Sized> {
-    model: &'m M,
+#[derive(Debug, Clone, PartialEq)]
+pub struct Solver {
     params: Vec<f64>,
     base: Vec<f64>,
     rotary: Vec<bool>,
@@ -89,12 +149,12 @@ pub struct Solver<'m, M: ErrorModel + ?Sized> {
 
 const SING: f64 = 1e-9;
 
-impl<'m, M: ErrorModel + ?Sized> Solver<'m, M> {
+impl Solver {
     /// Prepares the solver: `kinds` are the variables' joint kinds (model
     /// order), `params` the parameter values, `fixed` the held variables
     /// `(index, value)`.
-    pub fn new(
-        model: &'m M,
+    pub fn new<M: ErrorModel + ?Sized>(
+        model: &M,
         kinds: &[JointKind],
         params: &[f64],
         fixed: &[(usize, f64)],
@@ -135,7 +195,6 @@ impl<'m, M: ErrorModel + ?Sized> Solver<'m, M> {
         let lin = [lin[0], lin[1], lin[2]];
         let rotary = kinds.iter().map(|k| *k == JointKind::Rotary).collect();
         let mut s = Solver {
-            model,
             params: params.to_vec(),
             base,
             rotary,
@@ -151,8 +210,8 @@ impl<'m, M: ErrorModel + ?Sized> Solver<'m, M> {
         for (o, i) in [(rot[0], rot[1]), (rot[1], rot[0])] {
             s.outer = o;
             s.inner = i;
-            if s.fit() {
-                if !s.fit_position() {
+            if s.fit(model) {
+                if !s.fit_position(model) {
                     return Err(InverseError::NotClosedForm);
                 }
                 if det(&s.linear_model(0.3, -0.7).0).abs() < 1e-12 {
@@ -180,17 +239,17 @@ impl<'m, M: ErrorModel + ?Sized> Solver<'m, M> {
         q
     }
 
-    fn rot(&self, a: f64, b: f64, l: V3) -> [[f64; 3]; 3] {
-        self.model.nominal(&self.q(a, b, l), &self.params).rotation
+    fn rot<M: ErrorModel + ?Sized>(&self, model: &M, a: f64, b: f64, l: V3) -> [[f64; 3]; 3] {
+        model.nominal(&self.q(a, b, l), &self.params).rotation
     }
 
     /// Fits `u`, `R0`, `v` for the current outer/inner choice and checks the
     /// product form at a few points.
-    fn fit(&mut self) -> bool {
+    fn fit<M: ErrorModel + ?Sized>(&mut self, model: &M) -> bool {
         let z = [0.0; 3];
-        let r0 = self.rot(0.0, 0.0, z);
-        let ra = self.rot(std::f64::consts::FRAC_PI_2, 0.0, z);
-        let rb = self.rot(0.0, std::f64::consts::FRAC_PI_2, z);
+        let r0 = self.rot(model, 0.0, 0.0, z);
+        let ra = self.rot(model, std::f64::consts::FRAC_PI_2, 0.0, z);
+        let rb = self.rot(model, 0.0, std::f64::consts::FRAC_PI_2, z);
         self.r0 = r0;
         self.u = quarter_axis(&mul(&ra, &tr(&r0)));
         self.v = quarter_axis(&mul(&tr(&r0), &rb));
@@ -203,14 +262,14 @@ impl<'m, M: ErrorModel + ?Sized> Solver<'m, M> {
             (3.0, 0.4, [0.0, 100.0, -7.0]),
         ];
         checks.iter().all(|&(a, b, l)| {
-            let got = self.rot(a, b, l);
+            let got = self.rot(model, a, b, l);
             let want = mul(&mul(&rodrigues(self.u, a), &self.r0), &rodrigues(self.v, b));
             (0..3).all(|i| (0..3).all(|j| (got[i][j] - want[i][j]).abs() < 1e-9))
         })
     }
 
-    fn position(&self, a: f64, b: f64, l: V3) -> V3 {
-        self.model.nominal(&self.q(a, b, l), &self.params).position
+    fn position<M: ErrorModel + ?Sized>(&self, model: &M, a: f64, b: f64, l: V3) -> V3 {
+        model.nominal(&self.q(a, b, l), &self.params).position
     }
 
     /// Fits the position model from `nominal()` at the quarter turns
@@ -219,7 +278,7 @@ impl<'m, M: ErrorModel + ?Sized> Solver<'m, M> {
     /// is exact for any serial chain: each rotary joint appears once, so the
     /// position is linear in `(1, cos, sin)` of each angle and affine in the
     /// linear variables.
-    fn fit_position(&mut self) -> bool {
+    fn fit_position<M: ErrorModel + ?Sized>(&mut self, model: &M) -> bool {
         use std::f64::consts::{FRAC_PI_2, PI};
         let angles = [0.0, FRAC_PI_2, PI];
         // Values at the three angles -> coefficients of (1, cos, sin):
@@ -231,12 +290,12 @@ impl<'m, M: ErrorModel + ?Sized> Solver<'m, M> {
         let mut values = [[[[0.0; 3]; 4]; 3]; 3]; // [ia][ib][step][row]
         for (ia, &a) in angles.iter().enumerate() {
             for (ib, &b) in angles.iter().enumerate() {
-                let p0 = self.position(a, b, [0.0; 3]);
+                let p0 = self.position(model, a, b, [0.0; 3]);
                 values[ia][ib][0] = p0;
                 for k in 0..3 {
                     let mut l = [0.0; 3];
                     l[k] = 1.0;
-                    values[ia][ib][k + 1] = sub(self.position(a, b, l), p0);
+                    values[ia][ib][k + 1] = sub(self.position(model, a, b, l), p0);
                 }
             }
         }
@@ -269,7 +328,7 @@ impl<'m, M: ErrorModel + ?Sized> Solver<'m, M> {
             (3.0, 0.4, [0.0, 100.0, -7.0]),
         ];
         checks.iter().all(|&(a, b, l)| {
-            let want = self.position(a, b, l);
+            let want = self.position(model, a, b, l);
             let (m, p0) = self.linear_model(a, b);
             let got = [
                 p0[0] + dot(m[0], l),

@@ -1,0 +1,309 @@
+//! The general fallback: damped Newton (Levenberg–Marquardt) on the tool
+//! point and tool axis with the exact Jacobian of the symbolic engine
+//! ([`Kinematics::jacobian`]), from several starts.
+//!
+//! It serves any chain the closed form does not: other numbers of free
+//! variables (three rotary axes, redundant chains), orientations that are not
+//! a product of two fixed-axis rotations, or linear axes whose directions
+//! depend on each other. The residual is `[p(q) − p*, ℓ (z(q) − t)]` with
+//! `ℓ = max(1, |p*|)` so that both parts weigh alike; its Jacobian is
+//! `[∂p/∂q_k, ℓ ω_k × z]`. Starts: the previous row's values, then every
+//! combination of the free rotary variables at `0, ±π/2, π` (at most 256).
+//! Converged points (iterated to rounding level; accepted at position
+//! `1e-11·max(1, |p*|)`, axis `1e-12` when no step improves further) are
+//! wrapped, de-duplicated (1e-7) and sorted by their distance to the previous
+//! row.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::{norm, sub, wrap, InverseError, Solution, Status, V3};
+use crate::kinematics::Kinematics;
+use crate::model::JointKind;
+
+/// Most starts tried per pose.
+const MAX_STARTS: usize = 256;
+/// Most iterations per start.
+const MAX_ITERATIONS: usize = 100;
+
+/// Damped-Newton inverse kinematics for any machine.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NewtonSolver {
+    kinematics: Kinematics,
+    params: Vec<f64>,
+    base: Vec<f64>,
+    free: Vec<usize>,
+    rotary: Vec<bool>,
+}
+
+impl NewtonSolver {
+    /// Prepares the solver: `params` the parameter values, `fixed` the held
+    /// variables `(index, value)`. Free variables that move neither the tool
+    /// point nor the tool axis (a spindle's spin) are held at 0.
+    pub fn new(
+        kinematics: Kinematics,
+        params: &[f64],
+        fixed: &[(usize, f64)],
+    ) -> Result<NewtonSolver, InverseError> {
+        let n = kinematics.variables().len();
+        let mut base = vec![0.0; n];
+        let mut held = vec![false; n];
+        for &(i, v) in fixed {
+            if i < n {
+                base[i] = v;
+                held[i] = true;
+            }
+        }
+        let rotary: Vec<bool> = kinematics
+            .variables()
+            .iter()
+            .map(|(_, k)| *k == JointKind::Rotary)
+            .collect();
+        // A variable is idle when its Jacobian column vanishes at two
+        // unrelated configurations.
+        let probe = |s: f64| -> Vec<f64> {
+            (0..n)
+                .map(|k| {
+                    if held[k] {
+                        base[k]
+                    } else {
+                        s * (k as f64 + 1.0) * 0.61
+                    }
+                })
+                .collect()
+        };
+        let columns: Vec<Vec<[f64; 6]>> = [0.37, -1.9]
+            .iter()
+            .map(|&s| kinematics.jacobian(&probe(s), params))
+            .collect();
+        let free: Vec<usize> = (0..n)
+            .filter(|&k| !held[k])
+            .filter(|&k| columns.iter().any(|c| c[k].iter().any(|v| v.abs() > 1e-12)))
+            .collect();
+        if free.is_empty() {
+            return Err(InverseError::NoFreeVariable);
+        }
+        Ok(NewtonSolver {
+            kinematics,
+            params: params.to_vec(),
+            base,
+            free,
+            rotary,
+        })
+    }
+
+    /// The variables the solver moves (model order).
+    pub fn free_variables(&self) -> &[usize] {
+        &self.free
+    }
+
+    /// All solutions found for tool point `point` and tool axis `axis`
+    /// (normalised here); `prev` are the previous row's values.
+    pub fn solve(&self, point: V3, axis: V3, prev: &[f64]) -> Solution {
+        let unreachable = Solution {
+            status: Status::Unreachable,
+            solutions: Vec::new(),
+        };
+        let na = norm(axis);
+        if !(na.is_finite() && na > 0.0 && point.iter().all(|x| x.is_finite())) {
+            return unreachable;
+        }
+        let t = [axis[0] / na, axis[1] / na, axis[2] / na];
+        let mut start: Vec<f64> = self.base.clone();
+        for &k in &self.free {
+            start[k] = prev
+                .get(k)
+                .copied()
+                .filter(|v| v.is_finite())
+                .unwrap_or(0.0);
+        }
+        let mut found: Vec<Vec<f64>> = Vec::new();
+        let mut singular = false;
+        for q0 in self.starts(&start) {
+            if let Some((q, rank_deficient)) = self.converge(q0, point, t) {
+                if !found.iter().any(|o| same_point(o, &q, &self.rotary)) {
+                    singular |= rank_deficient;
+                    found.push(q);
+                }
+            }
+        }
+        if found.is_empty() {
+            return unreachable;
+        }
+        let dist = |s: &Vec<f64>| -> f64 {
+            s.iter()
+                .zip(prev)
+                .zip(&self.rotary)
+                .map(|((x, p), r)| {
+                    let d = if *r { wrap(x - p) } else { x - p };
+                    d * d
+                })
+                .sum()
+        };
+        found.sort_by(|x, y| dist(x).total_cmp(&dist(y)));
+        Solution {
+            status: if singular {
+                Status::Singular
+            } else {
+                Status::Ok
+            },
+            solutions: found,
+        }
+    }
+
+    /// The previous values, then the rotary grid around them.
+    fn starts(&self, start: &[f64]) -> Vec<Vec<f64>> {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let grid = [0.0, FRAC_PI_2, PI, -FRAC_PI_2];
+        let rotary: Vec<usize> = self
+            .free
+            .iter()
+            .copied()
+            .filter(|&k| self.rotary[k])
+            .collect();
+        let mut out = vec![start.to_vec()];
+        let combinations = grid.len().pow(rotary.len().min(4) as u32);
+        for c in 0..combinations.min(MAX_STARTS) {
+            let mut q = start.to_vec();
+            let mut code = c;
+            for &k in rotary.iter().take(4) {
+                q[k] = grid[code % grid.len()];
+                code /= grid.len();
+            }
+            out.push(q);
+        }
+        out
+    }
+
+    /// Levenberg–Marquardt from `q`; the wrapped solution and whether its
+    /// Jacobian is rank deficient, or `None` if it does not converge.
+    fn converge(&self, mut q: Vec<f64>, point: V3, t: V3) -> Option<(Vec<f64>, bool)> {
+        let scale = 1.0f64.max(norm(point));
+        let m = self.free.len();
+        let residual = |q: &[f64]| -> ([f64; 6], V3, V3) {
+            let pose = self.kinematics.pose(q, &self.params);
+            let z = [
+                pose.rotation[0][2],
+                pose.rotation[1][2],
+                pose.rotation[2][2],
+            ];
+            let dp = sub(pose.position, point);
+            let dz = sub(z, t);
+            (
+                [
+                    dp[0],
+                    dp[1],
+                    dp[2],
+                    scale * dz[0],
+                    scale * dz[1],
+                    scale * dz[2],
+                ],
+                dp,
+                z,
+            )
+        };
+        let cost = |r: &[f64; 6]| r.iter().map(|v| v * v).sum::<f64>();
+        let (mut r, mut dp, mut z) = residual(&q);
+        let mut lambda = 1e-3;
+        // Iterate to rounding level; a point where no step improves any more
+        // is accepted if it is within the looser tolerance.
+        let tight = |dp: V3, z: V3| norm(dp) <= 1e-13 * scale && norm(sub(z, t)) <= 1e-13;
+        let loose = |dp: V3, z: V3| norm(dp) <= 1e-11 * scale && norm(sub(z, t)) <= 1e-12;
+        for _ in 0..MAX_ITERATIONS {
+            let j = self.weighted_jacobian(&q, z, scale);
+            if tight(dp, z) {
+                return Some(self.finish(q, &j));
+            }
+            let a = j.transpose() * &j;
+            let g = j.transpose() * DVector::from_row_slice(&r);
+            let mut improved = false;
+            while lambda < 1e12 {
+                let mut damped = a.clone();
+                for i in 0..m {
+                    damped[(i, i)] += lambda * a[(i, i)].max(1e-9);
+                }
+                let Some(chol) = damped.cholesky() else {
+                    lambda *= 10.0;
+                    continue;
+                };
+                let step = chol.solve(&(-&g));
+                let mut trial = q.clone();
+                for (i, &k) in self.free.iter().enumerate() {
+                    trial[k] += step[i];
+                }
+                let (r2, dp2, z2) = residual(&trial);
+                if cost(&r2) < cost(&r) {
+                    q = trial;
+                    (r, dp, z) = (r2, dp2, z2);
+                    lambda = (lambda * 0.3).max(1e-12);
+                    improved = true;
+                    break;
+                }
+                lambda *= 10.0;
+            }
+            if !improved {
+                break;
+            }
+        }
+        if loose(dp, z) {
+            let j = self.weighted_jacobian(&q, z, scale);
+            return Some(self.finish(q, &j));
+        }
+        None
+    }
+
+    /// Wraps the rotary values and checks the rank of the Jacobian.
+    fn finish(&self, mut q: Vec<f64>, j: &DMatrix<f64>) -> (Vec<f64>, bool) {
+        for (k, v) in q.iter_mut().enumerate() {
+            if self.rotary[k] {
+                *v = wrap(*v);
+            }
+        }
+        (q, rank_deficient(j))
+    }
+
+    /// `[∂p/∂q_k ; scale·(ω_k × z)]` over the free variables.
+    fn weighted_jacobian(&self, q: &[f64], z: V3, scale: f64) -> DMatrix<f64> {
+        let columns = self.kinematics.jacobian(q, &self.params);
+        let mut j = DMatrix::zeros(6, self.free.len());
+        for (i, &k) in self.free.iter().enumerate() {
+            let c = columns[k];
+            let w = [c[3], c[4], c[5]];
+            let dz = [
+                w[1] * z[2] - w[2] * z[1],
+                w[2] * z[0] - w[0] * z[2],
+                w[0] * z[1] - w[1] * z[0],
+            ];
+            for r in 0..3 {
+                j[(r, i)] = c[r];
+                j[(r + 3, i)] = scale * dz[r];
+            }
+        }
+        j
+    }
+}
+
+/// True when the Jacobian has lost rank: the tool point and axis span at most
+/// five directions, so the rank to expect is `min(columns, 5)`.
+fn rank_deficient(j: &DMatrix<f64>) -> bool {
+    let expected = j.ncols().min(5);
+    let mut sv: Vec<f64> = j
+        .clone()
+        .svd(false, false)
+        .singular_values
+        .iter()
+        .copied()
+        .collect();
+    sv.sort_by(|a, b| b.total_cmp(a));
+    let largest = sv.first().copied().unwrap_or(0.0);
+    expected == 0 || sv.get(expected - 1).is_none_or(|s| *s <= 1e-9 * largest)
+}
+
+/// Two converged points are one solution when they agree to 1e-7 (radians, or
+/// relative to the length): far above the convergence tolerance, far below
+/// the distance between distinct branches.
+fn same_point(a: &[f64], b: &[f64], rotary: &[bool]) -> bool {
+    a.iter().zip(b).zip(rotary).all(|((x, y), r)| {
+        let d = if *r { wrap(x - y) } else { x - y };
+        d.abs() < 1e-7 * 1.0f64.max(x.abs())
+    })
+}
