@@ -66,6 +66,6 @@ pub use limit_state::{Affine, Criterion, Event, LimitState, ToleranceLimitState}
 pub use sensitivity::{sensitivity, InputSensitivity, SensitivityMethod, SensitivityResult};
 pub use simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult};
 pub use study::{
-    CaseResult, ErrorSensitivity, Grid, Study, StudyResult, StudySpec, Summary, System, Target,
-    TargetSensitivity,
+    CaseResult, ErrorMoments, ErrorSensitivity, Grid, Study, StudyResult, StudySpec, Summary,
+    System, Target, TargetSensitivity, VolumetricMoments,
 };

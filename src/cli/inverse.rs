@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use chain_core::inverse::{Inverse, Status};
 use serde_json::{json, Map, Value};
 
+use super::csv_input::read_poses;
 use super::reliability::{parse_assignment, write_stdout, Loaded};
 
 /// Arguments of `chain inverse`.
@@ -15,7 +16,8 @@ use super::reliability::{parse_assignment, write_stdout, Loaded};
 pub struct InverseArgs {
     /// Machine file (YAML).
     pub file: PathBuf,
-    /// Poses, CSV with header `px,py,pz,i,j,k`.
+    /// Poses, CSV with header `px,py,pz,i,j,k` (optionally after a first
+    /// column `t`, which is ignored); `-` reads stdin.
     #[arg(long, value_name = "POSE.csv")]
     pub pose: PathBuf,
     /// Hold a variable the pose does not determine, `NAME=VALUE` (repeatable).
@@ -68,7 +70,7 @@ pub fn exec(args: InverseArgs) -> miette::Result<()> {
         };
         fixed.push((i, *v));
     }
-    let poses = read_poses(&args.pose)?;
+    let (_, poses) = read_poses(&args.pose)?;
     let solver = Inverse::for_machine(m, &params, &fixed)
         .map_err(|e| miette::miette!("machine `{}`: {e}", m.name))?;
     let mut prev = vec![0.0; m.variables.len()];
@@ -82,8 +84,8 @@ pub fn exec(args: InverseArgs) -> miette::Result<()> {
         csv_text.push_str(&v.name);
     }
     csv_text.push('\n');
-    for (k, (p, a)) in poses.iter().enumerate() {
-        let s = solver.solve(*p, *a, &prev);
+    for (k, pose) in poses.iter().enumerate() {
+        let s = solver.solve(pose.point, pose.axis, &prev);
         if let Some(first) = s.solutions.first() {
             prev.clone_from(first);
         }
@@ -130,51 +132,4 @@ pub fn exec(args: InverseArgs) -> miette::Result<()> {
         .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
     text.push('\n');
     write_stdout(&text)
-}
-
-type Row = ([f64; 3], [f64; 3]);
-
-/// Reads the pose CSV; errors name the file and line.
-fn read_poses(path: &std::path::Path) -> miette::Result<Vec<Row>> {
-    let name = path.display();
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(|e| miette::miette!("cannot read {name}: {e}"))?;
-    let header = rdr
-        .headers()
-        .map_err(|e| miette::miette!("{name}:1: {e}"))?
-        .clone();
-    let want = ["px", "py", "pz", "i", "j", "k"];
-    let cols: Vec<&str> = header.iter().collect();
-    if cols != want {
-        miette::bail!(
-            "{name}:1: expected the header `px,py,pz,i,j,k`, found `{}`",
-            cols.join(",")
-        );
-    }
-    let mut out = Vec::new();
-    for rec in rdr.records() {
-        let rec = rec.map_err(|e| {
-            let line = e.position().map_or(0, |p| p.line());
-            miette::miette!("{name}:{line}: {e}")
-        })?;
-        let line = rec.position().map_or(0, |p| p.line());
-        let mut v = [0.0; 6];
-        for (k, field) in rec.iter().enumerate() {
-            let x: f64 = field.parse().map_err(|_| {
-                miette::miette!("{name}:{line}: `{field}` ({}) is not a number", want[k])
-            })?;
-            if !x.is_finite() {
-                miette::bail!("{name}:{line}: `{field}` ({}) is not finite", want[k]);
-            }
-            v[k] = x;
-        }
-        let n = (v[3] * v[3] + v[4] * v[4] + v[5] * v[5]).sqrt();
-        if n < 1e-12 {
-            miette::bail!("{name}:{line}: the tool axis (i, j, k) is zero");
-        }
-        out.push(([v[0], v[1], v[2]], [v[3], v[4], v[5]]));
-    }
-    Ok(out)
 }

@@ -3,8 +3,10 @@
 
 pub mod allocate;
 pub mod compensate;
+mod csv_input;
 pub mod derive;
 pub mod inverse;
+pub mod path;
 pub mod reliability;
 pub mod sensitivity;
 
@@ -33,6 +35,8 @@ enum Command {
     Compensate(compensate::CompensateArgs),
     /// Inverse kinematics: every axis solution of tool poses (point and axis) from a CSV.
     Inverse(inverse::InverseArgs),
+    /// Error and reliability along a path (axis values or tool poses) at every instant.
+    Path(path::PathArgs),
 }
 
 /// Runs the parsed command line.
@@ -44,5 +48,6 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Allocate(args) => allocate::exec(args),
         Command::Compensate(args) => compensate::exec(args),
         Command::Inverse(args) => inverse::exec(args),
+        Command::Path(args) => path::exec(args),
     }
 }

@@ -175,7 +175,7 @@ fn study_cases(study: &Study) -> u64 {
 
 /// FORM is exact only for one-sided components in normal inputs; say so on
 /// stderr when it is not.
-fn note_form_limits(study: &Study) {
+pub(crate) fn note_form_limits(study: &Study) {
     let spec = study.spec();
     let non_normal = !study.inputs().is_affine();
     let two = spec.sided == Sided::Two;
@@ -377,7 +377,7 @@ fn code(err: &ReliabilityError) -> &'static str {
     }
 }
 
-fn system_of(
+pub(crate) fn system_of(
     machine: &Machine,
     system: Option<SystemArg>,
     tolerance: Option<f64>,

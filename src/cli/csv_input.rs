@@ -1,0 +1,126 @@
+//! CSV input shared by the commands that read tables of numbers (`chain
+//! inverse`, `chain path`): a file or stdin (`-`), a header, and rows of finite
+//! numbers; every error names the file, the line and the column.
+
+use std::io::Read;
+use std::path::Path;
+
+/// An open CSV: display name, reader and trimmed header.
+pub(crate) struct CsvInput {
+    pub(crate) name: String,
+    pub(crate) reader: csv::Reader<Box<dyn Read>>,
+    pub(crate) header: Vec<String>,
+}
+
+/// Opens a CSV file (`-`: stdin) and reads its header.
+pub(crate) fn open_csv(path: &Path) -> miette::Result<CsvInput> {
+    let (name, source): (String, Box<dyn Read>) = if path.as_os_str() == "-" {
+        ("<stdin>".into(), Box::new(std::io::stdin()))
+    } else {
+        let file = std::fs::File::open(path)
+            .map_err(|e| miette::miette!("cannot read {}: {e}", path.display()))?;
+        (path.display().to_string(), Box::new(file))
+    };
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(source);
+    let header: Vec<String> = reader
+        .headers()
+        .map_err(|e| miette::miette!("{name}:1: {e}"))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    if header.iter().all(String::is_empty) {
+        miette::bail!("{name}:1: the file is empty; expected a header line");
+    }
+    if let Some(dup) = header
+        .iter()
+        .enumerate()
+        .find(|(k, h)| header[..*k].contains(h))
+        .map(|(_, h)| h)
+    {
+        miette::bail!("{name}:1: column `{dup}` appears twice in the header");
+    }
+    Ok(CsvInput {
+        name,
+        reader,
+        header,
+    })
+}
+
+/// Reads every data row as finite numbers: `(line, values)`. Errors name the
+/// file, the line and the column.
+pub(crate) fn numeric_rows(input: &mut CsvInput) -> miette::Result<Vec<(usize, Vec<f64>)>> {
+    let name = &input.name;
+    let mut out = Vec::new();
+    for rec in input.reader.records() {
+        let rec = rec.map_err(|e| {
+            let line = e.position().map_or(0, |p| p.line());
+            miette::miette!("{name}:{line}: {e}")
+        })?;
+        let line = rec.position().map_or(0, |p| p.line() as usize);
+        let values = rec
+            .iter()
+            .zip(&input.header)
+            .map(|(field, column)| {
+                let x: f64 = field.parse().map_err(|_| {
+                    miette::miette!("{name}:{line}: `{field}` (column `{column}`) is not a number")
+                })?;
+                if x.is_finite() {
+                    Ok(x)
+                } else {
+                    Err(miette::miette!(
+                        "{name}:{line}: `{field}` (column `{column}`) is not finite"
+                    ))
+                }
+            })
+            .collect::<miette::Result<Vec<f64>>>()?;
+        out.push((line, values));
+    }
+    if out.is_empty() {
+        miette::bail!("{name}: no data row (only a header)");
+    }
+    Ok(out)
+}
+
+/// One tool pose of a pose CSV.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PoseRow {
+    /// The instant of an optional first column `t`.
+    pub(crate) t: Option<f64>,
+    /// The tool point `px, py, pz`.
+    pub(crate) point: [f64; 3],
+    /// The tool axis `i, j, k` (non-zero; not normalised here).
+    pub(crate) axis: [f64; 3],
+}
+
+/// Reads a pose CSV: header `px,py,pz,i,j,k`, optionally after a first
+/// column `t`. Returns whether `t` was given, and the rows.
+pub(crate) fn read_poses(path: &Path) -> miette::Result<(bool, Vec<PoseRow>)> {
+    let mut input = open_csv(path)?;
+    let name = input.name.clone();
+    let want = ["px", "py", "pz", "i", "j", "k"];
+    let has_t = input.header.first().is_some_and(|h| h == "t");
+    let skip = usize::from(has_t);
+    if input.header[skip..] != want {
+        miette::bail!(
+            "{name}:1: expected the header `px,py,pz,i,j,k` (optionally after a first column `t`), found `{}`",
+            input.header.join(",")
+        );
+    }
+    let rows = numeric_rows(&mut input)?;
+    rows.into_iter()
+        .map(|(line, v)| {
+            let axis = [v[skip + 3], v[skip + 4], v[skip + 5]];
+            if (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt() < 1e-12 {
+                miette::bail!("{name}:{line}: the tool axis (i, j, k) is zero");
+            }
+            Ok(PoseRow {
+                t: has_t.then_some(v[0]),
+                point: [v[skip], v[skip + 1], v[skip + 2]],
+                axis,
+            })
+        })
+        .collect::<miette::Result<Vec<_>>>()
+        .map(|rows| (has_t, rows))
+}

@@ -1,0 +1,108 @@
+//! `--plot DIR` of `chain path`: the reliability of every target and the
+//! standard deviation of the toleranced error components along the path
+//! (PNG and SVG), drawn with the facade's [`chain::plot::XyChart`].
+//! Instants without axis values (unreachable poses) have no point.
+
+use std::path::{Path, PathBuf};
+
+use chain::plot::{Legend, Series, XyChart};
+
+use super::{quantity, PathResult, QUANTITIES};
+
+/// Writes `path_reliability`, `path_std` and, when an orientation component
+/// is toleranced, `path_std_angular`; returns the files written. Writes
+/// nothing when no instant was evaluated.
+pub(super) fn write_all(dir: &Path, r: &PathResult) -> miette::Result<Vec<PathBuf>> {
+    if r.instants.iter().all(|(_, e)| e.is_none()) {
+        eprintln!("note: no evaluated instant; no chart written");
+        return Ok(Vec::new());
+    }
+    let x_label = if r.has_t { "t" } else { "row" };
+    let method = match r.method {
+        "form" => "FORM",
+        "is" => "importance sampling",
+        _ => "Monte Carlo",
+    };
+    let mut files = Vec::new();
+
+    let mut chart = XyChart::new(
+        format!("{}: reliability along the path ({method})", r.machine),
+        x_label,
+        "reliability (%)",
+    )
+    .legend(Legend::LowerLeft);
+    for (t, (name, _)) in r.targets.iter().enumerate() {
+        let points = r
+            .instants
+            .iter()
+            .filter_map(|(i, e)| e.as_ref().map(|e| (i.t, 100.0 * e.reliability[t])))
+            .collect();
+        chart = chart.series(Series::line_points(*name, points));
+    }
+    if let Some(req) = r.study.as_ref().and_then(|s| s.requirement) {
+        chart = chart.hline(100.0 * req.min);
+    }
+    let chart = with_legend_room(chart, false);
+    files.extend(chart.write(dir, "path_reliability")?);
+
+    // Standard deviations, lengths and angles on separate charts.
+    let toleranced = |k: usize| r.targets.iter().any(|(t, _)| *t == QUANTITIES[k]);
+    let position: Vec<usize> = (0..3).filter(|&k| toleranced(k)).chain([6]).collect();
+    let angular: Vec<usize> = (3..6).filter(|&k| toleranced(k)).collect();
+    for (stem, ks, unit) in [
+        ("path_std", position, "std (length unit)"),
+        ("path_std_angular", angular, "std (rad)"),
+    ] {
+        if ks.is_empty() {
+            continue;
+        }
+        let mut chart = XyChart::new(
+            format!("{}: error standard deviation along the path", r.machine),
+            x_label,
+            unit,
+        )
+        .legend(Legend::UpperLeft);
+        for k in ks {
+            let label = if k == 6 {
+                "|p|".to_string()
+            } else {
+                QUANTITIES[k].to_string()
+            };
+            let points = r
+                .instants
+                .iter()
+                .filter_map(|(i, e)| e.as_ref().map(|e| (i.t, quantity(e, k).1)))
+                .collect();
+            chart = chart.series(Series::line_points(label, points));
+        }
+        files.extend(with_legend_room(chart, true).write(dir, stem)?);
+    }
+    Ok(files)
+}
+
+/// Fits the y range to the data and reference lines, with an empty band
+/// above (`top`) or below for the legend so that it covers no series.
+fn with_legend_room(chart: XyChart, top: bool) -> XyChart {
+    let values = chart
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .chain(chart.hlines.iter().copied())
+        .filter(|v| v.is_finite());
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    if !(lo.is_finite() && hi.is_finite()) {
+        return chart;
+    }
+    let span = if hi > lo {
+        hi - lo
+    } else {
+        lo.abs().max(1.0) * 0.1
+    };
+    if top {
+        chart.y_range(lo - 0.08 * span, hi + 0.45 * span)
+    } else {
+        chart.y_range(lo - 0.45 * span, hi + 0.08 * span)
+    }
+}
