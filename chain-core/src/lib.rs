@@ -22,7 +22,9 @@ pub mod jet;
 pub mod kinematics;
 pub mod load;
 pub mod model;
+pub mod motion;
 mod model_trait;
+pub mod settings;
 pub mod yaml;
 
 pub use derive::{derive, derive_in, SymbolicModel};

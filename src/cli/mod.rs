@@ -6,6 +6,7 @@ pub mod compensate;
 mod csv_input;
 pub mod derive;
 pub mod inverse;
+pub mod motion;
 pub mod path;
 pub mod reliability;
 pub mod sensitivity;
@@ -37,6 +38,8 @@ enum Command {
     Inverse(inverse::InverseArgs),
     /// Error and reliability along a path (axis values or tool poses) at every instant.
     Path(path::PathArgs),
+    /// Motion conversion (seed 002): CNC axis motions reproducing a cradle-type generator's roll, and their Maclaurin series.
+    Motion(motion::MotionArgs),
 }
 
 /// Runs the parsed command line.
@@ -49,5 +52,6 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Compensate(args) => compensate::exec(args),
         Command::Inverse(args) => inverse::exec(args),
         Command::Path(args) => path::exec(args),
+        Command::Motion(args) => motion::exec(args),
     }
 }
