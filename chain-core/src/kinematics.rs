@@ -24,7 +24,28 @@
 use crate::algebra::{Poly, Symbol};
 use crate::jet::Jet;
 use crate::model::{JointKind, Machine};
-use crate::{Pose, SymbolicModel};
+use crate::{ErrorModel, Pose, SymbolicModel};
+
+/// Anything that gives the nominal pose of a machine: every [`ErrorModel`]
+/// (its `nominal()`) and [`Kinematics`]. The inverse-kinematics solvers need
+/// no more than this.
+pub trait NominalPose {
+    /// `R_wt(q, 0)` and `T_wt(q, 0)·tool_point` at axis values `q` and
+    /// parameter values `p`.
+    fn nominal_pose(&self, q: &[f64], p: &[f64]) -> Pose;
+}
+
+impl<M: ErrorModel + ?Sized> NominalPose for M {
+    fn nominal_pose(&self, q: &[f64], p: &[f64]) -> Pose {
+        self.nominal(q, p)
+    }
+}
+
+impl NominalPose for Kinematics {
+    fn nominal_pose(&self, q: &[f64], p: &[f64]) -> Pose {
+        Kinematics::pose(self, q, p)
+    }
+}
 
 /// A number type the pose polynomials can be evaluated over.
 pub trait Scalar: Clone {

@@ -16,14 +16,15 @@ pub mod expand;
 pub mod export;
 pub mod expr;
 pub mod geometric;
+pub mod geometry;
 pub mod inline;
 pub mod inverse;
 pub mod jet;
 pub mod kinematics;
 pub mod load;
 pub mod model;
-pub mod motion;
 mod model_trait;
+pub mod motion;
 pub mod settings;
 pub mod yaml;
 

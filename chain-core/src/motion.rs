@@ -52,10 +52,9 @@ use crate::inverse::{wrap, Solver};
 use crate::jet::Jet;
 use crate::kinematics::{Kinematics, PoseOf};
 use crate::model::{JointKind, Machine};
-use crate::{ErrorModel, Pose};
+use crate::Pose;
 
-type V3 = [f64; 3];
-type M3 = [[f64; 3]; 3];
+use crate::geometry::{basis, col, cross, dot, log_so3, mul, norm, sub, tr, V3};
 
 /// What the CNC machine must reproduce of the generator's pose.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -594,12 +593,11 @@ impl Motion {
     pub fn solve_cold(&self, t: f64) -> Result<Vec<f64>, MotionError> {
         let target = self.generator_pose(t);
         let mut candidates: Vec<Vec<f64>> = vec![self.start.clone()];
-        let adapter = NominalModel::new(&self.cnc);
         let held: Vec<(usize, f64)> = match self.matching {
             Matching::Pose => Vec::new(),
             Matching::PointAxis => self.fixed.clone(),
         };
-        if let Ok(solver) = Solver::new(&adapter, &self.kinds, &self.cnc_params, &held) {
+        if let Ok(solver) = Solver::new(&self.cnc, &self.kinds, &self.cnc_params, &held) {
             let s = solver.solve(target.position, col(&target.rotation, 2), &self.start);
             candidates.extend(s.solutions);
         }
@@ -834,220 +832,48 @@ pub fn pose_difference(a: &Pose, b: &Pose) -> PoseError {
     }
 }
 
-/// The nominal pose of a [`Kinematics`] seen as an [`ErrorModel`] without
-/// errors, for the closed-form [`Solver`].
-struct NominalModel<'a> {
-    kin: &'a Kinematics,
-    variables: Vec<&'a str>,
-    parameters: Vec<&'a str>,
-}
-
-impl<'a> NominalModel<'a> {
-    fn new(kin: &'a Kinematics) -> Self {
-        NominalModel {
-            kin,
-            variables: kin.variables().iter().map(|v| v.0.as_str()).collect(),
-            parameters: kin.parameters().iter().map(|p| p.0.as_str()).collect(),
-        }
-    }
-}
-
-impl ErrorModel for NominalModel<'_> {
-    fn variables(&self) -> &[&str] {
-        &self.variables
-    }
-    fn parameters(&self) -> &[&str] {
-        &self.parameters
-    }
-    fn errors(&self) -> &[&str] {
-        &[]
-    }
-    fn error(&self, _q: &[f64], _p: &[f64], _e: &[f64], out: &mut [f64; 6]) {
-        *out = [0.0; 6];
-    }
-    fn sensitivity(&self, _q: &[f64], _p: &[f64], _out: &mut [f64]) {}
-    fn nominal(&self, q: &[f64], p: &[f64]) -> Pose {
-        self.kin.pose(q, p)
-    }
-}
-
-// ---------------------------------------------------------------------------
-// Small dense linear algebra
-
-/// Householder QR of an `m × n` matrix (`m ≥ n`) for least-squares solves.
+/// A QR factorisation (nalgebra) of an `m × n` matrix (`m ≥ n`) for
+/// least-squares solves.
 struct Qr {
-    m: usize,
-    n: usize,
-    /// R in the upper triangle, Householder vectors below (with `beta`).
-    a: Vec<Vec<f64>>,
-    v: Vec<Vec<f64>>,
-    beta: Vec<f64>,
+    q: nalgebra::DMatrix<f64>,
+    r: nalgebra::DMatrix<f64>,
 }
 
 impl Qr {
-    /// Factors `a`; `None` if `m < n` or the columns are (numerically)
-    /// dependent.
+    /// Factors `a` (given by rows); `None` if `m < n` or the columns are
+    /// (numerically) dependent: a diagonal entry of `R` below `1e-11` of the
+    /// largest.
     fn new(a: &[Vec<f64>]) -> Option<Qr> {
         let m = a.len();
         let n = a.first().map_or(0, Vec::len);
-        if m < n || n == 0 {
+        if m < n || n == 0 || a.iter().any(|row| row.len() != n) {
             return None;
         }
-        let mut a: Vec<Vec<f64>> = a.to_vec();
-        let mut v = Vec::with_capacity(n);
-        let mut beta = Vec::with_capacity(n);
-        for k in 0..n {
-            let x: Vec<f64> = (k..m).map(|i| a[i][k]).collect();
-            let alpha = x.iter().map(|t| t * t).sum::<f64>().sqrt();
-            let mut hv = x.clone();
-            let s = if x[0] >= 0.0 { 1.0 } else { -1.0 };
-            hv[0] += s * alpha;
-            let hn: f64 = hv.iter().map(|t| t * t).sum();
-            let b = if hn > 0.0 { 2.0 / hn } else { 0.0 };
-            for j in k..n {
-                let d: f64 = (k..m).map(|i| hv[i - k] * a[i][j]).sum();
-                for (i, row) in a.iter_mut().enumerate().skip(k) {
-                    row[j] -= b * d * hv[i - k];
-                }
-            }
-            v.push(hv);
-            beta.push(b);
-        }
-        let cols: Vec<f64> = (0..n).map(|k| a[k][k].abs()).collect();
-        let big = cols.iter().copied().fold(0.0, f64::max);
-        if !(big.is_finite() && big > 0.0) || cols.iter().any(|&c| c <= 1e-11 * big) {
+        let qr = nalgebra::DMatrix::from_fn(m, n, |i, j| a[i][j]).qr();
+        let r = qr.r();
+        let big = (0..n).map(|k| r[(k, k)].abs()).fold(0.0, f64::max);
+        if !(big.is_finite() && big > 0.0) || (0..n).any(|k| r[(k, k)].abs() <= 1e-11 * big) {
             return None;
         }
-        Some(Qr { m, n, a, v, beta })
+        Some(Qr { q: qr.q(), r })
     }
 
     /// The least-squares solution of `A x = b`.
     fn solve(&self, b: &[f64]) -> Option<Vec<f64>> {
-        if b.len() != self.m {
+        if b.len() != self.q.nrows() {
             return None;
         }
-        let mut y = b.to_vec();
-        for k in 0..self.n {
-            let hv = &self.v[k];
-            let d: f64 = (k..self.m).map(|i| hv[i - k] * y[i]).sum();
-            for i in k..self.m {
-                y[i] -= self.beta[k] * d * hv[i - k];
-            }
-        }
-        let mut x = vec![0.0; self.n];
-        for k in (0..self.n).rev() {
-            let s: f64 = (k + 1..self.n).map(|j| self.a[k][j] * x[j]).sum();
-            x[k] = (y[k] - s) / self.a[k][k];
-        }
-        x.iter().all(|v| v.is_finite()).then_some(x)
+        let qtb = self.q.tr_mul(&nalgebra::DVector::from_column_slice(b));
+        let x = self.r.solve_upper_triangular(&qtb)?;
+        x.iter()
+            .all(|v| v.is_finite())
+            .then(|| x.iter().copied().collect())
     }
-}
-
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn norm(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn col(r: &M3, j: usize) -> V3 {
-    [r[0][j], r[1][j], r[2][j]]
-}
-fn tr(a: &M3) -> M3 {
-    std::array::from_fn(|i| std::array::from_fn(|j| a[j][i]))
-}
-fn mul(a: &M3, b: &M3) -> M3 {
-    std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
-}
-
-/// Two unit vectors completing `z` to an orthonormal basis.
-fn basis(z: V3) -> (V3, V3) {
-    let n = norm(z);
-    let z = [z[0] / n, z[1] / n, z[2] / n];
-    let helper = if z[0].abs() < 0.6 {
-        [1.0, 0.0, 0.0]
-    } else {
-        [0.0, 1.0, 0.0]
-    };
-    let e1 = cross(z, helper);
-    let l = norm(e1);
-    let e1 = [e1[0] / l, e1[1] / l, e1[2] / l];
-    (e1, cross(z, e1))
-}
-
-/// The rotation vector `θ·u` of a rotation matrix (`θ ∈ [0, π]`).
-pub fn log_so3(r: &M3) -> V3 {
-    let w = [
-        0.5 * (r[2][1] - r[1][2]),
-        0.5 * (r[0][2] - r[2][0]),
-        0.5 * (r[1][0] - r[0][1]),
-    ];
-    let c = (0.5 * (r[0][0] + r[1][1] + r[2][2] - 1.0)).clamp(-1.0, 1.0);
-    let s = norm(w);
-    let theta = s.atan2(c);
-    if s < 1e-300 && c > 0.0 {
-        return [0.0; 3];
-    }
-    if theta < 3.0 {
-        let k = theta / s;
-        return [k * w[0], k * w[1], k * w[2]];
-    }
-    // Near π: the axis from the symmetric part, its sign from w.
-    let b: M3 = std::array::from_fn(|i| {
-        std::array::from_fn(|j| 0.5 * (r[i][j] + r[j][i]) - if i == j { c } else { 0.0 })
-    });
-    let k = (0..3)
-        .max_by(|&i, &j| b[i][i].total_cmp(&b[j][j]))
-        .unwrap_or(0);
-    let mut u = col(&b, k);
-    let l = norm(u);
-    if l == 0.0 {
-        return [theta, 0.0, 0.0];
-    }
-    u = [u[0] / l, u[1] / l, u[2] / l];
-    if dot(u, w) < 0.0 {
-        u = [-u[0], -u[1], -u[2]];
-    }
-    [theta * u[0], theta * u[1], theta * u[2]]
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn rot(u: V3, a: f64) -> M3 {
-        let (s, c) = a.sin_cos();
-        let n = norm(u);
-        let u = [u[0] / n, u[1] / n, u[2] / n];
-        std::array::from_fn(|i| {
-            std::array::from_fn(|j| {
-                let id = if i == j { 1.0 } else { 0.0 };
-                let k = [[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]];
-                c * id + s * k[i][j] + (1.0 - c) * u[i] * u[j]
-            })
-        })
-    }
-
-    #[test]
-    fn log_inverts_the_rotation_up_to_pi() {
-        for &a in &[0.0, 1e-9, 0.3, 2.9, 3.05, 3.1, std::f64::consts::PI - 1e-9] {
-            let u = [0.3, -0.5, 0.8];
-            let w = log_so3(&rot(u, a));
-            let n = norm(u);
-            for i in 0..3 {
-                assert!((w[i] - a * u[i] / n).abs() < 1e-7, "{a}: {w:?}");
-            }
-        }
-    }
 
     #[test]
     fn qr_solves_square_and_least_squares() {

@@ -31,11 +31,14 @@ mod newton;
 
 pub use newton::NewtonSolver;
 
-use crate::kinematics::Kinematics;
+use crate::kinematics::{Kinematics, NominalPose};
 use crate::model::{JointKind, Machine};
-use crate::{CompiledModel, ErrorModel};
+use crate::CompiledModel;
 
-type V3 = [f64; 3];
+use crate::geometry::{
+    cross, det, dot, mat_vec, mul, mul_t_vec, norm, quarter_axis, rodrigues, rodrigues_vec, scale,
+    solve3, sub, tr, V3,
+};
 
 /// Why a machine cannot be handled by [`Solver`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -153,7 +156,7 @@ impl Solver {
     /// Prepares the solver: `kinds` are the variables' joint kinds (model
     /// order), `params` the parameter values, `fixed` the held variables
     /// `(index, value)`.
-    pub fn new<M: ErrorModel + ?Sized>(
+    pub fn new<M: NominalPose + ?Sized>(
         model: &M,
         kinds: &[JointKind],
         params: &[f64],
@@ -239,13 +242,13 @@ impl Solver {
         q
     }
 
-    fn rot<M: ErrorModel + ?Sized>(&self, model: &M, a: f64, b: f64, l: V3) -> [[f64; 3]; 3] {
-        model.nominal(&self.q(a, b, l), &self.params).rotation
+    fn rot<M: NominalPose + ?Sized>(&self, model: &M, a: f64, b: f64, l: V3) -> [[f64; 3]; 3] {
+        model.nominal_pose(&self.q(a, b, l), &self.params).rotation
     }
 
     /// Fits `u`, `R0`, `v` for the current outer/inner choice and checks the
     /// product form at a few points.
-    fn fit<M: ErrorModel + ?Sized>(&mut self, model: &M) -> bool {
+    fn fit<M: NominalPose + ?Sized>(&mut self, model: &M) -> bool {
         let z = [0.0; 3];
         let r0 = self.rot(model, 0.0, 0.0, z);
         let ra = self.rot(model, std::f64::consts::FRAC_PI_2, 0.0, z);
@@ -268,8 +271,8 @@ impl Solver {
         })
     }
 
-    fn position<M: ErrorModel + ?Sized>(&self, model: &M, a: f64, b: f64, l: V3) -> V3 {
-        model.nominal(&self.q(a, b, l), &self.params).position
+    fn position<M: NominalPose + ?Sized>(&self, model: &M, a: f64, b: f64, l: V3) -> V3 {
+        model.nominal_pose(&self.q(a, b, l), &self.params).position
     }
 
     /// Fits the position model from `nominal()` at the quarter turns
@@ -278,7 +281,7 @@ impl Solver {
     /// is exact for any serial chain: each rotary joint appears once, so the
     /// position is linear in `(1, cos, sin)` of each angle and affine in the
     /// linear variables.
-    fn fit_position<M: ErrorModel + ?Sized>(&mut self, model: &M) -> bool {
+    fn fit_position<M: NominalPose + ?Sized>(&mut self, model: &M) -> bool {
         use std::f64::consts::{FRAC_PI_2, PI};
         let angles = [0.0, FRAC_PI_2, PI];
         // Values at the three angles -> coefficients of (1, cos, sin):
@@ -477,16 +480,16 @@ impl Solver {
 
 /// Whether variable `i` changes the tool point or the tool axis (checked at
 /// two configurations).
-fn moves_tool<M: ErrorModel + ?Sized>(model: &M, params: &[f64], base: &[f64], i: usize) -> bool {
+fn moves_tool<M: NominalPose + ?Sized>(model: &M, params: &[f64], base: &[f64], i: usize) -> bool {
     [0.37, -1.9].iter().any(|&s| {
         let mut q: Vec<f64> = base
             .iter()
             .enumerate()
             .map(|(k, b)| b + s * (k as f64 + 1.0) * 0.61)
             .collect();
-        let p1 = model.nominal(&q, params);
+        let p1 = model.nominal_pose(&q, params);
         q[i] += 0.9;
-        let p2 = model.nominal(&q, params);
+        let p2 = model.nominal_pose(&q, params);
         let a1 = [p1.rotation[0][2], p1.rotation[1][2], p1.rotation[2][2]];
         let a2 = [p2.rotation[0][2], p2.rotation[1][2], p2.rotation[2][2]];
         norm(sub(a1, a2)) > 1e-12
@@ -512,98 +515,4 @@ fn close(a: &[f64], b: &[f64], rotary: &[bool]) -> bool {
         let d = if *r { wrap(x - y) } else { x - y };
         d.abs() < 1e-9 * 1.0f64.max(x.abs())
     })
-}
-
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn norm(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
-fn scale(a: V3, s: f64) -> V3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn mul(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            c[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
-        }
-    }
-    c
-}
-fn tr(a: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            c[i][j] = a[j][i];
-        }
-    }
-    c
-}
-fn mat_vec(a: &[[f64; 3]; 3], x: V3) -> V3 {
-    [dot(a[0], x), dot(a[1], x), dot(a[2], x)]
-}
-fn mul_t_vec(a: &[[f64; 3]; 3], x: V3) -> V3 {
-    mat_vec(&tr(a), x)
-}
-fn det(a: &[[f64; 3]; 3]) -> f64 {
-    dot(a[0], cross(a[1], a[2]))
-}
-/// Solves `a x = y` by Cramer's rule.
-fn solve3(a: &[[f64; 3]; 3], y: V3) -> Option<V3> {
-    let d = det(a);
-    if d.abs() < 1e-12 {
-        return None;
-    }
-    let c = [
-        [a[0][0], a[1][0], a[2][0]],
-        [a[0][1], a[1][1], a[2][1]],
-        [a[0][2], a[1][2], a[2][2]],
-    ];
-    Some([
-        dot(y, cross(c[1], c[2])) / d,
-        dot(c[0], cross(y, c[2])) / d,
-        dot(c[0], cross(c[1], y)) / d,
-    ])
-}
-/// The axis of a rotation by +π/2.
-fn quarter_axis(r: &[[f64; 3]; 3]) -> V3 {
-    [
-        (r[2][1] - r[1][2]) / 2.0,
-        (r[0][2] - r[2][0]) / 2.0,
-        (r[1][0] - r[0][1]) / 2.0,
-    ]
-}
-fn rodrigues(u: V3, a: f64) -> [[f64; 3]; 3] {
-    let mut r = [[0.0; 3]; 3];
-    for j in 0..3 {
-        let mut e = [0.0; 3];
-        e[j] = 1.0;
-        let c = rodrigues_vec(u, a, e);
-        for i in 0..3 {
-            r[i][j] = c[i];
-        }
-    }
-    r
-}
-fn rodrigues_vec(u: V3, a: f64, x: V3) -> V3 {
-    let (s, c) = a.sin_cos();
-    let ux = cross(u, x);
-    let ud = dot(u, x) * (1.0 - c);
-    [
-        x[0] * c + ux[0] * s + u[0] * ud,
-        x[1] * c + ux[1] * s + u[1] * ud,
-        x[2] * c + ux[2] * s + u[2] * ud,
-    ]
 }
