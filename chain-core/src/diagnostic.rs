@@ -1,14 +1,20 @@
-//! Located diagnostics for machine files.
+//! Located diagnostics for machine files and the settings files of `chain
+//! motion`.
 //!
 //! Every rule of the machine-file contract that a file can break has one
 //! [`Problem`] variant, and its wording lives here and nowhere else: the YAML
 //! loader ([`crate::load`]) attaches a problem to an [`Origin`] (file, line,
 //! column, key path) to make a [`LoadError`], and the `machine!` macro can
 //! attach the same problem to a token span, so both front ends say the same
-//! thing about the same mistake.
+//! thing about the same mistake. The settings loader ([`crate::settings`])
+//! reads the same located tree and reports through the same types: the
+//! shared rules (unknown key, wrong type, ...) with their variants, its own
+//! rules (names of its two machines, angles, the roll) as a
+//! [`Problem::Message`] that it words itself.
 //!
-//! [`Diagnostics`] is the error type of [`crate::load_str`] and friends: a
-//! non-empty list of [`LoadError`]s for one file. Its `Display` names the file,
+//! [`Diagnostics`] is the error type of [`crate::load_str`], of
+//! [`crate::settings::load_settings_str`] and their friends: a non-empty list
+//! of [`LoadError`]s for one file. Its `Display` names the file,
 //! line, column and key of the first error on its own; through
 //! [`miette::Diagnostic`] it also carries the file text (labels at the spans)
 //! and the remaining errors as `related()` diagnostics.
@@ -19,7 +25,8 @@ use miette::{LabeledSpan, NamedSource, SourceCode};
 
 use crate::model::{ErrorKind, Origin};
 
-/// One thing wrong with a machine description, independent of where it is.
+/// One thing wrong with a machine description (or a settings file),
+/// independent of where it is.
 ///
 /// `Display` gives the full message (headline plus the parenthesised note);
 /// [`Problem::headline`], [`Problem::note`], [`Problem::help`],
@@ -286,6 +293,56 @@ pub enum Problem {
         /// Found number of items.
         found: usize,
     },
+    /// A rule of a settings file, worded by its reader.
+    Message(Message),
+}
+
+/// A problem worded at run time by the reader of a file other than a machine
+/// file (the settings of `chain motion`): the payload of [`Problem::Message`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Message {
+    /// The headline.
+    pub text: String,
+    /// The closest valid name, if one is close: the headline ends with
+    /// `(did you mean ...)`.
+    pub suggestion: Option<String>,
+    /// A longer hint, if one helps.
+    pub help: Option<String>,
+    /// The short label of the span.
+    pub label: &'static str,
+    /// A stable code, e.g. `chain::settings::unknown_name`.
+    pub code: &'static str,
+}
+
+impl Message {
+    /// `text`, with the span's `label` and a stable `code`.
+    pub fn new(text: impl Into<String>, label: &'static str, code: &'static str) -> Message {
+        Message {
+            text: text.into(),
+            suggestion: None,
+            help: None,
+            label,
+            code,
+        }
+    }
+
+    /// With a hint.
+    pub fn help(mut self, help: impl Into<String>) -> Message {
+        self.help = Some(help.into());
+        self
+    }
+
+    /// With the closest valid name, if there is one.
+    pub fn suggest(mut self, suggestion: Option<&str>) -> Message {
+        self.suggestion = suggestion.map(str::to_string);
+        self
+    }
+}
+
+impl From<Message> for Problem {
+    fn from(message: Message) -> Problem {
+        Problem::Message(message)
+    }
 }
 
 fn kind_name(kind: ErrorKind) -> &'static str {
@@ -416,6 +473,10 @@ impl Problem {
             Problem::WrongLength { expected, found } => {
                 format!("expected a list of {expected} items, found {found}")
             }
+            Problem::Message(m) => match did_you_mean(&m.suggestion) {
+                Some(s) => format!("{} ({s})", m.text),
+                None => m.text.clone(),
+            },
         }
     }
 
@@ -480,6 +541,7 @@ impl Problem {
                 "variables, parameters and error parameters share one namespace in the model"
                     .into(),
             ),
+            Problem::Message(m) => m.help.clone(),
             _ => None,
         }
     }
@@ -527,6 +589,7 @@ impl Problem {
             Problem::UnknownVariable { .. } => "unknown variable",
             Problem::EmptyList { .. } => "empty",
             Problem::WrongLength { .. } => "wrong length",
+            Problem::Message(m) => m.label,
         }
     }
 
@@ -577,6 +640,7 @@ impl Problem {
             Problem::UnknownVariable { .. } => "chain::unknown_variable",
             Problem::EmptyList { .. } => "chain::empty_list",
             Problem::WrongLength { .. } => "chain::wrong_length",
+            Problem::Message(m) => m.code,
         }
     }
 }
@@ -651,7 +715,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
     prev[n]
 }
 
-/// One located error in a machine file.
+/// One located error in a machine file (or settings file).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoadError {
     /// The file name as given to the loader.
@@ -759,7 +823,7 @@ impl miette::Diagnostic for Related {
     }
 }
 
-/// All errors found in one machine file: never empty.
+/// All errors found in one machine file (or settings file): never empty.
 ///
 /// `Display` shows the first error (`file:line:column: message at key `k``)
 /// followed by how many more there are; the alternate form (`{:#}`) lists every
@@ -817,6 +881,20 @@ impl Diagnostics {
                 related,
             }),
         })
+    }
+
+    /// The diagnostics of `file` (whose text is `source`) from problems
+    /// located in it; `None` if there are none.
+    pub fn located(
+        file: &str,
+        source: impl Into<String>,
+        problems: impl IntoIterator<Item = (Origin, Problem)>,
+    ) -> Option<Diagnostics> {
+        let errors = problems
+            .into_iter()
+            .map(|(origin, problem)| LoadError::new(file, origin, problem))
+            .collect();
+        Diagnostics::new(file, source, errors)
     }
 
     /// A single error.

@@ -1,7 +1,7 @@
 //! The validated machine model.
 //!
 //! A [`Machine`] is what the loader (YAML, [`crate::load`]) and the `machine!`
-//! macro both produce, and what the derivation ([`crate::derive`]) consumes. By
+//! macro both produce, and what the derivation ([`crate::derive()`]) consumes. By
 //! the time a `Machine` exists every rule of the machine-file contract has been
 //! checked: names resolve, the body graph is a tree with one root, every
 //! variable drives exactly one joint, every parameter an expression uses is

@@ -31,17 +31,16 @@
 //! only on rotary variables, CNC names exist) and produces the
 //! [`MotionSpec`] that [`crate::motion::Motion`] runs.
 
-use std::fmt;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use miette::{LabeledSpan, NamedSource, SourceCode};
-
-use crate::diagnostic::{closest, Diagnostics, Problem};
-use crate::expr;
+use crate::diagnostic::{closest, Diagnostics, Message, Problem};
+use crate::load::{
+    self,
+    reader::{index, join, start_origin, TreeReader},
+};
 use crate::model::{JointKind, Machine, Origin};
 use crate::motion::{Law, Matching, MotionSpec};
-use crate::yaml::{self, Node, Span};
+use crate::yaml::{self, Node};
 
 /// Keys allowed at the top level of a settings file.
 pub const TOP_KEYS: &[&str] = &[
@@ -71,237 +70,22 @@ pub const BUILTIN_GENERATOR_NAME: &str = "cradle_generator.yaml (built-in)";
 /// Settings files larger than this are refused.
 pub const MAX_SETTINGS_BYTES: usize = 1024 * 1024;
 
+/// How to write an angle, for an angle that cannot be read.
+const DMS_HELP: &str =
+    "write degrees-minutes-seconds as \"-115°39′\" or \"12°30'15\\\"\", or degrees as -115.65deg";
+
 // ---------------------------------------------------------------------------
 // Diagnostics
 
-/// One located problem of a settings file.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Issue {
-    /// Where (line 0: the file as a whole) and the dotted key path.
-    pub origin: Origin,
-    /// The message, without location.
-    pub message: String,
-    /// A short label for the span.
-    pub label: &'static str,
-    /// A hint, if one helps.
-    pub help: Option<String>,
-    /// A stable code, e.g. `chain::settings::unknown_name`.
-    pub code: &'static str,
-}
-
-impl Issue {
-    fn new(
-        origin: Origin,
-        message: impl Into<String>,
-        label: &'static str,
-        code: &'static str,
-    ) -> Issue {
-        Issue {
-            origin,
-            message: message.into(),
-            label,
-            help: None,
-            code,
-        }
-    }
-
-    fn with_help(mut self, help: impl Into<String>) -> Issue {
-        self.help = Some(help.into());
-        self
-    }
-
-    fn from_problem(origin: Origin, problem: &Problem) -> Issue {
-        Issue {
-            origin,
-            message: problem.to_string(),
-            label: problem.label(),
-            help: problem.help(),
-            code: problem.code(),
-        }
-    }
-
-    fn render(&self, file: &str, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{file}:")?;
-        if self.origin.line > 0 {
-            write!(f, "{}:{}:", self.origin.line, self.origin.column)?;
-        }
-        write!(f, " {}", self.message)?;
-        if !self.origin.key.is_empty() {
-            write!(f, " at key `{}`", self.origin.key)?;
-        }
-        Ok(())
-    }
-
-    fn labeled(&self, source_len: usize) -> Option<LabeledSpan> {
-        if self.origin.line == 0 || source_len == 0 {
-            return None;
-        }
-        let offset = self.origin.offset.min(source_len);
-        let len = self.origin.len.min(source_len - offset);
-        Some(LabeledSpan::new_with_span(
-            Some(self.label.to_string()),
-            (offset, len),
-        ))
-    }
-}
-
-/// Every problem found in one settings file (never empty).
-///
-/// `Display` gives the first (`file:line:column: message at key `k``) and
-/// how many more there are; `{:#}` lists them all. As a
-/// [`miette::Diagnostic`] it carries the file text with a label at the span
-/// and the other problems as related diagnostics.
-pub struct SettingsError {
-    // Boxed so that results stay small.
-    inner: Box<ErrorInner>,
-}
-
-struct ErrorInner {
-    file: String,
-    source: NamedSource<String>,
-    source_len: usize,
-    issues: Vec<Issue>,
-    related: Vec<RelatedIssue>,
-}
-
-impl SettingsError {
-    fn new(file: &str, source: &str, mut issues: Vec<Issue>) -> SettingsError {
-        issues.sort_by_key(|i| (i.origin.line, i.origin.column));
-        let related = issues
-            .iter()
-            .skip(1)
-            .map(|issue| RelatedIssue {
-                file: file.to_string(),
-                issue: issue.clone(),
-                source_len: source.len(),
-            })
-            .collect();
-        SettingsError {
-            inner: Box::new(ErrorInner {
-                file: file.to_string(),
-                source: NamedSource::new(file, source.to_string()).with_language("yaml"),
-                source_len: source.len(),
-                issues,
-                related,
-            }),
-        }
-    }
-
-    /// The file name as given.
-    pub fn file(&self) -> &str {
-        &self.inner.file
-    }
-
-    /// The problems, in source order.
-    pub fn issues(&self) -> &[Issue] {
-        &self.inner.issues
-    }
-
-    /// The first problem.
-    pub fn first(&self) -> &Issue {
-        &self.inner.issues[0]
-    }
-}
-
-impl fmt::Debug for SettingsError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("SettingsError")
-            .field("file", &self.inner.file)
-            .field("issues", &self.inner.issues)
-            .finish_non_exhaustive()
-    }
-}
-
-impl fmt::Display for SettingsError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if f.alternate() {
-            for (k, issue) in self.inner.issues.iter().enumerate() {
-                if k > 0 {
-                    writeln!(f)?;
-                }
-                issue.render(&self.inner.file, f)?;
-            }
-            return Ok(());
-        }
-        self.first().render(&self.inner.file, f)?;
-        match self.inner.issues.len() {
-            0 | 1 => Ok(()),
-            2 => write!(f, " (and 1 more error)"),
-            n => write!(f, " (and {} more errors)", n - 1),
-        }
-    }
-}
-
-impl std::error::Error for SettingsError {}
-
-impl miette::Diagnostic for SettingsError {
-    fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        Some(Box::new(self.first().code))
-    }
-
-    fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        self.first()
-            .help
-            .as_ref()
-            .map(|h| Box::new(h.clone()) as Box<dyn fmt::Display>)
-    }
-
-    fn source_code(&self) -> Option<&dyn SourceCode> {
-        (self.inner.source_len > 0).then_some(&self.inner.source as &dyn SourceCode)
-    }
-
-    fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
-        self.first()
-            .labeled(self.inner.source_len)
-            .map(|l| Box::new(std::iter::once(l)) as Box<dyn Iterator<Item = LabeledSpan>>)
-    }
-
-    fn related<'a>(&'a self) -> Option<Box<dyn Iterator<Item = &'a dyn miette::Diagnostic> + 'a>> {
-        if self.inner.related.is_empty() {
-            return None;
-        }
-        Some(Box::new(
-            self.inner
-                .related
-                .iter()
-                .map(|r| r as &dyn miette::Diagnostic),
-        ))
-    }
-}
-
-#[derive(Debug, Clone)]
-struct RelatedIssue {
-    file: String,
-    issue: Issue,
-    source_len: usize,
-}
-
-impl fmt::Display for RelatedIssue {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        self.issue.render(&self.file, f)
-    }
-}
-
-impl std::error::Error for RelatedIssue {}
-
-impl miette::Diagnostic for RelatedIssue {
-    fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        Some(Box::new(self.issue.code))
-    }
-
-    fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        self.issue
-            .help
-            .as_ref()
-            .map(|h| Box::new(h.clone()) as Box<dyn fmt::Display>)
-    }
-
-    fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
-        self.issue
-            .labeled(self.source_len)
-            .map(|l| Box::new(std::iter::once(l)) as Box<dyn Iterator<Item = LabeledSpan>>)
-    }
-}
+/// Every problem found in one settings file: the [`Diagnostics`] of the
+/// machine loader, never empty. `Display` gives the first problem
+/// (`file:line:column: message at key `k``) and how many more there are;
+/// `{:#}` lists them all; as a [`miette::Diagnostic`] it carries the file
+/// text with a label at the span and the other problems as related
+/// diagnostics. The shared rules (unknown key, wrong type, ...) keep their
+/// machine-file wording and codes; the settings' own rules are
+/// [`Problem::Message`]s with codes `chain::settings::*`.
+pub type SettingsError = Diagnostics;
 
 /// Why a machine named by a settings file could not be loaded.
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
@@ -400,327 +184,115 @@ pub struct Settings {
 /// Loads a settings file. `base` for relative paths is the file's directory.
 pub fn load_settings_file(path: &Path) -> Result<Settings, SettingsError> {
     let file = path.display().to_string();
-    let io = |message: String| {
-        SettingsError::new(
-            &file,
-            "",
-            vec![Issue::from_problem(
-                Origin::default(),
-                &Problem::Io { message },
-            )],
-        )
-    };
-    let handle = std::fs::File::open(path).map_err(|e| io(e.to_string()))?;
-    let mut bytes = Vec::new();
-    handle
-        .take(MAX_SETTINGS_BYTES as u64 + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| io(e.to_string()))?;
-    if bytes.len() > MAX_SETTINGS_BYTES {
-        return Err(SettingsError::new(
-            &file,
-            "",
-            vec![Issue::from_problem(
-                Origin::default(),
-                &Problem::TooLarge {
-                    limit: MAX_SETTINGS_BYTES,
-                },
-            )],
-        ));
-    }
-    let text = match String::from_utf8(bytes) {
-        Ok(t) => t,
-        Err(e) => {
-            let offset = e.utf8_error().valid_up_to();
-            return Err(SettingsError::new(
-                &file,
-                "",
-                vec![Issue::from_problem(
-                    Origin::default(),
-                    &Problem::InvalidUtf8 { offset },
-                )],
-            ));
-        }
-    };
+    let bytes = load::read_file(path, &file, MAX_SETTINGS_BYTES)?;
     let base = path
         .parent()
         .map(Path::to_path_buf)
         .unwrap_or_else(|| PathBuf::from("."));
-    load_settings_str(&text, &file, &base)
+    load_settings_str(load::decode(&bytes, &file)?, &file, &base)
 }
 
 /// Loads settings from text; `file` names it in messages, `base` is the
 /// directory relative paths are resolved against.
 pub fn load_settings_str(text: &str, file: &str, base: &Path) -> Result<Settings, SettingsError> {
-    if let Some(offset) = text.find('\0') {
-        return Err(SettingsError::new(
-            file,
-            "",
-            vec![Issue::from_problem(
-                Origin::default(),
-                &Problem::Binary { offset },
-            )],
-        ));
-    }
+    // A NUL byte: not a text file.
+    load::decode(text.as_bytes(), file)?;
     let parsed = yaml::parse(text);
-    let mut r = Reader::default();
-    for (span, key, problem) in &parsed.errors {
-        r.issues
-            .push(Issue::from_problem(span.origin(key.clone()), problem));
-    }
+    let mut r = Reader {
+        problems: (parsed.errors.into_iter())
+            .map(|(span, key, problem)| (span.origin(key), problem))
+            .collect(),
+    };
     let settings = match &parsed.root {
-        Some(root) if r.issues.is_empty() => r.settings(root, text, file, base),
+        Some(root) if r.problems.is_empty() => r.settings(root, text, file, base),
         Some(_) => None,
         None => {
-            if r.issues.is_empty() {
-                r.issues.push(
-                    Issue::new(
-                        top_origin(""),
-                        "the settings file is empty",
-                        "empty",
-                        "chain::settings::empty",
-                    )
-                    .with_help("expected a mapping with `settings`, `values` and `roll`"),
-                );
+            if r.problems.is_empty() {
+                let empty = Message::new(
+                    "the settings file is empty",
+                    "empty",
+                    "chain::settings::empty",
+                )
+                .help("expected a mapping with `settings`, `values` and `roll`");
+                r.problems.push((start_origin(""), empty.into()));
             }
             None
         }
     };
-    match settings {
-        Some(s) if r.issues.is_empty() => Ok(s),
-        _ => {
-            if r.issues.is_empty() {
-                r.issues.push(Issue::new(
-                    top_origin(""),
-                    "invalid settings file",
-                    "here",
-                    "chain::settings::invalid",
-                ));
-            }
-            Err(SettingsError::new(file, text, r.issues))
+    match (settings, Diagnostics::located(file, text, r.problems)) {
+        (_, Some(e)) => Err(e),
+        (Some(s), None) => Ok(s),
+        (None, None) => {
+            let invalid = Message::new("invalid settings file", "here", "chain::settings::invalid");
+            Err(Diagnostics::single(
+                file,
+                text,
+                start_origin(""),
+                invalid.into(),
+            ))
         }
     }
 }
 
-fn top_origin(key: &str) -> Origin {
-    Origin {
-        offset: 0,
-        len: 0,
-        line: 1,
-        column: 1,
-        key: key.to_string(),
-    }
-}
-
-fn join(path: &str, key: &str) -> String {
-    if path.is_empty() {
-        key.to_string()
-    } else {
-        format!("{path}.{key}")
-    }
-}
-
-#[derive(Default)]
+/// The reader of a settings file: the problems found so far.
 struct Reader {
-    issues: Vec<Issue>,
-    /// Valid keys suggested for unknown ones: a missing key that was
-    /// suggested is probably misspelt, so it is not reported again.
-    suggested: Vec<&'static str>,
+    problems: Vec<(Origin, Problem)>,
+}
+
+impl TreeReader for Reader {
+    fn problems(&mut self) -> &mut Vec<(Origin, Problem)> {
+        &mut self.problems
+    }
 }
 
 impl Reader {
-    fn problem(&mut self, span: Span, key: impl Into<String>, problem: Problem) {
-        self.issues
-            .push(Issue::from_problem(span.origin(key), &problem));
-    }
-
-    /// Reports a missing key, unless an unknown key looked like it.
-    fn missing(&mut self, span: Span, path: &str, key: &'static str) {
-        if !self.suggested.contains(&key) {
-            self.problem(span, path, Problem::MissingKey { key });
-        }
-    }
-
-    /// The entries of a mapping with keys in `allowed`; unknown keys are
-    /// reported. `null` is an empty mapping.
-    fn fields<'n>(
-        &mut self,
-        node: &'n Node,
-        path: &str,
-        allowed: &'static [&'static str],
-    ) -> Option<Vec<(&'static str, &'n Node, &'n Node)>> {
-        let entries = self.mapping(node, path)?;
-        let mut out = Vec::new();
-        for (k, v) in entries {
-            let key = k.as_str().unwrap_or("");
-            match allowed.iter().find(|a| **a == key) {
-                Some(&known) => {
-                    if !v.is_null() {
-                        out.push((known, k, v));
-                    }
-                }
-                None => {
-                    let close = closest(key, allowed.iter().copied());
-                    self.suggested.extend(close);
-                    let suggestion = close.map(str::to_string);
-                    self.problem(
-                        k.span,
-                        join(path, key),
-                        Problem::UnknownKey {
-                            key: key.to_string(),
-                            expected: allowed,
-                            suggestion,
-                        },
-                    );
-                }
-            }
-        }
-        Some(out)
-    }
-
-    fn mapping<'n>(&mut self, node: &'n Node, path: &str) -> Option<&'n [(Node, Node)]> {
-        if node.is_null() {
-            return Some(&[]);
-        }
-        match node.as_mapping() {
-            Some(m) => Some(m),
-            None => {
-                self.problem(
-                    node.span,
-                    path,
-                    Problem::WrongType {
-                        expected: "a mapping",
-                        found: node.describe(),
-                    },
-                );
-                None
-            }
-        }
-    }
-
+    /// A string that is not blank.
     fn string(&mut self, node: &Node, path: &str, expected: &'static str) -> Option<String> {
-        match node.as_scalar() {
-            Some(s) if !s.is_null() && !s.text.trim().is_empty() => Some(s.text.clone()),
-            _ => {
-                self.problem(
-                    node.span,
-                    path,
-                    Problem::WrongType {
-                        expected,
-                        found: node.describe(),
-                    },
-                );
-                None
-            }
-        }
+        self.text(node, path, expected, |t| !t.trim().is_empty())
+    }
+
+    /// A path to a file, with its origin.
+    fn file(&mut self, node: &Node, path: &str) -> Option<(String, Origin)> {
+        let p = self.string(node, path, "a file path")?;
+        Some((p, node.span.origin(path)))
     }
 
     /// A number or an angle (`<expr>deg`, `D°M′S″`), finite.
     fn value(&mut self, node: &Node, path: &str) -> Option<Value> {
-        let Some(text) = node
-            .as_scalar()
-            .filter(|s| !s.is_null())
-            .map(|s| s.text.clone())
-        else {
-            self.problem(
-                node.span,
-                path,
-                Problem::WrongType {
-                    expected: "a number or an angle (`2.5deg`, `\"46°33′\"`)",
-                    found: node.describe(),
-                },
-            );
-            return None;
-        };
-        let origin = node.span.origin(path);
+        let expected = "a number or an angle (`2.5deg`, `\"46°33′\"`)";
+        let text = self.text(node, path, expected, |_| true)?;
         let t = text.trim();
-        if let Some(prefix) = t.strip_suffix("deg") {
-            let v = self.expression(node, prefix, path)?.to_radians();
-            return self.finite(node, path, v, true, origin);
-        }
-        if t.contains('°') {
-            return match parse_dms(t) {
-                Ok(deg) => self.finite(node, path, deg.to_radians(), true, origin),
+        let (value, angle) = if let Some(prefix) = t.strip_suffix("deg") {
+            (self.number_in(node, prefix, path)?.to_radians(), true)
+        } else if t.contains('°') {
+            match parse_dms(t) {
+                Ok(deg) => (deg.to_radians(), true),
                 Err(message) => {
-                    self.issues.push(
-                        Issue::new(
-                            origin,
-                            format!("cannot read the angle `{t}`: {message}"),
-                            "angle",
-                            "chain::settings::angle",
-                        )
-                        .with_help("write degrees-minutes-seconds as \"-115°39′\" or \"12°30'15\\\"\", or degrees as -115.65deg"),
-                    );
-                    None
+                    let text = format!("cannot read the angle `{t}`: {message}");
+                    let bad = Message::new(text, "angle", "chain::settings::angle").help(DMS_HELP);
+                    self.report(node.span, path, bad.into());
+                    return None;
                 }
-            };
-        }
-        let special = match t.trim_start_matches(['+', '-']) {
-            ".inf" | ".Inf" | ".INF" | "inf" | "infinity" | "Infinity" => Some(f64::INFINITY),
-            ".nan" | ".NaN" | ".NAN" | "nan" | "NaN" => Some(f64::NAN),
-            _ => None,
-        };
-        let v = match special {
-            Some(v) => v,
-            None => self.expression(node, &text, path)?,
-        };
-        self.finite(node, path, v, false, origin)
-    }
-
-    fn finite(
-        &mut self,
-        node: &Node,
-        path: &str,
-        v: f64,
-        angle: bool,
-        origin: Origin,
-    ) -> Option<Value> {
-        if v.is_finite() {
-            Some(Value {
-                value: v,
-                angle,
-                origin,
-            })
+            }
         } else {
-            self.problem(node.span, path, Problem::NotFinite { what: "the value" });
-            None
-        }
-    }
-
-    /// A numbers-only expression (`pi` allowed), errors located in `node`.
-    fn expression(&mut self, node: &Node, text: &str, path: &str) -> Option<f64> {
-        let ast = match expr::parse(text) {
-            Ok(a) => a,
-            Err(e) => {
-                self.problem(
-                    node.span_at(e.offset),
-                    path,
-                    Problem::Expression { message: e.message },
-                );
-                return None;
-            }
+            (self.constant(node, &text, path)?, false)
         };
-        match expr::eval_const(&ast) {
-            Ok(v) => Some(v),
-            Err(errs) => {
-                for (offset, p) in errs {
-                    self.problem(node.span_at(offset), path, p);
-                }
-                None
-            }
+        if !value.is_finite() {
+            self.report(node.span, path, Problem::NotFinite { what: "the value" });
+            return None;
         }
+        Some(Value {
+            value,
+            angle,
+            origin: node.span.origin(path),
+        })
     }
 
     /// A plain number (no angle units).
-    fn number(&mut self, node: &Node, path: &str) -> Option<f64> {
+    fn plain_number(&mut self, node: &Node, path: &str) -> Option<f64> {
         let v = self.value(node, path)?;
         if v.angle {
-            self.issues.push(Issue::new(
-                v.origin,
-                "expected a plain number here, found an angle",
-                "angle",
-                "chain::settings::angle_not_allowed",
-            ));
+            self.wrong_type(node, path, "a plain number (no angle units)");
             return None;
         }
         Some(v.value)
@@ -728,7 +300,7 @@ impl Reader {
 
     /// `name: value` entries.
     fn named(&mut self, node: &Node, path: &str) -> Vec<Named> {
-        let Some(entries) = self.mapping(node, path) else {
+        let Some(entries) = self.entries(node, path) else {
             return Vec::new();
         };
         let mut out = Vec::new();
@@ -747,90 +319,39 @@ impl Reader {
     }
 
     fn settings(&mut self, root: &Node, text: &str, file: &str, base: &Path) -> Option<Settings> {
-        if root.as_mapping().is_none() {
-            self.problem(
-                root.span,
-                "",
-                Problem::TopLevelNotMapping {
-                    found: root.describe(),
-                },
-            );
-            return None;
-        }
-        let top = self.fields(root, "", TOP_KEYS)?;
-        let get = |key: &str| {
-            top.iter()
-                .find(|(k, _, _)| *k == key)
-                .map(|(_, k, v)| (*k, *v))
-        };
-        let missing = |r: &mut Reader, key: &'static str| r.missing(top_span(), "", key);
-
-        let name = match get("settings") {
-            Some((_, v)) => self.string(v, "settings", "a name"),
-            None => {
-                missing(self, "settings");
-                None
-            }
-        };
-        let description = match get("description") {
-            Some((_, v)) => self.string(v, "description", "a string"),
-            None => None,
-        };
-        let generator = match get("generator") {
-            Some((_, v)) => self
-                .string(v, "generator", "a file path")
-                .map(|p| (p, v.span.origin("generator"))),
-            None => None,
-        };
-        let (values, values_origin) = match get("values") {
+        let top = self.top(root, TOP_KEYS)?;
+        let name = self.required(&top, "settings");
+        let name = name.and_then(|v| self.string(v, "settings", "a name"));
+        let description = top.get("description");
+        let description = description.and_then(|v| self.string(v, "description", "a string"));
+        let generator = top.get("generator").and_then(|v| self.file(v, "generator"));
+        let (values, values_origin) = match top.entry("values") {
             Some((k, v)) => (self.named(v, "values"), k.span.origin("values")),
-            None => (Vec::new(), top_origin("values")),
+            None => (Vec::new(), start_origin("values")),
         };
         let mut omega_c = None;
         let mut interval = None;
         let mut drive = Vec::new();
-        let mut drive_origin = top_origin("roll.drive");
-        match get("roll") {
+        let mut drive_origin = start_origin("roll.drive");
+        match top.entry("roll") {
             Some((k, v)) => {
-                if let Some(roll) = self.fields(v, "roll", ROLL_KEYS) {
-                    let rget = |key: &str| {
-                        roll.iter()
-                            .find(|(k, _, _)| *k == key)
-                            .map(|(_, k, v)| (*k, *v))
-                    };
-                    match rget("omega_c") {
-                        Some((_, n)) => {
-                            if let Some(w) = self.value(n, "roll.omega_c") {
-                                if w.value > 0.0 {
-                                    omega_c = Some(w.value);
-                                } else {
-                                    self.problem(
-                                        n.span,
-                                        "roll.omega_c",
-                                        Problem::NotPositive {
-                                            what: "the cradle angular velocity omega_c",
-                                            value: w.value,
-                                        },
-                                    );
-                                }
-                            }
-                        }
-                        None => self.missing(k.span, "roll", "omega_c"),
-                    }
-                    match rget("interval") {
-                        Some((_, n)) => interval = self.interval(n),
-                        None => self.missing(k.span, "roll", "interval"),
-                    }
-                    match rget("drive") {
+                if let Some(roll) = self.fields(v, k.span, "roll", ROLL_KEYS) {
+                    omega_c = self
+                        .required(&roll, "omega_c")
+                        .and_then(|n| self.omega_c(n));
+                    interval = self
+                        .required(&roll, "interval")
+                        .and_then(|n| self.interval(n));
+                    match roll.entry("drive") {
                         Some((dk, n)) => {
                             drive_origin = dk.span.origin("roll.drive");
                             drive = self.drive(n);
                         }
-                        None => self.missing(k.span, "roll", "drive"),
+                        None => self.missing(&roll, "drive"),
                     }
                 }
             }
-            None => missing(self, "roll"),
+            None => self.missing(&top, "roll"),
         }
         let mut cnc_machine = None;
         let mut cnc_parameters = Vec::new();
@@ -838,59 +359,38 @@ impl Reader {
         let mut fix = Vec::new();
         let mut fix_origin = None;
         let mut start = Vec::new();
-        if let Some((_, v)) = get("cnc") {
-            if let Some(cnc) = self.fields(v, "cnc", CNC_KEYS) {
-                for (key, k, n) in cnc {
-                    let path = join("cnc", key);
-                    match key {
-                        "machine" => {
-                            cnc_machine = self
-                                .string(n, &path, "a file path")
-                                .map(|p| (p, n.span.origin(path.clone())));
-                        }
-                        "parameters" => cnc_parameters = self.named(n, &path),
-                        "match" => {
-                            matching = match self.string(n, &path, "`pose` or `point_axis`") {
-                                Some(t) if t == "pose" => Some(Matching::Pose),
-                                Some(t) if t == "point_axis" => Some(Matching::PointAxis),
-                                Some(t) => {
-                                    let suggestion = closest(&t, MATCH_VALUES.iter().copied())
-                                        .map(str::to_string);
-                                    self.problem(
-                                        n.span,
-                                        path,
-                                        Problem::UnknownValue {
-                                            what: "match",
-                                            found: t,
-                                            expected: MATCH_VALUES,
-                                            suggestion,
-                                        },
-                                    );
-                                    None
-                                }
-                                None => None,
-                            }
-                        }
-                        "fix" => {
-                            fix_origin = Some(k.span.origin(path.clone()));
-                            fix = self.named(n, &path);
-                        }
-                        _ => start = self.named(n, &path),
-                    }
-                }
+        let cnc = top.entry("cnc");
+        if let Some(cnc) = cnc.and_then(|(k, v)| self.fields(v, k.span, "cnc", CNC_KEYS)) {
+            cnc_machine = cnc.get("machine").and_then(|n| self.file(n, "cnc.machine"));
+            if let Some(n) = cnc.get("parameters") {
+                cnc_parameters = self.named(n, "cnc.parameters");
+            }
+            if let Some(n) = cnc.get("match") {
+                matching = self
+                    .string(n, "cnc.match", "`pose` or `point_axis`")
+                    .and_then(|t| self.choice(n, "cnc.match", t, "match", MATCH_VALUES))
+                    .map(|m| match m {
+                        "pose" => Matching::Pose,
+                        _ => Matching::PointAxis,
+                    });
+            }
+            if let Some((k, n)) = cnc.entry("fix") {
+                fix_origin = Some(k.span.origin("cnc.fix"));
+                fix = self.named(n, "cnc.fix");
+            }
+            if let Some(n) = cnc.get("start") {
+                start = self.named(n, "cnc.start");
             }
         }
         if let (Some(Matching::Pose), Some(origin)) = (matching, &fix_origin) {
             if !fix.is_empty() {
-                self.issues.push(
-                    Issue::new(
-                        origin.clone(),
-                        "`cnc.fix` holds variables, which only `match: point_axis` allows (a full pose determines every axis)",
-                        "fix",
-                        "chain::settings::fix_needs_point_axis",
-                    )
-                    .with_help("add `match: point_axis` under `cnc`, or remove `fix`"),
-                );
+                let pose = Message::new(
+                    "`cnc.fix` holds variables, which only `match: point_axis` allows (a full pose determines every axis)",
+                    "fix",
+                    "chain::settings::fix_needs_point_axis",
+                )
+                .help("add `match: point_axis` under `cnc`, or remove `fix`");
+                self.problems.push((origin.clone(), pose.into()));
             }
         }
         Some(Settings {
@@ -915,76 +415,57 @@ impl Reader {
         })
     }
 
+    /// `roll.omega_c`: positive.
+    fn omega_c(&mut self, node: &Node) -> Option<f64> {
+        let path = "roll.omega_c";
+        let value = self.value(node, path)?.value;
+        if value > 0.0 {
+            return Some(value);
+        }
+        let what = "the cradle angular velocity omega_c";
+        self.report(node.span, path, Problem::NotPositive { what, value });
+        None
+    }
+
     fn interval(&mut self, node: &Node) -> Option<(f64, f64)> {
         let path = "roll.interval";
-        let Some(items) = node.as_sequence() else {
-            self.problem(
-                node.span,
-                path,
-                Problem::WrongType {
-                    expected: "a list [t0, t1]",
-                    found: node.describe(),
-                },
-            );
-            return None;
-        };
-        let [a, b] = items else {
-            self.problem(
-                node.span,
-                path,
-                Problem::WrongLength {
-                    expected: 2,
-                    found: items.len(),
-                },
-            );
-            return None;
-        };
-        let t0 = self.number(a, &format!("{path}[0]"));
-        let t1 = self.number(b, &format!("{path}[1]"));
+        let [a, b] = self.items(node, path, "a list [t0, t1]")?;
+        let t0 = self.plain_number(a, &index(path, 0));
+        let t1 = self.plain_number(b, &index(path, 1));
         let (t0, t1) = (t0?, t1?);
         if t0 < t1 {
-            Some((t0, t1))
-        } else {
-            self.issues.push(Issue::new(
-                node.span.origin(path),
-                format!("the roll interval needs t0 < t1, got [{t0}, {t1}]"),
-                "empty interval",
-                "chain::settings::interval",
-            ));
-            None
+            return Some((t0, t1));
         }
+        let empty = Message::new(
+            format!("the roll interval needs t0 < t1, got [{t0}, {t1}]"),
+            "empty interval",
+            "chain::settings::interval",
+        );
+        self.report(node.span, path, empty.into());
+        None
     }
 
     fn drive(&mut self, node: &Node) -> Vec<Drive> {
-        let Some(entries) = self.mapping(node, "roll.drive") else {
+        let Some(entries) = self.entries(node, "roll.drive") else {
             return Vec::new();
         };
         if entries.is_empty() {
-            self.problem(
-                node.span,
-                "roll.drive",
-                Problem::EmptyList {
-                    what: "`roll.drive` (the generator variables that move)",
-                },
-            );
+            let what = "`roll.drive` (the generator variables that move)";
+            self.report(node.span, "roll.drive", Problem::EmptyList { what });
         }
         let mut out = Vec::new();
         for (k, v) in entries {
             let name = k.as_str().unwrap_or("").to_string();
             let path = join("roll.drive", &name);
-            let Some(fields) = self.fields(v, &path, DRIVE_KEYS) else {
+            let Some(fields) = self.fields(v, k.span, &path, DRIVE_KEYS) else {
                 continue;
             };
-            let mut start = None;
-            let mut ratio = Some(1.0);
-            for (key, _, n) in fields {
-                let p = join(&path, key);
-                if key == "start" {
-                    start = self.value(n, &p);
-                } else {
-                    ratio = self.number(n, &p);
-                }
-            }
+            let start = fields.get("start");
+            let start = start.and_then(|n| self.value(n, &fields.path("start")));
+            let ratio = match fields.get("ratio") {
+                Some(n) => self.plain_number(n, &fields.path("ratio")),
+                None => Some(1.0),
+            };
             if let Some(ratio) = ratio {
                 out.push(Drive {
                     name,
@@ -995,15 +476,6 @@ impl Reader {
             }
         }
         out
-    }
-}
-
-fn top_span() -> Span {
-    Span {
-        offset: 0,
-        len: 0,
-        line: 1,
-        column: 1,
     }
 }
 
@@ -1100,19 +572,14 @@ impl Settings {
         what: &str,
     ) -> Result<Machine, ReferenceError> {
         if let Err(e) = std::fs::File::open(path) {
-            return Err(ReferenceError::Path(self.error(vec![Issue::new(
-                origin.clone(),
-                format!("cannot read the {what} file `{}`: {e}", path.display()),
-                "file",
-                "chain::settings::machine_file",
-            )
-            .with_help("paths are relative to the settings file's directory")])));
+            let text = format!("cannot read the {what} file `{}`: {e}", path.display());
+            let unread = Message::new(text, "file", "chain::settings::machine_file")
+                .help("paths are relative to the settings file's directory");
+            let (file, source) = (&self.file, &self.source);
+            let error = Diagnostics::single(file, source, origin.clone(), unread.into());
+            return Err(ReferenceError::Path(error));
         }
         crate::load_file(path).map_err(ReferenceError::Machine)
-    }
-
-    fn error(&self, issues: Vec<Issue>) -> SettingsError {
-        SettingsError::new(&self.file, &self.source, issues)
     }
 
     /// Checks every name against the generator and the CNC machine and
@@ -1146,19 +613,16 @@ impl Settings {
             .filter_map(|n| closest(n, all_names.iter().copied()))
             .collect();
         let unknown = |name: &str, key: &Origin, what: &str| -> Issue {
-            let hint = closest(name, all_names.iter().copied())
-                .map(|s| format!(" (did you mean `{s}`?)"))
-                .unwrap_or_default();
-            Issue::new(
-                key.clone(),
-                format!("`{name}` is not a parameter or variable of the generator `{gname}`{hint}"),
-                "unknown name",
-                "chain::settings::unknown_name",
-            )
-            .with_help(format!(
+            let text =
+                format!("`{name}` is not a parameter or variable of the generator `{gname}`");
+            let help = format!(
                 "{what} names the generator's parameters and variables: {}",
                 all_names.join(", ")
-            ))
+            );
+            let message = Message::new(text, "unknown name", "chain::settings::unknown_name")
+                .suggest(closest(name, all_names.iter().copied()))
+                .help(help);
+            (key.clone(), message.into())
         };
         for n in &self.values {
             if let Some(i) = duplicate(&seen, &n.name, &n.key) {
@@ -1167,11 +631,10 @@ impl Settings {
             }
             if let Some(k) = generator.parameters.iter().position(|p| p.name == n.name) {
                 if n.value.angle {
-                    issues.push(Issue::new(
-                        n.value.origin.clone(),
-                        format!("`{}` is a parameter (a length) of the generator; angle units are not allowed", n.name),
-                        "angle on a length",
-                        "chain::settings::angle_on_length",
+                    issues.push(angle_on_length(
+                        &n.name,
+                        "a parameter (a length) of the generator",
+                        &n.value,
                     ));
                 }
                 gparams[k] = Some(n.value.value);
@@ -1196,12 +659,11 @@ impl Settings {
             }
             let Some(k) = generator.variables.iter().position(|v| v.name == d.name) else {
                 if generator.parameters.iter().any(|p| p.name == d.name) {
-                    issues.push(Issue::new(
-                        d.key.clone(),
-                        format!("`{}` is a parameter of the generator `{gname}`; only its variables can be driven", d.name),
-                        "not a variable",
-                        "chain::settings::drive_parameter",
-                    ).with_help("give it under `values`"));
+                    let text = format!("`{}` is a parameter of the generator `{gname}`; only its variables can be driven", d.name);
+                    let message =
+                        Message::new(text, "not a variable", "chain::settings::drive_parameter")
+                            .help("give it under `values`");
+                    issues.push((d.key.clone(), message.into()));
                 } else {
                     issues.push(unknown(&d.name, &d.key, "`roll.drive`"));
                 }
@@ -1220,99 +682,66 @@ impl Settings {
         }
         for (k, p) in generator.parameters.iter().enumerate() {
             if gparams[k].is_none() && !suggested.contains(&p.name.as_str()) {
-                issues.push(
-                    Issue::new(
-                        self.values_origin.clone(),
-                        format!("generator parameter `{}` has no value", p.name),
-                        "missing value",
-                        "chain::settings::missing_value",
-                    )
-                    .with_help(format!("add `{}: <value>` under `values`", p.name)),
-                );
+                let text = format!("generator parameter `{}` has no value", p.name);
+                let help = format!("add `{}: <value>` under `values`", p.name);
+                issues.push((self.values_origin.clone(), missing_value(text, help)));
             }
         }
         for (k, v) in generator.variables.iter().enumerate() {
             if laws[k].is_none() && !suggested.contains(&v.name.as_str()) {
-                issues.push(Issue::new(
-                    self.values_origin.clone(),
-                    format!("generator variable `{}` has no value", v.name),
-                    "missing value",
-                    "chain::settings::missing_value",
-                ).with_help(format!(
+                let text = format!("generator variable `{}` has no value", v.name);
+                let help = format!(
                     "hold it with `{}: <value>` under `values`, or move it with `{}: {{start: .., ratio: ..}}` under `roll.drive`",
                     v.name, v.name
-                )));
+                );
+                issues.push((self.values_origin.clone(), missing_value(text, help)));
             }
         }
         if !laws.iter().flatten().any(|l| l.rate != 0.0) && !self.drive.is_empty() {
-            issues.push(Issue::new(
-                self.drive_origin.clone(),
-                "no generator variable moves: every `ratio` is 0",
-                "no motion",
-                "chain::settings::no_motion",
-            ));
+            let text = "no generator variable moves: every `ratio` is 0";
+            let message = Message::new(text, "no motion", "chain::settings::no_motion");
+            issues.push((self.drive_origin.clone(), message.into()));
         }
 
         // CNC side.
         let cname = &cnc.name;
         let mut cparams: Vec<Option<f64>> = cnc.parameters.iter().map(|p| p.value).collect();
+        let not_a_parameter = |name: &str, via: &str, key: &Origin| -> Issue {
+            let text = format!("{via}`{name}` is not a parameter of the CNC machine `{cname}`");
+            let close = closest(name, cnc.parameters.iter().map(|p| p.name.as_str()));
+            let message = Message::new(text, "unknown parameter", "chain::settings::unknown_name")
+                .suggest(close);
+            (key.clone(), message.into())
+        };
         for n in &self.cnc_parameters {
             match cnc.parameters.iter().position(|p| p.name == n.name) {
                 Some(k) => {
                     if n.value.angle {
-                        issues.push(Issue::new(
-                            n.value.origin.clone(),
-                            format!("`{}` is a parameter (a length) of `{cname}`; angle units are not allowed", n.name),
-                            "angle on a length",
-                            "chain::settings::angle_on_length",
-                        ));
+                        let what = format!("a parameter (a length) of `{cname}`");
+                        issues.push(angle_on_length(&n.name, &what, &n.value));
                     }
                     cparams[k] = Some(n.value.value);
                 }
-                None => {
-                    let hint = closest(&n.name, cnc.parameters.iter().map(|p| p.name.as_str()))
-                        .map(|s| format!(" (did you mean `{s}`?)"))
-                        .unwrap_or_default();
-                    issues.push(Issue::new(
-                        n.key.clone(),
-                        format!(
-                            "`{}` is not a parameter of the CNC machine `{cname}`{hint}",
-                            n.name
-                        ),
-                        "unknown parameter",
-                        "chain::settings::unknown_name",
-                    ));
-                }
+                None => issues.push(not_a_parameter(&n.name, "", &n.key)),
             }
         }
         for (name, v) in cnc_overrides {
             match cnc.parameters.iter().position(|p| p.name == *name) {
                 Some(k) => cparams[k] = Some(*v),
-                None => issues.push(Issue::new(
-                    Origin::default(),
-                    format!("--param: `{name}` is not a parameter of the CNC machine `{cname}`"),
-                    "unknown parameter",
-                    "chain::settings::unknown_name",
-                )),
+                None => issues.push(not_a_parameter(name, "--param: ", &Origin::default())),
             }
         }
         for (k, p) in cnc.parameters.iter().enumerate() {
             if cparams[k].is_none() {
-                issues.push(
-                    Issue::new(
-                        top_origin("cnc.parameters"),
-                        format!(
-                            "parameter `{}` of the CNC machine `{cname}` has no value",
-                            p.name
-                        ),
-                        "missing value",
-                        "chain::settings::missing_value",
-                    )
-                    .with_help(format!(
-                        "add `cnc: {{parameters: {{{}: <value>}}}}` or pass --param {}=VALUE",
-                        p.name, p.name
-                    )),
+                let text = format!(
+                    "parameter `{}` of the CNC machine `{cname}` has no value",
+                    p.name
                 );
+                let help = format!(
+                    "add `cnc: {{parameters: {{{}: <value>}}}}` or pass --param {}=VALUE",
+                    p.name, p.name
+                );
+                issues.push((start_origin("cnc.parameters"), missing_value(text, help)));
             }
         }
         let cnc_variable = |n: &Named, what: &str, issues: &mut Vec<Issue>| -> Option<usize> {
@@ -1324,18 +753,18 @@ impl Settings {
                     Some(k)
                 }
                 None => {
-                    let hint = closest(&n.name, cnc.variables.iter().map(|v| v.name.as_str()))
-                        .map(|s| format!(" (did you mean `{s}`?)"))
-                        .unwrap_or_default();
-                    issues.push(Issue::new(
-                        n.key.clone(),
-                        format!(
-                            "`{}` in {what} is not a variable of the CNC machine `{cname}`{hint}",
-                            n.name
-                        ),
+                    let text = format!(
+                        "`{}` in {what} is not a variable of the CNC machine `{cname}`",
+                        n.name
+                    );
+                    let close = closest(&n.name, cnc.variables.iter().map(|v| v.name.as_str()));
+                    let message = Message::new(
+                        text,
                         "unknown variable",
                         "chain::settings::unknown_variable",
-                    ));
+                    )
+                    .suggest(close);
+                    issues.push((n.key.clone(), message.into()));
                     None
                 }
             }
@@ -1355,8 +784,8 @@ impl Settings {
         for &(k, v) in &fixed {
             start[k] = v;
         }
-        if !issues.is_empty() {
-            return Err(self.error(issues));
+        if let Some(e) = Diagnostics::located(&self.file, &self.source, issues) {
+            return Err(e);
         }
         Ok(MotionSpec {
             generator_parameters: gparams.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect(),
@@ -1378,34 +807,43 @@ impl Settings {
     }
 }
 
+/// A located problem of [`Settings::bind`].
+type Issue = (Origin, Problem);
+
 /// The issue of a name given twice (`values` and `roll.drive`).
 fn duplicate(seen: &[(&str, &Origin)], name: &str, key: &Origin) -> Option<Issue> {
     let (_, first) = seen.iter().find(|(n, _)| *n == name)?;
-    Some(
-        Issue::new(
-            key.clone(),
-            format!(
-                "`{name}` is given twice (first on line {}): in `values` and in `roll.drive`",
-                first.line
-            ),
-            "given twice",
-            "chain::settings::duplicate",
-        )
-        .with_help("a held setting goes in `values`, a moving one in `roll.drive`"),
-    )
+    let text = format!(
+        "`{name}` is given twice (first on line {}): in `values` and in `roll.drive`",
+        first.line
+    );
+    let message = Message::new(text, "given twice", "chain::settings::duplicate")
+        .help("a held setting goes in `values`, a moving one in `roll.drive`");
+    Some((key.clone(), message.into()))
+}
+
+/// A setting without a value.
+fn missing_value(text: String, help: String) -> Problem {
+    Message::new(text, "missing value", "chain::settings::missing_value")
+        .help(help)
+        .into()
+}
+
+/// The issue of angle units on `name`, which is `what` (a length).
+fn angle_on_length(name: &str, what: &str, value: &Value) -> Issue {
+    let text = format!("`{name}` is {what}; angle units are not allowed");
+    let message = Message::new(
+        text,
+        "angle on a length",
+        "chain::settings::angle_on_length",
+    );
+    (value.origin.clone(), message.into())
 }
 
 fn angle_on_prismatic(machine: &Machine, k: usize, name: &str, value: &Value) -> Option<Issue> {
     (value.angle && machine.variables[k].kind == JointKind::Prismatic).then(|| {
-        Issue::new(
-            value.origin.clone(),
-            format!(
-                "`{name}` is a prismatic (linear) variable of `{}`; angle units are not allowed",
-                machine.name
-            ),
-            "angle on a length",
-            "chain::settings::angle_on_length",
-        )
+        let what = format!("a prismatic (linear) variable of `{}`", machine.name);
+        angle_on_length(name, &what, value)
     })
 }
 

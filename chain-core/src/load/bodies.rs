@@ -4,7 +4,7 @@
 
 use std::collections::{HashMap, HashSet};
 
-use super::{index, join, Loader};
+use super::{index, join, Loader, TreeReader};
 use crate::diagnostic::{closest, Problem};
 use crate::model::{
     Axis, Body, ErrorKind, ErrorParam, ErrorSlots, FixedRotation, Joint, JointKind, SignedAxis,

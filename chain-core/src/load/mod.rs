@@ -22,6 +22,7 @@
 //!   order.
 
 mod bodies;
+pub(crate) mod reader;
 mod sections;
 
 use std::collections::{HashMap, HashSet};
@@ -31,7 +32,8 @@ use std::path::Path;
 use crate::diagnostic::{closest, Diagnostics, LoadError, Problem};
 use crate::expr;
 use crate::model::{Expr, Frame, Machine, Origin, Parameter};
-use crate::yaml::{self, Node, Span};
+use crate::yaml::{self, Node};
+use reader::{index, join, start_origin, Fields, TreeReader};
 
 /// Files larger than this many bytes are refused by [`load_file`].
 pub const MAX_FILE_BYTES: usize = 16 * 1024 * 1024;
@@ -67,7 +69,7 @@ pub fn load_str(text: &str, file: &str) -> Result<Machine, Diagnostics> {
     let machine = match &parsed.root {
         None => {
             if errors.is_empty() {
-                errors.push(LoadError::new(file, start_origin(), Problem::Empty));
+                errors.push(LoadError::new(file, start_origin(""), Problem::Empty));
             }
             None
         }
@@ -92,7 +94,7 @@ pub fn load_str(text: &str, file: &str) -> Result<Machine, Diagnostics> {
         (None, None) => Err(Diagnostics::single(
             file,
             text,
-            start_origin(),
+            start_origin(""),
             Problem::Empty,
         )),
     }
@@ -101,63 +103,53 @@ pub fn load_str(text: &str, file: &str) -> Result<Machine, Diagnostics> {
 /// Loads a machine from the bytes of a file: a NUL byte (binary file) or
 /// invalid UTF-8 is a diagnostic, like every other problem.
 pub fn load_bytes(bytes: &[u8], file: &str) -> Result<Machine, Diagnostics> {
-    if let Some(offset) = bytes.iter().position(|&b| b == 0) {
-        return Err(binary(bytes, offset, file));
-    }
-    match std::str::from_utf8(bytes) {
-        Ok(text) => load_str(text, file),
-        Err(e) => {
-            let offset = e.valid_up_to();
-            let lossy = String::from_utf8_lossy(bytes).into_owned();
-            Err(Diagnostics::single(
-                file,
-                lossy,
-                byte_origin(bytes, offset, 1),
-                Problem::InvalidUtf8 { offset },
-            ))
-        }
-    }
+    load_str(decode(bytes, file)?, file)
 }
 
 /// Loads a machine file. A file that cannot be read (missing, a directory,
 /// larger than [`MAX_FILE_BYTES`]) is a diagnostic too.
 pub fn load_file(path: &Path) -> Result<Machine, Diagnostics> {
     let file = path.display().to_string();
-    let io_error = |message: String| {
-        Diagnostics::single(
-            file.clone(),
-            String::new(),
-            Origin::default(),
-            Problem::Io { message },
-        )
-    };
-    let handle = std::fs::File::open(path).map_err(|e| io_error(e.to_string()))?;
-    let mut bytes = Vec::new();
-    handle
-        .take(MAX_FILE_BYTES as u64 + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| io_error(e.to_string()))?;
-    if bytes.len() > MAX_FILE_BYTES {
-        return Err(Diagnostics::single(
-            file,
-            String::new(),
-            Origin::default(),
-            Problem::TooLarge {
-                limit: MAX_FILE_BYTES,
-            },
-        ));
-    }
-    load_bytes(&bytes, &file)
+    load_bytes(&read_file(path, &file, MAX_FILE_BYTES)?, &file)
 }
 
-fn start_origin() -> Origin {
-    Origin {
-        offset: 0,
-        len: 0,
-        line: 1,
-        column: 1,
-        key: String::new(),
+/// The bytes of the file at `path` (named `file` in diagnostics), at most
+/// `limit` of them: a file that cannot be read or is larger is a diagnostic.
+pub(crate) fn read_file(path: &Path, file: &str, limit: usize) -> Result<Vec<u8>, Diagnostics> {
+    let error = |problem: Problem| Diagnostics::single(file, "", Origin::default(), problem);
+    let io_error = |e: std::io::Error| {
+        error(Problem::Io {
+            message: e.to_string(),
+        })
+    };
+    let handle = std::fs::File::open(path).map_err(io_error)?;
+    let mut bytes = Vec::new();
+    handle
+        .take(limit as u64 + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io_error)?;
+    if bytes.len() > limit {
+        return Err(error(Problem::TooLarge { limit }));
     }
+    Ok(bytes)
+}
+
+/// The text of a file's bytes: a NUL byte (binary file) or invalid UTF-8 is
+/// a located diagnostic.
+pub(crate) fn decode<'b>(bytes: &'b [u8], file: &str) -> Result<&'b str, Diagnostics> {
+    if let Some(offset) = bytes.iter().position(|&b| b == 0) {
+        return Err(binary(bytes, offset, file));
+    }
+    std::str::from_utf8(bytes).map_err(|e| {
+        let offset = e.valid_up_to();
+        let lossy = String::from_utf8_lossy(bytes).into_owned();
+        Diagnostics::single(
+            file,
+            lossy,
+            byte_origin(bytes, offset, 1),
+            Problem::InvalidUtf8 { offset },
+        )
+    })
 }
 
 /// The origin of byte `offset` of raw bytes (line and column counted on the
@@ -215,19 +207,6 @@ pub fn from_tree(root: &Node) -> Result<Machine, Vec<(Origin, Problem)>> {
     }
 }
 
-/// Dotted key path.
-fn join(path: &str, key: &str) -> String {
-    if path.is_empty() {
-        key.to_string()
-    } else {
-        format!("{path}.{key}")
-    }
-}
-
-fn index(path: &str, i: usize) -> String {
-    format!("{path}[{i}]")
-}
-
 /// True for `[A-Za-z_][A-Za-z0-9_]*`.
 pub fn is_identifier(name: &str) -> bool {
     let mut chars = name.chars();
@@ -235,41 +214,6 @@ pub fn is_identifier(name: &str) -> bool {
         .next()
         .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
-}
-
-/// The known entries of a mapping, with their key nodes.
-struct Fields<'n> {
-    /// `(key, key node, value node)` for keys in the allowed set.
-    known: Vec<(&'n str, &'n Node, &'n Node)>,
-    /// Entries with keys outside the allowed set (already reported).
-    unknown: Vec<(&'n Node, &'n Node)>,
-    /// The valid keys suggested for the unknown ones: a missing key that was
-    /// suggested is probably misspelt, so it is not reported again.
-    suggested: Vec<&'static str>,
-    /// Where to report a missing key: the key that owns this mapping.
-    owner: Span,
-    /// The mapping's key path.
-    path: String,
-}
-
-impl<'n> Fields<'n> {
-    /// The value of `key`, unless absent or null.
-    fn get(&self, key: &str) -> Option<&'n Node> {
-        self.entry(key).map(|(_, v)| v)
-    }
-
-    /// The key node and value of `key`, unless absent or null.
-    fn entry(&self, key: &str) -> Option<(&'n Node, &'n Node)> {
-        self.known
-            .iter()
-            .find(|(k, _, v)| *k == key && !v.is_null())
-            .map(|(_, k, v)| (*k, *v))
-    }
-
-    /// The key path of `key` in this mapping.
-    fn path(&self, key: &str) -> String {
-        join(&self.path, key)
-    }
 }
 
 /// Validation state: problems found and what is known so far.
@@ -285,115 +229,13 @@ struct Loader {
     seen_errors: HashSet<String>,
 }
 
+impl TreeReader for Loader {
+    fn problems(&mut self) -> &mut Vec<(Origin, Problem)> {
+        &mut self.errors
+    }
+}
+
 impl Loader {
-    fn report(&mut self, span: Span, key: impl Into<String>, problem: Problem) {
-        self.errors.push((span.origin(key), problem));
-    }
-
-    /// The entries of a mapping whose keys must be in `allowed` (`null` is an
-    /// empty mapping). Unknown keys are reported with the closest valid key.
-    fn fields<'n>(
-        &mut self,
-        node: &'n Node,
-        owner: Span,
-        path: &str,
-        allowed: &'static [&'static str],
-    ) -> Option<Fields<'n>> {
-        let mut f = Fields {
-            known: Vec::new(),
-            unknown: Vec::new(),
-            suggested: Vec::new(),
-            owner,
-            path: path.to_string(),
-        };
-        if node.is_null() {
-            return Some(f);
-        }
-        let Some(entries) = node.as_mapping() else {
-            self.report(
-                node.span,
-                path,
-                Problem::WrongType {
-                    expected: "a mapping",
-                    found: node.describe(),
-                },
-            );
-            return None;
-        };
-        for (k, v) in entries {
-            let key = k.as_str().unwrap_or("");
-            if let Some(&known) = allowed.iter().find(|a| **a == key) {
-                f.known.push((known, k, v));
-            } else {
-                let suggested = closest(key, allowed.iter().copied());
-                f.suggested.extend(suggested);
-                let suggestion = suggested.map(str::to_string);
-                self.report(
-                    k.span,
-                    join(path, key),
-                    Problem::UnknownKey {
-                        key: key.to_string(),
-                        expected: allowed,
-                        suggestion,
-                    },
-                );
-                f.unknown.push((k, v));
-            }
-        }
-        Some(f)
-    }
-
-    /// The entries of a free-form mapping (names as keys); `null` is empty.
-    fn entries<'n>(&mut self, node: &'n Node, path: &str) -> Option<&'n [(Node, Node)]> {
-        if node.is_null() {
-            return Some(&[]);
-        }
-        match node.as_mapping() {
-            Some(m) => Some(m),
-            None => {
-                self.report(
-                    node.span,
-                    path,
-                    Problem::WrongType {
-                        expected: "a mapping",
-                        found: node.describe(),
-                    },
-                );
-                None
-            }
-        }
-    }
-
-    /// Reports a missing key, unless an unknown key looked like it.
-    fn missing(&mut self, fields: &Fields<'_>, key: &'static str) {
-        if fields.suggested.contains(&key) {
-            return;
-        }
-        self.report(
-            fields.owner,
-            fields.path.clone(),
-            Problem::MissingKey { key },
-        );
-    }
-
-    /// A non-empty string scalar.
-    fn name(&mut self, node: &Node, path: &str, expected: &'static str) -> Option<String> {
-        match node.as_scalar() {
-            Some(s) if !s.is_null() && !s.text.is_empty() => Some(s.text.clone()),
-            _ => {
-                self.report(
-                    node.span,
-                    path,
-                    Problem::WrongType {
-                        expected,
-                        found: node.describe(),
-                    },
-                );
-                None
-            }
-        }
-    }
-
     /// A name usable in expressions: an identifier, not reserved.
     fn ident(&mut self, node: &Node, path: &str, what: &'static str) -> Option<String> {
         let name = self.name(node, path, "a name")?;
@@ -406,93 +248,6 @@ impl Loader {
             return None;
         }
         Some(name)
-    }
-
-    /// One of a fixed set of keywords.
-    fn keyword(
-        &mut self,
-        node: &Node,
-        path: &str,
-        what: &'static str,
-        expected: &'static [&'static str],
-    ) -> Option<&'static str> {
-        let text = self.name(node, path, "a name")?;
-        if let Some(&k) = expected.iter().find(|e| **e == text) {
-            return Some(k);
-        }
-        let suggestion = closest(&text, expected.iter().copied()).map(str::to_string);
-        self.report(
-            node.span,
-            path,
-            Problem::UnknownValue {
-                what,
-                found: text,
-                expected,
-                suggestion,
-            },
-        );
-        None
-    }
-
-    /// Reports an expression syntax error inside `node`.
-    fn expr_error(&mut self, node: &Node, path: &str, e: expr::ExprError) {
-        self.report(
-            node.span_at(e.offset),
-            path,
-            Problem::Expression { message: e.message },
-        );
-    }
-
-    /// A number: a numeric scalar or an arithmetic string of numbers
-    /// (`0.05/6`, `pi/2`); YAML's `.inf` and `.nan` are read as such so that
-    /// range checks can name them.
-    fn number(&mut self, node: &Node, path: &str) -> Option<f64> {
-        let text = match node.as_scalar() {
-            Some(s) if !s.is_null() => s.text.as_str(),
-            _ => {
-                self.report(
-                    node.span,
-                    path,
-                    Problem::WrongType {
-                        expected: "a number",
-                        found: node.describe(),
-                    },
-                );
-                return None;
-            }
-        };
-        let t = text.trim();
-        let special = match t.trim_start_matches(['+', '-']) {
-            ".inf" | ".Inf" | ".INF" | "inf" | "infinity" | "Infinity" => Some(f64::INFINITY),
-            ".nan" | ".NaN" | ".NAN" | "nan" | "NaN" => Some(f64::NAN),
-            _ => None,
-        };
-        if let Some(v) = special {
-            return Some(if t.starts_with('-') { -v } else { v });
-        }
-        let text = text.to_string();
-        self.number_in(node, &text, path)
-    }
-
-    /// Evaluates `text`, a prefix of `node`'s text, as a numbers-only
-    /// expression; errors point into `node`.
-    fn number_in(&mut self, node: &Node, text: &str, path: &str) -> Option<f64> {
-        let ast = match expr::parse(text) {
-            Ok(a) => a,
-            Err(e) => {
-                self.expr_error(node, path, e);
-                return None;
-            }
-        };
-        match expr::eval_const(&ast) {
-            Ok(v) => Some(v),
-            Err(errs) => {
-                for (offset, p) in errs {
-                    self.report(node.span_at(offset), path, p);
-                }
-                None
-            }
-        }
     }
 
     /// A positive, finite number.
@@ -519,20 +274,7 @@ impl Loader {
 
     /// An expression over numbers and parameters.
     fn expr(&mut self, node: &Node, path: &str) -> Option<Expr> {
-        let text = match node.as_scalar() {
-            Some(s) if !s.is_null() => s.text.clone(),
-            _ => {
-                self.report(
-                    node.span,
-                    path,
-                    Problem::WrongType {
-                        expected: "a number or an expression",
-                        found: node.describe(),
-                    },
-                );
-                return None;
-            }
-        };
+        let text = self.text(node, path, "a number or an expression", |_| true)?;
         let ast = match expr::parse(&text) {
             Ok(a) => a,
             Err(e) => {
@@ -589,28 +331,7 @@ impl Loader {
         let Some(node) = node else {
             return Some([Expr::Num(0.0), Expr::Num(0.0), Expr::Num(0.0)]);
         };
-        let Some(items) = node.as_sequence() else {
-            self.report(
-                node.span,
-                path,
-                Problem::WrongType {
-                    expected: "a list of 3 numbers or expressions",
-                    found: node.describe(),
-                },
-            );
-            return None;
-        };
-        let [a, b, c] = items else {
-            self.report(
-                node.span,
-                path,
-                Problem::WrongLength {
-                    expected: 3,
-                    found: items.len(),
-                },
-            );
-            return None;
-        };
+        let [a, b, c] = self.items(node, path, "a list of 3 numbers or expressions")?;
         let x = self.expr(a, &index(path, 0));
         let y = self.expr(b, &index(path, 1));
         let z = self.expr(c, &index(path, 2));
@@ -619,25 +340,10 @@ impl Loader {
 
     /// The whole machine.
     fn machine(&mut self, root: &Node) -> Option<Machine> {
-        if root.as_mapping().is_none() {
-            self.report(
-                root.span,
-                "",
-                Problem::TopLevelNotMapping {
-                    found: root.describe(),
-                },
-            );
-            return None;
-        }
-        let top = self.fields(root, start_span(), "", TOP_KEYS)?;
+        let top = self.top(root, TOP_KEYS)?;
 
-        let name = match top.get("machine") {
-            Some(n) => self.name(n, "machine", "a name"),
-            None => {
-                self.missing(&top, "machine");
-                None
-            }
-        };
+        let name = self.required(&top, "machine");
+        let name = name.and_then(|n| self.name(n, "machine", "a name"));
         let description = match top.get("description") {
             Some(n) => match n.as_str() {
                 Some(s) => Some(s.to_string()),
@@ -746,15 +452,6 @@ impl Loader {
             },
         );
         None
-    }
-}
-
-fn start_span() -> Span {
-    Span {
-        offset: 0,
-        len: 0,
-        line: 1,
-        column: 1,
     }
 }
 

@@ -3,7 +3,7 @@
 use std::collections::HashMap;
 
 use super::bodies::Tree;
-use super::{join, Fields, Loader};
+use super::{join, Fields, Loader, TreeReader};
 use crate::diagnostic::{closest, Problem};
 use crate::model::{
     Component, Distribution, Parameter, ReliabilitySpec, Requirement, Sided, Statistic,
