@@ -28,8 +28,8 @@ use serde_json::{json, Map, Value};
 
 use super::csv_input::{numeric_rows, open_csv, read_poses};
 use super::reliability::{
-    note_form_limits, parse_assignment, system_of, write_stdout, Loaded, MethodArg, SidedArg,
-    SystemArg,
+    note_form_limits, parse_assignment, requirement_text, system_of, write_stdout, Loaded,
+    MethodArg, SidedArg, SystemArg,
 };
 
 /// Output formats of `chain path`.
@@ -858,13 +858,7 @@ fn to_table(r: &PathResult) -> String {
                 r.study.as_ref().and_then(|s| s.requirement),
                 summary.and_then(|s| s.met),
             ) {
-                let _ = write!(
-                    out,
-                    "; requirement min {:.2} %, mean {:.2} %: {}",
-                    100.0 * req.min,
-                    100.0 * req.mean,
-                    if met { "met" } else { "NOT met" }
-                );
+                out.push_str(&requirement_text(&req, met));
             }
             out.push('\n');
         }

@@ -706,13 +706,7 @@ fn to_table(machine: &Machine, study: &Study, r: &StudyResult) -> String {
                 100.0 * s.max
             );
             if let (Some(req), Some(met)) = (r.requirement, s.met) {
-                let _ = write!(
-                    out,
-                    "; requirement min {:.2} %, mean {:.2} %: {}",
-                    100.0 * req.min,
-                    100.0 * req.mean,
-                    if met { "met" } else { "NOT met" }
-                );
+                out.push_str(&requirement_text(&req, met));
             }
             out.push('\n');
         }
@@ -738,4 +732,14 @@ fn fmt_num(v: f64) -> String {
     } else {
         format!("{v}")
     }
+}
+
+/// `; requirement min … %, mean … %: met` for the table summaries.
+pub(crate) fn requirement_text(req: &chain_core::model::Requirement, met: bool) -> String {
+    format!(
+        "; requirement min {:.2} %, mean {:.2} %: {}",
+        100.0 * req.min,
+        100.0 * req.mean,
+        if met { "met" } else { "NOT met" }
+    )
 }

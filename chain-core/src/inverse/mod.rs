@@ -132,6 +132,43 @@ impl Inverse {
     }
 }
 
+impl Solution {
+    /// The solutions found, nearest to `prev` first (rotary differences
+    /// wrapped to (−π, π]); `Unreachable` when there is none.
+    fn ranked(
+        mut solutions: Vec<Vec<f64>>,
+        prev: &[f64],
+        rotary: &[bool],
+        singular: bool,
+    ) -> Solution {
+        if solutions.is_empty() {
+            return Solution {
+                status: Status::Unreachable,
+                solutions,
+            };
+        }
+        let dist = |s: &Vec<f64>| -> f64 {
+            s.iter()
+                .zip(prev)
+                .zip(rotary)
+                .map(|((x, p), r)| {
+                    let d = if *r { wrap(x - p) } else { x - p };
+                    d * d
+                })
+                .sum()
+        };
+        solutions.sort_by(|x, y| dist(x).total_cmp(&dist(y)));
+        Solution {
+            status: if singular {
+                Status::Singular
+            } else {
+                Status::Ok
+            },
+            solutions,
+        }
+    }
+}
+
 /// A closed-form inverse-kinematics solver for one machine.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Solver {
@@ -429,28 +466,7 @@ impl Solver {
                 }
             }
         }
-        if sols.is_empty() {
-            return unreachable;
-        }
-        let dist = |s: &Vec<f64>| -> f64 {
-            s.iter()
-                .zip(prev)
-                .zip(&self.rotary)
-                .map(|((x, p), r)| {
-                    let d = if *r { wrap(x - p) } else { x - p };
-                    d * d
-                })
-                .sum()
-        };
-        sols.sort_by(|x, y| dist(x).total_cmp(&dist(y)));
-        Solution {
-            status: if singular {
-                Status::Singular
-            } else {
-                Status::Ok
-            },
-            solutions: sols,
-        }
+        Solution::ranked(sols, prev, &self.rotary, singular)
     }
 
     /// The prismatic values for angles `(a, b)`, verified against the pose

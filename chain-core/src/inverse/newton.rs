@@ -126,28 +126,7 @@ impl NewtonSolver {
                 }
             }
         }
-        if found.is_empty() {
-            return unreachable;
-        }
-        let dist = |s: &Vec<f64>| -> f64 {
-            s.iter()
-                .zip(prev)
-                .zip(&self.rotary)
-                .map(|((x, p), r)| {
-                    let d = if *r { wrap(x - p) } else { x - p };
-                    d * d
-                })
-                .sum()
-        };
-        found.sort_by(|x, y| dist(x).total_cmp(&dist(y)));
-        Solution {
-            status: if singular {
-                Status::Singular
-            } else {
-                Status::Ok
-            },
-            solutions: found,
-        }
+        Solution::ranked(found, prev, &self.rotary, singular)
     }
 
     /// The previous values, then the rotary grid around them.
