@@ -83,6 +83,15 @@ pub(crate) fn numeric_rows(input: &mut CsvInput) -> miette::Result<Vec<(usize, V
     Ok(out)
 }
 
+/// The orientation part of a pose row.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Orientation {
+    /// The tool axis `i, j, k` (non-zero; not normalised here).
+    Axis([f64; 3]),
+    /// The full rotation `r11 … r33` (row-major, orthonormal, det +1).
+    Rotation([[f64; 3]; 3]),
+}
+
 /// One tool pose of a pose CSV.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct PoseRow {
@@ -90,35 +99,70 @@ pub(crate) struct PoseRow {
     pub(crate) t: Option<f64>,
     /// The tool point `px, py, pz`.
     pub(crate) point: [f64; 3],
-    /// The tool axis `i, j, k` (non-zero; not normalised here).
-    pub(crate) axis: [f64; 3],
+    /// The tool axis or the full rotation.
+    pub(crate) orientation: Orientation,
 }
 
-/// Reads a pose CSV: header `px,py,pz,i,j,k`, optionally after a first
-/// column `t`. Returns whether `t` was given, and the rows.
+/// The header of a pose CSV with a tool axis (the spec's).
+const AXIS_HEADER: [&str; 6] = ["px", "py", "pz", "i", "j", "k"];
+/// The header of a pose CSV with a full rotation (an addition).
+const ROTATION_HEADER: [&str; 12] = [
+    "px", "py", "pz", "r11", "r12", "r13", "r21", "r22", "r23", "r31", "r32", "r33",
+];
+
+/// Reads a pose CSV: header `px,py,pz,i,j,k` (tool point and tool axis) or
+/// `px,py,pz,r11,…,r33` (tool point and the tool frame's rotation,
+/// row-major), optionally after a first column `t`. Returns whether `t` was
+/// given, and the rows.
 pub(crate) fn read_poses(path: &Path) -> miette::Result<(bool, Vec<PoseRow>)> {
     let mut input = open_csv(path)?;
     let name = input.name.clone();
-    let want = ["px", "py", "pz", "i", "j", "k"];
     let has_t = input.header.first().is_some_and(|h| h == "t");
     let skip = usize::from(has_t);
-    if input.header[skip..] != want {
+    let columns = &input.header[skip..];
+    let full = if columns == AXIS_HEADER {
+        false
+    } else if columns == ROTATION_HEADER {
+        true
+    } else {
         miette::bail!(
-            "{name}:1: expected the header `px,py,pz,i,j,k` (optionally after a first column `t`), found `{}`",
+            "{name}:1: expected the header `px,py,pz,i,j,k` or `px,py,pz,r11,r12,r13,r21,r22,r23,r31,r32,r33` (optionally after a first column `t`), found `{}`",
             input.header.join(",")
         );
-    }
+    };
     let rows = numeric_rows(&mut input)?;
     rows.into_iter()
-        .map(|(line, v)| {
-            let axis = [v[skip + 3], v[skip + 4], v[skip + 5]];
-            if (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt() < 1e-12 {
-                miette::bail!("{name}:{line}: the tool axis (i, j, k) is zero");
-            }
+        .map(|(line, all)| {
+            let v = &all[skip..];
+            let orientation = if full {
+                let r: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| v[3 + 3 * i + j]));
+                let mut worst = 0.0f64;
+                for i in 0..3 {
+                    for j in 0..3 {
+                        let dot: f64 = (0..3).map(|k| r[k][i] * r[k][j]).sum();
+                        worst = worst.max((dot - if i == j { 1.0 } else { 0.0 }).abs());
+                    }
+                }
+                let det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
+                    - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
+                    + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+                if worst > 1e-6 || det <= 0.0 {
+                    miette::bail!(
+                        "{name}:{line}: r11..r33 is not a rotation (|RᵀR − I| = {worst:.1e}, det = {det:.6})"
+                    );
+                }
+                Orientation::Rotation(r)
+            } else {
+                let axis = [v[3], v[4], v[5]];
+                if (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt() < 1e-12 {
+                    miette::bail!("{name}:{line}: the tool axis (i, j, k) is zero");
+                }
+                Orientation::Axis(axis)
+            };
             Ok(PoseRow {
-                t: has_t.then_some(v[0]),
-                point: [v[skip], v[skip + 1], v[skip + 2]],
-                axis,
+                t: has_t.then_some(all[0]),
+                point: [v[0], v[1], v[2]],
+                orientation,
             })
         })
         .collect::<miette::Result<Vec<_>>>()

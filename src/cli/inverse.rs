@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use chain_core::inverse::{Inverse, Status};
 use serde_json::{json, Map, Value};
 
-use super::csv_input::read_poses;
+use super::csv_input::{read_poses, Orientation};
 use super::reliability::{parse_assignment, write_stdout, Loaded};
 
 /// Arguments of `chain inverse`.
@@ -85,7 +85,10 @@ pub fn exec(args: InverseArgs) -> miette::Result<()> {
     }
     csv_text.push('\n');
     for (k, pose) in poses.iter().enumerate() {
-        let s = solver.solve(pose.point, pose.axis, &prev);
+        let s = match pose.orientation {
+            Orientation::Axis(axis) => solver.solve(pose.point, axis, &prev),
+            Orientation::Rotation(r) => solver.solve_pose(pose.point, &r, &prev),
+        };
         if let Some(first) = s.solutions.first() {
             prev.clone_from(first);
         }

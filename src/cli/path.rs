@@ -26,7 +26,7 @@ use reliability::{
 };
 use serde_json::{json, Map, Value};
 
-use super::csv_input::{numeric_rows, open_csv, read_poses};
+use super::csv_input::{numeric_rows, open_csv, read_poses, Orientation};
 use super::reliability::{
     note_form_limits, parse_assignment, requirement_text, system_of, write_stdout, Loaded,
     MethodArg, SidedArg, SystemArg,
@@ -458,8 +458,10 @@ fn pose_instants(
     }
     let mut instants = Vec::with_capacity(rows.len());
     for (k, row) in rows.into_iter().enumerate() {
-        let (p, a) = (row.point, row.axis);
-        let s = solver.solve(p, a, &prev);
+        let s = match row.orientation {
+            Orientation::Axis(axis) => solver.solve(row.point, axis, &prev),
+            Orientation::Rotation(r) => solver.solve_pose(row.point, &r, &prev),
+        };
         let q = s.solutions.first().cloned();
         if let Some(first) = &q {
             prev.clone_from(first);

@@ -36,8 +36,8 @@ use crate::model::{JointKind, Machine};
 use crate::CompiledModel;
 
 use crate::geometry::{
-    cross, det, dot, mat_vec, mul, mul_t_vec, norm, quarter_axis, rodrigues, rodrigues_vec, scale,
-    solve3, sub, tr, V3,
+    col, cross, det, dot, log_so3, mat_vec, mul, mul_t_vec, norm, quarter_axis, rodrigues,
+    rodrigues_vec, scale, solve3, sub, tr, M3, V3,
 };
 
 /// Why a machine cannot be handled by [`Solver`].
@@ -87,11 +87,21 @@ pub struct Solution {
 
 /// The inverse kinematics of one machine, by the best method that applies.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Inverse {
-    /// The closed form (two rotary and three prismatic free variables,
-    /// product-form orientation).
+pub struct Inverse {
+    method: Method,
+    kinematics: Kinematics,
+    params: Vec<f64>,
+    rotary: Vec<bool>,
+    /// Free rotary variables that move neither the tool point nor the tool
+    /// axis (a spindle's spin), with the sign `σ` of their turn about the tool
+    /// axis: `R(q + s e_k) = Rot(t, σ s) R(q)`.
+    spin: Vec<(usize, f64)>,
+}
+
+/// The solver behind an [`Inverse`].
+#[derive(Debug, Clone, PartialEq)]
+enum Method {
     ClosedForm(Box<Solver>),
-    /// Damped Newton with the exact Jacobian, for every other chain.
     Newton(Box<NewtonSolver>),
 }
 
@@ -106,29 +116,85 @@ impl Inverse {
     ) -> Result<Inverse, InverseError> {
         let symbolic = crate::derive(machine);
         let model = CompiledModel::new(&symbolic);
+        let kinematics = Kinematics::new(&symbolic);
         let kinds: Vec<JointKind> = machine.variables.iter().map(|v| v.kind).collect();
-        match Solver::new(&model, &kinds, params, fixed) {
-            Ok(solver) => Ok(Inverse::ClosedForm(Box::new(solver))),
-            Err(_) => NewtonSolver::new(Kinematics::new(&symbolic), params, fixed)
-                .map(|s| Inverse::Newton(Box::new(s))),
+        let method = match Solver::new(&model, &kinds, params, fixed) {
+            Ok(solver) => Method::ClosedForm(Box::new(solver)),
+            Err(_) => Method::Newton(Box::new(NewtonSolver::new(
+                kinematics.clone(),
+                params,
+                fixed,
+            )?)),
+        };
+        let mut base = vec![0.0; kinds.len()];
+        for &(i, v) in fixed {
+            if let Some(b) = base.get_mut(i) {
+                *b = v;
+            }
         }
+        let spin = (0..kinds.len())
+            .filter(|&k| kinds[k] == JointKind::Rotary && !fixed.iter().any(|f| f.0 == k))
+            .filter(|&k| !moves_tool(&kinematics, params, &base, k))
+            .map(|k| {
+                // The sign of the turn about the tool axis.
+                let r0 = kinematics.pose(&base, params).rotation;
+                let mut q = base.clone();
+                q[k] += 0.5;
+                let r1 = kinematics.pose(&q, params).rotation;
+                let w = log_so3(&mul(&r1, &tr(&r0)));
+                (k, dot(w, col(&r0, 2)).signum())
+            })
+            .collect();
+        Ok(Inverse {
+            method,
+            kinematics,
+            params: params.to_vec(),
+            rotary: kinds.iter().map(|k| *k == JointKind::Rotary).collect(),
+            spin,
+        })
     }
 
     /// `closed-form` or `newton`.
     pub fn method(&self) -> &'static str {
-        match self {
-            Inverse::ClosedForm(_) => "closed-form",
-            Inverse::Newton(_) => "newton",
+        match self.method {
+            Method::ClosedForm(_) => "closed-form",
+            Method::Newton(_) => "newton",
         }
     }
 
     /// All solutions for tool point `point` and tool axis `axis`; `prev` are
     /// the previous row's values (model order).
     pub fn solve(&self, point: V3, axis: V3, prev: &[f64]) -> Solution {
-        match self {
-            Inverse::ClosedForm(s) => s.solve(point, axis, prev),
-            Inverse::Newton(s) => s.solve(point, axis, prev),
+        match &self.method {
+            Method::ClosedForm(s) => s.solve(point, axis, prev),
+            Method::Newton(s) => s.solve(point, axis, prev),
         }
+    }
+
+    /// All solutions for a full tool pose: point `point` and orientation
+    /// `rotation` (the tool frame in the workpiece frame, row-major). The
+    /// point and axis are solved as in [`Inverse::solve`]; then a spin
+    /// variable (one that turns the tool about its own axis, `mu` of
+    /// `cnc5_bevel`) takes the remaining turn, or, without one, a solution is
+    /// kept only if its orientation already matches (to 1e-9).
+    pub fn solve_pose(&self, point: V3, rotation: &M3, prev: &[f64]) -> Solution {
+        let axis = col(rotation, 2);
+        let first = self.solve(point, axis, prev);
+        let singular = first.status == Status::Singular;
+        let mut out: Vec<Vec<f64>> = Vec::new();
+        for mut q in first.solutions {
+            if let Some(&(k, sign)) = self.spin.first() {
+                let r = self.kinematics.pose(&q, &self.params).rotation;
+                let w = log_so3(&mul(rotation, &tr(&r)));
+                q[k] = wrap(q[k] + sign * dot(w, axis));
+            }
+            let r = self.kinematics.pose(&q, &self.params).rotation;
+            let off = norm(log_so3(&mul(rotation, &tr(&r))));
+            if off <= 1e-9 && !out.iter().any(|o| close(o, &q, &self.rotary)) {
+                out.push(q);
+            }
+        }
+        Solution::ranked(out, prev, &self.rotary, singular)
     }
 }
 
