@@ -4,17 +4,19 @@
 //! against the paper's final tolerances), an analytic optimum, and the
 //! infeasible case.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use std::path::PathBuf;
 
 use chain_core::model::Machine;
 use chain_core::CompiledModel;
+use common::cli::{fails, ok, ok_json, scratch};
+use common::example_path;
 use reliability::allocate::{self, AllocateError, ErrorBounds, Optimal, Paper};
 use reliability::{machine, normal, Form, Study, Summary};
-use serde_json::Value;
 
 fn gantry_path() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/machines/gantry_grinder.yaml")
+    example_path("gantry_grinder.yaml")
 }
 
 fn load(text: &str) -> (Machine, CompiledModel, Study) {
@@ -26,20 +28,6 @@ fn load(text: &str) -> (Machine, CompiledModel, Study) {
 
 fn gantry() -> (Machine, CompiledModel, Study) {
     load(&std::fs::read_to_string(gantry_path()).expect("gantry file"))
-}
-
-fn chain(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_chain"))
-        .args(args)
-        .output()
-        .expect("run chain")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("chain-allocate-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    dir
 }
 
 fn summary<'a>(s: &'a [Summary], target: &str) -> &'a Summary {
@@ -262,9 +250,7 @@ fn cli_infeasible_exits_non_zero_naming_component_and_errors() {
     let dir = scratch("infeasible");
     let file = dir.join("gantry_tight.yaml");
     std::fs::write(&file, out).unwrap();
-    let o = chain(&["allocate", file.to_str().unwrap()]);
-    assert!(!o.status.success());
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = fails(&["allocate", file.to_str().unwrap()]);
     assert!(err.contains("infeasible"), "{err}");
     assert!(err.contains("px"), "{err}");
     assert!(err.contains("eyx") && err.contains("min_std"), "{err}");
@@ -274,7 +260,7 @@ fn cli_infeasible_exits_non_zero_naming_component_and_errors() {
 fn cli_json_follows_the_contract() {
     let file = gantry_path();
     for strategy in ["optimal", "paper"] {
-        let o = chain(&[
+        let doc = ok_json(&[
             "allocate",
             file.to_str().unwrap(),
             "--strategy",
@@ -282,8 +268,6 @@ fn cli_json_follows_the_contract() {
             "--format",
             "json",
         ]);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let doc: Value = serde_json::from_slice(&o.stdout).expect("one JSON document");
         assert_eq!(doc["machine"], "gantry_grinder");
         assert_eq!(doc["strategy"], strategy);
         assert_eq!(doc["requirement"]["min"], 0.95);
@@ -358,7 +342,7 @@ fn errata_000_6_and_000_7() {
 fn cli_plot_writes_maps_and_the_tightening_chart() {
     let dir = scratch("plot");
     let file = gantry_path();
-    let o = chain(&[
+    ok(&[
         "allocate",
         file.to_str().unwrap(),
         "--strategy",
@@ -366,7 +350,6 @@ fn cli_plot_writes_maps_and_the_tightening_chart() {
         "--plot",
         dir.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for stem in [
         "allocate_px",
         "allocate_py",

@@ -2,13 +2,16 @@
 //! Tables 1-2 and its printed R² values and law, and the `chain compensate`
 //! command line (JSON, tables, plots, every bad-CSV case).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use std::path::PathBuf;
 
 use chain::compensate::{
     self, analyze, f_survival, fit_polynomial, parse_csv, read_csv, swing_angle_error_deg,
     swing_angle_error_from_delta_z_deg, CompensateError, FitError, Grid, Options, SelectionRule,
 };
+use common::cli::{chain, fails, ok_json, ok_stdout, scratch, scratch_file};
+use common::example_file;
 
 /// L of the seed: "The distance L from the cutter center to the rotation center
 /// of the EM head is 577.11mm."
@@ -65,7 +68,7 @@ const TABLE2: [[f64; 4]; 40] = [
 const PAPER_R2: [f64; 5] = [0.0953, 0.1458, 0.1822, 0.1835, 0.1844];
 
 fn example_csv() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/swing_htm50200.csv")
+    example_file("data/swing_htm50200.csv")
 }
 
 fn paper_analysis() -> compensate::Analysis {
@@ -592,32 +595,11 @@ proptest::proptest! {
 // Command line
 // ---------------------------------------------------------------------------
 
-fn chain(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_chain"))
-        .args(args)
-        .env("NO_COLOR", "1")
-        .output()
-        .expect("run chain")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("compensate_tests");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-fn write_scratch(name: &str, text: &str) -> PathBuf {
-    let path = scratch(name);
-    std::fs::write(&path, text).unwrap();
-    path
-}
-
-/// stderr without whitespace, box-drawing characters or ANSI escapes, so that
-/// terminal wrapping cannot split what a test looks for.
-fn squashed_stderr(out: &Output) -> String {
-    let text = String::from_utf8_lossy(&out.stderr);
+/// `stderr` without whitespace, box-drawing characters or ANSI escapes, so
+/// that terminal wrapping cannot split what a test looks for.
+fn squashed(stderr: &str) -> String {
     let mut s = String::new();
-    let mut chars = text.chars().peekable();
+    let mut chars = stderr.chars().peekable();
     while let Some(c) = chars.next() {
         if c == '\u{1b}' {
             for d in chars.by_ref() {
@@ -635,7 +617,7 @@ fn squashed_stderr(out: &Output) -> String {
 #[test]
 fn cli_json_has_the_spec_shape() {
     let csv = example_csv();
-    let out = chain(&[
+    let v = ok_json(&[
         "compensate",
         csv.to_str().unwrap(),
         "--length",
@@ -643,13 +625,6 @@ fn cli_json_has_the_spec_shape() {
         "--format",
         "json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value =
-        serde_json::from_slice(&out.stdout).expect("stdout is one JSON document");
     assert_eq!(v["length"], 577.11);
     let points = v["points"].as_array().unwrap();
     assert_eq!(points.len(), 40);
@@ -676,8 +651,8 @@ fn cli_json_has_the_spec_shape() {
 #[test]
 fn cli_table_format_and_table_out() {
     let csv = example_csv();
-    let table = scratch("table_out.csv");
-    let out = chain(&[
+    let table = scratch("table_out").join("table_out.csv");
+    let stdout = ok_stdout(&[
         "compensate",
         csv.to_str().unwrap(),
         "--length",
@@ -689,12 +664,6 @@ fn cli_table_format_and_table_out() {
         "--grid",
         "1:0.5:40",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8(out.stdout).unwrap();
     assert!(
         stdout.contains("Selected order: 4 (rule: fixed"),
         "{stdout}"
@@ -710,7 +679,7 @@ fn cli_table_format_and_table_out() {
     assert_eq!(rows[0][0], 1.0);
     assert_eq!(rows[78][0], 40.0);
     // Outside the measured range without --allow-extrapolation: an error.
-    let out = chain(&[
+    let err = fails(&[
         "compensate",
         csv.to_str().unwrap(),
         "--length",
@@ -720,17 +689,16 @@ fn cli_table_format_and_table_out() {
         "--grid",
         "0.5:0.5:45",
     ]);
-    assert!(!out.status.success());
-    assert!(out.stdout.is_empty());
-    assert!(squashed_stderr(&out).contains("measuredrange"));
+    assert!(squashed(&err).contains("measuredrange"), "{err}");
 }
 
 #[test]
 fn cli_plot_writes_valid_png_and_svg() {
     let csv = example_csv();
+    // A directory that does not exist yet: --plot makes it.
     let dir = scratch("plots");
     let _ = std::fs::remove_dir_all(&dir);
-    let out = chain(&[
+    let v = ok_json(&[
         "compensate",
         csv.to_str().unwrap(),
         "--length",
@@ -740,12 +708,6 @@ fn cli_plot_writes_valid_png_and_svg() {
         "--plot",
         dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["written"].as_array().unwrap().len(), 14);
     let mut stems: Vec<String> = (2..=6).map(|p| format!("swing_fit_order{p}")).collect();
     stems.push("swing_fits".into());
@@ -783,11 +745,11 @@ fn cli_plot_writes_valid_png_and_svg() {
 
 /// Runs the CLI on `text` and checks a clean failure naming the file and line.
 fn assert_bad_csv(name: &str, text: &str, extra: &[&str], expect: &[&str]) {
-    let path = write_scratch(name, text);
+    let path = scratch_file(name, text);
     let mut args = vec!["compensate", path.to_str().unwrap(), "--length", "577.11"];
     args.extend_from_slice(extra);
     let out = chain(&args);
-    let err = squashed_stderr(&out);
+    let err = squashed(&String::from_utf8_lossy(&out.stderr));
     assert_eq!(out.status.code(), Some(1), "{name}: {err}");
     assert!(out.stdout.is_empty(), "{name}: stdout not empty");
     assert!(
@@ -879,9 +841,7 @@ fn cli_rejects_bad_options() {
         vec!["compensate", csv, "--length", "577.11", "--grid", "1:1:40"],
         vec!["compensate", "/nonexistent/swing.csv", "--length", "577.11"],
     ] {
-        let out = chain(&args);
-        assert!(!out.status.success(), "{args:?}");
-        assert!(out.stdout.is_empty(), "{args:?}");
-        assert!(!out.stderr.is_empty(), "{args:?}");
+        let err = fails(&args);
+        assert!(!err.is_empty(), "{args:?}");
     }
 }

@@ -3,12 +3,15 @@
 //! and must give identical canonical polynomials on every example machine, in
 //! both frames.
 
-use std::path::Path;
+mod common;
+
+use std::path::PathBuf;
 
 use chain_core::model::{Component, Frame};
+use common::{example_file, example_path};
 
-fn example_machines() -> Vec<std::path::PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/machines");
+fn example_machines() -> Vec<PathBuf> {
+    let dir = example_file("machines");
     let mut files: Vec<_> = std::fs::read_dir(&dir)
         .expect("examples/machines exists")
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -62,7 +65,7 @@ fn dmm_route_equals_matrix_route_on_every_example() {
 /// `nominal.position = ["-x", "y", "z"]` and px ∋ {dxx: -1, eyx: -z, ezx: y}.
 #[test]
 fn spec_example_json_excerpt() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/machines/gantry_grinder.yaml");
+    let path = example_path("gantry_grinder.yaml");
     let machine = chain_core::load_file(&path).unwrap_or_else(|e| panic!("{e}"));
     let model = chain_core::derive(&machine);
     let json = chain_core::export::to_json(&model);

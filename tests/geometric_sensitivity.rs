@@ -3,16 +3,19 @@
 //! and `chain sensitivity --kind geometric` (the JSON contract of
 //! shared/spec/machine-format.md). See docs/geometric_sensitivity.md.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use std::path::PathBuf;
 
 use chain::core::geometric::{self, GeometricSensitivity, NominalSizes};
 use chain::core::model::Component;
 use chain::core::{CompiledModel, Machine};
+use common::cli::{fails, ok_json, ok_stdout, scratch, unwrapped};
+use common::example_path;
 use serde_json::Value;
 
 fn grinder_file() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/machines/internal_grinder.yaml")
+    example_path("internal_grinder.yaml")
 }
 
 fn grinder() -> (Machine, CompiledModel) {
@@ -339,25 +342,17 @@ fn values_parsing() {
 // ---------------------------------------------------------------------------
 // CLI.
 
-fn chain(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_chain"))
-        .args(args)
-        .output()
-        .expect("run chain")
-}
-
-fn ok_json(args: &[&str]) -> Value {
-    let out = chain(args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("stdout is one JSON document")
-}
-
 fn file() -> String {
     grinder_file().display().to_string()
+}
+
+/// `chain sensitivity <grinder> --kind geometric --format json` with `extra`,
+/// which must succeed; returns the document.
+fn geometric_json(extra: &[&str]) -> Value {
+    let f = file();
+    let mut args = vec!["sensitivity", &f, "--kind", "geometric", "--format", "json"];
+    args.extend_from_slice(extra);
+    ok_json(&args)
 }
 
 fn check_components(doc: &Value) {
@@ -386,16 +381,7 @@ fn check_components(doc: &Value) {
 
 #[test]
 fn cli_json_at_the_case_point() {
-    let doc = ok_json(&[
-        "sensitivity",
-        &file(),
-        "--kind",
-        "geometric",
-        "--at",
-        "x1=-100,x2=0,z=40",
-        "--format",
-        "json",
-    ]);
+    let doc = geometric_json(&["--at", "x1=-100,x2=0,z=40"]);
     assert_eq!(doc["machine"], "internal_grinder");
     assert_eq!(doc["kind"], "geometric");
     assert_eq!(
@@ -409,17 +395,11 @@ fn cli_json_at_the_case_point() {
     assert_eq!(doc["components"]["pz"][0]["error"], "ey_x1");
 
     // Equal sizes: Eq. 6 as printed, 300/1003.
-    let doc = ok_json(&[
-        "sensitivity",
-        &file(),
-        "--kind",
-        "geometric",
+    let doc = geometric_json(&[
         "--at",
         "x1=-100,x2=0,z=40",
         "--values",
         "linear=0.001,angular=0.001",
-        "--format",
-        "json",
     ]);
     let c = doc["components"]["py"][0]["c"].as_f64().unwrap();
     assert!((c - 300.0 / 1003.0).abs() < 1e-12);
@@ -428,18 +408,10 @@ fn cli_json_at_the_case_point() {
 
 #[test]
 fn cli_grid_mean_and_plot() {
-    let dir = std::env::temp_dir().join(format!("chain-geometric-{}", std::process::id()));
+    // A directory that does not exist yet: --plot makes it.
+    let dir = scratch("plot");
     let _ = std::fs::remove_dir_all(&dir);
-    let doc = ok_json(&[
-        "sensitivity",
-        &file(),
-        "--kind",
-        "geometric",
-        "--format",
-        "json",
-        "--plot",
-        dir.to_str().unwrap(),
-    ]);
+    let doc = geometric_json(&["--plot", dir.to_str().unwrap()]);
     assert!(doc["at"].is_null());
     assert_eq!(doc["points"], 75); // 5 × 3 × 5, the file's reliability grid
     assert_eq!(doc["grid"]["x2"], serde_json::json!([-50.0, 0.0, 50.0]));
@@ -456,31 +428,9 @@ fn cli_grid_mean_and_plot() {
     let _ = std::fs::remove_dir_all(&dir);
 
     // --grid replaces an axis; a one-point grid is that point.
-    let grid = ok_json(&[
-        "sensitivity",
-        &file(),
-        "--kind",
-        "geometric",
-        "--format",
-        "json",
-        "--grid",
-        "x1=-100",
-        "--grid",
-        "x2=0",
-        "--grid",
-        "z=40",
-    ]);
+    let grid = geometric_json(&["--grid", "x1=-100", "--grid", "x2=0", "--grid", "z=40"]);
     assert_eq!(grid["points"], 1);
-    let at = ok_json(&[
-        "sensitivity",
-        &file(),
-        "--kind",
-        "geometric",
-        "--format",
-        "json",
-        "--at",
-        "x1=-100,x2=0,z=40",
-    ]);
+    let at = geometric_json(&["--at", "x1=-100,x2=0,z=40"]);
     let strip = |doc: &Value| -> Vec<(String, String, f64, f64)> {
         doc["components"]
             .as_object()
@@ -503,7 +453,7 @@ fn cli_grid_mean_and_plot() {
 
 #[test]
 fn cli_table() {
-    let out = chain(&[
+    let text = ok_stdout(&[
         "sensitivity",
         &file(),
         "--kind",
@@ -511,22 +461,15 @@ fn cli_table() {
         "--at",
         "x1=-100,x2=0,z=40",
     ]);
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("py (sum of S·e"), "{text}");
     assert!(text.contains("ez_x1"), "{text}");
 }
 
-fn fails(args: &[&str], needles: &[&str]) {
-    let out = chain(args);
-    assert!(!out.status.success(), "{args:?} should fail");
-    assert!(out.stdout.is_empty(), "nothing on stdout");
+/// Runs a command that must fail ([`fails`]) with a message containing each
+/// of `needles`.
+fn fails_naming(args: &[&str], needles: &[&str]) {
     // miette wraps long messages: compare with the frame and line breaks removed.
-    let err = String::from_utf8_lossy(&out.stderr)
-        .replace('│', " ")
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .join(" ");
+    let err = unwrapped(&fails(args));
     for n in needles {
         assert!(err.contains(n), "{args:?}: `{n}` not in\n{err}");
     }
@@ -545,7 +488,7 @@ fn cli_errors() {
     let run = |extra: &[&'static str], needles: &[&str]| {
         let args = with(extra);
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        fails(&args, needles);
+        fails_naming(&args, needles);
     };
     // An unknown variable in --at, with a hint.
     run(
@@ -573,7 +516,7 @@ fn cli_errors() {
     // A bad --grid axis.
     run(&["--grid", "w=1,2"], &["unknown axis variable `w`"]);
     // --values is for the geometric kind only.
-    fails(
+    fails_naming(
         &["sensitivity", &f, "--values", "linear=0.001"],
         &["--values applies only to --kind geometric"],
     );

@@ -2,17 +2,19 @@
 //! pose on random reachable poses, a singular and an unreachable pose, and the
 //! `chain inverse` CLI (JSON shape, bad CSV).
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use chain_core::inverse::{wrap, Inverse, NewtonSolver, Solver, Status};
 use chain_core::kinematics::Kinematics;
 use chain_core::model::{JointKind, Machine};
 use chain_core::{CompiledModel, ErrorModel};
-use serde_json::Value;
+use common::cli::{fails, ok_json, ok_stdout, scratch_file};
+use common::{example_path, Rng};
 
 fn machine_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("examples/machines/{name}.yaml"))
+    example_path(&format!("{name}.yaml"))
 }
 
 fn load(name: &str) -> (Machine, CompiledModel, Vec<JointKind>, Vec<f64>) {
@@ -27,22 +29,6 @@ fn load(name: &str) -> (Machine, CompiledModel, Vec<JointKind>, Vec<f64>) {
     (m, model, kinds, params)
 }
 
-/// A small deterministic generator (splitmix64), uniform in [0, 1).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-}
-
 fn axis_of(r: &[[f64; 3]; 3]) -> [f64; 3] {
     [r[0][2], r[1][2], r[2][2]]
 }
@@ -51,15 +37,37 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 
-/// Round trip on `n` random poses; returns the largest position and axis errors.
-fn round_trip(name: &str, fixed: &[(&str, f64)], n: usize, seed: u64) -> (f64, f64) {
+/// `a - b` for a joint of `kind`, wrapped to (-π, π] for a rotary one.
+fn joint_difference(kind: &JointKind, a: f64, b: f64) -> f64 {
+    if *kind == JointKind::Rotary {
+        wrap(a - b)
+    } else {
+        a - b
+    }
+}
+
+/// Random axis values: angles in [-3, 3) rad, slides in [-500, 500) mm.
+fn random_q(kinds: &[JointKind], rng: &mut Rng) -> Vec<f64> {
+    kinds
+        .iter()
+        .map(|k| match k {
+            JointKind::Rotary => rng.range(-3.0, 3.0),
+            JointKind::Prismatic => rng.range(-500.0, 500.0),
+        })
+        .collect()
+}
+
+/// Round trip on `n` random poses: the generating axis values are among the
+/// solutions, and every solution gives the pose back to 1e-10 (the largest
+/// position and axis errors are printed).
+fn round_trip(name: &str, fixed: &[(&str, f64)], n: usize, seed: u64) {
     let (m, model, kinds, params) = load(name);
     let fixed: Vec<(usize, f64)> = fixed
         .iter()
         .map(|(v, x)| (m.variables.iter().position(|y| y.name == *v).unwrap(), *x))
         .collect();
     let solver = Solver::new(&model, &kinds, &params, &fixed).expect("closed form applies");
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let (mut ep, mut ea) = (0.0f64, 0.0f64);
     let mut prev = vec![0.0; kinds.len()];
     for &(i, x) in &fixed {
@@ -92,42 +100,34 @@ fn round_trip(name: &str, fixed: &[(&str, f64)], n: usize, seed: u64) -> (f64, f
             let back = model.nominal(sol, &params);
             ep = ep.max(dist(back.position, pose.position));
             ea = ea.max(dist(axis_of(&back.rotation), axis));
-            let same = sol.iter().zip(&q).zip(&kinds).all(|((a, b), k)| {
-                let d = if *k == JointKind::Rotary {
-                    wrap(a - b)
-                } else {
-                    a - b
-                };
-                d.abs() < 1e-7
-            });
+            let same = sol
+                .iter()
+                .zip(&q)
+                .zip(&kinds)
+                .all(|((a, b), k)| joint_difference(k, *a, *b).abs() < 1e-7);
             found |= same;
         }
         assert!(found, "the generating axis values are among the solutions");
         // Branch order: the first is the nearest to the previous row.
         prev.clone_from(&s.solutions[0]);
     }
-    (ep, ea)
+    eprintln!("{name}: max position error {ep:e}, max axis error {ea:e}");
+    assert!(ep < 1e-10 && ea < 1e-10, "{ep:e} {ea:e}");
 }
 
 #[test]
 fn round_trip_ac_trunnion() {
-    let (ep, ea) = round_trip("ac_trunnion", &[], 10_000, 1);
-    eprintln!("ac_trunnion: max position error {ep:e}, max axis error {ea:e}");
-    assert!(ep < 1e-10 && ea < 1e-10, "{ep:e} {ea:e}");
+    round_trip("ac_trunnion", &[], 10_000, 1);
 }
 
 #[test]
 fn round_trip_cnc5_bevel() {
-    let (ep, ea) = round_trip("cnc5_bevel", &[("mu", 0.0)], 10_000, 2);
-    eprintln!("cnc5_bevel: max position error {ep:e}, max axis error {ea:e}");
-    assert!(ep < 1e-10 && ea < 1e-10, "{ep:e} {ea:e}");
+    round_trip("cnc5_bevel", &[("mu", 0.0)], 10_000, 2);
 }
 
 #[test]
 fn round_trip_head_head_bc() {
-    let (ep, ea) = round_trip("head_head_bc", &[], 10_000, 3);
-    eprintln!("head_head_bc: max position error {ep:e}, max axis error {ea:e}");
-    assert!(ep < 1e-10 && ea < 1e-10, "{ep:e} {ea:e}");
+    round_trip("head_head_bc", &[], 10_000, 3);
 }
 
 #[test]
@@ -171,42 +171,26 @@ fn unreachable_pose() {
     assert_ne!(s.status, Status::Unreachable);
 }
 
-fn chain(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_chain"))
-        .args(args)
-        .output()
-        .expect("run chain")
-}
-
-fn temp_csv(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("chain-inverse-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
+/// The arguments of `chain inverse <machine> --pose <poses>` and `extra`.
+fn inverse_args<'a>(machine: &'a Path, poses: &'a Path, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "inverse",
+        machine.to_str().unwrap(),
+        "--pose",
+        poses.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    args
 }
 
 #[test]
 fn cli_json_shape() {
-    let csv = temp_csv(
+    let csv = scratch_file(
         "poses.csv",
         "px,py,pz,i,j,k\n10,20,30,0.6,0,0.8\n10,20,30,0,0,1\n",
     );
     let file = machine_path("cnc5_bevel");
-    let out = chain(&[
-        "inverse",
-        file.to_str().unwrap(),
-        "--pose",
-        csv.to_str().unwrap(),
-        "--fix",
-        "mu=0",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).expect("one JSON document");
+    let v = ok_json(&inverse_args(&file, &csv, &["--fix", "mu=0"]));
     assert_eq!(v["machine"], "cnc5_bevel");
     let vars: Vec<&str> = v["variables"]
         .as_array()
@@ -233,31 +217,25 @@ fn cli_json_shape() {
 
 #[test]
 fn cli_bad_csv_names_the_line() {
-    let csv = temp_csv("bad.csv", "px,py,pz,i,j,k\n1,2,3,0,0,1\n1,2,oops,0,0,1\n");
     let file = machine_path("ac_trunnion");
-    let out = chain(&[
-        "inverse",
-        file.to_str().unwrap(),
-        "--pose",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains(":3:") && err.contains("oops"), "{err}");
-
-    let csv = temp_csv("header.csv", "x,y,z,i,j,k\n1,2,3,0,0,1\n");
-    let out = chain(&[
-        "inverse",
-        file.to_str().unwrap(),
-        "--pose",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains(":1:") && err.contains("px,py,pz,i,j,k"),
-        "{err}"
-    );
+    for (name, text, needles) in [
+        (
+            "bad.csv",
+            "px,py,pz,i,j,k\n1,2,3,0,0,1\n1,2,oops,0,0,1\n",
+            [":3:", "oops"],
+        ),
+        (
+            "header.csv",
+            "x,y,z,i,j,k\n1,2,3,0,0,1\n",
+            [":1:", "px,py,pz,i,j,k"],
+        ),
+    ] {
+        let csv = scratch_file(name, text);
+        let err = fails(&inverse_args(&file, &csv, &[]));
+        for n in needles {
+            assert!(err.contains(n), "{name}: `{n}` not in\n{err}");
+        }
+    }
 }
 
 #[test]
@@ -283,11 +261,7 @@ fn branch_selection_follows_a_smooth_path() {
         assert_eq!(s.status, Status::Ok);
         let first = &s.solutions[0];
         for ((a, b), kind) in first.iter().zip(&q).zip(&kinds) {
-            let d = if *kind == JointKind::Rotary {
-                wrap(a - b)
-            } else {
-                a - b
-            };
+            let d = joint_difference(kind, *a, *b);
             assert!(d.abs() < 1e-8, "step {k}: {first:?} vs {q:?}");
         }
         prev.clone_from(first);
@@ -308,18 +282,9 @@ fn undetermined_spin_defaults_to_zero() {
 
 #[test]
 fn cli_csv_format() {
-    let csv = temp_csv("poses_csv.csv", "px,py,pz,i,j,k\n10,20,30,0.6,0,0.8\n");
+    let csv = scratch_file("poses_csv.csv", "px,py,pz,i,j,k\n10,20,30,0.6,0,0.8\n");
     let file = machine_path("ac_trunnion");
-    let out = chain(&[
-        "inverse",
-        file.to_str().unwrap(),
-        "--pose",
-        csv.to_str().unwrap(),
-        "--format",
-        "csv",
-    ]);
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = ok_stdout(&inverse_args(&file, &csv, &["--format", "csv"]));
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines[0], "row,status,solution,y,A,C,x,z");
     assert_eq!(lines.len(), 3, "{text}");
@@ -331,16 +296,10 @@ fn newton_finds_every_closed_form_solution(name: &str, seed: u64) {
     let (m, model, kinds, params) = load(name);
     let closed = Solver::new(&model, &kinds, &params, &[]).expect("closed form");
     let newton = NewtonSolver::new(Kinematics::from_machine(&m), &params, &[]).expect("newton");
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let prev = vec![0.0; kinds.len()];
     for _ in 0..100 {
-        let q: Vec<f64> = kinds
-            .iter()
-            .map(|k| match k {
-                JointKind::Rotary => rng.range(-3.0, 3.0),
-                JointKind::Prismatic => rng.range(-500.0, 500.0),
-            })
-            .collect();
+        let q = random_q(&kinds, &mut rng);
         let pose = model.nominal(&q, &params);
         let axis = axis_of(&pose.rotation);
         let a = closed.solve(pose.position, axis, &prev);
@@ -350,14 +309,10 @@ fn newton_finds_every_closed_form_solution(name: &str, seed: u64) {
         assert_eq!(a.solutions.len(), b.solutions.len(), "{name} q = {q:?}");
         for s in &a.solutions {
             let matched = b.solutions.iter().any(|t| {
-                s.iter().zip(t).zip(&kinds).all(|((x, y), k)| {
-                    let d = if *k == JointKind::Rotary {
-                        wrap(x - y)
-                    } else {
-                        x - y
-                    };
-                    d.abs() < 1e-7
-                })
+                s.iter()
+                    .zip(t)
+                    .zip(&kinds)
+                    .all(|((x, y), k)| joint_difference(k, *x, *y).abs() < 1e-7)
             });
             assert!(
                 matched,
@@ -390,15 +345,9 @@ fn newton_solves_a_chain_without_closed_form() {
     assert_eq!(inverse.method(), "newton");
     let kin = Kinematics::from_machine(&m);
     let kinds: Vec<JointKind> = m.variables.iter().map(|v| v.kind).collect();
-    let mut rng = Rng(23);
+    let mut rng = Rng::new(23);
     for _ in 0..200 {
-        let q: Vec<f64> = kinds
-            .iter()
-            .map(|k| match k {
-                JointKind::Rotary => rng.range(-3.0, 3.0),
-                JointKind::Prismatic => rng.range(-500.0, 500.0),
-            })
-            .collect();
+        let q = random_q(&kinds, &mut rng);
         let pose = kin.pose(&q, &params);
         let axis = axis_of(&pose.rotation);
         // Previous row near the generating values: the first solution is it.
@@ -412,11 +361,7 @@ fn newton_solves_a_chain_without_closed_form() {
         }
         let first = &s.solutions[0];
         for ((a, b), k) in first.iter().zip(&q).zip(&kinds) {
-            let d = if *k == JointKind::Rotary {
-                wrap(a - b)
-            } else {
-                a - b
-            };
+            let d = joint_difference(k, *a, *b);
             // 1e-6: near B = 0 this chain is ill-conditioned (the pose fixes
             // the values only to ~1e-7 at rounding-level residuals).
             assert!(d.abs() < 1e-6 * a.abs().max(1.0), "{first:?} vs {q:?}");
@@ -437,26 +382,12 @@ fn newton_reports_a_singular_pose() {
 
 #[test]
 fn cli_reports_the_newton_method() {
-    let dir = std::env::temp_dir().join(format!("chain_inverse_newton_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let machine = dir.join("xy_cab.yaml");
-    std::fs::write(&machine, THREE_ROTARY).unwrap();
-    let csv = temp_csv(
+    let machine = scratch_file("xy_cab.yaml", THREE_ROTARY);
+    let csv = scratch_file(
         "poses_newton.csv",
         "px,py,pz,i,j,k\n100,50,250,0.3,0.2,0.9\n",
     );
-    let out = chain(&[
-        "inverse",
-        machine.to_str().unwrap(),
-        "--pose",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let doc = ok_json(&inverse_args(&machine, &csv, &[]));
     assert_eq!(doc["method"], "newton");
     assert_eq!(doc["rows"][0]["status"], "ok");
     assert!(!doc["rows"][0]["solutions"].as_array().unwrap().is_empty());

@@ -3,17 +3,16 @@
 //! orientation, so a spin variable (`mu` of `cnc5_bevel`) is solved too and a
 //! machine without one reaches only the orientations its axes produce.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
 use chain_core::inverse::{wrap, Inverse, Status};
 use chain_core::kinematics::Kinematics;
 use chain_core::model::{JointKind, Machine};
-use serde_json::Value;
+use common::cli::{fails, ok_json, scratch_file, unwrapped};
+use common::{example_path, load_example, Rng};
 
 fn load(name: &str) -> (Machine, Kinematics, Vec<f64>) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("examples/machines/{name}.yaml"));
-    let m = chain_core::load_file(&path).expect("load");
+    let m = load_example(&format!("{name}.yaml"));
     let kin = Kinematics::from_machine(&m);
     let params = m
         .parameters
@@ -21,19 +20,6 @@ fn load(name: &str) -> (Machine, Kinematics, Vec<f64>) {
         .map(|p| p.value.expect("numeric"))
         .collect();
     (m, kin, params)
-}
-
-/// SplitMix64, uniform in [lo, hi).
-struct Rng(u64);
-impl Rng {
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        lo + (hi - lo) * ((z >> 11) as f64 / (1u64 << 53) as f64)
-    }
 }
 
 fn random_q(kinds: &[JointKind], rng: &mut Rng) -> Vec<f64> {
@@ -70,7 +56,7 @@ fn round_trip(name: &str, seed: u64) {
     let (m, kin, params) = load(name);
     let kinds: Vec<JointKind> = m.variables.iter().map(|v| v.kind).collect();
     let inverse = Inverse::for_machine(&m, &params, &[]).expect("solver");
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let prev = vec![0.0; kinds.len()];
     for _ in 0..10_000 {
         let q = random_q(&kinds, &mut rng);
@@ -132,21 +118,6 @@ fn a_turn_about_the_tool_axis_is_unreachable_without_a_spin_axis() {
     );
 }
 
-fn temp(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("chain-inverse-pose-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    let path = dir.join(name);
-    std::fs::write(&path, text).expect("write");
-    path
-}
-
-fn chain(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_chain"))
-        .args(args)
-        .output()
-        .expect("run chain")
-}
-
 #[test]
 fn cli_reads_full_rotations() {
     let (m, kin, params) = load("cnc5_bevel");
@@ -171,26 +142,20 @@ fn cli_reads_full_rotations() {
         .chain(r.iter().flatten())
         .map(|v| format!("{v:.17e}"))
         .collect();
-    let csv = temp(
+    let csv = scratch_file(
         "rotation.csv",
         &format!(
             "px,py,pz,r11,r12,r13,r21,r22,r23,r31,r32,r33\n{}\n",
             row.join(",")
         ),
     );
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/machines/cnc5_bevel.yaml");
-    let out = chain(&[
+    let file = example_path("cnc5_bevel.yaml");
+    let doc = ok_json(&[
         "inverse",
         file.to_str().unwrap(),
         "--pose",
         csv.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let doc: Value = serde_json::from_slice(&out.stdout).expect("json");
     assert_eq!(doc["rows"][0]["status"], "ok");
     let sols = doc["rows"][0]["solutions"].as_array().unwrap();
     assert!(sols.iter().any(|s| {
@@ -200,21 +165,16 @@ fn cli_reads_full_rotations() {
             .all(|(k, want)| (s[*k].as_f64().unwrap() - want).abs() < 1e-8)
     }));
     // A row that is not a rotation is refused with its line.
-    let bad = temp(
+    let bad = scratch_file(
         "not_rotation.csv",
         "px,py,pz,r11,r12,r13,r21,r22,r23,r31,r32,r33\n0,0,0,1,0,0,0,1,0,0,0,1\n0,0,0,1,0,0,0,2,0,0,0,1\n",
     );
-    let out = chain(&[
+    let err = unwrapped(&fails(&[
         "inverse",
         file.to_str().unwrap(),
         "--pose",
         bad.to_str().unwrap(),
-    ]);
-    assert!(!out.status.success());
-    assert!(out.stdout.is_empty());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("not_rotation.csv:3") && err.contains("is not a"),
-        "{err}"
-    );
+    ]));
+    assert!(err.contains("not_rotation.csv:3"), "{err}");
+    assert!(err.contains("is not a rotation"), "{err}");
 }

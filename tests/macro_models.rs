@@ -3,7 +3,11 @@
 //! seed 000's Eq. 18 (errata applied, see docs/errata.md) against the
 //! generated functions.
 
+mod common;
+
 use chain::core::ErrorModel;
+use common::cli::ok_stdout;
+use common::root;
 
 chain::machine!(pub GantryFile = "examples/machines/gantry_grinder.yaml");
 chain::machine!(pub InternalGrinder = "examples/machines/internal_grinder.yaml");
@@ -143,7 +147,7 @@ fn generated_gantry_equals_corrected_eq18_at_10000_points() {
 }
 
 fn compare_with_runtime(generated: &dyn ErrorModel, file: &str, seed: u64) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+    let path = root().join(file);
     let machine = chain::core::load_file(&path).unwrap_or_else(|e| panic!("{e}"));
     let runtime = chain::core::compile(&machine);
     assert_eq!(generated.errors(), runtime.errors());
@@ -210,13 +214,8 @@ fn wrong_slice_lengths_give_nan_not_panic() {
 #[test]
 fn derive_format_rust_prints_what_the_macro_emits() {
     let file = "examples/machines/gantry_grinder.yaml";
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_chain"))
-        .args(["derive", file, "--format", "rust"])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run chain");
-    assert!(out.status.success());
-    let printed = String::from_utf8(out.stdout).expect("utf-8");
+    // Run from the package root, where `file` is.
+    let printed = ok_stdout(&["derive", file, "--format", "rust"]);
     // The macro's expansion of the same file, formatted the same way; only the
     // `include_bytes!` that tracks the file for rebuilds differs.
     let expanded = chain::core::expand::expand_pretty(

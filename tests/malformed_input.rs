@@ -3,13 +3,16 @@
 //! nothing hangs. The last tests run the `chain` binary on files under
 //! `tests/data/malformed/`.
 
+mod common;
+
 use std::path::Path;
-use std::process::Command;
 use std::time::{Duration, Instant};
 
 use chain_core::diagnostic::Problem;
 use chain_core::model::{Distribution, ErrorKind, Frame, JointKind, Sided};
 use chain_core::{load_bytes, load_file, load_str, Diagnostics};
+use common::cli::fails;
+use common::example_file;
 
 /// Loads `text` as `bad.yaml` and returns the diagnostics.
 fn diagnose(text: &str) -> Diagnostics {
@@ -166,8 +169,7 @@ reliability:
 
 #[test]
 fn example_machines_load() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/machines");
-    for entry in std::fs::read_dir(dir).unwrap() {
+    for entry in std::fs::read_dir(example_file("machines")).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "yaml") {
             load_file(&path).unwrap_or_else(|d| panic!("{d:#}"));
@@ -1153,24 +1155,13 @@ fn garbage_never_panics() {
 
 // ------------------------------------------------------------------ the CLI
 
-/// Runs `chain derive tests/data/malformed/<file>` and checks the contract:
-/// non-zero exit, empty stdout, stderr naming the file, line and key.
+/// Runs `chain derive tests/data/malformed/<file>` (from the package root)
+/// and checks the contract: non-zero exit, empty stdout, no panic, stderr
+/// naming the file, line and key.
 #[track_caller]
 fn cli(file: &str, line: usize, key: &str) {
     let rel = format!("tests/data/malformed/{file}");
-    let out = Command::new(env!("CARGO_BIN_EXE_chain"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .env("NO_COLOR", "1")
-        .args(["derive", &rel])
-        .output()
-        .expect("run chain");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "exit status {:?}", out.status);
-    assert!(
-        out.stdout.is_empty(),
-        "stdout: {}",
-        String::from_utf8_lossy(&out.stdout)
-    );
+    let stderr = fails(&["derive", &rel]);
     assert!(
         stderr.contains(&format!("{rel}:{line}:")),
         "stderr:\n{stderr}"
@@ -1211,8 +1202,7 @@ mod fuzz {
     use proptest::prelude::*;
 
     fn example() -> String {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("examples/machines/gantry_grinder.yaml");
+        let path = super::common::example_path("gantry_grinder.yaml");
         std::fs::read_to_string(path).unwrap_or_else(|_| super::BASE.to_string())
     }
 

@@ -3,30 +3,29 @@
 //! through the library, against a Monte Carlo estimate of the error moments,
 //! and against `chain inverse`; the JSON/CSV shapes; bad input.
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+mod common;
 
-use chain_core::model::Component;
+use std::path::{Path, PathBuf};
+
+use chain_core::model::{Component, Sided};
 use chain_core::{CompiledModel, ErrorModel, Machine};
+use common::cli::{chain_stdin, fails, ok_json, ok_stdout, scratch, success_json, write};
+use common::{example_file, example_path};
 use reliability::rng::CaseRng;
 use reliability::{machine, Form, System};
 use serde_json::Value;
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
 fn gantry() -> PathBuf {
-    root().join("examples/machines/gantry_grinder.yaml")
+    example_path("gantry_grinder.yaml")
 }
 
 fn bevel() -> PathBuf {
-    root().join("examples/paths/cnc5_bevel_stats.yaml")
+    example_file("paths/cnc5_bevel_stats.yaml")
 }
 
+/// `examples/paths/<name>`.
 fn example(name: &str) -> PathBuf {
-    root().join("examples/paths").join(name)
+    example_file("paths").join(name)
 }
 
 fn load(path: &Path) -> (Machine, CompiledModel) {
@@ -35,39 +34,25 @@ fn load(path: &Path) -> (Machine, CompiledModel) {
     (m, model)
 }
 
-fn chain(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_chain"))
-        .args(args)
-        .output()
-        .expect("run chain")
-}
-
-fn ok_json(args: &[&str]) -> Value {
-    let out = chain(args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("stdout is one JSON document")
-}
-
-/// A scratch directory unique to this test process and name.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("chain-path-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    dir
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).expect("write scratch file");
-    p
-}
-
 fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")
+}
+
+/// The five-axis example with statistics, and `chain path` on it along
+/// `examples/paths/cnc5_bevel_axes.csv`.
+fn bevel_along_its_axes() -> (Machine, CompiledModel, Value) {
+    let file = bevel();
+    let (m, model) = load(&file);
+    let doc = path_json(&file, &example("cnc5_bevel_axes.csv"), &[]);
+    (m, model, doc)
+}
+
+/// `chain path <machine> --axes <axes> --format json` with `extra`, which
+/// must succeed; returns the document.
+fn path_json(machine: &Path, axes: &Path, extra: &[&str]) -> Value {
+    let mut args = vec!["path", s(machine), "--axes", s(axes), "--format", "json"];
+    args.extend_from_slice(extra);
+    ok_json(&args)
 }
 
 fn f(v: &Value) -> f64 {
@@ -103,13 +88,11 @@ fn gantry_path_reliability_equals_the_grid_study_at_grid_points() {
         ),
         (vec!["--sided", "two"], None, true),
     ] {
-        let mut args = vec!["path", s(&file), "--axes", s(&path), "--format", "json"];
-        args.extend(extra.iter().copied());
-        let doc = ok_json(&args);
+        let doc = path_json(&file, &path, &extra);
         // The grid study of `chain reliability`, through the library.
         let mut spec = machine::spec(&m, system).unwrap();
         if sided_two {
-            spec.sided = chain_core::model::Sided::Two;
+            spec.sided = Sided::Two;
         }
         let study =
             reliability::Study::new(&model, &[], machine::inputs(&m).unwrap(), spec).unwrap();
@@ -139,7 +122,7 @@ fn gantry_path_reliability_equals_the_grid_study_at_grid_points() {
     }
     // Table 2 of seed 000 at (y, z) = (-1500, 600): 88.83 % printed, the
     // model gives 88.73 %.
-    let doc = ok_json(&["path", s(&file), "--axes", s(&path), "--format", "json"]);
+    let doc = path_json(&file, &path, &[]);
     let r = f(&doc["instants"][0]["reliability"]["px"]);
     assert!((100.0 * r - 88.73).abs() < 0.005, "{r}");
 }
@@ -171,16 +154,7 @@ fn estimate(xs: &[f64]) -> Estimate {
 #[test]
 fn mean_and_std_by_linear_propagation_equal_a_monte_carlo_estimate() {
     // The five-axis example has two errors with a systematic (non-zero) mean.
-    let file = bevel();
-    let (m, model) = load(&file);
-    let doc = ok_json(&[
-        "path",
-        s(&file),
-        "--axes",
-        s(&example("cnc5_bevel_axes.csv")),
-        "--format",
-        "json",
-    ]);
+    let (m, model, doc) = bevel_along_its_axes();
     let inputs = machine::inputs(&m).unwrap();
     // Inputs in the model's error order.
     let order: Vec<usize> = model
@@ -271,14 +245,7 @@ fn pose_path_axes_equal_chain_inverse_first_solutions() {
     assert_eq!(rows.len(), 21);
     assert_eq!(instants.len(), 21);
     // The axis values the poses were generated from.
-    let generating = ok_json(&[
-        "path",
-        s(&file),
-        "--axes",
-        s(&example("cnc5_bevel_axes.csv")),
-        "--format",
-        "json",
-    ]);
+    let generating = path_json(&file, &example("cnc5_bevel_axes.csv"), &[]);
     let params = machine::parameters(&m, &[]).unwrap();
     for (k, (row, inst)) in rows.iter().zip(instants).enumerate() {
         assert_eq!(inst["status"], "ok");
@@ -376,9 +343,7 @@ fn unreachable_rows_are_reported_not_dropped() {
         assert!(f(&inst[i]["mean"]["py"]).abs() > 1e-4);
     }
     // CSV: one line per instant, empty cells for the unreachable one; never NaN.
-    let out = chain(&["path", s(&file), "--pose", s(&pose), "--format", "csv"]);
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = ok_stdout(&["path", s(&file), "--pose", s(&pose), "--format", "csv"]);
     assert!(!text.to_lowercase().contains("nan"), "{text}");
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 4);
@@ -389,8 +354,7 @@ fn unreachable_rows_are_reported_not_dropped() {
     assert!(row2.contains(&"unreachable"));
     assert!(row2.iter().filter(|c| c.is_empty()).count() >= width - 3);
     // The table says so too.
-    let out = chain(&["path", s(&file), "--pose", s(&pose)]);
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = ok_stdout(&["path", s(&file), "--pose", s(&pose)]);
     assert!(
         text.contains("unreachable") && text.contains("1 unreachable"),
         "{text}"
@@ -401,13 +365,7 @@ fn unreachable_rows_are_reported_not_dropped() {
 fn cli_json_shape_and_csv_rows() {
     let file = gantry();
     let path = example("gantry_path.csv");
-    let doc = ok_json(&[
-        "path",
-        s(&file),
-        "--axes",
-        s(&path),
-        "--format",
-        "json",
+    let mc = [
         "--method",
         "mc",
         "--samples",
@@ -416,7 +374,8 @@ fn cli_json_shape_and_csv_rows() {
         "3",
         "--system",
         "volumetric",
-    ]);
+    ];
+    let doc = path_json(&file, &path, &mc);
     let keys: Vec<&str> = doc
         .as_object()
         .unwrap()
@@ -502,34 +461,17 @@ fn cli_json_shape_and_csv_rows() {
     assert!(summary["error"]["volumetric"]["max_mean"].is_number());
     assert_eq!(summary["requirement"]["met"], false);
     // Reproducible with the seed.
-    let again = ok_json(&[
-        "path",
-        s(&file),
-        "--axes",
-        s(&path),
-        "--format",
-        "json",
-        "--method",
-        "mc",
-        "--samples",
-        "2000",
-        "--seed",
-        "3",
-        "--system",
-        "volumetric",
-    ]);
+    let again = path_json(&file, &path, &mc);
     assert_eq!(doc, again);
 
     // CSV: a header and one row per instant, the same numbers.
-    let out = chain(&["path", s(&file), "--axes", s(&path), "--format", "csv"]);
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = ok_stdout(&["path", s(&file), "--axes", s(&path), "--format", "csv"]);
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 14);
     let header: Vec<&str> = lines[0].split(',').collect();
     assert_eq!(&header[..6], ["row", "t", "x", "z", "y", "status"]);
     assert!(header.contains(&"std_volumetric") && header.contains(&"reliability_pz"));
-    let form = ok_json(&["path", s(&file), "--axes", s(&path), "--format", "json"]);
+    let form = path_json(&file, &path, &[]);
     let col = header.iter().position(|h| *h == "reliability_px").unwrap();
     for (k, line) in lines[1..].iter().enumerate() {
         let cells: Vec<&str> = line.split(',').collect();
@@ -543,26 +485,10 @@ fn cli_json_shape_and_csv_rows() {
 fn header_order_fix_and_stdin() {
     let file = gantry();
     let dir = scratch("fix");
-    let reference = ok_json(&[
-        "path",
-        s(&file),
-        "--axes",
-        s(&example("gantry_path.csv")),
-        "--format",
-        "json",
-    ]);
+    let reference = path_json(&file, &example("gantry_path.csv"), &[]);
     // Without t (the row number is the instant), other column order, z held.
     let csv = write(&dir, "xy.csv", "y,x\n-1500,0\n-750,500\n");
-    let held = ok_json(&[
-        "path",
-        s(&file),
-        "--axes",
-        s(&csv),
-        "--fix",
-        "z=600",
-        "--format",
-        "json",
-    ]);
+    let held = path_json(&file, &csv, &["--fix", "z=600"]);
     let inst = held["instants"].as_array().unwrap();
     assert_eq!(f(&inst[1]["t"]), 2.0);
     assert_eq!(
@@ -574,26 +500,10 @@ fn header_order_fix_and_stdin() {
         serde_json::json!({"x": 500.0, "z": 600.0, "y": -750.0})
     );
     // `-` reads stdin: what `chain motion --format csv` prints (t, variables).
-    let mut child = Command::new(env!("CARGO_BIN_EXE_chain"))
-        .args(["path", s(&file), "--axes", "-", "--format", "json"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(b"t,x,z,y\n0.5,0,600,-1500\n")
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let doc = success_json(chain_stdin(
+        &["path", s(&file), "--axes", "-", "--format", "json"],
+        b"t,x,z,y\n0.5,0,600,-1500\n",
+    ));
     assert_eq!(f(&doc["instants"][0]["t"]), 0.5);
     assert_eq!(
         doc["instants"][0]["reliability"],
@@ -601,59 +511,58 @@ fn header_order_fix_and_stdin() {
     );
 }
 
-/// Runs a command that must fail: non-zero exit, nothing on stdout, no
-/// panic; returns stderr.
-fn fails(args: &[&str]) -> String {
-    let out = chain(args);
-    let err = String::from_utf8_lossy(&out.stderr).to_string();
-    assert!(!out.status.success(), "{args:?} succeeded");
-    assert!(out.stdout.is_empty(), "{args:?} wrote to stdout");
-    assert!(!err.contains("panicked"), "{err}");
-    err
-}
-
 #[test]
 fn bad_input_is_a_clear_error_naming_file_and_line() {
     let file = gantry();
     let g = s(&file);
     let dir = scratch("bad");
-    let bad = write(&dir, "cell.csv", "t,x,y,z\n0,0,0,600\n1,oops,0,600\n");
-    let err = fails(&["path", g, "--axes", s(&bad)]);
-    assert!(
-        err.contains("cell.csv:3:") && err.contains("oops") && err.contains("`x`"),
-        "{err}"
+    // Writes `name` and gives it to `chain path` as the last argument of
+    // `args`; the command must fail naming each of `needles`.
+    let rejects = |args: &[&str], name: &str, text: &str, needles: &[&str]| {
+        let bad = write(&dir, name, text);
+        let mut args = args.to_vec();
+        args.push(s(&bad));
+        let err = fails(&args);
+        for n in needles {
+            assert!(err.contains(n), "{name}: `{n}` not in\n{err}");
+        }
+    };
+    let on_axes = ["path", g, "--axes"];
+    rejects(
+        &on_axes,
+        "cell.csv",
+        "t,x,y,z\n0,0,0,600\n1,oops,0,600\n",
+        &["cell.csv:3:", "oops", "`x`"],
     );
-
-    let bad = write(&dir, "inf.csv", "x,y,z\n0,0,inf\n");
-    let err = fails(&["path", g, "--axes", s(&bad)]);
-    assert!(
-        err.contains("inf.csv:2:") && err.contains("not finite"),
-        "{err}"
+    rejects(
+        &on_axes,
+        "inf.csv",
+        "x,y,z\n0,0,inf\n",
+        &["inf.csv:2:", "not finite"],
     );
-
-    let bad = write(&dir, "ragged.csv", "x,y,z\n0,0,600\n0,0\n");
-    let err = fails(&["path", g, "--axes", s(&bad)]);
-    assert!(err.contains("ragged.csv:3:"), "{err}");
-
-    let bad = write(&dir, "unknown.csv", "t,x,yy,z\n0,0,0,600\n");
-    let err = fails(&["path", g, "--axes", s(&bad)]);
-    assert!(
-        err.contains("unknown.csv:1:") && err.contains("`yy`") && err.contains("`y`"),
-        "{err}"
+    rejects(
+        &on_axes,
+        "ragged.csv",
+        "x,y,z\n0,0,600\n0,0\n",
+        &["ragged.csv:3:"],
     );
-
-    let bad = write(&dir, "missing.csv", "x,y\n0,0\n");
-    let err = fails(&["path", g, "--axes", s(&bad)]);
-    assert!(
-        err.contains("missing.csv:1:") && err.contains("`z`") && err.contains("--fix"),
-        "{err}"
+    rejects(
+        &on_axes,
+        "unknown.csv",
+        "t,x,yy,z\n0,0,0,600\n",
+        &["unknown.csv:1:", "`yy`", "`y`"],
     );
-
-    let bad = write(&dir, "twice.csv", "x,y,z,x\n0,0,600,0\n");
-    let err = fails(&["path", g, "--axes", s(&bad)]);
-    assert!(
-        err.contains("twice.csv:1:") && err.contains("twice"),
-        "{err}"
+    rejects(
+        &on_axes,
+        "missing.csv",
+        "x,y\n0,0\n",
+        &["missing.csv:1:", "`z`", "--fix"],
+    );
+    rejects(
+        &on_axes,
+        "twice.csv",
+        "x,y,z,x\n0,0,600,0\n",
+        &["twice.csv:1:", "twice"],
     );
 
     let both = write(&dir, "both.csv", "x,y,z\n0,0,600\n");
@@ -663,37 +572,31 @@ fn bad_input_is_a_clear_error_naming_file_and_line() {
     let err = fails(&["path", g, "--axes", s(&both), "--fix", "w=1"]);
     assert!(err.contains("`w`"), "{err}");
 
-    let empty = write(&dir, "header_only.csv", "x,y,z\n");
-    let err = fails(&["path", g, "--axes", s(&empty)]);
-    assert!(
-        err.contains("header_only.csv") && err.contains("no data row"),
-        "{err}"
+    rejects(
+        &on_axes,
+        "header_only.csv",
+        "x,y,z\n",
+        &["header_only.csv", "no data row"],
     );
-
-    let nothing = write(&dir, "empty.csv", "");
-    let err = fails(&["path", g, "--axes", s(&nothing)]);
-    assert!(err.contains("empty.csv:1:"), "{err}");
+    rejects(&on_axes, "empty.csv", "", &["empty.csv:1:"]);
 
     let err = fails(&["path", g, "--axes", s(&dir.join("absent.csv"))]);
     assert!(err.contains("absent.csv"), "{err}");
 
     // Poses: header, zero axis.
     let b = bevel();
-    let bad = write(&dir, "pose_header.csv", "x,y,z,i,j,k\n1,2,3,0,0,1\n");
-    let err = fails(&["path", s(&b), "--pose", s(&bad), "--fix", "mu=0"]);
-    assert!(
-        err.contains("pose_header.csv:1:") && err.contains("px,py,pz,i,j,k"),
-        "{err}"
+    let on_poses = ["path", s(&b), "--fix", "mu=0", "--pose"];
+    rejects(
+        &on_poses,
+        "pose_header.csv",
+        "x,y,z,i,j,k\n1,2,3,0,0,1\n",
+        &["pose_header.csv:1:", "px,py,pz,i,j,k"],
     );
-    let bad = write(
-        &dir,
+    rejects(
+        &on_poses,
         "pose_zero.csv",
         "px,py,pz,i,j,k\n1,2,3,0,0,1\n1,2,3,0,0,0\n",
-    );
-    let err = fails(&["path", s(&b), "--pose", s(&bad), "--fix", "mu=0"]);
-    assert!(
-        err.contains("pose_zero.csv:3:") && err.contains("zero"),
-        "{err}"
+        &["pose_zero.csv:3:", "zero"],
     );
 
     // Neither or both inputs.
@@ -701,7 +604,7 @@ fn bad_input_is_a_clear_error_naming_file_and_line() {
     fails(&["path", g, "--axes", s(&both), "--pose", s(&both)]);
 
     // A machine without a reliability section, or without statistics.
-    let plain = root().join("examples/machines/cnc5_bevel.yaml");
+    let plain = example_path("cnc5_bevel.yaml");
     let err = fails(&[
         "path",
         s(&plain),
@@ -723,22 +626,12 @@ fn bad_input_is_a_clear_error_naming_file_and_line() {
 #[test]
 fn plot_writes_reliability_and_std_charts() {
     let dir = scratch("plot");
-    let out = chain(&[
-        "path",
-        s(&bevel()),
-        "--axes",
-        s(&example("cnc5_bevel_axes.csv")),
-        "--format",
-        "json",
-        "--plot",
-        s(&dir),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    // Only the JSON document on stdout.
+    path_json(
+        &bevel(),
+        &example("cnc5_bevel_axes.csv"),
+        &["--plot", s(&dir)],
     );
-    serde_json::from_slice::<Value>(&out.stdout).expect("only JSON on stdout");
     for stem in ["path_reliability", "path_std"] {
         for ext in ["png", "svg"] {
             let p = dir.join(format!("{stem}.{ext}"));
@@ -754,16 +647,7 @@ fn plot_writes_reliability_and_std_charts() {
 fn moments_follow_the_sensitivity_rows() {
     // std(px) at an instant is √(Σ_j S_pxj² σ_j²) of the model's exact
     // sensitivities (an independent evaluation of the same formula).
-    let file = bevel();
-    let (m, model) = load(&file);
-    let doc = ok_json(&[
-        "path",
-        s(&file),
-        "--axes",
-        s(&example("cnc5_bevel_axes.csv")),
-        "--format",
-        "json",
-    ]);
+    let (m, model, doc) = bevel_along_its_axes();
     let inputs = machine::inputs(&m).unwrap();
     let params = machine::parameters(&m, &[]).unwrap();
     let vars: Vec<&str> = model.variables().to_vec();
@@ -795,42 +679,20 @@ fn moments_follow_the_sensitivity_rows() {
 fn chain_motion_csv_feeds_chain_path_directly() {
     // The bridge of issue 8: the converted bevel-gear motion (`chain motion
     // --format csv`, header `t,<variables>`) read by `chain path --axes -`.
-    let motion = chain(&[
+    let text = ok_stdout(&[
         "motion",
-        s(&root().join("examples/machines/cnc5_bevel.yaml")),
+        s(&example_path("cnc5_bevel.yaml")),
         "--settings",
-        s(&root().join("examples/settings/seed002_concave.yaml")),
+        s(&example_file("settings/seed002_concave.yaml")),
         "--format",
         "csv",
         "--samples",
         "5",
     ]);
-    assert!(
-        motion.status.success(),
-        "{}",
-        String::from_utf8_lossy(&motion.stderr)
-    );
-    let text = String::from_utf8(motion.stdout).unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_chain"))
-        .args(["path", s(&bevel()), "--axes", "-", "--format", "json"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(text.as_bytes())
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let doc = success_json(chain_stdin(
+        &["path", s(&bevel()), "--axes", "-", "--format", "json"],
+        text.as_bytes(),
+    ));
     let lines: Vec<&str> = text.lines().collect();
     let header: Vec<&str> = lines[0].split(',').collect();
     let instants = doc["instants"].as_array().unwrap();

@@ -2,48 +2,30 @@
 //! gantry grinder of seed 000 (the CLI + JSON contract of
 //! shared/spec/machine-format.md, section 3).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
+use std::path::{Path, PathBuf};
+
+use common::cli::{chain, fails, ok, ok_json, ok_stdout, scratch};
+use common::example_path;
 use serde_json::Value;
 
 fn gantry() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/machines/gantry_grinder.yaml")
+    example_path("gantry_grinder.yaml")
 }
 
-fn chain(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_chain"))
-        .args(args)
-        .output()
-        .expect("run chain")
-}
-
-fn ok_json(args: &[&str]) -> Value {
-    let out = chain(args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    // Nothing but the JSON document on stdout.
-    serde_json::from_slice(&out.stdout).expect("stdout is one JSON document")
-}
-
-/// A scratch directory unique to this test process and name.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "chain-reliability-cli-{}-{name}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    dir
+/// `chain <command> <gantry> --format json` with `extra`, which must succeed;
+/// returns the document.
+fn gantry_json(command: &str, extra: &[&str]) -> Value {
+    let file = gantry();
+    let mut args = vec![command, file.to_str().unwrap(), "--format", "json"];
+    args.extend_from_slice(extra);
+    ok_json(&args)
 }
 
 #[test]
 fn form_json_follows_the_contract_and_table_2() {
-    let file = gantry();
-    let doc = ok_json(&["reliability", file.to_str().unwrap(), "--format", "json"]);
+    let doc = gantry_json("reliability", &[]);
     assert_eq!(doc["machine"], "gantry_grinder");
     assert_eq!(doc["method"], "form");
     let results = doc["results"].as_array().expect("results");
@@ -82,9 +64,8 @@ fn sampling_methods_add_std_error_and_samples_and_are_reproducible() {
         "--format",
         "json",
     ];
-    let a = chain(&args);
+    let a = ok(&args);
     let b = chain(&args);
-    assert!(a.status.success());
     assert_eq!(a.stdout, b.stdout, "same seed, same output");
     let doc: Value = serde_json::from_slice(&a.stdout).unwrap();
     assert_eq!(doc["method"], "mc");
@@ -98,16 +79,7 @@ fn sampling_methods_add_std_error_and_samples_and_are_reproducible() {
         String::from_utf8_lossy(&a.stderr)
     );
 
-    let doc = ok_json(&[
-        "reliability",
-        file.to_str().unwrap(),
-        "--method",
-        "is",
-        "--samples",
-        "500",
-        "--format",
-        "json",
-    ]);
+    let doc = gantry_json("reliability", &["--method", "is", "--samples", "500"]);
     assert_eq!(doc["method"], "is");
     // Linear limit state in normal inputs: zero variance (Eq. 28 with h = β).
     for r in doc["results"].as_array().unwrap() {
@@ -119,17 +91,13 @@ fn sampling_methods_add_std_error_and_samples_and_are_reproducible() {
 #[test]
 fn csv_and_table_formats() {
     let file = gantry();
-    let out = chain(&["reliability", file.to_str().unwrap(), "--format", "csv"]);
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = ok_stdout(&["reliability", file.to_str().unwrap(), "--format", "csv"]);
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some("component,x,y,z,reliability,pf,beta"));
     assert_eq!(lines.count(), 375);
     assert!(text.contains("\npx,0,-1500,600,0.88729"));
 
-    let out = chain(&["reliability", file.to_str().unwrap()]);
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = ok_stdout(&["reliability", file.to_str().unwrap()]);
     // The maps of Tables 2-4 and the summary lines.
     assert!(text.contains("px: reliability (%) over (y, z)"));
     assert!(text.contains("88.73"));
@@ -140,26 +108,25 @@ fn csv_and_table_formats() {
 #[test]
 fn system_targets_and_overrides() {
     let file = gantry();
-    let doc = ok_json(&[
+    let doc = gantry_json(
         "reliability",
-        file.to_str().unwrap(),
-        "--method",
-        "is",
-        "--samples",
-        "2000",
-        "--system",
-        "volumetric",
-        "--system-tolerance",
-        "0.05",
-        "--grid",
-        "x=1000",
-        "--grid",
-        "y=1500",
-        "--grid",
-        "z=1400",
-        "--format",
-        "json",
-    ]);
+        &[
+            "--method",
+            "is",
+            "--samples",
+            "2000",
+            "--system",
+            "volumetric",
+            "--system-tolerance",
+            "0.05",
+            "--grid",
+            "x=1000",
+            "--grid",
+            "y=1500",
+            "--grid",
+            "z=1400",
+        ],
+    );
     let results = doc["results"].as_array().unwrap();
     assert_eq!(results.len(), 4);
     let vol = &results[3];
@@ -170,7 +137,7 @@ fn system_targets_and_overrides() {
     let se = vol["std_error"].as_f64().unwrap();
     assert!((pf - 0.2069).abs() < 4.0 * se + 2e-4, "{pf} ± {se}");
 
-    let out = chain(&[
+    let out = ok(&[
         "reliability",
         file.to_str().unwrap(),
         "--sided",
@@ -178,7 +145,6 @@ fn system_targets_and_overrides() {
         "--format",
         "json",
     ]);
-    assert!(out.status.success());
     // FORM is not exact for two-sided tolerances: a note on stderr, not stdout.
     assert!(String::from_utf8_lossy(&out.stderr).contains("first-order approximation"));
     let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
@@ -215,19 +181,15 @@ fn clear_errors_name_the_file_and_the_missing_key() {
     ];
     for (file, key, more) in cases {
         for cmd in ["reliability", "sensitivity"] {
-            let out = chain(&[cmd, file.to_str().unwrap(), "--format", "json"]);
-            assert!(!out.status.success(), "{cmd} {}", file.display());
-            assert!(out.stdout.is_empty(), "nothing on stdout");
-            let err = String::from_utf8_lossy(&out.stderr);
+            let err = fails(&[cmd, file.to_str().unwrap(), "--format", "json"]);
             assert!(err.contains(key), "{cmd}: {err}");
             for m in more {
                 assert!(err.contains(m), "{cmd}: {err}");
             }
-            assert!(!err.contains("panicked"), "{err}");
         }
     }
     // With a value the symbolic machine runs.
-    let out = chain(&[
+    ok(&[
         "reliability",
         symbolic.to_str().unwrap(),
         "--param",
@@ -235,11 +197,6 @@ fn clear_errors_name_the_file_and_the_missing_key() {
         "--format",
         "json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     // Bad command-line values are errors, not panics.
     for args in [
         vec!["reliability", "--grid", "x=a,b"],
@@ -249,9 +206,7 @@ fn clear_errors_name_the_file_and_the_missing_key() {
     ] {
         let mut full = vec![args[0], file_str(&gantry())];
         full.extend_from_slice(&args[1..]);
-        let out = chain(&full);
-        assert!(!out.status.success(), "{full:?}");
-        assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+        fails(&full);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -263,20 +218,8 @@ fn file_str(p: &Path) -> &'static str {
 #[test]
 fn plots_are_valid_non_trivial_png_and_svg() {
     let dir = scratch("plots");
-    let out = chain(&[
-        "reliability",
-        file_str(&gantry()),
-        "--plot",
-        dir.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice::<Value>(&out.stdout).expect("JSON only on stdout");
+    // JSON only on stdout.
+    gantry_json("reliability", &["--plot", dir.to_str().unwrap()]);
     for stem in [
         "reliability_px",
         "reliability_py",
@@ -323,7 +266,7 @@ fn plots_are_valid_non_trivial_png_and_svg() {
 #[test]
 fn sensitivity_json_is_sorted_and_finds_figures_6_to_8() {
     let file = gantry();
-    let doc = ok_json(&["sensitivity", file.to_str().unwrap(), "--format", "json"]);
+    let doc = gantry_json("sensitivity", &[]);
     assert_eq!(doc["machine"], "gantry_grinder");
     assert!(doc["at"].is_null());
     // Figure 6 (x-direction): eyx, ezx, ezz, Sxy are the sensitive errors.
@@ -343,14 +286,7 @@ fn sensitivity_json_is_sorted_and_finds_figures_6_to_8() {
     let imp: f64 = px.iter().map(|e| e["importance"].as_f64().unwrap()).sum();
     assert!((imp - 1.0).abs() < 1e-9);
 
-    let doc = ok_json(&[
-        "sensitivity",
-        file.to_str().unwrap(),
-        "--at",
-        "x=0,y=1500,z=600",
-        "--format",
-        "json",
-    ]);
+    let doc = gantry_json("sensitivity", &["--at", "x=0,y=1500,z=600"]);
     assert_eq!(doc["at"]["y"], 1500.0);
     let px = doc["components"]["px"].as_array().unwrap();
     // At (y, z) = (1500, 600): ∂R/∂σ = −φ(β)·β·S²σ/σ_E² (Eq. 32-33); the
@@ -358,8 +294,6 @@ fn sensitivity_json_is_sorted_and_finds_figures_6_to_8() {
     assert_eq!(px[0]["error"], "Sxy");
     assert!(px[0]["dr_dstd"].as_f64().unwrap() < 0.0);
 
-    let out = chain(&["sensitivity", file.to_str().unwrap()]);
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = ok_stdout(&["sensitivity", file.to_str().unwrap()]);
     assert!(text.contains("px (exact), sorted by |dR/dstd|"));
 }

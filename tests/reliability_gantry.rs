@@ -6,18 +6,19 @@
 //! squareness tolerance/3 over 1000 mm), as `examples/machines/gantry_grinder.yaml`
 //! records.
 
-use std::path::Path;
+mod common;
 
 use chain_core::model::{Component, Machine, Sided};
 use chain_core::CompiledModel;
+use common::example_path;
 use reliability::{
     machine, normal, sensitivity, Criterion, Event, Form, ImportanceSampling, Inputs, MonteCarlo,
     SensitivityMethod, Study, System, Target, ToleranceLimitState,
 };
 
 fn gantry() -> (Machine, CompiledModel) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/machines/gantry_grinder.yaml");
-    let machine = chain_core::load_file(&path).expect("gantry_grinder.yaml loads");
+    let machine = chain_core::load_file(&example_path("gantry_grinder.yaml"))
+        .expect("gantry_grinder.yaml loads");
     let model = chain_core::compile(&machine);
     (machine, model)
 }

@@ -27,7 +27,6 @@ mod common;
 
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
 use chain_core::inverse::wrap;
 use chain_core::jet::Jet;
@@ -36,16 +35,11 @@ use chain_core::motion::{
     required_orders, truncation_errors, Law, Matching, Motion, MotionError, MotionSpec,
 };
 use chain_core::settings::{load_settings_file, load_settings_str, Settings};
-use common::{close, example_path, load_example, Exact, Rng};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
+use common::cli::{fails, ok_json, ok_stdout, scratch, unwrapped};
+use common::{close, example_file, example_path, load_example, Exact, Rng};
 
 fn settings_path(name: &str) -> PathBuf {
-    root()
-        .join("examples/settings")
-        .join(format!("{name}.yaml"))
+    example_file("settings").join(format!("{name}.yaml"))
 }
 
 /// Settings, generator, CNC machine and the bound specification.
@@ -856,7 +850,7 @@ fn any_pair_of_machines_the_cradle_on_a_table_tilting_trunnion() {
 // Bad settings files
 
 fn first_error(text: &str, generator: &Machine, cnc: &Machine) -> (usize, String, String) {
-    let base = root().join("examples/settings");
+    let base = example_file("settings");
     let err = match load_settings_str(text, "bad.yaml", &base) {
         Err(e) => e,
         Ok(s) => match s.bind(generator, cnc, &[]) {
@@ -875,7 +869,7 @@ fn bad_settings_are_reported_with_line_and_key() {
     let cnc = load_example("cnc5_bevel.yaml");
     let line_of = |needle: &str| good.lines().position(|l| l.contains(needle)).unwrap() + 1;
     // The file itself is accepted.
-    let ok = load_settings_str(&good, "good.yaml", &root().join("examples/settings")).unwrap();
+    let ok = load_settings_str(&good, "good.yaml", &example_file("settings")).unwrap();
     ok.bind(&generator, &cnc, &[]).unwrap();
     let cases: Vec<(String, usize, &str, &str)> = vec![
         (
@@ -968,20 +962,6 @@ fn bad_settings_are_reported_with_line_and_key() {
 // ---------------------------------------------------------------------------
 // The CLI
 
-fn chain(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_chain"))
-        .args(args)
-        .output()
-        .expect("run chain")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("chain-motion-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 fn cnc_file() -> String {
     example_path("cnc5_bevel.yaml").display().to_string()
 }
@@ -989,7 +969,7 @@ fn cnc_file() -> String {
 #[test]
 fn cli_csv_is_the_exact_motion_in_model_order() {
     let settings = settings_path("seed002_concave").display().to_string();
-    let out = chain(&[
+    let text = ok_stdout(&[
         "motion",
         &cnc_file(),
         "--settings",
@@ -997,12 +977,6 @@ fn cli_csv_is_the_exact_motion_in_model_order() {
         "--format",
         "csv",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some("t,x,y,mu,z,B,A"));
     let rows: Vec<Vec<f64>> = lines
@@ -1024,7 +998,7 @@ fn cli_csv_is_the_exact_motion_in_model_order() {
 fn cli_json_document_and_plots() {
     let dir = scratch("plots");
     let settings = settings_path("seed002_convex").display().to_string();
-    let out = chain(&[
+    let doc = ok_json(&[
         "motion",
         &cnc_file(),
         "--settings",
@@ -1042,12 +1016,6 @@ fn cli_json_document_and_plots() {
         "--plot",
         dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON document");
     assert_eq!(doc["machine"], "cnc5_bevel");
     assert_eq!(doc["generator"], "cradle_generator");
     assert_eq!(doc["settings"], "seed002_convex");
@@ -1101,7 +1069,7 @@ fn cli_json_document_and_plots() {
 #[test]
 fn cli_table_and_errors() {
     let settings = settings_path("seed002_concave").display().to_string();
-    let out = chain(&[
+    let text = ok_stdout(&[
         "motion",
         &cnc_file(),
         "--settings",
@@ -1115,12 +1083,6 @@ fn cli_table_and_errors() {
         "--fix",
         "mu=0",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("match: point_axis"), "{text}");
     assert!(text.contains("CNC variables held: mu = 0"), "{text}");
     assert!(text.contains("Maclaurin coefficients"), "{text}");
@@ -1138,10 +1100,13 @@ fn cli_table_and_errors() {
         .replace("  X_1: -7.98", "  X_11: -7.98");
     let file = dir.join("bad.yaml");
     std::fs::write(&file, &bad).unwrap();
-    let out = chain(&["motion", &cnc_file(), "--settings", file.to_str().unwrap()]);
-    assert!(!out.status.success());
-    assert!(out.stdout.is_empty());
-    let err = String::from_utf8_lossy(&out.stderr);
+    // miette wraps long messages: compare with the frame and line breaks removed.
+    let err = unwrapped(&fails(&[
+        "motion",
+        &cnc_file(),
+        "--settings",
+        file.to_str().unwrap(),
+    ]));
     let line = bad.lines().position(|l| l.contains("X_11:")).unwrap() + 1;
     assert!(err.contains(&format!("bad.yaml:{line}:3")), "{err}");
     assert!(
@@ -1154,9 +1119,12 @@ fn cli_table_and_errors() {
         good.replace("../machines/cradle_generator.yaml", "nowhere.yaml"),
     )
     .unwrap();
-    let out = chain(&["motion", &cnc_file(), "--settings", file.to_str().unwrap()]);
-    assert!(!out.status.success() && out.stdout.is_empty());
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = unwrapped(&fails(&[
+        "motion",
+        &cnc_file(),
+        "--settings",
+        file.to_str().unwrap(),
+    ]));
     assert!(
         err.contains("cannot read the generator file") && err.contains("`generator`"),
         "{err}"
@@ -1171,8 +1139,7 @@ fn cli_table_and_errors() {
     ] {
         let mut all = vec!["motion", cnc.as_str(), "--settings", settings.as_str()];
         all.extend(args);
-        let out = chain(&all);
-        assert!(!out.status.success() && out.stdout.is_empty(), "{args:?}");
+        fails(&all);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

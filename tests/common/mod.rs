@@ -22,8 +22,14 @@
 //! `machine.variables`, `p` like `machine.parameters`, `e` like
 //! `machine.errors`. The model under test has its own name lists; the helpers
 //! [`by_names`] and [`Exact::model_sensitivity`] translate by name.
+//!
+//! Shared by the other tests too: [`root`], [`example_file`] and
+//! [`example_path`] locate the example files, and the submodule [`cli`] runs
+//! the `chain` binary and makes the scratch files it is given.
 // Matrix code reads best with explicit indices.
 #![allow(dead_code, clippy::needless_range_loop)]
+
+pub mod cli;
 
 use chain_core::model::{ErrorSlots, Frame, JointKind, Machine};
 use chain_core::ErrorModel;
@@ -573,12 +579,19 @@ pub fn erfc(x: f64) -> f64 {
     }
 }
 
+/// The package root (`CARGO_MANIFEST_DIR`).
+pub fn root() -> &'static std::path::Path {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Path of an example file, `examples/<path>` (e.g. `paths/gantry_path.csv`).
+pub fn example_file(path: &str) -> std::path::PathBuf {
+    root().join("examples").join(path)
+}
+
 /// Path of an example machine file, `examples/machines/<file>`.
 pub fn example_path(file: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("examples")
-        .join("machines")
-        .join(file)
+    example_file("machines").join(file)
 }
 
 /// Loads an example machine file, panicking with the rendered diagnostics.
