@@ -164,6 +164,36 @@ fn cli_reads_full_rotations() {
             .zip([120.0, -40.0, 60.0, 1.1, 0.3, -0.8])
             .all(|(k, want)| (s[*k].as_f64().unwrap() - want).abs() < 1e-8)
     }));
+    // The same pose written with 8 decimals (as CAM output often is): the
+    // row is orthonormal only to ~1e-8, is replaced by the nearest rotation,
+    // and solves to the generating values within that rounding.
+    let short: Vec<String> = pose
+        .position
+        .iter()
+        .chain(r.iter().flatten())
+        .map(|v| format!("{v:.8}"))
+        .collect();
+    let csv = scratch_file(
+        "rotation_8_digits.csv",
+        &format!(
+            "px,py,pz,r11,r12,r13,r21,r22,r23,r31,r32,r33\n{}\n",
+            short.join(",")
+        ),
+    );
+    let doc = ok_json(&[
+        "inverse",
+        file.to_str().unwrap(),
+        "--pose",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(doc["rows"][0]["status"], "ok");
+    let sols = doc["rows"][0]["solutions"].as_array().unwrap();
+    assert!(sols.iter().any(|s| {
+        ["x", "y", "z", "mu", "B", "A"]
+            .iter()
+            .zip([120.0, -40.0, 60.0, 1.1, 0.3, -0.8])
+            .all(|(k, want)| (s[*k].as_f64().unwrap() - want).abs() < 1e-5)
+    }));
     // A row that is not a rotation is refused with its line.
     let bad = scratch_file(
         "not_rotation.csv",
@@ -177,4 +207,47 @@ fn cli_reads_full_rotations() {
     ]));
     assert!(err.contains("not_rotation.csv:3"), "{err}");
     assert!(err.contains("is not a rotation"), "{err}");
+}
+
+#[test]
+fn an_idle_spin_is_held_whatever_else_is_fixed() {
+    // cnc5_bevel with B fixed: A and the three slides remain, and the cutter
+    // spin mu (which moves neither the point nor the axis) is held at 0 — not
+    // taken for a second rotary axis, which would make every row singular.
+    let (m, kin, params) = load("cnc5_bevel");
+    let index = |name: &str| m.variables.iter().position(|v| v.name == name).unwrap();
+    let (b, mu) = (index("B"), index("mu"));
+    let inverse = Inverse::for_machine(&m, &params, &[(b, 0.3)]).expect("solver");
+    let mut q = vec![0.0; m.variables.len()];
+    for (name, value) in [
+        ("x", 10.0),
+        ("y", 20.0),
+        ("z", 30.0),
+        ("B", 0.3),
+        ("A", 0.5),
+    ] {
+        q[index(name)] = value;
+    }
+    let pose = kin.pose(&q, &params);
+    let axis = [
+        pose.rotation[0][2],
+        pose.rotation[1][2],
+        pose.rotation[2][2],
+    ];
+    let mut prev = vec![0.0; q.len()];
+    prev[b] = 0.3;
+    let s = inverse.solve(pose.position, axis, &prev);
+    assert_eq!(s.status, Status::Ok);
+    for sol in &s.solutions {
+        assert_eq!(sol[mu], 0.0);
+        assert_eq!(sol[b], 0.3);
+        let back = kin.pose(sol, &params);
+        for i in 0..3 {
+            assert!((back.position[i] - pose.position[i]).abs() < 1e-9);
+        }
+    }
+    assert!(s
+        .solutions
+        .iter()
+        .any(|sol| (sol[index("A")] - 0.5).abs() < 1e-9));
 }

@@ -541,7 +541,10 @@ impl Motion {
                 break;
             }
         }
-        let ok = self.accepted(&r, scale);
+        // The point-and-axis residual also vanishes for the reversed axis
+        // (z_C = −z_G): accept only a tool axis on the target's side.
+        let z = col(&self.cnc_pose(&q).rotation, 2);
+        let ok = self.accepted(&r, scale) && dot(z, col(&target.rotation, 2)) > 0.0;
         (q, ok)
     }
 

@@ -112,7 +112,8 @@ const ROTATION_HEADER: [&str; 12] = [
 
 /// Reads a pose CSV: header `px,py,pz,i,j,k` (tool point and tool axis) or
 /// `px,py,pz,r11,…,r33` (tool point and the tool frame's rotation,
-/// row-major), optionally after a first column `t`. Returns whether `t` was
+/// row-major; refused unless orthonormal to 1e-6 with det +1, then replaced
+/// by the nearest rotation), optionally after a first column `t`. Returns whether `t` was
 /// given, and the rows.
 pub(crate) fn read_poses(path: &Path) -> miette::Result<(bool, Vec<PoseRow>)> {
     let mut input = open_csv(path)?;
@@ -151,7 +152,15 @@ pub(crate) fn read_poses(path: &Path) -> miette::Result<(bool, Vec<PoseRow>)> {
                         "{name}:{line}: r11..r33 is not a rotation (|RᵀR − I| = {worst:.1e}, det = {det:.6})"
                     );
                 }
-                Orientation::Rotation(r)
+                // The nearest rotation (polar factor U Vᵀ): rows written with
+                // a few digits are orthonormal only to their rounding.
+                let m = nalgebra::Matrix3::from_fn(|i, j| r[i][j]);
+                let svd = m.svd(true, true);
+                let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+                    miette::bail!("{name}:{line}: r11..r33 is not a rotation");
+                };
+                let p = u * v_t;
+                Orientation::Rotation(std::array::from_fn(|i| std::array::from_fn(|j| p[(i, j)])))
             } else {
                 let axis = [v[3], v[4], v[5]];
                 if (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt() < 1e-12 {

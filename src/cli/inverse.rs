@@ -1,23 +1,25 @@
 //! `chain inverse FILE --pose POSE.csv [--fix mu=0] [--param NAME=VALUE] [--format json|csv]`.
 //!
 //! Inverse kinematics of every pose of a CSV (`px,py,pz,i,j,k`: tool point and
-//! tool axis in the workpiece frame), printed as the spec's JSON document.
+//! tool axis in the workpiece frame; or `px,py,pz,r11,…,r33`: tool point and
+//! the whole tool frame), printed as the spec's JSON document.
 
 use std::path::PathBuf;
 
-use chain_core::inverse::{Inverse, Status};
+use chain_core::inverse::{Inverse, Solution, Status};
 use serde_json::{json, Map, Value};
 
-use super::csv_input::{read_poses, Orientation};
-use super::reliability::{parse_assignment, write_stdout, Loaded};
+use super::csv_input::{read_poses, Orientation, PoseRow};
+use super::reliability::{parse_assignment, resolve_fixed, write_stdout, Loaded};
 
 /// Arguments of `chain inverse`.
 #[derive(Debug, clap::Args)]
 pub struct InverseArgs {
     /// Machine file (YAML).
     pub file: PathBuf,
-    /// Poses, CSV with header `px,py,pz,i,j,k` (optionally after a first
-    /// column `t`, which is ignored); `-` reads stdin.
+    /// Poses, CSV with header `px,py,pz,i,j,k` (tool point and axis) or
+    /// `px,py,pz,r11,r12,r13,r21,r22,r23,r31,r32,r33` (tool point and frame),
+    /// optionally after a first column `t`, which is ignored; `-` reads stdin.
     #[arg(long, value_name = "POSE.csv")]
     pub pose: PathBuf,
     /// Hold a variable the pose does not determine, `NAME=VALUE` (repeatable).
@@ -46,37 +48,11 @@ pub enum InverseFormat {
 pub fn exec(args: InverseArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
-    let mut params = Vec::with_capacity(m.parameters.len());
-    for p in &m.parameters {
-        let cli = args.params.iter().rev().find(|(n, _)| *n == p.name);
-        match cli.map(|c| c.1).or(p.value) {
-            Some(v) => params.push(v),
-            None => miette::bail!(
-                "parameter `{}` has no value; give --param {}=VALUE",
-                p.name,
-                p.name
-            ),
-        }
-    }
-    for (n, _) in &args.params {
-        if !m.parameters.iter().any(|p| p.name == *n) {
-            miette::bail!("`{n}` is not a parameter of machine `{}`", m.name);
-        }
-    }
-    let mut fixed = Vec::new();
-    for (n, v) in &args.fix {
-        let Some(i) = m.variables.iter().position(|x| x.name == *n) else {
-            miette::bail!("--fix: `{n}` is not a variable of machine `{}`", m.name);
-        };
-        fixed.push((i, *v));
-    }
+    let params = reliability::machine::parameters(m, &args.params).map_err(|e| loaded.report(e))?;
+    let fixed = resolve_fixed(m, &args.fix)?;
     let (_, poses) = read_poses(&args.pose)?;
     let solver = Inverse::for_machine(m, &params, &fixed)
         .map_err(|e| miette::miette!("machine `{}`: {e}", m.name))?;
-    let mut prev = vec![0.0; m.variables.len()];
-    for &(i, v) in &fixed {
-        prev[i] = v;
-    }
     let mut rows = Vec::with_capacity(poses.len());
     let mut csv_text = String::from("row,status,solution");
     for v in &m.variables {
@@ -84,14 +60,10 @@ pub fn exec(args: InverseArgs) -> miette::Result<()> {
         csv_text.push_str(&v.name);
     }
     csv_text.push('\n');
-    for (k, pose) in poses.iter().enumerate() {
-        let s = match pose.orientation {
-            Orientation::Axis(axis) => solver.solve(pose.point, axis, &prev),
-            Orientation::Rotation(r) => solver.solve_pose(pose.point, &r, &prev),
-        };
-        if let Some(first) = s.solutions.first() {
-            prev.clone_from(first);
-        }
+    for (k, s) in solve_rows(&solver, &poses, m.variables.len(), &fixed)
+        .into_iter()
+        .enumerate()
+    {
         let sols: Vec<Value> = s
             .solutions
             .iter()
@@ -135,4 +107,33 @@ pub fn exec(args: InverseArgs) -> miette::Result<()> {
         .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
     text.push('\n');
     write_stdout(&text)
+}
+
+/// Solves the pose rows in order, each row's solutions sorted by their
+/// distance to the previous row's first solution (the first row: to the
+/// fixed values, 0 elsewhere), so a smooth path stays on one branch.
+pub(crate) fn solve_rows(
+    solver: &Inverse,
+    rows: &[PoseRow],
+    variables: usize,
+    fixed: &[(usize, f64)],
+) -> Vec<Solution> {
+    let mut prev = vec![0.0; variables];
+    for &(i, v) in fixed {
+        if let Some(p) = prev.get_mut(i) {
+            *p = v;
+        }
+    }
+    rows.iter()
+        .map(|row| {
+            let s = match row.orientation {
+                Orientation::Axis(axis) => solver.solve(row.point, axis, &prev),
+                Orientation::Rotation(r) => solver.solve_pose(row.point, &r, &prev),
+            };
+            if let Some(first) = s.solutions.first() {
+                prev.clone_from(first);
+            }
+            s
+        })
+        .collect()
 }

@@ -18,10 +18,11 @@ use chain_core::motion::{self, Matching, Motion, PoseError, Series};
 use chain_core::settings;
 use serde_json::{json, Map, Value};
 
-use super::reliability::{parse_assignment, write_stdout};
+use super::reliability::{parse_assignment, resolve_fixed, write_stdout};
 
-/// Highest order accepted for `--order` and `--max-order`.
-pub const MAX_ORDER: usize = 200;
+/// Highest order accepted for `--order` and `--max-order`: the JSON lists
+/// the derivatives `k!·a_k`, and 171! overflows `f64`.
+pub const MAX_ORDER: usize = 170;
 /// Most instants accepted for `--samples`.
 pub const MAX_SAMPLES: usize = 1_000_000;
 
@@ -110,15 +111,9 @@ pub fn exec(args: MotionArgs) -> miette::Result<()> {
     if !args.fix.is_empty() {
         spec.matching = Matching::PointAxis;
         spec.fixed.clear();
-        for (name, v) in &args.fix {
-            let Some(i) = cnc.variables.iter().position(|x| x.name == *name) else {
-                miette::bail!(
-                    "--fix: `{name}` is not a variable of machine `{}`",
-                    cnc.name
-                );
-            };
-            spec.fixed.push((i, *v));
-            spec.start[i] = *v;
+        for (i, v) in resolve_fixed(&cnc, &args.fix)? {
+            spec.fixed.push((i, v));
+            spec.start[i] = v;
         }
     }
     let cnc_parameters: Vec<(String, f64)> = cnc

@@ -26,10 +26,11 @@ use reliability::{
 };
 use serde_json::{json, Map, Value};
 
-use super::csv_input::{numeric_rows, open_csv, read_poses, Orientation};
+use super::csv_input::{numeric_rows, open_csv, read_poses};
+use super::inverse::solve_rows;
 use super::reliability::{
-    note_form_limits, parse_assignment, requirement_text, system_of, write_stdout, Loaded,
-    MethodArg, SidedArg, SystemArg,
+    note_form_limits, parse_assignment, requirement_text, resolve_fixed, system_of, write_stdout,
+    Loaded, MethodArg, SidedArg, SystemArg,
 };
 
 /// Output formats of `chain path`.
@@ -54,8 +55,9 @@ pub struct PathArgs {
     /// column `t`; `-` reads stdin.
     #[arg(long, value_name = "AXES.csv")]
     pub axes: Option<PathBuf>,
-    /// Tool poses along the path: CSV with header `px,py,pz,i,j,k` (optional
-    /// leading `t`), solved by the inverse kinematics; `-` reads stdin.
+    /// Tool poses along the path: CSV with header `px,py,pz,i,j,k` or
+    /// `px,py,pz,r11,…,r33` (optional leading `t`), solved by the inverse
+    /// kinematics; `-` reads stdin.
     #[arg(long, value_name = "POSE.csv")]
     pub pose: Option<PathBuf>,
     /// Hold a variable at a value, `NAME=VALUE` (repeatable): a variable
@@ -321,28 +323,6 @@ fn tolerance_of(study: &Study, target: &str) -> Option<f64> {
     }
 }
 
-/// `--fix` names resolved to variable indices.
-fn resolve_fixed(m: &Machine, fix: &[(String, f64)]) -> miette::Result<Vec<(usize, f64)>> {
-    let mut out: Vec<(usize, f64)> = Vec::new();
-    for (name, v) in fix {
-        let Some(i) = m.variable_index(name) else {
-            let hint =
-                chain_core::diagnostic::closest(name, m.variables.iter().map(|v| v.name.as_str()))
-                    .map(|h| format!(" (did you mean `{h}`?)"))
-                    .unwrap_or_default();
-            miette::bail!(
-                "--fix: `{name}` is not an axis variable of machine `{}`{hint}",
-                m.name
-            );
-        };
-        match out.iter_mut().find(|(j, _)| *j == i) {
-            Some(slot) => slot.1 = *v,
-            None => out.push((i, *v)),
-        }
-    }
-    Ok(out)
-}
-
 // ---------------------------------------------------------------------------
 // Input.
 
@@ -452,27 +432,17 @@ fn pose_instants(
     let (has_t, rows) = read_poses(path)?;
     let solver = Inverse::for_machine(m, params, fixed)
         .map_err(|e| miette::miette!("machine `{}`: {e}", m.name))?;
-    let mut prev = vec![0.0; m.variables.len()];
-    for &(i, v) in fixed {
-        prev[i] = v;
-    }
-    let mut instants = Vec::with_capacity(rows.len());
-    for (k, row) in rows.into_iter().enumerate() {
-        let s = match row.orientation {
-            Orientation::Axis(axis) => solver.solve(row.point, axis, &prev),
-            Orientation::Rotation(r) => solver.solve_pose(row.point, &r, &prev),
-        };
-        let q = s.solutions.first().cloned();
-        if let Some(first) = &q {
-            prev.clone_from(first);
-        }
-        instants.push(Instant {
+    let instants = solve_rows(&solver, &rows, m.variables.len(), fixed)
+        .into_iter()
+        .zip(&rows)
+        .enumerate()
+        .map(|(k, (s, row))| Instant {
             row: k + 1,
             t: row.t.unwrap_or((k + 1) as f64),
             status: s.status,
-            q,
-        });
-    }
+            q: s.solutions.into_iter().next(),
+        })
+        .collect();
     Ok((has_t, instants))
 }
 

@@ -33,7 +33,6 @@ pub use newton::NewtonSolver;
 
 use crate::kinematics::{Kinematics, NominalPose};
 use crate::model::{JointKind, Machine};
-use crate::CompiledModel;
 
 use crate::geometry::{
     col, cross, det, dot, log_so3, mat_vec, mul, mul_t_vec, norm, quarter_axis, rodrigues,
@@ -55,6 +54,14 @@ pub enum InverseError {
     /// on a prismatic variable.
     #[error("the tool orientation of this machine is not a product of two fixed-axis rotations independent of the linear axes; the closed-form solver does not apply")]
     NotClosedForm,
+    /// A held variable's index is not a variable of the machine.
+    #[error("variable index {index} is out of range (the machine has {count} variables)")]
+    UnknownVariable {
+        /// The index given.
+        index: usize,
+        /// The number of variables.
+        count: usize,
+    },
     /// No free variable moves the tool.
     #[error("no free axis variable moves the tool point or the tool axis")]
     NoFreeVariable,
@@ -114,27 +121,23 @@ impl Inverse {
         params: &[f64],
         fixed: &[(usize, f64)],
     ) -> Result<Inverse, InverseError> {
-        let symbolic = crate::derive(machine);
-        let model = CompiledModel::new(&symbolic);
-        let kinematics = Kinematics::new(&symbolic);
+        let kinematics = Kinematics::from_machine(machine);
         let kinds: Vec<JointKind> = machine.variables.iter().map(|v| v.kind).collect();
-        let method = match Solver::new(&model, &kinds, params, fixed) {
+        let method = match Solver::new(&kinematics, &kinds, params, fixed) {
             Ok(solver) => Method::ClosedForm(Box::new(solver)),
+            Err(InverseError::UnknownVariable { index, count }) => {
+                return Err(InverseError::UnknownVariable { index, count })
+            }
             Err(_) => Method::Newton(Box::new(NewtonSolver::new(
                 kinematics.clone(),
                 params,
                 fixed,
             )?)),
         };
-        let mut base = vec![0.0; kinds.len()];
-        for &(i, v) in fixed {
-            if let Some(b) = base.get_mut(i) {
-                *b = v;
-            }
-        }
-        let spin = (0..kinds.len())
-            .filter(|&k| kinds[k] == JointKind::Rotary && !fixed.iter().any(|f| f.0 == k))
-            .filter(|&k| !moves_tool(&kinematics, params, &base, k))
+        let Held { base, idle, .. } = held_variables(&kinematics, kinds.len(), params, fixed)?;
+        let spin = idle
+            .into_iter()
+            .filter(|&k| kinds[k] == JointKind::Rotary)
             .map(|k| {
                 // The sign of the turn about the tool axis.
                 let r0 = kinematics.pose(&base, params).rotation;
@@ -176,7 +179,7 @@ impl Inverse {
     /// point and axis are solved as in [`Inverse::solve`]; then a spin
     /// variable (one that turns the tool about its own axis, `mu` of
     /// `cnc5_bevel`) takes the remaining turn, or, without one, a solution is
-    /// kept only if its orientation already matches (to 1e-9).
+    /// kept only if its orientation already matches (to 1e-7 rad).
     pub fn solve_pose(&self, point: V3, rotation: &M3, prev: &[f64]) -> Solution {
         let axis = col(rotation, 2);
         let first = self.solve(point, axis, prev);
@@ -190,7 +193,7 @@ impl Inverse {
             }
             let r = self.kinematics.pose(&q, &self.params).rotation;
             let off = norm(log_so3(&mul(rotation, &tr(&r))));
-            if off <= 1e-9 && !out.iter().any(|o| close(o, &q, &self.rotary)) {
+            if off <= FRAME_TOLERANCE && !out.iter().any(|o| close(o, &q, &self.rotary)) {
                 out.push(q);
             }
         }
@@ -255,6 +258,11 @@ pub struct Solver {
 
 const SING: f64 = 1e-9;
 
+/// How far (rad) the reached tool frame may be from a full-pose target: the
+/// axis is solved exactly, so this bounds the turn about it that no axis
+/// takes up — loose enough for rotations written with 8 decimals.
+const FRAME_TOLERANCE: f64 = 1e-7;
+
 impl Solver {
     /// Prepares the solver: `kinds` are the variables' joint kinds (model
     /// order), `params` the parameter values, `fixed` the held variables
@@ -266,29 +274,11 @@ impl Solver {
         fixed: &[(usize, f64)],
     ) -> Result<Self, InverseError> {
         let n = kinds.len();
-        let mut base = vec![0.0; n];
-        let mut free = vec![true; n];
-        for &(i, v) in fixed {
-            base[i] = v;
-            free[i] = false;
-        }
-        let mut rot: Vec<usize> = (0..n)
+        let Held { base, held, .. } = held_variables(model, n, params, fixed)?;
+        let free: Vec<bool> = held.iter().map(|h| !h).collect();
+        let rot: Vec<usize> = (0..n)
             .filter(|&i| free[i] && kinds[i] == JointKind::Rotary)
             .collect();
-        if rot.len() > 2 {
-            // Variables that move neither the tool point nor the tool axis
-            // (a spindle's own rotation) are not determined by a pose: hold
-            // them at 0 (the spec's default for `--fix`).
-            let idle: Vec<usize> = rot
-                .iter()
-                .copied()
-                .filter(|&i| !moves_tool(model, params, &base, i))
-                .collect();
-            for &i in &idle {
-                free[i] = false;
-            }
-            rot.retain(|i| !idle.contains(i));
-        }
         let lin: Vec<usize> = (0..n)
             .filter(|&i| free[i] && kinds[i] == JointKind::Prismatic)
             .collect();
@@ -502,7 +492,7 @@ impl Solver {
             if rhs.abs() > 1e-9 {
                 return unreachable;
             }
-            bs.push(prev[self.inner]);
+            bs.push(prev.get(self.inner).copied().unwrap_or(0.0));
         } else {
             let c = rhs / rho;
             if c.abs() > 1.0 + 1e-9 {
@@ -521,7 +511,7 @@ impl Solver {
             let qperp = sub(q, scale(u, dot(u, q)));
             let a = if norm(tperp) < SING || norm(qperp) < SING {
                 singular = true;
-                prev[self.outer]
+                prev.get(self.outer).copied().unwrap_or(0.0)
             } else {
                 dot(u, cross(qperp, tperp)).atan2(dot(qperp, tperp))
             };
@@ -558,6 +548,42 @@ impl Solver {
             && l.iter().all(|x| x.is_finite());
         ok.then(|| self.q(a, b, l))
     }
+}
+
+/// The variables a pose leaves alone: the `fixed` ones at their values, and
+/// every other variable that moves neither the tool point nor the tool axis
+/// (a spindle's spin), held at 0 (the spec's default for `--fix`).
+struct Held {
+    /// Values of the held variables (0 for the free ones).
+    base: Vec<f64>,
+    /// Per variable: held (fixed or idle).
+    held: Vec<bool>,
+    /// The idle variables found (not in `fixed`).
+    idle: Vec<usize>,
+}
+
+fn held_variables<M: NominalPose + ?Sized>(
+    model: &M,
+    count: usize,
+    params: &[f64],
+    fixed: &[(usize, f64)],
+) -> Result<Held, InverseError> {
+    let mut base = vec![0.0; count];
+    let mut held = vec![false; count];
+    for &(index, value) in fixed {
+        if index >= count {
+            return Err(InverseError::UnknownVariable { index, count });
+        }
+        base[index] = value;
+        held[index] = true;
+    }
+    let idle: Vec<usize> = (0..count)
+        .filter(|&i| !held[i] && !moves_tool(model, params, &base, i))
+        .collect();
+    for &i in &idle {
+        held[i] = true;
+    }
+    Ok(Held { base, held, idle })
 }
 
 /// Whether variable `i` changes the tool point or the tool axis (checked at

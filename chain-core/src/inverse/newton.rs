@@ -16,7 +16,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{norm, sub, wrap, InverseError, Solution, Status, V3};
+use super::{held_variables, norm, sub, wrap, Held, InverseError, Solution, Status, V3};
 use crate::kinematics::Kinematics;
 use crate::model::JointKind;
 
@@ -45,40 +45,13 @@ impl NewtonSolver {
         fixed: &[(usize, f64)],
     ) -> Result<NewtonSolver, InverseError> {
         let n = kinematics.variables().len();
-        let mut base = vec![0.0; n];
-        let mut held = vec![false; n];
-        for &(i, v) in fixed {
-            if i < n {
-                base[i] = v;
-                held[i] = true;
-            }
-        }
+        let Held { base, held, .. } = held_variables(&kinematics, n, params, fixed)?;
         let rotary: Vec<bool> = kinematics
             .variables()
             .iter()
             .map(|(_, k)| *k == JointKind::Rotary)
             .collect();
-        // A variable is idle when its Jacobian column vanishes at two
-        // unrelated configurations.
-        let probe = |s: f64| -> Vec<f64> {
-            (0..n)
-                .map(|k| {
-                    if held[k] {
-                        base[k]
-                    } else {
-                        s * (k as f64 + 1.0) * 0.61
-                    }
-                })
-                .collect()
-        };
-        let columns: Vec<Vec<[f64; 6]>> = [0.37, -1.9]
-            .iter()
-            .map(|&s| kinematics.jacobian(&probe(s), params))
-            .collect();
-        let free: Vec<usize> = (0..n)
-            .filter(|&k| !held[k])
-            .filter(|&k| columns.iter().any(|c| c[k].iter().any(|v| v.abs() > 1e-12)))
-            .collect();
+        let free: Vec<usize> = (0..n).filter(|&k| !held[k]).collect();
         if free.is_empty() {
             return Err(InverseError::NoFreeVariable);
         }
