@@ -254,6 +254,8 @@ pub struct Solver {
     /// with `f = (1, cos a, sin a)`, `g = (1, cos b, sin b)`.
     offset: [[V3; 3]; 3],
     gain: [[[[f64; 3]; 3]; 3]; 3],
+    /// `(α, β, γ)` of `u · R0 Rot(v, b) z = γ + α cos b + β sin b`.
+    sinusoid: [f64; 3],
 }
 
 const SING: f64 = 1e-9;
@@ -302,6 +304,7 @@ impl Solver {
             r0: [[0.0; 3]; 3],
             offset: [[[0.0; 3]; 3]; 3],
             gain: [[[[0.0; 3]; 3]; 3]; 3],
+            sinusoid: [0.0; 3],
         };
         for (o, i) in [(rot[0], rot[1]), (rot[1], rot[0])] {
             s.outer = o;
@@ -313,6 +316,11 @@ impl Solver {
                 if det(&s.linear_model(0.3, -0.7).0).abs() < 1e-12 {
                     return Err(InverseError::DegenerateLinear);
                 }
+                // u · R0 (z_par + cos b z_perp + sin b (v × z)), z_par = (v·z) v.
+                let ez = [0.0, 0.0, 1.0];
+                let w = mul_t_vec(&s.r0, s.u);
+                let zpar = scale(s.v, dot(s.v, ez));
+                s.sinusoid = [dot(w, sub(ez, zpar)), dot(w, cross(s.v, ez)), dot(w, zpar)];
                 return Ok(s);
             }
         }
@@ -476,23 +484,17 @@ impl Solver {
         let t = scale(axis, 1.0 / na);
         let (u, v) = (self.u, self.v);
         let ez = [0.0, 0.0, 1.0];
-        // u · R0 (z_par + cos b z_perp + sin b (v × z)) = u · t
-        let w = mul_t_vec(&self.r0, u); // R0^T u
-        let zpar = scale(v, dot(v, ez));
-        let zperp = sub(ez, zpar);
-        let alpha = dot(w, zperp);
-        let beta = dot(w, cross(v, ez));
-        let gamma = dot(w, zpar);
+        let [alpha, beta, gamma] = self.sinusoid;
         let rho = alpha.hypot(beta);
         let rhs = dot(u, t) - gamma;
         let mut singular = false;
-        let mut bs: Vec<f64> = Vec::new();
-        if rho < SING {
+        // At most two inner angles.
+        let (bs, count) = if rho < SING {
             singular = true;
             if rhs.abs() > 1e-9 {
                 return unreachable;
             }
-            bs.push(prev.get(self.inner).copied().unwrap_or(0.0));
+            ([prev.get(self.inner).copied().unwrap_or(0.0), 0.0], 1)
         } else {
             let c = rhs / rho;
             if c.abs() > 1.0 + 1e-9 {
@@ -500,12 +502,11 @@ impl Solver {
             }
             let phi = beta.atan2(alpha);
             let d = c.clamp(-1.0, 1.0).acos();
-            bs.push(phi + d);
-            bs.push(phi - d);
-        }
+            ([phi + d, phi - d], 2)
+        };
         let tperp = sub(t, scale(u, dot(u, t)));
-        let mut sols: Vec<Vec<f64>> = Vec::new();
-        for b in bs {
+        let mut sols: Vec<Vec<f64>> = Vec::with_capacity(count);
+        for &b in &bs[..count] {
             let b = wrap(b);
             let q = mat_vec(&self.r0, rodrigues_vec(v, b, ez));
             let qperp = sub(q, scale(u, dot(u, q)));
@@ -516,7 +517,7 @@ impl Solver {
                 dot(u, cross(qperp, tperp)).atan2(dot(qperp, tperp))
             };
             let a = wrap(a);
-            if let Some(s) = self.linear(a, b, point, t) {
+            if let Some(s) = self.linear(a, b, q, point, t) {
                 if !sols.iter().any(|o| close(o, &s, &self.rotary)) {
                     sols.push(s);
                 }
@@ -527,17 +528,14 @@ impl Solver {
 
     /// The prismatic values for angles `(a, b)`, verified against the pose
     /// (the tool axis from the rotation model, the point from the position
-    /// model, both checked against `nominal()` when the solver was built).
-    fn linear(&self, a: f64, b: f64, point: V3, t: V3) -> Option<Vec<f64>> {
+    /// model, both checked against `nominal()` when the solver was built);
+    /// `inner_axis` is `R0 Rot(v, b) z`.
+    fn linear(&self, a: f64, b: f64, inner_axis: V3, point: V3, t: V3) -> Option<Vec<f64>> {
         let (sa, ca) = a.sin_cos();
         let (sb, cb) = b.sin_cos();
         let (m, p0) = self.linear_model_trig([1.0, ca, sa], [1.0, cb, sb]);
         let l = solve3(&m, sub(point, p0))?;
-        let axis = rodrigues_vec(
-            self.u,
-            a,
-            mat_vec(&self.r0, rodrigues_vec(self.v, b, [0.0, 0.0, 1.0])),
-        );
+        let axis = rodrigues_vec(self.u, a, inner_axis);
         let reached = [
             p0[0] + dot(m[0], l),
             p0[1] + dot(m[1], l),
