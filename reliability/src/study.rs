@@ -277,7 +277,7 @@ impl VolumetricMoments {
             - cov[0][2] * cov[2][0]
             + cov[1][1] * cov[2][2]
             - cov[1][2] * cov[2][1];
-        let det = det3(&cov);
+        let det = chain_core::geometry::det(&cov);
         let one_minus_m = |s: f64| -> f64 {
             let a = 2.0 * s;
             let x = a * trace + a * a * minors + a * a * a * det;
@@ -308,12 +308,6 @@ impl VolumetricMoments {
             std: (q_mean - mean_norm * mean_norm).max(0.0).sqrt(),
         }
     }
-}
-
-fn det3(m: &[[f64; 3]; 3]) -> f64 {
-    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
 }
 
 fn adjugate3(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {

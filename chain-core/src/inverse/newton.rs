@@ -17,6 +17,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::{held_variables, norm, sub, wrap, Held, InverseError, Solution, Status, V3};
+use crate::geometry::{col, cross};
 use crate::kinematics::Kinematics;
 use crate::model::JointKind;
 
@@ -133,11 +134,7 @@ impl NewtonSolver {
         let m = self.free.len();
         let residual = |q: &[f64]| -> ([f64; 6], V3, V3) {
             let pose = self.kinematics.pose(q, &self.params);
-            let z = [
-                pose.rotation[0][2],
-                pose.rotation[1][2],
-                pose.rotation[2][2],
-            ];
+            let z = col(&pose.rotation, 2);
             let dp = sub(pose.position, point);
             let dz = sub(z, t);
             (
@@ -219,12 +216,7 @@ impl NewtonSolver {
         let mut j = DMatrix::zeros(6, self.free.len());
         for (i, &k) in self.free.iter().enumerate() {
             let c = columns[k];
-            let w = [c[3], c[4], c[5]];
-            let dz = [
-                w[1] * z[2] - w[2] * z[1],
-                w[2] * z[0] - w[0] * z[2],
-                w[0] * z[1] - w[1] * z[0],
-            ];
+            let dz = cross([c[3], c[4], c[5]], z);
             for r in 0..3 {
                 j[(r, i)] = c[r];
                 j[(r + 3, i)] = scale * dz[r];
