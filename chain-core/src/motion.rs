@@ -150,6 +150,15 @@ pub enum MotionError {
         /// Remaining angle error (rad).
         angle: f64,
     },
+    /// The motion cannot be followed continuously: near `t` a rotary axis
+    /// jumps however small the step (a singularity on the path).
+    #[error("near t = {t}: the CNC axes cannot follow the generator's {what} continuously (a rotary axis jumps however small the step: a singular configuration on the roll)")]
+    Discontinuous {
+        /// The instant.
+        t: f64,
+        /// `pose` or `tool point and axis`.
+        what: &'static str,
+    },
     /// The Jacobian of the conditions is singular at `t = 0`: the series is
     /// not defined by the method.
     #[error("the CNC axes are singular at t = 0 (the Jacobian of the {what} has rank below the number of free variables); no Maclaurin series")]
@@ -605,11 +614,20 @@ impl Motion {
             candidates.extend(s.solutions);
         }
         let mut best: Option<(f64, Vec<f64>)> = None;
-        let mut closest_failure = self.start.clone();
+        // The failed candidate with the smallest residual, for the message.
+        let mut closest_failure: Option<(f64, Vec<f64>)> = None;
         for c in candidates {
             let (mut q, ok) = self.newton(&c, &target);
             if !ok {
-                closest_failure = q;
+                let e = self.pose_error(&q, t);
+                let angle = match self.matching {
+                    Matching::Pose => e.rotation,
+                    Matching::PointAxis => e.axis,
+                };
+                let size = e.position / 1.0f64.max(norm(target.position)) + angle;
+                if closest_failure.as_ref().is_none_or(|(s, _)| size < *s) {
+                    closest_failure = Some((size, q));
+                }
                 continue;
             }
             self.nearest_turn(&mut q, &self.start);
@@ -618,8 +636,10 @@ impl Motion {
                 best = Some((d, q));
             }
         }
-        best.map(|b| b.1)
-            .ok_or_else(|| self.unreachable(&closest_failure, t))
+        best.map(|b| b.1).ok_or_else(|| {
+            let q = closest_failure.map_or_else(|| self.start.clone(), |f| f.1);
+            self.unreachable(&q, t)
+        })
     }
 
     /// The CNC axes at `t` by Newton from `guess` (the previous instant);
@@ -641,7 +661,12 @@ impl Motion {
             }
         }
         if depth >= 40 {
-            return Err(self.unreachable(qa, tb));
+            // The step has shrunk to nothing and a rotary axis still jumps
+            // (or Newton still fails): the motion crosses a singularity.
+            return Err(MotionError::Discontinuous {
+                t: tb,
+                what: what(self.matching),
+            });
         }
         let mid = 0.5 * (ta + tb);
         let qm = self.follow(ta, qa, mid, depth + 1)?;
