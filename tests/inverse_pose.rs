@@ -136,64 +136,52 @@ fn cli_reads_full_rotations() {
         .collect();
     let pose = kin.pose(&q, &params);
     let r = pose.rotation;
-    let row: Vec<String> = pose
-        .position
-        .iter()
-        .chain(r.iter().flatten())
-        .map(|v| format!("{v:.17e}"))
-        .collect();
-    let csv = scratch_file(
-        "rotation.csv",
-        &format!(
-            "px,py,pz,r11,r12,r13,r21,r22,r23,r31,r32,r33\n{}\n",
-            row.join(",")
-        ),
-    );
     let file = example_path("cnc5_bevel.yaml");
-    let doc = ok_json(&[
-        "inverse",
-        file.to_str().unwrap(),
-        "--pose",
-        csv.to_str().unwrap(),
-    ]);
-    assert_eq!(doc["rows"][0]["status"], "ok");
-    let sols = doc["rows"][0]["solutions"].as_array().unwrap();
-    assert!(sols.iter().any(|s| {
-        ["x", "y", "z", "mu", "B", "A"]
+    // Written with 17 significant digits, the row solves to the generating
+    // values; written with 8 decimals (as CAM output often is) it is
+    // orthonormal only to ~1e-8, is replaced by the nearest rotation and
+    // solves within that rounding.
+    for (name, digits, tolerance) in [
+        ("rotation.csv", 17, 1e-8),
+        ("rotation_8_digits.csv", 8, 1e-5),
+    ] {
+        let row: Vec<String> = pose
+            .position
             .iter()
-            .zip([120.0, -40.0, 60.0, 1.1, 0.3, -0.8])
-            .all(|(k, want)| (s[*k].as_f64().unwrap() - want).abs() < 1e-8)
-    }));
-    // The same pose written with 8 decimals (as CAM output often is): the
-    // row is orthonormal only to ~1e-8, is replaced by the nearest rotation,
-    // and solves to the generating values within that rounding.
-    let short: Vec<String> = pose
-        .position
-        .iter()
-        .chain(r.iter().flatten())
-        .map(|v| format!("{v:.8}"))
-        .collect();
-    let csv = scratch_file(
-        "rotation_8_digits.csv",
-        &format!(
-            "px,py,pz,r11,r12,r13,r21,r22,r23,r31,r32,r33\n{}\n",
-            short.join(",")
-        ),
-    );
-    let doc = ok_json(&[
-        "inverse",
-        file.to_str().unwrap(),
-        "--pose",
-        csv.to_str().unwrap(),
-    ]);
-    assert_eq!(doc["rows"][0]["status"], "ok");
-    let sols = doc["rows"][0]["solutions"].as_array().unwrap();
-    assert!(sols.iter().any(|s| {
-        ["x", "y", "z", "mu", "B", "A"]
-            .iter()
-            .zip([120.0, -40.0, 60.0, 1.1, 0.3, -0.8])
-            .all(|(k, want)| (s[*k].as_f64().unwrap() - want).abs() < 1e-5)
-    }));
+            .chain(r.iter().flatten())
+            .map(|v| {
+                if digits == 17 {
+                    format!("{v:.17e}")
+                } else {
+                    format!("{v:.8}")
+                }
+            })
+            .collect();
+        let csv = scratch_file(
+            name,
+            &format!(
+                "px,py,pz,r11,r12,r13,r21,r22,r23,r31,r32,r33\n{}\n",
+                row.join(",")
+            ),
+        );
+        let doc = ok_json(&[
+            "inverse",
+            file.to_str().unwrap(),
+            "--pose",
+            csv.to_str().unwrap(),
+        ]);
+        assert_eq!(doc["rows"][0]["status"], "ok", "{name}");
+        let sols = doc["rows"][0]["solutions"].as_array().unwrap();
+        assert!(
+            sols.iter().any(|s| {
+                ["x", "y", "z", "mu", "B", "A"]
+                    .iter()
+                    .zip([120.0, -40.0, 60.0, 1.1, 0.3, -0.8])
+                    .all(|(k, want)| (s[*k].as_f64().unwrap() - want).abs() < tolerance)
+            }),
+            "{name}: {sols:?}"
+        );
+    }
     // A row that is not a rotation is refused with its line.
     let bad = scratch_file(
         "not_rotation.csv",

@@ -201,7 +201,23 @@ impl Inverse {
     }
 }
 
+/// The unit tool axis, or `None` when the axis is zero or anything is not
+/// finite (such a target is unreachable).
+fn unit_axis(point: V3, axis: V3) -> Option<V3> {
+    let na = norm(axis);
+    (na.is_finite() && na > 0.0 && point.iter().all(|x| x.is_finite()))
+        .then(|| scale(axis, 1.0 / na))
+}
+
 impl Solution {
+    /// No solution.
+    fn unreachable() -> Solution {
+        Solution {
+            status: Status::Unreachable,
+            solutions: Vec::new(),
+        }
+    }
+
     /// The solutions found, nearest to `prev` first (rotary differences
     /// wrapped to (−π, π]); `Unreachable` when there is none.
     fn ranked(
@@ -211,10 +227,7 @@ impl Solution {
         singular: bool,
     ) -> Solution {
         if solutions.is_empty() {
-            return Solution {
-                status: Status::Unreachable,
-                solutions,
-            };
+            return Solution::unreachable();
         }
         let dist = |s: &Vec<f64>| -> f64 {
             s.iter()
@@ -473,15 +486,10 @@ impl Solver {
     /// here); `prev` are the previous row's values (model order), used for the
     /// branch order and the held angle of a singular pose.
     pub fn solve(&self, point: V3, axis: V3, prev: &[f64]) -> Solution {
-        let unreachable = Solution {
-            status: Status::Unreachable,
-            solutions: Vec::new(),
-        };
-        let na = norm(axis);
-        if !(na.is_finite() && na > 0.0 && point.iter().all(|x| x.is_finite())) {
+        let unreachable = Solution::unreachable();
+        let Some(t) = unit_axis(point, axis) else {
             return unreachable;
-        }
-        let t = scale(axis, 1.0 / na);
+        };
         let (u, v) = (self.u, self.v);
         let ez = [0.0, 0.0, 1.0];
         let [alpha, beta, gamma] = self.sinusoid;

@@ -16,7 +16,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{held_variables, norm, sub, wrap, Held, InverseError, Solution, Status, V3};
+use super::{held_variables, norm, sub, unit_axis, wrap, Held, InverseError, Solution, V3};
 use crate::geometry::{col, cross};
 use crate::kinematics::Kinematics;
 use crate::model::JointKind;
@@ -73,15 +73,9 @@ impl NewtonSolver {
     /// All solutions found for tool point `point` and tool axis `axis`
     /// (normalised here); `prev` are the previous row's values.
     pub fn solve(&self, point: V3, axis: V3, prev: &[f64]) -> Solution {
-        let unreachable = Solution {
-            status: Status::Unreachable,
-            solutions: Vec::new(),
+        let Some(t) = unit_axis(point, axis) else {
+            return Solution::unreachable();
         };
-        let na = norm(axis);
-        if !(na.is_finite() && na > 0.0 && point.iter().all(|x| x.is_finite())) {
-            return unreachable;
-        }
-        let t = [axis[0] / na, axis[1] / na, axis[2] / na];
         let mut start: Vec<f64> = self.base.clone();
         for &k in &self.free {
             start[k] = prev
