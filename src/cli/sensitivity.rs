@@ -123,41 +123,7 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
         ),
         Some(AtPoint(coords)) => {
             let vars = study.variables();
-            for (name, _) in coords {
-                if !vars.iter().any(|v| v == name) {
-                    return Err(loaded.report(ReliabilityError::UnknownName {
-                        kind: "axis variable",
-                        name: name.clone(),
-                        hint: chain_core::diagnostic::closest(
-                            name,
-                            vars.iter().map(String::as_str),
-                        )
-                        .map(str::to_string),
-                    }));
-                }
-            }
-            let point = vars
-                .iter()
-                .map(|v| {
-                    coords
-                        .iter()
-                        .rev()
-                        .find(|(n, _)| n == v)
-                        .map(|(_, x)| *x)
-                        .ok_or_else(|| {
-                            miette::miette!(
-                                help = format!(
-                                    "give every axis variable: --at {}",
-                                    vars.iter()
-                                        .map(|v| format!("{v}=…"))
-                                        .collect::<Vec<_>>()
-                                        .join(",")
-                                ),
-                                "--at has no value for axis variable `{v}`"
-                            )
-                        })
-                })
-                .collect::<miette::Result<Vec<f64>>>()?;
+            let point = resolve_at(coords, &loaded)?;
             let values =
                 machine::parameters(&loaded.machine, &args.params).map_err(|e| loaded.report(e))?;
             let r = study
@@ -288,6 +254,36 @@ fn unknown_variable(loaded: &Loaded, name: &str) -> miette::Report {
     })
 }
 
+/// The values of `--at` in the machine's variable order: every axis
+/// variable once (a repeated name: the last value), no unknown name.
+fn resolve_at(coords: &[(String, f64)], loaded: &Loaded) -> miette::Result<Vec<f64>> {
+    let vars: Vec<&str> = loaded
+        .machine
+        .variables
+        .iter()
+        .map(|v| v.name.as_str())
+        .collect();
+    if let Some((name, _)) = coords.iter().find(|(n, _)| !vars.contains(&n.as_str())) {
+        return Err(unknown_variable(loaded, name));
+    }
+    vars.iter()
+        .map(|v| {
+            coords
+                .iter()
+                .rev()
+                .find(|(n, _)| n == v)
+                .map(|(_, x)| *x)
+                .ok_or_else(|| {
+                    let every: Vec<String> = vars.iter().map(|v| format!("{v}=…")).collect();
+                    miette::miette!(
+                        help = format!("give every axis variable: --at {}", every.join(",")),
+                        "--at has no value for axis variable `{v}`"
+                    )
+                })
+        })
+        .collect()
+}
+
 fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
@@ -296,12 +292,6 @@ fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {
     let nominal = args.values.unwrap_or_default();
     let sizes = nominal.of(m);
     let vars: Vec<&str> = m.variables.iter().map(|v| v.name.as_str()).collect();
-    let every = || {
-        vars.iter()
-            .map(|v| format!("{v}=…"))
-            .collect::<Vec<_>>()
-            .join(",")
-    };
     let (where_, result) = match &args.at {
         Some(AtPoint(coords)) => {
             if !args.grid.is_empty() {
@@ -311,27 +301,7 @@ fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {
                     "--grid cannot be combined with --at"
                 ));
             }
-            for (name, _) in coords {
-                if !vars.contains(&name.as_str()) {
-                    return Err(unknown_variable(&loaded, name));
-                }
-            }
-            let point = vars
-                .iter()
-                .map(|v| {
-                    coords
-                        .iter()
-                        .rev()
-                        .find(|(n, _)| n == v)
-                        .map(|(_, x)| *x)
-                        .ok_or_else(|| {
-                            miette::miette!(
-                                help = format!("give every axis variable: --at {}", every()),
-                                "--at has no value for axis variable `{v}`"
-                            )
-                        })
-                })
-                .collect::<miette::Result<Vec<f64>>>()?;
+            let point = resolve_at(coords, &loaded)?;
             let r = geometric::at_point(&model, &point, &params, &sizes);
             let at = vars
                 .iter()
@@ -369,7 +339,7 @@ fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {
                         _ => Err(miette::miette!(
                             help = format!(
                                 "evaluate at one point with --at {}, or give the grid with --grid {v}=V1,V2,...",
-                                every()
+                                vars.iter().map(|v| format!("{v}=…")).collect::<Vec<_>>().join(",")
                             ),
                             "{}: no grid values for axis variable `{v}` (key `reliability.grid.{v}`)",
                             loaded.machine.file.as_deref().unwrap_or("machine")
