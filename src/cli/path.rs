@@ -20,17 +20,14 @@ use std::path::{Path, PathBuf};
 use chain_core::inverse::{Inverse, Status};
 use chain_core::model::{Component, Machine, Sided};
 use chain_core::ErrorModel;
-use reliability::{
-    machine, ErrorMoments, Form, ImportanceSampling, MonteCarlo, ReliabilityError, Study,
-    StudyResult, System, VolumetricMoments,
-};
+use reliability::{machine, ErrorMoments, Study, StudyResult, System, VolumetricMoments};
 use serde_json::{json, Map, Value};
 
 use super::csv_input::{numeric_rows, open_csv, read_poses};
 use super::inverse::solve_rows;
 use super::reliability::{
-    note_form_limits, parse_assignment, requirement_text, resolve_fixed, system_of, write_stdout,
-    Loaded, MethodArg, SidedArg, SystemArg,
+    note_form_limits, parse_assignment, requirement_text, resolve_fixed, run_study, system_of,
+    write_stdout, Loaded, MethodArg, SidedArg, SystemArg,
 };
 
 /// Output formats of `chain path`.
@@ -180,7 +177,9 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
     } else {
         let study = Study::at_points(&model, &params, inputs, spec, points)
             .map_err(|e| loaded.report(e))?;
-        let result = run(&study, &args).map_err(|e| loaded.report(e))?;
+        let samples = args.method.samples(args.samples);
+        let result = run_study(&study, args.method, samples, args.seed, &())
+            .map_err(|e| loaded.report(e))?;
         if args.method == MethodArg::Form {
             note_form_limits(&study);
         }
@@ -264,28 +263,6 @@ fn method_name(m: MethodArg) -> &'static str {
         MethodArg::Form => "form",
         MethodArg::Is => "is",
         MethodArg::Mc => "mc",
-    }
-}
-
-/// Runs the chosen algorithm over every (target, instant) case.
-fn run(study: &Study, args: &PathArgs) -> Result<StudyResult, ReliabilityError> {
-    match args.method {
-        MethodArg::Form => study.form(&Form::default()),
-        MethodArg::Is => study.importance_sampling(
-            &ImportanceSampling {
-                samples: args.samples.unwrap_or(10_000),
-                seed: args.seed,
-                form: Form::default(),
-            },
-            &|_| {},
-        ),
-        MethodArg::Mc => study.monte_carlo(
-            &MonteCarlo {
-                samples: args.samples.unwrap_or(100_000),
-                seed: args.seed,
-            },
-            &|_| {},
-        ),
     }
 }
 

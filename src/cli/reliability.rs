@@ -19,6 +19,29 @@ use reliability::{
 };
 use serde_json::{json, Map, Value};
 
+/// Runs the chosen algorithm over every case of a study (`samples` is
+/// ignored by FORM); `progress` receives the samples done.
+pub(crate) fn run_study(
+    study: &Study,
+    method: MethodArg,
+    samples: u64,
+    seed: u64,
+    progress: &dyn reliability::Progress,
+) -> Result<StudyResult, ReliabilityError> {
+    match method {
+        MethodArg::Form => study.form(&Form::default()),
+        MethodArg::Is => study.importance_sampling(
+            &ImportanceSampling {
+                samples,
+                seed,
+                form: Form::default(),
+            },
+            progress,
+        ),
+        MethodArg::Mc => study.monte_carlo(&MonteCarlo { samples, seed }, progress),
+    }
+}
+
 /// Algorithms of `--method`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum MethodArg {
@@ -28,6 +51,18 @@ pub enum MethodArg {
     Is,
     /// Crude Monte Carlo.
     Mc,
+}
+
+impl MethodArg {
+    /// The samples per case: `--samples` or the method's default (is:
+    /// 10,000, mc: 100,000; 0 for FORM, which draws none).
+    pub(crate) fn samples(self, given: Option<u64>) -> u64 {
+        match self {
+            MethodArg::Form => 0,
+            MethodArg::Is => given.unwrap_or(10_000),
+            MethodArg::Mc => given.unwrap_or(100_000),
+        }
+    }
 }
 
 /// Output formats of `chain reliability`.
@@ -103,37 +138,15 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     let system = system_of(&loaded.machine, args.system, args.system_tolerance)
         .map_err(|e| loaded.report(e))?;
     let (study, _model) = loaded.study(&args.params, &args.grid, args.sided, system)?;
-    let result = match args.method {
-        MethodArg::Form => study.form(&Form::default()),
-        MethodArg::Is => {
-            let samples = args.samples.unwrap_or(10_000);
-            let bar = ProgressBar::new(samples, study_cases(&study), args.format);
-            let r = study.importance_sampling(
-                &ImportanceSampling {
-                    samples,
-                    seed: args.seed,
-                    form: Form::default(),
-                },
-                &|n| bar.inc(n),
-            );
-            bar.finish();
-            r
-        }
-        MethodArg::Mc => {
-            let samples = args.samples.unwrap_or(100_000);
-            let bar = ProgressBar::new(samples, study_cases(&study), args.format);
-            let r = study.monte_carlo(
-                &MonteCarlo {
-                    samples,
-                    seed: args.seed,
-                },
-                &|n| bar.inc(n),
-            );
-            bar.finish();
-            r
-        }
-    }
-    .map_err(|e| loaded.report(e))?;
+    let samples = args.method.samples(args.samples);
+    let bar = if args.method == MethodArg::Form {
+        ProgressBar(None)
+    } else {
+        ProgressBar::new(samples, study_cases(&study), args.format)
+    };
+    let result = run_study(&study, args.method, samples, args.seed, &|n| bar.inc(n));
+    bar.finish();
+    let result = result.map_err(|e| loaded.report(e))?;
     if args.method == MethodArg::Form {
         note_form_limits(&study);
     }
