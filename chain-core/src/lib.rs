@@ -6,27 +6,16 @@
 //! canonical polynomials) → export (text / JSON / LaTeX / Rust) or
 //! [`compile`] → [`CompiledModel`], an [`ErrorModel`] evaluated from a flat tape.
 
-pub mod algebra;
-pub mod derive;
-pub mod diagnostic;
-pub mod dmm;
-pub mod emit;
-pub mod eval;
-pub mod expand;
-pub mod export;
-pub mod expr;
-pub mod geometric;
-pub mod geometry;
-pub mod inline;
-pub mod inverse;
-pub mod jet;
+pub mod input;
 pub mod kinematics;
-pub mod load;
-pub mod model;
 mod model_trait;
-pub mod motion;
-pub mod settings;
-pub mod yaml;
+pub mod symbolic;
+
+// The stages' modules under their historical flat paths (`chain_core::load`,
+// `chain_core::inverse`, ...), which downstream code and the docs use.
+pub use input::{diagnostic, expr, inline, load, model, settings, yaml};
+pub use kinematics::{geometry, inverse, jet, motion};
+pub use symbolic::{algebra, derive, dmm, emit, eval, expand, export, geometric};
 
 pub use derive::{derive, derive_in, SymbolicModel};
 pub use diagnostic::Diagnostics;
