@@ -13,7 +13,8 @@ use reliability::allocate::{self, AllocateError, Allocation, ErrorBounds, Optima
 use reliability::Summary;
 use serde_json::{json, Map, Value};
 
-use super::reliability::{parse_assignment, write_stdout, Loaded, SidedArg};
+use super::reliability::{parse_assignment, Loaded, SidedArg};
+use super::report::write_stdout;
 
 /// `--strategy`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

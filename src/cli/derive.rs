@@ -6,6 +6,8 @@ use chain_core::emit::{emit_pretty, EmitOptions};
 use chain_core::export;
 use chain_core::model::Frame;
 
+use super::report;
+
 /// Output formats of `chain derive`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum DeriveFormat {
@@ -53,14 +55,8 @@ pub fn exec(args: DeriveArgs) -> miette::Result<()> {
     let out = match args.format {
         DeriveFormat::Text => export::to_text(&model),
         DeriveFormat::Latex => export::to_latex(&model),
-        DeriveFormat::Json => {
-            let mut s = serde_json::to_string_pretty(&export::to_json(&model))
-                .map_err(|e| miette::miette!("cannot serialise the model: {e}"))?;
-            s.push('\n');
-            s
-        }
+        DeriveFormat::Json => report::json(&export::to_json(&model))?,
         DeriveFormat::Rust => emit_pretty(&model, &EmitOptions::for_model(&model)),
     };
-    print!("{out}");
-    Ok(())
+    report::write_stdout(&out)
 }

@@ -10,7 +10,8 @@ use chain_core::inverse::{Inverse, Solution, Status};
 use serde_json::{json, Map, Value};
 
 use super::csv_input::{read_poses, Orientation, PoseRow};
-use super::reliability::{parse_assignment, resolve_fixed, write_stdout, Loaded};
+use super::reliability::{parse_assignment, resolve_fixed, Loaded};
+use super::report::write_stdout;
 
 /// Arguments of `chain inverse`.
 #[derive(Debug, clap::Args)]

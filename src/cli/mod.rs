@@ -9,6 +9,7 @@ pub mod inverse;
 pub mod motion;
 pub mod path;
 pub mod reliability;
+pub mod report;
 pub mod sensitivity;
 
 use clap::{Parser, Subcommand};

@@ -18,7 +18,8 @@ use chain_core::motion::{self, Matching, Motion, PoseError, Series};
 use chain_core::settings;
 use serde_json::{json, Map, Value};
 
-use super::reliability::{parse_assignment, resolve_fixed, write_stdout};
+use super::reliability::{parse_assignment, resolve_fixed};
+use super::report::write_stdout;
 
 /// Highest order accepted for `--order` and `--max-order`: the JSON lists
 /// the derivatives `k!·a_k`, and 171! overflows `f64`.

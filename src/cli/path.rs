@@ -27,8 +27,9 @@ use super::csv_input::{numeric_rows, open_csv, read_poses};
 use super::inverse::solve_rows;
 use super::reliability::{
     note_form_limits, parse_assignment, requirement_text, resolve_fixed, run_study, system_of,
-    write_stdout, Loaded, MethodArg, SidedArg, SystemArg,
+    Loaded, MethodArg, SidedArg, SystemArg,
 };
+use super::report::write_stdout;
 
 /// Output formats of `chain path`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

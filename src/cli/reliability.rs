@@ -9,7 +9,9 @@
 #[path = "reliability_plot.rs"]
 mod reliability_plot;
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
+
+use super::report::write_stdout;
 use std::path::{Path, PathBuf};
 
 use chain_core::model::{Machine, Origin, Sided};
@@ -170,16 +172,6 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
         ReliabilityFormat::Table => to_table(&loaded.machine, &study, &result),
     };
     write_stdout(&text)
-}
-
-/// Writes to stdout; a closed pipe (`| head`) is not an error.
-pub(crate) fn write_stdout(text: &str) -> miette::Result<()> {
-    let mut out = std::io::stdout().lock();
-    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
-        Ok(()) => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        Err(e) => Err(miette::miette!("cannot write the output: {e}")),
-    }
 }
 
 fn study_cases(study: &Study) -> u64 {

@@ -22,7 +22,8 @@ use chain_core::geometric::{self, GeometricSensitivity, NominalSizes};
 use reliability::{machine, Form, ReliabilityError, SensitivityMethod, TargetSensitivity};
 use serde_json::{json, Map, Value};
 
-use super::reliability::{parse_assignment, parse_axis, write_stdout, Loaded, SidedArg};
+use super::reliability::{parse_assignment, parse_axis, Loaded, SidedArg};
+use super::report::write_stdout;
 
 /// What `chain sensitivity` computes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]

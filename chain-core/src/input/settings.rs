@@ -62,7 +62,8 @@ pub const MATCH_VALUES: &[&str] = &["pose", "point_axis"];
 
 /// The text of `examples/machines/cradle_generator.yaml`, the generator used
 /// when a settings file names none.
-pub const BUILTIN_GENERATOR: &str = include_str!("../../../examples/machines/cradle_generator.yaml");
+pub const BUILTIN_GENERATOR: &str =
+    include_str!("../../../examples/machines/cradle_generator.yaml");
 
 /// The file name under which the built-in generator is reported.
 pub const BUILTIN_GENERATOR_NAME: &str = "cradle_generator.yaml (built-in)";
