@@ -9,12 +9,13 @@
 pub mod input;
 pub mod kinematics;
 mod model_trait;
+pub mod named;
 pub mod symbolic;
 
 // The stages' modules under their historical flat paths (`chain_core::load`,
 // `chain_core::inverse`, ...), which downstream code and the docs use.
 pub use input::{diagnostic, expr, inline, load, model, settings, yaml};
-pub use kinematics::{geometry, inverse, jet, motion};
+pub use kinematics::{conversion, geometry, inverse, jet, motion};
 pub use symbolic::{algebra, derive, dmm, emit, eval, expand, export, geometric};
 
 pub use derive::{derive, derive_in, SymbolicModel};

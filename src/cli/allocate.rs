@@ -1,6 +1,6 @@
 //! `chain allocate FILE [--strategy optimal|paper] [--step TOL] [--format table|json]`.
 //!
-//! Precision allocation (seed 000, Section 3.3, Tables 5-7): the paper's
+//! Precision allocation (Wang & Yuan 2021, Section 3.3, Tables 5-7): the paper's
 //! fixed-step tightening of the most sensitive errors, or the least-cost
 //! standard deviations that meet the requirement (with a KKT check). An
 //! infeasible requirement is an error naming the component, the case and the
@@ -8,13 +8,17 @@
 
 use std::path::PathBuf;
 
+use std::fmt;
+
+use chain_core::model::Requirement;
+use chain_core::named::NameMap;
 use miette::MietteDiagnostic;
 use reliability::allocate::{self, AllocateError, Allocation, ErrorBounds, Optimal, Paper};
 use reliability::Summary;
-use serde_json::{json, Map, Value};
+use serde::{Serialize, Serializer};
 
 use super::reliability::{parse_assignment, Loaded, SidedArg};
-use super::report::write_stdout;
+use super::report::{self, Format, Report};
 
 /// `--strategy`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -100,7 +104,7 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
             },
         ),
     };
-    let result = result.map_err(|e| report(&loaded, e))?;
+    let result = result.map_err(|e| failure(&loaded, e))?;
     if let Some(dir) = &args.plot {
         let stds: Vec<f64> = result.std.iter().map(|(_, s)| *s).collect();
         let before = study
@@ -116,28 +120,31 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
             &result,
             &before,
             &after,
-        )
-        .map_err(|e| miette::miette!("{e}"))?;
+        )?;
         for f in files {
             eprintln!("wrote {}", f.display());
         }
     }
-    let req = study.spec().requirement;
-    let text = match args.format {
-        AllocateFormat::Json => {
-            let doc = to_json(&loaded.machine.name, req, &bounds, &result);
-            let mut s = serde_json::to_string_pretty(&doc)
-                .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
-            s.push('\n');
-            s
-        }
-        AllocateFormat::Table => to_table(&loaded.machine.name, req, &bounds, &result),
+    let doc = AllocationReport {
+        machine: &loaded.machine.name,
+        requirement: study.spec().requirement,
+        bounds: &bounds,
+        result: &result,
     };
-    write_stdout(&text)?;
+    report::emit(
+        &doc,
+        match args.format {
+            AllocateFormat::Json => Format::Json,
+            AllocateFormat::Table => Format::Table,
+        },
+    )?;
     if !result.met {
-        return Err(miette::miette!(
-            "the requirement is not met after {} rounds",
-            result.steps.len()
+        return Err(miette::Report::new(
+            MietteDiagnostic::new(format!(
+                "the requirement is not met after {} rounds",
+                result.steps.len()
+            ))
+            .with_code("chain::allocate::not_met"),
         ));
     }
     Ok(())
@@ -223,96 +230,245 @@ fn plot(
     Ok(files)
 }
 
-fn report(loaded: &Loaded, err: AllocateError) -> miette::Report {
-    match err {
+/// An allocation that failed, rendered as the library's error with the
+/// machine's name, a stable code and, where one helps, a hint.
+///
+/// [`AllocateError`] is reliability's plain `thiserror` error; this gives it
+/// its [`miette::Diagnostic`] face without flattening it to a string (the
+/// [`AllocateError::Reliability`] case goes through the located renderer of
+/// every reliability error instead, [`Loaded::report`]).
+#[derive(Debug)]
+struct AllocateFailure {
+    machine: String,
+    error: AllocateError,
+}
+
+impl fmt::Display for AllocateFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.machine, self.error)
+    }
+}
+
+impl std::error::Error for AllocateFailure {}
+
+impl miette::Diagnostic for AllocateFailure {
+    fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
+        let code = match &self.error {
+            AllocateError::Reliability(_) => "chain::allocate::reliability",
+            AllocateError::NoRequirement => "chain::allocate::no_requirement",
+            AllocateError::Unsupported(_) => "chain::allocate::unsupported",
+            AllocateError::Infeasible { .. } => "chain::allocate::infeasible",
+            AllocateError::Stalled { .. } => "chain::allocate::stalled",
+            AllocateError::NotConverged(_) => "chain::allocate::not_converged",
+        };
+        Some(Box::new(code))
+    }
+
+    fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
+        let help = match &self.error {
+            AllocateError::Infeasible { .. } => {
+                "lower the requirement, or lower (remove) `min_std` of the binding errors"
+            }
+            AllocateError::NoRequirement => {
+                "add, e.g., `requirement: {min: 0.95, mean: 0.97}` to the reliability section"
+            }
+            AllocateError::Stalled { .. } => {
+                "lower (remove) `min_std` of its errors, or use `--strategy optimal`"
+            }
+            AllocateError::Reliability(_)
+            | AllocateError::Unsupported(_)
+            | AllocateError::NotConverged(_) => return None,
+        };
+        Some(Box::new(help))
+    }
+}
+
+/// The one rendering of an [`AllocateError`]: reliability errors located in
+/// the machine file, the others as an [`AllocateFailure`].
+fn failure(loaded: &Loaded, error: AllocateError) -> miette::Report {
+    match error {
         AllocateError::Reliability(e) => loaded.report(e),
-        AllocateError::Infeasible { .. } => miette::Report::new(
-            MietteDiagnostic::new(format!("{}: {err}", loaded.machine.name))
-                .with_code("chain::allocate::infeasible")
-                .with_help(
-                    "lower the requirement, or lower (remove) `min_std` of the binding errors",
-                ),
-        ),
-        AllocateError::NoRequirement => miette::Report::new(
-            MietteDiagnostic::new(format!("{}: {err}", loaded.machine.name))
-                .with_code("chain::allocate::no_requirement")
-                .with_help(
-                    "add, e.g., `requirement: {min: 0.95, mean: 0.97}` to the reliability section",
-                ),
-        ),
-        other => miette::Report::new(
-            MietteDiagnostic::new(format!("{}: {other}", loaded.machine.name))
-                .with_code("chain::allocate::error"),
-        ),
+        error => miette::Report::new(AllocateFailure {
+            machine: loaded.machine.name.clone(),
+            error,
+        }),
     }
 }
 
-fn summary_json(s: &[Summary]) -> Value {
-    Value::Object(
-        s.iter()
-            .map(|s| {
-                (
-                    s.target.to_string(),
-                    json!({"mean": s.mean, "min": s.min, "max": s.max, "met": s.met}),
-                )
-            })
-            .collect(),
-    )
+/// The result document of `chain allocate`: the allocation of one machine
+/// with the bounds it started from (JSON: docs/allocation.md).
+struct AllocationReport<'a> {
+    machine: &'a str,
+    requirement: Option<Requirement>,
+    bounds: &'a [ErrorBounds],
+    result: &'a Allocation,
 }
 
-fn std_json(s: &[(String, f64)]) -> Value {
-    Value::Object(s.iter().map(|(n, v)| (n.clone(), json!(v))).collect())
-}
-
-fn to_json(
-    machine: &str,
-    req: Option<chain_core::model::Requirement>,
-    bounds: &[ErrorBounds],
-    r: &Allocation,
-) -> Value {
-    let steps: Vec<Value> = r
-        .steps
-        .iter()
+/// `{target: {mean, min, max, met}}` of a list of summaries.
+fn summaries(s: &[Summary]) -> NameMap<String, SummaryDoc> {
+    s.iter()
         .map(|s| {
-            json!({"round": s.round, "tightened": s.tightened, "std": std_json(&s.std),
-                   "summary": summary_json(&s.summaries)})
+            (
+                s.target.to_string(),
+                SummaryDoc {
+                    mean: s.mean,
+                    min: s.min,
+                    max: s.max,
+                    met: s.met,
+                },
+            )
         })
-        .collect();
-    let initial: Vec<(String, f64)> = bounds.iter().map(|b| (b.error.clone(), b.std0)).collect();
-    let mut doc = Map::new();
-    doc.insert("machine".into(), json!(machine));
-    doc.insert("strategy".into(), json!(r.strategy));
-    doc.insert(
-        "requirement".into(),
-        req.map_or(Value::Null, |q| json!({"min": q.min, "mean": q.mean})),
-    );
-    doc.insert(
-        "initial".into(),
-        json!({"std": std_json(&initial), "summary": summary_json(&r.initial)}),
-    );
-    doc.insert("steps".into(), Value::Array(steps));
-    doc.insert(
-        "final".into(),
-        json!({"std": std_json(&r.std), "cost": r.cost, "met": r.met,
-               "summary": summary_json(&r.summaries)}),
-    );
-    if let Some(k) = &r.kkt {
-        doc.insert(
-            "kkt".into(),
-            json!({
-                "stationarity": k.stationarity,
-                "complementarity": k.complementarity,
-                "feasibility": k.feasibility,
-                "dual_feasibility": k.dual_feasibility,
-                "residual": k.residual(),
-                "polished": k.polished,
-                "iterations": k.iterations,
-                "active": k.active.iter().map(|(n, l)| json!({"constraint": n, "multiplier": l})).collect::<Vec<_>>(),
-                "at_bound": k.at_bound.iter().map(|(n, b, z)| json!({"error": n, "bound": b, "multiplier": z})).collect::<Vec<_>>(),
+        .collect()
+}
+
+/// `{error: std}` of a list of named standard deviations.
+fn stds(s: &[(String, f64)]) -> NameMap<&str, f64> {
+    s.iter().map(|(n, v)| (n.as_str(), *v)).collect()
+}
+
+/// One component's reliability over the grid.
+#[derive(Serialize)]
+struct SummaryDoc {
+    mean: f64,
+    min: f64,
+    max: f64,
+    met: Option<bool>,
+}
+
+/// The JSON document (field order = key order).
+#[derive(Serialize)]
+struct AllocationDoc<'a> {
+    machine: &'a str,
+    strategy: &'a str,
+    requirement: Option<Requirement>,
+    initial: InitialDoc<'a>,
+    steps: Vec<StepDoc<'a>>,
+    #[serde(rename = "final")]
+    last: FinalDoc<'a>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    kkt: Option<KktDoc<'a>>,
+}
+
+#[derive(Serialize)]
+struct InitialDoc<'a> {
+    std: NameMap<&'a str, f64>,
+    summary: NameMap<String, SummaryDoc>,
+}
+
+#[derive(Serialize)]
+struct StepDoc<'a> {
+    round: usize,
+    tightened: &'a [String],
+    std: NameMap<&'a str, f64>,
+    summary: NameMap<String, SummaryDoc>,
+}
+
+#[derive(Serialize)]
+struct FinalDoc<'a> {
+    std: NameMap<&'a str, f64>,
+    cost: f64,
+    met: bool,
+    summary: NameMap<String, SummaryDoc>,
+}
+
+#[derive(Serialize)]
+struct KktDoc<'a> {
+    stationarity: f64,
+    complementarity: f64,
+    feasibility: f64,
+    dual_feasibility: f64,
+    residual: f64,
+    polished: bool,
+    iterations: usize,
+    active: Vec<ActiveDoc<'a>>,
+    at_bound: Vec<AtBoundDoc<'a>>,
+}
+
+#[derive(Serialize)]
+struct ActiveDoc<'a> {
+    constraint: &'a str,
+    multiplier: f64,
+}
+
+#[derive(Serialize)]
+struct AtBoundDoc<'a> {
+    error: &'a str,
+    bound: &'a str,
+    multiplier: f64,
+}
+
+impl AllocationReport<'_> {
+    fn document(&self) -> AllocationDoc<'_> {
+        let r = self.result;
+        AllocationDoc {
+            machine: self.machine,
+            strategy: r.strategy,
+            requirement: self.requirement,
+            initial: InitialDoc {
+                std: self
+                    .bounds
+                    .iter()
+                    .map(|b| (b.error.as_str(), b.std0))
+                    .collect(),
+                summary: summaries(&r.initial),
+            },
+            steps: r
+                .steps
+                .iter()
+                .map(|s| StepDoc {
+                    round: s.round,
+                    tightened: &s.tightened,
+                    std: stds(&s.std),
+                    summary: summaries(&s.summaries),
+                })
+                .collect(),
+            last: FinalDoc {
+                std: stds(&r.std),
+                cost: r.cost,
+                met: r.met,
+                summary: summaries(&r.summaries),
+            },
+            kkt: r.kkt.as_ref().map(|k| KktDoc {
+                stationarity: k.stationarity,
+                complementarity: k.complementarity,
+                feasibility: k.feasibility,
+                dual_feasibility: k.dual_feasibility,
+                residual: k.residual(),
+                polished: k.polished,
+                iterations: k.iterations,
+                active: k
+                    .active
+                    .iter()
+                    .map(|(n, l)| ActiveDoc {
+                        constraint: n,
+                        multiplier: *l,
+                    })
+                    .collect(),
+                at_bound: k
+                    .at_bound
+                    .iter()
+                    .map(|(n, b, z)| AtBoundDoc {
+                        error: n,
+                        bound: b,
+                        multiplier: *z,
+                    })
+                    .collect(),
             }),
-        );
+        }
     }
-    Value::Object(doc)
+}
+
+impl Serialize for AllocationReport<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        self.document().serialize(serializer)
+    }
+}
+
+impl Report for AllocationReport<'_> {
+    /// Rounds like Tables 5-7, the changed tolerances, the cost and the KKT check.
+    fn table(&self) -> String {
+        to_table(self.machine, self.requirement, self.bounds, self.result)
+    }
 }
 
 /// σ in Table 1's tolerance units (σ·6 mm, σ·6000 or σ·3000 for angles).
@@ -322,7 +478,7 @@ fn tolerance_units(b: &ErrorBounds, s: f64) -> f64 {
 
 fn to_table(
     machine: &str,
-    req: Option<chain_core::model::Requirement>,
+    req: Option<Requirement>,
     bounds: &[ErrorBounds],
     r: &Allocation,
 ) -> String {

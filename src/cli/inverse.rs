@@ -6,12 +6,13 @@
 
 use std::path::PathBuf;
 
-use chain_core::inverse::{Inverse, Solution, Status};
-use serde_json::{json, Map, Value};
+use chain_core::inverse::{Inverse, InverseError, Solution, Status};
+use chain_core::named::NameMap;
+use serde::{Serialize, Serializer};
 
 use super::csv_input::{read_poses, Orientation, PoseRow};
 use super::reliability::{parse_assignment, resolve_fixed, Loaded};
-use super::report::write_stdout;
+use super::report::{self, Csv, Format, Report};
 
 /// Arguments of `chain inverse`.
 #[derive(Debug, clap::Args)]
@@ -52,62 +53,121 @@ pub fn exec(args: InverseArgs) -> miette::Result<()> {
     let params = reliability::machine::parameters(m, &args.params).map_err(|e| loaded.report(e))?;
     let fixed = resolve_fixed(m, &args.fix)?;
     let (_, poses) = read_poses(&args.pose)?;
-    let solver = Inverse::for_machine(m, &params, &fixed)
-        .map_err(|e| miette::miette!("machine `{}`: {e}", m.name))?;
-    let mut rows = Vec::with_capacity(poses.len());
-    let mut csv_text = String::from("row,status,solution");
-    for v in &m.variables {
-        csv_text.push(',');
-        csv_text.push_str(&v.name);
-    }
-    csv_text.push('\n');
-    for (k, s) in solve_rows(&solver, &poses, m.variables.len(), &fixed)
-        .into_iter()
-        .enumerate()
-    {
-        let sols: Vec<Value> = s
-            .solutions
-            .iter()
-            .map(|q| {
-                let mut o = Map::new();
-                for (var, x) in m.variables.iter().zip(q) {
-                    o.insert(var.name.clone(), json!(x));
-                }
-                Value::Object(o)
-            })
-            .collect();
-        let status = match s.status {
-            Status::Ok => "ok",
-            Status::Unreachable => "unreachable",
-            Status::Singular => "singular",
-        };
-        if s.solutions.is_empty() {
-            csv_text.push_str(&format!("{},{status},", k + 1));
-            csv_text.push_str(&",".repeat(m.variables.len()));
-            csv_text.push('\n');
+    let solver = Inverse::for_machine(m, &params, &fixed).map_err(|error| OnMachine {
+        machine: m.name.clone(),
+        error,
+    })?;
+    let doc = InverseReport {
+        machine: &m.name,
+        method: solver.method(),
+        variables: m.variables.iter().map(|v| v.name.as_str()).collect(),
+        rows: solve_rows(&solver, &poses, m.variables.len(), &fixed),
+    };
+    report::emit(
+        &doc,
+        match args.format {
+            InverseFormat::Json => Format::Json,
+            InverseFormat::Csv => Format::Csv,
+        },
+    )
+}
+
+/// An [`InverseError`] of the machine `machine`: the library's error, its
+/// code and help, with the machine named in the message.
+#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+#[error("machine `{machine}`: {error}")]
+#[diagnostic(forward(error))]
+pub(crate) struct OnMachine {
+    /// The machine's name.
+    pub(crate) machine: String,
+    /// What went wrong.
+    pub(crate) error: InverseError,
+}
+
+/// The result document of `chain inverse`: every pose row's status and
+/// solutions (JSON: docs/inverse.md; CSV: one line per solution).
+struct InverseReport<'a> {
+    machine: &'a str,
+    method: &'static str,
+    variables: Vec<&'a str>,
+    rows: Vec<Solution>,
+}
+
+/// The JSON document (field order = key order).
+#[derive(Serialize)]
+struct InverseDoc<'a> {
+    machine: &'a str,
+    method: &'static str,
+    variables: &'a [&'a str],
+    rows: Vec<RowDoc<'a>>,
+}
+
+/// One pose row: its 1-based number, status and solutions `{variable: value}`.
+#[derive(Serialize)]
+struct RowDoc<'a> {
+    row: usize,
+    status: Status,
+    solutions: Vec<NameMap<&'a str, f64>>,
+}
+
+impl Serialize for InverseReport<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        InverseDoc {
+            machine: self.machine,
+            method: self.method,
+            variables: &self.variables,
+            rows: self
+                .rows
+                .iter()
+                .enumerate()
+                .map(|(k, s)| RowDoc {
+                    row: k + 1,
+                    status: s.status,
+                    solutions: s
+                        .solutions
+                        .iter()
+                        .map(|q| NameMap::zip(self.variables.iter().copied(), q.iter().copied()))
+                        .collect(),
+                })
+                .collect(),
         }
-        for (j, q) in s.solutions.iter().enumerate() {
-            csv_text.push_str(&format!("{},{status},{}", k + 1, j + 1));
-            for x in q {
-                csv_text.push_str(&format!(",{x}"));
+        .serialize(serializer)
+    }
+}
+
+impl Report for InverseReport<'_> {
+    /// `chain inverse` has no table: its text form is the JSON document.
+    fn table(&self) -> String {
+        report::json(self).unwrap_or_default()
+    }
+
+    /// `row,status,solution,<variables>`, one line per solution; an
+    /// unreachable row has one line with empty values.
+    fn csv(&self) -> Option<Csv> {
+        let mut csv = Csv::new(
+            ["row", "status", "solution"]
+                .into_iter()
+                .chain(self.variables.iter().copied()),
+        );
+        for (k, s) in self.rows.iter().enumerate() {
+            let (row, status) = ((k + 1).to_string(), s.status.name());
+            if s.solutions.is_empty() {
+                csv.row(
+                    [row.clone(), status.to_string(), String::new()]
+                        .into_iter()
+                        .chain(self.variables.iter().map(|_| String::new())),
+                );
             }
-            csv_text.push('\n');
+            for (j, q) in s.solutions.iter().enumerate() {
+                csv.row(
+                    [row.clone(), status.to_string(), (j + 1).to_string()]
+                        .into_iter()
+                        .chain(q.iter().map(f64::to_string)),
+                );
+            }
         }
-        rows.push(json!({"row": k + 1, "status": status, "solutions": sols}));
+        Some(csv)
     }
-    if args.format == InverseFormat::Csv {
-        return write_stdout(&csv_text);
-    }
-    let doc = json!({
-        "machine": m.name,
-        "method": solver.method(),
-        "variables": m.variables.iter().map(|v| v.name.clone()).collect::<Vec<_>>(),
-        "rows": rows,
-    });
-    let mut text = serde_json::to_string_pretty(&doc)
-        .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
-    text.push('\n');
-    write_stdout(&text)
 }
 
 /// Solves the pose rows in order, each row's solutions sorted by their

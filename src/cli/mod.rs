@@ -27,19 +27,19 @@ pub struct Cli {
 enum Command {
     /// Derive the exact first-order error model of a machine file.
     Derive(derive::DeriveArgs),
-    /// Machining-accuracy reliability over the workspace grid (FORM, importance sampling, Monte Carlo).
+    /// Machining-accuracy reliability over the workspace grid (FORM, importance sampling, Monte Carlo; Wang & Yuan 2021).
     Reliability(reliability::ReliabilityArgs),
-    /// Reliability sensitivity (default) or geometric sensitivity coefficients (`--kind geometric`, seed 004).
+    /// Reliability sensitivity (default) or geometric sensitivity coefficients (`--kind geometric`, Fan et al. 2020).
     Sensitivity(sensitivity::SensitivityArgs),
-    /// Precision allocation: the paper's tightening or the least-cost tolerances.
+    /// Precision allocation: Wang & Yuan 2021's tightening or the least-cost tolerances.
     Allocate(allocate::AllocateArgs),
-    /// Identify and compensate a swing-angle error from tool-tip heights (seed 003).
+    /// Identify and compensate a swing-angle error from tool-tip heights (Xiao et al. 2020).
     Compensate(compensate::CompensateArgs),
     /// Inverse kinematics: every axis solution of tool poses (point and axis) from a CSV.
     Inverse(inverse::InverseArgs),
     /// Error and reliability along a path (axis values or tool poses) at every instant.
     Path(path::PathArgs),
-    /// Motion conversion (seed 002): CNC axis motions reproducing a cradle-type generator's roll, and their Maclaurin series.
+    /// Motion conversion ("Precision Machining Technology of Jewelry on CNC Machine Tool", 2022): CNC axis motions reproducing a cradle-type generator's roll, and their Maclaurin series.
     Motion(motion::MotionArgs),
 }
 

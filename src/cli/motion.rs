@@ -1,7 +1,8 @@
 //! `chain motion FILE --settings SETTINGS.yaml [--order N] [--tolerance TOL]
 //! [--samples K] [--format table|json|csv] [--plot DIR]`.
 //!
-//! The motion conversion of seed 002: the CNC axis motions of `FILE` that
+//! The motion conversion of the five-axis jewelry machining paper (2022):
+//! the CNC axis motions of `FILE` that
 //! reproduce, at every instant of the roll, the tool pose of the generator
 //! described by the settings file (`docs/motion.md`), checked instant by
 //! instant, and their Maclaurin expansion at `t = 0` with its truncation error
@@ -13,13 +14,15 @@ mod motion_plot;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+use chain_core::conversion::{Conversion, RunOptions};
 use chain_core::model::JointKind;
-use chain_core::motion::{self, Matching, Motion, PoseError, Series};
+use chain_core::motion::{Law, Matching, Motion};
+use chain_core::named::NameMap;
 use chain_core::settings;
-use serde_json::{json, Map, Value};
+use serde::{Serialize, Serializer};
 
 use super::reliability::{parse_assignment, resolve_fixed};
-use super::report::write_stdout;
+use super::report::{self, Csv, Format, Report};
 
 /// Highest order accepted for `--order` and `--max-order`: the JSON lists
 /// the derivatives `k!·a_k`, and 171! overflows `f64`.
@@ -41,8 +44,9 @@ pub enum MotionFormat {
 
 /// Arguments of `chain motion`.
 ///
-/// Converts the roll of a generating machine (the cradle-type generator of
-/// seed 002 by default) into the motions of the CNC machine FILE, so that both
+/// Converts the roll of a generating machine (by default the cradle-type
+/// generator of "Precision Machining Technology of Jewelry on CNC Machine
+/// Tool", 2022) into the motions of the CNC machine FILE, so that both
 /// give the same tool pose relative to the workpiece at every instant, and
 /// expands every axis motion in its Maclaurin series.
 #[derive(Debug, clap::Args)]
@@ -86,22 +90,6 @@ pub struct MotionArgs {
     pub fix: Vec<(String, f64)>,
 }
 
-/// Everything computed for one run.
-struct Run {
-    motion: Motion,
-    settings: settings::Settings,
-    cnc_parameters: Vec<(String, f64)>,
-    times: Vec<f64>,
-    exact: Vec<Vec<f64>>,
-    worst: PoseError,
-    order: usize,
-    series: Series,
-    /// `errors[m][k]` for m = 0..=series order.
-    errors: Vec<Vec<f64>>,
-    tolerance: Option<Vec<f64>>,
-    required: Option<(Option<usize>, Vec<Option<usize>>)>,
-}
-
 /// Runs `chain motion`.
 pub fn exec(args: MotionArgs) -> miette::Result<()> {
     check_args(&args)?;
@@ -123,80 +111,38 @@ pub fn exec(args: MotionArgs) -> miette::Result<()> {
         .zip(&spec.cnc_parameters)
         .map(|(p, v)| (p.name.clone(), *v))
         .collect();
-    let motion = Motion::new(&generator, &cnc, spec).map_err(|e| miette::miette!("{e}"))?;
-    let times = motion.sample_times(args.samples);
-    let q0 = motion.solve_cold(0.0).map_err(|e| miette::miette!("{e}"))?;
-    let exact = motion
-        .trajectory_from(&q0, &times)
-        .map_err(|e| miette::miette!("{e}"))?;
-    let mut worst = PoseError {
-        position: 0.0,
-        rotation: 0.0,
-        axis: 0.0,
-    };
-    for (t, q) in times.iter().zip(&exact) {
-        let e = motion.pose_error(q, *t);
-        worst.position = worst.position.max(e.position);
-        worst.rotation = worst.rotation.max(e.rotation);
-        worst.axis = worst.axis.max(e.axis);
-    }
-    let tolerance: Option<Vec<f64>> = args.tolerance.map(|tol| {
-        let ang = args.angular_tolerance.unwrap_or(tol);
-        motion
-            .kinds()
-            .iter()
-            .map(|k| if *k == JointKind::Rotary { ang } else { tol })
-            .collect()
-    });
-    let computed = if tolerance.is_some() {
-        args.order.max(args.max_order)
-    } else {
-        args.order
-    };
-    let series = motion
-        .series_from(&q0, computed)
-        .map_err(|e| miette::miette!("{e}"))?;
-    let errors = motion::truncation_errors(&series, &times, &exact);
-    let required = tolerance
-        .as_ref()
-        .map(|tol| motion::required_orders(&errors, tol));
-    let run = Run {
+    let motion = Motion::new(&generator, &cnc, spec)?;
+    let conversion = Conversion::run(
         motion,
+        &RunOptions {
+            samples: args.samples,
+            order: args.order,
+            max_order: args.max_order,
+            tolerance: args.tolerance,
+            angular_tolerance: args.angular_tolerance,
+        },
+    )?;
+    let mut doc = MotionReport {
+        conversion,
         settings,
         cnc_parameters,
-        times,
-        exact,
-        worst,
-        order: args.order,
-        series,
-        errors,
-        tolerance,
-        required,
+        written: Vec::new(),
     };
-    if args.format == MotionFormat::Csv {
-        let mut files = Vec::new();
-        if let Some(dir) = &args.plot {
-            files = motion_plot::write_all(dir, &run_view(&run))?;
-        }
-        for f in &files {
-            eprintln!("wrote {}", f.display());
-        }
-        return write_stdout(&csv(&run));
+    if let Some(dir) = &args.plot {
+        doc.written = motion_plot::write_all(dir, &doc.view())?;
     }
-    let files = match &args.plot {
-        Some(dir) => motion_plot::write_all(dir, &run_view(&run))?,
-        None => Vec::new(),
-    };
-    let text = match args.format {
-        MotionFormat::Json => {
-            let mut s = serde_json::to_string_pretty(&json_document(&run, &files))
-                .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
-            s.push('\n');
-            s
+    let format = match args.format {
+        MotionFormat::Table => Format::Table,
+        MotionFormat::Json => Format::Json,
+        MotionFormat::Csv => {
+            // The CSV is the motion alone: the files go to stderr.
+            for f in &doc.written {
+                eprintln!("wrote {}", f.display());
+            }
+            Format::Csv
         }
-        _ => table(&run, &files),
     };
-    write_stdout(&text)
+    report::emit(&doc, format)
 }
 
 fn check_args(args: &MotionArgs) -> miette::Result<()> {
@@ -231,22 +177,34 @@ fn check_args(args: &MotionArgs) -> miette::Result<()> {
     Ok(())
 }
 
-fn run_view(run: &Run) -> motion_plot::View<'_> {
-    motion_plot::View {
-        title: format!(
-            "{} → {} ({})",
-            run.motion.generator_name(),
-            run.motion.cnc_name(),
-            run.settings.name
-        ),
-        variables: run.motion.variables(),
-        kinds: run.motion.kinds(),
-        times: &run.times,
-        exact: &run.exact,
-        series: &run.series,
-        order: run.order,
-        errors: &run.errors,
-        tolerance: run.tolerance.as_deref(),
+/// The result document of `chain motion`: one conversion run with the
+/// settings it came from and the plot files written (docs/motion.md).
+struct MotionReport {
+    conversion: Conversion,
+    settings: settings::Settings,
+    cnc_parameters: Vec<(String, f64)>,
+    written: Vec<PathBuf>,
+}
+
+impl MotionReport {
+    fn view(&self) -> motion_plot::View<'_> {
+        let run = &self.conversion;
+        motion_plot::View {
+            title: format!(
+                "{} → {} ({})",
+                run.motion.generator_name(),
+                run.motion.cnc_name(),
+                self.settings.name
+            ),
+            variables: run.motion.variables(),
+            kinds: run.motion.kinds(),
+            times: &run.times,
+            exact: &run.exact,
+            series: &run.series,
+            order: run.order,
+            errors: &run.errors,
+            tolerance: run.required.as_ref().map(|r| r.tolerance.as_slice()),
+        }
     }
 }
 
@@ -257,116 +215,160 @@ fn unit(kind: JointKind) -> &'static str {
     }
 }
 
-fn csv(run: &Run) -> String {
-    let mut s = String::from("t");
-    for v in run.motion.variables() {
-        s.push(',');
-        s.push_str(v);
-    }
-    s.push('\n');
-    for (t, q) in run.times.iter().zip(&run.exact) {
-        let _ = write!(s, "{t}");
-        for x in q {
-            let _ = write!(s, ",{x}");
+/// A value per CNC axis, keyed by the axis variable.
+type PerAxis<'a, V> = NameMap<&'a str, V>;
+
+/// The JSON document (field order = key order; docs/motion.md).
+#[derive(Serialize)]
+struct MotionDoc<'a> {
+    machine: &'a str,
+    generator: &'a str,
+    settings: &'a str,
+    #[serde(rename = "match")]
+    matching: Matching,
+    variables: &'a [String],
+    units: PerAxis<'a, &'static str>,
+    parameters: NameMap<&'a str, f64>,
+    fixed: PerAxis<'a, f64>,
+    generator_laws: NameMap<&'a str, Law>,
+    interval: [f64; 2],
+    samples: usize,
+    equivalence: EquivalenceDoc,
+    order: usize,
+    at_zero: PerAxis<'a, f64>,
+    coefficients: PerAxis<'a, &'a [f64]>,
+    derivatives: PerAxis<'a, Vec<f64>>,
+    truncation_error: PerAxis<'a, f64>,
+    errors_by_order: Vec<OrderDoc<'a>>,
+    required_order: Option<RequiredDoc<'a>>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    written: Vec<String>,
+}
+
+/// The worst pose difference of the two chains over the roll.
+#[derive(Serialize)]
+struct EquivalenceDoc {
+    max_position_error: f64,
+    max_rotation_error: f64,
+    max_axis_error: f64,
+}
+
+/// The truncation error of one order.
+#[derive(Serialize)]
+struct OrderDoc<'a> {
+    order: usize,
+    max_error: PerAxis<'a, f64>,
+}
+
+/// The order a tolerance needs.
+#[derive(Serialize)]
+struct RequiredDoc<'a> {
+    tolerance: PerAxis<'a, f64>,
+    searched_up_to: usize,
+    all: Option<usize>,
+    per_axis: PerAxis<'a, Option<usize>>,
+}
+
+impl Serialize for MotionReport {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let run = &self.conversion;
+        let m = &run.motion;
+        let names = || m.variables().iter().map(String::as_str);
+        let n = run.order;
+        MotionDoc {
+            machine: m.cnc_name(),
+            generator: m.generator_name(),
+            settings: &self.settings.name,
+            matching: m.matching(),
+            variables: m.variables(),
+            units: NameMap::zip(names(), m.kinds().iter().map(|k| unit(*k))),
+            parameters: self
+                .cnc_parameters
+                .iter()
+                .map(|(k, v)| (k.as_str(), *v))
+                .collect(),
+            fixed: m
+                .fixed()
+                .iter()
+                .map(|&(i, v)| (m.variables()[i].as_str(), v))
+                .collect(),
+            generator_laws: NameMap::zip(
+                m.generator_variables().iter().map(String::as_str),
+                m.laws().iter().copied(),
+            ),
+            interval: [m.interval().0, m.interval().1],
+            samples: run.times.len(),
+            equivalence: EquivalenceDoc {
+                max_position_error: run.worst.position,
+                max_rotation_error: run.worst.rotation,
+                max_axis_error: run.worst.axis,
+            },
+            order: n,
+            at_zero: NameMap::zip(names(), run.series.axes.iter().map(|j| j.value())),
+            coefficients: NameMap::zip(
+                names(),
+                run.series.axes.iter().map(|j| &j.coefficients()[..=n]),
+            ),
+            derivatives: NameMap::zip(
+                names(),
+                run.series
+                    .axes
+                    .iter()
+                    .map(|j| (0..=n).map(|k| j.derivative(k)).collect()),
+            ),
+            truncation_error: NameMap::zip(names(), run.truncation_error().iter().copied()),
+            errors_by_order: run
+                .errors
+                .iter()
+                .enumerate()
+                .map(|(order, e)| OrderDoc {
+                    order,
+                    max_error: NameMap::zip(names(), e.iter().copied()),
+                })
+                .collect(),
+            required_order: run.required.as_ref().map(|r| RequiredDoc {
+                tolerance: NameMap::zip(names(), r.tolerance.iter().copied()),
+                searched_up_to: r.searched_up_to,
+                all: r.all,
+                per_axis: NameMap::zip(names(), r.per_axis.iter().copied()),
+            }),
+            written: self
+                .written
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect(),
         }
-        s.push('\n');
+        .serialize(serializer)
     }
-    s
 }
 
-fn per_axis(names: &[String], values: impl IntoIterator<Item = Value>) -> Value {
-    let mut m = Map::new();
-    for (n, v) in names.iter().zip(values) {
-        m.insert(n.clone(), v);
+impl Report for MotionReport {
+    /// Settings, laws, the equivalence check, the coefficients, the
+    /// truncation errors and the required order.
+    fn table(&self) -> String {
+        table(self)
     }
-    Value::Object(m)
-}
 
-fn json_document(run: &Run, files: &[PathBuf]) -> Value {
-    let m = &run.motion;
-    let names = m.variables();
-    let n = run.order;
-    let laws: Map<String, Value> = m
-        .generator_variables()
-        .iter()
-        .zip(m.laws())
-        .map(|(v, l)| (v.clone(), json!({"start": l.start, "rate": l.rate})))
-        .collect();
-    let fixed: Map<String, Value> = m
-        .fixed()
-        .iter()
-        .map(|&(i, v)| (names[i].clone(), json!(v)))
-        .collect();
-    let coefficients = per_axis(
-        names,
-        run.series
-            .axes
-            .iter()
-            .map(|j| json!(j.coefficients()[..=n].to_vec())),
-    );
-    let derivatives = per_axis(
-        names,
-        run.series
-            .axes
-            .iter()
-            .map(|j| json!((0..=n).map(|k| j.derivative(k)).collect::<Vec<f64>>())),
-    );
-    let errors_by_order: Vec<Value> = run
-        .errors
-        .iter()
-        .enumerate()
-        .map(|(order, e)| {
-            json!({"order": order, "max_error": per_axis(names, e.iter().map(|x| json!(x)))})
-        })
-        .collect();
-    let required = match (&run.tolerance, &run.required) {
-        (Some(tol), Some((all, each))) => json!({
-            "tolerance": per_axis(names, tol.iter().map(|x| json!(x))),
-            "searched_up_to": run.series.order(),
-            "all": all,
-            "per_axis": per_axis(names, each.iter().map(|x| json!(x))),
-        }),
-        _ => Value::Null,
-    };
-    let mut doc = json!({
-        "machine": m.cnc_name(),
-        "generator": m.generator_name(),
-        "settings": run.settings.name,
-        "match": m.matching().name(),
-        "variables": names,
-        "units": per_axis(names, m.kinds().iter().map(|k| json!(unit(*k)))),
-        "parameters": run.cnc_parameters.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<Map<String, Value>>(),
-        "fixed": fixed,
-        "generator_laws": laws,
-        "interval": [m.interval().0, m.interval().1],
-        "samples": run.times.len(),
-        "equivalence": {
-            "max_position_error": run.worst.position,
-            "max_rotation_error": run.worst.rotation,
-            "max_axis_error": run.worst.axis,
-        },
-        "order": n,
-        "at_zero": per_axis(names, run.series.axes.iter().map(|j| json!(j.value()))),
-        "coefficients": coefficients,
-        "derivatives": derivatives,
-        "truncation_error": per_axis(names, run.errors[n].iter().map(|x| json!(x))),
-        "errors_by_order": errors_by_order,
-        "required_order": required,
-    });
-    if !files.is_empty() {
-        doc["written"] = json!(files
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect::<Vec<_>>());
+    /// The exact motion: `t,<CNC variables>`, one line per instant.
+    fn csv(&self) -> Option<Csv> {
+        let run = &self.conversion;
+        let mut csv = Csv::new(
+            std::iter::once("t").chain(run.motion.variables().iter().map(String::as_str)),
+        );
+        for (t, q) in run.times.iter().zip(&run.exact) {
+            csv.row(std::iter::once(t.to_string()).chain(q.iter().map(f64::to_string)));
+        }
+        Some(csv)
     }
-    doc
 }
 
 fn sci(x: f64) -> String {
     format!("{x:.3e}")
 }
 
-fn table(run: &Run, files: &[PathBuf]) -> String {
+fn table(doc: &MotionReport) -> String {
+    let run = &doc.conversion;
+    let files = &doc.written;
     let m = &run.motion;
     let names = m.variables();
     let kinds = m.kinds();
@@ -378,10 +380,10 @@ fn table(run: &Run, files: &[PathBuf]) -> String {
         "Motion conversion {} → {} (settings `{}`, {})",
         m.generator_name(),
         m.cnc_name(),
-        run.settings.name,
-        run.settings.file
+        doc.settings.name,
+        doc.settings.file
     );
-    if let Some(d) = &run.settings.description {
+    if let Some(d) = &doc.settings.description {
         let _ = writeln!(s, "  {d}");
     }
     let _ = writeln!(
@@ -401,7 +403,7 @@ fn table(run: &Run, files: &[PathBuf]) -> String {
             let _ = writeln!(s, "  {v:>10} = {:.10} + {:.10}·t", l.start, l.rate);
         }
     }
-    let params: Vec<String> = run
+    let params: Vec<String> = doc
         .cnc_parameters
         .iter()
         .map(|(k, v)| format!("{k} = {v}"))
@@ -453,9 +455,9 @@ fn table(run: &Run, files: &[PathBuf]) -> String {
     header(&mut s, "m");
     // Up to the requested order, or a little past the required one.
     let last = run.errors.len() - 1;
-    let shown = match &run.required {
-        Some((Some(all), _)) => n.max(all + 3).min(last),
-        Some((None, _)) => last,
+    let shown = match run.required.as_ref().map(|r| r.all) {
+        Some(Some(all)) => n.max(all + 3).min(last),
+        Some(None) => last,
         None => n,
     };
     for (order, e) in run.errors.iter().enumerate().take(shown + 1) {
@@ -474,7 +476,8 @@ fn table(run: &Run, files: &[PathBuf]) -> String {
     } else {
         let _ = writeln!(s, "  (* the requested order {n})");
     }
-    if let (Some(tol), Some((all, each))) = (&run.tolerance, &run.required) {
+    if let Some(required) = &run.required {
+        let (tol, all, each) = (&required.tolerance, required.all, &required.per_axis);
         let lin = kinds
             .iter()
             .zip(tol)

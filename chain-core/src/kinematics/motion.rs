@@ -121,13 +121,15 @@ pub struct MotionSpec {
 }
 
 /// Why a motion cannot be set up or solved.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error, miette::Diagnostic)]
 pub enum MotionError {
     /// The specification does not fit the machines.
     #[error("{0}")]
+    #[diagnostic(code(chain::motion::spec))]
     Spec(String),
     /// More free CNC variables than conditions.
     #[error("the CNC machine `{machine}` has {free} free variables but matching the {what} gives {rows} conditions; hold the others (cnc.fix / --fix, e.g. mu=0) or match the full pose")]
+    #[diagnostic(code(chain::motion::underdetermined))]
     Underdetermined {
         /// The CNC machine.
         machine: String,
@@ -140,6 +142,10 @@ pub enum MotionError {
     },
     /// No axis values reproduce the generator's pose at an instant.
     #[error("at t = {t}: the CNC machine cannot reproduce the generator's {what} (best residual: position {position:.3e}, angle {angle:.3e} rad)")]
+    #[diagnostic(
+        code(chain::motion::unreachable),
+        help("check the settings against the CNC machine's parameters and strokes, or its `start` guess")
+    )]
     Unreachable {
         /// The instant.
         t: f64,
@@ -153,6 +159,10 @@ pub enum MotionError {
     /// The motion cannot be followed continuously: near `t` a rotary axis
     /// jumps however small the step (a singularity on the path).
     #[error("near t = {t}: the CNC axes cannot follow the generator's {what} continuously (a rotary axis jumps however small the step: a singular configuration on the roll)")]
+    #[diagnostic(
+        code(chain::motion::discontinuous),
+        help("shorten the roll interval so that it stays on one side of the singular configuration")
+    )]
     Discontinuous {
         /// The instant.
         t: f64,
@@ -162,6 +172,7 @@ pub enum MotionError {
     /// The Jacobian of the conditions is singular at `t = 0`: the series is
     /// not defined by the method.
     #[error("the CNC axes are singular at t = 0 (the Jacobian of the {what} has rank below the number of free variables); no Maclaurin series")]
+    #[diagnostic(code(chain::motion::singular))]
     Singular {
         /// `pose` or `tool point and axis`.
         what: &'static str,
