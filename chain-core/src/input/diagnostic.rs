@@ -29,8 +29,10 @@ use crate::model::{ErrorKind, Origin};
 /// independent of where it is.
 ///
 /// `Display` gives the full message (headline plus the parenthesised note);
-/// [`Problem::headline`], [`Problem::note`], [`Problem::help`],
-/// [`Problem::label`] and [`Problem::code`] give its parts.
+/// [`Problem::describe`] gives all its parts (headline, note, help, span
+/// label, code) from one match arm per variant, and [`Problem::headline`],
+/// [`Problem::note`], [`Problem::help`], [`Problem::label`] and
+/// [`Problem::code`] each one of them.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum Problem {
@@ -1110,360 +1112,47 @@ impl miette::Diagnostic for Diagnostics {
 }
 
 #[cfg(test)]
-mod tmp_equivalence {
+mod tests {
     use super::*;
-    #[allow(dead_code)]
-    impl Problem {
-        /// The main message, without the parenthesised note.
-        pub fn old_headline(&self) -> String {
-            match self {
-                Problem::Io { message } => format!("cannot read the file: {message}"),
-                Problem::TooLarge { limit } => {
-                    format!("the file is too large (more than {limit} bytes)")
-                }
-                Problem::Binary { offset } => {
-                    format!("not a text file (NUL byte at byte offset {offset})")
-                }
-                Problem::InvalidUtf8 { offset } => {
-                    format!("the file is not valid UTF-8 (invalid byte at byte offset {offset})")
-                }
-                Problem::Empty => "the machine file is empty".into(),
-                Problem::Syntax { message } => format!("YAML syntax error: {message}"),
-                Problem::MultipleDocuments => "more than one YAML document in the file".into(),
-                Problem::TooDeep { limit } => format!("nested more than {limit} levels deep"),
-                Problem::AliasLimit { limit } => {
-                    format!("the file expands to more than {limit} YAML nodes")
-                }
-                Problem::RecursiveAlias => "an alias refers to a collection that contains it".into(),
-                Problem::NonScalarKey => "a mapping key must be a plain name".into(),
-                Problem::DuplicateKey { key, first_line } => {
-                    format!("duplicate key `{key}` (first given on line {first_line})")
-                }
-                Problem::TopLevelNotMapping { found } => {
-                    format!("the top level must be a mapping, found {found}")
-                }
-                Problem::WrongType { expected, found } => format!("expected {expected}, found {found}"),
-                Problem::UnknownKey { key, .. } => format!("unknown key `{key}`"),
-                Problem::MissingKey { key } => format!("missing required key `{key}`"),
-                Problem::InvalidName { name, what } => format!("`{name}` is not a valid {what} name"),
-                Problem::ReservedName { name } => {
-                    format!("`{name}` is reserved by the expression language")
-                }
-                Problem::UnknownValue { what, found, .. } => format!("unknown {what} `{found}`"),
-                Problem::NoBodies => "`bodies` is empty".into(),
-                Problem::UnknownBody { role, name, .. } => {
-                    format!("{role} `{name}` is not a body of this machine")
-                }
-                Problem::Cycle { bodies } => {
-                    let path: Vec<String> = bodies.iter().map(|b| format!("`{b}`")).collect();
-                    format!("the parent links form a cycle: {}", path.join(" -> "))
-                }
-                Problem::SecondRoot { first, second } => format!(
-                    "`{second}` is a second root body: both `{first}` and `{second}` have no parent"
-                ),
-                Problem::NoRoot => "no root body: every body has a parent".into(),
-                Problem::WorkpieceIsTool { name } => {
-                    format!("the workpiece and the tool are the same body `{name}`")
-                }
-                Problem::DuplicateVariable { name, body } => {
-                    format!("variable `{name}` already drives the joint of body `{body}`")
-                }
-                Problem::NameCollision { name, what, other } => {
-                    format!("{what} `{name}` has the same name as a {other}")
-                }
-                Problem::UnknownName { name, .. } => {
-                    format!("unknown name `{name}`: not a declared parameter")
-                }
-                Problem::Expression { message } => format!("cannot parse the expression: {message}"),
-                Problem::ParameterInDivisor { name } => format!("parameter `{name}` is in a divisor"),
-                Problem::NegativePowerOfParameter { name } => {
-                    format!("parameter `{name}` is raised to a negative power")
-                }
-                Problem::NameInNumber { name } => {
-                    format!("`{name}` is a name, but only numbers are allowed here")
-                }
-                Problem::NotPositive { what, value } => {
-                    format!("{what} must be positive and finite, got {value}")
-                }
-                Problem::NotFinite { what } => format!("{what} must be finite"),
-                Problem::OutOfRange { what, value, range } => {
-                    format!("{what} must be in {range}, got {value}")
-                }
-                Problem::UniformBounds { min, max } => {
-                    format!("a uniform distribution needs min < max, got min = {min}, max = {max}")
-                }
-                Problem::Conflict { first, second } => {
-                    format!("`{first}` and `{second}` cannot both be given")
-                }
-                Problem::MissingSpread { dist } => {
-                    if *dist == "uniform" {
-                        "a uniform distribution needs `min` and `max`, or `std` or `tolerance`".into()
-                    } else {
-                        format!("a {dist} distribution needs `std` or `tolerance`")
-                    }
-                }
-                Problem::KeyNotForDistribution { key, dist } => {
-                    format!("`{key}` does not apply to a {dist} distribution")
-                }
-                Problem::UnknownError { name, .. } => {
-                    format!("statistics for `{name}`, but no body uses an error parameter of that name")
-                }
-                Problem::ErrorKindConflict {
-                    name,
-                    first,
-                    second,
-                    first_line,
-                } => format!(
-                    "error `{name}` is used as {} here but as {} on line {first_line}",
-                    kind_name(*second),
-                    kind_name(*first)
-                ),
-                Problem::UnknownVariable { name, .. } => {
-                    format!("`{name}` is not an axis variable of this machine")
-                }
-                Problem::EmptyList { what } => format!("{what} must not be empty"),
-                Problem::WrongLength { expected, found } => {
-                    format!("expected a list of {expected} items, found {found}")
-                }
-                Problem::Message(m) => match did_you_mean(&m.suggestion) {
-                    Some(s) => format!("{} ({s})", m.text),
-                    None => m.text.clone(),
-                },
-            }
-        }
-    
-        /// The parenthesised note that follows the headline (and the key), if any:
-        /// the valid alternatives or the closest one.
-        pub fn old_note(&self) -> Option<String> {
-            match self {
-                Problem::UnknownKey {
-                    expected,
-                    suggestion,
-                    ..
-                }
-                | Problem::UnknownValue {
-                    expected,
-                    suggestion,
-                    ..
-                } => Some(match did_you_mean(suggestion) {
-                    Some(s) => format!("{s} {}", one_of(expected)),
-                    None => one_of(expected),
-                }),
-                Problem::UnknownBody { suggestion, .. }
-                | Problem::UnknownError { suggestion, .. }
-                | Problem::UnknownVariable { suggestion, .. } => did_you_mean(suggestion),
-                Problem::UnknownName { hint, .. } => hint.clone(),
-                Problem::InvalidName { .. } => {
-                    Some("use letters, digits and `_`, starting with a letter or `_`".into())
-                }
-                Problem::ReservedName { .. } => Some("pi, sin and cos are reserved".into()),
-                Problem::ParameterInDivisor { .. } | Problem::NegativePowerOfParameter { .. } => {
-                    Some("the derivation needs polynomials in the parameters".into())
-                }
-                Problem::AliasLimit { .. } => {
-                    Some("each use of an alias counts its whole anchor; an alias bomb?".into())
-                }
-                Problem::MultipleDocuments => Some("a machine file holds exactly one".into()),
-                Problem::Empty => {
-                    Some("expected a mapping with at least `machine` and `bodies`".into())
-                }
-                _ => None,
-            }
-        }
-    
-        /// A longer hint for the reader, if one helps.
-        pub fn old_help(&self) -> Option<String> {
-            match self {
-                Problem::SecondRoot { second, .. } => Some(format!(
-                    "give `{second}` a `parent`; exactly one body (the bed) has none"
-                )),
-                Problem::NoRoot | Problem::Cycle { .. } => {
-                    Some("exactly one body (the bed) has no `parent`".into())
-                }
-                Problem::UnknownName { .. } => {
-                    Some("declare it under `parameters` (null makes it symbolic)".into())
-                }
-                Problem::Conflict { first, second } if *first == "std" && *second == "tolerance" => {
-                    Some("std = tolerance / sigma_rule; give one of them".into())
-                }
-                Problem::UnknownError { .. } => {
-                    Some("statistics entries are keyed by error names used in the bodies".into())
-                }
-                Problem::NameCollision { .. } => Some(
-                    "variables, parameters and error parameters share one namespace in the model"
-                        .into(),
-                ),
-                Problem::Message(m) => m.help.clone(),
-                _ => None,
-            }
-        }
-    
-        /// A short label for the span in a rendered snippet.
-        pub fn old_label(&self) -> &'static str {
-            match self {
-                Problem::Io { .. } | Problem::TooLarge { .. } => "file",
-                Problem::Binary { .. } => "NUL byte",
-                Problem::InvalidUtf8 { .. } => "invalid UTF-8",
-                Problem::Empty => "empty",
-                Problem::Syntax { .. } => "syntax error",
-                Problem::MultipleDocuments => "second document",
-                Problem::TooDeep { .. } => "too deep",
-                Problem::AliasLimit { .. } | Problem::RecursiveAlias => "alias",
-                Problem::NonScalarKey => "not a name",
-                Problem::DuplicateKey { .. } => "duplicate key",
-                Problem::TopLevelNotMapping { .. } | Problem::WrongType { .. } => "wrong type",
-                Problem::UnknownKey { .. } => "unknown key",
-                Problem::MissingKey { .. } => "missing key",
-                Problem::InvalidName { .. } | Problem::ReservedName { .. } => "invalid name",
-                Problem::UnknownValue { .. } => "unknown value",
-                Problem::NoBodies => "no bodies",
-                Problem::UnknownBody { .. } => "unknown body",
-                Problem::Cycle { .. } => "cycle",
-                Problem::SecondRoot { .. } | Problem::NoRoot => "root",
-                Problem::WorkpieceIsTool { .. } => "same body",
-                Problem::DuplicateVariable { .. } => "duplicate variable",
-                Problem::NameCollision { .. } => "name collision",
-                Problem::UnknownName { .. } => "unknown name",
-                Problem::Expression { .. } => "here",
-                Problem::ParameterInDivisor { .. } | Problem::NegativePowerOfParameter { .. } => {
-                    "parameter"
-                }
-                Problem::NameInNumber { .. } => "not a number",
-                Problem::NotPositive { .. }
-                | Problem::NotFinite { .. }
-                | Problem::OutOfRange { .. }
-                | Problem::UniformBounds { .. } => "out of range",
-                Problem::Conflict { .. } => "conflicting key",
-                Problem::MissingSpread { .. } => "no spread",
-                Problem::KeyNotForDistribution { .. } => "not for this distribution",
-                Problem::UnknownError { .. } => "unknown error",
-                Problem::ErrorKindConflict { .. } => "kind conflict",
-                Problem::UnknownVariable { .. } => "unknown variable",
-                Problem::EmptyList { .. } => "empty",
-                Problem::WrongLength { .. } => "wrong length",
-                Problem::Message(m) => m.label,
-            }
-        }
-    
-        /// A stable machine-readable code, e.g. `chain::unknown_key`.
-        pub fn old_code(&self) -> &'static str {
-            match self {
-                Problem::Io { .. } => "chain::io",
-                Problem::TooLarge { .. } => "chain::too_large",
-                Problem::Binary { .. } => "chain::binary",
-                Problem::InvalidUtf8 { .. } => "chain::invalid_utf8",
-                Problem::Empty => "chain::empty",
-                Problem::Syntax { .. } => "chain::yaml_syntax",
-                Problem::MultipleDocuments => "chain::multiple_documents",
-                Problem::TooDeep { .. } => "chain::too_deep",
-                Problem::AliasLimit { .. } => "chain::alias_limit",
-                Problem::RecursiveAlias => "chain::recursive_alias",
-                Problem::NonScalarKey => "chain::non_scalar_key",
-                Problem::DuplicateKey { .. } => "chain::duplicate_key",
-                Problem::TopLevelNotMapping { .. } => "chain::top_level",
-                Problem::WrongType { .. } => "chain::wrong_type",
-                Problem::UnknownKey { .. } => "chain::unknown_key",
-                Problem::MissingKey { .. } => "chain::missing_key",
-                Problem::InvalidName { .. } => "chain::invalid_name",
-                Problem::ReservedName { .. } => "chain::reserved_name",
-                Problem::UnknownValue { .. } => "chain::unknown_value",
-                Problem::NoBodies => "chain::no_bodies",
-                Problem::UnknownBody { .. } => "chain::unknown_body",
-                Problem::Cycle { .. } => "chain::cycle",
-                Problem::SecondRoot { .. } => "chain::second_root",
-                Problem::NoRoot => "chain::no_root",
-                Problem::WorkpieceIsTool { .. } => "chain::workpiece_is_tool",
-                Problem::DuplicateVariable { .. } => "chain::duplicate_variable",
-                Problem::NameCollision { .. } => "chain::name_collision",
-                Problem::UnknownName { .. } => "chain::unknown_name",
-                Problem::Expression { .. } => "chain::expression",
-                Problem::ParameterInDivisor { .. } => "chain::parameter_in_divisor",
-                Problem::NegativePowerOfParameter { .. } => "chain::negative_power",
-                Problem::NameInNumber { .. } => "chain::name_in_number",
-                Problem::NotPositive { .. } => "chain::not_positive",
-                Problem::NotFinite { .. } => "chain::not_finite",
-                Problem::OutOfRange { .. } => "chain::out_of_range",
-                Problem::UniformBounds { .. } => "chain::uniform_bounds",
-                Problem::Conflict { .. } => "chain::conflicting_keys",
-                Problem::MissingSpread { .. } => "chain::missing_spread",
-                Problem::KeyNotForDistribution { .. } => "chain::key_not_for_distribution",
-                Problem::UnknownError { .. } => "chain::unknown_error",
-                Problem::ErrorKindConflict { .. } => "chain::error_kind_conflict",
-                Problem::UnknownVariable { .. } => "chain::unknown_variable",
-                Problem::EmptyList { .. } => "chain::empty_list",
-                Problem::WrongLength { .. } => "chain::wrong_length",
-                Problem::Message(m) => m.code,
-            }
-        }
-    }
-    
 
     #[test]
-    fn same_as_before() {
-        let s = || Some("abc".to_string());
-        let ps = vec![
-            Problem::Io { message: "m".into() },
-            Problem::TooLarge { limit: 3 },
-            Problem::Binary { offset: 3 },
-            Problem::InvalidUtf8 { offset: 3 },
-            Problem::Empty,
-            Problem::Syntax { message: "m".into() },
-            Problem::MultipleDocuments,
-            Problem::TooDeep { limit: 3 },
-            Problem::AliasLimit { limit: 3 },
-            Problem::RecursiveAlias,
-            Problem::NonScalarKey,
-            Problem::DuplicateKey { key: "k".into(), first_line: 2 },
-            Problem::TopLevelNotMapping { found: "f".into() },
-            Problem::WrongType { expected: "e", found: "f".into() },
-            Problem::UnknownKey { key: "k".into(), expected: &["a", "b"], suggestion: s() },
-            Problem::UnknownKey { key: "k".into(), expected: &["a", "b"], suggestion: None },
-            Problem::MissingKey { key: "k" },
-            Problem::InvalidName { name: "n".into(), what: "w" },
-            Problem::ReservedName { name: "n".into() },
-            Problem::UnknownValue { what: "w", found: "f".into(), expected: &["a"], suggestion: s() },
-            Problem::UnknownValue { what: "w", found: "f".into(), expected: &["a"], suggestion: None },
-            Problem::NoBodies,
-            Problem::UnknownBody { role: "r", name: "n".into(), suggestion: s() },
-            Problem::UnknownBody { role: "r", name: "n".into(), suggestion: None },
-            Problem::Cycle { bodies: vec!["a".into(), "b".into(), "a".into()] },
-            Problem::SecondRoot { first: "a".into(), second: "b".into() },
-            Problem::NoRoot,
-            Problem::WorkpieceIsTool { name: "n".into() },
-            Problem::DuplicateVariable { name: "n".into(), body: "b".into() },
-            Problem::NameCollision { name: "n".into(), what: "w", other: "o" },
-            Problem::UnknownName { name: "n".into(), hint: s() },
-            Problem::UnknownName { name: "n".into(), hint: None },
-            Problem::Expression { message: "m".into() },
-            Problem::ParameterInDivisor { name: "n".into() },
-            Problem::NegativePowerOfParameter { name: "n".into() },
-            Problem::NameInNumber { name: "n".into() },
-            Problem::NotPositive { what: "w", value: -1.5 },
-            Problem::NotFinite { what: "w" },
-            Problem::OutOfRange { what: "w", value: 2.0, range: "(0, 1]" },
-            Problem::UniformBounds { min: 1.0, max: 0.0 },
-            Problem::Conflict { first: "std", second: "tolerance" },
-            Problem::Conflict { first: "min", second: "tolerance" },
-            Problem::MissingSpread { dist: "uniform" },
-            Problem::MissingSpread { dist: "normal" },
-            Problem::KeyNotForDistribution { key: "k", dist: "d" },
-            Problem::UnknownError { name: "n".into(), suggestion: s() },
-            Problem::UnknownError { name: "n".into(), suggestion: None },
-            Problem::ErrorKindConflict { name: "n".into(), first: ErrorKind::Linear, second: ErrorKind::Squareness, first_line: 4 },
-            Problem::ErrorKindConflict { name: "n".into(), first: ErrorKind::Angular, second: ErrorKind::Linear, first_line: 4 },
-            Problem::UnknownVariable { name: "n".into(), suggestion: s() },
-            Problem::UnknownVariable { name: "n".into(), suggestion: None },
-            Problem::EmptyList { what: "w" },
-            Problem::WrongLength { expected: 3, found: 2 },
-            Problem::Message(Message::new("t", "l", "chain::c")),
-            Problem::Message(Message::new("t", "l", "chain::c").help("h").suggest(Some("x"))),
-        ];
-        for p in &ps {
-            assert_eq!(p.headline(), p.old_headline(), "{p:?}");
-            assert_eq!(p.note(), p.old_note(), "{p:?}");
-            assert_eq!(p.help(), p.old_help(), "{p:?}");
-            assert_eq!(p.label(), p.old_label(), "{p:?}");
-            assert_eq!(p.code(), p.old_code(), "{p:?}");
-        }
+    fn one_description_gives_every_part() {
+        let p = Problem::UnknownKey {
+            key: "tolerence".into(),
+            expected: &["tolerance", "grid"],
+            suggestion: Some("tolerance".into()),
+        };
+        assert_eq!(
+            p.describe(),
+            Description {
+                headline: "unknown key `tolerence`".into(),
+                note: Some("did you mean `tolerance`? expected one of tolerance, grid".into()),
+                help: None,
+                label: "unknown key",
+                code: "chain::unknown_key",
+            }
+        );
+        assert_eq!(
+            p.to_string(),
+            "unknown key `tolerence` (did you mean `tolerance`? expected one of tolerance, grid)"
+        );
+        let c = Problem::Conflict {
+            first: "std",
+            second: "tolerance",
+        };
+        assert_eq!(
+            c.help().as_deref(),
+            Some("std = tolerance / sigma_rule; give one of them")
+        );
+        let m = Problem::Message(
+            Message::new("unknown machine `x`", "unknown name", "chain::settings::unknown_name")
+                .suggest(Some("y"))
+                .help("name one of the two machines"),
+        );
+        let d = m.describe();
+        assert_eq!(d.headline, "unknown machine `x` (did you mean `y`?)");
+        assert_eq!(d.note, None);
+        assert_eq!(d.help.as_deref(), Some("name one of the two machines"));
+        assert_eq!((d.label, d.code), ("unknown name", "chain::settings::unknown_name"));
     }
 }
