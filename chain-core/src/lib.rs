@@ -6,6 +6,8 @@
 //! canonical polynomials) → export (text / JSON / LaTeX / Rust) or
 //! [`compile`] → [`CompiledModel`], an [`ErrorModel`] evaluated from a flat tape.
 
+#![warn(missing_docs)]
+
 pub mod input;
 pub mod kinematics;
 mod model_trait;

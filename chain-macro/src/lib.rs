@@ -4,6 +4,8 @@
 //! model and emits straight-line Rust. Use it through the facade,
 //! `chain::machine!`; see `docs/macro.md` for the inline syntax.
 
+#![warn(missing_docs)]
+
 use proc_macro::TokenStream;
 
 /// Declares a machine and generates its error model at compile time.
