@@ -46,10 +46,7 @@ mod tests {
     #[test]
     fn pairs_serialise_as_an_object_in_their_order() {
         let m = NameMap::zip(["z", "a"], [1.5, f64::NAN]);
-        assert_eq!(
-            serde_json::to_string(&m).unwrap(),
-            r#"{"z":1.5,"a":null}"#
-        );
+        assert_eq!(serde_json::to_string(&m).unwrap(), r#"{"z":1.5,"a":null}"#);
         let empty: NameMap<&str, f64> = NameMap(Vec::new());
         assert_eq!(serde_json::to_string(&empty).unwrap(), "{}");
     }

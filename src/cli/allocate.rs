@@ -25,14 +25,14 @@ use super::report::{self, Format, Report};
 pub enum StrategyArg {
     /// Least cost `Σ w (σ0/σ − 1)` subject to the requirement (interior point + KKT check).
     Optimal,
-    /// The paper's procedure: tighten the errors within 10 % of the largest sensitivity by one step a round.
+    /// Wang & Yuan 2021's procedure: tighten the errors within 10 % of the largest sensitivity by one step a round.
     Paper,
 }
 
 /// `--rank` of the paper's procedure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum RankArg {
-    /// Rank each unmet component's errors separately (Tables 5-7).
+    /// Rank each unmet component's errors separately (Wang & Yuan 2021, Tables 5-7).
     Component,
     /// Rank the summed sensitivities of all unmet components.
     Pooled,
@@ -41,7 +41,7 @@ pub enum RankArg {
 /// Output formats of `chain allocate`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum AllocateFormat {
-    /// Rounds like Tables 5-7, the final tolerances and the KKT check.
+    /// Rounds like Wang & Yuan 2021's Tables 5-7, the final tolerances and the KKT check.
     Table,
     /// The spec's JSON document.
     Json,
@@ -55,7 +55,7 @@ pub struct AllocateArgs {
     /// Allocation strategy.
     #[arg(long, value_enum, default_value = "optimal")]
     pub strategy: StrategyArg,
-    /// Step of `--strategy paper` in Table 1's tolerance units (σ decreases by
+    /// Step of `--strategy paper` in the tolerance units of Wang & Yuan 2021's Table 1 (σ decreases by
     /// step/6 mm, step/6000 rad for angular and step/3000 rad for squareness errors).
     #[arg(long, value_name = "TOL", default_value_t = 0.005)]
     pub step: f64,

@@ -352,9 +352,8 @@ impl Report for MotionReport {
     /// The exact motion: `t,<CNC variables>`, one line per instant.
     fn csv(&self) -> Option<Csv> {
         let run = &self.conversion;
-        let mut csv = Csv::new(
-            std::iter::once("t").chain(run.motion.variables().iter().map(String::as_str)),
-        );
+        let mut csv =
+            Csv::new(std::iter::once("t").chain(run.motion.variables().iter().map(String::as_str)));
         for (t, q) in run.times.iter().zip(&run.exact) {
             csv.row(std::iter::once(t.to_string()).chain(q.iter().map(f64::to_string)));
         }

@@ -411,9 +411,11 @@ impl Problem {
     pub fn describe(&self) -> Description {
         use Description as D;
         match self {
-            Problem::Io { message } => {
-                D::new("chain::io", "file", format!("cannot read the file: {message}"))
-            }
+            Problem::Io { message } => D::new(
+                "chain::io",
+                "file",
+                format!("cannot read the file: {message}"),
+            ),
             Problem::TooLarge { limit } => D::new(
                 "chain::too_large",
                 "file",
@@ -1145,14 +1147,21 @@ mod tests {
             Some("std = tolerance / sigma_rule; give one of them")
         );
         let m = Problem::Message(
-            Message::new("unknown machine `x`", "unknown name", "chain::settings::unknown_name")
-                .suggest(Some("y"))
-                .help("name one of the two machines"),
+            Message::new(
+                "unknown machine `x`",
+                "unknown name",
+                "chain::settings::unknown_name",
+            )
+            .suggest(Some("y"))
+            .help("name one of the two machines"),
         );
         let d = m.describe();
         assert_eq!(d.headline, "unknown machine `x` (did you mean `y`?)");
         assert_eq!(d.note, None);
         assert_eq!(d.help.as_deref(), Some("name one of the two machines"));
-        assert_eq!((d.label, d.code), ("unknown name", "chain::settings::unknown_name"));
+        assert_eq!(
+            (d.label, d.code),
+            ("unknown name", "chain::settings::unknown_name")
+        );
     }
 }

@@ -161,7 +161,9 @@ pub enum MotionError {
     #[error("near t = {t}: the CNC axes cannot follow the generator's {what} continuously (a rotary axis jumps however small the step: a singular configuration on the roll)")]
     #[diagnostic(
         code(chain::motion::discontinuous),
-        help("shorten the roll interval so that it stays on one side of the singular configuration")
+        help(
+            "shorten the roll interval so that it stays on one side of the singular configuration"
+        )
     )]
     Discontinuous {
         /// The instant.
