@@ -28,6 +28,7 @@ mod common;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::PathBuf;
 
+use chain_core::conversion::{Conversion, RunOptions};
 use chain_core::inverse::wrap;
 use chain_core::jet::Jet;
 use chain_core::model::Machine;
@@ -709,6 +710,101 @@ fn required_order_meets_the_tolerance_and_no_lower_order_does() {
         // The series converges down to the rounding floor of the exact motion.
         assert!(errors[30].iter().all(|e| *e < 1e-11), "{:?}", errors[30]);
     }
+}
+
+#[test]
+fn one_conversion_run_puts_the_pieces_together() {
+    let c = Case::new("seed002_concave");
+    let run = Conversion::run(
+        c.motion(),
+        &RunOptions {
+            samples: 1000,
+            order: 4,
+            max_order: 30,
+            tolerance: Some(1e-6),
+            angular_tolerance: Some(1e-7),
+        },
+    )
+    .unwrap();
+    let m = c.motion();
+    let times = m.sample_times(1000);
+    assert_eq!(run.times, times);
+    assert_eq!(run.exact, m.trajectory(&times).unwrap());
+    // With a tolerance the orders go up to max_order, the table shows order 4.
+    assert_eq!((run.order, run.series.order()), (4, 30));
+    let errors = truncation_errors(&m.series(30).unwrap(), &times, &run.exact);
+    assert_eq!(run.errors, errors);
+    assert_eq!(run.truncation_error(), errors[4].as_slice());
+    let tol: Vec<f64> = m
+        .kinds()
+        .iter()
+        .map(|k| match k {
+            chain_core::model::JointKind::Rotary => 1e-7,
+            chain_core::model::JointKind::Prismatic => 1e-6,
+        })
+        .collect();
+    let (all, each) = required_orders(&errors, &tol);
+    let required = run.required.as_ref().expect("a tolerance was given");
+    assert_eq!(required.tolerance, tol);
+    assert_eq!((required.all, &required.per_axis), (all, &each));
+    assert_eq!(required.searched_up_to, 30);
+    // The two chains agree at every instant (the bound of docs/motion.md).
+    assert!(run.worst.position < 1e-9 && run.worst.rotation < 1e-9, "{:?}", run.worst);
+    // Without a tolerance: the requested order only, no required order.
+    let plain = Conversion::run(
+        c.motion(),
+        &RunOptions {
+            samples: 11,
+            order: 6,
+            max_order: 30,
+            tolerance: None,
+            angular_tolerance: None,
+        },
+    )
+    .unwrap();
+    assert_eq!((plain.series.order(), plain.errors.len()), (6, 7));
+    assert!(plain.required.is_none());
+}
+
+#[test]
+fn specification_errors_are_typed_with_stable_codes() {
+    use miette::Diagnostic;
+    let c = Case::new("seed002_concave");
+    let code = |e: &MotionError| e.code().map(|c| c.to_string());
+    // Held variables with the full pose matched.
+    let mut spec = c.spec.clone();
+    spec.matching = Matching::Pose;
+    spec.fixed = vec![(0, 0.0)];
+    let e = Motion::new(&c.generator, &c.cnc, spec).unwrap_err();
+    assert_eq!(e, MotionError::HeldWithPose);
+    assert_eq!(code(&e).as_deref(), Some("chain::motion::held_with_pose"));
+    // One law short.
+    let mut spec = c.spec.clone();
+    spec.laws.pop();
+    let e = Motion::new(&c.generator, &c.cnc, spec).unwrap_err();
+    assert!(matches!(e, MotionError::LawCount { .. }), "{e:?}");
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "{} laws for the {} variables of the generator `{}`",
+            c.generator.variables.len() - 1,
+            c.generator.variables.len(),
+            c.generator.name
+        )
+    );
+    // A non-finite interval end; a non-finite instant.
+    let mut spec = c.spec.clone();
+    spec.interval.1 = f64::NAN;
+    let e = Motion::new(&c.generator, &c.cnc, spec).unwrap_err();
+    assert_eq!(code(&e).as_deref(), Some("chain::motion::not_finite"));
+    let e = c.motion().trajectory(&[0.0, f64::INFINITY]).unwrap_err();
+    assert_eq!(e, MotionError::InstantNotFinite { t: f64::INFINITY });
+    assert_eq!(e.to_string(), "instant inf is not finite");
+    // Too many free variables: the help says how to hold them.
+    let mut spec = c.spec.clone();
+    spec.matching = Matching::PointAxis;
+    let e = Motion::new(&c.generator, &c.cnc, spec).unwrap_err();
+    assert_eq!(code(&e).as_deref(), Some("chain::motion::underdetermined"));
 }
 
 // ---------------------------------------------------------------------------

@@ -123,10 +123,46 @@ pub struct MotionSpec {
 /// Why a motion cannot be set up or solved.
 #[derive(Debug, Clone, PartialEq, thiserror::Error, miette::Diagnostic)]
 pub enum MotionError {
-    /// The specification does not fit the machines.
-    #[error("{0}")]
-    #[diagnostic(code(chain::motion::spec))]
-    Spec(String),
+    /// The specification has not one law per generator variable.
+    #[error("{laws} laws for the {variables} variables of the generator `{generator}`")]
+    #[diagnostic(code(chain::motion::law_count))]
+    LawCount {
+        /// Laws given.
+        laws: usize,
+        /// Variables of the generator.
+        variables: usize,
+        /// The generator machine.
+        generator: String,
+    },
+    /// The parameter or start vectors of the specification do not have the
+    /// machines' lengths.
+    #[error("parameter or start vectors do not match the machines")]
+    #[diagnostic(code(chain::motion::vector_lengths))]
+    VectorLengths,
+    /// A machine's derived kinematics names variables or parameters the
+    /// machine does not have.
+    #[error("the derived model's names differ from the machine's")]
+    #[diagnostic(code(chain::motion::name_mismatch))]
+    NameMismatch,
+    /// A held variable's index is not a CNC variable.
+    #[error("a fixed variable index is out of range")]
+    #[diagnostic(code(chain::motion::fixed_out_of_range))]
+    FixedOutOfRange,
+    /// Variables are held while the full pose is matched.
+    #[error("held variables need matching of the tool point and axis (point_axis)")]
+    #[diagnostic(code(chain::motion::held_with_pose))]
+    HeldWithPose,
+    /// A setting, parameter, start value, law or interval end is not finite.
+    #[error("a setting, parameter or start value is not finite")]
+    #[diagnostic(code(chain::motion::not_finite))]
+    NotFinite,
+    /// An instant asked of the trajectory is not finite.
+    #[error("instant {t} is not finite")]
+    #[diagnostic(code(chain::motion::instant_not_finite))]
+    InstantNotFinite {
+        /// The instant.
+        t: f64,
+    },
     /// More free CNC variables than conditions.
     #[error("the CNC machine `{machine}` has {free} free variables but matching the {what} gives {rows} conditions; hold the others (cnc.fix / --fix, e.g. mu=0) or match the full pose")]
     #[diagnostic(code(chain::motion::underdetermined))]
@@ -261,22 +297,18 @@ impl Motion {
     ) -> Result<Motion, MotionError> {
         let gk = Kinematics::from_machine(generator);
         let ck = Kinematics::from_machine(cnc);
-        let spec_err = |m: String| MotionError::Spec(m);
         if spec.laws.len() != generator.variables.len() {
-            return Err(spec_err(format!(
-                "{} laws for the {} variables of the generator `{}`",
-                spec.laws.len(),
-                generator.variables.len(),
-                generator.name
-            )));
+            return Err(MotionError::LawCount {
+                laws: spec.laws.len(),
+                variables: generator.variables.len(),
+                generator: generator.name.clone(),
+            });
         }
         if spec.generator_parameters.len() != generator.parameters.len()
             || spec.cnc_parameters.len() != cnc.parameters.len()
             || spec.start.len() != cnc.variables.len()
         {
-            return Err(spec_err(
-                "parameter or start vectors do not match the machines".into(),
-            ));
+            return Err(MotionError::VectorLengths);
         }
         // Machine order → kinematics order, by name.
         let by_name = reorder;
@@ -288,7 +320,7 @@ impl Motion {
             .collect();
         let cvar_names: Vec<String> = cnc.variables.iter().map(|v| v.name.clone()).collect();
         let cpar_names: Vec<String> = cnc.parameters.iter().map(|p| p.name.clone()).collect();
-        let mismatch = || spec_err("the derived model's names differ from the machine's".into());
+        let mismatch = || MotionError::NameMismatch;
         let gen_params = by_name(&gpar_names, gk.parameters(), &spec.generator_parameters)
             .ok_or_else(mismatch)?;
         let cnc_params =
@@ -310,12 +342,10 @@ impl Motion {
         let start: Vec<f64> = perm.iter().map(|&i| spec.start[i]).collect();
         let fixed: Vec<(usize, f64)> = spec.fixed.iter().map(|&(i, v)| (to_kin(i), v)).collect();
         if fixed.iter().any(|&(i, _)| i >= perm.len()) {
-            return Err(spec_err("a fixed variable index is out of range".into()));
+            return Err(MotionError::FixedOutOfRange);
         }
         if spec.matching == Matching::Pose && !fixed.is_empty() {
-            return Err(spec_err(
-                "held variables need matching of the tool point and axis (point_axis)".into(),
-            ));
+            return Err(MotionError::HeldWithPose);
         }
         let all_finite = gen_params
             .iter()
@@ -328,9 +358,7 @@ impl Motion {
             && spec.interval.0.is_finite()
             && spec.interval.1.is_finite();
         if !all_finite {
-            return Err(spec_err(
-                "a setting, parameter or start value is not finite".into(),
-            ));
+            return Err(MotionError::NotFinite);
         }
         let n = ck.variables().len();
         let free: Vec<usize> = (0..n)
@@ -705,10 +733,7 @@ impl Motion {
             let (mut t, mut q) = (0.0, q0.to_vec());
             for i in side {
                 if !times[i].is_finite() {
-                    return Err(MotionError::Spec(format!(
-                        "instant {} is not finite",
-                        times[i]
-                    )));
+                    return Err(MotionError::InstantNotFinite { t: times[i] });
                 }
                 q = self.follow(t, &q, times[i], 0)?;
                 t = times[i];
