@@ -291,6 +291,43 @@ fn cli_csv_format() {
     assert!(lines[1].starts_with("1,ok,1,") && lines[2].starts_with("1,ok,2,"));
 }
 
+#[test]
+fn cli_csv_unreachable_row_has_empty_values() {
+    // The cone machine of `unreachable_pose`: -z is outside its axis cone.
+    let yaml = "machine: cone\nparameters: {}\nbodies:\n  bed: {}\n  x_slide: {parent: bed, joint: {type: prismatic, axis: +x, variable: x}}\n  y_slide: {parent: x_slide, joint: {type: prismatic, axis: +y, variable: y}}\n  z_slide: {parent: y_slide, joint: {type: prismatic, axis: +z, variable: z}}\n  c_head: {parent: z_slide, joint: {type: rotary, axis: +z, variable: C}}\n  b_head: {parent: c_head, rotation: [{about: x, angle: 30deg}], joint: {type: rotary, axis: +z, variable: B}}\n  tool: {parent: b_head, rotation: [{about: x, angle: 30deg}]}\nworkpiece: bed\ntool: tool\n";
+    let file = scratch_file("cone.yaml", yaml);
+    let csv = scratch_file(
+        "cone_poses.csv",
+        "px,py,pz,i,j,k\n1,2,3,0,0,-1\n1,2,3,0.5,0,0.8660254037844386\n",
+    );
+    let text = ok_stdout(&inverse_args(&file, &csv, &["--format", "csv"]));
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "row,status,solution,x,y,z,C,B");
+    assert_eq!(lines[1], "1,unreachable,,,,,,");
+    assert!(lines[2].starts_with("2,ok,1,"), "{text}");
+    let v = ok_json(&inverse_args(&file, &csv, &[]));
+    assert_eq!(v["rows"][0]["status"], "unreachable");
+    assert_eq!(v["rows"][0]["solutions"].as_array().map(Vec::len), Some(0));
+}
+
+#[test]
+fn cli_solver_errors_name_the_machine_and_keep_their_code() {
+    let csv = scratch_file("one_pose.csv", "px,py,pz,i,j,k\n10,20,30,0,0,1\n");
+    let file = machine_path("cnc5_bevel");
+    let mut extra = Vec::new();
+    for v in ["x=0", "y=0", "z=0", "mu=0", "A=0", "B=0"] {
+        extra.extend(["--fix", v]);
+    }
+    let err = fails(&inverse_args(&file, &csv, &extra));
+    assert!(err.contains("chain::inverse::no_free_variable"), "{err}");
+    let flat: String = err.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(
+        flat.contains("machine `cnc5_bevel`: no free axis variable moves the tool point or"),
+        "{err}"
+    );
+    assert!(flat.contains("hold fewer variables (--fix)"), "{err}");
+}
+
 /// Damped Newton with the exact Jacobian finds every closed-form branch.
 fn newton_finds_every_closed_form_solution(name: &str, seed: u64) {
     let (m, model, kinds, params) = load(name);
