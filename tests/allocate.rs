@@ -10,7 +10,7 @@ use std::path::PathBuf;
 
 use chain_core::model::Machine;
 use chain_core::CompiledModel;
-use common::cli::{fails, ok, ok_json, scratch};
+use common::cli::{chain, fails, ok, ok_json, scratch};
 use common::example_path;
 use reliability::allocate::{self, AllocateError, ErrorBounds, Optimal, Paper};
 use reliability::{machine, normal, Form, Study, Summary};
@@ -254,6 +254,50 @@ fn cli_infeasible_exits_non_zero_naming_component_and_errors() {
     assert!(err.contains("infeasible"), "{err}");
     assert!(err.contains("px"), "{err}");
     assert!(err.contains("eyx") && err.contains("min_std"), "{err}");
+    assert!(err.contains("chain::allocate::infeasible"), "{err}");
+    assert!(
+        err.contains("gantry_grinder: the requirement is infeasible"),
+        "{err}"
+    );
+}
+
+#[test]
+fn cli_allocation_errors_have_their_own_codes() {
+    // No requirement: its own code and the hint, no catch-all code.
+    let text = std::fs::read_to_string(gantry_path()).unwrap();
+    let out: String = text
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("requirement:"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let dir = scratch("no_requirement");
+    let file = dir.join("gantry_no_requirement.yaml");
+    std::fs::write(&file, out).unwrap();
+    let err = fails(&["allocate", file.to_str().unwrap()]);
+    assert!(err.contains("chain::allocate::no_requirement"), "{err}");
+    assert!(
+        err.contains("requirement: {min: 0.95, mean: 0.97}"),
+        "{err}"
+    );
+    assert!(!err.contains("chain::allocate::error"), "{err}");
+    // Steps too small for the paper's procedure to finish in its rounds:
+    // the table is written, then the exit is non-zero.
+    let out = chain(&[
+        "allocate",
+        gantry_path().to_str().unwrap(),
+        "--strategy",
+        "paper",
+        "--step",
+        "0.00001",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("round 200"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("chain::allocate::not_met"), "{err}");
+    assert!(
+        err.contains("the requirement is not met after 200 rounds"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -749,7 +749,11 @@ fn one_conversion_run_puts_the_pieces_together() {
     assert_eq!((required.all, &required.per_axis), (all, &each));
     assert_eq!(required.searched_up_to, 30);
     // The two chains agree at every instant (the bound of docs/motion.md).
-    assert!(run.worst.position < 1e-9 && run.worst.rotation < 1e-9, "{:?}", run.worst);
+    assert!(
+        run.worst.position < 1e-9 && run.worst.rotation < 1e-9,
+        "{:?}",
+        run.worst
+    );
     // Without a tolerance: the requested order only, no required order.
     let plain = Conversion::run(
         c.motion(),
