@@ -652,3 +652,19 @@ fn close(a: &[f64], b: &[f64], rotary: &[bool]) -> bool {
         d.abs() < 1e-9 * 1.0f64.max(x.abs())
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn status_names_are_their_serialised_form() {
+        for s in [Status::Ok, Status::Unreachable, Status::Singular] {
+            assert_eq!(
+                serde_json::to_string(&s).unwrap(),
+                format!("\"{}\"", s.name())
+            );
+        }
+        assert_eq!(Status::Unreachable.name(), "unreachable");
+    }
+}
