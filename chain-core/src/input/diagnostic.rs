@@ -21,6 +21,7 @@
 
 use std::fmt;
 
+#[cfg(feature = "miette")]
 use miette::{LabeledSpan, NamedSource, SourceCode};
 
 use crate::model::{ErrorKind, Origin};
@@ -737,6 +738,7 @@ impl LoadError {
         }
     }
 
+    #[cfg(feature = "miette")]
     fn label(&self, source_len: usize) -> Option<LabeledSpan> {
         if self.origin.line == 0 {
             return None;
@@ -769,6 +771,7 @@ impl fmt::Display for LoadError {
 
 impl std::error::Error for LoadError {}
 
+#[cfg(feature = "miette")]
 impl miette::Diagnostic for LoadError {
     fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
         Some(Box::new(self.problem.code()))
@@ -790,6 +793,7 @@ impl miette::Diagnostic for LoadError {
 
 /// A related error rendered against the parent's source text, with its span
 /// clamped to that text.
+#[cfg_attr(not(feature = "miette"), allow(dead_code))]
 #[derive(Debug, Clone)]
 struct Related {
     error: LoadError,
@@ -804,6 +808,7 @@ impl fmt::Display for Related {
 
 impl std::error::Error for Related {}
 
+#[cfg(feature = "miette")]
 impl miette::Diagnostic for Related {
     fn code<'b>(&'b self) -> Option<Box<dyn fmt::Display + 'b>> {
         self.error.code()
@@ -834,7 +839,10 @@ pub struct Diagnostics {
     inner: Box<Inner>,
 }
 
+#[cfg_attr(not(feature = "miette"), allow(dead_code))]
 struct Inner {
+    file: String,
+    #[cfg(feature = "miette")]
     source: NamedSource<String>,
     source_len: usize,
     errors: Vec<LoadError>,
@@ -875,7 +883,9 @@ impl Diagnostics {
             .collect();
         Some(Diagnostics {
             inner: Box::new(Inner {
-                source: NamedSource::new(file, source).with_language("yaml"),
+                #[cfg(feature = "miette")]
+                source: NamedSource::new(file.clone(), source).with_language("yaml"),
+                file,
                 source_len,
                 errors,
                 related,
@@ -910,7 +920,9 @@ impl Diagnostics {
         let source_len = source.len();
         Diagnostics {
             inner: Box::new(Inner {
-                source: NamedSource::new(file, source).with_language("yaml"),
+                #[cfg(feature = "miette")]
+                source: NamedSource::new(file.clone(), source).with_language("yaml"),
+                file,
                 source_len,
                 errors: vec![error],
                 related: Vec::new(),
@@ -920,7 +932,7 @@ impl Diagnostics {
 
     /// The file name.
     pub fn file(&self) -> &str {
-        self.inner.source.name()
+        &self.inner.file
     }
 
     /// The errors, in source order.
@@ -981,6 +993,7 @@ impl fmt::Display for Diagnostics {
 
 impl std::error::Error for Diagnostics {}
 
+#[cfg(feature = "miette")]
 impl miette::Diagnostic for Diagnostics {
     fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
         self.first().code()
