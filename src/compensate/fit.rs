@@ -1,11 +1,10 @@
 //! Least-squares polynomials of every order, with their goodness-of-fit
 //! figures and the overall F-test.
 
+use super::fdist::f_survival;
+use super::{FitError, MAX_SUPPORTED_ORDER};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
-use statrs::distribution::{ContinuousCDF, FisherSnedecor};
-
-use super::{FitError, MAX_SUPPORTED_ORDER};
 
 /// A least-squares polynomial `y ≈ Σ c_k x^k` with its goodness-of-fit figures.
 ///
@@ -201,24 +200,4 @@ fn expand_scaled(scaled: &[f64], centre: f64, scale: f64) -> Vec<f64> {
         }
     }
     out
-}
-
-/// Survival function `P(F > f)` of the F distribution with `d1`, `d2` degrees
-/// of freedom (statrs' `FisherSnedecor`, the regularized incomplete beta
-/// `I_{d2/(d2 + d1 f)}(d2/2, d1/2)`). Returns NaN for non-positive degrees of
-/// freedom or a NaN `f`.
-pub fn f_survival(f: f64, d1: f64, d2: f64) -> f64 {
-    if !(d1 > 0.0 && d2 > 0.0) || f.is_nan() {
-        return f64::NAN;
-    }
-    if f <= 0.0 {
-        return 1.0;
-    }
-    if f.is_infinite() {
-        return 0.0;
-    }
-    match FisherSnedecor::new(d1, d2) {
-        Ok(dist) => dist.sf(f),
-        Err(_) => f64::NAN,
-    }
 }

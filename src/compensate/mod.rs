@@ -34,12 +34,14 @@
 //!
 //! One job per file: [`error`] (what can go wrong, located), [`data`] (the
 //! measured points as typed rows), [`law`] (Eq. 1-5 and the law, Eq. 7),
-//! [`fit`] (least squares and the F-test), [`select`] (order selection),
+//! [`fit`] (least squares), [`fdist`] (the F distribution of the F-test),
+//! [`select`] (order selection),
 //! [`analysis`] (the workflow) and [`table`] (the compensation table).
 
 pub mod analysis;
 pub mod data;
 pub mod error;
+pub mod fdist;
 pub mod fit;
 pub mod law;
 pub mod select;
@@ -48,7 +50,8 @@ pub mod table;
 pub use analysis::{analyze, Analysis, Options, Point, ResidualSummary, Spread};
 pub use data::{Measurements, RawRecord, Record};
 pub use error::{CompensateError, FitError};
-pub use fit::{f_survival, fit_polynomial, PolyFit};
+pub use fdist::f_survival;
+pub use fit::{fit_polynomial, PolyFit};
 pub use law::{
     acos_argument, polynomial_text, swing_angle_error_deg, swing_angle_error_from_delta_z_deg,
     theoretical_drop, Compensation,
