@@ -201,3 +201,20 @@ fn unique_crates_folds_repeats_and_skips_the_root() {
         ]
     );
 }
+
+/// chain-core carries its built-in generator inside the crate (so that it
+/// packages); it must stay the example file, byte for byte.
+#[test]
+fn built_in_generator_is_the_example_file() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let inside = std::fs::read(root.join("chain-core/src/input/cradle_generator.yaml")).unwrap();
+    let example = std::fs::read(root.join("examples/machines/cradle_generator.yaml")).unwrap();
+    assert!(
+        inside == example,
+        "chain-core/src/input/cradle_generator.yaml differs from examples/machines/cradle_generator.yaml"
+    );
+    assert_eq!(
+        chain::core::settings::BUILTIN_GENERATOR.as_bytes(),
+        example.as_slice()
+    );
+}
