@@ -7,6 +7,13 @@
 //!
 //! and holds the paper workflows that are not part of either
 //! ([`compensate`]: swing-angle error identification and compensation).
+//!
+//! The library needs none of the command-line crates: with
+//! `default-features = false` a dependent compiles the models, the
+//! [`machine!`] macro, reliability and the workflows alone. The default
+//! feature `cli` builds the `chain` binary (argument parsing, progress bars,
+//! the diagnostic renderer, CSV input, plots, JSON output); `parallel` runs
+//! sampling on all cores (see `docs/packaging.md`).
 
 pub use chain_core as core;
 pub use reliability;
@@ -15,4 +22,3 @@ pub use reliability;
 pub use chain_macro::machine;
 
 pub mod compensate;
-pub mod plot;

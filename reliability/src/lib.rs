@@ -51,6 +51,7 @@ pub mod inputs;
 pub mod limit_state;
 pub mod machine;
 pub mod normal;
+mod par;
 pub mod rng;
 pub mod sensitivity;
 pub mod simulation;

@@ -31,10 +31,10 @@ use crate::error::ReliabilityError;
 use crate::form::{Form, FormResult, Termination};
 use crate::limit_state::{Criterion, Event, LimitState};
 use crate::normal;
+use crate::par::prelude::*;
 use crate::rng::CaseRng;
 use crate::util::dot;
 use chain_core::model::Sided;
-use rayon::prelude::*;
 
 /// Samples per block (the unit of parallel work and of random streams).
 pub const BLOCK: u64 = 1 << 16;
@@ -881,6 +881,7 @@ mod tests {
         assert!(is.std_error < mc.std_error);
     }
 
+    #[cfg(feature = "parallel")]
     #[test]
     fn thread_count_does_not_change_results() {
         let inputs = Inputs::new(

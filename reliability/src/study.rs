@@ -22,9 +22,9 @@ use crate::form::{Form, FormResult};
 use crate::inputs::Inputs;
 use crate::limit_state::{Criterion, Event, ToleranceLimitState};
 use crate::normal;
+use crate::par::prelude::*;
 use crate::sensitivity::{sensitivity, SensitivityMethod, SensitivityResult};
 use crate::simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult};
-use rayon::prelude::*;
 
 /// The axis values to evaluate: the cartesian product of the axes, first axis
 /// slowest.

@@ -160,8 +160,8 @@ fn plot(
     r: &Allocation,
     before: &reliability::StudyResult,
     after: &reliability::StudyResult,
-) -> Result<Vec<PathBuf>, chain::plot::PlotError> {
-    use chain::plot::{Legend, Series, XyChart};
+) -> Result<Vec<PathBuf>, crate::cli::plot::PlotError> {
+    use crate::cli::plot::{Legend, Series, XyChart};
     let mut files = Vec::new();
     let np = study.points().len();
     let axes: Vec<&str> = study

@@ -2,10 +2,17 @@
 //! (seed 003) from tool-tip heights measured at commanded angles.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use chain::compensate::{self, Analysis, CompensateError, Grid, Options, SelectionRule};
-use miette::IntoDiagnostic;
+use chain::compensate::{
+    self, Analysis, CompensateError, Grid, Measurements, Options, SelectionRule,
+};
+
+use super::csv_input::{self, RecordsError};
+use super::report::{self, Report};
+
+#[path = "compensate_plot.rs"]
+mod compensate_plot;
 
 /// Output format of `chain compensate`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -89,7 +96,7 @@ pub struct CompensateArgs {
 /// Runs `chain compensate`: everything that can fail runs before anything is
 /// printed, so a failure leaves stdout empty.
 pub fn exec(args: CompensateArgs) -> miette::Result<()> {
-    let measurements = compensate::read_csv(&args.file)?;
+    let measurements = read_measurements(&args.file)?;
     let options = Options {
         length: args.length,
         min_order: args.min_order,
@@ -119,157 +126,248 @@ pub fn exec(args: CompensateArgs) -> miette::Result<()> {
         return Err(miette::miette!("--grid needs --table-out FILE.csv"));
     }
     if let Some(dir) = &args.plot {
-        files.extend(compensate::write_plots(&analysis, dir)?);
+        files.extend(compensate_plot::write_plots(&analysis, dir)?);
     }
 
-    let text = match args.format {
-        Format::Json => {
-            let document = JsonDocument {
-                analysis: &analysis,
-                written: files.iter().map(|p| p.display().to_string()).collect(),
-            };
-            let mut s = serde_json::to_string_pretty(&document).into_diagnostic()?;
-            s.push('\n');
-            s
-        }
-        Format::Table => render_table(&analysis, &files, table_rows),
+    let document = CompensateReport {
+        analysis,
+        written: files.iter().map(|p| p.display().to_string()).collect(),
+        table_rows,
     };
-    use std::io::Write as _;
-    let mut stdout = std::io::stdout().lock();
-    // A closed pipe (`| head`) is not an error worth a message.
-    let _ = stdout
-        .write_all(text.as_bytes())
-        .and_then(|()| stdout.flush());
-    Ok(())
+    let format = match args.format {
+        Format::Table => report::Format::Table,
+        Format::Json => report::Format::Json,
+    };
+    report::emit(&document, format)
 }
 
-/// The `--format json` document: the analysis (spec fields first, in struct
-/// order) and the files written, if any.
-#[derive(serde::Serialize)]
-struct JsonDocument<'a> {
-    #[serde(flatten)]
-    analysis: &'a Analysis,
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    written: Vec<String>,
+/// The measurements of a CSV file: the records from the shared CSV input
+/// module, checked and typed by the library.
+pub(crate) fn read_measurements(path: &Path) -> Result<Measurements, CompensateError> {
+    let name = path.display().to_string();
+    let records = csv_input::read_records(path).map_err(records_error)?;
+    Measurements::from_records(&name, records)
 }
 
-/// The `--format table` report.
-fn render_table(a: &Analysis, files: &[PathBuf], table_rows: Option<usize>) -> String {
-    let mut s = String::new();
-    let has_z2 = a.points.iter().any(|p| p.z2.is_some());
-    let _ = writeln!(
-        s,
-        "Swing-angle error from {} ({} points, L = {} mm)\n",
-        a.file,
-        a.points.len(),
-        a.length
-    );
-    let _ = write!(s, "{:>8} {:>11}", "θ (°)", "Z1−Z3 (mm)");
-    if has_z2 {
-        let _ = write!(s, " {:>11} {:>11}", "Z1−Z2 (mm)", "Z2−Z3 (mm)");
+/// A reading failure in the library's words (same messages and codes as the
+/// analysis errors of the file).
+fn records_error(e: RecordsError) -> CompensateError {
+    match e {
+        RecordsError::Io { name, source } => CompensateError::Io { file: name, source },
+        RecordsError::Malformed {
+            name,
+            line,
+            message,
+        } => CompensateError::Malformed {
+            file: name,
+            line,
+            message,
+        },
     }
-    let _ = writeln!(
-        s,
-        " {:>11} {:>11} {:>11} {:>11}",
-        "ΔZ (mm)", "Δθ (°)", "fit (°)", "resid. (°)"
-    );
-    for p in &a.points {
-        let _ = write!(s, "{:>8} {:>11.6}", p.theta_deg, p.z1_minus_z3);
+}
+
+/// The result document of `chain compensate`: the analysis (the spec's fields
+/// first, in struct order), then the files written, if any. Its JSON is the
+/// `--format json` output.
+#[derive(serde::Serialize)]
+pub struct CompensateReport {
+    /// Everything derived from the measurement file.
+    #[serde(flatten)]
+    pub analysis: Analysis,
+    /// The files written (`--table-out`, `--plot`), in order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub written: Vec<String>,
+    /// Rows of the compensation table written, if one was.
+    #[serde(skip)]
+    pub table_rows: Option<usize>,
+}
+
+impl Report for CompensateReport {
+    /// The `--format table` report.
+    fn table(&self) -> String {
+        let (a, files, table_rows) = (&self.analysis, &self.written, self.table_rows);
+        let mut s = String::new();
+        let has_z2 = a.points.iter().any(|p| p.z2.is_some());
+        let _ = writeln!(
+            s,
+            "Swing-angle error from {} ({} points, L = {} mm)\n",
+            a.file,
+            a.points.len(),
+            a.length
+        );
+        let _ = write!(s, "{:>8} {:>11}", "θ (°)", "Z1−Z3 (mm)");
         if has_z2 {
-            let _ = write!(
-                s,
-                " {:>11.6} {:>11.6}",
-                p.z1_minus_z2.unwrap_or(f64::NAN),
-                p.z2_minus_z3.unwrap_or(f64::NAN)
-            );
+            let _ = write!(s, " {:>11} {:>11}", "Z1−Z2 (mm)", "Z2−Z3 (mm)");
         }
         let _ = writeln!(
             s,
-            " {:>11.6} {:>11.6} {:>11.6} {:>11.6}",
-            p.delta_z_mm, p.delta_theta_deg, p.fitted_deg, p.residual_deg
+            " {:>11} {:>11} {:>11} {:>11}",
+            "ΔZ (mm)", "Δθ (°)", "fit (°)", "resid. (°)"
         );
-    }
-    let _ = writeln!(
-        s,
-        "\nΔZ = Z2 − Z3 with the theoretical Z2 = Z1 − L(1 − cos θ); Δθ = acos(cos θ − ΔZ/L) − θ (Eq. 5)."
-    );
-    let _ = writeln!(s, "\nPolynomial fits of Δθ(θ), θ in degrees:\n");
-    let _ = writeln!(
-        s,
-        "{:>5} {:>8} {:>8} {:>10} {:>11} {:>9} {:>9} {:>8}  coefficients (ascending powers of θ)",
-        "order", "R²", "adj. R²", "RMSE (°)", "LOOCV (°)", "AICc", "BIC", "F-test p"
-    );
-    for f in &a.fits {
-        let coefficients: Vec<String> = f.coefficients.iter().map(|c| format!("{c:.6e}")).collect();
-        let mark = if f.order == a.selected_order {
-            "*"
-        } else {
-            " "
-        };
-        let _ = writeln!(
-            s,
-            "{mark}{:>4} {:>8.4} {:>8.4} {:>10.6} {:>11.6} {:>9} {:>9.3} {:>8}  [{}]",
-            f.order,
-            f.r2,
-            f.adjusted_r2,
-            f.rmse,
-            f.loocv_rmse,
-            f.aicc
-                .map_or_else(|| "-".to_string(), |v| format!("{v:.3}")),
-            f.bic,
-            f.f_test_p
-                .map_or_else(|| "-".to_string(), |v| format!("{v:.3}")),
-            coefficients.join(", ")
-        );
-    }
-    let by_rule: Vec<String> = a
-        .selection
-        .by_rule
-        .iter()
-        .map(|(rule, order)| format!("{rule} → {order}"))
-        .collect();
-    let _ = writeln!(
-        s,
-        "\nSelected order: {} (rule: {}: {})\nOrders the rules pick: {}",
-        a.selected_order,
-        a.selection.rule,
-        a.selection.description,
-        by_rule.join(", ")
-    );
-    let c = &a.compensation;
-    let _ = writeln!(s, "\nCompensation law (θ, Δθ in degrees):\n  {}", c.law);
-    let _ = writeln!(
-        s,
-        "  commanding θt leaves the axis at θa = θt + Δθ(θt) (Eq. 7);\n  to reach θt, command c with c + Δθ(c) = θt (≈ θt − Δθ(θt))."
-    );
-    let r = &c.residual;
-    let _ = writeln!(
-        s,
-        "\nError at the measured angles (°):\n  before: {:+.6} .. {:+.6}  (RMS {:.6})\n  after (predicted residual): {:+.6} .. {:+.6}  (RMS {:.6}; leave-one-out RMS {:.6})",
-        r.before.min_deg,
-        r.before.max_deg,
-        r.before.rms_deg,
-        r.after.min_deg,
-        r.after.max_deg,
-        r.after.rms_deg,
-        r.loocv_rms_deg
-    );
-    if let Some(best) = a.fits.iter().filter_map(|f| f.f_test_p).reduce(f64::min) {
-        if best > 0.05 {
+        for p in &a.points {
+            let _ = write!(s, "{:>8} {:>11.6}", p.theta_deg, p.z1_minus_z3);
+            if has_z2 {
+                let _ = write!(
+                    s,
+                    " {:>11.6} {:>11.6}",
+                    p.z1_minus_z2.unwrap_or(f64::NAN),
+                    p.z2_minus_z3.unwrap_or(f64::NAN)
+                );
+            }
             let _ = writeln!(
                 s,
-                "\nNote: no fit is significant against a constant error at the 5 % level (smallest F-test p = {best:.3})."
+                " {:>11.6} {:>11.6} {:>11.6} {:>11.6}",
+                p.delta_z_mm, p.delta_theta_deg, p.fitted_deg, p.residual_deg
             );
         }
-    }
-    if !files.is_empty() {
-        let _ = writeln!(s);
-        for f in files {
-            let _ = writeln!(s, "wrote {}", f.display());
+        let _ = writeln!(
+                s,
+                "\nΔZ = Z2 − Z3 with the theoretical Z2 = Z1 − L(1 − cos θ); Δθ = acos(cos θ − ΔZ/L) − θ (Eq. 5)."
+            );
+        let _ = writeln!(s, "\nPolynomial fits of Δθ(θ), θ in degrees:\n");
+        let _ = writeln!(
+                s,
+                "{:>5} {:>8} {:>8} {:>10} {:>11} {:>9} {:>9} {:>8}  coefficients (ascending powers of θ)",
+                "order", "R²", "adj. R²", "RMSE (°)", "LOOCV (°)", "AICc", "BIC", "F-test p"
+            );
+        for f in &a.fits {
+            let coefficients: Vec<String> =
+                f.coefficients.iter().map(|c| format!("{c:.6e}")).collect();
+            let mark = if f.order == a.selected_order {
+                "*"
+            } else {
+                " "
+            };
+            let _ = writeln!(
+                s,
+                "{mark}{:>4} {:>8.4} {:>8.4} {:>10.6} {:>11.6} {:>9} {:>9.3} {:>8}  [{}]",
+                f.order,
+                f.r2,
+                f.adjusted_r2,
+                f.rmse,
+                f.loocv_rmse,
+                f.aicc
+                    .map_or_else(|| "-".to_string(), |v| format!("{v:.3}")),
+                f.bic,
+                f.f_test_p
+                    .map_or_else(|| "-".to_string(), |v| format!("{v:.3}")),
+                coefficients.join(", ")
+            );
         }
-        if let Some(n) = table_rows {
-            let _ = writeln!(s, "(compensation table: {n} angles)");
+        let by_rule: Vec<String> = a
+            .selection
+            .by_rule
+            .iter()
+            .map(|(rule, order)| format!("{rule} → {order}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "\nSelected order: {} (rule: {}: {})\nOrders the rules pick: {}",
+            a.selected_order,
+            a.selection.rule,
+            a.selection.description,
+            by_rule.join(", ")
+        );
+        let c = &a.compensation;
+        let _ = writeln!(s, "\nCompensation law (θ, Δθ in degrees):\n  {}", c.law);
+        let _ = writeln!(
+                s,
+                "  commanding θt leaves the axis at θa = θt + Δθ(θt) (Eq. 7);\n  to reach θt, command c with c + Δθ(c) = θt (≈ θt − Δθ(θt))."
+            );
+        let r = &c.residual;
+        let _ = writeln!(
+                s,
+                "\nError at the measured angles (°):\n  before: {:+.6} .. {:+.6}  (RMS {:.6})\n  after (predicted residual): {:+.6} .. {:+.6}  (RMS {:.6}; leave-one-out RMS {:.6})",
+                r.before.min_deg,
+                r.before.max_deg,
+                r.before.rms_deg,
+                r.after.min_deg,
+                r.after.max_deg,
+                r.after.rms_deg,
+                r.loocv_rms_deg
+            );
+        if let Some(best) = a.fits.iter().filter_map(|f| f.f_test_p).reduce(f64::min) {
+            if best > 0.05 {
+                let _ = writeln!(
+                        s,
+                        "\nNote: no fit is significant against a constant error at the 5 % level (smallest F-test p = {best:.3})."
+                    );
+            }
+        }
+        if !files.is_empty() {
+            let _ = writeln!(s);
+            for f in files {
+                let _ = writeln!(s, "wrote {f}");
+            }
+            if let Some(n) = table_rows {
+                let _ = writeln!(s, "(compensation table: {n} angles)");
+            }
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What `chain compensate` makes of the bytes of a file named `name`.
+    fn parse(name: &str, data: &[u8]) -> Result<Measurements, CompensateError> {
+        let records = csv_input::parse_records(name, data).map_err(records_error)?;
+        Measurements::from_records(name, records)
+    }
+
+    #[test]
+    fn reader_skips_comments_blank_lines_and_a_byte_order_mark() {
+        let m = parse(
+            "mem.csv",
+            b"# comment\n\nZ3, note, THETA_DEG ,z1\r\n-171.1,\"a, b\",1,-170.99\n\n# again\n-171.4275,b,2,-170.99\n",
+        )
+        .unwrap();
+        assert_eq!(m.header_line, 3);
+        assert_eq!(m.records.iter().map(|r| r.line).collect::<Vec<_>>(), [4, 7]);
+        assert_eq!(m.records[1].theta_deg, 2.0);
+        assert_eq!(m.records[1].z3, -171.4275);
+        let m = parse("bom.csv", b"\xEF\xBB\xBFtheta_deg,z1,z3\n1,0,-0.1\n").unwrap();
+        assert_eq!((m.header_line, m.records[0].line), (1, 2));
+    }
+
+    #[test]
+    fn reader_errors_name_the_file_and_line() {
+        let e = parse("bad.csv", b"theta_deg,z1,z3\n1,0,\xFF\n").unwrap_err();
+        assert!(
+            matches!(e, CompensateError::Malformed { line: 2, .. }),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .starts_with("bad.csv, line 2: the line is not valid UTF-8"),
+            "{e}"
+        );
+        let e = parse("empty.csv", b"# only a comment\n\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "empty.csv, line 1: the file is empty; expected a header `theta_deg,z1,z3` (optionally with `z2`)"
+        );
+        let e = parse("short.csv", b"theta_deg,z1,z3\n1,0,-0.1\n2,0\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "short.csv, line 3: expected 3 fields as in the header (line 1), found 2"
+        );
+        let e = read_measurements(Path::new("/nonexistent/swing.csv")).unwrap_err();
+        assert!(matches!(e, CompensateError::Io { .. }), "{e}");
+        assert!(e
+            .to_string()
+            .starts_with("/nonexistent/swing.csv: cannot read the file: "));
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(256))]
+
+        /// No byte string makes the reader or the row checks panic.
+        #[test]
+        fn reader_never_panics(bytes in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..200)) {
+            let _ = parse("fuzz.csv", &bytes);
         }
     }
-    s
 }

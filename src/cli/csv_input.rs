@@ -1,9 +1,12 @@
 //! CSV input shared by the commands that read tables of numbers (`chain
-//! inverse`, `chain path`): a file or stdin (`-`), a header, and rows of finite
-//! numbers; every error names the file, the line and the column.
+//! inverse`, `chain path`: a file or stdin (`-`), a header, and rows of finite
+//! numbers; `chain compensate`: every record with its line, for the library
+//! to check); every error names the file, the line and the column.
 
 use std::io::Read;
 use std::path::Path;
+
+use chain::compensate::RawRecord;
 
 /// An open CSV: display name, reader and trimmed header.
 pub(crate) struct CsvInput {
@@ -176,4 +179,106 @@ pub(crate) fn read_poses(path: &Path) -> miette::Result<(bool, Vec<PoseRow>)> {
         })
         .collect::<miette::Result<Vec<_>>>()
         .map(|rows| (has_t, rows))
+}
+
+/// Why [`read_records`] could not read a file.
+#[derive(Debug)]
+pub(crate) enum RecordsError {
+    /// The file could not be read.
+    Io {
+        /// The file as named.
+        name: String,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A line is not well-formed CSV (bad UTF-8).
+    Malformed {
+        /// The file as named.
+        name: String,
+        /// The line (1-based).
+        line: u64,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Reads every record of a CSV file leniently, the header included: a
+/// leading byte-order mark is dropped, lines starting with `#` and blank lines
+/// are skipped, fields are trimmed and rows may differ in length (the caller
+/// checks them). Each record carries the line it starts on (1-based, after the
+/// comments and blank lines before it). `chain compensate` reads its
+/// measurements with it.
+pub(crate) fn read_records(path: &Path) -> Result<Vec<RawRecord>, RecordsError> {
+    let name = path.display().to_string();
+    let data = std::fs::read(path).map_err(|source| RecordsError::Io {
+        name: name.clone(),
+        source,
+    })?;
+    parse_records(&name, &data)
+}
+
+/// [`read_records`] over bytes already read; `name` names the source.
+pub(crate) fn parse_records(name: &str, data: &[u8]) -> Result<Vec<RawRecord>, RecordsError> {
+    let data = data.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(data);
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(data);
+    let malformed = |e: csv::Error| RecordsError::Malformed {
+        name: name.to_string(),
+        line: e.position().map_or(1, csv::Position::line),
+        message: csv_error_message(&e),
+    };
+    let mut out = Vec::new();
+    for (i, row) in reader.records().enumerate() {
+        let row = row.map_err(malformed)?;
+        // The header of a file whose reader reports no position is line 1.
+        let fallback = if i == 0 { 1 } else { 0 };
+        let line = row.position().map_or(fallback, |p| record_line(data, p));
+        out.push(RawRecord::new(line, row.iter()));
+    }
+    Ok(out)
+}
+
+/// The line a record starts on. The reader reports where it started reading,
+/// which is before any comment or blank lines it skipped; skip them here too.
+fn record_line(data: &[u8], pos: &csv::Position) -> u64 {
+    let mut line = pos.line();
+    let mut i = usize::try_from(pos.byte()).unwrap_or(usize::MAX);
+    while let Some(&b) = data.get(i) {
+        match b {
+            b'#' => match data[i..].iter().position(|&c| c == b'\n') {
+                Some(end) => {
+                    i += end + 1;
+                    line += 1;
+                }
+                None => break,
+            },
+            b'\n' => {
+                i += 1;
+                line += 1;
+            }
+            b'\r' => {
+                i += 1;
+                if data.get(i) == Some(&b'\n') {
+                    i += 1;
+                }
+                line += 1;
+            }
+            _ => break,
+        }
+    }
+    line
+}
+
+fn csv_error_message(e: &csv::Error) -> String {
+    match e.kind() {
+        csv::ErrorKind::Utf8 { err, .. } => format!("the line is not valid UTF-8 ({err})"),
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!("expected {expected_len} fields, found {len}"),
+        _ => e.to_string(),
+    }
 }

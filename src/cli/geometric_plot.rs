@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use chain::plot::BarChart;
+use crate::cli::plot::BarChart;
 use chain_core::geometric::GeometricSensitivity;
 
 /// Writes `geometric_<component>.{png,svg}` for every direction in which
@@ -22,7 +22,7 @@ pub(super) fn write_all(
             continue;
         }
         let chart = BarChart {
-            color: chain::plot::color(k),
+            color: crate::cli::plot::color(k),
             value_decimals: Some(1),
             ..BarChart::new(
                 format!(

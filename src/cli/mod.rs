@@ -8,6 +8,7 @@ pub mod derive;
 pub mod inverse;
 pub mod motion;
 pub mod path;
+pub mod plot;
 pub mod reliability;
 pub mod report;
 pub mod sensitivity;

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use chain::plot::{Legend, Series as Line, XyChart};
+use crate::cli::plot::{Legend, Series as Line, XyChart};
 use chain_core::model::JointKind;
 use chain_core::motion::Series;
 

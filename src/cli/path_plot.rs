@@ -1,11 +1,11 @@
 //! `--plot DIR` of `chain path`: the reliability of every target and the
 //! standard deviation of the toleranced error components along the path
-//! (PNG and SVG), drawn with the facade's [`chain::plot::XyChart`].
+//! (PNG and SVG), drawn with the CLI's [`crate::cli::plot::XyChart`].
 //! Instants without axis values (unreachable poses) have no point.
 
 use std::path::{Path, PathBuf};
 
-use chain::plot::{Legend, Series, XyChart};
+use crate::cli::plot::{Legend, Series, XyChart};
 
 use super::{quantity, PathResult, QUANTITIES};
 

@@ -35,7 +35,7 @@ pub(super) fn write_all(
 ) -> miette::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir)
         .map_err(|e| miette::miette!("{}: cannot create the plot directory: {e}", dir.display()))?;
-    chain::plot::ensure_fonts();
+    crate::cli::plot::ensure_fonts();
     let method = match result.method {
         "form" => "FORM",
         "is" => "importance sampling",
@@ -86,9 +86,9 @@ pub(super) fn write_all(
                     .map_or(0.0, |e| e.mean_abs_dr_dstd)
             })
             .collect();
-        let chart = chain::plot::BarChart {
+        let chart = crate::cli::plot::BarChart {
             size: BAR_SIZE,
-            ..chain::plot::BarChart::new(
+            ..crate::cli::plot::BarChart::new(
                 format!(
                     "{machine}: {} reliability sensitivity |∂R/∂σ| (grid mean)",
                     s.target

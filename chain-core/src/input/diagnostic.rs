@@ -21,6 +21,7 @@
 
 use std::fmt;
 
+#[cfg(feature = "miette")]
 use miette::{LabeledSpan, NamedSource, SourceCode};
 
 use crate::model::{ErrorKind, Origin};
@@ -830,6 +831,7 @@ impl LoadError {
         }
     }
 
+    #[cfg(feature = "miette")]
     fn label(&self, source_len: usize) -> Option<LabeledSpan> {
         if self.origin.line == 0 {
             return None;
@@ -862,6 +864,7 @@ impl fmt::Display for LoadError {
 
 impl std::error::Error for LoadError {}
 
+#[cfg(feature = "miette")]
 impl miette::Diagnostic for LoadError {
     fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
         Some(Box::new(self.problem.code()))
@@ -883,6 +886,7 @@ impl miette::Diagnostic for LoadError {
 
 /// A related error rendered against the parent's source text, with its span
 /// clamped to that text.
+#[cfg_attr(not(feature = "miette"), allow(dead_code))]
 #[derive(Debug, Clone)]
 struct Related {
     error: LoadError,
@@ -897,6 +901,7 @@ impl fmt::Display for Related {
 
 impl std::error::Error for Related {}
 
+#[cfg(feature = "miette")]
 impl miette::Diagnostic for Related {
     fn code<'b>(&'b self) -> Option<Box<dyn fmt::Display + 'b>> {
         self.error.code()
@@ -927,7 +932,10 @@ pub struct Diagnostics {
     inner: Box<Inner>,
 }
 
+#[cfg_attr(not(feature = "miette"), allow(dead_code))]
 struct Inner {
+    file: String,
+    #[cfg(feature = "miette")]
     source: NamedSource<String>,
     source_len: usize,
     errors: Vec<LoadError>,
@@ -968,7 +976,9 @@ impl Diagnostics {
             .collect();
         Some(Diagnostics {
             inner: Box::new(Inner {
-                source: NamedSource::new(file, source).with_language("yaml"),
+                #[cfg(feature = "miette")]
+                source: NamedSource::new(file.clone(), source).with_language("yaml"),
+                file,
                 source_len,
                 errors,
                 related,
@@ -1003,7 +1013,9 @@ impl Diagnostics {
         let source_len = source.len();
         Diagnostics {
             inner: Box::new(Inner {
-                source: NamedSource::new(file, source).with_language("yaml"),
+                #[cfg(feature = "miette")]
+                source: NamedSource::new(file.clone(), source).with_language("yaml"),
+                file,
                 source_len,
                 errors: vec![error],
                 related: Vec::new(),
@@ -1013,7 +1025,7 @@ impl Diagnostics {
 
     /// The file name.
     pub fn file(&self) -> &str {
-        self.inner.source.name()
+        &self.inner.file
     }
 
     /// The errors, in source order.
@@ -1074,6 +1086,7 @@ impl fmt::Display for Diagnostics {
 
 impl std::error::Error for Diagnostics {}
 
+#[cfg(feature = "miette")]
 impl miette::Diagnostic for Diagnostics {
     fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
         self.first().code()

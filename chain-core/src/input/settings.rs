@@ -60,10 +60,10 @@ pub const CNC_KEYS: &[&str] = &["machine", "parameters", "match", "fix", "start"
 /// Values of `cnc.match`.
 pub const MATCH_VALUES: &[&str] = &["pose", "point_axis"];
 
-/// The text of `examples/machines/cradle_generator.yaml`, the generator used
-/// when a settings file names none.
-pub const BUILTIN_GENERATOR: &str =
-    include_str!("../../../examples/machines/cradle_generator.yaml");
+/// The text of `examples/machines/cradle_generator.yaml` (a byte-identical
+/// copy inside this crate, so that it packages), the generator used when a
+/// settings file names none.
+pub const BUILTIN_GENERATOR: &str = include_str!("cradle_generator.yaml");
 
 /// The file name under which the built-in generator is reported.
 pub const BUILTIN_GENERATOR_NAME: &str = "cradle_generator.yaml (built-in)";
@@ -89,16 +89,17 @@ const DMS_HELP: &str =
 pub type SettingsError = Diagnostics;
 
 /// Why a machine named by a settings file could not be loaded.
-#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+#[derive(Debug, thiserror::Error)]
+#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
 pub enum ReferenceError {
     /// The path in the settings file cannot be read (located in the settings
     /// file).
     #[error(transparent)]
-    #[diagnostic(transparent)]
+    #[cfg_attr(feature = "miette", diagnostic(transparent))]
     Path(SettingsError),
     /// The machine file itself has errors (located in that file).
     #[error(transparent)]
-    #[diagnostic(transparent)]
+    #[cfg_attr(feature = "miette", diagnostic(transparent))]
     Machine(Diagnostics),
 }
 

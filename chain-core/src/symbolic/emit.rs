@@ -294,6 +294,7 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
 }
 
 /// Emits the generated type as formatted Rust source (prettyplease).
+#[cfg(feature = "pretty")]
 pub fn emit_pretty(model: &SymbolicModel, options: &EmitOptions) -> String {
     let tokens = emit(model, options);
     match syn::parse2::<syn::File>(tokens.clone()) {

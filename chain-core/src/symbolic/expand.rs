@@ -186,6 +186,7 @@ fn add_default_name(root: &mut Node, type_name: &str, conv: &mut Converter, at: 
 
 /// [`expand`], formatted with prettyplease (what `chain derive --format rust`
 /// prints for a file, plus the file-tracking `include_bytes!`).
+#[cfg(feature = "pretty")]
 pub fn expand_pretty(input: TokenStream) -> String {
     let tokens = expand(input);
     match syn::parse2::<syn::File>(tokens.clone()) {

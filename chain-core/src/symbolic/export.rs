@@ -6,6 +6,7 @@
 //! they are.
 
 use serde::Serialize;
+#[cfg(feature = "json")]
 use serde_json::{Map, Value};
 
 use crate::algebra::{Poly, Symbol};
@@ -13,6 +14,7 @@ use crate::derive::SymbolicModel;
 use crate::model::Component;
 
 /// The JSON document of `chain derive --format json` (spec section 3).
+#[cfg(feature = "json")]
 #[derive(Debug, Clone, Serialize)]
 pub struct DeriveJson {
     /// Machine identifier.
@@ -43,6 +45,7 @@ pub struct NominalJson {
 }
 
 /// Builds the JSON document.
+#[cfg(feature = "json")]
 pub fn to_json(model: &SymbolicModel) -> DeriveJson {
     let text = |p: &Poly| p.to_text(&|s| model.symbol_name(s));
     let mut components = Map::new();

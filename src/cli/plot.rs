@@ -5,14 +5,14 @@
 //! crate) and registered with plotters' `ab_glyph` renderer, so no system
 //! font or fontconfig is needed.
 //!
-//! ```no_run
-//! use chain::plot::{Series, XyChart};
+//! ```ignore
+//! use crate::cli::plot::{Series, XyChart};
 //! let chart = XyChart::new("Δθ", "θ (°)", "Δθ (°)")
 //!     .series(Series::points("measured", vec![(1.0, 0.1), (2.0, 0.2)]))
 //!     .series(Series::line("fit", vec![(1.0, 0.1), (2.0, 0.2)]))
 //!     .hline(0.0);
 //! let files = chart.write(std::path::Path::new("plots"), "delta_theta")?;
-//! # Ok::<(), chain::plot::PlotError>(())
+//! # Ok::<(), crate::cli::plot::PlotError>(())
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -156,8 +156,6 @@ pub enum Legend {
     LowerRight,
     /// Inside the plot, lower left.
     LowerLeft,
-    /// No legend.
-    Hidden,
 }
 
 /// A 2-D chart of line and scatter series on linear axes.
@@ -215,12 +213,6 @@ impl XyChart {
         self
     }
 
-    /// Fixes the x range.
-    pub fn x_range(mut self, lo: f64, hi: f64) -> XyChart {
-        self.x_range = Some((lo, hi));
-        self
-    }
-
     /// Fixes the y range.
     pub fn y_range(mut self, lo: f64, hi: f64) -> XyChart {
         self.y_range = Some((lo, hi));
@@ -230,12 +222,6 @@ impl XyChart {
     /// Sets the legend placement.
     pub fn legend(mut self, legend: Legend) -> XyChart {
         self.legend = legend;
-        self
-    }
-
-    /// Sets the image size in pixels.
-    pub fn size(mut self, width: u32, height: u32) -> XyChart {
-        self.size = (width.max(200), height.max(150));
         self
     }
 
@@ -413,13 +399,12 @@ impl XyChart {
             }
         }
         let position = match self.legend {
-            Legend::UpperRight => Some(SeriesLabelPosition::UpperRight),
-            Legend::UpperLeft => Some(SeriesLabelPosition::UpperLeft),
-            Legend::LowerRight => Some(SeriesLabelPosition::LowerRight),
-            Legend::LowerLeft => Some(SeriesLabelPosition::LowerLeft),
-            Legend::Hidden => None,
+            Legend::UpperRight => SeriesLabelPosition::UpperRight,
+            Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
+            Legend::LowerRight => SeriesLabelPosition::LowerRight,
+            Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
         };
-        if let (true, Some(position)) = (labelled, position) {
+        if labelled {
             chart
                 .configure_series_labels()
                 .position(position)
