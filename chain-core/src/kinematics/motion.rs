@@ -121,11 +121,12 @@ pub struct MotionSpec {
 }
 
 /// Why a motion cannot be set up or solved.
-#[derive(Debug, Clone, PartialEq, thiserror::Error, miette::Diagnostic)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
 pub enum MotionError {
     /// The specification has not one law per generator variable.
     #[error("{laws} laws for the {variables} variables of the generator `{generator}`")]
-    #[diagnostic(code(chain::motion::law_count))]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::motion::law_count)))]
     LawCount {
         /// Laws given.
         laws: usize,
@@ -137,35 +138,41 @@ pub enum MotionError {
     /// The parameter or start vectors of the specification do not have the
     /// machines' lengths.
     #[error("parameter or start vectors do not match the machines")]
-    #[diagnostic(code(chain::motion::vector_lengths))]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::motion::vector_lengths)))]
     VectorLengths,
     /// A machine's derived kinematics names variables or parameters the
     /// machine does not have.
     #[error("the derived model's names differ from the machine's")]
-    #[diagnostic(code(chain::motion::name_mismatch))]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::motion::name_mismatch)))]
     NameMismatch,
     /// A held variable's index is not a CNC variable.
     #[error("a fixed variable index is out of range")]
-    #[diagnostic(code(chain::motion::fixed_out_of_range))]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::motion::fixed_out_of_range))
+    )]
     FixedOutOfRange,
     /// Variables are held while the full pose is matched.
     #[error("held variables need matching of the tool point and axis (point_axis)")]
-    #[diagnostic(code(chain::motion::held_with_pose))]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::motion::held_with_pose)))]
     HeldWithPose,
     /// A setting, parameter, start value, law or interval end is not finite.
     #[error("a setting, parameter or start value is not finite")]
-    #[diagnostic(code(chain::motion::not_finite))]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::motion::not_finite)))]
     NotFinite,
     /// An instant asked of the trajectory is not finite.
     #[error("instant {t} is not finite")]
-    #[diagnostic(code(chain::motion::instant_not_finite))]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::motion::instant_not_finite))
+    )]
     InstantNotFinite {
         /// The instant.
         t: f64,
     },
     /// More free CNC variables than conditions.
     #[error("the CNC machine `{machine}` has {free} free variables but matching the {what} gives {rows} conditions; hold the others (cnc.fix / --fix, e.g. mu=0) or match the full pose")]
-    #[diagnostic(code(chain::motion::underdetermined))]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::motion::underdetermined)))]
     Underdetermined {
         /// The CNC machine.
         machine: String,
@@ -178,10 +185,10 @@ pub enum MotionError {
     },
     /// No axis values reproduce the generator's pose at an instant.
     #[error("at t = {t}: the CNC machine cannot reproduce the generator's {what} (best residual: position {position:.3e}, angle {angle:.3e} rad)")]
-    #[diagnostic(
+    #[cfg_attr(feature = "miette", diagnostic(
         code(chain::motion::unreachable),
         help("check the settings against the CNC machine's parameters and strokes, or its `start` guess")
-    )]
+    ))]
     Unreachable {
         /// The instant.
         t: f64,
@@ -195,12 +202,12 @@ pub enum MotionError {
     /// The motion cannot be followed continuously: near `t` a rotary axis
     /// jumps however small the step (a singularity on the path).
     #[error("near t = {t}: the CNC axes cannot follow the generator's {what} continuously (a rotary axis jumps however small the step: a singular configuration on the roll)")]
-    #[diagnostic(
+    #[cfg_attr(feature = "miette", diagnostic(
         code(chain::motion::discontinuous),
         help(
             "shorten the roll interval so that it stays on one side of the singular configuration"
         )
-    )]
+    ))]
     Discontinuous {
         /// The instant.
         t: f64,
@@ -210,7 +217,7 @@ pub enum MotionError {
     /// The Jacobian of the conditions is singular at `t = 0`: the series is
     /// not defined by the method.
     #[error("the CNC axes are singular at t = 0 (the Jacobian of the {what} has rank below the number of free variables); no Maclaurin series")]
-    #[diagnostic(code(chain::motion::singular))]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::motion::singular)))]
     Singular {
         /// `pose` or `tool point and axis`.
         what: &'static str,

@@ -40,13 +40,17 @@ use crate::geometry::{
 };
 
 /// Why a machine cannot be handled by [`Solver`].
-#[derive(Debug, Clone, PartialEq, thiserror::Error, miette::Diagnostic)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
 pub enum InverseError {
     /// The free variables are not two rotary and three prismatic ones.
     #[error("the closed-form inverse needs 2 free rotary and 3 free prismatic variables, found {rotary} rotary and {prismatic} prismatic")]
-    #[diagnostic(
-        code(chain::inverse::shape),
-        help("hold the extra variables with --fix NAME=VALUE (e.g. mu=0)")
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(
+            code(chain::inverse::shape),
+            help("hold the extra variables with --fix NAME=VALUE (e.g. mu=0)")
+        )
     )]
     Shape {
         /// Free rotary variables.
@@ -57,11 +61,11 @@ pub enum InverseError {
     /// The orientation is not of the form `Rot(u, a) R0 Rot(v, b)` or depends
     /// on a prismatic variable.
     #[error("the tool orientation of this machine is not a product of two fixed-axis rotations independent of the linear axes; the closed-form solver does not apply")]
-    #[diagnostic(code(chain::inverse::not_closed_form))]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::inverse::not_closed_form)))]
     NotClosedForm,
     /// A held variable's index is not a variable of the machine.
     #[error("variable index {index} is out of range (the machine has {count} variables)")]
-    #[diagnostic(code(chain::inverse::unknown_variable))]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::inverse::unknown_variable)))]
     UnknownVariable {
         /// The index given.
         index: usize,
@@ -70,14 +74,17 @@ pub enum InverseError {
     },
     /// No free variable moves the tool.
     #[error("no free axis variable moves the tool point or the tool axis")]
-    #[diagnostic(
+    #[cfg_attr(feature = "miette", diagnostic(
         code(chain::inverse::no_free_variable),
         help("hold fewer variables (--fix), or check that the axes move the tool relative to the workpiece")
-    )]
+    ))]
     NoFreeVariable,
     /// The linear axes cannot move the tool point in three independent directions.
     #[error("the linear axes do not span three directions")]
-    #[diagnostic(code(chain::inverse::degenerate_linear))]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::inverse::degenerate_linear))
+    )]
     DegenerateLinear,
 }
 
