@@ -311,3 +311,33 @@ impl Inputs {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn marginals_are_validated_and_serialise_by_family() {
+        assert!(Marginal::normal(0.0, 0.0).is_err());
+        assert!(Marginal::normal(f64::NAN, 1.0).is_err());
+        assert!(Marginal::uniform(1.0, 1.0).is_err());
+        assert!(Marginal::uniform(0.0, f64::INFINITY).is_err());
+        let n = Marginal::normal(0.5, 2.0).unwrap();
+        let u = Marginal::uniform(-1.0, 3.0).unwrap();
+        assert_eq!((n.family(), u.family()), (Family::Normal, Family::Uniform));
+        assert_eq!((n.mean(), n.std()), (0.5, 2.0));
+        assert_eq!(u.support(), (-1.0, 3.0));
+        assert!((u.std() - 4.0 / (2.0 * SQRT_3)).abs() < 1e-15);
+        // A moved moment keeps the family and is validated again.
+        assert!(u.with_moments(0.0, -1.0).is_err());
+        assert_eq!(u.with_moments(1.0, 1.0).unwrap().family(), Family::Uniform);
+        assert_eq!(
+            serde_json::to_string(&n).unwrap(),
+            r#"{"dist":"normal","mean":0.5,"std":2.0}"#
+        );
+        assert_eq!(
+            serde_json::to_string(&u).unwrap(),
+            r#"{"dist":"uniform","min":-1.0,"max":3.0}"#
+        );
+    }
+}

@@ -15,8 +15,13 @@
 //! 256-layer ziggurat (Marsaglia & Tsang 2000) that takes 32 random bits per
 //! variate on its fast path (two variates per 64-bit word); the rare wedge
 //! and tail steps use fresh 53-bit uniforms. `benches/kernels.rs` measures it
-//! against `rand_distr`'s [`StandardNormal`](rand_distr::StandardNormal)
-//! (a 64-bit-per-variate ziggurat) on the same stream: KERNEL_FIGURES
+//! against `rand_distr`'s `StandardNormal` (a ziggurat that takes a whole
+//! 64-bit word per variate) on the same ChaCha8 stream, in one run:
+//! 1024 variates in 5.3 µs (193 M/s) against 11.3 µs (91 M/s), 2.1× — above
+//! the 1.3× bar, so the kernel stays (Monte Carlo draws 21 normals per
+//! sample). The former 64-word buffer in front of ChaCha8 is gone: it was
+//! only 1.14× faster than `rand_chacha`'s own block buffer (1024 words in
+//! 4.8 µs against 5.4 µs). Figures: `docs/performance.md`.
 
 use std::convert::Infallible;
 use std::sync::OnceLock;
@@ -277,6 +282,18 @@ mod tests {
             .fold(0.0, f64::max);
         // 1 % critical value 1.63/√n.
         assert!(d < 1.63 / n.sqrt(), "KS distance {d}");
+    }
+
+    #[test]
+    fn the_stream_is_chacha8_of_seed_case_and_block() {
+        let mut a = CaseRng::new(9, 3, 5);
+        let mut b = ChaCha8Rng::seed_from_u64(9);
+        b.set_stream((3 << 32) | 5);
+        for _ in 0..100 {
+            assert_eq!(a.next_u64(), b.next_u64());
+        }
+        let u = a.uniform();
+        assert_eq!(u, (b.next_u64() >> 11) as f64 / (1u64 << 53) as f64);
     }
 
     #[test]
