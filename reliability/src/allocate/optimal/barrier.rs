@@ -102,6 +102,13 @@ pub(super) fn central_path(
 
 /// Cholesky solve of a symmetric positive definite system; `None` when not
 /// positive definite.
+///
+/// Kept hand-written (issue 11 asked for nalgebra): nalgebra's `Cholesky`
+/// accumulates `aᵢⱼ − Σ lᵢₖlⱼₖ` term by term (axpy) where this sums first,
+/// which moves the recorded optimal allocation by round-off (`dxx`
+/// 0.00677424086163459 → 0.006774240861634587, cost 3.5671584000649315 →
+/// 3.5671584000649363), and the allocation outputs are held to the last
+/// digit (`tests/golden_outputs.rs`). See `docs/performance.md`.
 fn cholesky_solve(a: &[f64], b: &[f64]) -> Option<Vec<f64>> {
     let n = b.len();
     let mut l = vec![0.0; n * n];

@@ -7,6 +7,13 @@ use crate::study::Study;
 
 /// Solves `A x = b` (dense, row-major `n × n`) by Gaussian elimination with
 /// partial pivoting; `None` when singular.
+///
+/// Kept hand-written (issue 11 asked for nalgebra): nalgebra's `LU` pivots
+/// the same way but scales by the reciprocal pivot and back-substitutes by
+/// columns, which moves the recorded optimal allocation by round-off
+/// (`eyx` 5.120825632501355e-6 → 5.1208256325013545e-6, KKT stationarity
+/// 8.88e-16 → 9.99e-16), and the allocation outputs are held to the last
+/// digit (`tests/golden_outputs.rs`). See `docs/performance.md`.
 fn solve(mut a: Vec<f64>, mut b: Vec<f64>) -> Option<Vec<f64>> {
     let n = b.len();
     let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
