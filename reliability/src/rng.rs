@@ -294,6 +294,17 @@ mod tests {
         }
         let u = a.uniform();
         assert_eq!(u, (b.next_u64() >> 11) as f64 / (1u64 << 53) as f64);
+        // The same words as the former buffered stream (little-endian words
+        // of `fill_bytes`), so the samplers draw what they drew before.
+        let mut a = CaseRng::new(9, 3, 5);
+        let mut c = ChaCha8Rng::seed_from_u64(9);
+        c.set_stream((3 << 32) | 5);
+        let mut bytes = [0u8; 8 * 200];
+        c.fill_bytes(&mut bytes);
+        for chunk in bytes.chunks_exact(8) {
+            let w = u64::from_le_bytes(chunk.try_into().unwrap());
+            assert_eq!(a.next_u64(), w);
+        }
     }
 
     #[test]
