@@ -19,24 +19,43 @@ use crate::rng::CaseRng;
 const SQRT_3: f64 = 1.732_050_807_568_877_2;
 
 /// The marginal distribution of one input.
+///
+/// Built only through the validating constructors [`Marginal::normal`] and
+/// [`Marginal::uniform`] (the law is private), so every `Marginal` has a
+/// finite mean and a positive spread; [`Marginal::family`] and the accessors
+/// read it back. It serialises as `{"dist": "normal", "mean": …, "std": …}` or
+/// `{"dist": "uniform", "min": …, "max": …}`.
+///
+/// ```
+/// use reliability::inputs::{Family, Marginal};
+/// let m = Marginal::uniform(-1.0, 2.0).unwrap();
+/// assert_eq!(m.family(), Family::Uniform);
+/// assert_eq!(m.support(), (-1.0, 2.0));
+/// assert!(Marginal::normal(0.0, -1.0).is_err());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(transparent)]
+pub struct Marginal(Law);
+
+/// The family of a [`Marginal`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+#[non_exhaustive]
+pub enum Family {
+    /// Normal: `x = μ + σ·u`.
+    Normal,
+    /// Uniform on `[min, max]`: `x = min + (max − min)·Φ(u)`.
+    Uniform,
+}
+
+/// The validated law behind a [`Marginal`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "dist", rename_all = "lowercase")]
-#[non_exhaustive]
-pub enum Marginal {
-    /// Normal with mean and standard deviation: `x = μ + σ·u`.
-    Normal {
-        /// Mean `μ`.
-        mean: f64,
-        /// Standard deviation `σ > 0`.
-        std: f64,
-    },
-    /// Uniform on `[min, max]`: `x = min + (max − min)·Φ(u)`.
-    Uniform {
-        /// Lower bound.
-        min: f64,
-        /// Upper bound (`> min`).
-        max: f64,
-    },
+enum Law {
+    /// Normal with mean `μ` and standard deviation `σ > 0`.
+    Normal { mean: f64, std: f64 },
+    /// Uniform on `[min, max]`, `min < max`.
+    Uniform { min: f64, max: f64 },
 }
 
 impl Marginal {
@@ -47,7 +66,7 @@ impl Marginal {
                 "normal(mean {mean}, std {std}): the mean must be finite and the std positive"
             )));
         }
-        Ok(Marginal::Normal { mean, std })
+        Ok(Marginal(Law::Normal { mean, std }))
     }
 
     /// A validated uniform marginal.
@@ -57,61 +76,78 @@ impl Marginal {
                 "uniform(min {min}, max {max}): the bounds must be finite with min < max"
             )));
         }
-        Ok(Marginal::Uniform { min, max })
+        Ok(Marginal(Law::Uniform { min, max }))
     }
 
     /// The mean.
     pub fn mean(&self) -> f64 {
-        match *self {
-            Marginal::Normal { mean, .. } => mean,
-            Marginal::Uniform { min, max } => 0.5 * (min + max),
+        match self.0 {
+            Law::Normal { mean, .. } => mean,
+            Law::Uniform { min, max } => 0.5 * (min + max),
         }
     }
 
     /// The standard deviation.
     pub fn std(&self) -> f64 {
-        match *self {
-            Marginal::Normal { std, .. } => std,
-            Marginal::Uniform { min, max } => (max - min) / (2.0 * SQRT_3),
+        match self.0 {
+            Law::Normal { std, .. } => std,
+            Law::Uniform { min, max } => (max - min) / (2.0 * SQRT_3),
+        }
+    }
+
+    /// The family (normal or uniform).
+    pub fn family(&self) -> Family {
+        match self.0 {
+            Law::Normal { .. } => Family::Normal,
+            Law::Uniform { .. } => Family::Uniform,
+        }
+    }
+
+    /// The support `(lower, upper)`: `(−∞, +∞)` for a normal, `(min, max)`
+    /// for a uniform.
+    pub fn support(&self) -> (f64, f64) {
+        match self.0 {
+            Law::Normal { .. } => (f64::NEG_INFINITY, f64::INFINITY),
+            Law::Uniform { min, max } => (min, max),
         }
     }
 
     /// True for a normal marginal (its transformation is affine).
     pub fn is_normal(&self) -> bool {
-        matches!(self, Marginal::Normal { .. })
+        matches!(self.0, Law::Normal { .. })
     }
 
     /// The same family with another mean and standard deviation.
     pub fn with_moments(&self, mean: f64, std: f64) -> Result<Marginal, ReliabilityError> {
-        match self {
-            Marginal::Normal { .. } => Marginal::normal(mean, std),
-            Marginal::Uniform { .. } => Marginal::uniform(mean - SQRT_3 * std, mean + SQRT_3 * std),
+        match self.0 {
+            Law::Normal { .. } => Marginal::normal(mean, std),
+            Law::Uniform { .. } => Marginal::uniform(mean - SQRT_3 * std, mean + SQRT_3 * std),
         }
     }
 
     /// `x = T(u)`, the physical value of a standard normal coordinate.
     #[inline]
     pub fn to_physical(&self, u: f64) -> f64 {
-        match *self {
-            Marginal::Normal { mean, std } => mean + std * u,
-            Marginal::Uniform { min, max } => min + (max - min) * normal::cdf(u),
+        match self.0 {
+            Law::Normal { mean, std } => mean + std * u,
+            Law::Uniform { min, max } => min + (max - min) * normal::cdf(u),
         }
     }
 
     /// `u = T⁻¹(x)`.
     pub fn to_standard(&self, x: f64) -> f64 {
-        match *self {
-            Marginal::Normal { mean, std } => (x - mean) / std,
-            Marginal::Uniform { min, max } => normal::inverse_cdf((x - min) / (max - min)),
+        match self.0 {
+            Law::Normal { mean, std } => (x - mean) / std,
+            Law::Uniform { min, max } => normal::inverse_cdf((x - min) / (max - min)),
         }
     }
 
     /// `dx/du` at `u`.
     #[inline]
     pub fn dx_du(&self, u: f64) -> f64 {
-        match *self {
-            Marginal::Normal { std, .. } => std,
-            Marginal::Uniform { min, max } => (max - min) * normal::pdf(u),
+        match self.0 {
+            Law::Normal { std, .. } => std,
+            Law::Uniform { min, max } => (max - min) * normal::pdf(u),
         }
     }
 
@@ -123,18 +159,18 @@ impl Marginal {
     /// `∂x/∂σ` at fixed `u` (the marginal parametrised by mean and std):
     /// `u` for a normal, `√3·(2Φ(u) − 1)` for a uniform.
     pub fn dx_dstd(&self, u: f64) -> f64 {
-        match self {
-            Marginal::Normal { .. } => u,
-            Marginal::Uniform { .. } => SQRT_3 * (2.0 * normal::cdf(u) - 1.0),
+        match self.0 {
+            Law::Normal { .. } => u,
+            Law::Uniform { .. } => SQRT_3 * (2.0 * normal::cdf(u) - 1.0),
         }
     }
 
     /// One physical sample.
     #[inline]
     pub fn sample(&self, rng: &mut CaseRng) -> f64 {
-        match *self {
-            Marginal::Normal { mean, std } => mean + std * rng.normal(),
-            Marginal::Uniform { min, max } => min + (max - min) * rng.uniform(),
+        match self.0 {
+            Law::Normal { mean, std } => mean + std * rng.normal(),
+            Law::Uniform { min, max } => min + (max - min) * rng.uniform(),
         }
     }
 }
@@ -171,17 +207,6 @@ impl Inputs {
                 expected: marginals.len(),
                 found: names.len(),
             });
-        }
-        for m in &marginals {
-            // Re-validate: the enum's fields are public.
-            match *m {
-                Marginal::Normal { mean, std } => {
-                    Marginal::normal(mean, std)?;
-                }
-                Marginal::Uniform { min, max } => {
-                    Marginal::uniform(min, max)?;
-                }
-            }
         }
         let all_normal = marginals.iter().all(Marginal::is_normal);
         let means = marginals.iter().map(Marginal::mean).collect();
@@ -284,5 +309,35 @@ impl Inputs {
                 *x = m.sample(rng);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn marginals_are_validated_and_serialise_by_family() {
+        assert!(Marginal::normal(0.0, 0.0).is_err());
+        assert!(Marginal::normal(f64::NAN, 1.0).is_err());
+        assert!(Marginal::uniform(1.0, 1.0).is_err());
+        assert!(Marginal::uniform(0.0, f64::INFINITY).is_err());
+        let n = Marginal::normal(0.5, 2.0).unwrap();
+        let u = Marginal::uniform(-1.0, 3.0).unwrap();
+        assert_eq!((n.family(), u.family()), (Family::Normal, Family::Uniform));
+        assert_eq!((n.mean(), n.std()), (0.5, 2.0));
+        assert_eq!(u.support(), (-1.0, 3.0));
+        assert!((u.std() - 4.0 / (2.0 * SQRT_3)).abs() < 1e-15);
+        // A moved moment keeps the family and is validated again.
+        assert!(u.with_moments(0.0, -1.0).is_err());
+        assert_eq!(u.with_moments(1.0, 1.0).unwrap().family(), Family::Uniform);
+        assert_eq!(
+            serde_json::to_string(&n).unwrap(),
+            r#"{"dist":"normal","mean":0.5,"std":2.0}"#
+        );
+        assert_eq!(
+            serde_json::to_string(&u).unwrap(),
+            r#"{"dist":"uniform","min":-1.0,"max":3.0}"#
+        );
     }
 }

@@ -5,8 +5,28 @@
 //! the `libm` port of fdlibm, accurate to about one ulp), never as `1 − Φ(β)`,
 //! so a failure probability of `Φ(−8) ≈ 6.2·10⁻¹⁶` keeps all its digits. This
 //! is the `R = Φ(β)` of the paper's Eq. 31.
+//!
+//! Which crate computes what was measured (issue 11: `statrs` unless a kernel
+//! is at least 1.3× faster or measurably more accurate in the tails, β up to
+//! 8). Accuracy against mpmath (80 digits) at 2,321 points `x ∈ [−8, 8]` and
+//! 7,940 points `p ∈ [10⁻¹⁶, 1 − 10⁻¹⁶]`; speed from `benches/kernels.rs`,
+//! 1024 evaluations, one run:
+//!
+//! | function | kept | accuracy (max / mean ulp) | speed |
+//! |---|---|---|---|
+//! | `cdf`, `sf` | `libm::erfc` | 75 / 5.2 (libm) vs 886,252 / 155,082 (statrs 0.19.1 `erfc`: ~5·10⁻¹¹ relative on `|x| ∈ [0.7, 1.8]`) | statrs 1.9× faster |
+//! | `pdf` | the formula | 15 / 2.66 vs 16 / 2.69 (statrs `Normal::pdf`) | formula 1.19× faster |
+//! | `inverse_cdf` | `statrs` `erfc_inv` | 3 / 0.64 (statrs) vs 204 / 0.75 (former Acklam + Halley) | statrs 7.0× faster |
+//!
+//! The `cdf`/`sf` error of both is dominated by the rounding of `x/√2`
+//! (`erfc` amplifies a relative argument error by `2y²`, ≈ 60 at `x = 8`);
+//! statrs' own error comes from its truncated interval constants (fixed
+//! upstream after 0.19.1). `statrs`' pdf divides by `√(2π)` instead of
+//! multiplying by `1/√(2π)`, which is no more accurate and moves the last
+//! printed digit of the sensitivity and allocation outputs, so the one-line
+//! formula stays.
 
-use std::f64::consts::FRAC_1_SQRT_2;
+use std::f64::consts::{FRAC_1_SQRT_2, SQRT_2};
 
 /// `1/√(2π)`.
 const FRAC_1_SQRT_2PI: f64 = 0.398_942_280_401_432_7;
@@ -22,7 +42,8 @@ pub fn pdf(x: f64) -> f64 {
 
 /// The standard normal distribution function `Φ(x) = ½·erfc(−x/√2)`.
 ///
-/// Relative accuracy is kept in the lower tail: `cdf(-8.0)` is
+/// `libm`'s `erfc`, not `statrs`' (see the module documentation: statrs 0.19.1
+/// is 1.9× faster but off by up to ~10⁶ ulp). Relative accuracy is kept in the lower tail: `cdf(-8.0)` is
 /// `6.220960574271785e-16` to about one ulp.
 ///
 /// ```
@@ -53,11 +74,14 @@ pub fn interval(a: f64, b: f64) -> f64 {
     }
 }
 
-/// The quantile `Φ⁻¹(p)` for `p ∈ (0, 1)`; `−∞` at 0, `+∞` at 1, NaN outside.
+/// The quantile `Φ⁻¹(p) = −√2·erfc⁻¹(2p)` for `p ∈ (0, 1)`; `−∞` at 0, `+∞`
+/// at 1, NaN outside (`statrs`' `Normal::inverse_cdf` panics there, so the
+/// inverse error function is called directly).
 ///
-/// Acklam's rational approximation (relative error below 1.2·10⁻⁹) refined by
-/// one Halley step on `Φ(x) − p` evaluated with `erfc`, which brings it to
-/// within a few ulps, also deep in the lower tail.
+/// `statrs::function::erf::erfc_inv` (Boost's rational approximations):
+/// against mpmath at 7,940 points `p ∈ [10⁻¹⁶, 1 − 10⁻¹⁶]` its largest error is
+/// 3 ulp (mean 0.64), where the former hand-written Acklam + two Halley steps
+/// reached 204 ulp near `p = ½` (mean 0.75); see `docs/performance.md`.
 ///
 /// ```
 /// use reliability::normal::{cdf, inverse_cdf};
@@ -69,80 +93,13 @@ pub fn inverse_cdf(p: f64) -> f64 {
     if p.is_nan() || !(0.0..=1.0).contains(&p) {
         return f64::NAN;
     }
-    if p == 0.0 {
-        return f64::NEG_INFINITY;
-    }
-    if p == 1.0 {
-        return f64::INFINITY;
-    }
-    // Work in the tail where p is represented accurately.
-    if p > 0.5 {
-        return -lower_quantile(1.0 - p);
-    }
-    lower_quantile(p)
+    -SQRT_2 * statrs::function::erf::erfc_inv(2.0 * p)
 }
 
 /// The generalised reliability index `β = −Φ⁻¹(p_f)` of a failure probability,
 /// accurate for tiny `p_f`.
 pub fn beta_from_pf(pf: f64) -> f64 {
     -inverse_cdf(pf)
-}
-
-/// `Φ⁻¹(p)` for `0 < p ≤ 0.5`.
-fn lower_quantile(p: f64) -> f64 {
-    const A: [f64; 6] = [
-        -3.969_683_028_665_376e1,
-        2.209_460_984_245_205e2,
-        -2.759_285_104_469_687e2,
-        1.383_577_518_672_69e2,
-        -3.066_479_806_614_716e1,
-        2.506_628_277_459_239,
-    ];
-    const B: [f64; 5] = [
-        -5.447_609_879_822_406e1,
-        1.615_858_368_580_409e2,
-        -1.556_989_798_598_866e2,
-        6.680_131_188_771_972e1,
-        -1.328_068_155_288_572e1,
-    ];
-    const C: [f64; 6] = [
-        -7.784_894_002_430_293e-3,
-        -3.223_964_580_411_365e-1,
-        -2.400_758_277_161_838,
-        -2.549_732_539_343_734,
-        4.374_664_141_464_968,
-        2.938_163_982_698_783,
-    ];
-    const D: [f64; 4] = [
-        7.784_695_709_041_462e-3,
-        3.224_671_290_700_398e-1,
-        2.445_134_137_142_996,
-        3.754_408_661_907_416,
-    ];
-    const P_LOW: f64 = 0.024_25;
-    let x = if p < P_LOW {
-        let q = (-2.0 * p.ln()).sqrt();
-        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
-            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
-    } else {
-        let q = p - 0.5;
-        let r = q * q;
-        (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
-            / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
-    };
-    // One Halley step: e = Φ(x) − p, u = e/φ(x), x ← x − u/(1 + x·u/2).
-    // Two steps when far in the tail keep the few-ulp accuracy.
-    let mut x = x;
-    for _ in 0..2 {
-        let e = cdf(x) - p;
-        let d = pdf(x);
-        if d == 0.0 || !e.is_finite() {
-            break;
-        }
-        let u = e / d;
-        x -= u / (1.0 + 0.5 * x * u);
-    }
-    x
 }
 
 #[cfg(test)]
@@ -173,6 +130,37 @@ mod tests {
         }
         assert!((beta_from_pf(sf(7.5)) - 7.5).abs() < 1e-12);
         assert!(inverse_cdf(2.0).is_nan());
+    }
+
+    #[test]
+    fn quantile_and_cdf_against_mpmath() {
+        // mpmath (60 digits): √2·erfinv(2p − 1) and ncdf.
+        let q = [
+            (1e-16, -8.222_082_216_130_435),
+            (3e-9, -5.816_757_740_125_828),
+            (0.024_25, -1.972_961_051_311_884_8),
+            (0.3, -0.524_400_512_708_040_8),
+            (0.999_999, 4.753_424_308_817_088),
+        ];
+        for (p, want) in q {
+            let got = inverse_cdf(p);
+            assert!(
+                (got / want - 1.0).abs() < 4.0 * f64::EPSILON,
+                "p {p}: {got}"
+            );
+        }
+        assert_eq!(inverse_cdf(0.5), 0.0);
+        assert_eq!(inverse_cdf(0.0), f64::NEG_INFINITY);
+        assert_eq!(inverse_cdf(1.0), f64::INFINITY);
+        // Where statrs 0.19.1's erfc is off by ~5e-11 (|x| in [0.7, 1.8]): libm
+        // keeps Φ to a few ulps.
+        for (x, want) in [
+            (-0.75, 0.226_627_352_376_868_2),
+            (1.0, 0.841_344_746_068_542_9),
+            (-1.5, 0.066_807_201_268_858_07),
+        ] {
+            assert!((cdf(x) / want - 1.0).abs() < 4.0 * f64::EPSILON, "x {x}");
+        }
     }
 
     #[test]

@@ -53,6 +53,7 @@ use crate::jet::Jet;
 use crate::kinematics::{Kinematics, PoseOf};
 use crate::model::{JointKind, Machine};
 use crate::Pose;
+use nalgebra::{DMatrix, DVector};
 
 use crate::geometry::{basis, col, cross, dot, log_so3, mul, norm, sub, tr, V3};
 
@@ -572,7 +573,7 @@ impl Motion {
                 break;
             }
             let (_, a) = self.linearise(&q, target, true);
-            let Some(d) = Qr::new(&a).and_then(|qr| qr.solve(&r)) else {
+            let Some(d) = qr_of(&a).and_then(|qr| least_squares(&qr, &r)) else {
                 break;
             };
             let mut lambda = 1.0;
@@ -763,7 +764,7 @@ impl Motion {
     pub fn series_from(&self, q0: &[f64], order: usize) -> Result<Series, MotionError> {
         let target0 = self.generator_pose(0.0);
         let (_, a) = self.linearise(q0, &target0, true);
-        let qr = Qr::new(&a).ok_or(MotionError::Singular {
+        let qr = qr_of(&a).ok_or(MotionError::Singular {
             what: what(self.matching),
         })?;
         let g = self.generator_series(order);
@@ -781,7 +782,7 @@ impl Motion {
             }
             for _pass in 0..2 {
                 let rhs = self.order_residual(&coefficients, &g, k, (e1, e2));
-                let d = qr.solve(&rhs).ok_or(MotionError::Singular {
+                let d = least_squares(&qr, &rhs).ok_or(MotionError::Singular {
                     what: what(self.matching),
                 })?;
                 for (ci, &f) in self.free.iter().enumerate() {
@@ -905,43 +906,36 @@ pub fn pose_difference(a: &Pose, b: &Pose) -> PoseError {
     }
 }
 
-/// A QR factorisation (nalgebra) of an `m × n` matrix (`m ≥ n`) for
-/// least-squares solves.
-struct Qr {
-    q: nalgebra::DMatrix<f64>,
-    r: nalgebra::DMatrix<f64>,
+/// nalgebra's QR factorisation `A = Q·R` of `a` (given by rows, `m × n`,
+/// `m ≥ n`), unpacked into the thin `Q` (`m × n`) and `R` (`n × n`); `None`
+/// if `m < n` or the columns are (numerically) dependent: a diagonal entry
+/// of `R` below `1e-11` of the largest.
+fn qr_of(a: &[Vec<f64>]) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
+    let m = a.len();
+    let n = a.first().map_or(0, Vec::len);
+    if m < n || n == 0 || a.iter().any(|row| row.len() != n) {
+        return None;
+    }
+    let (q, r) = DMatrix::from_fn(m, n, |i, j| a[i][j]).qr().unpack();
+    let big = (0..n).map(|k| r[(k, k)].abs()).fold(0.0, f64::max);
+    if !(big.is_finite() && big > 0.0) || (0..n).any(|k| r[(k, k)].abs() <= 1e-11 * big) {
+        return None;
+    }
+    Some((q, r))
 }
 
-impl Qr {
-    /// Factors `a` (given by rows); `None` if `m < n` or the columns are
-    /// (numerically) dependent: a diagonal entry of `R` below `1e-11` of the
-    /// largest.
-    fn new(a: &[Vec<f64>]) -> Option<Qr> {
-        let m = a.len();
-        let n = a.first().map_or(0, Vec::len);
-        if m < n || n == 0 || a.iter().any(|row| row.len() != n) {
-            return None;
-        }
-        let qr = nalgebra::DMatrix::from_fn(m, n, |i, j| a[i][j]).qr();
-        let r = qr.r();
-        let big = (0..n).map(|k| r[(k, k)].abs()).fold(0.0, f64::max);
-        if !(big.is_finite() && big > 0.0) || (0..n).any(|k| r[(k, k)].abs() <= 1e-11 * big) {
-            return None;
-        }
-        Some(Qr { q: qr.q(), r })
+/// The least-squares solution of `A x = b` from `(Q, R)` of [`qr_of`]:
+/// `R x = Qᵀ b` (`Q` formed explicitly, which keeps the motion outputs of
+/// the recorded runs to the last digit; applying the Householder reflectors
+/// with `QR::q_tr_mul` instead moves their last digits).
+fn least_squares((q, r): &(DMatrix<f64>, DMatrix<f64>), b: &[f64]) -> Option<Vec<f64>> {
+    if b.len() != q.nrows() {
+        return None;
     }
-
-    /// The least-squares solution of `A x = b`.
-    fn solve(&self, b: &[f64]) -> Option<Vec<f64>> {
-        if b.len() != self.q.nrows() {
-            return None;
-        }
-        let qtb = self.q.tr_mul(&nalgebra::DVector::from_column_slice(b));
-        let x = self.r.solve_upper_triangular(&qtb)?;
-        x.iter()
-            .all(|v| v.is_finite())
-            .then(|| x.iter().copied().collect())
-    }
+    let x = r.solve_upper_triangular(&q.tr_mul(&DVector::from_column_slice(b)))?;
+    x.iter()
+        .all(|v| v.is_finite())
+        .then(|| x.iter().copied().collect())
 }
 
 #[cfg(test)]
@@ -951,21 +945,21 @@ mod tests {
     #[test]
     fn qr_solves_square_and_least_squares() {
         let a = vec![vec![2.0, 1.0], vec![1.0, 3.0], vec![0.0, 1.0]];
-        let qr = Qr::new(&a).unwrap();
+        let qr = qr_of(&a).unwrap();
         // consistent right-hand side
-        let x = qr.solve(&[4.0, 7.0, 2.0]).unwrap();
+        let x = least_squares(&qr, &[4.0, 7.0, 2.0]).unwrap();
         assert!(
             (x[0] - 1.0).abs() < 1e-12 && (x[1] - 2.0).abs() < 1e-12,
             "{x:?}"
         );
         // inconsistent: the normal equations' solution
-        let x = qr.solve(&[1.0, 0.0, 0.0]).unwrap();
+        let x = least_squares(&qr, &[1.0, 0.0, 0.0]).unwrap();
         let ata = [[5.0, 5.0], [5.0, 11.0]];
         let atb = [2.0, 1.0];
         for i in 0..2 {
             let r = ata[i][0] * x[0] + ata[i][1] * x[1] - atb[i];
             assert!(r.abs() < 1e-12, "{x:?}");
         }
-        assert!(Qr::new(&[vec![1.0, 2.0], vec![2.0, 4.0]]).is_none());
+        assert!(qr_of(&[vec![1.0, 2.0], vec![2.0, 4.0]]).is_none());
     }
 }

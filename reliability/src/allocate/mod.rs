@@ -1,0 +1,318 @@
+//! Precision allocation (seed 000, Section 3.3, Tables 5-7): which standard
+//! deviations to tighten so that every toleranced component meets the
+//! requirement on its minimum and mean reliability over the grid.
+//!
+//! Two strategies:
+//!
+//! - [`paper()`] (`paper.rs`): the paper's procedure. Each round ranks the errors of every
+//!   component that misses the requirement by their grid-mean `|∂R/∂σ|`
+//!   (per component, as Tables 5-7 do), tightens every error whose
+//!   sensitivity is at least a fraction (10 %) of that component's largest by
+//!   one step in the units of Table 1 (`step/6` mm for linear errors,
+//!   `step/6000` rad for angular, `step/3000` rad for squareness), and
+//!   re-evaluates with FORM.
+//! - [`optimal()`] (`optimal/`): the least-cost standard deviations,
+//!   `min Σ wᵢ (σ0ᵢ/σᵢ − 1)` subject to `R_case(σ) ≥ R_min` for every grid
+//!   case of every component and `mean R(σ) ≥ R_mean` per component, with
+//!   `min_stdᵢ ≤ σᵢ ≤ σ0ᵢ`. It works in `tᵢ = ln(σ0ᵢ/σᵢ)` (the cost is
+//!   convex there), with the exact reliability `Φ(c/√V)` of a linear
+//!   component in normal inputs and its exact first and second derivatives,
+//!   by a log-barrier interior-point method (damped Newton per barrier
+//!   parameter, strictly feasible iterates), then a Newton polish of the
+//!   KKT system on the identified active set. The KKT conditions are checked
+//!   and reported ([`Kkt`]). `optimal/problem.rs` holds the problem (cases,
+//!   constraints and their exact derivatives), `optimal/barrier.rs` the
+//!   log-barrier Newton path and `optimal/kkt.rs` the active-set polish and
+//!   the KKT check.
+//!
+//! Infeasibility is exact, not a best effort: each reliability is increasing
+//! in every `tᵢ`, so the requirement is feasible if and only if it holds with
+//! every error at its lower bound (`min_std`); when it does not, the result
+//! is [`AllocateError::Infeasible`] naming the component, the case and the
+//! bounds that bind.
+
+// Dense linear algebra over small index ranges reads best with indices.
+#![allow(clippy::needless_range_loop)]
+
+use chain_core::model::{ErrorKind, Machine};
+use chain_core::ErrorModel;
+use serde::Serialize;
+
+use crate::error::ReliabilityError;
+use crate::form::Form;
+use crate::inputs::{Inputs, Marginal};
+use crate::study::{Study, StudyResult, Summary, Target};
+
+mod optimal;
+mod paper;
+
+pub use optimal::optimal;
+pub use paper::paper;
+
+/// The allocation data of one error parameter.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ErrorBounds {
+    /// The error parameter.
+    pub error: String,
+    /// Linear, angular or squareness (sets the step of [`paper()`]).
+    pub kind: ErrorKind,
+    /// The initial (largest allowed) standard deviation.
+    pub std0: f64,
+    /// The smallest allowed standard deviation (0 when unbounded).
+    pub min_std: f64,
+    /// The weight `wᵢ` of the cost.
+    pub cost_weight: f64,
+}
+
+/// The bounds of every input of `study`, in its input order, from the
+/// machine's `statistics` entries.
+pub fn bounds(machine: &Machine, study: &Study) -> Result<Vec<ErrorBounds>, ReliabilityError> {
+    let inputs = study.inputs();
+    inputs
+        .names()
+        .iter()
+        .zip(inputs.marginals())
+        .map(|(name, m)| {
+            let j = machine
+                .error_index(name)
+                .ok_or_else(|| ReliabilityError::MissingInput(name.clone()))?;
+            let stat = machine
+                .statistic(j)
+                .ok_or_else(|| ReliabilityError::MissingStatistic {
+                    name: name.clone(),
+                    origin: machine.errors[j].origin.clone(),
+                })?;
+            Ok(ErrorBounds {
+                error: name.clone(),
+                kind: machine.errors[j].kind,
+                std0: m.std(),
+                min_std: stat.min_std.unwrap_or(0.0),
+                cost_weight: stat.cost_weight,
+            })
+        })
+        .collect()
+}
+
+/// The cost `Σ wᵢ (σ0ᵢ/σᵢ − 1)` of a set of standard deviations.
+pub fn cost(bounds: &[ErrorBounds], stds: &[f64]) -> f64 {
+    bounds
+        .iter()
+        .zip(stds)
+        .map(|(b, s)| b.cost_weight * (b.std0 / s - 1.0))
+        .sum()
+}
+
+/// Options of the paper's procedure.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Paper {
+    /// The step, in the paper's tolerance units (0.005).
+    pub step: f64,
+    /// Tighten every error whose sensitivity is at least this fraction of
+    /// the largest (0.1).
+    pub threshold: f64,
+    /// Rank over all unmet components pooled instead of per component.
+    pub pooled: bool,
+    /// Give up after this many rounds.
+    pub max_rounds: usize,
+}
+
+impl Default for Paper {
+    fn default() -> Paper {
+        Paper {
+            step: 0.005,
+            threshold: 0.1,
+            pooled: false,
+            max_rounds: 200,
+        }
+    }
+}
+
+/// Options of the least-cost allocation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Optimal {
+    /// The requirement is imposed with this margin (so that an independent
+    /// evaluation finds it met despite round-off).
+    pub margin: f64,
+}
+
+impl Default for Optimal {
+    fn default() -> Optimal {
+        Optimal { margin: 1e-10 }
+    }
+}
+
+/// One round of the paper's procedure.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Step {
+    /// 1, 2, …
+    pub round: usize,
+    /// The errors tightened this round, in input order.
+    pub tightened: Vec<String>,
+    /// Their new standard deviations.
+    pub std: Vec<(String, f64)>,
+    /// The component summaries after the round.
+    pub summaries: Vec<Summary>,
+}
+
+/// The KKT conditions at the optimum (in the variables `tᵢ = ln(σ0ᵢ/σᵢ)`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Kkt {
+    /// `‖∇f − Σ λₖ∇gₖ − z‖∞` (z: bound multipliers).
+    pub stationarity: f64,
+    /// `max |λₖ gₖ|` and `max |zᵢ (tᵢ − boundᵢ)|`.
+    pub complementarity: f64,
+    /// `max(0, −gₖ)` (in reliability) and bound violations.
+    pub feasibility: f64,
+    /// `max(0, −λₖ)` and wrong-signed bound multipliers.
+    pub dual_feasibility: f64,
+    /// The active constraints with their multipliers.
+    pub active: Vec<(String, f64)>,
+    /// Errors at a bound: `(name, "unchanged" | "min_std", multiplier)`.
+    pub at_bound: Vec<(String, &'static str, f64)>,
+    /// Newton iterations (barrier and polish).
+    pub iterations: usize,
+    /// Whether the active-set Newton polish converged (else the barrier
+    /// solution is reported).
+    pub polished: bool,
+}
+
+impl Kkt {
+    /// The largest of the four residuals.
+    pub fn residual(&self) -> f64 {
+        self.stationarity
+            .max(self.complementarity)
+            .max(self.feasibility)
+            .max(self.dual_feasibility)
+    }
+}
+
+/// The outcome of an allocation.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Allocation {
+    /// `optimal` or `paper`.
+    pub strategy: &'static str,
+    /// The initial component summaries.
+    pub initial: Vec<Summary>,
+    /// The paper's rounds (empty for the optimal strategy).
+    pub steps: Vec<Step>,
+    /// The final standard deviations, in input order.
+    pub std: Vec<(String, f64)>,
+    /// Their cost.
+    pub cost: f64,
+    /// Whether every component meets the requirement (FORM re-evaluation).
+    pub met: bool,
+    /// The final component summaries (FORM re-evaluation).
+    pub summaries: Vec<Summary>,
+    /// The KKT check (optimal strategy).
+    pub kkt: Option<Kkt>,
+}
+
+/// Why an allocation failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AllocateError {
+    /// From the reliability engine.
+    #[error(transparent)]
+    Reliability(#[from] ReliabilityError),
+    /// The machine has no `requirement`.
+    #[error("the reliability section has no `requirement` (min and mean) to allocate for")]
+    NoRequirement,
+    /// A setting the strategy does not handle.
+    #[error("{0}")]
+    Unsupported(String),
+    /// The requirement cannot be met within the bounds.
+    #[error(
+        "the requirement is infeasible: {component} {what}{} reaches at most {:.4} % with every error at its bound (required {:.4} %); binding bounds: {}",
+        at.as_ref().map(|a| format!(" at {a}")).unwrap_or_default(),
+        best * 100.0,
+        required * 100.0,
+        binding.join(", ")
+    )]
+    Infeasible {
+        /// The component.
+        component: String,
+        /// `minimum reliability` or `mean reliability`.
+        what: &'static str,
+        /// The grid point of the failing case.
+        at: Option<String>,
+        /// The best reachable value.
+        best: f64,
+        /// The required value.
+        required: f64,
+        /// The errors at their `min_std` that drive the component, largest
+        /// contribution first (`name (min_std …)`).
+        binding: Vec<String>,
+    },
+    /// The paper's procedure can tighten nothing more.
+    #[error("the paper's procedure stops after round {round}: {component} misses the requirement and none of its errors can be tightened further ({errors} at min_std or zero)")]
+    Stalled {
+        /// The last round.
+        round: usize,
+        /// The component.
+        component: String,
+        /// Its ranked errors.
+        errors: String,
+    },
+    /// The optimiser did not converge.
+    #[error("the optimiser did not converge: {0}")]
+    NotConverged(String),
+}
+
+/// The study's inputs with other standard deviations (same families and means).
+pub fn with_stds(study: &Study, stds: &[f64]) -> Result<Inputs, ReliabilityError> {
+    let inputs = study.inputs();
+    let marginals = inputs
+        .marginals()
+        .iter()
+        .zip(stds)
+        .map(|(m, &s)| m.with_moments(m.mean(), s))
+        .collect::<Result<Vec<Marginal>, _>>()?;
+    Inputs::new(inputs.names().to_vec(), marginals)
+}
+
+/// FORM over the study's grid with other standard deviations.
+pub fn evaluate<M: ErrorModel + ?Sized>(
+    model: &M,
+    parameters: &[f64],
+    study: &Study,
+    stds: &[f64],
+) -> Result<(Study, StudyResult), ReliabilityError> {
+    let s = Study::new(
+        model,
+        parameters,
+        with_stds(study, stds)?,
+        study.spec().clone(),
+    )?;
+    let r = s.form(&Form::default())?;
+    Ok((s, r))
+}
+
+pub(crate) fn component_summaries(r: &StudyResult) -> Vec<Summary> {
+    r.summaries
+        .iter()
+        .filter(|s| !matches!(s.target, "series" | "volumetric"))
+        .cloned()
+        .collect()
+}
+
+pub(crate) fn all_met(s: &[Summary]) -> bool {
+    s.iter().all(|s| s.met.unwrap_or(true))
+}
+
+/// One step of `kind` in standard-deviation units (Table 1's units).
+pub fn step_std(kind: ErrorKind, step: f64) -> f64 {
+    match kind {
+        ErrorKind::Linear => step / 6.0,
+        ErrorKind::Angular => step / 6000.0,
+        ErrorKind::Squareness => step / 3000.0,
+    }
+}
+
+/// The targets of a study that allocation handles (its components).
+pub fn components(study: &Study) -> Vec<Target> {
+    study
+        .targets()
+        .iter()
+        .copied()
+        .filter(|t| matches!(t, Target::Component(_)))
+        .collect()
+}
