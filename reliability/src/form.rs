@@ -60,6 +60,33 @@ pub enum Termination {
     Degenerate,
 }
 
+impl Termination {
+    /// `closed_form`, `converged`, `max_iterations` or `degenerate` (the
+    /// JSON spelling).
+    pub fn name(self) -> &'static str {
+        match self {
+            Termination::ClosedForm => "closed_form",
+            Termination::Converged => "converged",
+            Termination::MaxIterations => "max_iterations",
+            Termination::Degenerate => "degenerate",
+        }
+    }
+
+    /// Every termination, in declaration order.
+    pub const ALL: [Termination; 4] = [
+        Termination::ClosedForm,
+        Termination::Converged,
+        Termination::MaxIterations,
+        Termination::Degenerate,
+    ];
+}
+
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// Function-call counts (the argmin / OpenTURNS habit).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
 pub struct Calls {
