@@ -65,7 +65,7 @@ pub use chain_core::ErrorModel;
 pub use error::ReliabilityError;
 pub use form::{BranchResult, Calls, Form, FormResult, Termination};
 pub use inputs::{Inputs, Marginal};
-pub use limit_state::{Affine, Criterion, Event, LimitState, ToleranceLimitState};
+pub use limit_state::{Affine, AffineView, Criterion, Event, LimitState, ToleranceLimitState};
 pub use path::{
     Extreme, InstantResult, PathInstant, PathRecord, PathResult, PathStudy, PathTarget, Quantity,
     TargetSummary,
