@@ -316,7 +316,10 @@ fn assert_chart(dir: &Path, stem: &str, bars: usize) {
         .chunks_exact(px)
         .filter(|p| p[..3] != [255, 255, 255])
         .count();
-    assert!(drawn * 20 > (info.width * info.height) as usize, "{stem}.png");
+    assert!(
+        drawn * 20 > (info.width * info.height) as usize,
+        "{stem}.png"
+    );
     let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).expect("svg");
     assert!(svg.contains("<svg") && svg.trim_end().ends_with("</svg>"));
     assert!(svg.matches("<rect").count() >= bars, "{stem}.svg has bars");
@@ -458,7 +461,10 @@ fn form_reports_termination_and_calls_in_every_format() {
         .rfind(|l| l.starts_with("  FORM: "))
         .expect("volumetric FORM line");
     assert!(
-        line.starts_with(&format!("  FORM: {} of 125 cases converged (", 125 - unconverged)),
+        line.starts_with(&format!(
+            "  FORM: {} of 125 cases converged (",
+            125 - unconverged
+        )),
         "{line}"
     );
     assert_eq!(
@@ -500,7 +506,12 @@ fn unknown_names_get_a_close_suggestion_or_none() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("did you mean `y`?"), "{err}");
     assert!(err.contains("chain::reliability::unknown_name"), "{err}");
-    let out = chain(&["reliability", file.to_str().unwrap(), "--grid", "spindle=0,1"]);
+    let out = chain(&[
+        "reliability",
+        file.to_str().unwrap(),
+        "--grid",
+        "spindle=0,1",
+    ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("did you mean"), "{err}");
     // Every error has its own code (no generic fallback).

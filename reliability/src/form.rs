@@ -413,10 +413,10 @@ impl Work {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::limit_state::Criterion;
-    use chain_core::model::Sided;
     use crate::inputs::{Inputs, Marginal};
+    use crate::limit_state::Criterion;
     use crate::limit_state::ToleranceLimitState;
+    use chain_core::model::Sided;
 
     fn inputs(stds: &[f64]) -> Inputs {
         Inputs::new(

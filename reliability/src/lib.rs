@@ -73,6 +73,6 @@ pub use path::{
 pub use sensitivity::{sensitivity, InputSensitivity, SensitivityMethod, SensitivityResult};
 pub use simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult};
 pub use study::{
-    Algorithm, CaseResult, ErrorMoments, ErrorSensitivity, FormCase, FormLimit, Grid, Method, Study,
-    StudyResult, StudySpec, Summary, System, Target, TargetSensitivity, VolumetricMoments,
+    Algorithm, CaseResult, ErrorMoments, ErrorSensitivity, FormCase, FormLimit, Grid, Method,
+    Study, StudyResult, StudySpec, Summary, System, Target, TargetSensitivity, VolumetricMoments,
 };

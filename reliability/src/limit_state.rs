@@ -565,11 +565,7 @@ impl<'l> Affine<'l> {
                 a[c * n + j] = s * m.std();
             }
         }
-        Affine {
-            view: ls,
-            mean,
-            a,
-        }
+        Affine { view: ls, mean, a }
     }
 
     /// Row `c` of `a`.

@@ -482,7 +482,10 @@ mod tests {
                         })
                         .sum();
                     let got = e.moments.covariance[a][b];
-                    assert!((got - cov).abs() <= 1e-12 * cov.abs().max(1e-20), "{got} {cov}");
+                    assert!(
+                        (got - cov).abs() <= 1e-12 * cov.abs().max(1e-20),
+                        "{got} {cov}"
+                    );
                 }
             }
             assert!(e.mean(Quantity::Component(Component::Px)).abs() > 1e-3);

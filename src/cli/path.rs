@@ -20,8 +20,8 @@ use std::path::{Path, PathBuf};
 use chain_core::inverse::{Inverse, Status};
 use chain_core::model::{Machine, Sided};
 use reliability::{
-    machine, Algorithm, Calls, Extreme, Form, FormCase, ImportanceSampling, InstantResult,
-    Method, MonteCarlo, PathInstant, PathResult, PathStudy, Quantity, Target,
+    machine, Algorithm, Calls, Extreme, Form, FormCase, ImportanceSampling, InstantResult, Method,
+    MonteCarlo, PathInstant, PathResult, PathStudy, Quantity, Target,
 };
 use serde::Serialize;
 
@@ -119,8 +119,8 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
         }
         (None, None) => miette::bail!("give the path with --axes AXES.csv or --pose POSE.csv"),
     };
-    let path = PathStudy::new(&model, &params, inputs, spec, instants)
-        .map_err(|e| loaded.report(e))?;
+    let path =
+        PathStudy::new(&model, &params, inputs, spec, instants).map_err(|e| loaded.report(e))?;
     match path.study() {
         None => eprintln!("note: no instant of the path has axis values; nothing to evaluate"),
         Some(study) => {
@@ -612,7 +612,12 @@ impl Report for PathDoc {
                 row.extend(Quantity::ALL.iter().map(|&q| format!("{:?}", e.std(q))));
                 row.extend(e.cases.iter().map(|c| format!("{:?}", c.reliability)));
                 if sampled {
-                    match e.cases.iter().map(|c| c.std_error).collect::<Option<Vec<_>>>() {
+                    match e
+                        .cases
+                        .iter()
+                        .map(|c| c.std_error)
+                        .collect::<Option<Vec<_>>>()
+                    {
                         Some(se) => row.extend(se.iter().map(|x| format!("{x:?}"))),
                         None => row.extend(names.iter().map(|_| String::new())),
                     }

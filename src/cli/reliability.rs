@@ -850,7 +850,8 @@ fn to_table(machine: &str, study: &Study, r: &StudyResult) -> String {
                         let coords: Vec<String> = [(&map.rows, i), (&map.cols, j)]
                             .iter()
                             .filter_map(|(axis, k)| {
-                                axis.as_ref().map(|(n, v)| format!("{n} = {}", fmt_num(v[*k])))
+                                axis.as_ref()
+                                    .map(|(n, v)| format!("{n} = {}", fmt_num(v[*k])))
                             })
                             .collect();
                         bad.push(if coords.is_empty() {

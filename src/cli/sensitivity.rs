@@ -487,7 +487,12 @@ impl<'a> GeometricDoc<'a> {
             points: grid.then_some(r.points),
             normalisation: "c = s*e / sum(s*e)",
             values: nominal,
-            totals: Pairs(r.components.iter().map(|c| (c.component, c.total)).collect()),
+            totals: Pairs(
+                r.components
+                    .iter()
+                    .map(|c| (c.component, c.total))
+                    .collect(),
+            ),
             components: Pairs(
                 r.components
                     .iter()
