@@ -20,16 +20,16 @@ use std::path::{Path, PathBuf};
 use chain_core::inverse::{Inverse, Status};
 use chain_core::model::{Machine, Sided};
 use reliability::{
-    machine, Algorithm, Calls, Extreme, Form, FormCase, ImportanceSampling, InstantResult, Method,
-    MonteCarlo, PathInstant, PathResult, PathStudy, Quantity, Target,
+    machine, Calls, Extreme, FormCase, InstantResult, Method, PathInstant, PathResult, PathStudy,
+    Quantity, Target,
 };
 use serde::Serialize;
 
 use super::csv_input::{numeric_rows, open_csv, read_poses};
 use super::inverse::solve_rows;
 use super::reliability::{
-    calls_text, note_form_limits, parse_assignment, requirement_text, resolve_fixed, system_of,
-    warn_unconverged, Loaded, MethodArg, Pairs, RequirementDoc, SidedArg, SystemArg,
+    calls_text, note_form_limits, parse_assignment, requirement_text, resolve_fixed, sided_title,
+    system_of, warn_unconverged, Loaded, MethodArg, Pairs, RequirementDoc, SidedArg, SystemArg,
 };
 use super::report::{self, Csv, Report};
 
@@ -136,7 +136,7 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
     }
     let samples = args.method.samples(args.samples);
     let result = path
-        .run(&algorithm(args.method, samples, args.seed), &())
+        .run(&args.method.algorithm(samples, args.seed), &())
         .map_err(|e| loaded.report(e))?;
     if let (Some(study), Some(r)) = (path.study(), &result.study) {
         warn_unconverged(r, study.variables());
@@ -160,19 +160,6 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
         }
     }
     report::emit(&doc, args.format.into())
-}
-
-/// The algorithm of `--method` with the samples and the seed.
-fn algorithm(method: MethodArg, samples: u64, seed: u64) -> Algorithm {
-    match method {
-        MethodArg::Form => Algorithm::Form(Form::default()),
-        MethodArg::Is => Algorithm::ImportanceSampling(ImportanceSampling {
-            samples,
-            seed,
-            form: Form::default(),
-        }),
-        MethodArg::Mc => Algorithm::MonteCarlo(MonteCarlo { samples, seed }),
-    }
 }
 
 impl From<PathFormat> for report::Format {
@@ -688,10 +675,7 @@ fn to_table(doc: &PathDoc) -> String {
     use std::fmt::Write as _;
     let r = &doc.result;
     let mut out = String::new();
-    let sided = match r.sided {
-        Sided::Upper => "upper",
-        Sided::Two => "two-sided",
-    };
+    let sided = sided_title(r.sided);
     let _ = writeln!(
         out,
         "{}: error and reliability along a path ({} instants from {}, {}, {sided}, frame {})",

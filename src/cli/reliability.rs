@@ -15,8 +15,8 @@ use std::path::{Path, PathBuf};
 use chain_core::model::{Machine, Origin, Sided};
 use miette::{LabeledSpan, MietteDiagnostic, NamedSource};
 use reliability::{
-    machine, Calls, Form, FormCase, ImportanceSampling, Method, MonteCarlo, ReliabilityError,
-    Study, StudyResult, System, Target, Termination,
+    machine, Algorithm, Calls, Form, FormCase, ImportanceSampling, Method, MonteCarlo,
+    ReliabilityError, Study, StudyResult, System, Target, Termination,
 };
 use serde::Serialize;
 
@@ -31,18 +31,7 @@ pub(crate) fn run_study(
     seed: u64,
     progress: &dyn reliability::Progress,
 ) -> Result<StudyResult, ReliabilityError> {
-    match method {
-        MethodArg::Form => study.form(&Form::default()),
-        MethodArg::Is => study.importance_sampling(
-            &ImportanceSampling {
-                samples,
-                seed,
-                form: Form::default(),
-            },
-            progress,
-        ),
-        MethodArg::Mc => study.monte_carlo(&MonteCarlo { samples, seed }, progress),
-    }
+    study.run(&method.algorithm(samples, seed), progress)
 }
 
 /// Algorithms of `--method`.
@@ -57,6 +46,20 @@ pub enum MethodArg {
 }
 
 impl MethodArg {
+    /// The library's algorithm with these samples per case and seed
+    /// (FORM ignores both).
+    pub(crate) fn algorithm(self, samples: u64, seed: u64) -> Algorithm {
+        match self {
+            MethodArg::Form => Algorithm::Form(Form::default()),
+            MethodArg::Is => Algorithm::ImportanceSampling(ImportanceSampling {
+                samples,
+                seed,
+                form: Form::default(),
+            }),
+            MethodArg::Mc => Algorithm::MonteCarlo(MonteCarlo { samples, seed }),
+        }
+    }
+
     /// The samples per case: `--samples` or the method's default (is:
     /// 10,000, mc: 100,000; 0 for FORM, which draws none).
     pub(crate) fn samples(self, given: Option<u64>) -> u64 {
@@ -793,10 +796,7 @@ pub(crate) fn calls_text<'a>(
 fn to_table(machine: &str, study: &Study, r: &StudyResult) -> String {
     use std::fmt::Write as _;
     let mut out = String::new();
-    let sided = match study.spec().sided {
-        Sided::Upper => "upper",
-        Sided::Two => "two-sided",
-    };
+    let sided = sided_title(study.spec().sided);
     let _ = writeln!(
         out,
         "{machine}: machining-accuracy reliability ({}, {sided})",
@@ -901,6 +901,15 @@ fn to_table(machine: &str, study: &Study, r: &StudyResult) -> String {
         );
     }
     out
+}
+
+/// `upper` or `two-sided`: how the tables name [`Sided`] (the JSON has
+/// [`Sided::name`]).
+pub(crate) fn sided_title(s: Sided) -> &'static str {
+    match s {
+        Sided::Upper => "upper",
+        Sided::Two => "two-sided",
+    }
 }
 
 fn fmt_num(v: f64) -> String {
