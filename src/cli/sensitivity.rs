@@ -1,11 +1,12 @@
 //! `chain sensitivity FILE [--kind reliability|geometric] [--at x=..,y=..,z=..]
-//! [--format table|json]`.
+//! [--format table|json] [--plot DIR]`.
 //!
 //! `--kind reliability` (the default): the reliability sensitivity of each component to the mean and standard
 //! deviation of every error parameter (seed 000, Eq. 32-33) and its FORM
 //! importance factor: at one point with `--at`, otherwise the mean over the
 //! file's reliability grid (the paper's Figures 6-8). Lists are sorted by
-//! `|∂R/∂σ|`, largest first.
+//! `|∂R/∂σ|`, largest first; `--plot DIR` draws them as bar charts (the
+//! charts of `chain reliability --plot`).
 //!
 //! `--kind geometric`: the geometric error sensitivity coefficients of seed
 //! 004 (Eq. 4-6), `S = |∂E_u/∂e_v|` and `C = S·e / Σ S·e` per direction,
@@ -156,32 +157,7 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
             eprintln!("wrote {}", f.display());
         }
     }
-    let doc = SensitivityDoc {
-        machine: &loaded.machine.name,
-        at: at.map(Pairs),
-        methods: Pairs(result.iter().map(|t| (t.target, t.method)).collect()),
-        components: Pairs(
-            result
-                .iter()
-                .map(|t| {
-                    let list = t
-                        .errors
-                        .iter()
-                        .map(|e| ErrorDoc {
-                            error: &e.error,
-                            dr_dstd: e.dr_dstd,
-                            dr_dmean: e.dr_dmean,
-                            importance: e.importance,
-                            mean_abs_dr_dstd: args.at.is_none().then_some(e.mean_abs_dr_dstd),
-                            mean_abs_dr_dmean: args.at.is_none().then_some(e.mean_abs_dr_dmean),
-                        })
-                        .collect();
-                    (t.target, list)
-                })
-                .collect(),
-        ),
-        result: &result,
-    };
+    let doc = SensitivityDoc::new(&loaded.machine.name, at, &result);
     report::emit(&doc, args.format.into())
 }
 
@@ -236,6 +212,38 @@ struct ErrorDoc<'a> {
     mean_abs_dr_dstd: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     mean_abs_dr_dmean: Option<f64>,
+}
+
+impl<'a> SensitivityDoc<'a> {
+    /// The document of the sensitivities `result`, at the point `at` (or the
+    /// grid mean, which adds the mean absolute values).
+    fn new(
+        machine: &'a str,
+        at: Option<Vec<(String, f64)>>,
+        result: &'a [TargetSensitivity],
+    ) -> SensitivityDoc<'a> {
+        let mean = at.is_none();
+        let errors = |t: &'a TargetSensitivity| -> Vec<ErrorDoc<'a>> {
+            t.errors
+                .iter()
+                .map(|e| ErrorDoc {
+                    error: &e.error,
+                    dr_dstd: e.dr_dstd,
+                    dr_dmean: e.dr_dmean,
+                    importance: e.importance,
+                    mean_abs_dr_dstd: mean.then_some(e.mean_abs_dr_dstd),
+                    mean_abs_dr_dmean: mean.then_some(e.mean_abs_dr_dmean),
+                })
+                .collect()
+        };
+        SensitivityDoc {
+            machine,
+            at: at.map(Pairs),
+            methods: Pairs(result.iter().map(|t| (t.target, t.method)).collect()),
+            components: Pairs(result.iter().map(|t| (t.target, errors(t))).collect()),
+            result,
+        }
+    }
 }
 
 impl Report for SensitivityDoc<'_> {
