@@ -1130,6 +1130,31 @@ mod tests {
     }
 
     #[test]
+    fn an_unknown_grid_axis_gets_a_close_name_or_no_hint() {
+        let (m, model) = gantry();
+        let inputs = machine::inputs(&m).unwrap();
+        let run = |axis: &str| {
+            let mut spec = machine::spec(&m, None).unwrap();
+            spec.grid.axes[0].0 = axis.to_string();
+            Study::new(&model, &[], inputs.clone(), spec).unwrap_err()
+        };
+        let hint = |e: ReliabilityError| match e {
+            ReliabilityError::UnknownName { hint, .. } => hint,
+            other => panic!("{other:?}"),
+        };
+        // The variables are x, z, y: `zz` is close to `z`, `spindle` to none
+        // (the first variable is not a suggestion).
+        assert_eq!(hint(run("zz")), Some("z".to_string()));
+        assert_eq!(hint(run("spindle")), None);
+        let e = run("spindle");
+        assert_eq!(
+            miette::Diagnostic::code(&e).map(|c| c.to_string()),
+            Some("chain::reliability::unknown_name".to_string())
+        );
+        assert_eq!(e.to_string(), "unknown variable `spindle`");
+    }
+
+    #[test]
     fn at_points_rejects_bad_points() {
         let (m, model) = gantry();
         let spec = machine::spec(&m, None).unwrap();
