@@ -418,8 +418,20 @@ fn cli_json_shape_and_csv_rows() {
             "mean",
             "std",
             "reliability",
-            "std_error"
+            "std_error",
+            "cases"
         ]
+    );
+    // Monte Carlo has no FORM account; its calls are the samples.
+    for t in ["px", "volumetric"] {
+        let c = &i4["cases"][t];
+        assert!(c.get("termination").is_none(), "{c}");
+        assert_eq!(c["calls"]["values"], 2000);
+    }
+    assert!(doc["summary"].get("form").is_none());
+    assert_eq!(
+        doc["summary"]["calls"]["values"].as_u64(),
+        Some(13 * 4 * 2000)
     );
     assert_eq!(i4["row"], 5);
     assert_eq!(f(&i4["t"]), 4.0);
@@ -479,6 +491,31 @@ fn cli_json_shape_and_csv_rows() {
         let r: f64 = cells[col].parse().unwrap();
         assert!((r - f(&form["instants"][k]["reliability"]["px"])).abs() <= 1e-15);
     }
+    // FORM's account, appended: per-target termination and calls columns.
+    let last = &header[header.len() - 3..];
+    assert_eq!(
+        last,
+        [
+            "gradient_calls_px",
+            "gradient_calls_py",
+            "gradient_calls_pz"
+        ]
+    );
+    let term = header.iter().position(|h| *h == "termination_px").unwrap();
+    assert!(lines[1..]
+        .iter()
+        .all(|l| l.split(',').nth(term) == Some("closed_form")));
+    // And in the FORM JSON: every case closed form, converged, exact.
+    assert_eq!(form["summary"]["form"]["cases"], 13 * 3);
+    assert_eq!(form["summary"]["form"]["converged"], 13 * 3);
+    assert_eq!(
+        form["summary"]["form"]["terminations"],
+        serde_json::json!({"closed_form": 39})
+    );
+    let c = &form["instants"][0]["cases"]["py"];
+    assert_eq!(c["termination"], "closed_form");
+    assert_eq!(c["exact"], true);
+    assert_eq!(c["converged"], true);
 }
 
 #[test]

@@ -93,7 +93,11 @@ fn csv_and_table_formats() {
     let file = gantry();
     let text = ok_stdout(&["reliability", file.to_str().unwrap(), "--format", "csv"]);
     let mut lines = text.lines();
-    assert_eq!(lines.next(), Some("component,x,y,z,reliability,pf,beta"));
+    // FORM's account is appended after the contract's columns.
+    assert_eq!(
+        lines.next(),
+        Some("component,x,y,z,reliability,pf,beta,termination,converged,iterations,exact,value_calls,gradient_calls")
+    );
     assert_eq!(lines.count(), 375);
     assert!(text.contains("\npx,0,-1500,600,0.88729"));
 
@@ -296,4 +300,229 @@ fn sensitivity_json_is_sorted_and_finds_figures_6_to_8() {
 
     let text = ok_stdout(&["sensitivity", file.to_str().unwrap()]);
     assert!(text.contains("px (exact), sorted by |dR/dstd|"));
+}
+
+/// The PNG and SVG of `stem` in `dir` are valid, non-empty charts.
+fn assert_chart(dir: &Path, stem: &str, bars: usize) {
+    let png = dir.join(format!("{stem}.png"));
+    let bytes = std::fs::read(&png).unwrap_or_else(|_| panic!("{} exists", png.display()));
+    let decoder = png::Decoder::new(std::io::Cursor::new(&bytes));
+    let mut reader = decoder.read_info().expect("valid PNG");
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).expect("PNG frame");
+    assert!(info.width >= 800 && info.height >= 500, "{stem}.png size");
+    let px = info.color_type.samples();
+    let drawn = buf[..info.buffer_size()]
+        .chunks_exact(px)
+        .filter(|p| p[..3] != [255, 255, 255])
+        .count();
+    assert!(
+        drawn * 20 > (info.width * info.height) as usize,
+        "{stem}.png"
+    );
+    let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).expect("svg");
+    assert!(svg.contains("<svg") && svg.trim_end().ends_with("</svg>"));
+    assert!(svg.matches("<rect").count() >= bars, "{stem}.svg has bars");
+}
+
+#[test]
+fn sensitivity_plot_draws_the_reliability_sensitivity_charts() {
+    let file = gantry();
+    // The grid mean (Figures 6-8) and one point.
+    for (name, extra) in [
+        ("sens_plot_mean", vec![]),
+        ("sens_plot_at", vec!["--at", "x=0,y=1500,z=600"]),
+    ] {
+        let dir = scratch(name);
+        let mut args = vec![
+            "sensitivity",
+            file.to_str().unwrap(),
+            "--format",
+            "json",
+            "--plot",
+            dir.to_str().unwrap(),
+        ];
+        args.extend_from_slice(&extra);
+        let out = common::cli::success(chain(&args));
+        // JSON alone on stdout, the files named on stderr.
+        let doc: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        assert!(doc["components"]["px"].is_array());
+        let err = String::from_utf8_lossy(&out.stderr);
+        for stem in ["sensitivity_px", "sensitivity_py", "sensitivity_pz"] {
+            // At one point few errors act on a component.
+            assert_chart(&dir, stem, if extra.is_empty() { 10 } else { 3 });
+            assert!(err.contains(&format!("{stem}.png")), "{err}");
+        }
+        let svg = std::fs::read_to_string(dir.join("sensitivity_px.svg")).unwrap();
+        if extra.is_empty() {
+            assert!(svg.contains("grid mean"), "title says where");
+        } else {
+            assert!(svg.contains("at x = 0"), "title says where");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+#[test]
+fn form_reports_termination_and_calls_in_every_format() {
+    let file = gantry();
+    // One-sided components in normal inputs: closed form, exact, no call.
+    let doc = gantry_json("reliability", &[]);
+    for case in doc["results"].as_array().unwrap() {
+        assert_eq!(case["termination"], "closed_form");
+        assert_eq!(case["converged"], true);
+        assert_eq!(case["iterations"], 0);
+        assert_eq!(case["exact"], true);
+        assert_eq!(case["calls"]["values"], 0);
+        assert_eq!(case["calls"]["gradients"], 0);
+    }
+    // Two-sided: closed form per branch, not exact (the far side).
+    let doc = gantry_json("reliability", &["--sided", "two"]);
+    assert_eq!(doc["results"][0]["exact"], false);
+    assert_eq!(doc["results"][0]["termination"], "closed_form");
+
+    // The volumetric norm is iterated (HL-RF): calls are counted, and the
+    // cases where the search stopped at the iteration limit are flagged.
+    let args = [
+        "reliability",
+        file.to_str().unwrap(),
+        "--system",
+        "volumetric",
+    ];
+    let mut json_args = args.to_vec();
+    json_args.extend(["--format", "json"]);
+    let out = common::cli::success(chain(&json_args));
+    let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let vol: Vec<&Value> = doc["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["component"] == "volumetric")
+        .collect();
+    assert_eq!(vol.len(), 125);
+    let mut unconverged = 0;
+    for c in &vol {
+        let calls = c["calls"]["gradients"].as_u64().unwrap();
+        let iterations = c["iterations"].as_u64().unwrap();
+        assert!(calls > iterations && iterations > 0, "{c}");
+        assert_eq!(c["exact"], false);
+        match c["termination"].as_str().unwrap() {
+            "converged" => assert_eq!(c["converged"], true),
+            "max_iterations" => {
+                assert_eq!(c["converged"], false);
+                assert_eq!(iterations, 200);
+                unconverged += 1;
+            }
+            other => panic!("{other}"),
+        }
+    }
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if unconverged > 0 {
+        assert!(
+            stderr.contains(&format!(
+                "warning: FORM did not converge on {unconverged} of 500 cases"
+            )),
+            "{stderr}"
+        );
+    } else {
+        assert!(!stderr.contains("did not converge"), "{stderr}");
+    }
+
+    // CSV: the same facts in columns appended at the end.
+    let mut csv_args = args.to_vec();
+    csv_args.extend(["--format", "csv"]);
+    let csv = ok_stdout(&csv_args);
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(
+        &header[header.len() - 6..],
+        [
+            "termination",
+            "converged",
+            "iterations",
+            "exact",
+            "value_calls",
+            "gradient_calls"
+        ]
+    );
+    let flagged = lines
+        .filter(|l| l.starts_with("volumetric,") && l.contains(",max_iterations,false,"))
+        .count();
+    assert_eq!(flagged, unconverged);
+
+    // Table: one line per target on how FORM ended, and the unconverged
+    // cells listed under their map.
+    let table = ok_stdout(&args);
+    assert!(table.contains(
+        "  FORM: 125 of 125 cases converged (closed form 125); limit-state calls: 0 values, 0 gradients"
+    ));
+    let line = table
+        .lines()
+        .rfind(|l| l.starts_with("  FORM: "))
+        .expect("volumetric FORM line");
+    assert!(
+        line.starts_with(&format!(
+            "  FORM: {} of 125 cases converged (",
+            125 - unconverged
+        )),
+        "{line}"
+    );
+    assert_eq!(
+        table.contains("  * not converged at ("),
+        unconverged > 0,
+        "{table}"
+    );
+}
+
+#[test]
+fn sampling_reports_its_calls_and_the_centring_form() {
+    let file = gantry();
+    let doc = gantry_json("reliability", &["--method", "is", "--samples", "1000"]);
+    let c = &doc["results"][0];
+    assert_eq!(c["samples"], 1000);
+    assert_eq!(c["termination"], "closed_form");
+    assert_eq!(c["calls"]["values"], 1000);
+    let doc = gantry_json("reliability", &["--method", "mc", "--samples", "1000"]);
+    let c = &doc["results"][0];
+    assert!(c.get("termination").is_none() && c.get("converged").is_none());
+    assert_eq!(c["calls"]["values"], 1000);
+    let table = ok_stdout(&[
+        "reliability",
+        file.to_str().unwrap(),
+        "--method",
+        "mc",
+        "--samples",
+        "1000",
+    ]);
+    // 125 grid points per target, 1000 samples each.
+    assert!(table.contains("  limit-state calls: 125000 values, 0 gradients"));
+}
+
+#[test]
+fn unknown_names_get_a_close_suggestion_or_none() {
+    let file = gantry();
+    let out = chain(&["reliability", file.to_str().unwrap(), "--grid", "yy=0,1"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("did you mean `y`?"), "{err}");
+    assert!(err.contains("chain::reliability::unknown_name"), "{err}");
+    let out = chain(&[
+        "reliability",
+        file.to_str().unwrap(),
+        "--grid",
+        "spindle=0,1",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("did you mean"), "{err}");
+    // Every error has its own code (no generic fallback).
+    let out = chain(&[
+        "reliability",
+        file.to_str().unwrap(),
+        "--method",
+        "mc",
+        "--samples",
+        "0",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("chain::reliability::invalid_samples"), "{err}");
 }

@@ -6,14 +6,26 @@ use chain_core::model::Origin;
 ///
 /// Variants that come from a machine file carry the [`Origin`] of the node
 /// concerned so that the CLI can point at the file, line and key.
+///
+/// Each variant has its diagnostic code (`chain::reliability::…`); the binary
+/// renders them (with the file's text where a variant has an [`Origin`]).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
 #[non_exhaustive]
 pub enum ReliabilityError {
     /// The machine has no `reliability` section.
     #[error("the machine has no `reliability` section (tolerance, sided, grid)")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::reliability::no_reliability))
+    )]
     NoReliabilitySection,
     /// An error parameter used by the model has no `statistics` entry.
     #[error("error parameter `{name}` has no `statistics` entry")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::reliability::missing_statistic))
+    )]
     MissingStatistic {
         /// The error parameter.
         name: String,
@@ -22,6 +34,10 @@ pub enum ReliabilityError {
     },
     /// A parameter is symbolic (`null`) and no value was supplied.
     #[error("parameter `{name}` is symbolic (null) and has no value")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::reliability::symbolic_parameter))
+    )]
     SymbolicParameter {
         /// The parameter.
         name: String,
@@ -30,9 +46,17 @@ pub enum ReliabilityError {
     },
     /// A distribution's numbers are out of range.
     #[error("invalid distribution: {0}")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::reliability::invalid_distribution))
+    )]
     InvalidDistribution(String),
     /// A tolerance is not a positive finite number.
     #[error("tolerance of `{component}` must be positive and finite (found {value})")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::reliability::invalid_tolerance))
+    )]
     InvalidTolerance {
         /// The component or system.
         component: String,
@@ -41,6 +65,7 @@ pub enum ReliabilityError {
     },
     /// Sizes that must agree do not.
     #[error("{what}: expected {expected}, found {found}")]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::reliability::dimension)))]
     Dimension {
         /// What was being sized.
         what: &'static str,
@@ -51,6 +76,7 @@ pub enum ReliabilityError {
     },
     /// A name (variable, error, parameter) is unknown.
     #[error("unknown {kind} `{name}`{}", hint.as_ref().map(|h| format!(" (did you mean `{h}`?)")).unwrap_or_default())]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::reliability::unknown_name)))]
     UnknownName {
         /// `variable`, `error`, `parameter` or `component`.
         kind: &'static str,
@@ -61,18 +87,32 @@ pub enum ReliabilityError {
     },
     /// The reliability grid has no point, or an axis has no value.
     #[error("the reliability grid is empty: {0}")]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::reliability::empty_grid)))]
     EmptyGrid(String),
     /// A point misses a value for an axis variable.
     #[error("no value for axis variable `{0}`")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::reliability::missing_coordinate))
+    )]
     MissingCoordinate(String),
     /// A computation produced a non-finite number.
     #[error("non-finite value in {0}")]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::reliability::non_finite)))]
     NonFinite(&'static str),
     /// An error of the model has no input distribution.
     #[error("no input distribution for error `{0}`")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::reliability::missing_input))
+    )]
     MissingInput(String),
     /// A sampler was asked for no samples, or for too many.
     #[error("the number of samples must be between 1 and {max} (found {found})")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::reliability::invalid_samples))
+    )]
     InvalidSamples {
         /// The count asked for.
         found: u64,

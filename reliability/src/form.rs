@@ -20,11 +20,10 @@
 //! are reported in [`FormResult::branches`]. FORM is exact only when the
 //! failure set is a single half-space in `u` ([`FormResult::exact`]).
 
-use chain_core::model::Sided;
 use serde::Serialize;
 
 use crate::error::ReliabilityError;
-use crate::limit_state::{Criterion, Event, LimitState};
+use crate::limit_state::{Event, LimitState};
 use crate::normal;
 use crate::util::{dot, norm};
 
@@ -58,6 +57,33 @@ pub enum Termination {
     MaxIterations,
     /// The gradient vanishes: `g` does not depend on the inputs (`β = ±∞`).
     Degenerate,
+}
+
+impl Termination {
+    /// `closed_form`, `converged`, `max_iterations` or `degenerate` (the
+    /// JSON spelling).
+    pub fn name(self) -> &'static str {
+        match self {
+            Termination::ClosedForm => "closed_form",
+            Termination::Converged => "converged",
+            Termination::MaxIterations => "max_iterations",
+            Termination::Degenerate => "degenerate",
+        }
+    }
+
+    /// Every termination, in declaration order.
+    pub const ALL: [Termination; 4] = [
+        Termination::ClosedForm,
+        Termination::Converged,
+        Termination::MaxIterations,
+        Termination::Degenerate,
+    ];
+}
+
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// Function-call counts (the argmin / OpenTURNS habit).
@@ -143,18 +169,15 @@ impl Form {
         let affine = event.affine();
         let mut branches = Vec::with_capacity(nb);
         for b in 0..nb {
-            let branch = match (
-                &affine,
-                event.limit_state.structure().map(|s| s.criterion()),
-            ) {
-                (Some(a), Some(Criterion::Each(sided))) => {
-                    let (c, sign) = match sided {
-                        Sided::Upper => (b, 1.0),
-                        Sided::Two => (b / 2, if b % 2 == 0 { 1.0 } else { -1.0 }),
-                    };
-                    closed_form(a.row(c), a.mean[c], a.limit_state.tolerances()[c], sign)
+            // A half-space branch in normal inputs: the closed form.
+            let half_space = affine
+                .as_ref()
+                .and_then(|a| a.view.criterion().half_space(b).map(|cs| (a, cs)));
+            let branch = match half_space {
+                Some((a, (c, sign))) => {
+                    closed_form(a.row(c), a.mean[c], a.view.tolerances()[c], sign)
                 }
-                _ => self.hlrf(event, b, &mut calls)?,
+                None => self.hlrf(event, b, &mut calls)?,
             };
             branches.push(branch);
         }
@@ -176,11 +199,7 @@ impl Form {
         } = &branches[best];
         let mut x = vec![0.0; n];
         event.inputs.to_physical(u, &mut x);
-        let exact = affine.is_some()
-            && event
-                .limit_state
-                .structure()
-                .is_some_and(|s| s.is_half_space());
+        let exact = affine.as_ref().is_some_and(|a| a.view.is_half_space());
         let summary = branches
             .iter()
             .enumerate()
@@ -395,7 +414,9 @@ impl Work {
 mod tests {
     use super::*;
     use crate::inputs::{Inputs, Marginal};
+    use crate::limit_state::Criterion;
     use crate::limit_state::ToleranceLimitState;
+    use chain_core::model::Sided;
 
     fn inputs(stds: &[f64]) -> Inputs {
         Inputs::new(
@@ -435,6 +456,83 @@ mod tests {
             assert!((a - b).abs() < 1e-12);
         }
         assert!((exact.importance.iter().sum::<f64>() - 1.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn a_user_limit_state_offering_an_affine_view_gets_the_fast_paths() {
+        struct Offered(ToleranceLimitState);
+        impl LimitState for Offered {
+            fn dim(&self) -> usize {
+                self.0.dim()
+            }
+            fn branches(&self) -> usize {
+                self.0.branches()
+            }
+            fn branch(&self, b: usize, x: &[f64], g: Option<&mut [f64]>) -> f64 {
+                self.0.branch(b, x, g)
+            }
+            fn affine(&self) -> Option<crate::limit_state::AffineView<'_>> {
+                Some(self.0.view())
+            }
+        }
+        let inp = inputs(&[0.01, 0.02, 1e-5]);
+        let rows = vec![-1.0, 1.0, 1200.0, 0.5, 0.0, -300.0];
+        let ls = ToleranceLimitState::new(3, rows, vec![0.03, 0.02], Criterion::Each(Sided::Two))
+            .unwrap();
+        let reference = Form::default()
+            .run(&Event::new(&inp, ls.clone()).unwrap())
+            .unwrap();
+        let event = Event::new(&inp, Offered(ls)).unwrap();
+        let offered = Form::default().run(&event).unwrap();
+        assert_eq!(offered, reference);
+        assert_eq!(offered.termination, Termination::ClosedForm);
+        assert_eq!(offered.calls, Calls::default());
+        assert!(!offered.exact && offered.branches.len() == 4);
+        // The importance sampling takes the exact line kernel too: the same
+        // estimate as the tolerance limit state's, bit for bit.
+        let is = crate::simulation::ImportanceSampling {
+            samples: 2000,
+            seed: 3,
+            form: Form::default(),
+        };
+        let a = is.run(&event).unwrap();
+        let b = is
+            .run(&Event::new(&inp, event.limit_state.0.clone()).unwrap())
+            .unwrap();
+        assert_eq!(a.pf, b.pf);
+        assert_eq!(a.std_error, b.std_error);
+    }
+
+    #[test]
+    fn criterion_geometry_agrees_with_the_branches() {
+        // Along a line E(t) = b + t·d, `safe_interval` must be where every
+        // branch is positive, and `fails` the complement.
+        let rows = vec![1.0, 0.0, 0.0, 1.0];
+        for criterion in [
+            Criterion::Each(Sided::Upper),
+            Criterion::Each(Sided::Two),
+            Criterion::Norm,
+        ] {
+            let tol = match criterion {
+                Criterion::Norm => vec![1.5],
+                _ => vec![1.0, 2.0],
+            };
+            let ls = ToleranceLimitState::new(2, rows.clone(), tol.clone(), criterion).unwrap();
+            let (b, d) = ([0.3, -0.4], [0.8, 0.6]);
+            let (lo, hi) = criterion
+                .safe_interval(&tol, 2, |c| b[c], &d)
+                .expect("the origin side is safe");
+            for k in -400..400 {
+                let t = k as f64 * 0.01;
+                let x = [b[0] + t * d[0], b[1] + t * d[1]];
+                let g = ls.value(&x);
+                let fails = criterion.fails(&tol, 2, |c| x[c]);
+                assert_eq!(fails, g <= 0.0, "{criterion:?} t = {t}");
+                if (t - lo).abs() > 1e-9 && (t - hi).abs() > 1e-9 {
+                    assert_eq!(t > lo && t < hi, g > 0.0, "{criterion:?} t = {t}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -21,7 +21,9 @@
 //!   ([`FormResult`], [`SimulationResult`], [`SensitivityResult`]);
 //! - [`Study`]: all of it over a workspace grid for any
 //!   [`chain_core::ErrorModel`] (runtime-compiled or `machine!`-generated),
-//!   and [`machine`] to build one from a machine file.
+//!   and [`machine`] to build one from a machine file;
+//! - [`PathStudy`]: the same along a tool path, instant by instant, with the
+//!   moments of the errors ([`PathResult`]).
 //!
 //! # Example
 //!
@@ -52,6 +54,7 @@ pub mod limit_state;
 pub mod machine;
 pub mod normal;
 mod par;
+pub mod path;
 pub mod rng;
 pub mod sensitivity;
 pub mod simulation;
@@ -63,10 +66,14 @@ pub use chain_core::ErrorModel;
 pub use error::ReliabilityError;
 pub use form::{BranchResult, Calls, Form, FormResult, Termination};
 pub use inputs::{Inputs, Marginal};
-pub use limit_state::{Affine, Criterion, Event, LimitState, ToleranceLimitState};
+pub use limit_state::{Affine, AffineView, Criterion, Event, LimitState, ToleranceLimitState};
+pub use path::{
+    Extreme, InstantResult, PathInstant, PathRecord, PathResult, PathStudy, PathTarget, Quantity,
+    TargetSummary,
+};
 pub use sensitivity::{sensitivity, InputSensitivity, SensitivityMethod, SensitivityResult};
 pub use simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult};
 pub use study::{
-    CaseResult, ErrorMoments, ErrorSensitivity, Grid, Study, StudyResult, StudySpec, Summary,
-    System, Target, TargetSensitivity, VolumetricMoments,
+    Algorithm, CaseResult, ErrorMoments, ErrorSensitivity, FormCase, FormLimit, Grid, Method,
+    Study, StudyResult, StudySpec, Summary, System, Target, TargetSensitivity, VolumetricMoments,
 };

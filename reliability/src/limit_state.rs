@@ -59,11 +59,211 @@ pub trait LimitState: Sync {
         true
     }
 
-    /// The tolerance structure `g = G(S·x)`, when the limit state has it. It
-    /// lets FORM use its closed form and the importance sampling solve
-    /// `g = 0` along a line exactly.
-    fn structure(&self) -> Option<&ToleranceLimitState> {
+    /// The affine view `g = G(S·x)`, when the limit state has it: rows `S`
+    /// of error components linear in `x`, judged by a [`Criterion`] against
+    /// tolerances. It lets FORM use its closed form (Eq. 21-22), Monte Carlo
+    /// evaluate the components on the normal draws and the importance
+    /// sampling solve `g = 0` along a line exactly. A user's limit state
+    /// that is affine offers one with [`AffineView::new`]; it must agree
+    /// with [`LimitState::branch`] (same branches, same values).
+    fn affine(&self) -> Option<AffineView<'_>> {
         None
+    }
+}
+
+impl Criterion {
+    /// The number of smooth branches over `k` components: `k` (upper),
+    /// `2k` (two-sided: `+E_c` and `−E_c`), 1 (norm).
+    pub fn branches(self, k: usize) -> usize {
+        match self {
+            Criterion::Each(Sided::Upper) => k,
+            Criterion::Each(Sided::Two) => 2 * k,
+            Criterion::Norm => 1,
+        }
+    }
+
+    /// Branch `b` as a half-space `g_b = I_c − sign·E_c`: `(c, sign)`;
+    /// `None` for the norm, which has no half-space branch.
+    #[inline]
+    pub fn half_space(self, b: usize) -> Option<(usize, f64)> {
+        match self {
+            Criterion::Each(Sided::Upper) => Some((b, 1.0)),
+            Criterion::Each(Sided::Two) => Some((b / 2, if b % 2 == 0 { 1.0 } else { -1.0 })),
+            Criterion::Norm => None,
+        }
+    }
+
+    /// Whether the components `E_c = e(c)`, `c < k`, fail (`g ≤ 0`).
+    #[inline]
+    pub fn fails(self, tolerances: &[f64], k: usize, e: impl Fn(usize) -> f64) -> bool {
+        match self {
+            Criterion::Each(Sided::Upper) => (0..k).any(|c| e(c) >= tolerances[c]),
+            Criterion::Each(Sided::Two) => (0..k).any(|c| e(c).abs() >= tolerances[c]),
+            Criterion::Norm => {
+                let t = tolerances[0];
+                (0..k).map(|c| e(c).powi(2)).sum::<f64>() >= t * t
+            }
+        }
+    }
+
+    /// The safe set on the line `E_c(t) = b_c + t·d_c` (`b_c = offset(c)`,
+    /// `c < k`): the interval `[lo, hi]` of `t` (possibly infinite ends), or
+    /// `None` when the whole line fails. Half-spaces intersect to an
+    /// interval; the norm's safe set is the chord of the ellipsoid
+    /// `|b + t·d|² ≤ I²` (the stable roots of the quadratic).
+    #[inline]
+    pub fn safe_interval(
+        self,
+        tolerances: &[f64],
+        k: usize,
+        offset: impl Fn(usize) -> f64,
+        d: &[f64],
+    ) -> Option<(f64, f64)> {
+        let mut lo = f64::NEG_INFINITY;
+        let mut hi = f64::INFINITY;
+        match self {
+            Criterion::Each(sided) => {
+                for c in 0..k {
+                    let b = offset(c);
+                    let dc = d[c];
+                    let i = tolerances[c];
+                    let (upper, lower) = match sided {
+                        Sided::Upper => (i, f64::NEG_INFINITY),
+                        Sided::Two => (i, -i),
+                    };
+                    // lower ≤ b + t·dc ≤ upper
+                    if dc > 0.0 {
+                        hi = hi.min((upper - b) / dc);
+                        lo = lo.max((lower - b) / dc);
+                    } else if dc < 0.0 {
+                        hi = hi.min((lower - b) / dc);
+                        lo = lo.max((upper - b) / dc);
+                    } else if b > upper || b < lower {
+                        return None;
+                    }
+                }
+            }
+            Criterion::Norm => {
+                // |b + t·d|² ≤ I²  ⇔  A t² + 2B t + C ≤ 0.
+                let (mut a2, mut b2, mut c2) = (0.0, 0.0, 0.0);
+                for (c, &dc) in d.iter().enumerate().take(k) {
+                    let b = offset(c);
+                    a2 += dc * dc;
+                    b2 += b * dc;
+                    c2 += b * b;
+                }
+                let i = tolerances[0];
+                c2 -= i * i;
+                if a2 == 0.0 {
+                    return if c2 > 0.0 { None } else { Some((lo, hi)) };
+                }
+                let disc = b2 * b2 - a2 * c2;
+                if disc < 0.0 {
+                    return None;
+                }
+                let r = disc.sqrt();
+                // Stable roots: q = −(B + sign(B)·r), t = q/A and C/q.
+                let q = -(b2 + if b2 >= 0.0 { r } else { -r });
+                let (t1, t2) = if q != 0.0 {
+                    (q / a2, c2 / q)
+                } else {
+                    (0.0, 0.0)
+                };
+                lo = t1.min(t2);
+                hi = t1.max(t2);
+            }
+        }
+        if lo >= hi {
+            return None;
+        }
+        Some((lo, hi))
+    }
+}
+
+/// The affine structure `g = G(S·x)` of a limit state: `k` rows `S_c` of
+/// error components `E_c(x) = S_c·x`, their tolerances and the
+/// [`Criterion`] that judges them (per-branch half-spaces for
+/// [`Criterion::Each`], the norm for [`Criterion::Norm`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AffineView<'a> {
+    n: usize,
+    rows: &'a [f64],
+    tolerances: &'a [f64],
+    criterion: Criterion,
+}
+
+impl<'a> AffineView<'a> {
+    /// A view over `rows` (`k × n`, row-major) and `tolerances` (`k` for
+    /// [`Criterion::Each`], one for [`Criterion::Norm`]).
+    pub fn new(
+        n: usize,
+        rows: &'a [f64],
+        tolerances: &'a [f64],
+        criterion: Criterion,
+    ) -> Result<AffineView<'a>, ReliabilityError> {
+        if n == 0 || rows.is_empty() || rows.len() % n != 0 {
+            return Err(ReliabilityError::Dimension {
+                what: "sensitivity rows (k × n)",
+                expected: n.max(1),
+                found: rows.len(),
+            });
+        }
+        let expected = match criterion {
+            Criterion::Each(_) => rows.len() / n,
+            Criterion::Norm => 1,
+        };
+        if tolerances.len() != expected {
+            return Err(ReliabilityError::Dimension {
+                what: "tolerances",
+                expected,
+                found: tolerances.len(),
+            });
+        }
+        Ok(AffineView {
+            n,
+            rows,
+            tolerances,
+            criterion,
+        })
+    }
+
+    /// Number of inputs `n`.
+    pub fn dim(&self) -> usize {
+        self.n
+    }
+
+    /// Number of components `k`.
+    pub fn components(&self) -> usize {
+        self.rows.len() / self.n
+    }
+
+    /// Row `c` of `S`.
+    #[inline]
+    pub fn row(&self, c: usize) -> &'a [f64] {
+        &self.rows[c * self.n..(c + 1) * self.n]
+    }
+
+    /// The tolerances.
+    pub fn tolerances(&self) -> &'a [f64] {
+        self.tolerances
+    }
+
+    /// The criterion.
+    pub fn criterion(&self) -> Criterion {
+        self.criterion
+    }
+
+    /// Branch `b` as a half-space `g_b = I_c − sign·S_c·x`:
+    /// `(row S_c, offset I_c, sign)`; `None` for the norm.
+    pub fn half_space(&self, b: usize) -> Option<(&'a [f64], f64, f64)> {
+        let (c, sign) = self.criterion.half_space(b)?;
+        Some((self.row(c), self.tolerances[c], sign))
+    }
+
+    /// True when the limit state is one half-space in `x` (one component,
+    /// [`Sided::Upper`]): FORM is then exact for normal inputs.
+    pub fn is_half_space(&self) -> bool {
+        self.components() == 1 && self.criterion == Criterion::Each(Sided::Upper)
     }
 }
 
@@ -185,7 +385,17 @@ impl ToleranceLimitState {
     /// True when the limit state is one half-space in `x`
     /// (one component, [`Sided::Upper`]): FORM is then exact for normal inputs.
     pub fn is_half_space(&self) -> bool {
-        self.components() == 1 && self.criterion == Criterion::Each(Sided::Upper)
+        self.view().is_half_space()
+    }
+
+    /// Its affine view (always there).
+    pub fn view(&self) -> AffineView<'_> {
+        AffineView {
+            n: self.n,
+            rows: &self.rows,
+            tolerances: &self.tolerances,
+            criterion: self.criterion,
+        }
     }
 
     #[inline]
@@ -200,20 +410,12 @@ impl LimitState for ToleranceLimitState {
     }
 
     fn branches(&self) -> usize {
-        match self.criterion {
-            Criterion::Each(Sided::Upper) => self.components(),
-            Criterion::Each(Sided::Two) => 2 * self.components(),
-            Criterion::Norm => 1,
-        }
+        self.criterion.branches(self.components())
     }
 
     fn branch(&self, b: usize, x: &[f64], gradient: Option<&mut [f64]>) -> f64 {
-        match self.criterion {
-            Criterion::Each(sided) => {
-                let (c, sign) = match sided {
-                    Sided::Upper => (b, 1.0),
-                    Sided::Two => (b / 2, if b % 2 == 0 { 1.0 } else { -1.0 }),
-                };
+        match self.criterion.half_space(b) {
+            Some((c, sign)) => {
                 if let Some(g) = gradient {
                     for (g, s) in g.iter_mut().zip(self.row(c)) {
                         *g = -sign * s;
@@ -221,7 +423,7 @@ impl LimitState for ToleranceLimitState {
                 }
                 self.tolerances[c] - sign * self.dot(c, x)
             }
-            Criterion::Norm => {
+            None => {
                 let k = self.components();
                 let mut norm2 = 0.0;
                 for c in 0..k {
@@ -274,8 +476,8 @@ impl LimitState for ToleranceLimitState {
         self.active.get(j).copied().unwrap_or(false)
     }
 
-    fn structure(&self) -> Option<&ToleranceLimitState> {
-        Some(self)
+    fn affine(&self) -> Option<AffineView<'_>> {
+        Some(self.view())
     }
 }
 
@@ -307,11 +509,11 @@ impl<'a, L: LimitState> Event<'a, L> {
     /// The linear-normal view `E_c = m_c + a_c·u` of the event, when the
     /// limit state has the tolerance structure and every input is normal.
     pub fn affine(&self) -> Option<Affine<'_>> {
-        let ls = self.limit_state.structure()?;
+        let view = self.limit_state.affine()?;
         if !self.inputs.is_affine() {
             return None;
         }
-        Some(Affine::new(ls, self.inputs))
+        Some(Affine::new(view, self.inputs))
     }
 
     /// The exact failure probability when it has a closed form: one component
@@ -319,13 +521,13 @@ impl<'a, L: LimitState> Event<'a, L> {
     /// `Φ(−β₊) + Φ(−β₋)` for a two-sided one.
     pub fn exact_pf(&self) -> Option<f64> {
         let a = self.affine()?;
-        if a.limit_state.components() != 1 {
+        if a.view.components() != 1 {
             return None;
         }
         let s = a.std(0);
         let m = a.mean[0];
-        let i = a.limit_state.tolerances[0];
-        match a.limit_state.criterion {
+        let i = a.view.tolerances()[0];
+        match a.view.criterion() {
             Criterion::Each(Sided::Upper) => Some(crate::normal::sf((i - m) / s)),
             Criterion::Each(Sided::Two) => {
                 Some(crate::normal::sf((i - m) / s) + crate::normal::sf((i + m) / s))
@@ -337,13 +539,13 @@ impl<'a, L: LimitState> Event<'a, L> {
     }
 }
 
-/// A tolerance limit state over normal inputs, seen in standard space:
+/// An affine limit state over normal inputs, seen in standard space:
 /// `E_c(u) = m_c + a_c·u` with `m_c = Σ_j S_cj·μ_j` and `a_cj = S_cj·σ_j`
 /// (the `μ_ZL` and `σ_ZL` ingredients of Eq. 21).
 #[derive(Debug, Clone)]
 pub struct Affine<'l> {
-    /// The limit state.
-    pub limit_state: &'l ToleranceLimitState,
+    /// The limit state's affine view.
+    pub view: AffineView<'l>,
     /// `m_c`, one per component.
     pub mean: Vec<f64>,
     /// `a_cj`, `k × n` row-major.
@@ -351,7 +553,7 @@ pub struct Affine<'l> {
 }
 
 impl<'l> Affine<'l> {
-    fn new(ls: &'l ToleranceLimitState, inputs: &Inputs) -> Affine<'l> {
+    fn new(ls: AffineView<'l>, inputs: &Inputs) -> Affine<'l> {
         let n = ls.n;
         let k = ls.components();
         let mut mean = vec![0.0; k];
@@ -363,16 +565,12 @@ impl<'l> Affine<'l> {
                 a[c * n + j] = s * m.std();
             }
         }
-        Affine {
-            limit_state: ls,
-            mean,
-            a,
-        }
+        Affine { view: ls, mean, a }
     }
 
     /// Row `c` of `a`.
     pub fn row(&self, c: usize) -> &[f64] {
-        let n = self.limit_state.n;
+        let n = self.view.n;
         &self.a[c * n..(c + 1) * n]
     }
 

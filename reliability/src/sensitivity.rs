@@ -84,7 +84,7 @@ pub fn sensitivity<L: LimitState>(
     }
     let importance = |j: usize| form.importance[j];
     if let Some(aff) = event.affine() {
-        let ls = aff.limit_state;
+        let ls = aff.view;
         if ls.components() == 1 {
             if let Criterion::Each(sided) = ls.criterion() {
                 let row = ls.row(0);

@@ -361,7 +361,7 @@ struct AffineMc {
 impl AffineMc {
     fn new<L: LimitState>(event: &Event<'_, L>) -> Option<AffineMc> {
         let aff = event.affine()?;
-        let ls = aff.limit_state;
+        let ls = aff.view;
         Some(AffineMc {
             k: ls.components(),
             n: event.inputs.len(),
@@ -376,14 +376,7 @@ impl AffineMc {
     #[inline]
     fn fails(&self, z: &[f64]) -> bool {
         let e = |c: usize| self.m[c] + dot(&self.a[c * self.n..(c + 1) * self.n], z);
-        match self.criterion {
-            Criterion::Each(Sided::Upper) => (0..self.k).any(|c| e(c) >= self.tolerances[c]),
-            Criterion::Each(Sided::Two) => (0..self.k).any(|c| e(c).abs() >= self.tolerances[c]),
-            Criterion::Norm => {
-                let t = self.tolerances[0];
-                (0..self.k).map(|c| e(c).powi(2)).sum::<f64>() >= t * t
-            }
-        }
+        self.criterion.fails(&self.tolerances, self.k, e)
     }
 }
 
@@ -448,7 +441,7 @@ impl Kernel {
         v[na - 1] += s;
         let vv = dot(&v, &v);
         if let Some(aff) = event.affine() {
-            let lsx = aff.limit_state;
+            let lsx = aff.view;
             let k = lsx.components();
             let dim = na - 1;
             let mut w = vec![0.0; k * dim];
@@ -655,8 +648,6 @@ fn line_pf_affine(
     dim: usize,
     k: usize,
 ) -> f64 {
-    let mut lo = f64::NEG_INFINITY;
-    let mut hi = f64::INFINITY;
     let offset = |c: usize| {
         m[c] + if dim > 0 {
             dot(&w[c * dim..(c + 1) * dim], z)
@@ -664,61 +655,9 @@ fn line_pf_affine(
             0.0
         }
     };
-    match criterion {
-        Criterion::Each(sided) => {
-            for c in 0..k {
-                let b = offset(c);
-                let dc = d[c];
-                let i = tolerances[c];
-                let (upper, lower) = match sided {
-                    Sided::Upper => (i, f64::NEG_INFINITY),
-                    Sided::Two => (i, -i),
-                };
-                // lower ≤ b + t·dc ≤ upper
-                if dc > 0.0 {
-                    hi = hi.min((upper - b) / dc);
-                    lo = lo.max((lower - b) / dc);
-                } else if dc < 0.0 {
-                    hi = hi.min((lower - b) / dc);
-                    lo = lo.max((upper - b) / dc);
-                } else if b > upper || b < lower {
-                    return 1.0;
-                }
-            }
-        }
-        Criterion::Norm => {
-            // |b + t·d|² ≤ I²  ⇔  A t² + 2B t + C ≤ 0.
-            let (mut a2, mut b2, mut c2) = (0.0, 0.0, 0.0);
-            for (c, &dc) in d.iter().enumerate().take(k) {
-                let b = offset(c);
-                a2 += dc * dc;
-                b2 += b * dc;
-                c2 += b * b;
-            }
-            let i = tolerances[0];
-            c2 -= i * i;
-            if a2 == 0.0 {
-                return if c2 > 0.0 { 1.0 } else { 0.0 };
-            }
-            let disc = b2 * b2 - a2 * c2;
-            if disc < 0.0 {
-                return 1.0;
-            }
-            let r = disc.sqrt();
-            // Stable roots: q = −(B + sign(B)·r), t = q/A and C/q.
-            let q = -(b2 + if b2 >= 0.0 { r } else { -r });
-            let (t1, t2) = if q != 0.0 {
-                (q / a2, c2 / q)
-            } else {
-                (0.0, 0.0)
-            };
-            lo = t1.min(t2);
-            hi = t1.max(t2);
-        }
-    }
-    if lo >= hi {
+    let Some((lo, hi)) = criterion.safe_interval(tolerances, k, offset, d) else {
         return 1.0;
-    }
+    };
     let left = if lo == f64::NEG_INFINITY {
         0.0
     } else {

@@ -18,7 +18,7 @@ use chain_core::ErrorModel;
 use serde::Serialize;
 
 use crate::error::ReliabilityError;
-use crate::form::{Form, FormResult};
+use crate::form::{Calls, Form, FormResult, Termination};
 use crate::inputs::Inputs;
 use crate::limit_state::{Criterion, Event, ToleranceLimitState};
 use crate::normal;
@@ -88,9 +88,9 @@ pub struct StudySpec {
     pub system: Option<System>,
 }
 
-/// One target of a study.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
+/// One target of a study. It serialises (and displays) as its name: `px`,
+/// …, `series`, `volumetric`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Target {
     /// One component.
     Component(Component),
@@ -111,6 +111,152 @@ impl Target {
     }
 }
 
+impl std::fmt::Display for Target {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Serialize for Target {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name())
+    }
+}
+
+/// A target compares equal to its name (`Target::Series == "series"`).
+impl PartialEq<str> for Target {
+    fn eq(&self, other: &str) -> bool {
+        self.name() == other
+    }
+}
+
+/// A target compares equal to its name (`Target::Series == "series"`).
+impl PartialEq<&str> for Target {
+    fn eq(&self, other: &&str) -> bool {
+        self.name() == *other
+    }
+}
+
+/// The algorithm behind a [`StudyResult`].
+///
+/// It serialises as the short name of `--method` (`form`, `is`, `mc`);
+/// [`Method::title`] is the name a report prints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum Method {
+    /// FORM (Eq. 19-22, 31).
+    #[serde(rename = "form")]
+    Form,
+    /// The advanced importance sampling (Eq. 23-28), centred by FORM.
+    #[serde(rename = "is")]
+    ImportanceSampling,
+    /// Crude Monte Carlo.
+    #[serde(rename = "mc")]
+    MonteCarlo,
+}
+
+impl Method {
+    /// `form`, `is` or `mc` (the `--method` spelling, and the JSON's).
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Form => "form",
+            Method::ImportanceSampling => "is",
+            Method::MonteCarlo => "mc",
+        }
+    }
+
+    /// `FORM`, `importance sampling` or `Monte Carlo` (for reports).
+    pub fn title(self) -> &'static str {
+        match self {
+            Method::Form => "FORM",
+            Method::ImportanceSampling => "importance sampling",
+            Method::MonteCarlo => "Monte Carlo",
+        }
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One of the study's algorithms with its settings (see [`Study::run`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Algorithm {
+    /// FORM.
+    Form(Form),
+    /// The advanced importance sampling.
+    ImportanceSampling(ImportanceSampling),
+    /// Crude Monte Carlo.
+    MonteCarlo(MonteCarlo),
+}
+
+impl Algorithm {
+    /// The method it is.
+    pub fn method(&self) -> Method {
+        match self {
+            Algorithm::Form(_) => Method::Form,
+            Algorithm::ImportanceSampling(_) => Method::ImportanceSampling,
+            Algorithm::MonteCarlo(_) => Method::MonteCarlo,
+        }
+    }
+}
+
+/// Why FORM is only a first-order approximation for a study (it is exact
+/// when every case is one half-space in normal inputs, Eq. 21, 31).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FormLimit {
+    /// Two-sided tolerances: FORM keeps the nearer side only.
+    TwoSided,
+    /// A system limit state (series or volumetric).
+    System,
+    /// Some input is not normal: the limit state is not linear in `u`.
+    NonNormal,
+}
+
+impl FormLimit {
+    /// The reason, in words.
+    pub fn reason(self) -> &'static str {
+        match self {
+            FormLimit::TwoSided => "two-sided tolerances (the far side is not counted)",
+            FormLimit::System => "a system limit state",
+            FormLimit::NonNormal => "non-normal inputs",
+        }
+    }
+}
+
+/// What FORM reports about one case: how its design-point searches ended
+/// and what they cost (see [`FormResult`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct FormCase {
+    /// Why the nearest branch's search stopped.
+    pub termination: Termination,
+    /// False when some branch stopped at the iteration limit: its `β` is the
+    /// last iterate's, not a design point.
+    pub converged: bool,
+    /// HL-RF iterations, summed over the branches (0 for the closed form).
+    pub iterations: usize,
+    /// True when `Φ(−β)` is the exact failure probability (one half-space
+    /// in normal inputs, [`FormResult::exact`]).
+    pub exact: bool,
+}
+
+impl FormCase {
+    /// The account of one FORM result.
+    pub fn of(r: &FormResult) -> FormCase {
+        FormCase {
+            termination: r.termination,
+            converged: r
+                .branches
+                .iter()
+                .all(|b| b.termination != Termination::MaxIterations),
+            iterations: r.branches.iter().map(|b| b.iterations).sum(),
+            exact: r.exact,
+        }
+    }
+}
+
 /// A study ready to run: inputs, grid points and the sensitivities there.
 #[derive(Debug, Clone)]
 pub struct Study {
@@ -126,8 +272,8 @@ pub struct Study {
 /// The outcome of one case.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CaseResult {
-    /// The target's name.
-    pub target: &'static str,
+    /// The target.
+    pub target: Target,
     /// The axis values, in the model's variable order.
     pub point: Vec<f64>,
     /// `R = 1 − p_f`.
@@ -142,14 +288,28 @@ pub struct CaseResult {
     pub cov: Option<f64>,
     /// Samples drawn (sampling only).
     pub samples: Option<u64>,
+    /// FORM's account of the case (FORM, and the FORM that centred the
+    /// importance sampling; `None` for Monte Carlo).
+    pub form: Option<FormCase>,
+    /// Every limit-state call of the case (FORM's and the sampler's; a
+    /// sampler's calls count as values).
+    pub calls: Calls,
+}
+
+impl CaseResult {
+    /// False when FORM did not converge on this case (its reliability is
+    /// then not a FORM result but the last iterate's).
+    pub fn converged(&self) -> bool {
+        self.form.is_none_or(|f| f.converged)
+    }
 }
 
 /// The summary of a target over the grid (the paper's "minimum and average
 /// reliability").
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
-    /// The target's name.
-    pub target: &'static str,
+    /// The target.
+    pub target: Target,
     /// Mean reliability over the grid.
     pub mean: f64,
     /// Minimum reliability over the grid.
@@ -163,8 +323,8 @@ pub struct Summary {
 /// The outcome of a study.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StudyResult {
-    /// `form`, `is` or `mc`.
-    pub method: &'static str,
+    /// The algorithm.
+    pub method: Method,
     /// The model's axis variables.
     pub variables: Vec<String>,
     /// Every case, target-major.
@@ -173,6 +333,24 @@ pub struct StudyResult {
     pub summaries: Vec<Summary>,
     /// The requirement.
     pub requirement: Option<Requirement>,
+}
+
+impl StudyResult {
+    /// The cases of target `t` (its index in the study's targets).
+    pub fn target_cases(&self, t: usize) -> &[CaseResult] {
+        let np = self.cases.len() / self.summaries.len().max(1);
+        &self.cases[t * np..(t + 1) * np]
+    }
+
+    /// The cases on which FORM did not converge.
+    pub fn unconverged(&self) -> impl Iterator<Item = &CaseResult> {
+        self.cases.iter().filter(|c| !c.converged())
+    }
+
+    /// True when every summary's requirement holds (or there is none).
+    pub fn requirement_met(&self) -> bool {
+        self.summaries.iter().all(|s| s.met != Some(false))
+    }
 }
 
 /// The grid-mean sensitivities of one error for one target.
@@ -195,8 +373,8 @@ pub struct ErrorSensitivity {
 /// The sensitivities of one target, sorted by `|∂R/∂σ|`, largest first.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TargetSensitivity {
-    /// The target's name.
-    pub target: &'static str,
+    /// The target.
+    pub target: Target,
     /// Exact or FORM (the FORM route if any point needed it).
     pub method: SensitivityMethod,
     /// Per error, sorted.
@@ -471,6 +649,41 @@ impl Study {
         &self.targets
     }
 
+    /// Why FORM is only a first-order approximation on this study (empty
+    /// when it is exact on every case: one-sided components in normal
+    /// inputs, no system).
+    pub fn form_limits(&self) -> Vec<FormLimit> {
+        let mut out = Vec::new();
+        if self.spec.sided == Sided::Two {
+            out.push(FormLimit::TwoSided);
+        }
+        if self.spec.system.is_some() {
+            out.push(FormLimit::System);
+        }
+        if !self.inputs.is_affine() {
+            out.push(FormLimit::NonNormal);
+        }
+        out
+    }
+
+    /// The allowable value of `target` (`None` for the series system, whose
+    /// tolerances are its components').
+    pub fn tolerance(&self, target: Target) -> Option<f64> {
+        match target {
+            Target::Series => None,
+            Target::Volumetric => match self.spec.system {
+                Some(System::Volumetric { tolerance }) => Some(tolerance),
+                _ => None,
+            },
+            Target::Component(c) => self
+                .spec
+                .tolerances
+                .iter()
+                .find(|(x, _)| *x == c)
+                .map(|(_, t)| *t),
+        }
+    }
+
     /// The sensitivity row `∂E_c/∂e` at point `p`.
     pub fn row(&self, p: usize, c: Component) -> &[f64] {
         let n = self.inputs.len();
@@ -565,9 +778,14 @@ impl Study {
         let cases = results
             .iter()
             .enumerate()
-            .map(|(i, r)| self.case(i, r.reliability, r.pf, r.beta))
+            .map(|(i, r)| {
+                let mut c = self.case(i, r.reliability, r.pf, r.beta);
+                c.form = Some(FormCase::of(r));
+                c.calls = r.calls;
+                c
+            })
             .collect();
-        Ok(self.finish("form", cases))
+        Ok(self.finish(Method::Form, cases))
     }
 
     /// The importance sampling on every case.
@@ -579,7 +797,7 @@ impl Study {
         let events = self.events()?;
         let forms = self.run_form(&events, &is.form)?;
         let results = is.run_cases_with(&events, forms, progress)?;
-        Ok(self.finish("is", self.sampled(&results)))
+        Ok(self.finish(Method::ImportanceSampling, self.sampled(&results)))
     }
 
     /// Crude Monte Carlo on every case.
@@ -590,7 +808,21 @@ impl Study {
     ) -> Result<StudyResult, ReliabilityError> {
         let events = self.events()?;
         let results = mc.run_cases(&events, progress)?;
-        Ok(self.finish("mc", self.sampled(&results)))
+        Ok(self.finish(Method::MonteCarlo, self.sampled(&results)))
+    }
+
+    /// Runs `algorithm` on every case (`progress` hears of the samples
+    /// drawn; FORM draws none).
+    pub fn run(
+        &self,
+        algorithm: &Algorithm,
+        progress: &dyn Progress,
+    ) -> Result<StudyResult, ReliabilityError> {
+        match algorithm {
+            Algorithm::Form(form) => self.form(form),
+            Algorithm::ImportanceSampling(is) => self.importance_sampling(is, progress),
+            Algorithm::MonteCarlo(mc) => self.monte_carlo(mc, progress),
+        }
     }
 
     fn run_form(
@@ -614,6 +846,12 @@ impl Study {
                 c.std_error = Some(r.std_error);
                 c.cov = Some(r.cov);
                 c.samples = Some(r.samples);
+                c.form = r.form.as_ref().map(FormCase::of);
+                let form_calls = r.form.as_ref().map(|f| f.calls).unwrap_or_default();
+                c.calls = Calls {
+                    values: form_calls.values + r.calls,
+                    gradients: form_calls.gradients,
+                };
                 c
             })
             .collect()
@@ -622,7 +860,7 @@ impl Study {
     fn case(&self, i: usize, reliability: f64, pf: f64, beta: f64) -> CaseResult {
         let np = self.points.len();
         CaseResult {
-            target: self.targets[i / np].name(),
+            target: self.targets[i / np],
             point: self.points[i % np].clone(),
             reliability,
             pf,
@@ -630,10 +868,12 @@ impl Study {
             std_error: None,
             cov: None,
             samples: None,
+            form: None,
+            calls: Calls::default(),
         }
     }
 
-    fn finish(&self, method: &'static str, cases: Vec<CaseResult>) -> StudyResult {
+    fn finish(&self, method: Method, cases: Vec<CaseResult>) -> StudyResult {
         let np = self.points.len();
         let summaries = self
             .targets
@@ -648,7 +888,7 @@ impl Study {
                 let min = rs.iter().copied().fold(f64::INFINITY, f64::min);
                 let max = rs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                 Summary {
-                    target: target.name(),
+                    target: *target,
                     mean,
                     min,
                     max,
@@ -760,7 +1000,7 @@ impl Study {
                     .collect();
                 errors.sort_by(|a, b| b.dr_dstd.abs().total_cmp(&a.dr_dstd.abs()));
                 TargetSensitivity {
-                    target: target.name(),
+                    target,
                     method,
                     errors,
                 }
@@ -807,7 +1047,8 @@ fn grid_points(grid: &Grid, variables: &[String]) -> Result<Vec<Vec<f64>>, Relia
             ReliabilityError::UnknownName {
                 kind: "variable",
                 name: name.clone(),
-                hint: variables.first().cloned(),
+                hint: chain_core::diagnostic::closest(name, variables.iter().map(String::as_str))
+                    .map(str::to_string),
             }
         })?;
         if values.is_empty() {
@@ -886,6 +1127,32 @@ mod tests {
                 assert_eq!(grid.moments(p), at.moments(k));
             }
         }
+    }
+
+    #[test]
+    fn an_unknown_grid_axis_gets_a_close_name_or_no_hint() {
+        let (m, model) = gantry();
+        let inputs = machine::inputs(&m).unwrap();
+        let run = |axis: &str| {
+            let mut spec = machine::spec(&m, None).unwrap();
+            spec.grid.axes[0].0 = axis.to_string();
+            Study::new(&model, &[], inputs.clone(), spec).unwrap_err()
+        };
+        let hint = |e: ReliabilityError| match e {
+            ReliabilityError::UnknownName { hint, .. } => hint,
+            other => panic!("{other:?}"),
+        };
+        // The variables are x, z, y: `zz` is close to `z`, `spindle` to none
+        // (the first variable is not a suggestion).
+        assert_eq!(hint(run("zz")), Some("z".to_string()));
+        assert_eq!(hint(run("spindle")), None);
+        let e = run("spindle");
+        #[cfg(feature = "miette")]
+        assert_eq!(
+            miette::Diagnostic::code(&e).map(|c| c.to_string()),
+            Some("chain::reliability::unknown_name".to_string())
+        );
+        assert_eq!(e.to_string(), "unknown variable `spindle`");
     }
 
     #[test]

@@ -18,18 +18,20 @@ mod path_plot;
 use std::path::{Path, PathBuf};
 
 use chain_core::inverse::{Inverse, Status};
-use chain_core::model::{Component, Machine, Sided};
-use chain_core::ErrorModel;
-use reliability::{machine, ErrorMoments, Study, StudyResult, System, VolumetricMoments};
-use serde_json::{json, Map, Value};
+use chain_core::model::{Machine, Sided};
+use reliability::{
+    machine, Calls, Extreme, FormCase, InstantResult, Method, PathInstant, PathResult, PathStudy,
+    Quantity, Target,
+};
+use serde::Serialize;
 
 use super::csv_input::{numeric_rows, open_csv, read_poses};
 use super::inverse::solve_rows;
 use super::reliability::{
-    note_form_limits, parse_assignment, requirement_text, resolve_fixed, run_study, system_of,
-    Loaded, MethodArg, SidedArg, SystemArg,
+    calls_text, note_form_limits, parse_assignment, requirement_text, resolve_fixed, sided_title,
+    system_of, warn_unconverged, Loaded, MethodArg, Pairs, RequirementDoc, SidedArg, SystemArg,
 };
-use super::report::write_stdout;
+use super::report::{self, Csv, Report};
 
 /// Output formats of `chain path`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -93,52 +95,6 @@ pub struct PathArgs {
     pub plot: Option<PathBuf>,
 }
 
-/// One instant of the path.
-struct Instant {
-    /// 1-based data row of the input CSV.
-    row: usize,
-    /// The `t` column, or the row number.
-    t: f64,
-    /// `ok` for `--axes`; the inverse-kinematics status for `--pose`.
-    status: Status,
-    /// The axis values (model order), when the row has them.
-    q: Option<Vec<f64>>,
-}
-
-/// What was computed at an instant with axis values.
-struct Evaluated {
-    /// `T_wt(q, 0) · tool_point`.
-    nominal: [f64; 3],
-    /// Mean and covariance of the six components.
-    moments: ErrorMoments,
-    /// Mean and standard deviation of `|p|`.
-    volumetric: VolumetricMoments,
-    /// Reliability per target (study order).
-    reliability: Vec<f64>,
-    /// Standard error of `p_f` per target (sampling only).
-    std_error: Option<Vec<f64>>,
-}
-
-/// The whole result.
-struct PathResult {
-    machine: String,
-    frame: &'static str,
-    input: &'static str,
-    source: String,
-    variables: Vec<String>,
-    /// `(target name, allowable value)`; the series target has none.
-    targets: Vec<(&'static str, Option<f64>)>,
-    sided: Sided,
-    method: &'static str,
-    has_t: bool,
-    instants: Vec<(Instant, Option<Evaluated>)>,
-    /// The engine's result over the evaluated instants, if any.
-    study: Option<StudyResult>,
-}
-
-/// The six components and the volumetric error, as reported.
-const QUANTITIES: [&str; 7] = ["px", "py", "pz", "ox", "oy", "oz", "volumetric"];
-
 /// Runs `chain path`.
 pub fn exec(args: PathArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
@@ -146,10 +102,7 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
     let system = system_of(m, args.system, args.system_tolerance).map_err(|e| loaded.report(e))?;
     let mut spec = machine::spec(m, system).map_err(|e| loaded.report(e))?;
     if let Some(s) = args.sided {
-        spec.sided = match s {
-            SidedArg::Upper => Sided::Upper,
-            SidedArg::Two => Sided::Two,
-        };
+        spec.sided = s.into();
     }
     let inputs = machine::inputs(m).map_err(|e| loaded.report(e))?;
     let params = machine::parameters(m, &args.params).map_err(|e| loaded.report(e))?;
@@ -166,61 +119,29 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
         }
         (None, None) => miette::bail!("give the path with --axes AXES.csv or --pose POSE.csv"),
     };
-    let points: Vec<Vec<f64>> = instants.iter().filter_map(|i| i.q.clone()).collect();
-    let mut evaluated: Vec<Option<Evaluated>> = Vec::with_capacity(instants.len());
-    let mut study_result = None;
-    let targets;
-    if points.is_empty() {
-        // Nothing reachable: the instants are still reported.
-        eprintln!("note: no instant of the path has axis values; nothing to evaluate");
-        targets = target_list(&spec.tolerances, spec.system);
-        evaluated.extend(instants.iter().map(|_| None));
-    } else {
-        let study = Study::at_points(&model, &params, inputs, spec, points)
-            .map_err(|e| loaded.report(e))?;
-        let samples = args.method.samples(args.samples);
-        let result = run_study(&study, args.method, samples, args.seed, &())
-            .map_err(|e| loaded.report(e))?;
-        if args.method == MethodArg::Form {
-            note_form_limits(&study);
+    let path =
+        PathStudy::new(&model, &params, inputs, spec, instants).map_err(|e| loaded.report(e))?;
+    match path.study() {
+        None => eprintln!("note: no instant of the path has axis values; nothing to evaluate"),
+        Some(study) => {
+            if args.method == MethodArg::Form {
+                note_form_limits(study);
+            }
+            if !study.inputs().is_affine() {
+                eprintln!(
+                    "note: non-normal inputs: the mean and std of |p| are those of the normal law with the same mean and covariance (the component moments are exact)"
+                );
+            }
         }
-        if !study.inputs().is_affine() {
-            eprintln!(
-                "note: non-normal inputs: the mean and std of |p| are those of the normal law with the same mean and covariance (the component moments are exact)"
-            );
-        }
-        targets = study
-            .targets()
-            .iter()
-            .map(|t| (t.name(), tolerance_of(&study, t.name())))
-            .collect();
-        let np = study.points().len();
-        let mut k = 0;
-        for inst in &instants {
-            let Some(q) = &inst.q else {
-                evaluated.push(None);
-                continue;
-            };
-            let moments = study.moments(k);
-            let reliability = (0..study.targets().len())
-                .map(|t| result.cases[t * np + k].reliability)
-                .collect();
-            let std_error = (0..study.targets().len())
-                .map(|t| result.cases[t * np + k].std_error)
-                .collect::<Option<Vec<f64>>>();
-            evaluated.push(Some(Evaluated {
-                // `+ 0.0` turns a negative zero into 0.
-                nominal: model.nominal(q, &params).position.map(|x| x + 0.0),
-                volumetric: moments.volumetric(),
-                moments,
-                reliability,
-                std_error,
-            }));
-            k += 1;
-        }
-        study_result = Some(result);
     }
-    let result = PathResult {
+    let samples = args.method.samples(args.samples);
+    let result = path
+        .run(&args.method.algorithm(samples, args.seed), &())
+        .map_err(|e| loaded.report(e))?;
+    if let (Some(study), Some(r)) = (path.study(), &result.study) {
+        warn_unconverged(r, study.variables());
+    }
+    let doc = PathDoc {
         machine: m.name.clone(),
         frame: m.frame.name(),
         input,
@@ -230,74 +151,24 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
             source.display().to_string()
         },
         variables: m.variables.iter().map(|v| v.name.clone()).collect(),
-        targets,
-        sided: match args.sided {
-            Some(SidedArg::Two) => Sided::Two,
-            Some(SidedArg::Upper) => Sided::Upper,
-            None => m.reliability.as_ref().map_or(Sided::Upper, |r| r.sided),
-        },
-        method: method_name(args.method),
         has_t,
-        instants: instants.into_iter().zip(evaluated).collect(),
-        study: study_result,
+        result,
     };
     if let Some(dir) = &args.plot {
-        for f in path_plot::write_all(dir, &result)? {
+        for f in path_plot::write_all(dir, &doc)? {
             eprintln!("wrote {}", f.display());
         }
     }
-    let text = match args.format {
-        PathFormat::Json => {
-            let mut s = serde_json::to_string_pretty(&to_json(&result))
-                .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
-            s.push('\n');
-            s
+    report::emit(&doc, args.format.into())
+}
+
+impl From<PathFormat> for report::Format {
+    fn from(f: PathFormat) -> report::Format {
+        match f {
+            PathFormat::Table => report::Format::Table,
+            PathFormat::Json => report::Format::Json,
+            PathFormat::Csv => report::Format::Csv,
         }
-        PathFormat::Csv => to_csv(&result)?,
-        PathFormat::Table => to_table(&result),
-    };
-    write_stdout(&text)
-}
-
-fn method_name(m: MethodArg) -> &'static str {
-    match m {
-        MethodArg::Form => "form",
-        MethodArg::Is => "is",
-        MethodArg::Mc => "mc",
-    }
-}
-
-/// The targets a study of these tolerances and system would have (used only
-/// when no instant is evaluated).
-fn target_list(
-    tolerances: &[(Component, f64)],
-    system: Option<System>,
-) -> Vec<(&'static str, Option<f64>)> {
-    let mut out: Vec<_> = tolerances
-        .iter()
-        .map(|(c, t)| (c.name(), Some(*t)))
-        .collect();
-    match system {
-        Some(System::Series) => out.push(("series", None)),
-        Some(System::Volumetric { tolerance }) => out.push(("volumetric", Some(tolerance))),
-        None => {}
-    }
-    out
-}
-
-fn tolerance_of(study: &Study, target: &str) -> Option<f64> {
-    match target {
-        "series" => None,
-        "volumetric" => match study.spec().system {
-            Some(System::Volumetric { tolerance }) => Some(tolerance),
-            _ => None,
-        },
-        name => study
-            .spec()
-            .tolerances
-            .iter()
-            .find(|(c, _)| c.name() == name)
-            .map(|(_, t)| *t),
     }
 }
 
@@ -316,7 +187,7 @@ fn axes_instants(
     path: &Path,
     m: &Machine,
     fixed: &[(usize, f64)],
-) -> miette::Result<(bool, Vec<Instant>)> {
+) -> miette::Result<(bool, Vec<PathInstant>)> {
     let mut input = open_csv(path)?;
     let name = input.name.clone();
     let has_t = leading_t(&input.header, m);
@@ -378,11 +249,11 @@ fn axes_instants(
                     None => fixed.iter().find(|(i, _)| *i == v).map_or(0.0, |(_, x)| *x),
                 })
                 .collect();
-            Instant {
+            PathInstant {
                 row: k + 1,
                 t: if has_t { values[0] } else { (k + 1) as f64 },
                 status: Status::Ok,
-                q: Some(q),
+                axes: Some(q),
             }
         })
         .collect();
@@ -406,7 +277,7 @@ fn pose_instants(
     m: &Machine,
     params: &[f64],
     fixed: &[(usize, f64)],
-) -> miette::Result<(bool, Vec<Instant>)> {
+) -> miette::Result<(bool, Vec<PathInstant>)> {
     let (has_t, rows) = read_poses(path)?;
     let solver = Inverse::for_machine(m, params, fixed)
         .map_err(|e| miette::miette!("machine `{}`: {e}", m.name))?;
@@ -414,11 +285,11 @@ fn pose_instants(
         .into_iter()
         .zip(&rows)
         .enumerate()
-        .map(|(k, (s, row))| Instant {
+        .map(|(k, (s, row))| PathInstant {
             row: k + 1,
             t: row.t.unwrap_or((k + 1) as f64),
             status: s.status,
-            q: s.solutions.into_iter().next(),
+            axes: s.solutions.into_iter().next(),
         })
         .collect();
     Ok((has_t, instants))
@@ -427,249 +298,341 @@ fn pose_instants(
 // ---------------------------------------------------------------------------
 // Output.
 
+/// The report of `chain path`: the library's [`PathResult`] with what the
+/// command knows of its input (the JSON document of `docs/path.md`).
+pub(crate) struct PathDoc {
+    pub(crate) machine: String,
+    frame: &'static str,
+    input: &'static str,
+    source: String,
+    variables: Vec<String>,
+    pub(crate) has_t: bool,
+    pub(crate) result: PathResult,
+}
+
+/// `{"row": …, "t": …}`: where an extreme occurs.
+#[derive(Serialize)]
+struct AtDoc {
+    row: usize,
+    t: f64,
+}
+
+impl PathDoc {
+    fn at(&self, e: &Extreme) -> AtDoc {
+        let i = &self.result.records[e.record].instant;
+        AtDoc { row: i.row, t: i.t }
+    }
+
+    fn targets(&self) -> impl Iterator<Item = Target> + '_ {
+        self.result.targets.iter().map(|t| t.target)
+    }
+
+    fn per_target<V: Serialize>(&self, values: impl Iterator<Item = V>) -> Pairs<Target, V> {
+        Pairs(self.targets().zip(values).collect())
+    }
+}
+
+/// The JSON document.
+#[derive(Serialize)]
+struct PathJson<'a> {
+    machine: &'a str,
+    method: Method,
+    input: &'a str,
+    frame: &'a str,
+    sided: Sided,
+    tolerances: Pairs<Target, f64>,
+    variables: &'a [String],
+    instants: Vec<InstantDoc<'a>>,
+    summary: SummaryDoc,
+}
+
+/// One instant of [`PathJson`]; the results are `null` for an instant
+/// without axis values.
+#[derive(Serialize)]
+struct InstantDoc<'a> {
+    row: usize,
+    t: f64,
+    axes: Option<Pairs<&'a str, f64>>,
+    status: Status,
+    nominal: Option<[f64; 3]>,
+    mean: Option<Pairs<Quantity, f64>>,
+    std: Option<Pairs<Quantity, f64>>,
+    reliability: Option<Pairs<Target, f64>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    std_error: Option<Pairs<Target, f64>>,
+    /// How each target's case was computed (FORM's termination, calls).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cases: Option<Pairs<Target, CaseInfo>>,
+}
+
+/// FORM's account and the calls of one case.
+#[derive(Serialize)]
+struct CaseInfo {
+    #[serde(flatten)]
+    form: Option<FormCase>,
+    calls: Calls,
+}
+
+#[derive(Serialize)]
+struct SummaryDoc {
+    instants: usize,
+    evaluated: usize,
+    unreachable: usize,
+    singular: usize,
+    reliability: Pairs<Target, Option<TargetDoc>>,
+    error: Pairs<Quantity, Option<ErrorDoc>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    requirement: Option<RequirementDoc>,
+    /// How many cases FORM solved and how (FORM and the importance sampling).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    form: Option<FormSummaryDoc>,
+    /// Limit-state calls over every case.
+    calls: Calls,
+}
+
+#[derive(Serialize)]
+struct TargetDoc {
+    min: f64,
+    mean: f64,
+    worst: AtDoc,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    met: Option<bool>,
+}
+
+/// The extremes of one quantity; a component's mean key is `max_abs_mean`,
+/// that of `|p|` is `max_mean`.
+struct ErrorDoc {
+    volumetric: bool,
+    mean: f64,
+    mean_at: AtDoc,
+    std: f64,
+    std_at: AtDoc,
+}
+
+impl Serialize for ErrorDoc {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let key = if self.volumetric {
+            "max_mean"
+        } else {
+            "max_abs_mean"
+        };
+        let mut map = serializer.serialize_map(Some(4))?;
+        map.serialize_entry(key, &self.mean)?;
+        map.serialize_entry(&format!("{key}_at"), &self.mean_at)?;
+        map.serialize_entry("max_std", &self.std)?;
+        map.serialize_entry("max_std_at", &self.std_at)?;
+        map.end()
+    }
+}
+
+#[derive(Serialize)]
+struct FormSummaryDoc {
+    cases: usize,
+    converged: usize,
+    terminations: Pairs<Termination, usize>,
+}
+
+use reliability::Termination;
+
+impl Serialize for PathDoc {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        self.json().serialize(serializer)
+    }
+}
+
+impl PathDoc {
+    fn json(&self) -> PathJson<'_> {
+        let r = &self.result;
+        let instants = r
+            .records
+            .iter()
+            .map(|rec| {
+                let i = &rec.instant;
+                let e = rec.result.as_ref();
+                let moments = |pick: fn(&InstantResult, Quantity) -> f64| {
+                    e.map(|e| Pairs(Quantity::ALL.iter().map(|&q| (q, pick(e, q))).collect()))
+                };
+                InstantDoc {
+                    row: i.row,
+                    t: i.t,
+                    axes: i.axes.as_ref().map(|q| {
+                        Pairs(
+                            self.variables
+                                .iter()
+                                .map(String::as_str)
+                                .zip(q.iter().copied())
+                                .collect(),
+                        )
+                    }),
+                    status: i.status,
+                    nominal: e.map(|e| e.nominal),
+                    mean: moments(InstantResult::mean),
+                    std: moments(InstantResult::std),
+                    reliability: e.map(|e| self.per_target(e.cases.iter().map(|c| c.reliability))),
+                    std_error: e.and_then(|e| {
+                        let se: Option<Vec<f64>> = e.cases.iter().map(|c| c.std_error).collect();
+                        se.map(|se| self.per_target(se.into_iter()))
+                    }),
+                    cases: e.map(|e| {
+                        self.per_target(e.cases.iter().map(|c| CaseInfo {
+                            form: c.form,
+                            calls: c.calls,
+                        }))
+                    }),
+                }
+            })
+            .collect();
+        let reliability = self.per_target((0..r.targets.len()).map(|t| {
+            r.summary(t).map(|s| TargetDoc {
+                min: s.min.value,
+                mean: s.mean,
+                worst: self.at(&s.min),
+                met: s.met,
+            })
+        }));
+        let error = Pairs(
+            Quantity::ALL
+                .iter()
+                .map(|&q| {
+                    let doc = match (r.max_mean(q), r.max_std(q)) {
+                        (Some(m), Some(s)) => Some(ErrorDoc {
+                            volumetric: q == Quantity::Volumetric,
+                            mean: m.value,
+                            mean_at: self.at(&m),
+                            std: s.value,
+                            std_at: self.at(&s),
+                        }),
+                        _ => None,
+                    };
+                    (q, doc)
+                })
+                .collect(),
+        );
+        let forms: Vec<&FormCase> = r.cases().filter_map(|c| c.form.as_ref()).collect();
+        let form = (!forms.is_empty()).then(|| FormSummaryDoc {
+            cases: forms.len(),
+            converged: forms.iter().filter(|f| f.converged).count(),
+            terminations: Pairs(
+                Termination::ALL
+                    .iter()
+                    .map(|&t| (t, forms.iter().filter(|f| f.termination == t).count()))
+                    .filter(|(_, n)| *n > 0)
+                    .collect(),
+            ),
+        });
+        let calls = r.cases().fold(Calls::default(), |a, c| Calls {
+            values: a.values + c.calls.values,
+            gradients: a.gradients + c.calls.gradients,
+        });
+        let summary = SummaryDoc {
+            instants: r.records.len(),
+            evaluated: r.evaluated(),
+            unreachable: r.count(Status::Unreachable),
+            singular: r.count(Status::Singular),
+            reliability,
+            error,
+            requirement: r.study.as_ref().and_then(RequirementDoc::of),
+            form,
+            calls,
+        };
+        PathJson {
+            machine: &self.machine,
+            method: r.method,
+            input: self.input,
+            frame: self.frame,
+            sided: r.sided,
+            tolerances: Pairs(
+                r.targets
+                    .iter()
+                    .filter_map(|t| t.tolerance.map(|v| (t.target, v)))
+                    .collect(),
+            ),
+            variables: &self.variables,
+            instants,
+            summary,
+        }
+    }
+}
+
+impl Report for PathDoc {
+    fn table(&self) -> String {
+        to_table(self)
+    }
+
+    fn csv(&self) -> Option<Csv> {
+        let r = &self.result;
+        let sampled = r.cases().any(|c| c.std_error.is_some());
+        let names: Vec<&str> = r.targets.iter().map(|t| t.target.name()).collect();
+        let mut header = vec!["row".to_string(), "t".to_string()];
+        header.extend(self.variables.iter().cloned());
+        header.push("status".into());
+        header.extend(["nominal_x", "nominal_y", "nominal_z"].map(String::from));
+        header.extend(Quantity::ALL.iter().map(|q| format!("mean_{q}")));
+        header.extend(Quantity::ALL.iter().map(|q| format!("std_{q}")));
+        header.extend(names.iter().map(|t| format!("reliability_{t}")));
+        if sampled {
+            header.extend(names.iter().map(|t| format!("std_error_{t}")));
+        }
+        for key in [
+            "termination",
+            "converged",
+            "iterations",
+            "value_calls",
+            "gradient_calls",
+        ] {
+            header.extend(names.iter().map(|t| format!("{key}_{t}")));
+        }
+        let width = header.len();
+        let mut csv = Csv::new(header);
+        for rec in &r.records {
+            let i = &rec.instant;
+            let mut row = vec![i.row.to_string(), format!("{:?}", i.t)];
+            match &i.axes {
+                Some(q) => row.extend(q.iter().map(|x| format!("{x:?}"))),
+                None => row.extend(self.variables.iter().map(|_| String::new())),
+            }
+            row.push(status_name(i.status).into());
+            if let Some(e) = &rec.result {
+                row.extend(e.nominal.iter().map(|x| format!("{x:?}")));
+                row.extend(Quantity::ALL.iter().map(|&q| format!("{:?}", e.mean(q))));
+                row.extend(Quantity::ALL.iter().map(|&q| format!("{:?}", e.std(q))));
+                row.extend(e.cases.iter().map(|c| format!("{:?}", c.reliability)));
+                if sampled {
+                    match e
+                        .cases
+                        .iter()
+                        .map(|c| c.std_error)
+                        .collect::<Option<Vec<_>>>()
+                    {
+                        Some(se) => row.extend(se.iter().map(|x| format!("{x:?}"))),
+                        None => row.extend(names.iter().map(|_| String::new())),
+                    }
+                }
+                let form = |f: fn(&FormCase) -> String| {
+                    e.cases
+                        .iter()
+                        .map(move |c| c.form.as_ref().map(f).unwrap_or_default())
+                };
+                row.extend(form(|f| f.termination.to_string()));
+                row.extend(form(|f| f.converged.to_string()));
+                row.extend(form(|f| f.iterations.to_string()));
+                row.extend(e.cases.iter().map(|c| c.calls.values.to_string()));
+                row.extend(e.cases.iter().map(|c| c.calls.gradients.to_string()));
+            }
+            row.resize(width, String::new());
+            csv.row(row);
+        }
+        Some(csv)
+    }
+}
+
 fn status_name(s: Status) -> &'static str {
     match s {
         Status::Ok => "ok",
         Status::Unreachable => "unreachable",
         Status::Singular => "singular",
     }
-}
-
-/// The mean and standard deviation of quantity `k` of [`QUANTITIES`].
-fn quantity(e: &Evaluated, k: usize) -> (f64, f64) {
-    if k < 6 {
-        (e.moments.mean[k], e.moments.std(Component::ALL[k]))
-    } else {
-        (e.volumetric.mean, e.volumetric.std)
-    }
-}
-
-/// The instant where `value` is largest (first on ties), with that value.
-fn arg_max(r: &PathResult, value: impl Fn(&Evaluated) -> f64) -> Option<(&Instant, f64)> {
-    r.instants
-        .iter()
-        .filter_map(|(i, e)| e.as_ref().map(|e| (i, value(e))))
-        .fold(None, |best, (i, v)| match best {
-            Some((_, b)) if b >= v => best,
-            _ => Some((i, v)),
-        })
-}
-
-/// One target's summary over the evaluated instants: (min, mean, worst instant).
-fn target_summary(r: &PathResult, t: usize) -> Option<(f64, f64, &Instant)> {
-    let (worst, neg_min) = arg_max(r, |e| -e.reliability[t])?;
-    let values: Vec<f64> = r
-        .instants
-        .iter()
-        .filter_map(|(_, e)| e.as_ref().map(|e| e.reliability[t]))
-        .collect();
-    let mean = values.iter().sum::<f64>() / values.len() as f64;
-    Some((-neg_min, mean, worst))
-}
-
-fn count(r: &PathResult, status: Status) -> usize {
-    r.instants
-        .iter()
-        .filter(|(i, _)| i.status == status)
-        .count()
-}
-
-fn at_json(i: &Instant) -> Value {
-    json!({"row": i.row, "t": i.t})
-}
-
-fn to_json(r: &PathResult) -> Value {
-    let instants: Vec<Value> = r
-        .instants
-        .iter()
-        .map(|(i, e)| {
-            let mut o = Map::new();
-            o.insert("row".into(), json!(i.row));
-            o.insert("t".into(), json!(i.t));
-            o.insert(
-                "axes".into(),
-                match &i.q {
-                    Some(q) => Value::Object(
-                        r.variables
-                            .iter()
-                            .zip(q)
-                            .map(|(v, x)| (v.clone(), json!(x)))
-                            .collect(),
-                    ),
-                    None => Value::Null,
-                },
-            );
-            o.insert("status".into(), json!(status_name(i.status)));
-            match e {
-                Some(e) => {
-                    o.insert("nominal".into(), json!(e.nominal));
-                    let moments = |pick: fn((f64, f64)) -> f64| -> Value {
-                        Value::Object(
-                            QUANTITIES
-                                .iter()
-                                .enumerate()
-                                .map(|(k, q)| (q.to_string(), json!(pick(quantity(e, k)))))
-                                .collect(),
-                        )
-                    };
-                    o.insert("mean".into(), moments(|m| m.0));
-                    o.insert("std".into(), moments(|m| m.1));
-                    let per_target = |values: &[f64]| -> Value {
-                        Value::Object(
-                            r.targets
-                                .iter()
-                                .zip(values)
-                                .map(|((t, _), v)| (t.to_string(), json!(v)))
-                                .collect(),
-                        )
-                    };
-                    o.insert("reliability".into(), per_target(&e.reliability));
-                    if let Some(se) = &e.std_error {
-                        o.insert("std_error".into(), per_target(se));
-                    }
-                }
-                None => {
-                    for key in ["nominal", "mean", "std", "reliability"] {
-                        o.insert(key.into(), Value::Null);
-                    }
-                }
-            }
-            Value::Object(o)
-        })
-        .collect();
-    let mut reliability = Map::new();
-    for (t, (name, _)) in r.targets.iter().enumerate() {
-        let v = match target_summary(r, t) {
-            Some((min, mean, worst)) => {
-                let mut o = Map::new();
-                o.insert("min".into(), json!(min));
-                o.insert("mean".into(), json!(mean));
-                o.insert("worst".into(), at_json(worst));
-                if let Some(met) = r
-                    .study
-                    .as_ref()
-                    .and_then(|s| s.summaries.get(t))
-                    .and_then(|s| s.met)
-                {
-                    o.insert("met".into(), json!(met));
-                }
-                Value::Object(o)
-            }
-            None => Value::Null,
-        };
-        reliability.insert(name.to_string(), v);
-    }
-    let mut error = Map::new();
-    for (k, q) in QUANTITIES.iter().enumerate() {
-        let mean_key = if k < 6 { "max_abs_mean" } else { "max_mean" };
-        let v = match (
-            arg_max(r, |e| quantity(e, k).0.abs()),
-            arg_max(r, |e| quantity(e, k).1),
-        ) {
-            (Some((im, vm)), Some((is, vs))) => {
-                let mut o = Map::new();
-                o.insert(mean_key.into(), json!(vm));
-                o.insert(format!("{mean_key}_at"), at_json(im));
-                o.insert("max_std".into(), json!(vs));
-                o.insert("max_std_at".into(), at_json(is));
-                Value::Object(o)
-            }
-            _ => Value::Null,
-        };
-        error.insert(q.to_string(), v);
-    }
-    let mut summary = Map::new();
-    summary.insert("instants".into(), json!(r.instants.len()));
-    summary.insert(
-        "evaluated".into(),
-        json!(r.instants.iter().filter(|(_, e)| e.is_some()).count()),
-    );
-    summary.insert("unreachable".into(), json!(count(r, Status::Unreachable)));
-    summary.insert("singular".into(), json!(count(r, Status::Singular)));
-    summary.insert("reliability".into(), Value::Object(reliability));
-    summary.insert("error".into(), Value::Object(error));
-    if let Some(req) = r.study.as_ref().and_then(|s| s.requirement) {
-        let met = r
-            .study
-            .as_ref()
-            .is_some_and(|s| s.summaries.iter().all(|x| x.met != Some(false)));
-        summary.insert(
-            "requirement".into(),
-            json!({"min": req.min, "mean": req.mean, "met": met}),
-        );
-    }
-    let tolerances: Map<String, Value> = r
-        .targets
-        .iter()
-        .filter_map(|(t, v)| v.map(|v| (t.to_string(), json!(v))))
-        .collect();
-    json!({
-        "machine": r.machine,
-        "method": r.method,
-        "input": r.input,
-        "frame": r.frame,
-        "sided": sided_name(r.sided),
-        "tolerances": tolerances,
-        "variables": r.variables,
-        "instants": instants,
-        "summary": summary,
-    })
-}
-
-fn sided_name(s: Sided) -> &'static str {
-    match s {
-        Sided::Upper => "upper",
-        Sided::Two => "two",
-    }
-}
-
-fn to_csv(r: &PathResult) -> miette::Result<String> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let sampled = r
-        .instants
-        .iter()
-        .any(|(_, e)| e.as_ref().is_some_and(|e| e.std_error.is_some()));
-    let mut header = vec!["row".to_string(), "t".to_string()];
-    header.extend(r.variables.iter().cloned());
-    header.push("status".into());
-    header.extend(["nominal_x", "nominal_y", "nominal_z"].map(String::from));
-    header.extend(QUANTITIES.iter().map(|q| format!("mean_{q}")));
-    header.extend(QUANTITIES.iter().map(|q| format!("std_{q}")));
-    header.extend(r.targets.iter().map(|(t, _)| format!("reliability_{t}")));
-    if sampled {
-        header.extend(r.targets.iter().map(|(t, _)| format!("std_error_{t}")));
-    }
-    let err = |e: csv::Error| miette::miette!("cannot write CSV: {e}");
-    w.write_record(&header).map_err(err)?;
-    for (i, e) in &r.instants {
-        let mut row = vec![i.row.to_string(), format!("{:?}", i.t)];
-        match &i.q {
-            Some(q) => row.extend(q.iter().map(|x| format!("{x:?}"))),
-            None => row.extend(r.variables.iter().map(|_| String::new())),
-        }
-        row.push(status_name(i.status).into());
-        let width = 3 + 2 * QUANTITIES.len() + r.targets.len() * (1 + usize::from(sampled));
-        match e {
-            Some(e) => {
-                row.extend(e.nominal.iter().map(|x| format!("{x:?}")));
-                row.extend((0..QUANTITIES.len()).map(|k| format!("{:?}", quantity(e, k).0)));
-                row.extend((0..QUANTITIES.len()).map(|k| format!("{:?}", quantity(e, k).1)));
-                row.extend(e.reliability.iter().map(|x| format!("{x:?}")));
-                if sampled {
-                    match &e.std_error {
-                        Some(se) => row.extend(se.iter().map(|x| format!("{x:?}"))),
-                        None => row.extend(r.targets.iter().map(|_| String::new())),
-                    }
-                }
-            }
-            None => row.extend((0..width).map(|_| String::new())),
-        }
-        w.write_record(&row).map_err(err)?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| miette::miette!("cannot write CSV: {e}"))?;
-    String::from_utf8(bytes).map_err(|e| miette::miette!("cannot write CSV: {e}"))
 }
 
 /// A compact number for the table: integers as such, others with up to six
@@ -692,7 +655,7 @@ fn sci(v: f64) -> String {
     }
 }
 
-fn at_text(i: &Instant, has_t: bool) -> String {
+fn at_text(i: &PathInstant, has_t: bool) -> String {
     if has_t {
         format!("row {} (t = {})", i.row, num(i.t))
     } else {
@@ -700,85 +663,90 @@ fn at_text(i: &Instant, has_t: bool) -> String {
     }
 }
 
-fn to_table(r: &PathResult) -> String {
+/// `|p|` for the volumetric quantity, the component's name otherwise.
+pub(crate) fn label(q: Quantity) -> &'static str {
+    match q {
+        Quantity::Volumetric => "|p|",
+        Quantity::Component(c) => c.name(),
+    }
+}
+
+fn to_table(doc: &PathDoc) -> String {
     use std::fmt::Write as _;
+    let r = &doc.result;
     let mut out = String::new();
-    let method = match r.method {
-        "form" => "FORM",
-        "is" => "importance sampling",
-        _ => "Monte Carlo",
-    };
-    let sided = match r.sided {
-        Sided::Upper => "upper",
-        Sided::Two => "two-sided",
-    };
+    let sided = sided_title(r.sided);
     let _ = writeln!(
         out,
-        "{}: error and reliability along a path ({} instants from {}, {method}, {sided}, frame {})",
-        r.machine,
-        r.instants.len(),
-        r.source,
-        r.frame
+        "{}: error and reliability along a path ({} instants from {}, {}, {sided}, frame {})",
+        doc.machine,
+        r.records.len(),
+        doc.source,
+        r.method.title(),
+        doc.frame
     );
     let tol: Vec<String> = r
         .targets
         .iter()
-        .filter_map(|(t, v)| v.map(|v| format!("{t} {}", num(v))))
+        .filter_map(|t| t.tolerance.map(|v| format!("{} {}", t.target, num(v))))
         .collect();
     let _ = writeln!(out, "tolerances: {}", tol.join(", "));
     // Which error quantities to show: the toleranced components and |p|.
-    let shown: Vec<usize> = QUANTITIES
+    let shown: Vec<Quantity> = Quantity::ALL
         .iter()
-        .enumerate()
-        .filter(|(k, q)| *k == 6 || r.targets.iter().any(|(t, _)| t == *q))
-        .map(|(k, _)| k)
+        .copied()
+        .filter(|q| *q == Quantity::Volumetric || doc.targets().any(|t| t.name() == q.name()))
         .collect();
-    let label = |k: usize| if k == 6 { "|p|" } else { QUANTITIES[k] };
     let _ = writeln!(
         out,
         "\nmean and standard deviation of the error (lengths in the file's unit, angles in rad)"
     );
-    let _ = write!(out, "{:>5} {:>10}", "row", if r.has_t { "t" } else { "" });
-    for v in &r.variables {
+    let _ = write!(out, "{:>5} {:>10}", "row", if doc.has_t { "t" } else { "" });
+    for v in &doc.variables {
         let _ = write!(out, " {v:>10}");
     }
     let _ = write!(out, "  {:<11}", "status");
-    for &k in &shown {
-        let _ = write!(out, " {:>11} {:>10}", format!("{} mean", label(k)), "std");
+    for &q in &shown {
+        let _ = write!(out, " {:>11} {:>10}", format!("{} mean", label(q)), "std");
     }
     out.push('\n');
-    for (i, e) in &r.instants {
-        let t = if r.has_t { num(i.t) } else { String::new() };
+    for rec in &r.records {
+        let i = &rec.instant;
+        let t = if doc.has_t { num(i.t) } else { String::new() };
         let _ = write!(out, "{:>5} {t:>10}", i.row);
-        match &i.q {
+        match &i.axes {
             Some(q) => q.iter().for_each(|x| {
                 let _ = write!(out, " {:>10}", num(*x));
             }),
-            None => r.variables.iter().for_each(|_| {
+            None => doc.variables.iter().for_each(|_| {
                 let _ = write!(out, " {:>10}", "-");
             }),
         }
         let _ = write!(out, "  {:<11}", status_name(i.status));
-        if let Some(e) = e {
-            for &k in &shown {
-                let (m, s) = quantity(e, k);
-                let _ = write!(out, " {:>11} {:>10}", sci(m), sci(s));
+        if let Some(e) = &rec.result {
+            for &q in &shown {
+                let _ = write!(out, " {:>11} {:>10}", sci(e.mean(q)), sci(e.std(q)));
             }
         }
         out.push('\n');
     }
     let _ = writeln!(out, "\nreliability (%)");
-    let _ = write!(out, "{:>5} {:>10}", "row", if r.has_t { "t" } else { "" });
-    for (t, _) in &r.targets {
-        let _ = write!(out, " {t:>10}");
+    let _ = write!(out, "{:>5} {:>10}", "row", if doc.has_t { "t" } else { "" });
+    for t in doc.targets() {
+        let _ = write!(out, " {:>10}", t.name());
     }
     out.push('\n');
-    for (i, e) in &r.instants {
-        let t = if r.has_t { num(i.t) } else { String::new() };
+    let mut bad = Vec::new();
+    for rec in &r.records {
+        let i = &rec.instant;
+        let t = if doc.has_t { num(i.t) } else { String::new() };
         let _ = write!(out, "{:>5} {t:>10}", i.row);
-        match e {
-            Some(e) => e.reliability.iter().for_each(|v| {
-                let _ = write!(out, " {:>10.3}", 100.0 * v);
+        match &rec.result {
+            Some(e) => e.cases.iter().for_each(|c| {
+                let _ = write!(out, " {:>10.3}", 100.0 * c.reliability);
+                if !c.converged() {
+                    bad.push(format!("{} at {}", c.target, at_text(i, doc.has_t)));
+                }
             }),
             None => {
                 let _ = write!(out, " {}", status_name(i.status));
@@ -786,59 +754,61 @@ fn to_table(r: &PathResult) -> String {
         }
         out.push('\n');
     }
-    let evaluated = r.instants.iter().filter(|(_, e)| e.is_some()).count();
+    if !bad.is_empty() {
+        let _ = writeln!(
+            out,
+            "* FORM stopped at the iteration limit (the value shown is the last iterate's, not a converged reliability): {}",
+            bad.join(", ")
+        );
+    }
     let _ = writeln!(
         out,
-        "\nsummary over {} instants ({evaluated} evaluated, {} unreachable, {} singular)",
-        r.instants.len(),
-        count(r, Status::Unreachable),
-        count(r, Status::Singular)
+        "\nsummary over {} instants ({} evaluated, {} unreachable, {} singular)",
+        r.records.len(),
+        r.evaluated(),
+        r.count(Status::Unreachable),
+        r.count(Status::Singular)
     );
-    for (t, (name, _)) in r.targets.iter().enumerate() {
-        if let Some((min, mean, worst)) = target_summary(r, t) {
+    for (t, target) in doc.targets().enumerate() {
+        if let Some(s) = r.summary(t) {
+            let worst = &r.records[s.min.record].instant;
             let _ = write!(
                 out,
-                "  {name:<10} reliability min {:.3} % at {}, mean {:.3} %",
-                100.0 * min,
-                at_text(worst, r.has_t),
-                100.0 * mean
+                "  {:<10} reliability min {:.3} % at {}, mean {:.3} %",
+                target.name(),
+                100.0 * s.min.value,
+                at_text(worst, doc.has_t),
+                100.0 * s.mean
             );
-            let summary = r.study.as_ref().and_then(|s| s.summaries.get(t));
-            if let (Some(req), Some(met)) = (
-                r.study.as_ref().and_then(|s| s.requirement),
-                summary.and_then(|s| s.met),
-            ) {
+            if let (Some(req), Some(met)) = (r.requirement(), s.met) {
                 out.push_str(&requirement_text(&req, met));
             }
             out.push('\n');
         }
     }
-    for &k in &shown {
-        if let (Some((im, vm)), Some((is, vs))) = (
-            arg_max(r, |e| quantity(e, k).0.abs()),
-            arg_max(r, |e| quantity(e, k).1),
-        ) {
-            let what = if k == 6 { "max mean" } else { "max |mean|" };
+    for &q in &shown {
+        if let (Some(m), Some(s)) = (r.max_mean(q), r.max_std(q)) {
+            let what = if q == Quantity::Volumetric {
+                "max mean"
+            } else {
+                "max |mean|"
+            };
             let _ = writeln!(
                 out,
                 "  {:<10} {what} {} at {}, max std {} at {}",
-                label(k),
-                sci(vm),
-                at_text(im, r.has_t),
-                sci(vs),
-                at_text(is, r.has_t)
+                label(q),
+                sci(m.value),
+                at_text(&r.records[m.record].instant, doc.has_t),
+                sci(s.value),
+                at_text(&r.records[s.record].instant, doc.has_t)
             );
         }
     }
-    if let Some(se) = r
-        .instants
-        .iter()
-        .filter_map(|(_, e)| e.as_ref().and_then(|e| e.std_error.as_ref()))
-        .flatten()
-        .copied()
-        .reduce(f64::max)
-    {
+    if let Some(se) = r.cases().filter_map(|c| c.std_error).reduce(f64::max) {
         let _ = writeln!(out, "  sampling: largest standard error of p_f {se:.2e}");
+    }
+    if r.evaluated() > 0 {
+        let _ = writeln!(out, "  {}", calls_text(r.cases(), r.method));
     }
     out
 }

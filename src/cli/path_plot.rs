@@ -6,49 +6,54 @@
 use std::path::{Path, PathBuf};
 
 use crate::cli::plot::{Legend, Series, XyChart};
+use reliability::Quantity;
 
-use super::{quantity, PathResult, QUANTITIES};
+use super::{label, PathDoc};
 
 /// Writes `path_reliability`, `path_std` and, when an orientation component
 /// is toleranced, `path_std_angular`; returns the files written. Writes
 /// nothing when no instant was evaluated.
-pub(super) fn write_all(dir: &Path, r: &PathResult) -> miette::Result<Vec<PathBuf>> {
-    if r.instants.iter().all(|(_, e)| e.is_none()) {
+pub(super) fn write_all(dir: &Path, doc: &PathDoc) -> miette::Result<Vec<PathBuf>> {
+    let r = &doc.result;
+    if r.evaluated() == 0 {
         eprintln!("note: no evaluated instant; no chart written");
         return Ok(Vec::new());
     }
-    let x_label = if r.has_t { "t" } else { "row" };
-    let method = match r.method {
-        "form" => "FORM",
-        "is" => "importance sampling",
-        _ => "Monte Carlo",
-    };
+    let x_label = if doc.has_t { "t" } else { "row" };
+    let method = r.method.title();
     let mut files = Vec::new();
 
     let mut chart = XyChart::new(
-        format!("{}: reliability along the path ({method})", r.machine),
+        format!("{}: reliability along the path ({method})", doc.machine),
         x_label,
         "reliability (%)",
     )
     .legend(Legend::LowerLeft);
-    for (t, (name, _)) in r.targets.iter().enumerate() {
+    for (t, target) in r.targets.iter().enumerate() {
         let points = r
-            .instants
+            .records
             .iter()
-            .filter_map(|(i, e)| e.as_ref().map(|e| (i.t, 100.0 * e.reliability[t])))
+            .filter_map(|rec| {
+                let e = rec.result.as_ref()?;
+                Some((rec.instant.t, 100.0 * e.cases[t].reliability))
+            })
             .collect();
-        chart = chart.series(Series::line_points(*name, points));
+        chart = chart.series(Series::line_points(target.target.name(), points));
     }
-    if let Some(req) = r.study.as_ref().and_then(|s| s.requirement) {
+    if let Some(req) = r.requirement() {
         chart = chart.hline(100.0 * req.min);
     }
     let chart = with_legend_room(chart, false);
     files.extend(chart.write(dir, "path_reliability")?);
 
     // Standard deviations, lengths and angles on separate charts.
-    let toleranced = |k: usize| r.targets.iter().any(|(t, _)| *t == QUANTITIES[k]);
-    let position: Vec<usize> = (0..3).filter(|&k| toleranced(k)).chain([6]).collect();
-    let angular: Vec<usize> = (3..6).filter(|&k| toleranced(k)).collect();
+    let toleranced = |k: &usize| {
+        r.targets
+            .iter()
+            .any(|t| t.target.name() == Quantity::ALL[*k].name())
+    };
+    let position: Vec<usize> = (0..3).filter(toleranced).chain([6]).collect();
+    let angular: Vec<usize> = (3..6).filter(toleranced).collect();
     for (stem, ks, unit) in [
         ("path_std", position, "std (length unit)"),
         ("path_std_angular", angular, "std (rad)"),
@@ -57,23 +62,19 @@ pub(super) fn write_all(dir: &Path, r: &PathResult) -> miette::Result<Vec<PathBu
             continue;
         }
         let mut chart = XyChart::new(
-            format!("{}: error standard deviation along the path", r.machine),
+            format!("{}: error standard deviation along the path", doc.machine),
             x_label,
             unit,
         )
         .legend(Legend::UpperLeft);
         for k in ks {
-            let label = if k == 6 {
-                "|p|".to_string()
-            } else {
-                QUANTITIES[k].to_string()
-            };
+            let q = Quantity::ALL[k];
             let points = r
-                .instants
+                .records
                 .iter()
-                .filter_map(|(i, e)| e.as_ref().map(|e| (i.t, quantity(e, k).1)))
+                .filter_map(|rec| rec.result.as_ref().map(|e| (rec.instant.t, e.std(q))))
                 .collect();
-            chart = chart.series(Series::line_points(label, points));
+            chart = chart.series(Series::line_points(label(q), points));
         }
         files.extend(with_legend_room(chart, true).write(dir, stem)?);
     }

@@ -7,19 +7,20 @@
 //! the study, rendering errors against the file) live here too.
 
 #[path = "reliability_plot.rs"]
-mod reliability_plot;
+pub(crate) mod reliability_plot;
 
 use std::io::IsTerminal;
-
-use super::report::write_stdout;
 use std::path::{Path, PathBuf};
 
 use chain_core::model::{Machine, Origin, Sided};
-use miette::{LabeledSpan, MietteDiagnostic, NamedSource, Report};
+use miette::{LabeledSpan, MietteDiagnostic, NamedSource};
 use reliability::{
-    machine, Form, ImportanceSampling, MonteCarlo, ReliabilityError, Study, StudyResult, System,
+    machine, Algorithm, Calls, Form, FormCase, ImportanceSampling, Method, MonteCarlo,
+    ReliabilityError, Study, StudyResult, System, Target, Termination,
 };
-use serde_json::{json, Map, Value};
+use serde::Serialize;
+
+use super::report::{self, Csv, Report};
 
 /// Runs the chosen algorithm over every case of a study (`samples` is
 /// ignored by FORM); `progress` receives the samples done.
@@ -30,18 +31,7 @@ pub(crate) fn run_study(
     seed: u64,
     progress: &dyn reliability::Progress,
 ) -> Result<StudyResult, ReliabilityError> {
-    match method {
-        MethodArg::Form => study.form(&Form::default()),
-        MethodArg::Is => study.importance_sampling(
-            &ImportanceSampling {
-                samples,
-                seed,
-                form: Form::default(),
-            },
-            progress,
-        ),
-        MethodArg::Mc => study.monte_carlo(&MonteCarlo { samples, seed }, progress),
-    }
+    study.run(&method.algorithm(samples, seed), progress)
 }
 
 /// Algorithms of `--method`.
@@ -56,6 +46,20 @@ pub enum MethodArg {
 }
 
 impl MethodArg {
+    /// The library's algorithm with these samples per case and seed
+    /// (FORM ignores both).
+    pub(crate) fn algorithm(self, samples: u64, seed: u64) -> Algorithm {
+        match self {
+            MethodArg::Form => Algorithm::Form(Form::default()),
+            MethodArg::Is => Algorithm::ImportanceSampling(ImportanceSampling {
+                samples,
+                seed,
+                form: Form::default(),
+            }),
+            MethodArg::Mc => Algorithm::MonteCarlo(MonteCarlo { samples, seed }),
+        }
+    }
+
     /// The samples per case: `--samples` or the method's default (is:
     /// 10,000, mc: 100,000; 0 for FORM, which draws none).
     pub(crate) fn samples(self, given: Option<u64>) -> u64 {
@@ -85,6 +89,15 @@ pub enum SidedArg {
     Upper,
     /// `|E| ≤ I`.
     Two,
+}
+
+impl From<SidedArg> for Sided {
+    fn from(s: SidedArg) -> Sided {
+        match s {
+            SidedArg::Upper => Sided::Upper,
+            SidedArg::Two => Sided::Two,
+        }
+    }
 }
 
 /// `--system`: an extra system target.
@@ -152,6 +165,7 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     if args.method == MethodArg::Form {
         note_form_limits(&study);
     }
+    warn_unconverged(&result, study.variables());
     if let Some(dir) = &args.plot {
         let sens = study
             .sensitivity_mean(&Form::default())
@@ -161,17 +175,18 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
             eprintln!("wrote {}", f.display());
         }
     }
-    let text = match args.format {
-        ReliabilityFormat::Json => {
-            let mut s = serde_json::to_string_pretty(&to_json(&loaded.machine, &study, &result))
-                .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
-            s.push('\n');
-            s
+    let doc = ReliabilityDoc::new(&loaded.machine.name, &study, &result);
+    report::emit(&doc, args.format.into())
+}
+
+impl From<ReliabilityFormat> for report::Format {
+    fn from(f: ReliabilityFormat) -> report::Format {
+        match f {
+            ReliabilityFormat::Table => report::Format::Table,
+            ReliabilityFormat::Json => report::Format::Json,
+            ReliabilityFormat::Csv => report::Format::Csv,
         }
-        ReliabilityFormat::Csv => to_csv(&study, &result)?,
-        ReliabilityFormat::Table => to_table(&loaded.machine, &study, &result),
-    };
-    write_stdout(&text)
+    }
 }
 
 fn study_cases(study: &Study) -> u64 {
@@ -181,21 +196,13 @@ fn study_cases(study: &Study) -> u64 {
 /// FORM is exact only for one-sided components in normal inputs; say so on
 /// stderr when it is not.
 pub(crate) fn note_form_limits(study: &Study) {
-    let spec = study.spec();
-    let non_normal = !study.inputs().is_affine();
-    let two = spec.sided == Sided::Two;
-    let system = spec.system.is_some();
-    if non_normal || two || system {
-        let why = [
-            (two, "two-sided tolerances (the far side is not counted)"),
-            (system, "a system limit state"),
-            (non_normal, "non-normal inputs"),
-        ]
-        .iter()
-        .filter(|(on, _)| *on)
-        .map(|(_, w)| *w)
-        .collect::<Vec<_>>()
-        .join(", ");
+    let limits = study.form_limits();
+    if !limits.is_empty() {
+        let why = limits
+            .iter()
+            .map(|l| l.reason())
+            .collect::<Vec<_>>()
+            .join(", ");
         eprintln!(
             "note: FORM is a first-order approximation here ({why}); `--method is` corrects it"
         );
@@ -274,10 +281,7 @@ impl Loaded {
         let m = &self.machine;
         let mut spec = machine::spec(m, system).map_err(|e| self.report(e))?;
         if let Some(s) = sided {
-            spec.sided = match s {
-                SidedArg::Upper => Sided::Upper,
-                SidedArg::Two => Sided::Two,
-            };
+            spec.sided = s.into();
         }
         for (name, values) in grid {
             if m.variable_index(name).is_none() {
@@ -304,7 +308,7 @@ impl Loaded {
     }
 
     /// A located, rendered diagnostic for a reliability error.
-    pub(crate) fn report(&self, err: ReliabilityError) -> Report {
+    pub(crate) fn report(&self, err: ReliabilityError) -> miette::Report {
         let file = &self.file;
         let (message, origin, label, help): (String, Option<&Origin>, &str, String) = match &err {
             ReliabilityError::MissingStatistic { name, origin } => (
@@ -342,19 +346,21 @@ impl Loaded {
             ),
             other => (format!("{file}: {other}"), None, "", String::new()),
         };
-        let mut diag =
-            MietteDiagnostic::new(message).with_code(format!("chain::reliability::{}", code(&err)));
+        let mut diag = MietteDiagnostic::new(message);
+        if let Some(code) = miette::Diagnostic::code(&err) {
+            diag = diag.with_code(code.to_string());
+        }
         if !help.is_empty() {
             diag = diag.with_help(help);
         }
         if let Some(o) = origin.filter(|o| o.line > 0 && o.offset <= self.source.len()) {
             let len = o.len.min(self.source.len() - o.offset);
             diag = diag.with_label(LabeledSpan::at(o.offset..o.offset + len, label));
-            return Report::new(diag).with_source_code(
+            return miette::Report::new(diag).with_source_code(
                 NamedSource::new(file.clone(), self.source.clone()).with_language("yaml"),
             );
         }
-        Report::new(diag)
+        miette::Report::new(diag)
     }
 }
 
@@ -363,22 +369,6 @@ fn at(origin: &Origin) -> String {
         format!(":{}:{}", origin.line, origin.column)
     } else {
         String::new()
-    }
-}
-
-fn code(err: &ReliabilityError) -> &'static str {
-    match err {
-        ReliabilityError::NoReliabilitySection => "no_reliability",
-        ReliabilityError::MissingStatistic { .. } => "missing_statistic",
-        ReliabilityError::SymbolicParameter { .. } => "symbolic_parameter",
-        ReliabilityError::InvalidDistribution(_) => "invalid_distribution",
-        ReliabilityError::InvalidTolerance { .. } => "invalid_tolerance",
-        ReliabilityError::UnknownName { .. } => "unknown_name",
-        ReliabilityError::EmptyGrid(_) => "empty_grid",
-        ReliabilityError::MissingCoordinate(_) => "missing_coordinate",
-        ReliabilityError::NonFinite(_) => "non_finite",
-        ReliabilityError::InvalidSamples { .. } => "invalid_samples",
-        _ => "error",
     }
 }
 
@@ -447,6 +437,22 @@ pub(crate) fn parse_axis(s: &str) -> Result<(String, Vec<f64>), String> {
 // ---------------------------------------------------------------------------
 // Output.
 
+/// Pairs serialised as a JSON object, in their order (point coordinates,
+/// per-target values).
+#[derive(Debug, Clone)]
+pub(crate) struct Pairs<K, V>(pub(crate) Vec<(K, V)>);
+
+impl<K: Serialize, V: Serialize> Serialize for Pairs<K, V> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(Some(self.0.len()))?;
+        for (k, v) in &self.0 {
+            map.serialize_entry(k, v)?;
+        }
+        map.end()
+    }
+}
+
 /// The grid axes in file order, as (name, index in the model's variables).
 pub(crate) fn axes(study: &Study) -> Vec<(String, usize)> {
     study
@@ -464,106 +470,198 @@ pub(crate) fn axes(study: &Study) -> Vec<(String, usize)> {
         .collect()
 }
 
-fn point_json(study: &Study, point: &[f64]) -> Value {
-    let mut m = Map::new();
-    for (name, i) in axes(study) {
-        m.insert(name, json!(point[i]));
-    }
-    Value::Object(m)
+/// The document of `chain reliability` (the spec's JSON; its table and CSV).
+#[derive(Serialize)]
+pub(crate) struct ReliabilityDoc<'a> {
+    machine: &'a str,
+    method: Method,
+    sided: Sided,
+    results: Vec<CaseDoc<'a>>,
+    summary: Pairs<Target, SummaryDoc>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    requirement: Option<RequirementDoc>,
+    #[serde(skip)]
+    study: &'a Study,
+    #[serde(skip)]
+    result: &'a StudyResult,
 }
 
-fn to_json(machine: &Machine, study: &Study, r: &StudyResult) -> Value {
-    let results: Vec<Value> = r
-        .cases
-        .iter()
-        .map(|c| {
-            let mut o = Map::new();
-            o.insert("component".into(), json!(c.target));
-            o.insert("point".into(), point_json(study, &c.point));
-            o.insert("reliability".into(), json!(c.reliability));
-            o.insert("pf".into(), json!(c.pf));
-            o.insert("beta".into(), finite(c.beta));
-            if let Some(se) = c.std_error {
-                o.insert("std_error".into(), json!(se));
-            }
-            if let Some(n) = c.samples {
-                o.insert("samples".into(), json!(n));
-            }
-            if let Some(cov) = c.cov {
-                o.insert("cov".into(), json!(cov));
-            }
-            Value::Object(o)
+/// One case of [`ReliabilityDoc`].
+#[derive(Serialize)]
+struct CaseDoc<'a> {
+    component: Target,
+    point: Pairs<&'a str, f64>,
+    reliability: f64,
+    pf: f64,
+    /// Infinite for a component the errors do not reach: JSON `null`.
+    beta: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    std_error: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    samples: Option<u64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cov: Option<f64>,
+    #[serde(flatten)]
+    form: Option<FormCase>,
+    calls: Calls,
+}
+
+/// One target's summary of [`ReliabilityDoc`].
+#[derive(Serialize)]
+struct SummaryDoc {
+    mean: f64,
+    min: f64,
+    max: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    met: Option<bool>,
+}
+
+/// The requirement and whether every target meets it.
+#[derive(Serialize)]
+pub(crate) struct RequirementDoc {
+    min: f64,
+    mean: f64,
+    met: bool,
+}
+
+impl RequirementDoc {
+    /// The requirement of a study result, if it has one.
+    pub(crate) fn of(r: &StudyResult) -> Option<RequirementDoc> {
+        r.requirement.map(|req| RequirementDoc {
+            min: req.min,
+            mean: req.mean,
+            met: r.requirement_met(),
         })
-        .collect();
-    let mut summary = Map::new();
-    for s in &r.summaries {
-        let mut o = Map::new();
-        o.insert("mean".into(), json!(s.mean));
-        o.insert("min".into(), json!(s.min));
-        o.insert("max".into(), json!(s.max));
-        if let Some(met) = s.met {
-            o.insert("met".into(), json!(met));
-        }
-        summary.insert(s.target.into(), Value::Object(o));
     }
-    let mut doc = Map::new();
-    doc.insert("machine".into(), json!(machine.name));
-    doc.insert("method".into(), json!(r.method));
-    doc.insert(
-        "sided".into(),
-        json!(match study.spec().sided {
-            Sided::Upper => "upper",
-            Sided::Two => "two",
-        }),
-    );
-    doc.insert("results".into(), Value::Array(results));
-    doc.insert("summary".into(), Value::Object(summary));
-    if let Some(req) = r.requirement {
-        doc.insert(
-            "requirement".into(),
-            json!({"min": req.min, "mean": req.mean, "met": r.summaries.iter().all(|s| s.met != Some(false))}),
+}
+
+impl<'a> ReliabilityDoc<'a> {
+    /// The document of a study's result.
+    pub(crate) fn new(machine: &'a str, study: &'a Study, r: &'a StudyResult) -> Self {
+        let ax: Vec<(&'a str, usize)> = study
+            .spec()
+            .grid
+            .axes
+            .iter()
+            .filter_map(|(n, _)| {
+                let i = study.variables().iter().position(|v| v == n)?;
+                Some((n.as_str(), i))
+            })
+            .collect();
+        let results = r
+            .cases
+            .iter()
+            .map(|c| CaseDoc {
+                component: c.target,
+                point: Pairs(ax.iter().map(|&(n, i)| (n, c.point[i])).collect()),
+                reliability: c.reliability,
+                pf: c.pf,
+                beta: c.beta,
+                std_error: c.std_error,
+                samples: c.samples,
+                cov: c.cov,
+                form: c.form,
+                calls: c.calls,
+            })
+            .collect();
+        let summary = Pairs(
+            r.summaries
+                .iter()
+                .map(|s| {
+                    let doc = SummaryDoc {
+                        mean: s.mean,
+                        min: s.min,
+                        max: s.max,
+                        met: s.met,
+                    };
+                    (s.target, doc)
+                })
+                .collect(),
+        );
+        ReliabilityDoc {
+            machine,
+            method: r.method,
+            sided: study.spec().sided,
+            results,
+            summary,
+            requirement: RequirementDoc::of(r),
+            study,
+            result: r,
+        }
+    }
+}
+
+impl Report for ReliabilityDoc<'_> {
+    fn table(&self) -> String {
+        to_table(self.machine, self.study, self.result)
+    }
+
+    fn csv(&self) -> Option<Csv> {
+        let (study, r) = (self.study, self.result);
+        let ax = axes(study);
+        let sampled = r.cases.first().is_some_and(|c| c.samples.is_some());
+        let mut header = vec!["component".to_string()];
+        header.extend(ax.iter().map(|(n, _)| n.clone()));
+        header.extend(["reliability", "pf", "beta"].map(String::from));
+        if sampled {
+            header.extend(["std_error", "cov", "samples"].map(String::from));
+        }
+        header.extend(
+            [
+                "termination",
+                "converged",
+                "iterations",
+                "exact",
+                "value_calls",
+                "gradient_calls",
+            ]
+            .map(String::from),
+        );
+        let mut csv = Csv::new(header);
+        for c in &r.cases {
+            let mut row = vec![c.target.to_string()];
+            row.extend(ax.iter().map(|(_, i)| fmt_num(c.point[*i])));
+            row.extend([c.reliability, c.pf, c.beta].map(|v| format!("{v:?}")));
+            if sampled {
+                row.push(format!("{:?}", c.std_error.unwrap_or(0.0)));
+                row.push(format!("{:?}", c.cov.unwrap_or(0.0)));
+                row.push(c.samples.unwrap_or(0).to_string());
+            }
+            match &c.form {
+                Some(f) => row.extend([
+                    f.termination.to_string(),
+                    f.converged.to_string(),
+                    f.iterations.to_string(),
+                    f.exact.to_string(),
+                ]),
+                None => row.extend((0..4).map(|_| String::new())),
+            }
+            row.push(c.calls.values.to_string());
+            row.push(c.calls.gradients.to_string());
+            csv.row(row);
+        }
+        Some(csv)
+    }
+}
+
+/// Warns on stderr about the cases on which FORM did not converge (their
+/// reliability is the last iterate's, not a FORM result).
+pub(crate) fn warn_unconverged(r: &StudyResult, variables: &[String]) {
+    let bad: Vec<&reliability::CaseResult> = r.unconverged().collect();
+    if let Some(first) = bad.first() {
+        let at = variables
+            .iter()
+            .zip(&first.point)
+            .map(|(v, x)| format!("{v} = {x}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        eprintln!(
+            "warning: FORM did not converge on {} of {} cases (first: {} at {at}); their reliabilities are the last iterates' (listed under the table, `converged: false` in JSON and CSV)",
+            bad.len(),
+            r.cases.len(),
+            first.target
         );
     }
-    Value::Object(doc)
-}
-
-/// JSON has no infinities: an infinite β (a component the errors do not
-/// reach) is written as null.
-fn finite(v: f64) -> Value {
-    if v.is_finite() {
-        json!(v)
-    } else {
-        Value::Null
-    }
-}
-
-fn to_csv(study: &Study, r: &StudyResult) -> miette::Result<String> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let ax = axes(study);
-    let sampled = r.cases.first().is_some_and(|c| c.samples.is_some());
-    let mut header = vec!["component".to_string()];
-    header.extend(ax.iter().map(|(n, _)| n.clone()));
-    header.extend(["reliability", "pf", "beta"].map(String::from));
-    if sampled {
-        header.extend(["std_error", "cov", "samples"].map(String::from));
-    }
-    let err = |e: csv::Error| miette::miette!("cannot write CSV: {e}");
-    w.write_record(&header).map_err(err)?;
-    for c in &r.cases {
-        let mut row = vec![c.target.to_string()];
-        row.extend(ax.iter().map(|(_, i)| fmt_num(c.point[*i])));
-        row.extend([c.reliability, c.pf, c.beta].map(|v| format!("{v:?}")));
-        if sampled {
-            row.push(format!("{:?}", c.std_error.unwrap_or(0.0)));
-            row.push(format!("{:?}", c.cov.unwrap_or(0.0)));
-            row.push(c.samples.unwrap_or(0).to_string());
-        }
-        w.write_record(&row).map_err(err)?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| miette::miette!("cannot write CSV: {e}"))?;
-    String::from_utf8(bytes).map_err(|e| miette::miette!("cannot write CSV: {e}"))
 }
 
 /// One target's reliabilities as maps over the two grid axes it varies along
@@ -574,16 +672,15 @@ pub(crate) struct TargetMap {
     pub(crate) cols: Option<(String, Vec<f64>)>,
     /// One map per combination of the other varying axes: (label, values[row][col]).
     pub(crate) maps: Vec<(String, Vec<Vec<f64>>)>,
+    /// Parallel to `maps`: true where FORM did not converge.
+    pub(crate) unconverged: Vec<Vec<Vec<bool>>>,
 }
 
 /// Builds the maps of target `t` from a study result.
 pub(crate) fn target_map(study: &Study, r: &StudyResult, t: usize) -> TargetMap {
     let grid = &study.spec().grid;
     let np = study.points().len();
-    let values: Vec<f64> = r.cases[t * np..(t + 1) * np]
-        .iter()
-        .map(|c| c.reliability)
-        .collect();
+    let cases = r.target_cases(t);
     let dims: Vec<usize> = grid.axes.iter().map(|(_, v)| v.len()).collect();
     // Axes along which the limit state changes (decided on the model, not on
     // sampled values, which are noisy).
@@ -610,6 +707,7 @@ pub(crate) fn target_map(study: &Study, r: &StudyResult, t: usize) -> TargetMap 
     let len = |a: Option<usize>| a.map_or(1, |a| dims[a]);
     let other_count: usize = others.iter().map(|&a| dims[a]).product();
     let mut maps = Vec::new();
+    let mut unconverged = Vec::new();
     for o in 0..other_count.max(1) {
         let mut idx = vec![0; dims.len()];
         let mut rest = o;
@@ -622,23 +720,28 @@ pub(crate) fn target_map(study: &Study, r: &StudyResult, t: usize) -> TargetMap 
             label.push(format!("{} = {}", grid.axes[a].0, grid.axes[a].1[idx[a]]));
         }
         let mut m = vec![vec![0.0; len(col_axis)]; len(row_axis)];
-        for (i, row) in m.iter_mut().enumerate() {
-            for (j, cell) in row.iter_mut().enumerate() {
+        let mut u = vec![vec![false; len(col_axis)]; len(row_axis)];
+        for (i, (row, urow)) in m.iter_mut().zip(&mut u).enumerate() {
+            for (j, (cell, ucell)) in row.iter_mut().zip(urow.iter_mut()).enumerate() {
                 if let Some(a) = row_axis {
                     idx[a] = i;
                 }
                 if let Some(a) = col_axis {
                     idx[a] = j;
                 }
-                *cell = values[flat(&idx, &dims)];
+                let case = &cases[flat(&idx, &dims)];
+                *cell = case.reliability;
+                *ucell = !case.converged();
             }
         }
         maps.push((label.join(", "), m));
+        unconverged.push(u);
     }
     TargetMap {
         rows: row_axis.map(|a| grid.axes[a].clone()),
         cols: col_axis.map(|a| grid.axes[a].clone()),
         maps,
+        unconverged,
     }
 }
 
@@ -646,23 +749,60 @@ fn flat(idx: &[usize], dims: &[usize]) -> usize {
     idx.iter().zip(dims).fold(0, |acc, (i, d)| acc * d + i)
 }
 
-fn to_table(machine: &Machine, study: &Study, r: &StudyResult) -> String {
+/// `closed form 45, converged 3` (the terminations that occur).
+pub(crate) fn terminations_text<'a>(forms: impl Iterator<Item = &'a FormCase>) -> String {
+    let mut counts = [0usize; Termination::ALL.len()];
+    for f in forms {
+        if let Some(k) = Termination::ALL.iter().position(|t| *t == f.termination) {
+            counts[k] += 1;
+        }
+    }
+    Termination::ALL
+        .iter()
+        .zip(counts)
+        .filter(|(_, n)| *n > 0)
+        .map(|(t, n)| format!("{} {n}", t.name().replace('_', " ")))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The table line on how FORM ended and what the cases cost: `FORM: 25 of
+/// 25 cases converged (closed form 25); limit-state calls: 0 values, 0
+/// gradients`.
+pub(crate) fn calls_text<'a>(
+    cases: impl Iterator<Item = &'a reliability::CaseResult> + Clone,
+    method: Method,
+) -> String {
+    let values: u64 = cases.clone().map(|c| c.calls.values).sum();
+    let gradients: u64 = cases.clone().map(|c| c.calls.gradients).sum();
+    let calls = format!("limit-state calls: {values} values, {gradients} gradients");
+    let forms: Vec<&FormCase> = cases.filter_map(|c| c.form.as_ref()).collect();
+    if forms.is_empty() {
+        return calls;
+    }
+    let converged = forms.iter().filter(|f| f.converged).count();
+    let what = if method == Method::Form {
+        "FORM"
+    } else {
+        "FORM (centring)"
+    };
+    format!(
+        "{what}: {converged} of {} cases converged ({}); {calls}",
+        forms.len(),
+        terminations_text(forms.iter().copied())
+    )
+}
+
+fn to_table(machine: &str, study: &Study, r: &StudyResult) -> String {
     use std::fmt::Write as _;
     let mut out = String::new();
-    let method = match r.method {
-        "form" => "FORM",
-        "is" => "importance sampling",
-        _ => "Monte Carlo",
-    };
-    let sided = match study.spec().sided {
-        Sided::Upper => "upper",
-        Sided::Two => "two-sided",
-    };
+    let sided = sided_title(study.spec().sided);
     let _ = writeln!(
         out,
-        "{}: machining-accuracy reliability ({method}, {sided})",
-        machine.name
+        "{machine}: machining-accuracy reliability ({}, {sided})",
+        r.method.title()
     );
+    let mut marked = false;
     for (t, target) in study.targets().iter().enumerate() {
         let map = target_map(study, r, t);
         let over = match (&map.rows, &map.cols) {
@@ -670,8 +810,8 @@ fn to_table(machine: &Machine, study: &Study, r: &StudyResult) -> String {
             (Some(a), None) => format!(" over {}", a.0),
             _ => String::new(),
         };
-        let _ = writeln!(out, "\n{}: reliability (%){over}", target.name());
-        for (label, m) in &map.maps {
+        let _ = writeln!(out, "\n{target}: reliability (%){over}");
+        for ((label, m), u) in map.maps.iter().zip(&map.unconverged) {
             if !label.is_empty() {
                 let _ = writeln!(out, "  at {label}");
             }
@@ -701,6 +841,31 @@ fn to_table(machine: &Machine, study: &Study, r: &StudyResult) -> String {
                 }
                 out.push('\n');
             }
+            // The cells FORM did not converge on, listed under the map (the
+            // map's own lines stay those of a converged study).
+            let mut bad = Vec::new();
+            for (i, urow) in u.iter().enumerate() {
+                for (j, unconverged) in urow.iter().enumerate() {
+                    if *unconverged {
+                        let coords: Vec<String> = [(&map.rows, i), (&map.cols, j)]
+                            .iter()
+                            .filter_map(|(axis, k)| {
+                                axis.as_ref()
+                                    .map(|(n, v)| format!("{n} = {}", fmt_num(v[*k])))
+                            })
+                            .collect();
+                        bad.push(if coords.is_empty() {
+                            "the point".to_string()
+                        } else {
+                            format!("({})", coords.join(", "))
+                        });
+                    }
+                }
+            }
+            if !bad.is_empty() {
+                marked = true;
+                let _ = writeln!(out, "  * not converged at {}", bad.join(", "));
+            }
         }
         if let Some(s) = r.summaries.get(t) {
             let _ = write!(
@@ -715,20 +880,36 @@ fn to_table(machine: &Machine, study: &Study, r: &StudyResult) -> String {
             }
             out.push('\n');
         }
-        let np = study.points().len();
-        let se = r.cases[t * np..(t + 1) * np]
+        let cases = r.target_cases(t);
+        let se = cases
             .iter()
             .filter_map(|c| c.std_error)
             .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))));
-        if let (Some(se), Some(n)) = (se, r.cases[t * np].samples) {
+        if let (Some(se), Some(n)) = (se, cases.first().and_then(|c| c.samples)) {
             let _ = writeln!(
                 out,
                 "  sampling: {n} samples per point, largest standard error {:.2e}",
                 se
             );
         }
+        let _ = writeln!(out, "  {}", calls_text(cases.iter(), r.method));
+    }
+    if marked {
+        let _ = writeln!(
+            out,
+            "\n* FORM stopped at the iteration limit there: the value shown is the last iterate's, not a converged reliability"
+        );
     }
     out
+}
+
+/// `upper` or `two-sided`: how the tables name [`Sided`] (the JSON has
+/// [`Sided::name`]).
+pub(crate) fn sided_title(s: Sided) -> &'static str {
+    match s {
+        Sided::Upper => "upper",
+        Sided::Two => "two-sided",
+    }
 }
 
 fn fmt_num(v: f64) -> String {

@@ -36,11 +36,7 @@ pub(super) fn write_all(
     std::fs::create_dir_all(dir)
         .map_err(|e| miette::miette!("{}: cannot create the plot directory: {e}", dir.display()))?;
     crate::cli::plot::ensure_fonts();
-    let method = match result.method {
-        "form" => "FORM",
-        "is" => "importance sampling",
-        _ => "Monte Carlo",
-    };
+    let method = result.method.title();
     let mut files = Vec::new();
     for (t, target) in study.targets().iter().enumerate() {
         let map = target_map(study, result, t);
@@ -74,9 +70,32 @@ pub(super) fn write_all(
             })?);
         }
     }
+    files.extend(write_sensitivity(
+        dir,
+        machine,
+        study.inputs().names(),
+        sens,
+        "grid mean",
+    )?);
+    Ok(files)
+}
+
+/// Writes one bar chart of `|∂R/∂σ|` per target (`sensitivity_<target>`,
+/// PNG and SVG, like Figures 6-8) into `dir`, the errors in `order` (the
+/// model's error order, as in Table 1); `where_` says where the values hold
+/// (`grid mean`, `at x = 0, …`). Returns the files written.
+pub(crate) fn write_sensitivity(
+    dir: &Path,
+    machine: &str,
+    order: &[String],
+    sens: &[TargetSensitivity],
+    where_: &str,
+) -> miette::Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| miette::miette!("{}: cannot create the plot directory: {e}", dir.display()))?;
+    crate::cli::plot::ensure_fonts();
+    let mut files = Vec::new();
     for s in sens {
-        // The model's error order (errors 1..N as in Table 1), like Figures 6-8.
-        let order = study.inputs().names();
         let values: Vec<f64> = order
             .iter()
             .map(|n| {
@@ -90,7 +109,7 @@ pub(super) fn write_all(
             size: BAR_SIZE,
             ..crate::cli::plot::BarChart::new(
                 format!(
-                    "{machine}: {} reliability sensitivity |∂R/∂σ| (grid mean)",
+                    "{machine}: {} reliability sensitivity |∂R/∂σ| ({where_})",
                     s.target
                 ),
                 "|∂R/∂σ| (per unit of the error)",

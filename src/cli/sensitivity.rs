@@ -1,11 +1,12 @@
 //! `chain sensitivity FILE [--kind reliability|geometric] [--at x=..,y=..,z=..]
-//! [--format table|json]`.
+//! [--format table|json] [--plot DIR]`.
 //!
 //! `--kind reliability` (the default): the reliability sensitivity of each component to the mean and standard
 //! deviation of every error parameter (seed 000, Eq. 32-33) and its FORM
 //! importance factor: at one point with `--at`, otherwise the mean over the
 //! file's reliability grid (the paper's Figures 6-8). Lists are sorted by
-//! `|∂R/∂σ|`, largest first.
+//! `|∂R/∂σ|`, largest first; `--plot DIR` draws them as bar charts (the
+//! charts of `chain reliability --plot`).
 //!
 //! `--kind geometric`: the geometric error sensitivity coefficients of seed
 //! 004 (Eq. 4-6), `S = |∂E_u/∂e_v|` and `C = S·e / Σ S·e` per direction,
@@ -18,12 +19,14 @@ mod geometric_plot;
 
 use std::path::PathBuf;
 
-use chain_core::geometric::{self, GeometricSensitivity, NominalSizes};
-use reliability::{machine, Form, ReliabilityError, SensitivityMethod, TargetSensitivity};
-use serde_json::{json, Map, Value};
+use chain_core::geometric::{self, Coefficient, GeometricSensitivity, NominalSizes};
+use chain_core::model::Component;
+use reliability::{machine, Form, ReliabilityError, SensitivityMethod, Target, TargetSensitivity};
+use serde::Serialize;
 
-use super::reliability::{parse_assignment, parse_axis, Loaded, SidedArg};
-use super::report::write_stdout;
+use super::reliability::reliability_plot;
+use super::reliability::{parse_assignment, parse_axis, Loaded, Pairs, SidedArg};
+use super::report::{self, Report};
 
 /// What `chain sensitivity` computes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -72,7 +75,9 @@ pub struct SensitivityArgs {
     /// Replace the grid values of one axis for the grid mean, `VAR=v1,v2,...` (repeatable).
     #[arg(long = "grid", value_name = "VAR=V1,V2,...", value_parser = parse_axis)]
     pub grid: Vec<(String, Vec<f64>)>,
-    /// Write bar charts of the coefficients (PNG and SVG) into DIR (`--kind geometric`).
+    /// Write bar charts (PNG and SVG) into DIR: `|∂R/∂σ|` per component
+    /// (`--kind reliability`, like Figures 6-8 of Wang & Yuan 2021) or the
+    /// geometric coefficients (`--kind geometric`).
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
 }
@@ -106,12 +111,6 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
             "--values applies only to --kind geometric"
         ));
     }
-    if args.plot.is_some() {
-        return Err(miette::miette!(
-            help = "`chain reliability --plot DIR` draws the reliability sensitivities; or add --kind geometric",
-            "--plot applies only to --kind geometric"
-        ));
-    }
     let loaded = Loaded::new(&args.file)?;
     let (study, model) = loaded.study(&args.params, &args.grid, args.sided, None)?;
     let form = Form::default();
@@ -142,20 +141,33 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
             (Some(at), r)
         }
     };
-    let text = match args.format {
-        SensitivityFormat::Json => {
-            let mut s = serde_json::to_string_pretty(&to_json(
-                &loaded.machine.name,
-                at.as_deref(),
-                &result,
-            ))
-            .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
-            s.push('\n');
-            s
+    if let Some(dir) = &args.plot {
+        let where_ = match &at {
+            Some(a) => at_text(a),
+            None => "grid mean".to_string(),
+        };
+        let files = reliability_plot::write_sensitivity(
+            dir,
+            &loaded.machine.name,
+            study.inputs().names(),
+            &result,
+            &where_,
+        )?;
+        for f in files {
+            eprintln!("wrote {}", f.display());
         }
-        SensitivityFormat::Table => to_table(&loaded.machine.name, at.as_deref(), &result),
-    };
-    write_stdout(&text)
+    }
+    let doc = SensitivityDoc::new(&loaded.machine.name, at, &result);
+    report::emit(&doc, args.format.into())
+}
+
+impl From<SensitivityFormat> for report::Format {
+    fn from(f: SensitivityFormat) -> report::Format {
+        match f {
+            SensitivityFormat::Table => report::Format::Table,
+            SensitivityFormat::Json => report::Format::Json,
+        }
+    }
 }
 
 fn method_name(m: SensitivityMethod) -> &'static str {
@@ -165,73 +177,110 @@ fn method_name(m: SensitivityMethod) -> &'static str {
     }
 }
 
-fn to_json(machine: &str, at: Option<&[(String, f64)]>, result: &[TargetSensitivity]) -> Value {
-    let mut components = Map::new();
-    let mut methods = Map::new();
-    for t in result {
-        let list: Vec<Value> = t
-            .errors
-            .iter()
-            .map(|e| {
-                let mut o = Map::new();
-                o.insert("error".into(), json!(e.error));
-                o.insert("dr_dstd".into(), json!(e.dr_dstd));
-                o.insert("dr_dmean".into(), json!(e.dr_dmean));
-                o.insert("importance".into(), json!(e.importance));
-                if at.is_none() {
-                    o.insert("mean_abs_dr_dstd".into(), json!(e.mean_abs_dr_dstd));
-                    o.insert("mean_abs_dr_dmean".into(), json!(e.mean_abs_dr_dmean));
-                }
-                Value::Object(o)
-            })
-            .collect();
-        components.insert(t.target.into(), Value::Array(list));
-        methods.insert(t.target.into(), json!(method_name(t.method)));
-    }
-    let at = at.map_or(Value::Null, |a| {
-        Value::Object(a.iter().map(|(n, v)| (n.clone(), json!(v))).collect())
-    });
-    json!({"machine": machine, "at": at, "methods": methods, "components": components})
+/// `at x = 0, y = 1500, z = 600`.
+fn at_text(a: &[(String, f64)]) -> String {
+    format!(
+        "at {}",
+        a.iter()
+            .map(|(n, v)| format!("{n} = {v}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
 }
 
-fn to_table(machine: &str, at: Option<&[(String, f64)]>, result: &[TargetSensitivity]) -> String {
-    use std::fmt::Write as _;
-    let mut out = String::new();
-    let where_ = match at {
-        Some(a) => format!(
-            "at {}",
-            a.iter()
-                .map(|(n, v)| format!("{n} = {v}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-        None => "mean over the reliability grid".to_string(),
-    };
-    let _ = writeln!(
-        out,
-        "{machine}: reliability sensitivity (Eq. 32-33), {where_}"
-    );
-    for t in result {
-        let _ = writeln!(
-            out,
-            "\n{} ({}), sorted by |dR/dstd|:",
-            t.target,
-            method_name(t.method)
-        );
-        let _ = writeln!(
-            out,
-            "  {:<8} {:>14} {:>14} {:>11}",
-            "error", "dR/dstd", "dR/dmean", "importance"
-        );
-        for e in &t.errors {
-            let _ = writeln!(
-                out,
-                "  {:<8} {:>14.6e} {:>14.6e} {:>11.6}",
-                e.error, e.dr_dstd, e.dr_dmean, e.importance
-            );
+/// The document of `chain sensitivity --kind reliability`.
+#[derive(Serialize)]
+struct SensitivityDoc<'a> {
+    machine: &'a str,
+    /// The point, or `null` for the grid mean.
+    at: Option<Pairs<String, f64>>,
+    methods: Pairs<Target, SensitivityMethod>,
+    components: Pairs<Target, Vec<ErrorDoc<'a>>>,
+    #[serde(skip)]
+    result: &'a [TargetSensitivity],
+}
+
+/// One error of [`SensitivityDoc`]; the grid mean also has the mean
+/// absolute values.
+#[derive(Serialize)]
+struct ErrorDoc<'a> {
+    error: &'a str,
+    dr_dstd: f64,
+    dr_dmean: f64,
+    importance: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mean_abs_dr_dstd: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mean_abs_dr_dmean: Option<f64>,
+}
+
+impl<'a> SensitivityDoc<'a> {
+    /// The document of the sensitivities `result`, at the point `at` (or the
+    /// grid mean, which adds the mean absolute values).
+    fn new(
+        machine: &'a str,
+        at: Option<Vec<(String, f64)>>,
+        result: &'a [TargetSensitivity],
+    ) -> SensitivityDoc<'a> {
+        let mean = at.is_none();
+        let errors = |t: &'a TargetSensitivity| -> Vec<ErrorDoc<'a>> {
+            t.errors
+                .iter()
+                .map(|e| ErrorDoc {
+                    error: &e.error,
+                    dr_dstd: e.dr_dstd,
+                    dr_dmean: e.dr_dmean,
+                    importance: e.importance,
+                    mean_abs_dr_dstd: mean.then_some(e.mean_abs_dr_dstd),
+                    mean_abs_dr_dmean: mean.then_some(e.mean_abs_dr_dmean),
+                })
+                .collect()
+        };
+        SensitivityDoc {
+            machine,
+            at: at.map(Pairs),
+            methods: Pairs(result.iter().map(|t| (t.target, t.method)).collect()),
+            components: Pairs(result.iter().map(|t| (t.target, errors(t))).collect()),
+            result,
         }
     }
-    out
+}
+
+impl Report for SensitivityDoc<'_> {
+    fn table(&self) -> String {
+        use std::fmt::Write as _;
+        let mut out = String::new();
+        let where_ = match &self.at {
+            Some(a) => at_text(&a.0),
+            None => "mean over the reliability grid".to_string(),
+        };
+        let _ = writeln!(
+            out,
+            "{}: reliability sensitivity (Eq. 32-33), {where_}",
+            self.machine
+        );
+        for t in self.result {
+            let _ = writeln!(
+                out,
+                "\n{} ({}), sorted by |dR/dstd|:",
+                t.target,
+                method_name(t.method)
+            );
+            let _ = writeln!(
+                out,
+                "  {:<8} {:>14} {:>14} {:>11}",
+                "error", "dR/dstd", "dR/dmean", "importance"
+            );
+            for e in &t.errors {
+                let _ = writeln!(
+                    out,
+                    "  {:<8} {:>14.6e} {:>14.6e} {:>11.6}",
+                    e.error, e.dr_dstd, e.dr_dmean, e.importance
+                );
+            }
+        }
+        out
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -360,17 +409,8 @@ fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {
             eprintln!("wrote {}", f.display());
         }
     }
-    let text = match args.format {
-        SensitivityFormat::Json => {
-            let mut s =
-                serde_json::to_string_pretty(&geometric_json(&m.name, &where_, &nominal, &result))
-                    .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
-            s.push('\n');
-            s
-        }
-        SensitivityFormat::Table => geometric_table(&m.name, &where_, &nominal, &result),
-    };
-    write_stdout(&text)
+    let doc = GeometricDoc::new(&m.name, &where_, &nominal, &result);
+    report::emit(&doc, args.format.into())
 }
 
 fn where_text(w: &Where) -> String {
@@ -389,60 +429,94 @@ fn where_text(w: &Where) -> String {
     }
 }
 
-fn geometric_json(
-    machine: &str,
-    where_: &Where,
-    nominal: &NominalSizes,
-    r: &GeometricSensitivity,
-) -> Value {
-    let mut components = Map::new();
-    let mut totals = Map::new();
-    for c in &r.components {
-        let list: Vec<Value> = c
-            .ranked
-            .iter()
-            .map(|e| {
-                let mut o = Map::new();
-                o.insert("error".into(), json!(e.error));
-                o.insert("s".into(), json!(e.s));
-                o.insert("c".into(), json!(e.c));
-                o.insert("e".into(), json!(e.e));
-                if let Where::Grid(_) = where_ {
-                    o.insert("c_min".into(), json!(e.c_min));
-                    o.insert("c_max".into(), json!(e.c_max));
-                }
-                Value::Object(o)
-            })
-            .collect();
-        components.insert(c.component.name().into(), Value::Array(list));
-        totals.insert(c.component.name().into(), json!(c.total));
+/// The document of `chain sensitivity --kind geometric`.
+#[derive(Serialize)]
+struct GeometricDoc<'a> {
+    machine: &'a str,
+    kind: &'static str,
+    /// The point, or `null` for the grid mean.
+    at: Option<Pairs<&'a str, f64>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    grid: Option<Pairs<&'a str, &'a [f64]>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    points: Option<usize>,
+    normalisation: &'static str,
+    values: &'a NominalSizes,
+    totals: Pairs<Component, f64>,
+    components: Pairs<Component, Vec<CoefficientDoc<'a>>>,
+    #[serde(skip)]
+    where_: &'a Where,
+    #[serde(skip)]
+    result: &'a GeometricSensitivity,
+}
+
+/// One coefficient of [`GeometricDoc`]; the grid mean also has the range.
+#[derive(Serialize)]
+struct CoefficientDoc<'a> {
+    error: &'a str,
+    s: f64,
+    c: f64,
+    e: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    c_min: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    c_max: Option<f64>,
+}
+
+impl<'a> GeometricDoc<'a> {
+    fn new(
+        machine: &'a str,
+        where_: &'a Where,
+        nominal: &'a NominalSizes,
+        r: &'a GeometricSensitivity,
+    ) -> GeometricDoc<'a> {
+        let grid = matches!(where_, Where::Grid(_));
+        let coefficient = |e: &'a Coefficient| CoefficientDoc {
+            error: &e.error,
+            s: e.s,
+            c: e.c,
+            e: e.e,
+            c_min: grid.then_some(e.c_min),
+            c_max: grid.then_some(e.c_max),
+        };
+        GeometricDoc {
+            machine,
+            kind: "geometric",
+            at: match where_ {
+                Where::At(a) => Some(Pairs(a.iter().map(|(n, v)| (n.as_str(), *v)).collect())),
+                Where::Grid(_) => None,
+            },
+            grid: match where_ {
+                Where::Grid(g) => Some(Pairs(
+                    g.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect(),
+                )),
+                Where::At(_) => None,
+            },
+            points: grid.then_some(r.points),
+            normalisation: "c = s*e / sum(s*e)",
+            values: nominal,
+            totals: Pairs(
+                r.components
+                    .iter()
+                    .map(|c| (c.component, c.total))
+                    .collect(),
+            ),
+            components: Pairs(
+                r.components
+                    .iter()
+                    .map(|c| (c.component, c.ranked.iter().map(coefficient).collect()))
+                    .collect(),
+            ),
+            where_,
+            result: r,
+        }
     }
-    let (at, grid) = match where_ {
-        Where::At(a) => (
-            Value::Object(a.iter().map(|(n, v)| (n.clone(), json!(v))).collect()),
-            Value::Null,
-        ),
-        Where::Grid(g) => (
-            Value::Null,
-            Value::Object(g.iter().map(|(n, v)| (n.clone(), json!(v))).collect()),
-        ),
-    };
-    let mut doc = Map::new();
-    doc.insert("machine".into(), json!(machine));
-    doc.insert("kind".into(), json!("geometric"));
-    doc.insert("at".into(), at);
-    if !grid.is_null() {
-        doc.insert("grid".into(), grid);
-        doc.insert("points".into(), json!(r.points));
+}
+
+impl Report for GeometricDoc<'_> {
+    fn table(&self) -> String {
+        geometric_table(self.machine, self.where_, self.values, self.result)
     }
-    doc.insert("normalisation".into(), json!("c = s*e / sum(s*e)"));
-    doc.insert(
-        "values".into(),
-        json!({"linear": nominal.linear, "angular": nominal.angular, "squareness": nominal.squareness}),
-    );
-    doc.insert("totals".into(), Value::Object(totals));
-    doc.insert("components".into(), Value::Object(components));
-    Value::Object(doc)
 }
 
 fn geometric_table(

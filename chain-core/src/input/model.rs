@@ -420,6 +420,16 @@ pub enum Sided {
     Two,
 }
 
+impl Sided {
+    /// `upper` or `two` (the machine file's spelling).
+    pub fn name(self) -> &'static str {
+        match self {
+            Sided::Upper => "upper",
+            Sided::Two => "two",
+        }
+    }
+}
+
 /// The `reliability` section of a machine file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ReliabilitySpec {

@@ -289,7 +289,7 @@ pub fn evaluate<M: ErrorModel + ?Sized>(
 pub(crate) fn component_summaries(r: &StudyResult) -> Vec<Summary> {
     r.summaries
         .iter()
-        .filter(|s| !matches!(s.target, "series" | "volumetric"))
+        .filter(|s| matches!(s.target, crate::Target::Component(_)))
         .cloned()
         .collect()
 }

@@ -36,7 +36,7 @@ pub fn paper<M: ErrorModel + ?Sized>(
     while !all_met(&summaries) && round < options.max_rounds {
         round += 1;
         let sens = current.sensitivity_mean(&form)?;
-        let unmet: Vec<&str> = summaries
+        let unmet: Vec<crate::Target> = summaries
             .iter()
             .filter(|s| s.met == Some(false))
             .map(|s| s.target)
@@ -55,7 +55,7 @@ pub fn paper<M: ErrorModel + ?Sized>(
                 match groups.first_mut() {
                     Some((name, g)) => {
                         name.push('+');
-                        name.push_str(t.target);
+                        name.push_str(t.target.name());
                         for (a, b) in g.iter_mut().zip(&score) {
                             *a += b;
                         }
