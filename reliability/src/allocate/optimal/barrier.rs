@@ -2,6 +2,8 @@
 //! towards the bounds, then damped Newton on
 //! `f(t) − μ Σ ln gₖ(t) − μ Σ ln tᵢ − μ Σ ln(tmaxᵢ − tᵢ)` for decreasing `μ`.
 
+use nalgebra::{DMatrix, DVector};
+
 use super::problem::Problem;
 use crate::allocate::AllocateError;
 
@@ -100,60 +102,21 @@ pub(super) fn central_path(
     Ok((t, mu, iterations))
 }
 
-/// Cholesky solve of a symmetric positive definite system; `None` when not
-/// positive definite.
-///
-/// Kept hand-written (issue 11 asked for nalgebra): nalgebra's `Cholesky`
-/// accumulates `aᵢⱼ − Σ lᵢₖlⱼₖ` term by term (axpy) where this sums first,
-/// which moves the recorded optimal allocation by round-off (`dxx`
-/// 0.00677424086163459 → 0.006774240861634587, cost 3.5671584000649315 →
-/// 3.5671584000649363), and the allocation outputs are held to the last
-/// digit (`tests/golden_outputs.rs`). See `docs/performance.md`.
-fn cholesky_solve(a: &[f64], b: &[f64]) -> Option<Vec<f64>> {
-    let n = b.len();
-    let mut l = vec![0.0; n * n];
-    for i in 0..n {
-        for j in 0..=i {
-            let s: f64 = (0..j).map(|k| l[i * n + k] * l[j * n + k]).sum();
-            if i == j {
-                let d = a[i * n + i] - s;
-                if d <= 0.0 || !d.is_finite() {
-                    return None;
-                }
-                l[i * n + i] = d.sqrt();
-            } else {
-                l[i * n + j] = (a[i * n + j] - s) / l[j * n + j];
-            }
-        }
-    }
-    let mut y = vec![0.0; n];
-    for i in 0..n {
-        let s: f64 = (0..i).map(|k| l[i * n + k] * y[k]).sum();
-        y[i] = (b[i] - s) / l[i * n + i];
-    }
-    let mut x = vec![0.0; n];
-    for i in (0..n).rev() {
-        let s: f64 = (i + 1..n).map(|k| l[k * n + i] * x[k]).sum();
-        x[i] = (y[i] - s) / l[i * n + i];
-    }
-    Some(x)
-}
-
-/// `H d = −g` with `H` made positive definite by a growing multiple of `I`.
+/// `H d = −g` with `H` made positive definite by a growing multiple of `I`:
+/// the first shift `δ ∈ {0, 10⁻¹⁰·max|Hᵢᵢ|, 10× …}` for which nalgebra's
+/// Cholesky factorisation of `H + δI` exists and gives a finite direction.
 fn newton_direction(h: &[f64], g: &[f64]) -> Vec<f64> {
     let n = g.len();
-    let rhs: Vec<f64> = g.iter().map(|x| -x).collect();
-    let diag = (0..n)
-        .fold(0.0f64, |m, i| m.max(h[i * n + i].abs()))
-        .max(1e-12);
+    let h = DMatrix::from_row_slice(n, n, h);
+    let rhs = -DVector::from_column_slice(g);
+    let diag = h.diagonal().amax().max(1e-12);
     let mut delta = 0.0;
     loop {
-        let mut a = h.to_vec();
-        for i in 0..n {
-            a[i * n + i] += delta;
-        }
-        if let Some(d) = cholesky_solve(&a, &rhs) {
-            return d;
+        let shifted = &h + DMatrix::from_diagonal_element(n, n, delta);
+        if let Some(d) = shifted.cholesky().map(|c| c.solve(&rhs)) {
+            if d.iter().all(|x| x.is_finite()) {
+                return d.as_slice().to_vec();
+            }
         }
         delta = if delta == 0.0 {
             1e-10 * diag

@@ -1,50 +1,25 @@
 //! The active-set Newton polish of the barrier solution and the KKT check
 //! of the result.
 
+use nalgebra::{DMatrix, DVector};
+
 use super::problem::{CaseEval, Problem};
 use crate::allocate::Kkt;
 use crate::study::Study;
 
-/// Solves `A x = b` (dense, row-major `n × n`) by Gaussian elimination with
-/// partial pivoting; `None` when singular.
-///
-/// Kept hand-written (issue 11 asked for nalgebra): nalgebra's `LU` pivots
-/// the same way but scales by the reciprocal pivot and back-substitutes by
-/// columns, which moves the recorded optimal allocation by round-off
-/// (`eyx` 5.120825632501355e-6 → 5.1208256325013545e-6, KKT stationarity
-/// 8.88e-16 → 9.99e-16), and the allocation outputs are held to the last
-/// digit (`tests/golden_outputs.rs`). See `docs/performance.md`.
-fn solve(mut a: Vec<f64>, mut b: Vec<f64>) -> Option<Vec<f64>> {
+/// Solves `A x = b` (dense, row-major `n × n`) by nalgebra's LU
+/// factorisation with partial pivoting; `None` when singular: a pivot (a
+/// diagonal entry of `U`) at most `10⁻¹⁴` of the largest entry of `A`.
+fn solve(a: Vec<f64>, b: Vec<f64>) -> Option<Vec<f64>> {
     let n = b.len();
-    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
-    for col in 0..n {
-        let piv =
-            (col..n).max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))?;
-        if a[piv * n + col].abs() <= 1e-14 * scale {
-            return None;
-        }
-        if piv != col {
-            for k in 0..n {
-                a.swap(col * n + k, piv * n + k);
-            }
-            b.swap(col, piv);
-        }
-        for i in col + 1..n {
-            let f = a[i * n + col] / a[col * n + col];
-            if f != 0.0 {
-                for k in col..n {
-                    a[i * n + k] -= f * a[col * n + k];
-                }
-                b[i] -= f * b[col];
-            }
-        }
+    let a = DMatrix::from_row_slice(n, n, &a);
+    let scale = a.amax().max(1e-300);
+    let lu = a.lu();
+    if lu.u().diagonal().iter().any(|d| d.abs() <= 1e-14 * scale) {
+        return None;
     }
-    let mut x = vec![0.0; n];
-    for i in (0..n).rev() {
-        let s: f64 = (i + 1..n).map(|k| a[i * n + k] * x[k]).sum();
-        x[i] = (b[i] - s) / a[i * n + i];
-    }
-    Some(x)
+    lu.solve(&DVector::from_vec(b))
+        .map(|x| x.as_slice().to_vec())
 }
 
 /// Newton on the KKT system of the active set identified by the barrier
