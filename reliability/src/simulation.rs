@@ -33,6 +33,7 @@ use crate::limit_state::{Criterion, Event, LimitState};
 use crate::normal;
 use crate::par::prelude::*;
 use crate::rng::CaseRng;
+use crate::study::Method;
 use crate::util::dot;
 use chain_core::model::Sided;
 
@@ -61,8 +62,8 @@ impl<F: Fn(u64) + Sync> Progress for F {
 /// The result of a simulation.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SimulationResult {
-    /// `importance_sampling` or `monte_carlo`.
-    pub method: &'static str,
+    /// [`Method::ImportanceSampling`] or [`Method::MonteCarlo`].
+    pub method: Method,
     /// The failure-probability estimate.
     pub pf: f64,
     /// `1 − p_f`.
@@ -184,7 +185,7 @@ impl MonteCarlo {
                     0.0
                 };
                 finish(
-                    "monte_carlo",
+                    Method::MonteCarlo,
                     pf,
                     (var / n).sqrt(),
                     self.samples,
@@ -264,7 +265,7 @@ impl ImportanceSampling {
                     0.0
                 };
                 finish(
-                    "importance_sampling",
+                    Method::ImportanceSampling,
                     pf.clamp(0.0, 1.0),
                     (var / n).sqrt(),
                     self.samples,
@@ -277,7 +278,7 @@ impl ImportanceSampling {
 }
 
 fn finish(
-    method: &'static str,
+    method: Method,
     pf: f64,
     std_error: f64,
     samples: u64,

@@ -8,8 +8,6 @@
 
 use std::path::PathBuf;
 
-use std::fmt;
-
 use chain_core::model::Requirement;
 use chain_core::named::NameMap;
 use miette::MietteDiagnostic;
@@ -233,54 +231,15 @@ fn plot(
 /// An allocation that failed, rendered as the library's error with the
 /// machine's name, a stable code and, where one helps, a hint.
 ///
-/// [`AllocateError`] is reliability's plain `thiserror` error; this gives it
-/// its [`miette::Diagnostic`] face without flattening it to a string (the
-/// [`AllocateError::Reliability`] case goes through the located renderer of
-/// every reliability error instead, [`Loaded::report`]).
-#[derive(Debug)]
+/// The code and help are [`AllocateError`]'s own (its `miette::Diagnostic`
+/// derive, forwarded); the [`AllocateError::Reliability`] case goes through
+/// the located renderer of every reliability error instead, [`Loaded::report`].
+#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+#[error("{machine}: {error}")]
+#[diagnostic(forward(error))]
 struct AllocateFailure {
     machine: String,
     error: AllocateError,
-}
-
-impl fmt::Display for AllocateFailure {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.machine, self.error)
-    }
-}
-
-impl std::error::Error for AllocateFailure {}
-
-impl miette::Diagnostic for AllocateFailure {
-    fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        let code = match &self.error {
-            AllocateError::Reliability(_) => "chain::allocate::reliability",
-            AllocateError::NoRequirement => "chain::allocate::no_requirement",
-            AllocateError::Unsupported(_) => "chain::allocate::unsupported",
-            AllocateError::Infeasible { .. } => "chain::allocate::infeasible",
-            AllocateError::Stalled { .. } => "chain::allocate::stalled",
-            AllocateError::NotConverged(_) => "chain::allocate::not_converged",
-        };
-        Some(Box::new(code))
-    }
-
-    fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        let help = match &self.error {
-            AllocateError::Infeasible { .. } => {
-                "lower the requirement, or lower (remove) `min_std` of the binding errors"
-            }
-            AllocateError::NoRequirement => {
-                "add, e.g., `requirement: {min: 0.95, mean: 0.97}` to the reliability section"
-            }
-            AllocateError::Stalled { .. } => {
-                "lower (remove) `min_std` of its errors, or use `--strategy optimal`"
-            }
-            AllocateError::Reliability(_)
-            | AllocateError::Unsupported(_)
-            | AllocateError::NotConverged(_) => return None,
-        };
-        Some(Box::new(help))
-    }
 }
 
 /// The one rendering of an [`AllocateError`]: reliability errors located in

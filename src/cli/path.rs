@@ -279,8 +279,11 @@ fn pose_instants(
     fixed: &[(usize, f64)],
 ) -> miette::Result<(bool, Vec<PathInstant>)> {
     let (has_t, rows) = read_poses(path)?;
-    let solver = Inverse::for_machine(m, params, fixed)
-        .map_err(|e| miette::miette!("machine `{}`: {e}", m.name))?;
+    let solver =
+        Inverse::for_machine(m, params, fixed).map_err(|error| super::inverse::OnMachine {
+            machine: m.name.clone(),
+            error,
+        })?;
     let instants = solve_rows(&solver, &rows, m.variables.len(), fixed)
         .into_iter()
         .zip(&rows)

@@ -209,15 +209,25 @@ pub struct Allocation {
 
 /// Why an allocation failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
 pub enum AllocateError {
     /// From the reliability engine.
     #[error(transparent)]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::allocate::reliability)))]
     Reliability(#[from] ReliabilityError),
     /// The machine has no `requirement`.
     #[error("the reliability section has no `requirement` (min and mean) to allocate for")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(
+            code(chain::allocate::no_requirement),
+            help("add, e.g., `requirement: {{min: 0.95, mean: 0.97}}` to the reliability section")
+        )
+    )]
     NoRequirement,
     /// A setting the strategy does not handle.
     #[error("{0}")]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::allocate::unsupported)))]
     Unsupported(String),
     /// The requirement cannot be met within the bounds.
     #[error(
@@ -226,6 +236,13 @@ pub enum AllocateError {
         best * 100.0,
         required * 100.0,
         binding.join(", ")
+    )]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(
+            code(chain::allocate::infeasible),
+            help("lower the requirement, or lower (remove) `min_std` of the binding errors")
+        )
     )]
     Infeasible {
         /// The component.
@@ -244,6 +261,13 @@ pub enum AllocateError {
     },
     /// The paper's procedure can tighten nothing more.
     #[error("the paper's procedure stops after round {round}: {component} misses the requirement and none of its errors can be tightened further ({errors} at min_std or zero)")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(
+            code(chain::allocate::stalled),
+            help("lower (remove) `min_std` of its errors, or use `--strategy optimal`")
+        )
+    )]
     Stalled {
         /// The last round.
         round: usize,
@@ -254,6 +278,7 @@ pub enum AllocateError {
     },
     /// The optimiser did not converge.
     #[error("the optimiser did not converge: {0}")]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::allocate::not_converged)))]
     NotConverged(String),
 }
 
