@@ -231,6 +231,22 @@ fn infeasible_requirement_names_component_and_errors() {
     }
 }
 
+/// Asserts that `err` contains every one of `needles`.
+#[track_caller]
+fn mentions(err: &str, needles: &[&str]) {
+    for n in needles {
+        assert!(err.contains(n), "{n:?} is missing from:\n{err}");
+    }
+}
+
+/// `chain allocate` on the machine file `text` (written as `NAME.yaml`) must
+/// fail; its stderr.
+fn allocate_fails_on(name: &str, text: &str) -> String {
+    let file = scratch(name).join(format!("{name}.yaml"));
+    std::fs::write(&file, text).unwrap();
+    fails(&["allocate", file.to_str().unwrap()])
+}
+
 #[test]
 fn cli_infeasible_exits_non_zero_naming_component_and_errors() {
     // The gantry with every σ bounded at 90 % of Table 1 and min ≥ 99.99 %.
@@ -247,17 +263,17 @@ fn cli_infeasible_exits_non_zero_naming_component_and_errors() {
         }
         out.push('\n');
     }
-    let dir = scratch("infeasible");
-    let file = dir.join("gantry_tight.yaml");
-    std::fs::write(&file, out).unwrap();
-    let err = fails(&["allocate", file.to_str().unwrap()]);
-    assert!(err.contains("infeasible"), "{err}");
-    assert!(err.contains("px"), "{err}");
-    assert!(err.contains("eyx") && err.contains("min_std"), "{err}");
-    assert!(err.contains("chain::allocate::infeasible"), "{err}");
-    assert!(
-        err.contains("gantry_grinder: the requirement is infeasible"),
-        "{err}"
+    let err = allocate_fails_on("gantry_tight", &out);
+    mentions(
+        &err,
+        &[
+            "infeasible",
+            "px",
+            "eyx",
+            "min_std",
+            "chain::allocate::infeasible",
+            "gantry_grinder: the requirement is infeasible",
+        ],
     );
 }
 
@@ -270,14 +286,13 @@ fn cli_allocation_errors_have_their_own_codes() {
         .filter(|l| !l.trim_start().starts_with("requirement:"))
         .map(|l| format!("{l}\n"))
         .collect();
-    let dir = scratch("no_requirement");
-    let file = dir.join("gantry_no_requirement.yaml");
-    std::fs::write(&file, out).unwrap();
-    let err = fails(&["allocate", file.to_str().unwrap()]);
-    assert!(err.contains("chain::allocate::no_requirement"), "{err}");
-    assert!(
-        err.contains("requirement: {min: 0.95, mean: 0.97}"),
-        "{err}"
+    let err = allocate_fails_on("gantry_no_requirement", &out);
+    mentions(
+        &err,
+        &[
+            "chain::allocate::no_requirement",
+            "requirement: {min: 0.95, mean: 0.97}",
+        ],
     );
     assert!(!err.contains("chain::allocate::error"), "{err}");
     // Steps too small for the paper's procedure to finish in its rounds:
@@ -293,10 +308,12 @@ fn cli_allocation_errors_have_their_own_codes() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stdout).contains("round 200"));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("chain::allocate::not_met"), "{err}");
-    assert!(
-        err.contains("the requirement is not met after 200 rounds"),
-        "{err}"
+    mentions(
+        &err,
+        &[
+            "chain::allocate::not_met",
+            "the requirement is not met after 200 rounds",
+        ],
     );
 }
 

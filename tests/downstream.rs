@@ -30,56 +30,6 @@ const CLI_ONLY: [&str; 10] = [
     "image",
 ];
 
-const MAIN_RS: &str = r#"//! Uses the library as a dependent would: a macro-generated model (inline and
-//! from a file) and a FORM reliability on it.
-use chain::core::ErrorModel;
-use chain::reliability::{Event, Form, Inputs, Marginal, ToleranceLimitState};
-
-chain::machine! {
-    pub Slide {
-        parameters: { L: 250 },
-        bodies {
-            bed {},
-            x_slide {
-                parent: bed,
-                joint: { type: prismatic, axis: +x, variable: x },
-                errors: { dx: dxx, ey: eyx },
-            },
-            spindle { parent: x_slide, offset: [0, 0, -L] },
-        },
-        workpiece: bed,
-        tool: spindle,
-    }
-}
-
-chain::machine!(pub Gantry = "gantry_grinder.yaml");
-
-fn main() {
-    let s = Slide::sensitivity(&[10.0], &[250.0]);
-    assert_eq!(s[0][Slide::ERR_EYX], -250.0);
-    let model: &dyn ErrorModel = &Gantry;
-    assert_eq!(model.errors().len(), 21);
-    // px = dxx - L*eyx against a 0.03 mm tolerance.
-    let inputs = Inputs::new(
-        vec!["dxx".into(), "eyx".into()],
-        vec![
-            Marginal::normal(0.0, 0.01).unwrap(),
-            Marginal::normal(0.0, 0.00001).unwrap(),
-        ],
-    )
-    .unwrap();
-    let g = ToleranceLimitState::component(
-        vec![s[0][Slide::ERR_DXX], s[0][Slide::ERR_EYX]],
-        0.03,
-        chain::core::model::Sided::Upper,
-    )
-    .unwrap();
-    let event = Event::new(&inputs, g).unwrap();
-    let form = Form::default().run(&event).unwrap();
-    assert!(form.reliability > 0.99);
-}
-"#;
-
 fn cargo() -> Command {
     let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     // The child resolves and builds its own crate, not ours.
@@ -108,9 +58,15 @@ fn downstream_crate() -> PathBuf {
         }
     };
     write("Cargo.toml", manifest.as_bytes());
-    write("src/main.rs", MAIN_RS.as_bytes());
+    // The trybuild pass case (a macro-generated model, inline and from a
+    // file, and FORM on it) is the downstream crate's main.
     write(
-        "gantry_grinder.yaml",
+        "src/main.rs",
+        &std::fs::read(root.join("tests/ui/pass_downstream.rs")).unwrap(),
+    );
+    std::fs::create_dir_all(dir.join("examples/machines")).unwrap();
+    write(
+        "examples/machines/gantry_grinder.yaml",
         &std::fs::read(root.join("examples/machines/gantry_grinder.yaml")).unwrap(),
     );
     write(

@@ -11,7 +11,7 @@ use chain_core::kinematics::Kinematics;
 use chain_core::model::{JointKind, Machine};
 use chain_core::{CompiledModel, ErrorModel};
 use common::cli::{fails, ok_json, ok_stdout, scratch_file};
-use common::{example_path, Rng};
+use common::{example_path, random_q, Rng};
 
 fn machine_path(name: &str) -> PathBuf {
     example_path(&format!("{name}.yaml"))
@@ -44,17 +44,6 @@ fn joint_difference(kind: &JointKind, a: f64, b: f64) -> f64 {
     } else {
         a - b
     }
-}
-
-/// Random axis values: angles in [-3, 3) rad, slides in [-500, 500) mm.
-fn random_q(kinds: &[JointKind], rng: &mut Rng) -> Vec<f64> {
-    kinds
-        .iter()
-        .map(|k| match k {
-            JointKind::Rotary => rng.range(-3.0, 3.0),
-            JointKind::Prismatic => rng.range(-500.0, 500.0),
-        })
-        .collect()
 }
 
 /// Round trip on `n` random poses: the generating axis values are among the
@@ -336,7 +325,7 @@ fn newton_finds_every_closed_form_solution(name: &str, seed: u64) {
     let mut rng = Rng::new(seed);
     let prev = vec![0.0; kinds.len()];
     for _ in 0..100 {
-        let q = random_q(&kinds, &mut rng);
+        let q = random_q(&kinds, &mut rng, 3.0);
         let pose = model.nominal(&q, &params);
         let axis = axis_of(&pose.rotation);
         let a = closed.solve(pose.position, axis, &prev);
@@ -384,7 +373,7 @@ fn newton_solves_a_chain_without_closed_form() {
     let kinds: Vec<JointKind> = m.variables.iter().map(|v| v.kind).collect();
     let mut rng = Rng::new(23);
     for _ in 0..200 {
-        let q = random_q(&kinds, &mut rng);
+        let q = random_q(&kinds, &mut rng, 3.0);
         let pose = kin.pose(&q, &params);
         let axis = axis_of(&pose.rotation);
         // Previous row near the generating values: the first solution is it.

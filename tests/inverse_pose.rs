@@ -9,7 +9,7 @@ use chain_core::inverse::{wrap, Inverse, Status};
 use chain_core::kinematics::Kinematics;
 use chain_core::model::{JointKind, Machine};
 use common::cli::{fails, ok_json, scratch_file, unwrapped};
-use common::{example_path, load_example, Rng};
+use common::{example_path, load_example, random_q, Rng};
 
 fn load(name: &str) -> (Machine, Kinematics, Vec<f64>) {
     let m = load_example(&format!("{name}.yaml"));
@@ -20,16 +20,6 @@ fn load(name: &str) -> (Machine, Kinematics, Vec<f64>) {
         .map(|p| p.value.expect("numeric"))
         .collect();
     (m, kin, params)
-}
-
-fn random_q(kinds: &[JointKind], rng: &mut Rng) -> Vec<f64> {
-    kinds
-        .iter()
-        .map(|k| match k {
-            JointKind::Rotary => rng.range(-3.1, 3.1),
-            JointKind::Prismatic => rng.range(-500.0, 500.0),
-        })
-        .collect()
 }
 
 fn max_diff(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> f64 {
@@ -59,7 +49,7 @@ fn round_trip(name: &str, seed: u64) {
     let mut rng = Rng::new(seed);
     let prev = vec![0.0; kinds.len()];
     for _ in 0..10_000 {
-        let q = random_q(&kinds, &mut rng);
+        let q = random_q(&kinds, &mut rng, 3.1);
         let pose = kin.pose(&q, &params);
         let s = inverse.solve_pose(pose.position, &pose.rotation, &prev);
         assert_eq!(s.status, Status::Ok, "{name} q = {q:?}");

@@ -19,6 +19,7 @@ mod common;
 
 use chain_core::model::Machine;
 use chain_core::ErrorModel;
+use common::wang_yuan_2021::TABLE2;
 use common::{close, load_example, normal_cdf, Exact, Rng};
 
 /// The 21 errors of Table 1 as named in the machine file (paper symbols:
@@ -499,16 +500,6 @@ fn common_module_finite_differences_reproduce_corrected_eq_18() {
         assert!(close(fd[ezz] - printed[ezz], -y, 1e-8, 1e-8));
     }
 }
-
-/// Table 2 (reliability of machining accuracy in the x direction, %), rows
-/// z = 600 … 1400, columns y = -1500 … 1500 (x does not enter px).
-const TABLE2: [[f64; 5]; 5] = [
-    [88.83, 96.14, 98.74, 96.14, 88.83],
-    [88.31, 95.42, 98.14, 95.42, 88.31],
-    [87.67, 94.51, 97.28, 94.51, 87.67],
-    [86.93, 93.41, 96.17, 93.41, 86.93],
-    [86.07, 92.36, 94.74, 92.36, 86.07],
-];
 
 #[test]
 fn table_2_is_reproduced_only_with_the_ezz_term_of_eq_17() {

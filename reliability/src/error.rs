@@ -120,3 +120,19 @@ pub enum ReliabilityError {
         max: u64,
     },
 }
+
+impl ReliabilityError {
+    /// An unknown `name` of this `kind`, with the closest of `known` as the
+    /// hint when one is close enough (chain-core's did-you-mean rule).
+    pub fn unknown<'a>(
+        kind: &'static str,
+        name: &str,
+        known: impl IntoIterator<Item = &'a str>,
+    ) -> ReliabilityError {
+        ReliabilityError::UnknownName {
+            kind,
+            name: name.to_string(),
+            hint: chain_core::diagnostic::closest(name, known).map(str::to_string),
+        }
+    }
+}

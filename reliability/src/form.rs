@@ -549,14 +549,10 @@ mod tests {
 
     #[test]
     fn uniform_inputs_converge() {
-        let inp = Inputs::new(
-            vec!["a".into(), "b".into()],
-            vec![
-                Marginal::uniform(-1.0, 1.0).unwrap(),
-                Marginal::normal(0.0, 0.5).unwrap(),
-            ],
-        )
-        .unwrap();
+        let inp = crate::util::fixtures::inputs(vec![
+            Marginal::uniform(-1.0, 1.0).unwrap(),
+            Marginal::normal(0.0, 0.5).unwrap(),
+        ]);
         let ls = ToleranceLimitState::component(vec![1.0, 1.0], 1.5, Sided::Two).unwrap();
         let r = Form::default().run(&Event::new(&inp, ls).unwrap()).unwrap();
         assert_eq!(r.termination, Termination::Converged);

@@ -309,25 +309,8 @@ impl ToleranceLimitState {
         tolerances: Vec<f64>,
         criterion: Criterion,
     ) -> Result<ToleranceLimitState, ReliabilityError> {
-        if n == 0 || rows.is_empty() || rows.len() % n != 0 {
-            return Err(ReliabilityError::Dimension {
-                what: "sensitivity rows (k × n)",
-                expected: n.max(1),
-                found: rows.len(),
-            });
-        }
-        let k = rows.len() / n;
-        let expected = match criterion {
-            Criterion::Each(_) => k,
-            Criterion::Norm => 1,
-        };
-        if tolerances.len() != expected {
-            return Err(ReliabilityError::Dimension {
-                what: "tolerances",
-                expected,
-                found: tolerances.len(),
-            });
-        }
+        // The dimensions are the affine view's.
+        AffineView::new(n, &rows, &tolerances, criterion)?;
         for &t in &tolerances {
             if !t.is_finite() || t <= 0.0 {
                 return Err(ReliabilityError::InvalidTolerance {

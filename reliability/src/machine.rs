@@ -48,15 +48,11 @@ pub fn parameters(
 ) -> Result<Vec<f64>, ReliabilityError> {
     for (name, _) in overrides {
         if machine.parameter_index(name).is_none() {
-            return Err(ReliabilityError::UnknownName {
-                kind: "parameter",
-                name: name.clone(),
-                hint: chain_core::diagnostic::closest(
-                    name,
-                    machine.parameters.iter().map(|p| p.name.as_str()),
-                )
-                .map(str::to_string),
-            });
+            return Err(ReliabilityError::unknown(
+                "parameter",
+                name,
+                machine.parameters.iter().map(|p| p.name.as_str()),
+            ));
         }
     }
     machine

@@ -400,17 +400,7 @@ mod tests {
     use super::*;
     use crate::form::Form;
     use crate::machine;
-    use chain_core::{CompiledModel, Machine};
-
-    fn gantry() -> (Machine, CompiledModel) {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../examples/machines/gantry_grinder.yaml"
-        );
-        let m = chain_core::load_file(std::path::Path::new(path)).expect("gantry loads");
-        let model = chain_core::compile(&m);
-        (m, model)
-    }
+    use crate::util::fixtures::gantry;
 
     fn instant(row: usize, axes: Option<Vec<f64>>) -> PathInstant {
         PathInstant {

@@ -192,14 +192,10 @@ mod tests {
         // Volumetric ‖(e0, e1)‖ ≤ 0.05 with a uniform and a normal input: the
         // FORM route (∂β/∂θ = ∂g/∂θ / |∇_u g| at u*) against central
         // differences of the FORM reliability.
-        let inputs = Inputs::new(
-            vec!["a".into(), "b".into()],
-            vec![
-                Marginal::uniform(-0.02, 0.03).unwrap(),
-                Marginal::normal(0.004, 0.015).unwrap(),
-            ],
-        )
-        .unwrap();
+        let inputs = crate::util::fixtures::inputs(vec![
+            Marginal::uniform(-0.02, 0.03).unwrap(),
+            Marginal::normal(0.004, 0.015).unwrap(),
+        ]);
         let ls = ToleranceLimitState::new(2, vec![1.0, 0.3, 0.2, 1.0], vec![0.05], Criterion::Norm)
             .unwrap();
         let e = Event::new(&inputs, ls.clone()).unwrap();

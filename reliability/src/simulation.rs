@@ -753,7 +753,7 @@ fn illinois(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::inputs::{Inputs, Marginal};
+    use crate::inputs::Marginal;
     use crate::limit_state::ToleranceLimitState;
 
     #[test]
@@ -766,15 +766,11 @@ mod tests {
 
     #[test]
     fn two_sided_affine_is_exact() {
-        let inputs = Inputs::new(
-            vec!["a".into(), "b".into(), "c".into()],
-            vec![
-                Marginal::normal(0.001, 0.01).unwrap(),
-                Marginal::normal(0.0, 0.02).unwrap(),
-                Marginal::normal(0.0, 0.005).unwrap(),
-            ],
-        )
-        .unwrap();
+        let inputs = crate::util::fixtures::inputs(vec![
+            Marginal::normal(0.001, 0.01).unwrap(),
+            Marginal::normal(0.0, 0.02).unwrap(),
+            Marginal::normal(0.0, 0.005).unwrap(),
+        ]);
         let ls = ToleranceLimitState::component(vec![1.0, -1.0, 2.0], 0.05, Sided::Two).unwrap();
         let event = Event::new(&inputs, ls).unwrap();
         let exact = event.exact_pf().unwrap();
@@ -793,14 +789,10 @@ mod tests {
 
     #[test]
     fn uniform_inputs_agree_with_monte_carlo() {
-        let inputs = Inputs::new(
-            vec!["a".into(), "b".into()],
-            vec![
-                Marginal::uniform(-1.0, 1.0).unwrap(),
-                Marginal::normal(0.0, 0.5).unwrap(),
-            ],
-        )
-        .unwrap();
+        let inputs = crate::util::fixtures::inputs(vec![
+            Marginal::uniform(-1.0, 1.0).unwrap(),
+            Marginal::normal(0.0, 0.5).unwrap(),
+        ]);
         let ls = ToleranceLimitState::component(vec![1.0, 1.0], 1.4, Sided::Two).unwrap();
         let event = Event::new(&inputs, ls).unwrap();
         let is = ImportanceSampling {
@@ -824,14 +816,10 @@ mod tests {
     #[cfg(feature = "parallel")]
     #[test]
     fn thread_count_does_not_change_results() {
-        let inputs = Inputs::new(
-            vec!["a".into(), "b".into()],
-            vec![
-                Marginal::normal(0.0, 1.0).unwrap(),
-                Marginal::normal(0.0, 1.0).unwrap(),
-            ],
-        )
-        .unwrap();
+        let inputs = crate::util::fixtures::inputs(vec![
+            Marginal::normal(0.0, 1.0).unwrap(),
+            Marginal::normal(0.0, 1.0).unwrap(),
+        ]);
         let ls = ToleranceLimitState::new(2, vec![1.0, 0.2, -0.3, 1.0], vec![2.5], Criterion::Norm)
             .unwrap();
         let event = Event::new(&inputs, ls).unwrap();

@@ -1044,12 +1044,7 @@ fn grid_points(grid: &Grid, variables: &[String]) -> Result<Vec<Vec<f64>>, Relia
     let mut axis_of = vec![None; variables.len()];
     for (a, (name, values)) in grid.axes.iter().enumerate() {
         let v = variables.iter().position(|x| x == name).ok_or_else(|| {
-            ReliabilityError::UnknownName {
-                kind: "variable",
-                name: name.clone(),
-                hint: chain_core::diagnostic::closest(name, variables.iter().map(String::as_str))
-                    .map(str::to_string),
-            }
+            ReliabilityError::unknown("variable", name, variables.iter().map(String::as_str))
         })?;
         if values.is_empty() {
             return Err(ReliabilityError::EmptyGrid(format!(
@@ -1089,17 +1084,7 @@ pub fn closed_form_reliability(tolerance: f64, sigma_e: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::machine;
-    use chain_core::{CompiledModel, Machine};
-
-    fn gantry() -> (Machine, CompiledModel) {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../examples/machines/gantry_grinder.yaml"
-        );
-        let m = chain_core::load_file(std::path::Path::new(path)).expect("gantry loads");
-        let model = chain_core::compile(&m);
-        (m, model)
-    }
+    use crate::util::fixtures::gantry;
 
     #[test]
     fn at_points_equals_the_grid_study_at_the_same_points() {

@@ -39,3 +39,30 @@ mod tests {
         assert_eq!(super::dot(&[], &[]), 0.0);
     }
 }
+
+#[cfg(test)]
+pub(crate) mod fixtures {
+    use chain_core::{CompiledModel, Machine};
+
+    use crate::inputs::{Inputs, Marginal};
+
+    /// Inputs named `a`, `b`, `c`, … with these marginals.
+    pub(crate) fn inputs(marginals: Vec<Marginal>) -> Inputs {
+        let names = (0..marginals.len())
+            .map(|i| char::from(b'a' + i as u8).to_string())
+            .collect();
+        Inputs::new(names, marginals).unwrap()
+    }
+
+    /// The gantry grinder of Wang & Yuan 2021 (the workspace's example file)
+    /// and its compiled model: the fixture of the unit tests.
+    pub(crate) fn gantry() -> (Machine, CompiledModel) {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../examples/machines/gantry_grinder.yaml"
+        );
+        let m = chain_core::load_file(std::path::Path::new(path)).expect("gantry loads");
+        let model = chain_core::compile(&m);
+        (m, model)
+    }
+}

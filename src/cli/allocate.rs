@@ -15,8 +15,9 @@ use reliability::allocate::{self, AllocateError, Allocation, ErrorBounds, Optima
 use reliability::Summary;
 use serde::{Serialize, Serializer};
 
-use super::reliability::{parse_assignment, Loaded, SidedArg};
-use super::report::{self, Format, Report};
+use super::args::ModelArgs;
+use super::reliability::Loaded;
+use super::report::{self, Report};
 
 /// `--strategy`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -45,6 +46,8 @@ pub enum AllocateFormat {
     Json,
 }
 
+report::formats!(AllocateFormat: Table, Json);
+
 /// Arguments of `chain allocate`.
 #[derive(Debug, clap::Args)]
 pub struct AllocateArgs {
@@ -66,12 +69,8 @@ pub struct AllocateArgs {
     /// Output format.
     #[arg(long, value_enum, default_value = "table")]
     pub format: AllocateFormat,
-    /// Value of a parameter, `NAME=VALUE` (repeatable; required for symbolic ones).
-    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_assignment)]
-    pub params: Vec<(String, f64)>,
-    /// Override the file's `sided`.
-    #[arg(long, value_enum)]
-    pub sided: Option<SidedArg>,
+    #[command(flatten)]
+    pub model: ModelArgs,
     /// Write before/after reliability charts per component and a chart of
     /// the tightening per error (PNG and SVG) into DIR.
     #[arg(long, value_name = "DIR")]
@@ -81,8 +80,8 @@ pub struct AllocateArgs {
 /// Runs `chain allocate`.
 pub fn exec(args: AllocateArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
-    let (study, model) = loaded.study(&args.params, &[], args.sided, None)?;
-    let values = reliability::machine::parameters(&loaded.machine, &args.params)
+    let (study, model) = loaded.study(&args.model.param.params, &[], args.model.sided, None)?;
+    let values = reliability::machine::parameters(&loaded.machine, &args.model.param.params)
         .map_err(|e| loaded.report(e))?;
     let bounds = allocate::bounds(&loaded.machine, &study).map_err(|e| loaded.report(e))?;
     let result = match args.strategy {
@@ -129,13 +128,7 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
         bounds: &bounds,
         result: &result,
     };
-    report::emit(
-        &doc,
-        match args.format {
-            AllocateFormat::Json => Format::Json,
-            AllocateFormat::Table => Format::Table,
-        },
-    )?;
+    report::emit(&doc, args.format.into())?;
     if !result.met {
         return Err(miette::Report::new(
             MietteDiagnostic::new(format!(

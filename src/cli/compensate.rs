@@ -134,12 +134,10 @@ pub fn exec(args: CompensateArgs) -> miette::Result<()> {
         written: files.iter().map(|p| p.display().to_string()).collect(),
         table_rows,
     };
-    let format = match args.format {
-        Format::Table => report::Format::Table,
-        Format::Json => report::Format::Json,
-    };
-    report::emit(&document, format)
+    report::emit(&document, args.format.into())
 }
+
+report::formats!(Format: Table, Json);
 
 /// The measurements of a CSV file: the records from the shared CSV input
 /// module, checked and typed by the library.

@@ -10,9 +10,10 @@ use chain_core::inverse::{Inverse, InverseError, Solution, Status};
 use chain_core::named::NameMap;
 use serde::{Serialize, Serializer};
 
+use super::args::ParamArgs;
 use super::csv_input::{read_poses, Orientation, PoseRow};
 use super::reliability::{parse_assignment, resolve_fixed, Loaded};
-use super::report::{self, Csv, Format, Report};
+use super::report::{self, Csv, Report};
 
 /// Arguments of `chain inverse`.
 #[derive(Debug, clap::Args)]
@@ -27,9 +28,8 @@ pub struct InverseArgs {
     /// Hold a variable the pose does not determine, `NAME=VALUE` (repeatable).
     #[arg(long = "fix", value_name = "NAME=VALUE", value_parser = parse_assignment)]
     pub fix: Vec<(String, f64)>,
-    /// Value of a parameter, `NAME=VALUE` (repeatable; required for symbolic ones).
-    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_assignment)]
-    pub params: Vec<(String, f64)>,
+    #[command(flatten)]
+    pub param: ParamArgs,
     /// Output format: the spec's JSON document, or CSV with one line per
     /// solution (`row,status,solution,<variables>`; an unreachable row has
     /// one line with empty values).
@@ -50,7 +50,8 @@ pub enum InverseFormat {
 pub fn exec(args: InverseArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
-    let params = reliability::machine::parameters(m, &args.params).map_err(|e| loaded.report(e))?;
+    let params =
+        reliability::machine::parameters(m, &args.param.params).map_err(|e| loaded.report(e))?;
     let fixed = resolve_fixed(m, &args.fix)?;
     let (_, poses) = read_poses(&args.pose)?;
     let solver = Inverse::for_machine(m, &params, &fixed).map_err(|error| OnMachine {
@@ -63,14 +64,10 @@ pub fn exec(args: InverseArgs) -> miette::Result<()> {
         variables: m.variables.iter().map(|v| v.name.as_str()).collect(),
         rows: solve_rows(&solver, &poses, m.variables.len(), &fixed),
     };
-    report::emit(
-        &doc,
-        match args.format {
-            InverseFormat::Json => Format::Json,
-            InverseFormat::Csv => Format::Csv,
-        },
-    )
+    report::emit(&doc, args.format.into())
 }
+
+report::formats!(InverseFormat: Json, Csv);
 
 /// An [`InverseError`] of the machine `machine`: the library's error, its
 /// code and help, with the machine named in the message.

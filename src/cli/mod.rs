@@ -2,6 +2,7 @@
 //! `exec` over the libraries.
 
 pub mod allocate;
+mod args;
 pub mod compensate;
 mod csv_input;
 pub mod derive;

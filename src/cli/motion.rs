@@ -22,7 +22,7 @@ use chain_core::settings;
 use serde::{Serialize, Serializer};
 
 use super::reliability::{parse_assignment, resolve_fixed};
-use super::report::{self, Csv, Format, Report};
+use super::report::{self, Csv, Report};
 
 /// Highest order accepted for `--order` and `--max-order`: the JSON lists
 /// the derivatives `k!·a_k`, and 171! overflows `f64`.
@@ -131,19 +131,16 @@ pub fn exec(args: MotionArgs) -> miette::Result<()> {
     if let Some(dir) = &args.plot {
         doc.written = motion_plot::write_all(dir, &doc.view())?;
     }
-    let format = match args.format {
-        MotionFormat::Table => Format::Table,
-        MotionFormat::Json => Format::Json,
-        MotionFormat::Csv => {
-            // The CSV is the motion alone: the files go to stderr.
-            for f in &doc.written {
-                eprintln!("wrote {}", f.display());
-            }
-            Format::Csv
+    if args.format == MotionFormat::Csv {
+        // The CSV is the motion alone: the files go to stderr.
+        for f in &doc.written {
+            eprintln!("wrote {}", f.display());
         }
-    };
-    report::emit(&doc, format)
+    }
+    report::emit(&doc, args.format.into())
 }
+
+report::formats!(MotionFormat: Table, Json, Csv);
 
 fn check_args(args: &MotionArgs) -> miette::Result<()> {
     if args.order > MAX_ORDER {

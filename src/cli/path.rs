@@ -25,11 +25,12 @@ use reliability::{
 };
 use serde::Serialize;
 
+use super::args::{AlgorithmArgs, ModelArgs, SystemArgs};
 use super::csv_input::{numeric_rows, open_csv, read_poses};
 use super::inverse::solve_rows;
 use super::reliability::{
     calls_text, note_form_limits, parse_assignment, requirement_text, resolve_fixed, sided_title,
-    system_of, warn_unconverged, Loaded, MethodArg, Pairs, RequirementDoc, SidedArg, SystemArg,
+    system_of, warn_unconverged, Loaded, MethodArg, Pairs, RequirementDoc,
 };
 use super::report::{self, Csv, Report};
 
@@ -64,28 +65,12 @@ pub struct PathArgs {
     /// without a column (`--axes`) or one a pose does not determine (`--pose`).
     #[arg(long = "fix", value_name = "NAME=VALUE", value_parser = parse_assignment)]
     pub fix: Vec<(String, f64)>,
-    /// Value of a parameter, `NAME=VALUE` (repeatable; required for symbolic ones).
-    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_assignment)]
-    pub params: Vec<(String, f64)>,
-    /// Reliability algorithm.
-    #[arg(long, value_enum, default_value = "form")]
-    pub method: MethodArg,
-    /// Samples per instant and target (is: 10000, mc: 100000 by default).
-    #[arg(long)]
-    pub samples: Option<u64>,
-    /// Seed of the random streams.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
-    /// Override the file's `sided`.
-    #[arg(long, value_enum)]
-    pub sided: Option<SidedArg>,
-    /// Also assess a system limit state.
-    #[arg(long, value_enum)]
-    pub system: Option<SystemArg>,
-    /// Allowable volumetric error for `--system volumetric` (default: the
-    /// smallest position tolerance).
-    #[arg(long, value_name = "T", requires = "system")]
-    pub system_tolerance: Option<f64>,
+    #[command(flatten)]
+    pub model: ModelArgs,
+    #[command(flatten)]
+    pub algorithm: AlgorithmArgs,
+    #[command(flatten)]
+    pub system: SystemArgs,
     /// Output format.
     #[arg(long, value_enum, default_value = "table")]
     pub format: PathFormat,
@@ -99,13 +84,14 @@ pub struct PathArgs {
 pub fn exec(args: PathArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
-    let system = system_of(m, args.system, args.system_tolerance).map_err(|e| loaded.report(e))?;
+    let system =
+        system_of(m, args.system.system, args.system.tolerance).map_err(|e| loaded.report(e))?;
     let mut spec = machine::spec(m, system).map_err(|e| loaded.report(e))?;
-    if let Some(s) = args.sided {
+    if let Some(s) = args.model.sided {
         spec.sided = s.into();
     }
     let inputs = machine::inputs(m).map_err(|e| loaded.report(e))?;
-    let params = machine::parameters(m, &args.params).map_err(|e| loaded.report(e))?;
+    let params = machine::parameters(m, &args.model.param.params).map_err(|e| loaded.report(e))?;
     let fixed = resolve_fixed(m, &args.fix)?;
     let model = chain_core::compile(m);
     let (input, source, has_t, instants) = match (&args.axes, &args.pose) {
@@ -124,7 +110,7 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
     match path.study() {
         None => eprintln!("note: no instant of the path has axis values; nothing to evaluate"),
         Some(study) => {
-            if args.method == MethodArg::Form {
+            if args.algorithm.method == MethodArg::Form {
                 note_form_limits(study);
             }
             if !study.inputs().is_affine() {
@@ -134,9 +120,15 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
             }
         }
     }
-    let samples = args.method.samples(args.samples);
+    let samples = args.algorithm.method.samples(args.algorithm.samples);
     let result = path
-        .run(&args.method.algorithm(samples, args.seed), &())
+        .run(
+            &args
+                .algorithm
+                .method
+                .algorithm(samples, args.algorithm.seed),
+            &(),
+        )
         .map_err(|e| loaded.report(e))?;
     if let (Some(study), Some(r)) = (path.study(), &result.study) {
         warn_unconverged(r, study.variables());
@@ -162,15 +154,7 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
     report::emit(&doc, args.format.into())
 }
 
-impl From<PathFormat> for report::Format {
-    fn from(f: PathFormat) -> report::Format {
-        match f {
-            PathFormat::Table => report::Format::Table,
-            PathFormat::Json => report::Format::Json,
-            PathFormat::Csv => report::Format::Csv,
-        }
-    }
-}
+report::formats!(PathFormat: Table, Json, Csv);
 
 // ---------------------------------------------------------------------------
 // Input.
@@ -641,11 +625,12 @@ fn status_name(s: Status) -> &'static str {
 /// A compact number for the table: integers as such, others with up to six
 /// decimals.
 fn num(v: f64) -> String {
-    if v == v.trunc() && v.abs() < 1e15 {
-        format!("{}", v as i64)
-    } else {
-        let s = format!("{v:.6}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    match report::whole(v) {
+        Some(i) => i.to_string(),
+        None => {
+            let s = format!("{v:.6}");
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        }
     }
 }
 

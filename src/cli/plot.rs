@@ -241,20 +241,24 @@ impl XyChart {
 
     /// Draws the chart into a PNG file.
     pub fn write_png(&self, path: &Path) -> Result<(), PlotError> {
-        let ranges = self.ranges()?;
-        ensure_fonts();
-        let root = BitMapBackend::new(path, self.size).into_drawing_area();
-        self.draw(root, ranges).map_err(|message| PlotError::Draw {
-            path: path.display().to_string(),
-            message,
-        })
+        self.write_file(path, BitMapBackend::new)
     }
 
     /// Draws the chart into an SVG file.
     pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
+        self.write_file(path, SVGBackend::new)
+    }
+
+    /// Draws the chart into `path` through the backend `backend` opens there
+    /// (once the ranges are known).
+    fn write_file<'a, DB: DrawingBackend>(
+        &self,
+        path: &'a Path,
+        backend: impl FnOnce(&'a Path, (u32, u32)) -> DB,
+    ) -> Result<(), PlotError> {
         let ranges = self.ranges()?;
         ensure_fonts();
-        let root = SVGBackend::new(path, self.size).into_drawing_area();
+        let root = backend(path, self.size).into_drawing_area();
         self.draw(root, ranges).map_err(|message| PlotError::Draw {
             path: path.display().to_string(),
             message,

@@ -20,6 +20,7 @@ use reliability::{
 };
 use serde::Serialize;
 
+use super::args::{AlgorithmArgs, ModelArgs, SystemArgs};
 use super::report::{self, Csv, Report};
 
 /// Runs the chosen algorithm over every case of a study (`samples` is
@@ -115,54 +116,50 @@ pub enum SystemArg {
 pub struct ReliabilityArgs {
     /// Machine file (YAML) with `statistics` and `reliability` sections.
     pub file: PathBuf,
-    /// Algorithm.
-    #[arg(long, value_enum, default_value = "form")]
-    pub method: MethodArg,
-    /// Samples per case (is: 10000, mc: 100000 by default).
-    #[arg(long)]
-    pub samples: Option<u64>,
-    /// Seed of the random streams (results do not depend on the thread count).
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    #[command(flatten)]
+    pub algorithm: AlgorithmArgs,
     /// Output format.
     #[arg(long, value_enum, default_value = "table")]
     pub format: ReliabilityFormat,
     /// Write heat maps and sensitivity bar charts (PNG and SVG) into DIR.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
-    /// Value of a parameter, `NAME=VALUE` (repeatable; required for symbolic ones).
-    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_assignment)]
-    pub params: Vec<(String, f64)>,
+    #[command(flatten)]
+    pub model: ModelArgs,
     /// Replace the grid values of one axis, `VAR=v1,v2,...` (repeatable).
     #[arg(long = "grid", value_name = "VAR=V1,V2,...", value_parser = parse_axis)]
     pub grid: Vec<(String, Vec<f64>)>,
-    /// Override the file's `sided`.
-    #[arg(long, value_enum)]
-    pub sided: Option<SidedArg>,
-    /// Also assess a system limit state.
-    #[arg(long, value_enum)]
-    pub system: Option<SystemArg>,
-    /// Allowable volumetric error for `--system volumetric`.
-    #[arg(long, value_name = "I")]
-    pub system_tolerance: Option<f64>,
+    #[command(flatten)]
+    pub system: SystemArgs,
 }
 
 /// Runs `chain reliability`.
 pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
-    let system = system_of(&loaded.machine, args.system, args.system_tolerance)
+    let system = system_of(&loaded.machine, args.system.system, args.system.tolerance)
         .map_err(|e| loaded.report(e))?;
-    let (study, _model) = loaded.study(&args.params, &args.grid, args.sided, system)?;
-    let samples = args.method.samples(args.samples);
-    let bar = if args.method == MethodArg::Form {
+    let (study, _model) = loaded.study(
+        &args.model.param.params,
+        &args.grid,
+        args.model.sided,
+        system,
+    )?;
+    let samples = args.algorithm.method.samples(args.algorithm.samples);
+    let bar = if args.algorithm.method == MethodArg::Form {
         ProgressBar(None)
     } else {
         ProgressBar::new(samples, study_cases(&study), args.format)
     };
-    let result = run_study(&study, args.method, samples, args.seed, &|n| bar.inc(n));
+    let result = run_study(
+        &study,
+        args.algorithm.method,
+        samples,
+        args.algorithm.seed,
+        &|n| bar.inc(n),
+    );
     bar.finish();
     let result = result.map_err(|e| loaded.report(e))?;
-    if args.method == MethodArg::Form {
+    if args.algorithm.method == MethodArg::Form {
         note_form_limits(&study);
     }
     warn_unconverged(&result, study.variables());
@@ -179,15 +176,7 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     report::emit(&doc, args.format.into())
 }
 
-impl From<ReliabilityFormat> for report::Format {
-    fn from(f: ReliabilityFormat) -> report::Format {
-        match f {
-            ReliabilityFormat::Table => report::Format::Table,
-            ReliabilityFormat::Json => report::Format::Json,
-            ReliabilityFormat::Csv => report::Format::Csv,
-        }
-    }
-}
+report::formats!(ReliabilityFormat: Table, Json, Csv);
 
 fn study_cases(study: &Study) -> u64 {
     (study.targets().len() * study.points().len()) as u64
@@ -285,15 +274,11 @@ impl Loaded {
         }
         for (name, values) in grid {
             if m.variable_index(name).is_none() {
-                return Err(self.report(ReliabilityError::UnknownName {
-                    kind: "axis variable",
-                    name: name.clone(),
-                    hint: chain_core::diagnostic::closest(
-                        name,
-                        m.variables.iter().map(|v| v.name.as_str()),
-                    )
-                    .map(str::to_string),
-                }));
+                return Err(self.report(ReliabilityError::unknown(
+                    "axis variable",
+                    name,
+                    m.variables.iter().map(|v| v.name.as_str()),
+                )));
             }
             match spec.grid.axes.iter_mut().find(|(n, _)| n == name) {
                 Some(axis) => axis.1 = values.clone(),
@@ -913,11 +898,7 @@ pub(crate) fn sided_title(s: Sided) -> &'static str {
 }
 
 fn fmt_num(v: f64) -> String {
-    if v == v.trunc() && v.abs() < 1e15 {
-        format!("{}", v as i64)
-    } else {
-        format!("{v}")
-    }
+    report::whole(v).map_or_else(|| v.to_string(), |i| i.to_string())
 }
 
 /// `; requirement min … %, mean … %: met` for the table summaries.

@@ -189,18 +189,13 @@ where
     root.fill(&WHITE).map_err(err)?;
     let nr = heat.values.len().max(1);
     let nc = heat.values.first().map_or(1, |r| r.len().max(1));
-    let lo = heat
+    let (lo, hi) = heat
         .values
         .iter()
         .flatten()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
-    let hi = heat
-        .values
-        .iter()
-        .flatten()
-        .copied()
-        .fold(f64::NEG_INFINITY, f64::max);
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
     let span = if hi > lo { hi - lo } else { 1.0 };
     let mut chart = ChartBuilder::on(&root)
         .caption(&heat.title, ("sans-serif", 22))

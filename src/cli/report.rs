@@ -31,6 +31,28 @@ pub enum Format {
     Csv,
 }
 
+/// `impl From<E> for Format` for a command's own `--format` enum `E` (its
+/// help texts are the command's), whose variants are named like
+/// [`Format`]'s: `report::formats!(PathFormat: Table, Json, Csv);`.
+macro_rules! formats {
+    ($ty:ident: $($variant:ident),+) => {
+        impl From<$ty> for $crate::cli::report::Format {
+            fn from(f: $ty) -> Self {
+                match f {
+                    $($ty::$variant => $crate::cli::report::Format::$variant,)+
+                }
+            }
+        }
+    };
+}
+pub(crate) use formats;
+
+/// `v` as an integer when it is a whole number below 1e15 in magnitude: how
+/// the tables print whole numbers.
+pub(crate) fn whole(v: f64) -> Option<i64> {
+    (v == v.trunc() && v.abs() < 1e15).then_some(v as i64)
+}
+
 /// A command's result document: serialisable (its JSON form) with a table and,
 /// optionally, a CSV form.
 pub trait Report: Serialize {

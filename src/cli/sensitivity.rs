@@ -24,8 +24,9 @@ use chain_core::model::Component;
 use reliability::{machine, Form, ReliabilityError, SensitivityMethod, Target, TargetSensitivity};
 use serde::Serialize;
 
+use super::args::ModelArgs;
 use super::reliability::reliability_plot;
-use super::reliability::{parse_assignment, parse_axis, Loaded, Pairs, SidedArg};
+use super::reliability::{parse_assignment, parse_axis, Loaded, Pairs};
 use super::report::{self, Report};
 
 /// What `chain sensitivity` computes.
@@ -59,12 +60,8 @@ pub struct SensitivityArgs {
     /// Output format.
     #[arg(long, value_enum, default_value = "table")]
     pub format: SensitivityFormat,
-    /// Value of a parameter, `NAME=VALUE` (repeatable; required for symbolic ones).
-    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_assignment)]
-    pub params: Vec<(String, f64)>,
-    /// Override the file's `sided`.
-    #[arg(long, value_enum)]
-    pub sided: Option<SidedArg>,
+    #[command(flatten)]
+    pub model: ModelArgs,
     /// What to compute.
     #[arg(long, value_enum, default_value = "reliability")]
     pub kind: SensitivityKind,
@@ -112,7 +109,8 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
         ));
     }
     let loaded = Loaded::new(&args.file)?;
-    let (study, model) = loaded.study(&args.params, &args.grid, args.sided, None)?;
+    let (study, model) =
+        loaded.study(&args.model.param.params, &args.grid, args.model.sided, None)?;
     let form = Form::default();
     let (at, result) = match &args.at {
         None => (
@@ -124,8 +122,8 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
         Some(AtPoint(coords)) => {
             let vars = study.variables();
             let point = resolve_at(coords, &loaded)?;
-            let values =
-                machine::parameters(&loaded.machine, &args.params).map_err(|e| loaded.report(e))?;
+            let values = machine::parameters(&loaded.machine, &args.model.param.params)
+                .map_err(|e| loaded.report(e))?;
             let r = study
                 .sensitivity_point(&model, &values, &point, &form)
                 .map_err(|e| loaded.report(e))?;
@@ -161,14 +159,7 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
     report::emit(&doc, args.format.into())
 }
 
-impl From<SensitivityFormat> for report::Format {
-    fn from(f: SensitivityFormat) -> report::Format {
-        match f {
-            SensitivityFormat::Table => report::Format::Table,
-            SensitivityFormat::Json => report::Format::Json,
-        }
-    }
-}
+report::formats!(SensitivityFormat: Table, Json);
 
 fn method_name(m: SensitivityMethod) -> &'static str {
     match m {
@@ -296,12 +287,11 @@ enum Where {
 
 fn unknown_variable(loaded: &Loaded, name: &str) -> miette::Report {
     let m = &loaded.machine;
-    loaded.report(ReliabilityError::UnknownName {
-        kind: "axis variable",
-        name: name.to_string(),
-        hint: chain_core::diagnostic::closest(name, m.variables.iter().map(|v| v.name.as_str()))
-            .map(str::to_string),
-    })
+    loaded.report(ReliabilityError::unknown(
+        "axis variable",
+        name,
+        m.variables.iter().map(|v| v.name.as_str()),
+    ))
 }
 
 /// The values of `--at` in the machine's variable order: every axis
@@ -337,7 +327,7 @@ fn resolve_at(coords: &[(String, f64)], loaded: &Loaded) -> miette::Result<Vec<f
 fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
-    let params = machine::parameters(m, &args.params).map_err(|e| loaded.report(e))?;
+    let params = machine::parameters(m, &args.model.param.params).map_err(|e| loaded.report(e))?;
     let model = chain_core::compile(m);
     let nominal = args.values.unwrap_or_default();
     let sizes = nominal.of(m);

@@ -30,6 +30,7 @@
 #![allow(dead_code, clippy::needless_range_loop)]
 
 pub mod cli;
+pub mod wang_yuan_2021;
 
 use chain_core::model::{ErrorSlots, Frame, JointKind, Machine};
 use chain_core::ErrorModel;
@@ -154,6 +155,18 @@ pub fn vee_skew(m: &Mat3) -> [f64; 3] {
         0.5 * (m[0][2] - m[2][0]),
         0.5 * (m[1][0] - m[0][1]),
     ]
+}
+
+/// Random axis values: angles in [-angle, angle) rad, slides in
+/// [-500, 500) mm.
+pub fn random_q(kinds: &[JointKind], rng: &mut Rng, angle: f64) -> Vec<f64> {
+    kinds
+        .iter()
+        .map(|k| match k {
+            JointKind::Rotary => rng.range(-angle, angle),
+            JointKind::Prismatic => rng.range(-500.0, 500.0),
+        })
+        .collect()
 }
 
 /// A small deterministic generator (SplitMix64) for random test points.

@@ -207,6 +207,36 @@ pub struct Allocation {
     pub kkt: Option<Kkt>,
 }
 
+impl Allocation {
+    /// The allocation of `stds` (one per bound, in input order) with the
+    /// final summaries of its FORM re-evaluation: the cost and whether the
+    /// requirement is met follow from them.
+    pub(crate) fn new(
+        strategy: &'static str,
+        initial: Vec<Summary>,
+        steps: Vec<Step>,
+        bounds: &[ErrorBounds],
+        stds: &[f64],
+        summaries: Vec<Summary>,
+        kkt: Option<Kkt>,
+    ) -> Allocation {
+        Allocation {
+            strategy,
+            initial,
+            steps,
+            std: bounds
+                .iter()
+                .zip(stds)
+                .map(|(b, s)| (b.error.clone(), *s))
+                .collect(),
+            cost: cost(bounds, stds),
+            met: all_met(&summaries),
+            summaries,
+            kkt,
+        }
+    }
+}
+
 /// Why an allocation failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[cfg_attr(feature = "miette", derive(miette::Diagnostic))]

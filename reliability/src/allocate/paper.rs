@@ -4,7 +4,7 @@
 
 use chain_core::ErrorModel;
 
-use super::{all_met, component_summaries, cost, evaluate, step_std};
+use super::{all_met, component_summaries, evaluate, step_std};
 use super::{AllocateError, Allocation, ErrorBounds, Paper, Step};
 use crate::form::Form;
 use crate::study::Study;
@@ -119,18 +119,7 @@ pub fn paper<M: ErrorModel + ?Sized>(
             summaries: summaries.clone(),
         });
     }
-    Ok(Allocation {
-        strategy: "paper",
-        initial,
-        steps,
-        std: bounds
-            .iter()
-            .zip(&stds)
-            .map(|(b, s)| (b.error.clone(), *s))
-            .collect(),
-        cost: cost(bounds, &stds),
-        met: all_met(&summaries),
-        summaries,
-        kkt: None,
-    })
+    Ok(Allocation::new(
+        "paper", initial, steps, bounds, &stds, summaries, None,
+    ))
 }

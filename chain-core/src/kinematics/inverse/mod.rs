@@ -39,6 +39,14 @@ use crate::geometry::{
     rodrigues_vec, scale, solve3, sub, tr, M3, V3,
 };
 
+/// Off-grid sample poses `(a, b, l)` at which a fitted closed form is checked
+/// against the model before it is used (angles in rad, tool vector in mm).
+const CHECKS: [(f64, f64, [f64; 3]); 3] = [
+    (0.7, -1.3, [10.0, -20.0, 30.0]),
+    (-2.1, 2.9, [-50.0, 5.0, 1.0]),
+    (3.0, 0.4, [0.0, 100.0, -7.0]),
+];
+
 /// Why a machine cannot be handled by [`Solver`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
@@ -402,12 +410,7 @@ impl Solver {
         if norm(self.u) < 0.5 || norm(self.v) < 0.5 {
             return false;
         }
-        let checks = [
-            (0.7, -1.3, [10.0, -20.0, 30.0]),
-            (-2.1, 2.9, [-50.0, 5.0, 1.0]),
-            (3.0, 0.4, [0.0, 100.0, -7.0]),
-        ];
-        checks.iter().all(|&(a, b, l)| {
+        CHECKS.iter().all(|&(a, b, l)| {
             let got = self.rot(model, a, b, l);
             let want = mul(&mul(&rodrigues(self.u, a), &self.r0), &rodrigues(self.v, b));
             (0..3).all(|i| (0..3).all(|j| (got[i][j] - want[i][j]).abs() < 1e-9))
@@ -468,12 +471,7 @@ impl Solver {
                 }
             }
         }
-        let checks = [
-            (0.7, -1.3, [10.0, -20.0, 30.0]),
-            (-2.1, 2.9, [-50.0, 5.0, 1.0]),
-            (3.0, 0.4, [0.0, 100.0, -7.0]),
-        ];
-        checks.iter().all(|&(a, b, l)| {
+        CHECKS.iter().all(|&(a, b, l)| {
             let want = self.position(model, a, b, l);
             let (m, p0) = self.linear_model(a, b);
             let got = [

@@ -4,7 +4,7 @@
 
 use chain_core::ErrorModel;
 
-use super::{all_met, component_summaries, cost, evaluate};
+use super::{component_summaries, evaluate};
 use super::{AllocateError, Allocation, ErrorBounds, Kkt, Optimal};
 use crate::form::Form;
 use crate::study::{Study, Summary};
@@ -172,20 +172,15 @@ fn finish<M: ErrorModel + ?Sized>(
 ) -> Result<Allocation, AllocateError> {
     let (_, result) = evaluate(model, parameters, study, &stds)?;
     let summaries = component_summaries(&result);
-    Ok(Allocation {
-        strategy: "optimal",
+    Ok(Allocation::new(
+        "optimal",
         initial,
-        steps: Vec::new(),
-        std: bounds
-            .iter()
-            .zip(&stds)
-            .map(|(b, s)| (b.error.clone(), *s))
-            .collect(),
-        cost: cost(bounds, &stds),
-        met: all_met(&summaries),
+        Vec::new(),
+        bounds,
+        &stds,
         summaries,
         kkt,
-    })
+    ))
 }
 
 #[cfg(test)]

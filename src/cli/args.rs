@@ -1,0 +1,49 @@
+//! Command-line arguments shared by several subcommands, flattened into
+//! their argument structs with `#[command(flatten)]`.
+
+use super::reliability::{parse_assignment, MethodArg, SidedArg, SystemArg};
+
+/// `--param NAME=VALUE`: the values of the machine file's parameters.
+#[derive(Debug, clap::Args)]
+pub struct ParamArgs {
+    /// Value of a parameter, `NAME=VALUE` (repeatable; required for symbolic ones).
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_assignment)]
+    pub params: Vec<(String, f64)>,
+}
+
+/// `--param` and `--sided`: the model of a machine file with `statistics`.
+#[derive(Debug, clap::Args)]
+pub struct ModelArgs {
+    #[command(flatten)]
+    pub param: ParamArgs,
+    /// Override the file's `sided`.
+    #[arg(long, value_enum)]
+    pub sided: Option<SidedArg>,
+}
+
+/// `--method`, `--samples`, `--seed`: the reliability algorithm of a study.
+#[derive(Debug, clap::Args)]
+pub struct AlgorithmArgs {
+    /// Reliability algorithm.
+    #[arg(long, value_enum, default_value = "form")]
+    pub method: MethodArg,
+    /// Samples per case, one case per target and point or instant (is: 10000,
+    /// mc: 100000 by default).
+    #[arg(long)]
+    pub samples: Option<u64>,
+    /// Seed of the random streams (results do not depend on the thread count).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+/// `--system`, `--system-tolerance`: a system target besides the components.
+#[derive(Debug, clap::Args)]
+pub struct SystemArgs {
+    /// Also assess a system limit state.
+    #[arg(long, value_enum)]
+    pub system: Option<SystemArg>,
+    /// Allowable volumetric error for `--system volumetric` (default: the
+    /// smallest position tolerance).
+    #[arg(long = "system-tolerance", value_name = "I", requires = "system")]
+    pub tolerance: Option<f64>,
+}
