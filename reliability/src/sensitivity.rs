@@ -36,6 +36,16 @@ pub enum SensitivityMethod {
     Form,
 }
 
+impl SensitivityMethod {
+    /// `exact` or `form`, as serialised.
+    pub fn name(self) -> &'static str {
+        match self {
+            SensitivityMethod::Exact => "exact",
+            SensitivityMethod::Form => "form",
+        }
+    }
+}
+
 /// The sensitivities of one input.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct InputSensitivity {
@@ -179,6 +189,13 @@ pub fn sensitivity<L: LimitState>(
 mod tests {
     use super::*;
     use crate::form::Form;
+
+    #[test]
+    fn method_names_are_the_serialised_ones() {
+        for m in [SensitivityMethod::Exact, SensitivityMethod::Form] {
+            assert_eq!(serde_json::to_value(m).unwrap(), m.name());
+        }
+    }
     use crate::inputs::{Inputs, Marginal};
     use crate::limit_state::ToleranceLimitState;
 

@@ -579,7 +579,7 @@ impl Report for PathDoc {
                 Some(q) => row.extend(q.iter().map(|x| format!("{x:?}"))),
                 None => row.extend(self.variables.iter().map(|_| String::new())),
             }
-            row.push(status_name(i.status).into());
+            row.push(i.status.name().into());
             if let Some(e) = &rec.result {
                 row.extend(e.nominal.iter().map(|x| format!("{x:?}")));
                 row.extend(Quantity::ALL.iter().map(|&q| format!("{:?}", e.mean(q))));
@@ -611,14 +611,6 @@ impl Report for PathDoc {
             csv.row(row);
         }
         Some(csv)
-    }
-}
-
-fn status_name(s: Status) -> &'static str {
-    match s {
-        Status::Ok => "ok",
-        Status::Unreachable => "unreachable",
-        Status::Singular => "singular",
     }
 }
 
@@ -710,7 +702,7 @@ fn to_table(doc: &PathDoc) -> String {
                 let _ = write!(out, " {:>10}", "-");
             }),
         }
-        let _ = write!(out, "  {:<11}", status_name(i.status));
+        let _ = write!(out, "  {:<11}", i.status.name());
         if let Some(e) = &rec.result {
             for &q in &shown {
                 let _ = write!(out, " {:>11} {:>10}", sci(e.mean(q)), sci(e.std(q)));
@@ -737,7 +729,7 @@ fn to_table(doc: &PathDoc) -> String {
                 }
             }),
             None => {
-                let _ = write!(out, " {}", status_name(i.status));
+                let _ = write!(out, " {}", i.status.name());
             }
         }
         out.push('\n');

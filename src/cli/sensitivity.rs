@@ -161,13 +161,6 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
 
 report::formats!(SensitivityFormat: Table, Json);
 
-fn method_name(m: SensitivityMethod) -> &'static str {
-    match m {
-        SensitivityMethod::Exact => "exact",
-        SensitivityMethod::Form => "form",
-    }
-}
-
 /// `at x = 0, y = 1500, z = 600`.
 fn at_text(a: &[(String, f64)]) -> String {
     format!(
@@ -255,7 +248,7 @@ impl Report for SensitivityDoc<'_> {
                 out,
                 "\n{} ({}), sorted by |dR/dstd|:",
                 t.target,
-                method_name(t.method)
+                t.method.name()
             );
             let _ = writeln!(
                 out,
