@@ -25,4 +25,4 @@ pub use diagnostic::Diagnostics;
 pub use eval::{compile, CompiledModel};
 pub use load::{load_bytes, load_file, load_str};
 pub use model::Machine;
-pub use model_trait::{ErrorModel, Pose};
+pub use model_trait::{ErrorModel, ErrorValues, OutOfRange, Pose};

@@ -39,6 +39,59 @@ pub trait ErrorModel {
     /// The nominal pose of the tool relative to the workpiece:
     /// `R_wt(q, 0)` and `T_wt(q, 0) · tool_point`.
     fn nominal(&self, q: &[f64], p: &[f64]) -> Pose;
+
+    /// The error of a built machine at `q`: `E(q) = Σ_j c_j(q) · v_j(q)`,
+    /// with the error values `v(q)` taken from `values` (a values file, see
+    /// [`ErrorValues`], or a closure `|q, e| ...`) into the caller's scratch
+    /// `e` (`e.len()` must be the number of errors; no allocation per point).
+    fn error_with(
+        &self,
+        q: &[f64],
+        p: &[f64],
+        values: &(impl ErrorValues + ?Sized),
+        e: &mut [f64],
+        out: &mut [f64; 6],
+    ) -> Result<(), OutOfRange> {
+        values.values_at(q, e)?;
+        self.error(q, p, e, out);
+        Ok(())
+    }
+}
+
+/// Error values that may depend on the axis values: `v(q)`, one value per
+/// error parameter of a model, in its [`ErrorModel::errors`] order.
+///
+/// A closure `Fn(&[f64], &mut [f64])` (axis values in, error values out) is
+/// one; so is a values file read for a machine.
+pub trait ErrorValues {
+    /// Writes `v(q)` into `out` (`out.len()` = the number of errors).
+    fn values_at(&self, q: &[f64], out: &mut [f64]) -> Result<(), OutOfRange>;
+}
+
+impl<F: Fn(&[f64], &mut [f64])> ErrorValues for F {
+    fn values_at(&self, q: &[f64], out: &mut [f64]) -> Result<(), OutOfRange> {
+        self(q, out);
+        Ok(())
+    }
+}
+
+/// An axis value outside a measured table's range (no silent extrapolation:
+/// measured-machines spec, section 2).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{variable} = {value} is outside the table of `{name}` ({table}), which covers {lo} to {hi}; add `extrapolate: hold` to its entry to hold the end values")]
+pub struct OutOfRange {
+    /// The error motion whose table it is.
+    pub name: String,
+    /// Where the table came from (a CSV file and column, or `points`).
+    pub table: String,
+    /// The axis variable.
+    pub variable: String,
+    /// The value asked for.
+    pub value: f64,
+    /// The table's first position.
+    pub lo: f64,
+    /// The table's last position.
+    pub hi: f64,
 }
 
 /// A rigid pose: rotation matrix and position.

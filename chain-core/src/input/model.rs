@@ -268,6 +268,192 @@ pub struct ErrorParam {
     pub origin: Origin,
 }
 
+/// The basis of a function slot (measured-machines spec, section 1): how an
+/// error motion `F(q)` of a jointed body varies along its own joint variable
+/// `q` (the variable's value, before the axis sign).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "basis", rename_all = "lowercase")]
+pub enum Basis {
+    /// `F(q) = Σ_{k ∈ powers} F_k · q^k`.
+    Powers {
+        /// The exponents, as written (distinct, non-negative).
+        powers: Vec<u32>,
+    },
+    /// `F(q) = Σ_{k=from..degree} F_k · P_k(t)`, `t = (2q − lo − hi)/(hi − lo)`.
+    Legendre {
+        /// Highest degree.
+        degree: u32,
+        /// `[lo, hi]`, `lo < hi`.
+        range: [f64; 2],
+        /// Lowest degree (default 0).
+        from: u32,
+    },
+    /// `F(q) = Σ_{k=from..degree} F_k · T_k(t)`, `t` as for Legendre.
+    Chebyshev {
+        /// Highest degree.
+        degree: u32,
+        /// `[lo, hi]`, `lo < hi`.
+        range: [f64; 2],
+        /// Lowest degree (default 0).
+        from: u32,
+    },
+    /// `F(q) = F_0 + Σ_{k=1..harmonics} (F_c<k>·cos kq + F_s<k>·sin kq)`
+    /// (rotary joints only).
+    Fourier {
+        /// Number of harmonics.
+        harmonics: u32,
+    },
+}
+
+impl Basis {
+    /// The basis functions in coefficient order: powers in the order
+    /// written; `from..=degree`; Fourier `1, cos q, sin q, cos 2q, ...`.
+    pub fn terms(&self) -> Vec<BasisFn> {
+        match self {
+            Basis::Powers { powers } => powers.iter().map(|&k| BasisFn::Power(k)).collect(),
+            Basis::Legendre {
+                degree,
+                range,
+                from,
+            } => (*from..=*degree)
+                .map(|k| BasisFn::Legendre { k, range: *range })
+                .collect(),
+            Basis::Chebyshev {
+                degree,
+                range,
+                from,
+            } => (*from..=*degree)
+                .map(|k| BasisFn::Chebyshev { k, range: *range })
+                .collect(),
+            Basis::Fourier { harmonics } => std::iter::once(BasisFn::Cos(0))
+                .chain((1..=*harmonics).flat_map(|k| [BasisFn::Cos(k), BasisFn::Sin(k)]))
+                .collect(),
+        }
+    }
+
+    /// `powers`, `legendre`, `chebyshev` or `fourier`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Basis::Powers { .. } => "powers",
+            Basis::Legendre { .. } => "legendre",
+            Basis::Chebyshev { .. } => "chebyshev",
+            Basis::Fourier { .. } => "fourier",
+        }
+    }
+}
+
+/// One basis function `b_k(q)` of a function slot.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum BasisFn {
+    /// `q^k`.
+    Power(u32),
+    /// The Legendre polynomial `P_k(t)`, `t = (2q − lo − hi)/(hi − lo)`.
+    Legendre {
+        /// Degree.
+        k: u32,
+        /// `[lo, hi]`.
+        range: [f64; 2],
+    },
+    /// The Chebyshev polynomial of the first kind `T_k(t)`, `t` as above.
+    Chebyshev {
+        /// Degree.
+        k: u32,
+        /// `[lo, hi]`.
+        range: [f64; 2],
+    },
+    /// `cos kq` (`k = 0`: the constant 1).
+    Cos(u32),
+    /// `sin kq`, `k ≥ 1`.
+    Sin(u32),
+}
+
+impl BasisFn {
+    /// `b(q)`. Legendre by Bonnet's recurrence `(n+1)P_{n+1} = (2n+1)tP_n − nP_{n−1}`,
+    /// Chebyshev by `T_{n+1} = 2tT_n − T_{n−1}`, Fourier by `cos`/`sin` of `kq`.
+    pub fn value(&self, q: f64) -> f64 {
+        match *self {
+            BasisFn::Power(k) => q.powi(i32::try_from(k).unwrap_or(i32::MAX)),
+            BasisFn::Legendre { k, range } => {
+                let t = Self::scaled(q, range);
+                let (mut p0, mut p1) = (1.0, t);
+                if k == 0 {
+                    return 1.0;
+                }
+                for n in 1..k {
+                    let n = f64::from(n);
+                    let p2 = ((2.0 * n + 1.0) * t * p1 - n * p0) / (n + 1.0);
+                    p0 = p1;
+                    p1 = p2;
+                }
+                p1
+            }
+            BasisFn::Chebyshev { k, range } => {
+                let t = Self::scaled(q, range);
+                let (mut t0, mut t1) = (1.0, t);
+                if k == 0 {
+                    return 1.0;
+                }
+                for _ in 1..k {
+                    let t2 = 2.0 * t * t1 - t0;
+                    t0 = t1;
+                    t1 = t2;
+                }
+                t1
+            }
+            BasisFn::Cos(k) => (f64::from(k) * q).cos(),
+            BasisFn::Sin(k) => (f64::from(k) * q).sin(),
+        }
+    }
+
+    /// `t = (2q − lo − hi)/(hi − lo)`, the spec's map of `[lo, hi]` onto `[−1, 1]`.
+    pub fn scaled(q: f64, range: [f64; 2]) -> f64 {
+        let [lo, hi] = range;
+        (2.0 * q - lo - hi) / (hi - lo)
+    }
+
+    /// The coefficient's name suffix: `k` (powers, Legendre, Chebyshev),
+    /// `0`, `c<k>`, `s<k>` (Fourier).
+    pub fn suffix(&self) -> String {
+        match *self {
+            BasisFn::Power(k) | BasisFn::Legendre { k, .. } | BasisFn::Chebyshev { k, .. } => {
+                k.to_string()
+            }
+            BasisFn::Cos(0) => "0".to_string(),
+            BasisFn::Cos(k) => format!("c{k}"),
+            BasisFn::Sin(k) => format!("s{k}"),
+        }
+    }
+
+    /// True if `b(q) ≡ 1` (`q^0`, `P_0`, `T_0`, the Fourier constant).
+    pub fn is_constant(&self) -> bool {
+        matches!(
+            *self,
+            BasisFn::Power(0)
+                | BasisFn::Legendre { k: 0, .. }
+                | BasisFn::Chebyshev { k: 0, .. }
+                | BasisFn::Cos(0)
+        )
+    }
+}
+
+/// A function slot: an error motion `F(q) = Σ_k F_k b_k(q)` of a jointed
+/// body, whose coefficients `F_k` are ordinary error parameters named
+/// `<name>_<suffix>` (measured-machines spec, section 1).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ErrorFunction {
+    /// The function's name (`EYX`); not itself an error parameter.
+    pub name: String,
+    /// Its basis.
+    pub basis: Basis,
+    /// Index into [`Machine::variables`] of the joint variable `q`.
+    pub variable: usize,
+    /// `(error index, basis function)` per coefficient, in [`Basis::terms`] order.
+    pub coefficients: Vec<(usize, BasisFn)>,
+    /// Where it was first declared.
+    pub origin: Origin,
+}
+
 /// A body of the machine: a rigid frame placed in its parent's frame by
 /// `Trans(offset) * Rot(rotation) * E(location_errors) * J(q) * E(errors + squareness)`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -467,8 +653,12 @@ pub struct Machine {
     pub parameters: Vec<Parameter>,
     /// Axis variables in body (tree pre-order) order.
     pub variables: Vec<Variable>,
-    /// Error parameters in order of first use along the bodies.
+    /// Error parameters in order of first use along the bodies (a function
+    /// slot's coefficients among them).
     pub errors: Vec<ErrorParam>,
+    /// Function slots (error motions varying along their axis), in order of
+    /// first declaration.
+    pub functions: Vec<ErrorFunction>,
     /// Bodies, parents before children; index 0 is the root.
     pub bodies: Vec<Body>,
     /// Index of the workpiece body.
@@ -516,6 +706,22 @@ impl Machine {
         }
         path.reverse();
         path
+    }
+
+    /// The function and basis function an error parameter is a coefficient
+    /// of, if it is one (`None` for a constant error parameter).
+    pub fn coefficient_of(&self, error: usize) -> Option<(&ErrorFunction, BasisFn)> {
+        self.functions.iter().find_map(|f| {
+            f.coefficients
+                .iter()
+                .find(|(j, _)| *j == error)
+                .map(|(_, b)| (f, *b))
+        })
+    }
+
+    /// Index of the function slot with this name.
+    pub fn function_index(&self, name: &str) -> Option<usize> {
+        self.functions.iter().position(|f| f.name == name)
     }
 
     /// The statistics entry of an error, if any.

@@ -234,9 +234,19 @@ pub(crate) fn body_factors(machine: &Machine, b: usize) -> Vec<Factor> {
     f
 }
 
+/// The value of one slot, `Σ sign·w_j(q)·e_j` over the errors it holds: the
+/// weight `w_j` is the basis function of a function slot's coefficient, 1
+/// for a constant error parameter ([`crate::algebra::error_weight`]).
+pub(crate) fn slot_dual(machine: &Machine, errors: &[usize], sign: f64) -> Dual {
+    if machine.functions.is_empty() {
+        return Dual::errors(errors, sign);
+    }
+    Dual::weighted(errors, sign, |j| crate::algebra::error_weight(machine, j))
+}
+
 /// The small-error transform of a set of error slots.
-pub(crate) fn error_transform(slots: &ErrorSlots) -> Transform {
-    let s = |i: usize| Dual::errors(&slots.slots[i], 1.0);
+pub(crate) fn error_transform(machine: &Machine, slots: &ErrorSlots) -> Transform {
+    let s = |i: usize| slot_dual(machine, &slots.slots[i], 1.0);
     Transform::small_error([s(0), s(1), s(2)], [s(3), s(4), s(5)])
 }
 
@@ -246,7 +256,7 @@ pub(crate) fn body_transform(machine: &Machine, b: usize) -> Transform {
         .iter()
         .fold(Transform::identity(), |acc, f| match f {
             Factor::Nominal(t) => acc.mul(t),
-            Factor::Error(slots) => acc.mul(&error_transform(slots)),
+            Factor::Error(slots) => acc.mul(&error_transform(machine, slots)),
         })
 }
 
@@ -342,6 +352,7 @@ mod tests {
             frame: Frame::Workpiece,
             statistics: vec![],
             reliability: None,
+            functions: vec![],
         }
     }
 

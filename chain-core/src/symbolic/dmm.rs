@@ -16,7 +16,7 @@
 //! twists (Eq. 5, then Eq. 18) gives `d` and `δ`; the tool point adds `δ × tp`.
 
 use crate::algebra::{expr_to_poly, Dual, Poly, Transform};
-use crate::derive::{body_factors, branches, transpose_apply, Factor};
+use crate::derive::{body_factors, branches, slot_dual, transpose_apply, Factor};
 use crate::model::{ErrorSlots, Frame, Machine};
 
 /// The six components, as [`crate::SymbolicModel::components`], derived by the
@@ -54,7 +54,7 @@ pub fn derive_dmm(machine: &Machine, frame: Frame) -> [Vec<(usize, Poly)>; 6] {
             Signed::Nominal(t) => after = t.mul(&after),
             Signed::Error(slots, sign) => {
                 let local: [Dual; 6] =
-                    std::array::from_fn(|i| Dual::errors(&slots.slots[i], *sign));
+                    std::array::from_fn(|i| slot_dual(machine, &slots.slots[i], *sign));
                 let dj = differential_motion_matrix(&after);
                 for (i, row) in dj.iter().enumerate() {
                     for (k, entry) in row.iter().enumerate() {

@@ -50,6 +50,8 @@ pub(super) struct Tree {
     pub variables: Vec<Variable>,
     /// Error parameters in order of first use.
     pub errors: Vec<ErrorParam>,
+    /// Function slots in order of first declaration.
+    pub functions: Vec<crate::model::ErrorFunction>,
 }
 
 impl Tree {
@@ -198,6 +200,7 @@ impl Loader {
             bodies,
             variables,
             errors,
+            functions: Vec::new(),
         })
     }
 

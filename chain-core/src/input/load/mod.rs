@@ -411,6 +411,7 @@ impl Loader {
             parameters: std::mem::take(&mut self.parameters),
             variables: tree.variables,
             errors: tree.errors,
+            functions: tree.functions,
             bodies: tree.bodies,
             workpiece,
             tool,

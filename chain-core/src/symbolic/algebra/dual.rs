@@ -50,6 +50,18 @@ impl Dual {
         d
     }
 
+    /// `Σ sign·w_j·e_j` over the given errors with polynomial weights.
+    pub fn weighted(errors: &[usize], sign: f64, weight: impl Fn(usize) -> Poly) -> Dual {
+        let mut d = Dual::zero();
+        for &j in errors {
+            d = d.add(&Dual {
+                value: Poly::zero(),
+                slopes: vec![(j, weight(j).scale(sign))],
+            });
+        }
+        d
+    }
+
     /// True if value and all slopes are zero.
     pub fn is_zero(&self) -> bool {
         self.value.is_zero() && self.slopes.is_empty()

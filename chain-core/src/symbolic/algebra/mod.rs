@@ -8,7 +8,7 @@ mod poly;
 pub use dual::{Dual, Transform};
 pub use poly::{format_number, Monomial, Poly, Symbol};
 
-use crate::model::{Axis, Expr, FixedRotation, Machine};
+use crate::model::{Axis, BasisFn, Expr, FixedRotation, Machine};
 
 /// Converts a model expression to a polynomial in the parameters.
 ///
@@ -35,6 +35,77 @@ pub fn expr_to_poly(expr: &Expr) -> Poly {
                 Poly::constant(c.powi(*n))
             }
         }
+    }
+}
+
+/// A function slot's basis function `b(q)` of axis variable `var` as an exact
+/// canonical polynomial (measured-machines spec, section 1): `q^k`; Legendre
+/// and Chebyshev polynomials of `t = a·q + b` (`a = 2/(hi − lo)`,
+/// `b = −(lo + hi)/(hi − lo)`) by their three-term recurrences, expanded in
+/// `q`; `cos kq = T_k(cos q)` and `sin kq = sin q · U_{k−1}(cos q)` (the
+/// Chebyshev polynomials of the first and second kind in `cos q`), so Fourier
+/// harmonics are polynomials in `sin q`, `cos q` like every rotary term.
+pub fn basis_poly(b: &BasisFn, var: u16) -> Poly {
+    let q = || Poly::symbol(Symbol::Var(var));
+    let t = |range: [f64; 2]| {
+        let [lo, hi] = range;
+        q().scale(2.0 / (hi - lo))
+            .add(&Poly::constant(-(lo + hi) / (hi - lo)))
+    };
+    // A three-term recurrence p_{n+1} = step(n, p_n, p_{n−1}) from p_0 = 1 and p_1.
+    let recur = |p1: Poly, k: u32, step: &dyn Fn(u32, &Poly, &Poly) -> Poly| {
+        if k == 0 {
+            return Poly::constant(1.0);
+        }
+        let (mut a, mut b) = (Poly::constant(1.0), p1);
+        for n in 1..k {
+            let c = step(n, &b, &a);
+            a = b;
+            b = c;
+        }
+        b
+    };
+    match *b {
+        BasisFn::Power(k) => q().pow(k),
+        BasisFn::Legendre { k, range } => {
+            let x = t(range);
+            recur(x.clone(), k, &|n, pn, pm| {
+                let n = f64::from(n);
+                x.mul(pn)
+                    .scale((2.0 * n + 1.0) / (n + 1.0))
+                    .sub(&pm.scale(n / (n + 1.0)))
+            })
+        }
+        BasisFn::Chebyshev { k, range } => {
+            let x = t(range);
+            recur(x.clone(), k, &|_, pn, pm| x.mul(pn).scale(2.0).sub(pm))
+        }
+        BasisFn::Cos(k) => {
+            let c = Poly::symbol(Symbol::Cos(var));
+            recur(c.clone(), k, &|_, pn, pm| c.mul(pn).scale(2.0).sub(pm))
+        }
+        BasisFn::Sin(k) => {
+            let c = Poly::symbol(Symbol::Cos(var));
+            // U_0 = 1, U_1 = 2c, U_{n+1} = 2c U_n − U_{n−1}; sin kq = sin q · U_{k−1}.
+            let u = if k == 0 {
+                Poly::zero()
+            } else {
+                recur(c.scale(2.0), k - 1, &|_, pn, pm| {
+                    c.mul(pn).scale(2.0).sub(pm)
+                })
+            };
+            Poly::symbol(Symbol::Sin(var)).mul(&u)
+        }
+    }
+}
+
+/// The weight of error `j` in the slots that hold it: its basis function
+/// (a polynomial in its joint variable) for a function slot's coefficient,
+/// 1 for a constant error parameter.
+pub fn error_weight(machine: &Machine, j: usize) -> Poly {
+    match machine.coefficient_of(j) {
+        Some((f, b)) => basis_poly(&b, index_u16(f.variable)),
+        None => Poly::constant(1.0),
     }
 }
 
