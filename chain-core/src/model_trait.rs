@@ -48,7 +48,7 @@ pub trait ErrorModel {
         &self,
         q: &[f64],
         p: &[f64],
-        values: &(impl ErrorValues + ?Sized),
+        values: &dyn ErrorValues,
         e: &mut [f64],
         out: &mut [f64; 6],
     ) -> Result<(), OutOfRange> {
