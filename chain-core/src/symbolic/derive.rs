@@ -161,7 +161,10 @@ fn representatives(machine: &Machine) -> Vec<usize> {
     // Occurrences as (body, section, slot), in a fixed order; duplicates kept.
     let mut occurrences: Vec<Vec<(usize, usize, usize)>> = vec![Vec::new(); machine.errors.len()];
     for (b, body) in machine.bodies.iter().enumerate() {
-        for (section, slots) in [&body.location_errors, &body.errors].into_iter().enumerate() {
+        for (section, slots) in [&body.location_errors, &body.errors]
+            .into_iter()
+            .enumerate()
+        {
             for (s, slot) in slots.slots.iter().enumerate() {
                 for &j in slot {
                     if let Some(o) = occurrences.get_mut(j) {
