@@ -1096,4 +1096,3 @@ fn error_at_takes_a_closure_or_any_error_values() {
     let dynamic: &dyn chain::core::ErrorValues = &Covered;
     assert!(RotaryPolynomial::error_at(&[-1.5], &[100.0], dynamic).is_err());
 }
-

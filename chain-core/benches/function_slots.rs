@@ -76,11 +76,22 @@ fn sensitivity(c: &mut Criterion) {
         });
     }
     c.bench_function("function_slots/generated_sensitivity/legendre5.yaml", |b| {
-        b.iter(|| black_box(generated::Legendre5::sensitivity(black_box(&q), black_box(&p))))
+        b.iter(|| {
+            black_box(generated::Legendre5::sensitivity(
+                black_box(&q),
+                black_box(&p),
+            ))
+        })
     });
     let e = [1e-4; 131];
     c.bench_function("function_slots/generated_error/legendre5.yaml", |b| {
-        b.iter(|| black_box(generated::Legendre5::error(black_box(&q), black_box(&p), &e)))
+        b.iter(|| {
+            black_box(generated::Legendre5::error(
+                black_box(&q),
+                black_box(&p),
+                &e,
+            ))
+        })
     });
 }
 
