@@ -496,6 +496,28 @@ fn template_loads() {
 }
 
 #[test]
+fn ranges_and_orders_are_numbers_or_arithmetic() {
+    // A rotary axis in radians: `pi` is allowed, as in every number.
+    let m = load(&c_ex(
+        "{name: EAC, basis: legendre, degree: 1+1, range: [-pi/2, pi/2], from: 1}",
+    ));
+    let h = std::f64::consts::FRAC_PI_2;
+    assert_eq!(
+        m.functions[0].basis,
+        Basis::Legendre {
+            degree: 2,
+            range: [-h, h],
+            from: 1
+        }
+    );
+    assert_eq!(m.functions[0].variable, m.variable_index("C").unwrap());
+    // `degree: 0` and `harmonics: 0` are the constant alone.
+    let m = load(&c_ex("{name: EAC, basis: fourier, harmonics: 0}"));
+    assert_eq!(m.functions[0].coefficients, [(2, BasisFn::Cos(0))]);
+    assert_eq!(m.errors[2].name, "EAC_0");
+}
+
+#[test]
 fn function_slot_on_a_body_without_a_joint() {
     let text = TEMPLATE
         .replace(
