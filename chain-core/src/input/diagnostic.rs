@@ -296,6 +296,118 @@ pub enum Problem {
         /// Found number of items.
         found: usize,
     },
+    /// A function slot (a mapping in an `errors` slot) on a body without a
+    /// joint: there is no variable for it to vary along.
+    FunctionWithoutJoint {
+        /// The body.
+        body: String,
+    },
+    /// A function slot in `location_errors` or `squareness`, which take
+    /// error names only.
+    FunctionNotAllowed {
+        /// The group (`location_errors`, `squareness`).
+        group: &'static str,
+    },
+    /// A Fourier basis on a prismatic joint.
+    FourierOnPrismatic {
+        /// The body.
+        body: String,
+    },
+    /// A Legendre or Chebyshev basis without its `range`.
+    MissingRange {
+        /// The basis.
+        basis: &'static str,
+    },
+    /// A basis range `[lo, hi]` with `lo >= hi`.
+    RangeOrder {
+        /// Lower end.
+        lo: f64,
+        /// Upper end.
+        hi: f64,
+    },
+    /// A degree, harmonic count, power or `from` that is not a whole number
+    /// from 0 to [`crate::load::MAX_ORDER`].
+    BadOrder {
+        /// What the number is (`the degree`, `a power`, ...).
+        what: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// A power listed twice in `powers`.
+    DuplicatePower {
+        /// The power.
+        power: u32,
+        /// Its first position in the list (0-based).
+        first: usize,
+    },
+    /// `from` above `degree`.
+    FromAboveDegree {
+        /// `from`.
+        from: u32,
+        /// `degree`.
+        degree: u32,
+    },
+    /// A key of a function slot that its basis does not use.
+    KeyNotForBasis {
+        /// The key.
+        key: &'static str,
+        /// The basis (`powers`, `legendre`, ...).
+        basis: &'static str,
+    },
+    /// A function slot with neither `powers` nor `basis`.
+    MissingBasis,
+    /// A function name declared again with a different basis, on another
+    /// axis or in a slot of another kind.
+    FunctionRedeclared {
+        /// The function.
+        name: String,
+        /// How this declaration differs from the first.
+        difference: String,
+        /// 1-based line of the first declaration.
+        first_line: usize,
+    },
+    /// A function or coefficient name that is already another name of the
+    /// machine, or a name that is already a function or coefficient.
+    FunctionClash {
+        /// What the name is here (`coefficient `EYX_1` of function `EYX``).
+        what: String,
+        /// What it already is (`the error parameter `EYX_1` (line 7)`).
+        other: String,
+    },
+    /// Statistics keyed by a function's name instead of its coefficients.
+    FunctionStatistics {
+        /// The function.
+        name: String,
+        /// Its coefficients.
+        coefficients: Vec<String>,
+    },
+    /// `errors: iso` on a body without a joint.
+    IsoWithoutJoint {
+        /// The body.
+        body: String,
+    },
+    /// `errors:` a scalar other than `iso`.
+    ErrorsScalar {
+        /// The value as written.
+        found: String,
+        /// `iso`, if the value is close to it.
+        suggestion: Option<String>,
+    },
+    /// `iso` as the value of `location_errors` or `squareness`.
+    IsoNotAllowed {
+        /// The group.
+        group: &'static str,
+    },
+    /// Two bodies whose `errors: iso` give the same names (their variables
+    /// differ only in case).
+    IsoClash {
+        /// The name.
+        name: String,
+        /// This body.
+        body: String,
+        /// The body that named it first.
+        other: String,
+    },
     /// A rule of a settings file, worded by its reader.
     Message(Message),
 }
@@ -686,6 +798,153 @@ impl Problem {
                 "wrong length",
                 format!("expected a list of {expected} items, found {found}"),
             ),
+            Problem::FunctionWithoutJoint { body } => D::new(
+                "chain::function_without_joint",
+                "no joint",
+                format!("body `{body}` has no joint, so its errors cannot vary along an axis"),
+            )
+            .help(
+                "a function slot is a function of the body's own joint variable; give the body a \
+                 `joint`, or write a constant error name"
+                    .to_string(),
+            ),
+            Problem::FunctionNotAllowed { group } => D::new(
+                "chain::function_not_allowed",
+                "not a name",
+                format!("`{group}` takes error names only, not a function of the axis"),
+            )
+            .help(
+                "functions of the joint variable go in the body's `errors` (the motion errors)"
+                    .to_string(),
+            ),
+            Problem::FourierOnPrismatic { body } => D::new(
+                "chain::fourier_on_prismatic",
+                "prismatic joint",
+                format!("a fourier basis needs a rotary joint, but body `{body}` is prismatic"),
+            )
+            .help(
+                "along a linear axis use `powers`, `basis: legendre` or `basis: chebyshev` over \
+                 the axis range"
+                    .to_string(),
+            ),
+            Problem::MissingRange { basis } => D::new(
+                "chain::missing_range",
+                "no range",
+                format!("a {basis} basis needs `range: [lo, hi]`"),
+            )
+            .help(
+                "the range is mapped onto [-1, 1]: t = (2q - lo - hi) / (hi - lo); give the \
+                 axis travel"
+                    .to_string(),
+            ),
+            Problem::RangeOrder { lo, hi } => D::new(
+                "chain::range_order",
+                "empty range",
+                format!("a basis range `[lo, hi]` needs lo < hi, got lo = {lo}, hi = {hi}"),
+            ),
+            Problem::BadOrder { what, value } => D::new(
+                "chain::bad_order",
+                "out of range",
+                format!(
+                    "{what} must be a whole number from 0 to {}, got {value}",
+                    crate::load::MAX_ORDER
+                ),
+            ),
+            Problem::DuplicatePower { power, first } => D::new(
+                "chain::duplicate_power",
+                "duplicate power",
+                format!("power {power} is listed twice (first as item {first})"),
+            )
+            .help("each power has one coefficient; list it once".to_string()),
+            Problem::FromAboveDegree { from, degree } => D::new(
+                "chain::from_above_degree",
+                "out of range",
+                format!("`from` ({from}) is above `degree` ({degree})"),
+            )
+            .note("the coefficients are k = from..degree".to_string()),
+            Problem::KeyNotForBasis { key, basis } => D::new(
+                "chain::key_not_for_basis",
+                "not for this basis",
+                format!("`{key}` does not apply to a {basis} basis"),
+            )
+            .note(basis_keys(basis)),
+            Problem::MissingBasis => D::new(
+                "chain::missing_basis",
+                "no basis",
+                "a function slot needs `powers: [..]` or `basis: legendre | chebyshev | fourier`",
+            ),
+            Problem::FunctionRedeclared {
+                name,
+                difference,
+                first_line,
+            } => D::new(
+                "chain::function_redeclared",
+                "redeclared",
+                format!("function `{name}` is declared again {difference}"),
+            )
+            .note(format!("first declared on line {first_line}"))
+            .help(
+                "a function declared twice must be the same function: same basis, same axis, \
+                 same kind of slot; otherwise give it another name"
+                    .to_string(),
+            ),
+            Problem::FunctionClash { what, other } => D::new(
+                "chain::name_collision",
+                "name collision",
+                format!("{what} has the same name as {other}"),
+            )
+            .help(
+                "a function `F`'s coefficients are error parameters named `F_<k>`; variables, \
+                 parameters, error parameters, functions and coefficients share one namespace"
+                    .to_string(),
+            ),
+            Problem::FunctionStatistics { name, coefficients } => D::new(
+                "chain::unknown_error",
+                "function",
+                format!(
+                    "statistics for `{name}`, a function slot, not an error parameter"
+                ),
+            )
+            .note(coefficients.first().map(|c| format!("did you mean `{c}`?")))
+            .help(format!(
+                "statistics go on the coefficients of `{name}`: {}",
+                coefficients.join(", ")
+            )),
+            Problem::IsoWithoutJoint { body } => D::new(
+                "chain::iso_without_joint",
+                "no joint",
+                format!(
+                    "`errors: iso` names the errors after the joint variable, but body `{body}` has no joint"
+                ),
+            )
+            .help("give the body a `joint`, or name its errors slot by slot".to_string()),
+            Problem::ErrorsScalar { found, suggestion } => D::new(
+                "chain::errors_value",
+                "unknown value",
+                format!("`errors` must be a mapping of slots or `iso`, found `{found}`"),
+            )
+            .note(did_you_mean(suggestion)),
+            Problem::IsoNotAllowed { group } => D::new(
+                "chain::iso_not_allowed",
+                "not here",
+                format!("`{group}` cannot be `iso`"),
+            )
+            .help(
+                "`iso` names the six motion errors of a joint and is written `errors: iso`"
+                    .to_string(),
+            ),
+            Problem::IsoClash { name, body, other } => D::new(
+                "chain::iso_clash",
+                "name collision",
+                format!(
+                    "`errors: iso` of body `{body}` names `{name}`, as does `errors: iso` of body `{other}`"
+                ),
+            )
+            .help(
+                "the two joint variables upper-case alike; rename one, or name the errors slot \
+                 by slot"
+                    .to_string(),
+            ),
             Problem::Message(m) => D::new(
                 m.code,
                 m.label,
@@ -730,6 +989,16 @@ impl Problem {
 
 /// The note of a parameter in a divisor or under a negative power.
 const POLYNOMIALS: &str = "the derivation needs polynomials in the parameters";
+
+/// The note of a key that does not apply to a basis: the keys it takes.
+fn basis_keys(basis: &str) -> String {
+    let keys = match basis {
+        "powers" => "name, powers",
+        "fourier" => "name, basis, harmonics",
+        _ => "name, basis, degree, range, from",
+    };
+    format!("a {basis} basis takes {keys}")
+}
 
 /// The note of an unknown key or value: the closest valid one, then all.
 fn alternatives(expected: &[&str], suggestion: &Option<String>) -> String {

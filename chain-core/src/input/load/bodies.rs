@@ -4,11 +4,11 @@
 
 use std::collections::{HashMap, HashSet};
 
-use super::{index, join, Loader, TreeReader};
-use crate::diagnostic::{closest, Problem};
+use super::{index, join, Fields, Loader, TreeReader, MAX_ORDER};
+use crate::diagnostic::{closest, Message, Problem};
 use crate::model::{
-    Axis, Body, ErrorKind, ErrorParam, ErrorSlots, FixedRotation, Joint, JointKind, SignedAxis,
-    Slot, Variable,
+    Axis, Basis, Body, ErrorFunction, ErrorKind, ErrorParam, ErrorSlots, FixedRotation, Joint,
+    JointKind, SignedAxis, Slot, Variable,
 };
 use crate::yaml::{Node, NodeKind, Span};
 
@@ -30,6 +30,21 @@ pub const ROTATION_KEYS: &[&str] = &["about", "angle"];
 pub const SLOT_KEYS: &[&str] = &["dx", "dy", "dz", "ex", "ey", "ez"];
 /// Slots of `squareness`.
 pub const SQUARENESS_KEYS: &[&str] = &["ex", "ey", "ez"];
+/// Keys of a function slot (measured-machines spec, section 1).
+pub const FUNCTION_KEYS: &[&str] = &[
+    "name",
+    "powers",
+    "basis",
+    "degree",
+    "range",
+    "from",
+    "harmonics",
+];
+/// Values of a function slot's `basis` (the power basis is `powers: [..]`).
+pub const BASES: &[&str] = &["legendre", "chebyshev", "fourier"];
+/// The ISO 230-1 letters of the six slots under `errors: iso`: `dx: EXV`,
+/// `dy: EYV`, `dz: EZV`, `ex: EAV`, `ey: EBV`, `ez: ECV`.
+pub const ISO_LETTERS: [char; 6] = ['X', 'Y', 'Z', 'A', 'B', 'C'];
 /// Joint types.
 pub const JOINT_TYPES: &[&str] = &["prismatic", "rotary"];
 /// Signed axes.
@@ -51,7 +66,7 @@ pub(super) struct Tree {
     /// Error parameters in order of first use.
     pub errors: Vec<ErrorParam>,
     /// Function slots in order of first declaration.
-    pub functions: Vec<crate::model::ErrorFunction>,
+    pub functions: Vec<ErrorFunction>,
 }
 
 impl Tree {
@@ -69,12 +84,73 @@ struct Use {
     path: String,
 }
 
+/// A function slot as declared: its name and (valid) basis.
+#[derive(Clone)]
+struct RawFunction {
+    /// The `name` value, located at it (key path `….name`).
+    name: Use,
+    /// The basis.
+    basis: Basis,
+}
+
+/// One entry of a slot.
+#[derive(Clone)]
+enum Item {
+    /// A constant error parameter by name.
+    Name(Use),
+    /// One of the six names of `errors: iso`.
+    Iso(Use),
+    /// A function of the body's joint variable.
+    Function(RawFunction),
+}
+
 struct RawJoint {
     kind: Option<JointKind>,
     axis: Option<SignedAxis>,
     variable: Option<Use>,
+    /// The variable as written, valid or not (for `errors: iso`).
+    variable_text: Option<String>,
     span: Span,
     path: String,
+}
+
+/// What a body's slots know of its joint.
+#[derive(Clone, Copy)]
+enum JointState {
+    /// A `joint` key (its kind, if valid).
+    Present(Option<JointKind>),
+    /// No `joint`, but a misspelt key that looked like it (reported there).
+    Misspelt,
+    /// No `joint`.
+    Absent,
+}
+
+/// Where a slot is, for the checks of its items.
+struct SlotContext<'a> {
+    /// 0: location_errors, 1: errors, 2: squareness.
+    group: usize,
+    /// The body's name.
+    body: &'a str,
+    /// The body's joint.
+    joint: JointState,
+}
+
+impl SlotContext<'_> {
+    /// What an item of this slot may be.
+    fn expected(&self) -> &'static str {
+        if self.group == 1 {
+            "an error name, a function `{name: …, powers | basis: …}` or a list of them"
+        } else {
+            "an error name or a list of error names"
+        }
+    }
+}
+
+/// The name `errors: iso` gives slot letter `letter` (`X`..`C`) of a joint
+/// driven by `variable`: `E` + letter + the variable upper-cased (`EXX`,
+/// `EAX`; a multi-letter variable `x2` gives `EXX2`).
+pub fn iso_name(letter: char, variable: &str) -> String {
+    format!("E{letter}{}", variable.to_uppercase())
 }
 
 enum Parent {
@@ -94,8 +170,8 @@ struct RawBody<'n> {
     offset: Option<&'n Node>,
     rotation: Vec<FixedRotation>,
     joint: Option<RawJoint>,
-    /// Uses per group (0: location_errors, 1: errors, 2: squareness) and slot.
-    slots: [[Vec<Use>; 6]; 3],
+    /// Items per group (0: location_errors, 1: errors, 2: squareness) and slot.
+    slots: [[Vec<Item>; 6]; 3],
 }
 
 /// Slot groups in the order errors are numbered within a body.
@@ -142,7 +218,7 @@ impl Loader {
 
         let (parents, order) = self.tree(&raws, key.span);
         let (variables, var_of_body) = self.variables(&raws, &order);
-        let (errors, slots) = self.errors(&raws, &order);
+        let (errors, functions, slots) = self.errors(&raws, &order, &variables, &var_of_body);
 
         let mut position = vec![usize::MAX; raws.len()];
         for (new, &old) in order.iter().enumerate() {
@@ -200,7 +276,7 @@ impl Loader {
             bodies,
             variables,
             errors,
-            functions: Vec::new(),
+            functions,
         })
     }
 
@@ -243,11 +319,22 @@ impl Loader {
         if let Some((k, v)) = f.entry("joint") {
             raw.joint = Some(self.joint(k, v, &f.path("joint")));
         }
+        // A misspelt `joint` key is reported once, not again by every
+        // function slot or `iso` that needs the joint.
+        let joint = match &raw.joint {
+            Some(j) => JointState::Present(j.kind),
+            None if f.suggested.contains(&"joint") => JointState::Misspelt,
+            None => JointState::Absent,
+        };
         for (g, (group, allowed)) in GROUPS.iter().enumerate() {
             let Some((k, v)) = f.entry(group) else {
                 continue;
             };
             let gpath = f.path(group);
+            if let Some(text) = v.as_str() {
+                self.group_scalar(&mut raw, g, v, text, &gpath, joint);
+                continue;
+            }
             let Some(sf) = self.fields(v, k.span, &gpath, allowed) else {
                 continue;
             };
@@ -255,9 +342,14 @@ impl Loader {
                 let Some(s) = SLOT_KEYS.iter().position(|k| k == slot) else {
                     continue;
                 };
-                let uses = self.slot_names(node, &sf.path(slot));
+                let ctx = SlotContext {
+                    group: g,
+                    body: &raw.name,
+                    joint,
+                };
+                let items = self.slot_items(node, &sf.path(slot), &ctx);
                 if let Some(list) = raw.slots.get_mut(g).and_then(|gr| gr.get_mut(s)) {
-                    list.extend(uses);
+                    list.extend(items);
                 }
             }
             for (_, node) in &sf.unknown {
@@ -293,43 +385,332 @@ impl Loader {
         }
     }
 
-    /// The error names of one slot: a name or a list of names.
-    fn slot_names(&mut self, node: &Node, path: &str) -> Vec<Use> {
-        self.note_error_names(node);
-        if let Some(items) = node.as_sequence() {
-            let mut uses = Vec::new();
-            for (i, item) in items.iter().enumerate() {
-                let p = index(path, i);
-                if let Some(name) = self.ident(item, &p, "error") {
-                    uses.push(Use {
-                        name,
-                        span: item.span,
-                        path: p,
-                    });
-                }
+    /// A group whose value is a scalar: `errors: iso`, or a mistake.
+    fn group_scalar(
+        &mut self,
+        raw: &mut RawBody<'_>,
+        g: usize,
+        node: &Node,
+        text: &str,
+        path: &str,
+        joint: JointState,
+    ) {
+        let group = GROUPS.get(g).map_or("errors", |(name, _)| *name);
+        if g != 1 {
+            if text == "iso" {
+                self.report(node.span, path, Problem::IsoNotAllowed { group });
+            } else {
+                self.wrong_type(node, path, "a mapping");
             }
-            return uses;
+            return;
         }
-        if node.as_scalar().is_some() {
-            return self
-                .ident(node, path, "error")
-                .map(|name| Use {
+        if text != "iso" {
+            let suggestion = closest(text, ["iso"]).map(str::to_string);
+            let found = text.to_string();
+            self.report(node.span, path, Problem::ErrorsScalar { found, suggestion });
+            return;
+        }
+        let variable = raw.joint.as_ref().and_then(|j| j.variable_text.clone());
+        match joint {
+            JointState::Absent => {
+                let body = raw.name.clone();
+                self.report(node.span, path, Problem::IsoWithoutJoint { body });
+                return;
+            }
+            JointState::Misspelt => return,
+            JointState::Present(_) => {}
+        }
+        let Some(variable) = variable else {
+            // The joint's variable is missing (reported there).
+            return;
+        };
+        let valid = raw.joint.as_ref().is_some_and(|j| j.variable.is_some());
+        for (s, names) in raw.slots.get_mut(1).into_iter().flatten().enumerate() {
+            let Some(letter) = ISO_LETTERS.get(s) else {
+                continue;
+            };
+            let name = iso_name(*letter, &variable);
+            self.seen_errors.insert(name.clone());
+            if valid {
+                names.push(Item::Iso(Use {
                     name,
                     span: node.span,
                     path: path.to_string(),
-                })
-                .into_iter()
-                .collect();
+                }));
+            }
         }
-        self.report(
-            node.span,
-            path,
-            Problem::WrongType {
-                expected: "an error name or a list of error names",
-                found: node.describe(),
-            },
-        );
-        Vec::new()
+    }
+
+    /// The items of one slot: a name, a function mapping, or a list of them.
+    fn slot_items(&mut self, node: &Node, path: &str, ctx: &SlotContext<'_>) -> Vec<Item> {
+        self.note_error_names(node);
+        if let Some(items) = node.as_sequence() {
+            let mut out = Vec::new();
+            for (i, item) in items.iter().enumerate() {
+                let p = index(path, i);
+                if item.as_sequence().is_some() {
+                    self.wrong_type(item, &p, ctx.expected());
+                    continue;
+                }
+                out.extend(self.slot_item(item, &p, ctx));
+            }
+            return out;
+        }
+        self.slot_item(node, path, ctx).into_iter().collect()
+    }
+
+    /// One item of a slot: a name or (in `errors`) a function mapping.
+    fn slot_item(&mut self, node: &Node, path: &str, ctx: &SlotContext<'_>) -> Option<Item> {
+        if node.as_scalar().is_some() {
+            let name = self.ident(node, path, "error")?;
+            return Some(Item::Name(Use {
+                name,
+                span: node.span,
+                path: path.to_string(),
+            }));
+        }
+        if node.as_mapping().is_none() {
+            self.wrong_type(node, path, ctx.expected());
+            return None;
+        }
+        let refused = |l: &mut Loader, problem: Option<Problem>| {
+            l.note_function_name(node);
+            if let Some(p) = problem {
+                l.report(node.span, path, p);
+            }
+            None
+        };
+        if ctx.group != 1 {
+            let group = GROUPS.get(ctx.group).map_or("errors", |(name, _)| *name);
+            return refused(self, Some(Problem::FunctionNotAllowed { group }));
+        }
+        let kind = match ctx.joint {
+            JointState::Present(kind) => kind,
+            JointState::Misspelt => return refused(self, None),
+            JointState::Absent => {
+                let body = ctx.body.to_string();
+                return refused(self, Some(Problem::FunctionWithoutJoint { body }));
+            }
+        };
+        let function = self.function(node, path, kind, ctx.body);
+        if function.is_none() {
+            self.note_function_name(node);
+        }
+        function.map(Item::Function)
+    }
+
+    /// Remembers the `name` of a refused function mapping, so that
+    /// statistics on it or its coefficients are not reported again.
+    fn note_function_name(&mut self, node: &Node) {
+        for (k, v) in node.as_mapping().unwrap_or(&[]) {
+            if let (Some("name"), Some(name)) = (k.as_str(), v.as_str()) {
+                self.failed_functions.insert(name.to_string());
+            }
+        }
+    }
+
+    /// A function slot `{name, powers | basis, ...}` (measured-machines
+    /// spec, section 1); `kind` is the body's joint kind, if valid.
+    fn function(
+        &mut self,
+        node: &Node,
+        path: &str,
+        kind: Option<JointKind>,
+        body: &str,
+    ) -> Option<RawFunction> {
+        let before = self.errors.len();
+        let f = self.fields(node, node.span, path, FUNCTION_KEYS)?;
+        let name = match f.get("name") {
+            Some(n) => {
+                let p = f.path("name");
+                self.ident(n, &p, "function").map(|name| Use {
+                    name,
+                    span: n.span,
+                    path: p,
+                })
+            }
+            None => {
+                self.missing(&f, "name");
+                None
+            }
+        };
+        let basis = match (f.entry("powers"), f.entry("basis")) {
+            (Some(_), Some((k, _))) => {
+                let problem = Problem::Conflict {
+                    first: "powers",
+                    second: "basis",
+                };
+                self.report(k.span, f.path("basis"), problem);
+                None
+            }
+            (Some((_, p)), None) => {
+                self.not_for_basis(&f, "powers", &["degree", "range", "from", "harmonics"]);
+                self.powers(p, &f.path("powers"))
+                    .map(|powers| Basis::Powers { powers })
+            }
+            (None, Some((_, b))) => self.named_basis(&f, b, kind, body),
+            (None, None) => {
+                if !f.suggested.contains(&"powers") && !f.suggested.contains(&"basis") {
+                    self.report(node.span, path, Problem::MissingBasis);
+                }
+                None
+            }
+        };
+        if self.errors.len() != before {
+            return None;
+        }
+        Some(RawFunction {
+            name: name?,
+            basis: basis?,
+        })
+    }
+
+    /// `basis: legendre | chebyshev | fourier` and its keys.
+    fn named_basis(
+        &mut self,
+        f: &Fields<'_>,
+        node: &Node,
+        kind: Option<JointKind>,
+        body: &str,
+    ) -> Option<Basis> {
+        let path = f.path("basis");
+        let text = self.name(node, &path, "a basis name")?;
+        if text == "powers" {
+            let message = Message::new(
+                "unknown basis `powers`",
+                "unknown value",
+                "chain::unknown_value",
+            )
+            .help("the power basis is written `powers: [1, 2]`, without `basis`");
+            self.report(node.span, path, message.into());
+            return None;
+        }
+        match self.choice(node, &path, text, "basis", BASES)? {
+            "fourier" => {
+                self.not_for_basis(f, "fourier", &["degree", "range", "from"]);
+                if kind == Some(JointKind::Prismatic) {
+                    let body = body.to_string();
+                    self.report(node.span, path, Problem::FourierOnPrismatic { body });
+                }
+                let harmonics = self.required_order(f, "harmonics", "the harmonic count");
+                Some(Basis::Fourier {
+                    harmonics: harmonics?,
+                })
+            }
+            basis => {
+                self.not_for_basis(f, basis, &["harmonics"]);
+                let degree = self.required_order(f, "degree", "the degree");
+                let range = self.basis_range(f, basis);
+                let from = match f.get("from") {
+                    Some(n) => {
+                        let p = f.path("from");
+                        let from = self.order(n, &p, "`from`")?;
+                        if let Some(degree) = degree.filter(|&d| from > d) {
+                            self.report(n.span, p, Problem::FromAboveDegree { from, degree });
+                            return None;
+                        }
+                        from
+                    }
+                    None => 0,
+                };
+                let (degree, range) = (degree?, range?);
+                Some(if basis == "legendre" {
+                    Basis::Legendre {
+                        degree,
+                        range,
+                        from,
+                    }
+                } else {
+                    Basis::Chebyshev {
+                        degree,
+                        range,
+                        from,
+                    }
+                })
+            }
+        }
+    }
+
+    /// Reports each of `keys` present in `f` as not applying to `basis`.
+    fn not_for_basis(&mut self, f: &Fields<'_>, basis: &'static str, keys: &[&'static str]) {
+        for &key in keys {
+            if let Some((k, _)) = f.entry(key) {
+                self.report(k.span, f.path(key), Problem::KeyNotForBasis { key, basis });
+            }
+        }
+    }
+
+    /// `range: [lo, hi]`, finite, `lo < hi`.
+    fn basis_range(&mut self, f: &Fields<'_>, basis: &'static str) -> Option<[f64; 2]> {
+        let Some(node) = f.get("range") else {
+            if !f.suggested.contains(&"range") {
+                self.report(f.owner, f.path.clone(), Problem::MissingRange { basis });
+            }
+            return None;
+        };
+        let path = f.path("range");
+        let [a, b] = self.items(node, &path, "a range `[lo, hi]`")?;
+        let lo = self.finite(a, &index(&path, 0), "a range end");
+        let hi = self.finite(b, &index(&path, 1), "a range end");
+        let (lo, hi) = (lo?, hi?);
+        if lo >= hi {
+            self.report(node.span, path, Problem::RangeOrder { lo, hi });
+            return None;
+        }
+        Some([lo, hi])
+    }
+
+    /// `powers: [k, ...]`: non-empty, distinct orders.
+    fn powers(&mut self, node: &Node, path: &str) -> Option<Vec<u32>> {
+        let Some(items) = node.as_sequence() else {
+            self.wrong_type(node, path, "a list of powers");
+            return None;
+        };
+        if items.is_empty() {
+            let what = "the power list";
+            self.report(node.span, path, Problem::EmptyList { what });
+            return None;
+        }
+        // (power, item index) of each valid item.
+        let mut seen: Vec<(u32, usize)> = Vec::with_capacity(items.len());
+        let mut complete = true;
+        for (i, item) in items.iter().enumerate() {
+            let p = index(path, i);
+            let Some(k) = self.order(item, &p, "a power") else {
+                complete = false;
+                continue;
+            };
+            if let Some(&(_, first)) = seen.iter().find(|(power, _)| *power == k) {
+                self.report(item.span, p, Problem::DuplicatePower { power: k, first });
+                complete = false;
+            } else {
+                seen.push((k, i));
+            }
+        }
+        let powers = seen.into_iter().map(|(k, _)| k).collect();
+        complete.then_some(powers)
+    }
+
+    /// A required order (`degree`, `harmonics`).
+    fn required_order(
+        &mut self,
+        f: &Fields<'_>,
+        key: &'static str,
+        what: &'static str,
+    ) -> Option<u32> {
+        let node = self.required(f, key)?;
+        self.order(node, &f.path(key), what)
+    }
+
+    /// A whole number from 0 to [`MAX_ORDER`].
+    fn order(&mut self, node: &Node, path: &str, what: &'static str) -> Option<u32> {
+        let value = self.number(node, path)?;
+        if value.fract() == 0.0 && (0.0..=f64::from(MAX_ORDER)).contains(&value) {
+            // Exact: a whole number from 0 to 12.
+            return Some(value as u32);
+        }
+        self.report(node.span, path, Problem::BadOrder { what, value });
+        None
     }
 
     /// `joint: {type, axis, variable}`.
@@ -338,6 +719,7 @@ impl Loader {
             kind: None,
             axis: None,
             variable: None,
+            variable_text: None,
             span: key.span,
             path: path.to_string(),
         };
@@ -365,6 +747,7 @@ impl Loader {
             Some(n) => {
                 if let Some(s) = n.as_str() {
                     self.seen_variables.insert(s.to_string());
+                    j.variable_text = Some(s.to_string());
                 }
                 let p = f.path("variable");
                 j.variable = self.ident(n, &p, "variable").map(|name| Use {
@@ -673,24 +1056,34 @@ impl Loader {
         (variables, of_body)
     }
 
-    /// Error parameters in order of first use, and each body's slots
-    /// (`location_errors`, `errors` + `squareness`), by file index.
+    /// Error parameters in order of first use, the function slots in order
+    /// of first declaration, and each body's slots (`location_errors`,
+    /// `errors` + `squareness`), by file index.
     fn errors(
         &mut self,
         raws: &[RawBody<'_>],
         order: &[usize],
-    ) -> (Vec<ErrorParam>, Vec<(ErrorSlots, ErrorSlots)>) {
-        let variable_names: HashSet<String> = raws
-            .iter()
-            .filter_map(|r| r.joint.as_ref()?.variable.as_ref().map(|u| u.name.clone()))
-            .collect();
-        let mut errors: Vec<ErrorParam> = Vec::new();
-        let mut by_name: HashMap<String, usize> = HashMap::new();
+        variables: &[Variable],
+        var_of_body: &[Option<usize>],
+    ) -> (
+        Vec<ErrorParam>,
+        Vec<ErrorFunction>,
+        Vec<(ErrorSlots, ErrorSlots)>,
+    ) {
+        let mut r = Registry {
+            variable_names: raws
+                .iter()
+                .filter_map(|r| r.joint.as_ref()?.variable.as_ref().map(|u| u.name.clone()))
+                .collect(),
+            variables,
+            ..Registry::default()
+        };
         let mut slots = vec![(ErrorSlots::default(), ErrorSlots::default()); raws.len()];
         for &old in order {
             let Some(raw) = raws.get(old) else { continue };
+            let variable = var_of_body.get(old).copied().flatten();
             for (g, group) in raw.slots.iter().enumerate() {
-                for (s, uses) in group.iter().enumerate() {
+                for (s, items) in group.iter().enumerate() {
                     let Some(&slot) = Slot::ALL.get(s) else {
                         continue;
                     };
@@ -701,37 +1094,60 @@ impl Loader {
                     } else {
                         ErrorKind::Angular
                     };
-                    for u in uses {
-                        let Some(i) =
-                            self.error_use(u, kind, &mut errors, &mut by_name, &variable_names)
-                        else {
-                            continue;
-                        };
-                        let Some((loc, err)) = slots.get_mut(old) else {
-                            continue;
-                        };
-                        let target = if g == 0 { loc } else { err };
-                        if let Some(list) = target.slots.get_mut(s) {
-                            list.push(i);
+                    let mut indices = Vec::new();
+                    for item in items {
+                        match item {
+                            Item::Name(u) => indices.extend(self.error_use(u, kind, &mut r)),
+                            Item::Iso(u) => {
+                                if let Some(other) = r.iso_owner.get(&u.name) {
+                                    if *other != raw.name {
+                                        let problem = Problem::IsoClash {
+                                            name: u.name.clone(),
+                                            body: raw.name.clone(),
+                                            other: other.clone(),
+                                        };
+                                        self.report(u.span, u.path.clone(), problem);
+                                        continue;
+                                    }
+                                }
+                                r.iso_owner.insert(u.name.clone(), raw.name.clone());
+                                indices.extend(self.error_use(u, kind, &mut r));
+                            }
+                            Item::Function(f) => {
+                                // Without a valid variable the joint was
+                                // reported already.
+                                if let Some(v) = variable {
+                                    indices.extend(self.function_use(f, kind, v, &mut r));
+                                }
+                            }
                         }
+                    }
+                    let Some((loc, err)) = slots.get_mut(old) else {
+                        continue;
+                    };
+                    let target = if g == 0 { loc } else { err };
+                    if let Some(list) = target.slots.get_mut(s) {
+                        list.extend(indices);
                     }
                 }
             }
         }
-        (errors, slots)
+        (r.errors, r.functions, slots)
     }
 
     /// Registers one use of an error name; returns its index.
-    fn error_use(
-        &mut self,
-        u: &Use,
-        kind: ErrorKind,
-        errors: &mut Vec<ErrorParam>,
-        by_name: &mut HashMap<String, usize>,
-        variable_names: &HashSet<String>,
-    ) -> Option<usize> {
-        if let Some(&i) = by_name.get(&u.name) {
-            let e = errors.get_mut(i)?;
+    fn error_use(&mut self, u: &Use, kind: ErrorKind, r: &mut Registry<'_>) -> Option<usize> {
+        if r.coefficient_of.contains_key(&u.name) || r.function_by_name.contains_key(&u.name) {
+            let other = r.describe(&u.name, &self.parameter_index)?;
+            let problem = Problem::FunctionClash {
+                what: format!("error parameter `{}`", u.name),
+                other,
+            };
+            self.report(u.span, u.path.clone(), problem);
+            return None;
+        }
+        if let Some(&i) = r.by_name.get(&u.name) {
+            let e = r.errors.get_mut(i)?;
             let linear = |k: ErrorKind| k == ErrorKind::Linear;
             if linear(e.kind) != linear(kind) {
                 let problem = Problem::ErrorKindConflict {
@@ -758,7 +1174,7 @@ impl Loader {
                     other: "parameter",
                 },
             );
-        } else if variable_names.contains(&u.name) {
+        } else if r.variable_names.contains(&u.name) {
             self.report(
                 u.span,
                 u.path.clone(),
@@ -769,13 +1185,230 @@ impl Loader {
                 },
             );
         }
-        let i = errors.len();
-        by_name.insert(u.name.clone(), i);
-        errors.push(ErrorParam {
+        Some(r.push(ErrorParam {
             name: u.name.clone(),
             kind,
             origin: u.span.origin(u.path.clone()),
+        }))
+    }
+
+    /// Registers one declaration of a function slot on the joint driven by
+    /// variable `variable`, in a slot of `kind`; returns its coefficients'
+    /// indices (empty if refused).
+    fn function_use(
+        &mut self,
+        f: &RawFunction,
+        kind: ErrorKind,
+        variable: usize,
+        r: &mut Registry<'_>,
+    ) -> Vec<usize> {
+        let name = &f.name.name;
+        if let Some(&fi) = r.function_by_name.get(name) {
+            let Some(first) = r.functions.get(fi) else {
+                return Vec::new();
+            };
+            let first_kind = first
+                .coefficients
+                .first()
+                .and_then(|(j, _)| r.errors.get(*j))
+                .map(|e| e.kind);
+            let difference = if first.basis != f.basis {
+                Some(format!(
+                    "with a different basis ({} here, {} first)",
+                    describe_basis(&f.basis),
+                    describe_basis(&first.basis)
+                ))
+            } else if first.variable != variable {
+                let var = |i: usize| r.variables.get(i).map_or("?", |v| v.name.as_str());
+                Some(format!(
+                    "on another axis (variable `{}` here, `{}` first)",
+                    var(variable),
+                    var(first.variable)
+                ))
+            } else if first_kind
+                .is_some_and(|k| (k == ErrorKind::Linear) != (kind == ErrorKind::Linear))
+            {
+                Some(format!(
+                    "in a slot of another kind ({} here, {} first)",
+                    slot_kind(kind),
+                    slot_kind(first_kind.unwrap_or(kind))
+                ))
+            } else {
+                None
+            };
+            if let Some(difference) = difference {
+                let problem = Problem::FunctionRedeclared {
+                    name: name.clone(),
+                    difference,
+                    first_line: first.origin.line,
+                };
+                self.report(f.name.span, f.name.path.clone(), problem);
+                return Vec::new();
+            }
+            return first.coefficients.iter().map(|(j, _)| *j).collect();
+        }
+
+        // A new function: its name and every coefficient's must be new.
+        let terms = f.basis.terms();
+        let names: Vec<String> = terms
+            .iter()
+            .map(|t| format!("{name}_{}", t.suffix()))
+            .collect();
+        let mut clashes = Vec::new();
+        if let Some(other) = r.describe(name, &self.parameter_index) {
+            clashes.push((format!("function `{name}`"), other));
+        }
+        for c in &names {
+            if let Some(other) = r.describe(c, &self.parameter_index) {
+                clashes.push((format!("coefficient `{c}` of function `{name}`"), other));
+            }
+        }
+        if !clashes.is_empty() {
+            for (what, other) in clashes {
+                self.report(
+                    f.name.span,
+                    f.name.path.clone(),
+                    Problem::FunctionClash { what, other },
+                );
+            }
+            self.failed_functions.insert(name.clone());
+            return Vec::new();
+        }
+        let origin = f.name.span.origin(f.name.path.clone());
+        let coefficients: Vec<(usize, crate::model::BasisFn)> = names
+            .into_iter()
+            .zip(terms)
+            .map(|(c, t)| {
+                r.coefficient_of.insert(c.clone(), name.clone());
+                let j = r.push(ErrorParam {
+                    name: c,
+                    kind,
+                    origin: origin.clone(),
+                });
+                (j, t)
+            })
+            .collect();
+        r.function_by_name.insert(name.clone(), r.functions.len());
+        let indices = coefficients.iter().map(|(j, _)| *j).collect();
+        r.functions.push(ErrorFunction {
+            name: name.clone(),
+            basis: f.basis.clone(),
+            variable,
+            coefficients,
+            origin,
         });
-        Some(i)
+        indices
+    }
+}
+
+/// The error parameters and function slots found so far, in the walk over
+/// the bodies of [`Loader::errors`].
+#[derive(Default)]
+struct Registry<'v> {
+    errors: Vec<ErrorParam>,
+    /// Error name → index into `errors`.
+    by_name: HashMap<String, usize>,
+    functions: Vec<ErrorFunction>,
+    /// Function name → index into `functions`.
+    function_by_name: HashMap<String, usize>,
+    /// Coefficient name → its function's name.
+    coefficient_of: HashMap<String, String>,
+    /// Name given by `errors: iso` → the body whose `iso` gave it.
+    iso_owner: HashMap<String, String>,
+    /// Every variable name written in a joint.
+    variable_names: HashSet<String>,
+    /// The valid variables.
+    variables: &'v [Variable],
+}
+
+impl Registry<'_> {
+    /// Adds an error parameter; returns its index.
+    fn push(&mut self, e: ErrorParam) -> usize {
+        let i = self.errors.len();
+        self.by_name.insert(e.name.clone(), i);
+        self.errors.push(e);
+        i
+    }
+
+    /// What `name` already is, if anything: an error parameter, a
+    /// coefficient, a function, a parameter or an axis variable (for the
+    /// messages of [`Problem::FunctionClash`]).
+    fn describe(&self, name: &str, parameters: &HashMap<String, usize>) -> Option<String> {
+        if let Some(function) = self.coefficient_of.get(name) {
+            let line = self
+                .function_by_name
+                .get(function)
+                .and_then(|&i| self.functions.get(i))
+                .map_or(0, |f| f.origin.line);
+            return Some(format!(
+                "a coefficient of function `{function}` (declared on line {line})"
+            ));
+        }
+        if let Some(f) = self
+            .function_by_name
+            .get(name)
+            .and_then(|&i| self.functions.get(i))
+        {
+            return Some(format!(
+                "function `{name}` (declared on line {})",
+                f.origin.line
+            ));
+        }
+        if let Some(e) = self.by_name.get(name).and_then(|&i| self.errors.get(i)) {
+            return Some(format!(
+                "the error parameter `{name}` (first used on line {})",
+                e.origin.line
+            ));
+        }
+        if parameters.contains_key(name) {
+            return Some(format!("the parameter `{name}`"));
+        }
+        if self.variable_names.contains(name) {
+            return Some(format!("the axis variable `{name}`"));
+        }
+        None
+    }
+}
+
+/// A basis as it is written, for messages: `powers [1, 2]`, `legendre
+/// degree 3 on [0, 1000]`, `fourier with 2 harmonics`.
+fn describe_basis(basis: &Basis) -> String {
+    match basis {
+        Basis::Powers { powers } => {
+            let list: Vec<String> = powers.iter().map(u32::to_string).collect();
+            format!("powers [{}]", list.join(", "))
+        }
+        Basis::Legendre {
+            degree,
+            range,
+            from,
+        }
+        | Basis::Chebyshev {
+            degree,
+            range,
+            from,
+        } => {
+            let from = if *from == 0 {
+                String::new()
+            } else {
+                format!(" from {from}")
+            };
+            format!(
+                "{} degree {degree}{from} on [{}, {}]",
+                basis.name(),
+                range[0],
+                range[1]
+            )
+        }
+        Basis::Fourier { harmonics } => format!("fourier with {harmonics} harmonics"),
+    }
+}
+
+/// The kind of a slot, for messages.
+fn slot_kind(kind: ErrorKind) -> &'static str {
+    if kind == ErrorKind::Linear {
+        "a linear slot (dx, dy, dz)"
+    } else {
+        "an angular slot (ex, ey, ez)"
     }
 }

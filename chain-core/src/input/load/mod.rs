@@ -17,7 +17,10 @@
 //! - variables in that body order;
 //! - errors in order of first use, walking the bodies in that order and,
 //!   within a body, `location_errors` (`dx..ez`), then `errors` (`dx..ez`),
-//!   then `squareness` (`ex, ey, ez`);
+//!   then `squareness` (`ex, ey, ez`); a function slot's coefficients in
+//!   its basis order at the place of its first use, `errors: iso` as the
+//!   six slots `dx..ez`;
+//! - function slots in order of first declaration, in the same walk;
 //! - parameters, statistics, reliability tolerances and grid axes in file
 //!   order.
 
@@ -51,6 +54,10 @@ pub const TOP_KEYS: &[&str] = &[
     "statistics",
     "reliability",
 ];
+
+/// The highest degree, harmonic count or power of a function slot
+/// (measured-machines spec, section 1).
+pub const MAX_ORDER: u32 = 12;
 
 /// Names the expression language reserves.
 pub const RESERVED: &[&str] = &["pi", "sin", "cos"];
@@ -227,6 +234,9 @@ struct Loader {
     seen_variables: HashSet<String>,
     /// Error names seen in any slot, valid or not (no-cascade checks).
     seen_errors: HashSet<String>,
+    /// Names of function slots that were refused (already reported): neither
+    /// they nor `<name>_…` are reported again in `statistics`.
+    failed_functions: HashSet<String>,
 }
 
 impl TreeReader for Loader {

@@ -86,17 +86,25 @@ impl Loader {
             let path = join("statistics", name);
             let error = error_index.get(name).copied();
             if let Some(t) = tree {
-                if error.is_none() && !self.seen_errors.contains(name) {
-                    let suggestion =
-                        closest(name, t.errors.iter().map(|e| e.name.as_str())).map(str::to_string);
-                    self.report(
-                        k.span,
-                        path.clone(),
-                        Problem::UnknownError {
+                if error.is_none() && !self.seen_errors.contains(name) && !self.refused(name) {
+                    let problem = match t.functions.iter().find(|f| f.name == name) {
+                        // A function's name: its coefficients take statistics.
+                        Some(f) => Problem::FunctionStatistics {
                             name: name.to_string(),
-                            suggestion,
+                            coefficients: f
+                                .coefficients
+                                .iter()
+                                .filter_map(|(j, _)| t.errors.get(*j))
+                                .map(|e| e.name.clone())
+                                .collect(),
                         },
-                    );
+                        None => Problem::UnknownError {
+                            name: name.to_string(),
+                            suggestion: closest(name, t.errors.iter().map(|e| e.name.as_str()))
+                                .map(str::to_string),
+                        },
+                    };
+                    self.report(k.span, path.clone(), problem);
                 }
             }
             let entry = self.statistic(k, v, &path);
@@ -112,6 +120,17 @@ impl Loader {
             }
         }
         complete.then_some(out)
+    }
+
+    /// True for the name of a refused function slot or one of its possible
+    /// coefficients `<name>_…`: already reported where it was declared.
+    fn refused(&self, name: &str) -> bool {
+        self.failed_functions.iter().any(|f| {
+            name == f
+                || name
+                    .strip_prefix(f.as_str())
+                    .is_some_and(|rest| rest.starts_with('_'))
+        })
     }
 
     /// An optional number-valued key: `None` if absent, `Some(None)` if
