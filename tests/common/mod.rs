@@ -15,8 +15,14 @@
 //! `frame: tool`. The first-order model is the derivative of these at `e = 0`,
 //! which [`Exact::fd_sensitivity`] estimates by a 5-point central difference.
 //!
+//! A function slot (measured-machines spec, section 1) holds
+//! `F(q) = Σ_k F_k b_k(q)` of its body's own variable; its value enters `E`
+//! like any slot value, with `b_k(q)` from `BasisFn::value` (numeric
+//! recurrences and `cos`/`sin`, not the symbolic engine's polynomials).
+//!
 //! It reads the validated [`Machine`] directly and shares no code with
-//! `chain-core`'s derivation (only `Expr::eval` for offsets and tool points).
+//! `chain-core`'s derivation (only `Expr::eval` for offsets and tool points
+//! and `BasisFn::value` for function slots).
 //!
 //! Index conventions inside this module: `q` is indexed like
 //! `machine.variables`, `p` like `machine.parameters`, `e` like
@@ -32,7 +38,9 @@
 pub mod cli;
 pub mod wang_yuan_2021;
 
-use chain_core::model::{ErrorSlots, Frame, JointKind, Machine};
+use chain_core::model::{
+    Basis, ErrorFunction, ErrorKind, ErrorParam, ErrorSlots, Frame, JointKind, Machine, Slot,
+};
 use chain_core::ErrorModel;
 
 /// Row-major 3×3 matrix.
@@ -227,9 +235,27 @@ impl<'m> Exact<'m> {
             .collect()
     }
 
-    /// Summed slot values of an error-slot set.
-    fn slot_values(slots: &ErrorSlots, e: &[f64]) -> [f64; 6] {
-        std::array::from_fn(|s| slots.slots[s].iter().map(|&j| e[j]).sum())
+    /// The weight of error `j` at `q`: `b_k(q_v)` if it is the coefficient of
+    /// basis function `b_k` of a function slot of variable `v`, else 1.
+    pub fn weight(&self, j: usize, q: &[f64]) -> f64 {
+        for f in &self.machine.functions {
+            for (k, b) in &f.coefficients {
+                if *k == j {
+                    return b.value(q[f.variable]);
+                }
+            }
+        }
+        1.0
+    }
+
+    /// Summed slot values of an error-slot set: `Σ_j w_j(q)·e_j` per slot.
+    fn slot_values(&self, slots: &ErrorSlots, q: &[f64], e: &[f64]) -> [f64; 6] {
+        std::array::from_fn(|s| {
+            slots.slots[s]
+                .iter()
+                .map(|&j| self.weight(j, q) * e[j])
+                .sum()
+        })
     }
 
     /// `T(parent -> body)`, exact.
@@ -242,7 +268,7 @@ impl<'m> Exact<'m> {
         }
         t = mul4(
             &t,
-            &error_transform(Self::slot_values(&body.location_errors, e)),
+            &error_transform(self.slot_values(&body.location_errors, q, e)),
         );
         if let Some(joint) = &body.joint {
             let k = joint.axis.axis.index();
@@ -257,7 +283,7 @@ impl<'m> Exact<'m> {
             };
             t = mul4(&t, &j);
         }
-        mul4(&t, &error_transform(Self::slot_values(&body.errors, e)))
+        mul4(&t, &error_transform(self.slot_values(&body.errors, q, e)))
     }
 
     /// `P(b)`: the product of the body transforms from the root to `b`
@@ -330,6 +356,9 @@ impl<'m> Exact<'m> {
         let mut out = vec![0.0; 6 * n];
         let mut e = vec![0.0; n];
         for j in 0..n {
+            // A coefficient moves its slot by w_j(q)·e_j: the step is scaled so
+            // that the slot moves by h (1 for constant errors: unchanged).
+            let h = h / self.weight(j, q).abs().max(1.0);
             let mut at = |s: f64| {
                 e[j] = s * h;
                 let v = self.exact_error_in(frame, q, p, &e);
@@ -409,7 +438,8 @@ impl<'m> Exact<'m> {
     }
 
     /// Compares the model's sensitivity with the finite difference of the exact
-    /// product: `|model - fd| <= rel · max(|model|, |fd|) + floor · scale`.
+    /// product: `|model - fd| <= rel · max(|model|, |fd|) + floor · scale · w_j`
+    /// (`w_j = max(1, |b_k(q)|)` for a coefficient, 1 for a constant error).
     /// Returns a description of the first mismatch.
     pub fn check_sensitivity<M: ErrorModel + ?Sized>(
         &self,
@@ -423,8 +453,11 @@ impl<'m> Exact<'m> {
         let s = self.model_sensitivity(model, q, p);
         let fd = self.fd_sensitivity(q, p, 1e-3);
         let scale = self.length_scale(q, p);
-        for c in 0..6 {
-            for j in 0..n {
+        for j in 0..n {
+            // A coefficient's column is its weight times a plain error's:
+            // so is the floor (1 for constant errors: unchanged).
+            let floor = floor * self.weight(j, q).abs().max(1.0);
+            for c in 0..6 {
                 let (a, b) = (s[c * n + j], fd[c * n + j]);
                 let tol = rel * a.abs().max(b.abs()) + floor * scale;
                 if !within(a - b, tol) {
@@ -623,4 +656,87 @@ pub fn within(d: f64, tol: f64) -> bool {
 /// `|a - b| <= rel · max(|a|, |b|) + abs` (false if either is NaN).
 pub fn close(a: f64, b: f64, rel: f64, abs: f64) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()) + abs
+}
+
+/// A copy of `machine` in which the motion errors that `choose` picks become
+/// function slots, built by hand (no loader): `choose(machine, body, slot,
+/// error)` is asked for every linear or angular error that occurs exactly
+/// once in the whole machine, in the `errors` of a jointed body, and returns
+/// the basis of its function (named after the error) or `None` to keep it
+/// constant. The function's coefficients `<name>_<suffix>` take the error's
+/// place in `Machine::errors` and in its slot, of the error's kind; the
+/// error's statistics entry (if any) is dropped.
+pub fn with_function_slots(
+    machine: &Machine,
+    mut choose: impl FnMut(&Machine, usize, Slot, usize) -> Option<Basis>,
+) -> Machine {
+    let n = machine.errors.len();
+    let mut uses = vec![0usize; n];
+    for b in &machine.bodies {
+        for slots in [&b.location_errors, &b.errors] {
+            for slot in &slots.slots {
+                for &j in slot {
+                    uses[j] += 1;
+                }
+            }
+        }
+    }
+    // Basis (and variable) per error to convert.
+    let mut convert: Vec<Option<(Basis, usize)>> = vec![None; n];
+    for (b, body) in machine.bodies.iter().enumerate() {
+        let Some(joint) = &body.joint else { continue };
+        for slot in Slot::ALL {
+            for &j in &body.errors.slots[slot.index()] {
+                let kind = machine.errors[j].kind;
+                if uses[j] == 1 && kind != ErrorKind::Squareness {
+                    if let Some(basis) = choose(machine, b, slot, j) {
+                        convert[j] = Some((basis, joint.variable));
+                    }
+                }
+            }
+        }
+    }
+    let mut m = machine.clone();
+    m.errors.clear();
+    m.functions.clear();
+    let mut map: Vec<Vec<usize>> = Vec::with_capacity(n);
+    for (j, e) in machine.errors.iter().enumerate() {
+        match &convert[j] {
+            None => {
+                map.push(vec![m.errors.len()]);
+                m.errors.push(e.clone());
+            }
+            Some((basis, variable)) => {
+                let mut coefficients = Vec::new();
+                for b in basis.terms() {
+                    coefficients.push((m.errors.len(), b));
+                    m.errors.push(ErrorParam {
+                        name: format!("{}_{}", e.name, b.suffix()),
+                        kind: e.kind,
+                        origin: e.origin.clone(),
+                    });
+                }
+                map.push(coefficients.iter().map(|(k, _)| *k).collect());
+                m.functions.push(ErrorFunction {
+                    name: e.name.clone(),
+                    basis: basis.clone(),
+                    variable: *variable,
+                    coefficients,
+                    origin: e.origin.clone(),
+                });
+            }
+        }
+    }
+    for body in &mut m.bodies {
+        for slots in [&mut body.location_errors, &mut body.errors] {
+            for slot in &mut slots.slots {
+                *slot = slot.iter().flat_map(|&j| map[j].iter().copied()).collect();
+            }
+        }
+    }
+    m.statistics.retain(|s| convert[s.error].is_none());
+    for s in &mut m.statistics {
+        s.error = map[s.error][0];
+    }
+    m
 }

@@ -9,9 +9,25 @@
 //! the slopes of `T_wt·tool_point` and of `R_wt(q,e)·R_wt(q,0)ᵀ` are the
 //! position and orientation coefficients. Nothing is differentiated
 //! numerically.
+//!
+//! A function slot (measured-machines spec, section 1) holds
+//! `F(q) = Σ_k F_k b_k(q)`; its coefficient `F_k` enters the slot with the
+//! weight `b_k(q)`, a nominal (error-free) polynomial of the body's own
+//! variable. The first-order model is linear in the slot values, so
+//! `∂E/∂F_k = b_k(q) · ∂E/∂(slot)`: every coefficient of one function has the
+//! coefficient a plain error in the same slots would have, times its basis
+//! function. [`derive_in`] uses exactly that: errors that occur in the same
+//! slots (with the same multiplicities) are carried through the transform
+//! product once, by one representative with unit weight, and each error's
+//! coefficient is the representative's times its weight
+//! ([`crate::algebra::error_weight`]). The differential-motion-matrix route
+//! ([`crate::dmm`]) keeps the weights inside its product, so the two routes
+//! cross-check this factoring too.
 
-use crate::algebra::{expr_to_poly, fixed_rotation, index_u16, Dual, Poly, Symbol, Transform};
-use crate::model::{Component, ErrorKind, ErrorSlots, Frame, JointKind, Machine};
+use crate::algebra::{
+    error_weight, expr_to_poly, fixed_rotation, index_u16, Dual, Poly, Symbol, Transform,
+};
+use crate::model::{Component, ErrorFunction, ErrorKind, ErrorSlots, Frame, JointKind, Machine};
 
 /// The exact first-order error model of a machine.
 ///
@@ -40,6 +56,10 @@ pub struct SymbolicModel {
     pub nominal_position: [Poly; 3],
     /// Sparse coefficients per component.
     pub components: [Vec<(usize, Poly)>; 6],
+    /// The machine's function slots (variable and coefficient indices as in
+    /// [`SymbolicModel::variables`] and [`SymbolicModel::errors`]); empty
+    /// for a machine without any. The exports list them.
+    pub functions: Vec<ErrorFunction>,
 }
 
 impl SymbolicModel {
@@ -100,7 +120,88 @@ pub fn derive(machine: &Machine) -> SymbolicModel {
 }
 
 /// Derives the machine's error model in the given frame.
+///
+/// On a machine with function slots, the coefficient of `F_k` is the exact
+/// product `b_k(q) · c(q)` of its basis function with the coefficient `c`
+/// of its slot (module docs); the errors sharing a slot are derived once.
 pub fn derive_in(machine: &Machine, frame: Frame) -> SymbolicModel {
+    if machine.functions.is_empty() {
+        return derive_direct(machine, frame);
+    }
+    let representative = representatives(machine);
+    let plain = derive_direct(&reduced(machine, &representative), frame);
+    let mut components: [Vec<(usize, Poly)>; 6] = Default::default();
+    let weights: Vec<Option<Poly>> = (0..machine.errors.len())
+        .map(|j| machine.coefficient_of(j).map(|_| error_weight(machine, j)))
+        .collect();
+    for (c, out) in components.iter_mut().enumerate() {
+        let c = Component::ALL[c];
+        for (j, (&r, weight)) in representative.iter().zip(&weights).enumerate() {
+            let base = plain.coefficient(c, r);
+            let value = match weight {
+                Some(w) => base.mul(w),
+                None => base,
+            };
+            if !value.is_zero() {
+                out.push((j, value));
+            }
+        }
+    }
+    SymbolicModel {
+        components,
+        functions: machine.functions.clone(),
+        ..plain
+    }
+}
+
+/// Per error, the first error (a representative) that occurs in exactly the
+/// same slots with the same multiplicities: such errors have the same
+/// coefficient up to their weights.
+fn representatives(machine: &Machine) -> Vec<usize> {
+    // Occurrences as (body, section, slot), in a fixed order; duplicates kept.
+    let mut occurrences: Vec<Vec<(usize, usize, usize)>> = vec![Vec::new(); machine.errors.len()];
+    for (b, body) in machine.bodies.iter().enumerate() {
+        for (section, slots) in [&body.location_errors, &body.errors]
+            .into_iter()
+            .enumerate()
+        {
+            for (s, slot) in slots.slots.iter().enumerate() {
+                for &j in slot {
+                    if let Some(o) = occurrences.get_mut(j) {
+                        o.push((b, section, s));
+                    }
+                }
+            }
+        }
+    }
+    let mut first: std::collections::HashMap<&[(usize, usize, usize)], usize> =
+        std::collections::HashMap::new();
+    occurrences
+        .iter()
+        .enumerate()
+        .map(|(j, o)| *first.entry(o.as_slice()).or_insert(j))
+        .collect()
+}
+
+/// The machine with unit weights (no function slots) and only the
+/// representatives in its slots: every other error of a class is dropped
+/// from each slot, which keeps the representative's own multiplicity there.
+fn reduced(machine: &Machine, representative: &[usize]) -> Machine {
+    let mut m = machine.clone();
+    m.functions.clear();
+    for body in &mut m.bodies {
+        for slots in [&mut body.location_errors, &mut body.errors] {
+            for slot in &mut slots.slots {
+                slot.retain(|&j| representative.get(j) == Some(&j));
+            }
+        }
+    }
+    m
+}
+
+/// The derivation proper, every error carried through the transform product
+/// with its slot weight.
+fn derive_direct(machine: &Machine, frame: Frame) -> SymbolicModel {
     let t_wt = tool_in_workpiece(machine);
     let tool_point: [Dual; 3] =
         std::array::from_fn(|i| Dual::nominal(expr_to_poly(&machine.tool_point[i])));
@@ -152,6 +253,7 @@ pub fn derive_in(machine: &Machine, frame: Frame) -> SymbolicModel {
         nominal_rotation: r0,
         nominal_position: std::array::from_fn(|i| position[i].value.clone()),
         components,
+        functions: machine.functions.clone(),
     }
 }
 

@@ -195,9 +195,55 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
         model.frame.name()
     );
     let vars_doc = format!(" Axis variables, in `q` order: {}.", var_names.join(", "));
+    // Function slots: their definitions in the type's docs and `error_at`, a
+    // built machine's error from error values that vary along the axes.
+    // Machines without function slots generate exactly what they did before.
+    let function_docs: Vec<String> = if model.functions.is_empty() {
+        Vec::new()
+    } else {
+        std::iter::once(String::new())
+            .chain(std::iter::once(
+                " Error motions that vary along their axis (their coefficients are errors):"
+                    .to_string(),
+            ))
+            .chain(
+                model
+                    .functions
+                    .iter()
+                    .map(|f| format!(" - `{}`", crate::export::function_text(model, f))),
+            )
+            .collect()
+    };
+    let error_at = if model.functions.is_empty() {
+        TokenStream::new()
+    } else {
+        quote! {
+            /// The error `[px, py, pz, ox, oy, oz]` of a built machine at `q`:
+            /// `E(q) = Σ_j c_j(q)·v_j(q)`, with the error values `v(q)` from
+            /// `values` (a closure `|q: &[f64], e: &mut [f64]| …` or any
+            /// `ErrorValues`, e.g. a values file) in `ERRORS` order; the
+            /// scratch is a stack array.
+            ///
+            /// # Errors
+            ///
+            /// `OutOfRange` when `values` has no value at `q` (a measured
+            /// table that does not cover it).
+            #[inline]
+            pub fn error_at(
+                q: &[f64; #v],
+                p: &[f64; #p],
+                values: &(impl #krate::core::ErrorValues + ?Sized),
+            ) -> ::core::result::Result<[f64; 6], #krate::core::OutOfRange> {
+                let mut e = [0.0f64; #n];
+                #krate::core::ErrorValues::values_at(values, q, &mut e)?;
+                ::core::result::Result::Ok(Self::error(q, p, &e))
+            }
+        }
+    };
 
     quote! {
         #[doc = #type_doc]
+        #(#[doc = #function_docs])*
         #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
         #vis struct #ty;
 
@@ -222,6 +268,8 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
                 #err_prelude
                 [#(#err_rows),*]
             }
+
+            #error_at
 
             /// The sensitivity matrix `s[c][j] = ∂E_c/∂e_j` (rows `px, py, pz, ox, oy, oz`):
             ///

@@ -6,6 +6,13 @@
 //! ...), then one slot per distinct monomial; each monomial is the product of a
 //! shorter monomial and one symbol, so shared sub-products are computed once.
 //! Every output is a short dot product of coefficients with monomial registers.
+//!
+//! Every symbol a model uses gets a register: besides the ones loaded up front
+//! (each prismatic variable, `cos`/`sin` of each rotary variable, each
+//! parameter) a symbol first met in a monomial is loaded then. That is how the
+//! value `A` of a rotary variable reaches the tape when a powers, Legendre or
+//! Chebyshev function slot varies along a rotary axis (measured-machines spec,
+//! section 1: the slot is a polynomial in the variable's value).
 
 use std::collections::{HashMap, HashSet};
 use std::sync::Mutex;
@@ -218,6 +225,15 @@ impl TapeBuilder {
         self.monomial_reg.insert(Monomial::symbol(s), to_u32(r));
     }
 
+    /// The register of a symbol, loading it on first use.
+    fn symbol(&mut self, s: Symbol) -> u32 {
+        if let Some(&r) = self.symbol_reg.get(&s) {
+            return r;
+        }
+        self.load(s);
+        to_u32(self.registers - 1)
+    }
+
     fn monomial(&mut self, m: &Monomial) -> u32 {
         if m.is_one() {
             return 0;
@@ -230,7 +246,11 @@ impl TapeBuilder {
             return 0;
         };
         let a = self.monomial(&parent);
-        let b = self.symbol_reg.get(&sym).copied().unwrap_or(0);
+        let b = self.symbol(sym);
+        if a == 0 {
+            // A single symbol (first met here, or the caller asked for it).
+            return b;
+        }
         let dst = to_u32(self.registers);
         self.registers += 1;
         self.products.push((dst, a, b));

@@ -35,7 +35,7 @@
 
 use serde::Serialize;
 
-use crate::model::{Component, ErrorKind, Machine};
+use crate::model::{BasisFn, Component, ErrorKind, Machine};
 use crate::ErrorModel;
 
 /// One degree in radians.
@@ -75,11 +75,18 @@ impl NominalSizes {
 
     /// `e_v` for every error of the machine, in `machine.errors` order (the
     /// order of the compiled model's [`ErrorModel::errors`]).
+    ///
+    /// The coefficient `F_k` of a function slot (measured-machines spec,
+    /// section 1) moves its slot by `F_k·b_k(q)`, so its size is the kind's
+    /// size over the largest `|b_k|` along the axis ([`coefficient_extent`]):
+    /// the coefficient value that moves the slot by the nominal size at the
+    /// far end of the travel.
     pub fn of(&self, machine: &Machine) -> Vec<f64> {
         machine
             .errors
             .iter()
-            .map(|e| self.of_kind(e.kind))
+            .enumerate()
+            .map(|(j, e)| self.of_kind(e.kind) / coefficient_extent(machine, j))
             .collect()
     }
 
@@ -137,6 +144,38 @@ impl NominalSizes {
         }
         out.squareness = squareness.unwrap_or(out.angular);
         Ok(out)
+    }
+}
+
+/// The largest `|b_k(q)|` of error `j`'s basis function along its axis; 1
+/// for a constant error parameter.
+///
+/// Legendre and Chebyshev polynomials are bounded by 1 on their `range`, and
+/// `cos kq`, `sin kq` by 1 everywhere. A power `q^k` (`k ≥ 1`) is bounded by
+/// the largest `|q|^k` over the machine's reliability grid of that variable;
+/// without such a grid the extent is taken as 1 (the size is then per unit
+/// of `q^k`).
+pub fn coefficient_extent(machine: &Machine, j: usize) -> f64 {
+    let Some((f, b)) = machine.coefficient_of(j) else {
+        return 1.0;
+    };
+    if !matches!(b, BasisFn::Power(_)) {
+        return 1.0;
+    }
+    let grid = machine
+        .reliability
+        .as_ref()
+        .and_then(|r| r.grid.iter().find(|(v, _)| *v == f.variable));
+    let extent = grid.map_or(0.0, |(_, values)| {
+        values
+            .iter()
+            .map(|q| b.value(q.abs()).abs())
+            .fold(0.0, f64::max)
+    });
+    if extent > 0.0 && extent.is_finite() {
+        extent
+    } else {
+        1.0
     }
 }
 
