@@ -626,4 +626,3 @@ fn emitted_code_reads_a_rotary_variable_for_a_polynomial_slot() {
         chain_core::emit::emit_pretty(&plain, &chain_core::emit::EmitOptions::for_model(&plain));
     assert!(!code.contains("error_at"));
 }
-

@@ -15,7 +15,7 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use chain_core::built::{BuiltMachine, MapError};
-use chain_core::values::{Entry, Given, Values};
+use chain_core::values::{Entry, EntryKind, Given, Values};
 use chain_core::MapResult;
 use miette::MietteDiagnostic;
 use reliability::machine;
@@ -143,10 +143,21 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
     let result = built.map_with_progress(&points, &|n| bar.inc(n));
     bar.finish();
     let result = result.map_err(|e| map_error(e, &args.values))?;
+    // Error parameters the file gave a value: a function's table gives all
+    // its coefficients.
+    let given: usize = (built.values().entries().iter())
+        .map(|e| match e.kind {
+            EntryKind::Function => m
+                .function_index(&e.name)
+                .map_or(1, |f| m.functions[f].coefficients.len()),
+            _ => 1,
+        })
+        .sum();
     let doc = MapDoc {
         values_file: args.values.display().to_string(),
         entries: built.values().entries().to_vec(),
         errors: m.errors.len(),
+        unset: m.errors.len().saturating_sub(given),
         input,
         result,
     };
@@ -342,6 +353,8 @@ pub(crate) struct MapDoc {
     values_file: String,
     entries: Vec<Entry>,
     errors: usize,
+    /// Error parameters the values file does not give (zero).
+    unset: usize,
     pub(crate) input: Input,
     pub(crate) result: MapResult,
 }
@@ -392,14 +405,20 @@ impl Report for MapDoc {
             .filter(|e| matches!(e.given, Given::Table { .. }))
             .count();
         let constants = self.entries.len() - tables;
+        let rest = match self.unset {
+            0 => format!("all {} error parameters given", self.errors),
+            n => format!(
+                "{n} of the {} error parameters not given (zero)",
+                self.errors
+            ),
+        };
         let _ = writeln!(
             out,
-            "values: {} tabulated error motion{}, {} constant{}; every other error parameter is zero ({} error parameters)",
+            "values: {} tabulated error motion{}, {} constant{}; {rest}",
             tables,
             if tables == 1 { "" } else { "s" },
             constants,
             if constants == 1 { "" } else { "s" },
-            self.errors
         );
         match &self.input {
             Input::Grid(axes) => {

@@ -2,8 +2,9 @@
 //!
 //! On a grid with at least two axes of several values, the plotting plane is
 //! spanned by the two axes with the most values (the earlier axis when counts
-//! tie); every other axis is held at its middle value (the lower middle one
-//! for an even count), and the title says where. In that plane:
+//! tie), the one with more values horizontal; every other axis is held at its
+//! middle value (the lower middle one for an even count), and the title says
+//! where. In that plane:
 //!
 //! - `map_<component>` for `px … oz` and `map_volumetric`: heat maps over
 //!   the two axes (µm, µrad), each cell centred on its grid node, a diverging
@@ -50,10 +51,7 @@ pub(super) fn write_all(
                 (0..axes.len()).filter(|&k| axes[k].1.len() > 1).collect();
             by_count.sort_by_key(|&k| std::cmp::Reverse(axes[k].1.len()));
             match by_count.as_slice() {
-                [a, b, ..] => {
-                    let (a, b) = ((*a).min(*b), (*a).max(*b));
-                    plane(dir, doc, built, axes, a, b)
-                }
+                [a, b, ..] => plane(dir, doc, built, axes, *a, *b),
                 [a] => {
                     let lines = along_axis(axes, *a);
                     lines_charts(dir, doc, &axes[*a].0, &lines, &slice_text(axes, &[*a]))
