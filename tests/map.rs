@@ -34,11 +34,14 @@ const LEGENDRE: &str = "examples/values/vmc3_legendre.yaml";
 /// splines (the file says so; the others are linear).
 const CUBIC: [&str; 5] = ["EYX", "EZX", "EZY", "EXZ", "EYZ"];
 
+/// One error's value as a function of the machine-ordered axis values.
+type Motion = Box<dyn Fn(&[f64]) -> f64>;
+
 /// The test's own `v(q)` for the vmc3 values files: per machine error, a
 /// function of the machine-ordered axis values.
 struct Reference {
     machine: Machine,
-    values: Vec<Box<dyn Fn(&[f64]) -> f64>>,
+    values: Vec<Motion>,
 }
 
 impl Reference {
@@ -46,7 +49,7 @@ impl Reference {
     /// coefficients) instead of examples/values/vmc3.yaml.
     fn vmc3(legendre: bool) -> Reference {
         let machine = load_example("vmc3.yaml");
-        let mut values: Vec<Box<dyn Fn(&[f64]) -> f64>> = (0..machine.errors.len())
+        let mut values: Vec<Motion> = (0..machine.errors.len())
             .map(|_| Box::new(|_: &[f64]| 0.0) as Box<_>)
             .collect();
         let index = |n: &str| machine.error_index(n).unwrap_or_else(|| panic!("{n}"));
@@ -713,7 +716,7 @@ fn the_gantry_grinder_maps_like_its_numeric_product() {
     let n = m.errors.len();
     let arcsec = std::f64::consts::PI / 648_000.0;
     let spline = Spline::new(&[0.0, 500.0, 1000.0], &[0.0, 3.1e-3, 5.2e-3]);
-    let mut by_name: HashMap<&str, Box<dyn Fn(&[f64]) -> f64>> = HashMap::new();
+    let mut by_name: HashMap<&str, Motion> = HashMap::new();
     let x = m.variable_index("x").unwrap();
     let z = m.variable_index("z").unwrap();
     by_name.insert("dxx", Box::new(move |q| spline.eval(q[x])));

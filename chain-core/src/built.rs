@@ -88,7 +88,7 @@ pub enum MapError {
         /// The point, `x = 0, y = 500`.
         at: String,
         /// The table and the value.
-        source: OutOfRange,
+        source: Box<OutOfRange>,
     },
 }
 
@@ -444,7 +444,7 @@ impl<M: ErrorModel + Sync> BuiltMachine<M> {
                         .map(|(n, x)| format!("{n} = {x}"))
                         .collect::<Vec<_>>()
                         .join(", "),
-                    source,
+                    source: Box::new(source),
                 });
             }
             *v = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
@@ -479,10 +479,10 @@ impl Partial {
 
     #[inline]
     fn add(&mut self, i: usize, e: &[f64; 6], v: f64) {
-        for c in 0..6 {
-            self.min[c] = self.min[c].min(e[c]);
-            self.max[c] = self.max[c].max(e[c]);
-            self.squares[c] += e[c] * e[c];
+        for (c, &x) in e.iter().enumerate() {
+            self.min[c] = self.min[c].min(x);
+            self.max[c] = self.max[c].max(x);
+            self.squares[c] += x * x;
         }
         // The first of equal maxima.
         if v > self.volumetric_max {

@@ -129,12 +129,12 @@ fn lines_charts(
     )
     .legend(Legend::UpperLeft)
     .hline(0.0);
-    for c in 0..3 {
+    for (c, name) in COMPONENTS.iter().enumerate().take(3) {
         let pts = points
             .iter()
             .map(|&(x, i)| (x, r.errors[i][c] * 1e3))
             .collect();
-        position = position.series(Series::line_points(COMPONENTS[c], pts));
+        position = position.series(Series::line_points(*name, pts));
     }
     let vol = points
         .iter()
@@ -149,12 +149,12 @@ fn lines_charts(
     )
     .legend(Legend::UpperLeft)
     .hline(0.0);
-    for c in 3..6 {
+    for (c, name) in COMPONENTS.iter().enumerate().skip(3) {
         let pts = points
             .iter()
             .map(|&(x, i)| (x, r.errors[i][c] * 1e6))
             .collect();
-        orientation = orientation.series(Series::line_points(COMPONENTS[c], pts));
+        orientation = orientation.series(Series::line_points(*name, pts));
     }
     files.extend(orientation.write(dir, "map_orientation")?);
     Ok(files)

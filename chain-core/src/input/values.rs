@@ -1289,7 +1289,7 @@ impl Reader {
         fields: &Fields<'_>,
         factor: f64,
         var_name: &str,
-    ) -> Option<(Vec<((f64, f64), Origin)>, String, (String, String))> {
+    ) -> Option<CsvPoints> {
         use csv::{CsvFile, CsvOpenError};
         let path = self.base.join(file);
         let shown = path.display().to_string();
@@ -1381,7 +1381,7 @@ impl Reader {
         fields: &Fields<'_>,
         _factor: f64,
         _variable: &str,
-    ) -> Option<(Vec<((f64, f64), Origin)>, String, (String, String))> {
+    ) -> Option<CsvPoints> {
         let text =
             "reading a CSV table needs chain-core's `csv` feature, which this build does not have";
         let off = Message::new(text, "CSV table", "chain::values::csv_feature")
@@ -1390,6 +1390,11 @@ impl Reader {
         None
     }
 }
+
+/// The points of a CSV table with their origins, its description
+/// (`FILE.csv, column NAME`), and the CSV file's name and text (for locating
+/// a point's problem).
+type CsvPoints = (Vec<((f64, f64), Origin)>, String, (String, String));
 
 /// True if an entry's node is a table (a mapping with `points` or `table`).
 fn is_table(node: &Node) -> bool {
