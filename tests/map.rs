@@ -16,7 +16,7 @@ mod reference;
 
 use std::collections::HashMap;
 
-use chain::core::built::{full_factorial, BuiltMachine, MapError, PartKind};
+use chain::core::built::{full_factorial, BuiltMachine, MapError, PartKind, Points};
 use chain::core::values::Values;
 use chain::core::{ErrorModel, Machine};
 use common::cli::{chain, fails, ok_json, ok_stdout, scratch, success, unwrapped, write};
@@ -587,26 +587,36 @@ fn the_map_does_not_depend_on_the_thread_count() {
         (0..=50).map(|k| 16.0 * f64::from(k)).collect(),
         (0..=20).map(|k| 25.0 * f64::from(k)).collect(),
     ];
-    let points = full_factorial(&axes);
-    assert_eq!(points.len(), 3 * 41 * 51 * 21);
-    let run = |threads: usize| {
+    let grid = Points::Grid(axes.to_vec());
+    let flat = full_factorial(&axes);
+    assert_eq!(flat.len(), 3 * 41 * 51 * 21);
+    let list = Points::list(3, flat.clone()).unwrap();
+    let run = |threads: usize, points: &Points| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| b.map(&points).unwrap())
+            .install(|| (b.map(points.clone()).unwrap(), b.summary(points, &|_| {}).unwrap()))
     };
-    let one = run(1);
-    let two = run(2);
-    let three = run(3);
-    assert_eq!(one, two);
-    assert_eq!(one, three);
-    // Point by point, as BuiltMachine::error gives it.
+    let (one, summary) = run(1, &grid);
+    for threads in [2, 3] {
+        let (other, s) = run(threads, &grid);
+        assert_eq!(one.errors, other.errors);
+        assert_eq!(one.summary, other.summary);
+        assert_eq!(s, summary);
+    }
+    // The summary alone is the map's; a list of the same points maps the same.
+    assert_eq!(summary, one.summary);
+    let (listed, _) = run(2, &list);
+    assert_eq!(listed.errors, one.errors);
+    assert_eq!(listed.summary, one.summary);
+    // Point by point, as BuiltMachine::error gives it (every table evaluated).
     for i in (0..one.len()).step_by(997) {
-        assert_eq!(b.error(one.point(i)).unwrap(), one.errors[i]);
+        assert_eq!(one.point(i), flat[3 * i..3 * i + 3]);
+        assert_eq!(b.error(&one.point(i)).unwrap(), one.errors[i]);
     }
     let counted = std::sync::atomic::AtomicUsize::new(0);
-    b.map_with_progress(&points, &|n| {
+    b.map_with_progress(grid, &|n| {
         counted.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
     })
     .unwrap();
@@ -643,14 +653,14 @@ fn the_generated_type_gives_the_same_map() {
     let values = Values::read(&example_file("values/vmc3.yaml"), &m).unwrap();
     let generated = BuiltMachine::new(&m, Vmc3, values.clone(), vec![150.0]).unwrap();
     let compiled = BuiltMachine::compile(&m, values, vec![150.0]).unwrap();
-    let points = full_factorial(&[
+    let points = Points::Grid(vec![
         vec![0.0, 250.0, 500.0],
         vec![0.0, 333.0, 800.0],
         vec![0.0, 100.0, 500.0],
     ]);
     let (a, b) = (
-        generated.map(&points).unwrap(),
-        compiled.map(&points).unwrap(),
+        generated.map(points.clone()).unwrap(),
+        compiled.map(points).unwrap(),
     );
     for (x, y) in a.errors.iter().zip(&b.errors) {
         for c in 0..6 {
@@ -663,15 +673,29 @@ fn the_generated_type_gives_the_same_map() {
 #[test]
 fn the_library_refuses_what_does_not_fit() {
     let b = built();
-    assert!(matches!(b.map(&[]), Err(MapError::NoPoints)));
     assert!(matches!(
-        b.map(&[1.0, 2.0]),
+        b.map(Points::list(3, vec![]).unwrap()),
+        Err(MapError::NoPoints)
+    ));
+    assert!(matches!(
+        b.map(Points::Grid(vec![vec![0.0], vec![], vec![0.0]])),
+        Err(MapError::NoPoints)
+    ));
+    assert!(matches!(
+        Points::list(3, vec![1.0, 2.0]),
         Err(MapError::Ragged {
             len: 2,
             variables: 3
         })
     ));
-    match b.map(&[0.0, 0.0, 0.0, 0.0, 900.0, 0.0]) {
+    assert!(matches!(
+        b.map(Points::Grid(vec![vec![0.0]])),
+        Err(MapError::Dimension {
+            found: 1,
+            variables: 3
+        })
+    ));
+    match b.map(Points::list(3, vec![0.0, 0.0, 0.0, 0.0, 900.0, 0.0]).unwrap()) {
         Err(MapError::OutOfRange {
             point: 1, source, ..
         }) => assert_eq!(source.value, 900.0),

@@ -19,7 +19,9 @@
 //!
 //! The map evaluates the values and the model once per point into one
 //! scratch vector per block of [`MAP_BLOCK`] points, so nothing is allocated
-//! per point; with the `parallel` feature the blocks run on rayon's threads.
+//! per point, and re-evaluates only the tables whose axis value changed from
+//! the previous point ([`Values::update`]: along a grid, mostly one axis);
+//! with the `parallel` feature the blocks run on rayon's threads.
 //! Each block's summary is computed inside the block and the blocks' are
 //! combined in block order, so the result is the same, bit for bit, with or
 //! without threads and whatever their number.
@@ -72,6 +74,14 @@ pub enum MapError {
     /// No point was given.
     #[error("the map has no point")]
     NoPoints,
+    /// Points of another dimension than the model's.
+    #[error("points of {found} axis values for a model of {variables} axis variables")]
+    Dimension {
+        /// The points' dimension.
+        found: usize,
+        /// The number of axis variables.
+        variables: usize,
+    },
     /// The axis values do not divide into points.
     #[error("{len} axis values do not make whole points of {variables} variables")]
     Ragged {
@@ -132,7 +142,7 @@ struct Motion {
 /// # Example
 ///
 /// ```
-/// use chain_core::built::BuiltMachine;
+/// use chain_core::built::{BuiltMachine, Points};
 /// use chain_core::values::Values;
 /// let yaml = "machine: m\nbodies:\n  bed: {}\n  x_slide: {parent: bed, joint: {type: prismatic, axis: +x, variable: x}, errors: {dx: dxx, ey: eyx}}\n  spindle: {parent: x_slide, offset: [0, 0, -100]}\nworkpiece: bed\ntool: spindle\n";
 /// let machine = chain_core::load_str(yaml, "m.yaml").unwrap();
@@ -142,7 +152,7 @@ struct Motion {
 /// // px = dxx − 100·eyx = 0.005 − 100 · 20e-6 at x = 500
 /// let e = built.error(&[500.0]).unwrap();
 /// assert!((e[0] - 0.003).abs() < 1e-15);
-/// let map = built.map(&[0.0, 500.0, 1000.0]).unwrap();
+/// let map = built.map(Points::Grid(vec![vec![0.0, 500.0, 1000.0]])).unwrap();
 /// assert!((map.summary.px.max - 0.008).abs() < 1e-15);
 /// ```
 #[derive(Debug, Clone)]
@@ -346,10 +356,10 @@ impl<M: ErrorModel> BuiltMachine<M> {
 }
 
 impl<M: ErrorModel + Sync> BuiltMachine<M> {
-    /// The error map over `points`, flat: point `i` is
-    /// `points[i·n .. (i+1)·n]` with `n` = [`BuiltMachine::variables`]`.len()`
-    /// (a machine without axis variables has one point, `points` empty).
-    pub fn map(&self, points: &[f64]) -> Result<MapResult, MapError> {
+    /// The error map over `points` (a grid or a list, in
+    /// [`BuiltMachine::variables`] order): every point's error and the
+    /// summary.
+    pub fn map(&self, points: Points) -> Result<MapResult, MapError> {
         self.map_with_progress(points, &|_| {})
     }
 
@@ -357,100 +367,274 @@ impl<M: ErrorModel + Sync> BuiltMachine<M> {
     /// finished (from any thread).
     pub fn map_with_progress(
         &self,
-        points: &[f64],
+        points: Points,
         progress: &(dyn Fn(usize) + Sync),
     ) -> Result<MapResult, MapError> {
-        let nv = self.variables.len();
-        let count = match nv {
-            0 => 1,
-            _ if points.len() % nv != 0 => {
-                return Err(MapError::Ragged {
-                    len: points.len(),
-                    variables: nv,
-                })
-            }
-            _ => points.len() / nv,
-        };
-        if count == 0 {
-            return Err(MapError::NoPoints);
-        }
+        let count = self.check(&points)?;
         let mut errors = vec![[0.0; 6]; count];
-        let mut volumetric = vec![0.0; count];
-        let block = |(b, (e, v)): (usize, (&mut [[f64; 6]], &mut [f64]))| {
-            let start = b * MAP_BLOCK;
-            let r = self.block(points, start, e, v);
+        let block = |(b, e): (usize, &mut [[f64; 6]])| {
+            let r = self.block(&points, b * MAP_BLOCK, e.len(), Some(e));
             progress(e.len());
             r
         };
         #[cfg(feature = "parallel")]
         let partials: Vec<Result<Partial, MapError>> = {
             use rayon::prelude::*;
-            errors
-                .par_chunks_mut(MAP_BLOCK)
-                .zip(volumetric.par_chunks_mut(MAP_BLOCK))
-                .enumerate()
-                .map(block)
-                .collect()
+            errors.par_chunks_mut(MAP_BLOCK).enumerate().map(block).collect()
         };
         #[cfg(not(feature = "parallel"))]
-        let partials: Vec<Result<Partial, MapError>> = errors
-            .chunks_mut(MAP_BLOCK)
-            .zip(volumetric.chunks_mut(MAP_BLOCK))
-            .enumerate()
-            .map(block)
-            .collect();
+        let partials: Vec<Result<Partial, MapError>> =
+            errors.chunks_mut(MAP_BLOCK).enumerate().map(block).collect();
+        let summary = self.summary_of(&points, count, partials)?;
+        Ok(MapResult {
+            machine: self.machine.clone(),
+            frame: self.frame,
+            variables: self.variables.clone(),
+            points,
+            errors,
+            summary,
+        })
+    }
+
+    /// The summary of the map over `points` alone, without keeping each
+    /// point's error (the same numbers as [`BuiltMachine::map`]'s summary,
+    /// bit for bit, in a fixed amount of memory).
+    pub fn summary(
+        &self,
+        points: &Points,
+        progress: &(dyn Fn(usize) + Sync),
+    ) -> Result<MapSummary, MapError> {
+        let count = self.check(points)?;
+        let blocks = count.div_ceil(MAP_BLOCK);
+        let block = |b: usize| {
+            let len = MAP_BLOCK.min(count - b * MAP_BLOCK);
+            let r = self.block(points, b * MAP_BLOCK, len, None);
+            progress(len);
+            r
+        };
+        #[cfg(feature = "parallel")]
+        let partials: Vec<Result<Partial, MapError>> = {
+            use rayon::prelude::*;
+            (0..blocks).into_par_iter().map(block).collect()
+        };
+        #[cfg(not(feature = "parallel"))]
+        let partials: Vec<Result<Partial, MapError>> = (0..blocks).map(block).collect();
+        self.summary_of(points, count, partials)
+    }
+
+    /// The number of points, if they fit the model.
+    fn check(&self, points: &Points) -> Result<usize, MapError> {
+        let nv = self.variables.len();
+        if points.dimension() != nv {
+            return Err(MapError::Dimension {
+                found: points.dimension(),
+                variables: nv,
+            });
+        }
+        match points.len() {
+            0 => Err(MapError::NoPoints),
+            n => Ok(n),
+        }
+    }
+
+    /// The blocks' summaries combined in block order.
+    fn summary_of(
+        &self,
+        points: &Points,
+        count: usize,
+        partials: Vec<Result<Partial, MapError>>,
+    ) -> Result<MapSummary, MapError> {
         let mut total = Partial::new();
         for p in partials {
             total.merge(&p?);
         }
         let at = total.volumetric_at;
-        let point =
-            |i: usize| &points[(i * nv).min(points.len())..((i + 1) * nv).min(points.len())];
-        let summary = MapSummary::new(
-            &total,
-            count,
-            NameMap::zip(self.variables.iter().cloned(), point(at).iter().copied()),
-            at,
-        );
-        Ok(MapResult {
-            machine: self.machine.clone(),
-            frame: self.frame,
-            variables: self.variables.clone(),
-            points: points.to_vec(),
-            errors,
-            volumetric,
-            summary,
-        })
+        let mut q = vec![0.0; self.variables.len()];
+        points.point_into(at, &mut q);
+        let at_point = NameMap::zip(self.variables.iter().cloned(), q);
+        Ok(MapSummary::new(&total, count, at_point, at))
     }
 
-    /// Evaluates the points `start..start + errors.len()`.
+    /// Evaluates the points `start..start + len` (into `errors`, if given).
     fn block(
         &self,
-        points: &[f64],
+        points: &Points,
         start: usize,
-        errors: &mut [[f64; 6]],
-        volumetric: &mut [f64],
+        len: usize,
+        mut errors: Option<&mut [[f64; 6]]>,
     ) -> Result<Partial, MapError> {
         let nv = self.variables.len();
         let mut scratch = self.scratch();
+        let mut cursor = points.cursor(start);
+        // The previous point: the values of its tables are in `scratch`.
+        let mut previous = vec![f64::NAN; nv];
+        let mut q = vec![0.0; nv];
         let mut part = Partial::new();
-        for (k, (e, v)) in errors.iter_mut().zip(volumetric.iter_mut()).enumerate() {
+        let mut e = [0.0; 6];
+        for k in 0..len {
             let i = start + k;
-            let q = &points[i * nv..(i + 1) * nv];
-            if let Err(source) = self.error_into(q, &mut scratch, e) {
+            cursor.next_into(&mut q);
+            let values = if k == 0 {
+                crate::ErrorValues::values_at(&self.values, &q, &mut scratch)
+            } else {
+                self.values.update(&previous, &q, &mut scratch)
+            };
+            if let Err(source) = values {
                 return Err(MapError::OutOfRange {
                     point: i,
-                    at: (self.variables.iter().zip(q))
+                    at: (self.variables.iter().zip(&q))
                         .map(|(n, x)| format!("{n} = {x}"))
                         .collect::<Vec<_>>()
                         .join(", "),
                     source: Box::new(source),
                 });
             }
-            *v = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
-            part.add(i, e, *v);
+            self.model.error(&q, &self.parameters, &scratch, &mut e);
+            std::mem::swap(&mut previous, &mut q);
+            part.add(i, &e, volumetric(&e));
+            if let Some(out) = errors.as_deref_mut() {
+                out[k] = e;
+            }
         }
         Ok(part)
+    }
+}
+
+/// `|(px, py, pz)|`.
+#[inline]
+fn volumetric(e: &[f64; 6]) -> f64 {
+    (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt()
+}
+
+/// The points of a map: a full-factorial grid (kept as its axes, never
+/// expanded) or a list.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Points {
+    /// Every combination of one value per axis (in the model's variable
+    /// order), the last axis varying fastest (the order of the reliability
+    /// grid).
+    Grid(Vec<Vec<f64>>),
+    /// Explicit points, flat: point `i` is `values[i·dimension ..
+    /// (i+1)·dimension]`.
+    List {
+        /// The number of axis values per point.
+        dimension: usize,
+        /// The values.
+        values: Vec<f64>,
+    },
+}
+
+impl Points {
+    /// Explicit points of `dimension` values each, flat. Values that do not
+    /// make whole points are an error.
+    pub fn list(dimension: usize, values: Vec<f64>) -> Result<Points, MapError> {
+        if (dimension == 0 && !values.is_empty()) || (dimension > 0 && values.len() % dimension != 0)
+        {
+            return Err(MapError::Ragged {
+                len: values.len(),
+                variables: dimension,
+            });
+        }
+        Ok(Points::List { dimension, values })
+    }
+
+    /// The number of axis values per point.
+    pub fn dimension(&self) -> usize {
+        match self {
+            Points::Grid(axes) => axes.len(),
+            Points::List { dimension, .. } => *dimension,
+        }
+    }
+
+    /// The number of points (a grid of no axis has one point, the empty
+    /// one).
+    pub fn len(&self) -> usize {
+        match self {
+            Points::Grid(axes) => axes.iter().map(Vec::len).product(),
+            Points::List { dimension: 0, .. } => 0,
+            Points::List { dimension, values } => values.len() / dimension,
+        }
+    }
+
+    /// True when there is no point.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Writes point `i` into `out` (`dimension` values).
+    pub fn point_into(&self, i: usize, out: &mut [f64]) {
+        match self {
+            Points::Grid(axes) => {
+                let mut rest = i;
+                for (o, a) in out.iter_mut().zip(axes).rev() {
+                    *o = a[rest % a.len()];
+                    rest /= a.len();
+                }
+            }
+            Points::List { dimension, values } => {
+                out.copy_from_slice(&values[i * dimension..(i + 1) * dimension]);
+            }
+        }
+    }
+
+    /// Point `i`.
+    pub fn point(&self, i: usize) -> Vec<f64> {
+        let mut q = vec![0.0; self.dimension()];
+        self.point_into(i, &mut q);
+        q
+    }
+
+    /// The points from `start` on, one after the other without division.
+    fn cursor(&self, start: usize) -> Cursor<'_> {
+        let index = match self {
+            Points::Grid(axes) => {
+                let mut idx = vec![0; axes.len()];
+                let mut rest = start;
+                for (k, a) in idx.iter_mut().zip(axes).rev() {
+                    *k = rest % a.len().max(1);
+                    rest /= a.len().max(1);
+                }
+                idx
+            }
+            Points::List { .. } => vec![start],
+        };
+        Cursor {
+            points: self,
+            index,
+        }
+    }
+}
+
+/// Walks the points of a [`Points`] in order.
+struct Cursor<'p> {
+    points: &'p Points,
+    /// Grid: the multi-index of the next point; list: its index.
+    index: Vec<usize>,
+}
+
+impl Cursor<'_> {
+    /// Writes the next point into `out` and advances.
+    #[inline]
+    fn next_into(&mut self, out: &mut [f64]) {
+        match self.points {
+            Points::Grid(axes) => {
+                for ((o, a), &k) in out.iter_mut().zip(axes).zip(&self.index) {
+                    *o = a[k];
+                }
+                for (k, a) in self.index.iter_mut().zip(axes).rev() {
+                    *k += 1;
+                    if *k < a.len() {
+                        break;
+                    }
+                    *k = 0;
+                }
+            }
+            Points::List { dimension, values } => {
+                let i = self.index[0];
+                out.copy_from_slice(&values[i * dimension..(i + 1) * dimension]);
+                self.index[0] += 1;
+            }
+        }
     }
 }
 
@@ -600,12 +784,10 @@ pub struct MapResult {
     pub frame: Frame,
     /// The axis variables, in a point's order.
     pub variables: Vec<String>,
-    /// The points, flat (`variables.len()` values each).
-    pub points: Vec<f64>,
+    /// The points.
+    pub points: Points,
     /// `E` at each point.
     pub errors: Vec<[f64; 6]>,
-    /// `|(px, py, pz)|` at each point.
-    pub volumetric: Vec<f64>,
     /// The summary.
     pub summary: MapSummary,
 }
@@ -622,9 +804,13 @@ impl MapResult {
     }
 
     /// The axis values of point `i`.
-    pub fn point(&self, i: usize) -> &[f64] {
-        let n = self.variables.len();
-        &self.points[i * n..(i + 1) * n]
+    pub fn point(&self, i: usize) -> Vec<f64> {
+        self.points.point(i)
+    }
+
+    /// `|(px, py, pz)|` at point `i`.
+    pub fn volumetric(&self, i: usize) -> f64 {
+        volumetric(&self.errors[i])
     }
 }
 
@@ -646,11 +832,14 @@ impl Serialize for PointList<'_> {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         let m = self.0;
         let mut seq = serializer.serialize_seq(Some(m.len()))?;
-        for i in 0..m.len() {
+        let mut q = vec![0.0; m.variables.len()];
+        let mut cursor = m.points.cursor(0);
+        for e in &m.errors {
+            cursor.next_into(&mut q);
             seq.serialize_element(&MapPoint {
-                point: Named(&m.variables, m.point(i)),
-                error: Named(&COMPONENTS, &m.errors[i]),
-                volumetric: m.volumetric[i],
+                point: Named(&m.variables, &q),
+                error: Named(&COMPONENTS, e),
+                volumetric: volumetric(e),
             })?;
         }
         seq.end()
@@ -680,7 +869,8 @@ impl<N: AsRef<str>> Serialize for Named<'_, N> {
 
 /// The full-factorial grid of `axes` (one list of values per axis variable,
 /// in the model's variable order), flat, the last axis varying fastest (the
-/// order of the reliability grid).
+/// order of the reliability grid and of [`Points::Grid`], which does not
+/// expand it).
 pub fn full_factorial(axes: &[Vec<f64>]) -> Vec<f64> {
     let nv = axes.len();
     let count: usize = axes.iter().map(Vec::len).product();

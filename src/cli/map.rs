@@ -14,7 +14,8 @@ mod map_plot;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use chain_core::built::{BuiltMachine, MapError};
+use chain_core::built::{BuiltMachine, MapError, MapSummary, Points};
+use chain_core::model::Frame;
 use chain_core::values::{Entry, EntryKind, Given, Values};
 use chain_core::MapResult;
 use miette::MietteDiagnostic;
@@ -121,26 +122,35 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
     let values = Values::read(&args.values, m)?;
     let params = machine::parameters(m, &args.param.params).map_err(|e| loaded.report(e))?;
     let (points, input) = match &args.axes {
-        Some(path) => (
-            axes_points(path, m)?,
-            Input::Axes(path.display().to_string()),
-        ),
+        Some(path) => {
+            let flat = axes_points(path, m)?;
+            let points = Points::list(m.variables.len(), flat)
+                .map_err(|e| miette::miette!("{}: {e}", path.display()))?;
+            (points, Input::Axes(path.display().to_string()))
+        }
         None => {
             let file = args.file.display().to_string();
             let axes = grid_axes(m, &loaded, &file, &args.grid)?;
-            let flat: Vec<Vec<f64>> = axes.iter().map(|(_, v)| v.clone()).collect();
-            (chain_core::built::full_factorial(&flat), Input::Grid(axes))
+            let values = axes.iter().map(|(_, v)| v.clone()).collect();
+            (Points::Grid(values), Input::Grid(axes))
         }
     };
     let built = BuiltMachine::compile(m, values, params)
         .map_err(|e| miette::miette!("{}: {e}", args.values.display()))?;
-    let count = if m.variables.is_empty() {
-        1
-    } else {
-        points.len() / m.variables.len()
-    };
+    let count = points.len();
     let bar = Progress::new(count, args.format);
-    let result = built.map_with_progress(&points, &|n| bar.inc(n));
+    // The table of a large map shows the summary only: it needs no point's
+    // error kept (the plots and the other formats do).
+    let keep = args.format != MapFormat::Table || args.plot.is_some() || count <= TABLE_POINTS;
+    let result = if keep {
+        built
+            .map_with_progress(points, &|n| bar.inc(n))
+            .map(Mapped::Full)
+    } else {
+        built
+            .summary(&points, &|n| bar.inc(n))
+            .map(|summary| Mapped::Summary { summary, points })
+    };
     bar.finish();
     let result = result.map_err(|e| map_error(e, &args.values))?;
     // Error parameters the file gave a value: a function's table gives all
@@ -158,6 +168,9 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
         entries: built.values().entries().to_vec(),
         errors: m.errors.len(),
         unset: m.errors.len().saturating_sub(given),
+        machine: m.name.clone(),
+        frame: m.frame,
+        variables: built.variables().to_vec(),
         input,
         result,
     };
@@ -347,6 +360,33 @@ pub(crate) enum Input {
     Axes(String),
 }
 
+/// What the map computed: every point's error, or the summary alone.
+pub(crate) enum Mapped {
+    /// The library's whole result.
+    Full(MapResult),
+    /// The summary, and the points it is of.
+    Summary {
+        summary: MapSummary,
+        points: Points,
+    },
+}
+
+impl Mapped {
+    fn summary(&self) -> &MapSummary {
+        match self {
+            Mapped::Full(r) => &r.summary,
+            Mapped::Summary { summary, .. } => summary,
+        }
+    }
+
+    fn points(&self) -> &Points {
+        match self {
+            Mapped::Full(r) => &r.points,
+            Mapped::Summary { points, .. } => points,
+        }
+    }
+}
+
 /// The report of `chain map`: the library's [`MapResult`] (its JSON is the
 /// spec's document) with what the command knows of its input.
 pub(crate) struct MapDoc {
@@ -355,13 +395,29 @@ pub(crate) struct MapDoc {
     errors: usize,
     /// Error parameters the values file does not give (zero).
     unset: usize,
+    pub(crate) machine: String,
+    frame: Frame,
+    variables: Vec<String>,
     pub(crate) input: Input,
-    pub(crate) result: MapResult,
+    pub(crate) result: Mapped,
+}
+
+impl MapDoc {
+    /// The whole result (every format but a large map's table has it).
+    pub(crate) fn full(&self) -> Option<&MapResult> {
+        match &self.result {
+            Mapped::Full(r) => Some(r),
+            Mapped::Summary { .. } => None,
+        }
+    }
 }
 
 impl Serialize for MapDoc {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        self.result.serialize(s)
+        match self.full() {
+            Some(r) => r.serialize(s),
+            None => Err(serde::ser::Error::custom("the map kept no point")),
+        }
     }
 }
 
@@ -372,9 +428,8 @@ const UNITS: [&str; 6] = ["µm", "µm", "µm", "µrad", "µrad", "µrad"];
 
 impl MapDoc {
     fn point_text(&self, i: usize) -> String {
-        let r = &self.result;
-        (r.variables.iter().zip(r.point(i)))
-            .map(|(n, x)| format!("{n} = {}", number(*x)))
+        (self.variables.iter().zip(self.result.points().point(i)))
+            .map(|(n, x)| format!("{n} = {}", number(x)))
             .collect::<Vec<_>>()
             .join(", ")
     }
@@ -391,14 +446,14 @@ fn number(x: f64) -> String {
 impl Report for MapDoc {
     fn table(&self) -> String {
         use std::fmt::Write;
-        let r = &self.result;
-        let s = &r.summary;
+        let s = self.result.summary();
+        let count = self.result.points().len();
         let mut out = String::new();
         let _ = writeln!(
             out,
             "Error map of {} (frame: {}), values {}",
-            r.machine,
-            r.frame.name(),
+            self.machine,
+            self.frame.name(),
             self.values_file
         );
         let tables = (self.entries.iter())
@@ -435,10 +490,10 @@ impl Report for MapDoc {
                         [] => format!("{n}: none"),
                     })
                     .collect();
-                let _ = writeln!(out, "{} points: {}", r.len(), desc.join(", "));
+                let _ = writeln!(out, "{count} points: {}", desc.join(", "));
             }
             Input::Axes(file) => {
-                let _ = writeln!(out, "{} points: the rows of {file}", r.len());
+                let _ = writeln!(out, "{count} points: the rows of {file}");
             }
         }
         let _ = writeln!(out);
@@ -467,7 +522,7 @@ impl Report for MapDoc {
             self.point_text(s.volumetric.index),
             s.volumetric.rms * 1e3
         );
-        if r.len() <= TABLE_POINTS {
+        if let Some(r) = self.full().filter(|r| r.len() <= TABLE_POINTS) {
             let _ = writeln!(out);
             let mut header: Vec<String> = r.variables.clone();
             header
@@ -488,7 +543,7 @@ impl Report for MapDoc {
             for i in 0..r.len() {
                 let mut cells: Vec<String> = r.point(i).iter().map(|x| number(*x)).collect();
                 cells.extend((0..6).map(|c| format!("{:.3}", r.errors[i][c] * MICRO[c])));
-                cells.push(format!("{:.3}", r.volumetric[i] * 1e3));
+                cells.push(format!("{:.3}", r.volumetric(i) * 1e3));
                 let _ = writeln!(out, "{}", line(&cells));
             }
         }
@@ -496,14 +551,14 @@ impl Report for MapDoc {
     }
 
     fn csv(&self) -> Option<Csv> {
-        let r = &self.result;
+        let r = self.full()?;
         let mut header: Vec<String> = r.variables.clone();
         header.extend(["px", "py", "pz", "ox", "oy", "oz", "volumetric"].map(String::from));
         let mut csv = Csv::new(header);
         for i in 0..r.len() {
             let mut row: Vec<String> = r.point(i).iter().map(|x| format!("{x}")).collect();
             row.extend(r.errors[i].iter().map(|x| format!("{x}")));
-            row.push(format!("{}", r.volumetric[i]));
+            row.push(format!("{}", r.volumetric(i)));
             csv.row(row);
         }
         Some(csv)

@@ -23,7 +23,7 @@
 use std::path::{Path, PathBuf};
 
 use chain_core::model::Frame;
-use chain_core::{BuiltMachine, CompiledModel, ErrorModel};
+use chain_core::{BuiltMachine, CompiledModel, ErrorModel, MapResult};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -42,6 +42,9 @@ pub(super) fn write_all(
     doc: &MapDoc,
     built: &BuiltMachine<CompiledModel>,
 ) -> miette::Result<Vec<PathBuf>> {
+    let Some(r) = doc.full() else {
+        return Ok(Vec::new());
+    };
     std::fs::create_dir_all(dir)
         .map_err(|e| miette::miette!("{}: cannot create the plot directory: {e}", dir.display()))?;
     ensure_fonts();
@@ -51,10 +54,10 @@ pub(super) fn write_all(
                 (0..axes.len()).filter(|&k| axes[k].1.len() > 1).collect();
             by_count.sort_by_key(|&k| std::cmp::Reverse(axes[k].1.len()));
             match by_count.as_slice() {
-                [a, b, ..] => plane(dir, doc, built, axes, *a, *b),
+                [a, b, ..] => plane(dir, r, built, axes, *a, *b),
                 [a] => {
                     let lines = along_axis(axes, *a);
-                    lines_charts(dir, doc, &axes[*a].0, &lines, &slice_text(axes, &[*a]))
+                    lines_charts(dir, r, &axes[*a].0, &lines, &slice_text(axes, &[*a]))
                 }
                 [] => {
                     eprintln!("note: the map has one point; no chart written");
@@ -63,9 +66,8 @@ pub(super) fn write_all(
             }
         }
         Input::Axes(_) => {
-            let r = &doc.result;
             let lines: Vec<(f64, usize)> = (0..r.len()).map(|i| ((i + 1) as f64, i)).collect();
-            lines_charts(dir, doc, "row", &lines, "")
+            lines_charts(dir, r, "row", &lines, "")
         }
     }
 }
@@ -110,12 +112,11 @@ fn along_axis(axes: &[(String, Vec<f64>)], a: usize) -> Vec<(f64, usize)> {
 /// Position and orientation components along one axis (or the row).
 fn lines_charts(
     dir: &Path,
-    doc: &MapDoc,
+    r: &MapResult,
     x_label: &str,
     points: &[(f64, usize)],
     slice: &str,
 ) -> miette::Result<Vec<PathBuf>> {
-    let r = &doc.result;
     let at = if slice.is_empty() {
         String::new()
     } else {
@@ -138,7 +139,7 @@ fn lines_charts(
     }
     let vol = points
         .iter()
-        .map(|&(x, i)| (x, r.volumetric[i] * 1e3))
+        .map(|&(x, i)| (x, r.volumetric(i) * 1e3))
         .collect();
     position = position.series(Series::line("|p|", vol).width(3));
     files.extend(position.write(dir, "map_position")?);
@@ -164,13 +165,12 @@ fn lines_charts(
 /// (rows).
 fn plane(
     dir: &Path,
-    doc: &MapDoc,
+    r: &MapResult,
     built: &BuiltMachine<CompiledModel>,
     axes: &[(String, Vec<f64>)],
     a: usize,
     b: usize,
 ) -> miette::Result<Vec<PathBuf>> {
-    let r = &doc.result;
     let slice = slice_text(axes, &[a, b]);
     let at = if slice.is_empty() {
         String::new()
@@ -195,7 +195,7 @@ fn plane(
                         if c < 6 {
                             r.errors[k][c] * MICRO[c]
                         } else {
-                            r.volumetric[k] * 1e3
+                            r.volumetric(k) * 1e3
                         }
                     })
                     .collect()
@@ -224,7 +224,7 @@ fn plane(
             Area::Svg(root) => heat_on(root, &heat),
         })?);
     }
-    files.extend(distortion(dir, doc, built, axes, a, b, &at)?);
+    files.extend(distortion(dir, r, built, axes, a, b, &at)?);
     Ok(files)
 }
 
@@ -232,14 +232,13 @@ fn plane(
 #[allow(clippy::too_many_arguments)]
 fn distortion(
     dir: &Path,
-    doc: &MapDoc,
+    r: &MapResult,
     built: &BuiltMachine<CompiledModel>,
     axes: &[(String, Vec<f64>)],
     a: usize,
     b: usize,
     at: &str,
 ) -> miette::Result<Vec<PathBuf>> {
-    let r = &doc.result;
     let mid = middle(axes);
     let (na, nb) = (axes[a].1.len(), axes[b].1.len());
     // Nominal tool point and position error in the workpiece frame, per node.
@@ -251,7 +250,7 @@ fn distortion(
             idx[a] = i;
             idx[b] = j;
             let k = flat(&idx, axes);
-            let pose = built.model().nominal(r.point(k), built.parameters());
+            let pose = built.model().nominal(&r.point(k), built.parameters());
             let p = [r.errors[k][0], r.errors[k][1], r.errors[k][2]];
             let p = match r.frame {
                 Frame::Workpiece => p,

@@ -535,6 +535,31 @@ impl ErrorValues for Values {
 }
 
 impl Values {
+    /// `v(q)` into `out`, which holds `v(previous)` of these values: only the
+    /// tables whose axis value differs from `previous` are evaluated (the
+    /// constants are already there). Consecutive points of a grid differ in
+    /// few axes, so [`crate::BuiltMachine::map`] evaluates them this way; the
+    /// result is the same as [`ErrorValues::values_at`]'s, bit for bit.
+    #[inline]
+    pub fn update(&self, previous: &[f64], q: &[f64], out: &mut [f64]) -> Result<(), OutOfRange> {
+        for t in &self.tables {
+            let x = q.get(t.variable).copied().unwrap_or(f64::NAN);
+            // NaN is never equal: it is evaluated, and refused.
+            if previous.get(t.variable) == Some(&x) {
+                continue;
+            }
+            match t.table.eval(x) {
+                Some(v) => {
+                    if let Some(o) = out.get_mut(t.error) {
+                        *o = v;
+                    }
+                }
+                None => return Err(self.out_of_range(t, x)),
+            }
+        }
+        Ok(())
+    }
+
     #[cold]
     fn out_of_range(&self, t: &Tabulated, value: f64) -> OutOfRange {
         let (lo, hi) = t.table.range();

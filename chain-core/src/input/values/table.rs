@@ -3,12 +3,13 @@
 //! spec, section 2).
 //!
 //! Everything that does not depend on the query is computed once, when the
-//! table is built: the slope of every interval (linear) or the second
-//! derivative at every knot (cubic), and whether the knots are evenly spaced.
-//! [`Table::eval`] then finds the interval in `O(1)` for evenly spaced knots
-//! (one multiplication, corrected by at most a step either way against round
-//! off) and by binary search otherwise; it takes `&self`, allocates nothing
-//! and keeps no state, so one table serves any number of threads.
+//! table is built: the second derivative at every knot (cubic), each
+//! interval's polynomial in `d = q − q_i` (degree 1 or 3), and whether the
+//! knots are evenly spaced. [`Table::eval`] then finds the interval in `O(1)`
+//! for evenly spaced knots (one multiplication, corrected by at most a step
+//! either way against round-off) and by binary search otherwise, and
+//! evaluates its polynomial by Horner's rule; it takes `&self`, allocates
+//! nothing and keeps no state, so one table serves any number of threads.
 
 use serde::Serialize;
 
@@ -114,7 +115,9 @@ const UNIFORM_TOLERANCE: f64 = 1e-9;
 /// for `i = 1 … n−2`, with `m_0 = m_{n−1} = 0` (the natural end conditions).
 /// The system is strictly diagonally dominant, so elimination without
 /// pivoting (the Thomas algorithm) is stable. With two points the spline is
-/// the straight line.
+/// the straight line. Expanded in `d = q − q_i`, the same cubic is
+/// `v_i + (s_i − h_i (2 m_i + m_{i+1})/6) d + (m_i/2) d² + ((m_{i+1} − m_i)/(6 h_i)) d³`,
+/// the form [`Table::eval`] evaluates (it is `v_i` at the knot itself).
 ///
 /// # Example
 ///
@@ -133,10 +136,12 @@ const UNIFORM_TOLERANCE: f64 = 1e-9;
 pub struct Table {
     q: Vec<f64>,
     v: Vec<f64>,
-    /// Linear: the slope of each interval (`n − 1`). Cubic: the second
-    /// derivative at each knot (`n`).
+    /// Cubic: the second derivative at each knot (`n`); linear: empty.
     #[serde(skip)]
-    d: Vec<f64>,
+    m: Vec<f64>,
+    /// Per interval, the polynomial in `d = q − q_i`: `[c0, c1, c2, c3]`.
+    #[serde(skip)]
+    poly: Vec<[f64; 4]>,
     interpolation: Interpolation,
     extrapolation: Extrapolation,
     /// `1/h` when the knots are evenly spaced (step `h`).
@@ -173,10 +178,24 @@ impl Table {
         let slopes: Vec<f64> = (0..q.len() - 1)
             .map(|i| (v[i + 1] - v[i]) / (q[i + 1] - q[i]))
             .collect();
-        let d = match interpolation {
-            Interpolation::Linear => slopes,
+        let m = match interpolation {
+            Interpolation::Linear => Vec::new(),
             Interpolation::Cubic => natural_second_derivatives(&q, &slopes),
         };
+        let poly = (0..q.len() - 1)
+            .map(|i| match interpolation {
+                Interpolation::Linear => [v[i], slopes[i], 0.0, 0.0],
+                Interpolation::Cubic => {
+                    let h = q[i + 1] - q[i];
+                    [
+                        v[i],
+                        slopes[i] - h * (2.0 * m[i] + m[i + 1]) / 6.0,
+                        m[i] / 2.0,
+                        (m[i + 1] - m[i]) / (6.0 * h),
+                    ]
+                }
+            })
+            .collect();
         let n = q.len();
         let step = (q[n - 1] - q[0]) / (n - 1) as f64;
         let uniform = q
@@ -186,7 +205,8 @@ impl Table {
         Ok(Table {
             q,
             v,
-            d,
+            m,
+            poly,
             interpolation,
             extrapolation,
             inverse_step: uniform.then_some(1.0 / step),
@@ -206,7 +226,7 @@ impl Table {
     /// The second derivatives `m_i` of the cubic spline at the positions
     /// (`None` for a linear table).
     pub fn second_derivatives(&self) -> Option<&[f64]> {
-        (self.interpolation == Interpolation::Cubic).then_some(&self.d[..])
+        (self.interpolation == Interpolation::Cubic).then_some(&self.m[..])
     }
 
     /// How the table is read between its points.
@@ -230,30 +250,25 @@ impl Table {
     pub fn eval(&self, q: f64) -> Option<f64> {
         let n = self.q.len();
         let (lo, hi) = (self.q[0], self.q[n - 1]);
-        if !(q >= lo && q <= hi) {
+        if !(q >= lo && q < hi) {
+            // The last knot exactly (the polynomial of the last interval
+            // would give it to rounding only), or outside.
             return match self.extrapolation {
+                _ if q == hi => Some(self.v[n - 1]),
                 Extrapolation::Hold if q < lo => Some(self.v[0]),
                 Extrapolation::Hold if q > hi => Some(self.v[n - 1]),
                 _ => None,
             };
         }
         let i = self.interval(q);
-        let (x0, x1) = (self.q[i], self.q[i + 1]);
-        Some(match self.interpolation {
-            Interpolation::Linear => self.v[i] + self.d[i] * (q - x0),
-            Interpolation::Cubic => {
-                let h = x1 - x0;
-                let a = (x1 - q) / h;
-                let b = 1.0 - a;
-                a * self.v[i]
-                    + b * self.v[i + 1]
-                    + ((a * a * a - a) * self.d[i] + (b * b * b - b) * self.d[i + 1]) * (h * h)
-                        / 6.0
-            }
-        })
+        let d = q - self.q[i];
+        let [c0, c1, c2, c3] = self.poly[i];
+        // A linear interval has c2 = c3 = 0: the same expression is
+        // `c0 + c1·d` exactly.
+        Some(c0 + d * (c1 + d * (c2 + d * c3)))
     }
 
-    /// The interval `i` with `q_i ≤ q ≤ q_{i+1}`, for `q` in range.
+    /// The interval `i` with `q_i ≤ q ≤ q_{i+1}`, for `q` in `[q_0, q_{n−1})`.
     #[inline]
     fn interval(&self, q: f64) -> usize {
         let last = self.q.len() - 2;
