@@ -8,7 +8,13 @@
 //!   validate the machine file, read the values file and its three CSV
 //!   tables, derive and compile the model, build the 10⁶ grid points,
 //!   evaluate them all (rayon, every core) and summarise;
-//! - `map/evaluate_1e6`: the evaluation and summary alone;
+//! - `map/end_to_end_summary_1e6`: the same, keeping only the summary (what
+//!   `chain map --format table` does for a large map);
+//! - `map/evaluate_1e6`, `map/evaluate_summary_1e6`: the evaluation and
+//!   summary alone (`_one_thread`: on one thread, the cost per point;
+//!   `evaluate_list_1e6`: the same points as an explicit list;
+//!   `_generated_one_thread`: through the `machine!` type instead of the
+//!   compiled tape);
 //! - `map/json_1e6`, `map/csv_1e6`: writing the result (serde_json's pretty
 //!   JSON; the CSV rows), the I/O part, measured separately;
 //! - `point/...`: one point, one thread: the values (`values_at`), the
@@ -27,12 +33,18 @@ use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 chain::machine!(Vmc3 = "examples/machines/vmc3.yaml");
 
 fn example(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples").join(path)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples")
+        .join(path)
 }
 
 /// The 100 × 100 × 100 grid in the machine's variable order (y, x, z).
 fn grid() -> Points {
-    let axis = |hi: f64| (0..100).map(|k| hi * f64::from(k) / 99.0).collect::<Vec<_>>();
+    let axis = |hi: f64| {
+        (0..100)
+            .map(|k| hi * f64::from(k) / 99.0)
+            .collect::<Vec<_>>()
+    };
     Points::Grid(vec![axis(500.0), axis(800.0), axis(500.0)])
 }
 
@@ -76,6 +88,21 @@ fn map(c: &mut Criterion) {
     });
     g.bench_function("evaluate_summary_1e6", |b| {
         b.iter(|| black_box(b1.summary(&points, &|_| {}).unwrap()))
+    });
+    // One thread: the cost per point.
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    g.bench_function("evaluate_1e6_one_thread", |b| {
+        b.iter(|| one.install(|| black_box(b1.map(points.clone()).unwrap().summary)))
+    });
+    // The same map through the `machine!`-generated type.
+    let machine = chain::core::load_file(&example("machines/vmc3.yaml")).unwrap();
+    let values = Values::read(&example("values/vmc3.yaml"), &machine).unwrap();
+    let generated = BuiltMachine::new(&machine, Vmc3, values, vec![150.0]).unwrap();
+    g.bench_function("evaluate_1e6_generated_one_thread", |b| {
+        b.iter(|| one.install(|| black_box(generated.map(points.clone()).unwrap().summary)))
     });
     let list = Points::list(3, full_factorial_of(&points)).unwrap();
     g.bench_function("evaluate_list_1e6", |b| {

@@ -596,7 +596,12 @@ fn the_map_does_not_depend_on_the_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| (b.map(points.clone()).unwrap(), b.summary(points, &|_| {}).unwrap()))
+            .install(|| {
+                (
+                    b.map(points.clone()).unwrap(),
+                    b.summary(points, &|_| {}).unwrap(),
+                )
+            })
     };
     let (one, summary) = run(1, &grid);
     for threads in [2, 3] {

@@ -380,11 +380,18 @@ impl<M: ErrorModel + Sync> BuiltMachine<M> {
         #[cfg(feature = "parallel")]
         let partials: Vec<Result<Partial, MapError>> = {
             use rayon::prelude::*;
-            errors.par_chunks_mut(MAP_BLOCK).enumerate().map(block).collect()
+            errors
+                .par_chunks_mut(MAP_BLOCK)
+                .enumerate()
+                .map(block)
+                .collect()
         };
         #[cfg(not(feature = "parallel"))]
-        let partials: Vec<Result<Partial, MapError>> =
-            errors.chunks_mut(MAP_BLOCK).enumerate().map(block).collect();
+        let partials: Vec<Result<Partial, MapError>> = errors
+            .chunks_mut(MAP_BLOCK)
+            .enumerate()
+            .map(block)
+            .collect();
         let summary = self.summary_of(&points, count, partials)?;
         Ok(MapResult {
             machine: self.machine.clone(),
@@ -491,7 +498,7 @@ impl<M: ErrorModel + Sync> BuiltMachine<M> {
             }
             self.model.error(&q, &self.parameters, &scratch, &mut e);
             std::mem::swap(&mut previous, &mut q);
-            part.add(i, &e, volumetric(&e));
+            part.add(i, &e);
             if let Some(out) = errors.as_deref_mut() {
                 out[k] = e;
             }
@@ -528,7 +535,8 @@ impl Points {
     /// Explicit points of `dimension` values each, flat. Values that do not
     /// make whole points are an error.
     pub fn list(dimension: usize, values: Vec<f64>) -> Result<Points, MapError> {
-        if (dimension == 0 && !values.is_empty()) || (dimension > 0 && values.len() % dimension != 0)
+        if (dimension == 0 && !values.is_empty())
+            || (dimension > 0 && values.len() % dimension != 0)
         {
             return Err(MapError::Ragged {
                 len: values.len(),
@@ -638,15 +646,16 @@ impl Cursor<'_> {
     }
 }
 
-/// The running summary of some points.
+/// The running summary of some points. The volumetric error is tracked by
+/// its square (`√` is monotonic: the largest `|p|²` is at the largest `|p|`,
+/// and `Σ|p|² = Σpx² + Σpy² + Σpz²`), so no point needs a square root.
 #[derive(Debug, Clone, Copy)]
 struct Partial {
     min: [f64; 6],
     max: [f64; 6],
     squares: [f64; 6],
-    volumetric_max: f64,
+    volumetric_max_squared: f64,
     volumetric_at: usize,
-    volumetric_squares: f64,
 }
 
 impl Partial {
@@ -655,25 +664,29 @@ impl Partial {
             min: [f64::INFINITY; 6],
             max: [f64::NEG_INFINITY; 6],
             squares: [0.0; 6],
-            volumetric_max: f64::NEG_INFINITY,
+            volumetric_max_squared: f64::NEG_INFINITY,
             volumetric_at: 0,
-            volumetric_squares: 0.0,
         }
     }
 
     #[inline]
-    fn add(&mut self, i: usize, e: &[f64; 6], v: f64) {
+    fn add(&mut self, i: usize, e: &[f64; 6]) {
         for (c, &x) in e.iter().enumerate() {
-            self.min[c] = self.min[c].min(x);
-            self.max[c] = self.max[c].max(x);
+            // Plain comparisons (a NaN changes nothing, as with f64::min).
+            if x < self.min[c] {
+                self.min[c] = x;
+            }
+            if x > self.max[c] {
+                self.max[c] = x;
+            }
             self.squares[c] += x * x;
         }
+        let v2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
         // The first of equal maxima.
-        if v > self.volumetric_max {
-            self.volumetric_max = v;
+        if v2 > self.volumetric_max_squared {
+            self.volumetric_max_squared = v2;
             self.volumetric_at = i;
         }
-        self.volumetric_squares += v * v;
     }
 
     /// Adds the summary of later points.
@@ -683,11 +696,10 @@ impl Partial {
             self.max[c] = self.max[c].max(later.max[c]);
             self.squares[c] += later.squares[c];
         }
-        if later.volumetric_max > self.volumetric_max {
-            self.volumetric_max = later.volumetric_max;
+        if later.volumetric_max_squared > self.volumetric_max_squared {
+            self.volumetric_max_squared = later.volumetric_max_squared;
             self.volumetric_at = later.volumetric_at;
         }
-        self.volumetric_squares += later.volumetric_squares;
     }
 }
 
@@ -751,9 +763,9 @@ impl MapSummary {
             oy: c(4),
             oz: c(5),
             volumetric: VolumetricSummary {
-                max: p.volumetric_max,
+                max: p.volumetric_max_squared.sqrt(),
                 at,
-                rms: (p.volumetric_squares / n).sqrt(),
+                rms: ((p.squares[0] + p.squares[1] + p.squares[2]) / n).sqrt(),
                 index,
             },
         }
@@ -914,20 +926,19 @@ mod tests {
                 [x.sin(), x.cos(), 0.1 * x, -x, 2.0, (3.0 * x).sin()]
             })
             .collect();
-        let vol = |e: &[f64; 6]| (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
         let mut one = Partial::new();
         for (i, e) in pts.iter().enumerate() {
-            one.add(i, e, vol(e));
+            one.add(i, e);
         }
         let (mut a, mut b) = (Partial::new(), Partial::new());
         for (i, e) in pts.iter().enumerate() {
-            if i < 4 { &mut a } else { &mut b }.add(i, e, vol(e));
+            if i < 4 { &mut a } else { &mut b }.add(i, e);
         }
         a.merge(&b);
         assert_eq!(a.min, one.min);
         assert_eq!(a.max, one.max);
         assert_eq!(a.volumetric_at, one.volumetric_at);
-        assert_eq!(a.volumetric_max, one.volumetric_max);
+        assert_eq!(a.volumetric_max_squared, one.volumetric_max_squared);
         for c in 0..6 {
             assert!((a.squares[c] - one.squares[c]).abs() <= 1e-12 * one.squares[c].abs());
         }

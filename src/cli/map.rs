@@ -365,10 +365,7 @@ pub(crate) enum Mapped {
     /// The library's whole result.
     Full(MapResult),
     /// The summary, and the points it is of.
-    Summary {
-        summary: MapSummary,
-        points: Points,
-    },
+    Summary { summary: MapSummary, points: Points },
 }
 
 impl Mapped {

@@ -8,8 +8,9 @@
 //! knots are evenly spaced. [`Table::eval`] then finds the interval in `O(1)`
 //! for evenly spaced knots (one multiplication, corrected by at most a step
 //! either way against round-off) and by binary search otherwise, and
-//! evaluates its polynomial by Horner's rule; it takes `&self`, allocates
-//! nothing and keeps no state, so one table serves any number of threads.
+//! evaluates its polynomial (a cubic by Estrin's scheme); it takes `&self`,
+//! allocates nothing and keeps no state, so one table serves any number of
+//! threads.
 
 use serde::Serialize;
 
@@ -263,9 +264,11 @@ impl Table {
         let i = self.interval(q);
         let d = q - self.q[i];
         let [c0, c1, c2, c3] = self.poly[i];
-        // A linear interval has c2 = c3 = 0: the same expression is
-        // `c0 + c1·d` exactly.
-        Some(c0 + d * (c1 + d * (c2 + d * c3)))
+        Some(match self.interpolation {
+            Interpolation::Linear => c0 + c1 * d,
+            // Estrin's scheme: the two halves and d² in parallel.
+            Interpolation::Cubic => (c0 + c1 * d) + (d * d) * (c2 + c3 * d),
+        })
     }
 
     /// The interval `i` with `q_i ≤ q ≤ q_{i+1}`, for `q` in `[q_0, q_{n−1})`.
