@@ -26,4 +26,12 @@ fn machine_macro_ui() {
     t.compile_fail("tests/ui/bad_key_in_file.rs");
     t.compile_fail("tests/ui/negative_std.rs");
     t.compile_fail("tests/ui/syntax.rs");
+    // Function slots and `errors: iso` (measured-machines spec, section 1).
+    t.pass("tests/ui/pass_function_slots.rs");
+    t.compile_fail("tests/ui/fourier_on_prismatic.rs");
+    t.compile_fail("tests/ui/legendre_without_range.rs");
+    t.compile_fail("tests/ui/degree_above_12.rs");
+    t.compile_fail("tests/ui/coefficient_clash.rs");
+    t.compile_fail("tests/ui/iso_without_joint.rs");
+    t.compile_fail("tests/ui/function_slot_in_file.rs");
 }

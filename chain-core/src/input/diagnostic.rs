@@ -363,8 +363,10 @@ pub enum Problem {
         name: String,
         /// How this declaration differs from the first.
         difference: String,
-        /// 1-based line of the first declaration.
-        first_line: usize,
+        /// Where the first declaration is: `on line 8` (a file) or
+        /// ``at `bodies.x_slide.errors.dy.name` `` (the inline `machine!`
+        /// form, whose tokens have no lines).
+        first: String,
     },
     /// A function or coefficient name that is already another name of the
     /// machine, or a name that is already a function or coefficient.
@@ -776,11 +778,20 @@ impl Problem {
             } => D::new(
                 "chain::error_kind_conflict",
                 "kind conflict",
-                format!(
-                    "error `{name}` is used as {} here but as {} on line {first_line}",
-                    kind_name(*second),
-                    kind_name(*first)
-                ),
+                if *first_line > 0 {
+                    format!(
+                        "error `{name}` is used as {} here but as {} on line {first_line}",
+                        kind_name(*second),
+                        kind_name(*first)
+                    )
+                } else {
+                    // The inline `machine!` form: tokens have no lines.
+                    format!(
+                        "error `{name}` is used as {} here but as {} before",
+                        kind_name(*second),
+                        kind_name(*first)
+                    )
+                },
             ),
             Problem::UnknownVariable { name, suggestion } => D::new(
                 "chain::unknown_variable",
@@ -876,13 +887,13 @@ impl Problem {
             Problem::FunctionRedeclared {
                 name,
                 difference,
-                first_line,
+                first,
             } => D::new(
                 "chain::function_redeclared",
                 "redeclared",
                 format!("function `{name}` is declared again {difference}"),
             )
-            .note(format!("first declared on line {first_line}"))
+            .note(format!("first declared {first}"))
             .help(
                 "a function declared twice must be the same function: same basis, same axis, \
                  same kind of slot; otherwise give it another name"

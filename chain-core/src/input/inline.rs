@@ -35,13 +35,16 @@ pub struct Converter {
 }
 
 impl Converter {
+    /// A node location: `offset` indexes the token table; `line` and
+    /// `column` are 0 (tokens have no lines of a file), so messages that
+    /// refer to an earlier place name its key path instead of a line.
     fn locate(&mut self, span: TokenSpan) -> Span {
         self.spans.push(span);
         Span {
             offset: self.spans.len() - 1,
             len: 1,
-            line: 1,
-            column: self.spans.len(),
+            line: 0,
+            column: 0,
         }
     }
 

@@ -1240,7 +1240,7 @@ impl Loader {
                 let problem = Problem::FunctionRedeclared {
                     name: name.clone(),
                     difference,
-                    first_line: first.origin.line,
+                    first: place(&first.origin),
                 };
                 self.report(f.name.span, f.name.path.clone(), problem);
                 return Vec::new();
@@ -1335,29 +1335,24 @@ impl Registry<'_> {
     /// messages of [`Problem::FunctionClash`]).
     fn describe(&self, name: &str, parameters: &HashMap<String, usize>) -> Option<String> {
         if let Some(function) = self.coefficient_of.get(name) {
-            let line = self
+            let at = self
                 .function_by_name
                 .get(function)
                 .and_then(|&i| self.functions.get(i))
-                .map_or(0, |f| f.origin.line);
-            return Some(format!(
-                "a coefficient of function `{function}` (declared on line {line})"
-            ));
+                .map_or_else(String::new, |f| format!(" (declared {})", place(&f.origin)));
+            return Some(format!("a coefficient of function `{function}`{at}"));
         }
         if let Some(f) = self
             .function_by_name
             .get(name)
             .and_then(|&i| self.functions.get(i))
         {
-            return Some(format!(
-                "function `{name}` (declared on line {})",
-                f.origin.line
-            ));
+            return Some(format!("function `{name}` (declared {})", place(&f.origin)));
         }
         if let Some(e) = self.by_name.get(name).and_then(|&i| self.errors.get(i)) {
             return Some(format!(
-                "the error parameter `{name}` (first used on line {})",
-                e.origin.line
+                "the error parameter `{name}` (first used {})",
+                place(&e.origin)
             ));
         }
         if parameters.contains_key(name) {
@@ -1367,6 +1362,17 @@ impl Registry<'_> {
             return Some(format!("the axis variable `{name}`"));
         }
         None
+    }
+}
+
+/// Where an earlier declaration is, for messages: `on line 8` in a file,
+/// ``at `bodies.x_slide.errors.dy` `` in the inline `machine!` form (whose
+/// tokens have no lines).
+fn place(origin: &crate::model::Origin) -> String {
+    if origin.line > 0 {
+        format!("on line {}", origin.line)
+    } else {
+        format!("at `{}`", origin.key)
     }
 }
 

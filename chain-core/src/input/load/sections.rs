@@ -86,8 +86,10 @@ impl Loader {
             let path = join("statistics", name);
             let error = error_index.get(name).copied();
             if let Some(t) = tree {
-                if error.is_none() && !self.seen_errors.contains(name) && !self.refused(name) {
-                    let problem = match t.functions.iter().find(|f| f.name == name) {
+                let function = t.functions.iter().find(|f| f.name == name);
+                let known = self.seen_errors.contains(name) || self.refused(name);
+                if error.is_none() && (function.is_some() || !known) {
+                    let problem = match function {
                         // A function's name: its coefficients take statistics.
                         Some(f) => Problem::FunctionStatistics {
                             name: name.to_string(),

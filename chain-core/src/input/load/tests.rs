@@ -1,7 +1,7 @@
 //! Unit tests of the loader on the spec's example and on ordering rules.
 
 use super::*;
-use crate::model::{Distribution, ErrorKind, JointKind, Sided};
+use crate::model::{Basis, Distribution, ErrorKind, JointKind, Sided};
 
 const GANTRY: &str = r#"machine: gantry_grinder                # identifier
 description: Large CNC gantry guide-rail grinder
@@ -108,4 +108,111 @@ fn collects_several_errors() {
     let text = "machine: m\nbodies:\n  bed: {}\n  a: {parent: bde, joint: {type: prismatic, axis: +w, variable: x}}\nworkpiece: bed\ntool: a\nfoo: 1\n";
     let d = load_str(text, "m.yaml").unwrap_err();
     assert_eq!(d.len(), 3, "{d:#}");
+}
+
+/// The inline `machine!` form of a token string: the same located tree as
+/// YAML, through [`crate::inline::Converter`].
+fn inline(tokens: &str) -> Result<Machine, Vec<(Origin, Problem)>> {
+    let stream: proc_macro2::TokenStream = tokens.parse().expect("tokens");
+    let mut conv = crate::inline::Converter::default();
+    let root = conv
+        .mapping(stream, proc_macro2::Span::call_site())
+        .expect("inline syntax");
+    from_tree(&root)
+}
+
+#[test]
+fn inline_form_takes_function_slots_and_iso() {
+    let m = inline(
+        "machine: m,
+         bodies {
+             bed {},
+             x_slide {
+                 parent: bed,
+                 joint: { type: prismatic, axis: +x, variable: x },
+                 errors: {
+                     dy: [dyc, { name: EYX, powers: [1, 2] }],
+                     dz: { name: EZX, basis: legendre, degree: 2, range: [-500, 500] },
+                     ez: { name: ECX, basis: chebyshev, degree: 2, range: [0, 1e3], from: 1 },
+                 },
+             },
+             table {
+                 parent: bed,
+                 joint: { type: rotary, axis: +z, variable: C },
+                 errors: iso,
+                 location_errors: { ex: { name: EAC, basis: fourier, harmonics: 1 } },
+             },
+         },
+         workpiece: table,
+         tool: x_slide,",
+    );
+    // `location_errors` takes names only: one error, then the valid form.
+    let problems = m.unwrap_err();
+    assert_eq!(problems.len(), 1, "{problems:?}");
+    assert_eq!(problems[0].0.key, "bodies.table.location_errors.ex");
+    assert_eq!(problems[0].1.code(), "chain::function_not_allowed");
+
+    let m = inline(
+        "machine: m,
+         bodies {
+             bed {},
+             x_slide {
+                 parent: bed,
+                 joint: { type: prismatic, axis: +x, variable: x },
+                 errors: {
+                     dy: [dyc, { name: EYX, powers: [1, 2] }],
+                     dz: { name: EZX, basis: legendre, degree: 2, range: [-500, 500] },
+                     ez: { name: ECX, basis: chebyshev, degree: 2, range: [0, 1e3], from: 1 },
+                 },
+             },
+             table {
+                 parent: bed,
+                 joint: { type: rotary, axis: +z, variable: C },
+                 errors: iso,
+                 squareness: { ex: Sxz },
+             },
+             spindle { parent: table, joint: { type: rotary, axis: +x, variable: A },
+                       errors: { ex: { name: EAA, basis: fourier, harmonics: 1 } } },
+         },
+         workpiece: spindle,
+         tool: x_slide,",
+    )
+    .unwrap();
+    let names: Vec<&str> = m.errors.iter().map(|e| e.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "dyc", "EYX_1", "EYX_2", "EZX_0", "EZX_1", "EZX_2", "ECX_1", "ECX_2", "EXC", "EYC",
+            "EZC", "EAC", "EBC", "ECC", "Sxz", "EAA_0", "EAA_c1", "EAA_s1"
+        ]
+    );
+    let f: Vec<(&str, &Basis)> = m
+        .functions
+        .iter()
+        .map(|f| (f.name.as_str(), &f.basis))
+        .collect();
+    assert_eq!(
+        f,
+        [
+            ("EYX", &Basis::Powers { powers: vec![1, 2] }),
+            (
+                "EZX",
+                &Basis::Legendre {
+                    degree: 2,
+                    range: [-500.0, 500.0],
+                    from: 0
+                }
+            ),
+            (
+                "ECX",
+                &Basis::Chebyshev {
+                    degree: 2,
+                    range: [0.0, 1000.0],
+                    from: 1
+                }
+            ),
+            ("EAA", &Basis::Fourier { harmonics: 1 }),
+        ]
+    );
+    assert_eq!(m.functions[3].variable, m.variable_index("A").unwrap());
 }

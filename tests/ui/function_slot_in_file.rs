@@ -1,0 +1,2 @@
+chain::machine!(pub M = "tests/ui/function_slot.yaml");
+fn main() {}
