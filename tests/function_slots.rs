@@ -402,23 +402,13 @@ fn mixed_slots_shared_functions_and_multiplicities_match_the_exact_product() {
 
 // ------------------------------------------------------------ the two routes
 
-/// `a` and `b` have the same monomials and coefficients equal to `rel` of
-/// the polynomial's largest coefficient (0 asks for bit equality).
-fn same_poly(a: &Poly, b: &Poly, rel: f64) -> bool {
-    if a.terms().len() != b.terms().len() {
-        return false;
-    }
-    let scale = a.terms().iter().map(|(_, c)| c.abs()).fold(0.0, f64::max);
-    a.terms()
-        .iter()
-        .zip(b.terms())
-        .all(|((ma, ca), (mb, cb))| ma == mb && (ca - cb).abs() <= rel * scale)
-}
-
 /// The matrix route (weights multiplied in after the product, errors of one
 /// slot derived once) and the differential-motion-matrix route (weights in
-/// the product) give the same canonical polynomials, bit for bit (`rel` =
-/// 0), or to `rel` of each polynomial's largest coefficient.
+/// the product) give the same canonical polynomials bit for bit (`rel` = 0:
+/// the same errors, monomials and coefficients), or as functions to `rel`:
+/// every coefficient of their difference within `rel` of the component's
+/// largest coefficient (arbitrary fixed rotations leave round-off residues,
+/// e.g. `3e-19·cos q·sin q`, that one route cancels and the other keeps).
 fn assert_routes_agree_to(m: &Machine, rel: f64) -> usize {
     let mut compared = 0;
     for frame in [Frame::Tool, Frame::Workpiece] {
@@ -426,18 +416,54 @@ fn assert_routes_agree_to(m: &Machine, rel: f64) -> usize {
         let dmm = chain_core::dmm::derive_dmm(m, frame);
         for c in Component::ALL {
             let (a, b) = (&model.components[c.index()], &dmm[c.index()]);
-            let names = |v: &[(usize, Poly)]| v.iter().map(|(j, _)| *j).collect::<Vec<_>>();
-            assert_eq!(names(a), names(b), "{} {frame:?} {}", m.name, c.name());
-            for ((j, pa), (_, pb)) in a.iter().zip(b) {
-                let show = |p: &Poly| p.to_text(&|s| model.symbol_name(s));
+            let show = |p: &Poly| p.to_text(&|s| model.symbol_name(s));
+            if rel == 0.0 {
+                let names = |v: &[(usize, Poly)]| v.iter().map(|(j, _)| *j).collect::<Vec<_>>();
+                assert_eq!(names(a), names(b), "{} {frame:?} {}", m.name, c.name());
+                for ((j, pa), (_, pb)) in a.iter().zip(b) {
+                    assert!(
+                        pa == pb,
+                        "{} {frame:?} d{}/d{}:\n  matrix: {}\n  dmm:    {}",
+                        m.name,
+                        c.name(),
+                        m.errors[*j].name,
+                        show(pa),
+                        show(pb)
+                    );
+                    compared += 1;
+                }
+                continue;
+            }
+            let scale = a
+                .iter()
+                .chain(b)
+                .flat_map(|(_, p)| p.terms().iter().map(|(_, k)| k.abs()))
+                .fold(0.0, f64::max);
+            let get = |v: &[(usize, Poly)], j: usize| {
+                v.iter()
+                    .find(|(k, _)| *k == j)
+                    .map(|(_, p)| p.clone())
+                    .unwrap_or_default()
+            };
+            let mut errors: Vec<usize> = a.iter().chain(b).map(|(j, _)| *j).collect();
+            errors.sort_unstable();
+            errors.dedup();
+            for j in errors {
+                let (pa, pb) = (get(a, j), get(b, j));
+                let worst = pa
+                    .sub(&pb)
+                    .terms()
+                    .iter()
+                    .map(|(_, k)| k.abs())
+                    .fold(0.0, f64::max);
                 assert!(
-                    same_poly(pa, pb, rel),
+                    worst <= rel * scale,
                     "{} {frame:?} d{}/d{}:\n  matrix: {}\n  dmm:    {}",
                     m.name,
                     c.name(),
-                    m.errors[*j].name,
-                    show(pa),
-                    show(pb)
+                    m.errors[j].name,
+                    show(&pa),
+                    show(&pb)
                 );
                 compared += 1;
             }
@@ -625,4 +651,474 @@ fn emitted_code_reads_a_rotary_variable_for_a_polynomial_slot() {
     let code =
         chain_core::emit::emit_pretty(&plain, &chain_core::emit::EmitOptions::for_model(&plain));
     assert!(!code.contains("error_at"));
+}
+
+// ----------------------------------------------------- machine files (loader)
+
+/// Every basis of the spec in one machine file: a rotary table C on an X
+/// slide, the tool on a Z slide; Chebyshev with and without `from`, and a
+/// powers and a Legendre slot on the rotary axis.
+const ALL_BASES: &str = "\
+machine: all_bases
+parameters: {L: 120}
+bodies:
+  bed: {}
+  x_slide:
+    parent: bed
+    joint: {type: prismatic, axis: +x, variable: x}
+    errors:
+      dx: {name: EXX, basis: chebyshev, degree: 3, range: [0, 1000]}
+      dy: {name: EYX, powers: [1, 2]}
+      dz: {name: EZX, basis: legendre, degree: 3, range: [0, 1000]}
+      ez: {name: ECX, basis: chebyshev, degree: 2, range: [0, 1000], from: 1}
+    squareness: {ez: Sxy}
+  c_table:
+    parent: x_slide
+    offset: [0, 0, 50]
+    location_errors: {dx: EX0C, ey: EB0C}
+    joint: {type: rotary, axis: +z, variable: C}
+    errors:
+      dx: {name: EXC, powers: [0, 1, 2]}
+      dy: {name: EYC, basis: legendre, degree: 2, range: [-3.2, 3.2], from: 1}
+      ex: {name: EAC, basis: fourier, harmonics: 2}
+      ez: ECC
+  z_slide:
+    parent: bed
+    joint: {type: prismatic, axis: -z, variable: z}
+    errors: {dx: EXZ, ey: {name: EBZ, basis: legendre, degree: 2, range: [-100, 500]}}
+  tool: {parent: z_slide, offset: [0, L, 0]}
+workpiece: c_table
+tool: tool
+tool_point: [10, 0, L]
+";
+
+fn all_bases_range(name: &str) -> [f64; 2] {
+    match name {
+        "x" => [0.0, 1000.0],
+        "z" => [-100.0, 500.0],
+        _ => [-PI, PI],
+    }
+}
+
+#[test]
+fn machine_files_with_function_slots_match_the_exact_product() {
+    let m = chain_core::load_str(ALL_BASES, "all_bases.yaml").unwrap_or_else(|d| panic!("{d}"));
+    let names: Vec<&str> = m.errors.iter().map(|e| e.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "EXX_0", "EXX_1", "EXX_2", "EXX_3", "EYX_1", "EYX_2", "EZX_0", "EZX_1", "EZX_2",
+            "EZX_3", "ECX_1", "ECX_2", "Sxy", "EX0C", "EB0C", "EXC_0", "EXC_1", "EXC_2", "EYC_1",
+            "EYC_2", "EAC_0", "EAC_c1", "EAC_s1", "EAC_c2", "EAC_s2", "ECC", "EXZ", "EBZ_0",
+            "EBZ_1", "EBZ_2"
+        ]
+    );
+    assert_eq!(m.functions.len(), 8);
+    for frame in [Frame::Tool, Frame::Workpiece] {
+        let mut m = m.clone();
+        m.frame = frame;
+        check_against_exact(&m, 40, &all_bases_range, 23);
+        assert!(assert_routes_agree(&m) > 100);
+    }
+    // The two example files.
+    let legendre5 = load_example("legendre5.yaml");
+    assert_eq!(legendre5.errors.len(), 131);
+    assert_eq!(legendre5.functions.len(), 30);
+    let range = |v: &str| match v {
+        "A" => [-2.1, 2.1],
+        "C" => [-PI, PI],
+        _ => [-400.0, 400.0],
+    };
+    check_against_exact(&legendre5, 20, &range, 29);
+    let spread = load_example("spread_along_axis.yaml");
+    check_against_exact(&spread, 20, &gantry_range, 31);
+}
+
+#[test]
+fn iso_names_reach_the_derived_model() {
+    // `errors: iso` names the six component errors after the variable,
+    // upper-cased (spec section 1), and they are the model's error names.
+    let yaml = "machine: iso\nbodies:\n  bed: {}\n  x_slide: {parent: bed, joint: {type: prismatic, axis: +x, variable: x}, errors: iso}\n  table: {parent: bed, joint: {type: rotary, axis: +z, variable: c}, errors: iso}\nworkpiece: table\ntool: x_slide\ntool_point: [0, 0, 100]\n";
+    let m = chain_core::load_str(yaml, "iso.yaml").unwrap_or_else(|d| panic!("{d}"));
+    let json = serde_json::to_value(chain_core::export::to_json(&chain_core::derive(&m))).unwrap();
+    assert_eq!(
+        json["errors"],
+        serde_json::json!([
+            "EXX", "EYX", "EZX", "EAX", "EBX", "ECX", "EXC", "EYC", "EZC", "EAC", "EBC", "ECC"
+        ])
+    );
+    assert!(json.get("functions").is_none());
+    // In the (rotating) workpiece frame the x slide's EXX is seen along
+    // Rz(-c)·x = (cos c, -sin c, 0); the table's own EXC moves the
+    // workpiece, so the tool moves by -EXC relative to it.
+    assert_eq!(json["components"]["px"]["EXX"], "cos(c)");
+    assert_eq!(json["components"]["py"]["EXX"], "-sin(c)");
+    assert_eq!(json["components"]["px"]["EXC"], "-1");
+    check_against_exact(
+        &m,
+        10,
+        &|v| if v == "x" { [0.0, 500.0] } else { [-PI, PI] },
+        37,
+    );
+}
+
+// ------------------------------------------------------------ random machines
+
+use proptest::prelude::*;
+
+/// One slot of a generated body: empty, a constant, or a function.
+#[derive(Debug, Clone)]
+enum GenSlot {
+    Empty,
+    Constant,
+    /// Exponents as a bit set of 0..=4 (non-empty), written reversed if set.
+    Powers(u8, bool),
+    /// (Chebyshev instead of Legendre, degree, from, lo, width).
+    Orthogonal(bool, u32, u32, f64, f64),
+    /// Harmonics (rotary joints only; powers on prismatic ones).
+    Fourier(u32),
+}
+
+#[derive(Debug, Clone)]
+struct GenBody {
+    parent: usize,
+    offset: [f64; 3],
+    rotation: Option<(usize, f64)>,
+    /// (rotary, axis, negative)
+    joint: Option<(bool, usize, bool)>,
+    errors: [GenSlot; 6],
+    location: [bool; 6],
+}
+
+#[derive(Debug, Clone)]
+struct GenMachine {
+    bodies: Vec<GenBody>,
+    workpiece: usize,
+    tool: usize,
+    tool_point: [f64; 3],
+    tool_frame: bool,
+}
+
+const SLOTS: [&str; 6] = ["dx", "dy", "dz", "ex", "ey", "ez"];
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+impl GenMachine {
+    fn yaml(&self) -> String {
+        let n = self.bodies.len();
+        let wp = self.workpiece % n;
+        let mut tool = self.tool % n;
+        if tool == wp {
+            tool = (tool + 1) % n;
+        }
+        let mut y = String::from("machine: random_functions\nbodies:\n  b0: {}\n");
+        for (b, body) in self.bodies.iter().enumerate().skip(1) {
+            y.push_str(&format!("  b{b}:\n    parent: b{}\n", body.parent % b));
+            let [ox, oy, oz] = body.offset;
+            y.push_str(&format!("    offset: [{ox}, {oy}, {oz}]\n"));
+            if let Some((axis, angle)) = body.rotation {
+                y.push_str(&format!(
+                    "    rotation: [{{about: {}, angle: {angle}}}]\n",
+                    AXES[axis]
+                ));
+            }
+            let location: Vec<String> = (0..6)
+                .filter(|&s| body.location[s])
+                .map(|s| format!("{}: l{b}{}", SLOTS[s], SLOTS[s]))
+                .collect();
+            if !location.is_empty() {
+                y.push_str(&format!(
+                    "    location_errors: {{{}}}\n",
+                    location.join(", ")
+                ));
+            }
+            let mut errors = Vec::new();
+            for (s, slot) in body.errors.iter().enumerate() {
+                let name = format!("F{b}{}", SLOTS[s]);
+                let entry = match (slot, body.joint) {
+                    (GenSlot::Empty, _) => continue,
+                    (GenSlot::Constant, _) | (_, None) => format!("e{b}{}", SLOTS[s]),
+                    (GenSlot::Powers(bits, reversed), _) => {
+                        let mut p: Vec<String> =
+                            (0..5).filter(|k| bits & (1 << k) != 0).map(|k| k.to_string()).collect();
+                        if *reversed {
+                            p.reverse();
+                        }
+                        format!("{{name: {name}, powers: [{}]}}", p.join(", "))
+                    }
+                    (GenSlot::Orthogonal(cheb, degree, from, lo, width), _) => format!(
+                        "{{name: {name}, basis: {}, degree: {degree}, range: [{lo}, {}], from: {}}}",
+                        if *cheb { "chebyshev" } else { "legendre" },
+                        lo + width,
+                        from.min(degree)
+                    ),
+                    (GenSlot::Fourier(h), Some((true, _, _))) => {
+                        format!("{{name: {name}, basis: fourier, harmonics: {h}}}")
+                    }
+                    (GenSlot::Fourier(h), Some((false, _, _))) => {
+                        format!("{{name: {name}, powers: [{}]}}", h % 5)
+                    }
+                };
+                errors.push(format!("{}: {entry}", SLOTS[s]));
+            }
+            if let Some((rotary, axis, negative)) = body.joint {
+                y.push_str(&format!(
+                    "    joint: {{type: {}, axis: {}{}, variable: q{b}}}\n",
+                    if rotary { "rotary" } else { "prismatic" },
+                    if negative { "-" } else { "+" },
+                    AXES[axis]
+                ));
+            }
+            if !errors.is_empty() {
+                y.push_str("    errors:\n");
+                for e in errors {
+                    y.push_str(&format!("      {e}\n"));
+                }
+            }
+        }
+        let [tx, ty, tz] = self.tool_point;
+        y.push_str(&format!(
+            "workpiece: b{wp}\ntool: b{tool}\ntool_point: [{tx}, {ty}, {tz}]\nframe: {}\n",
+            if self.tool_frame { "tool" } else { "workpiece" }
+        ));
+        y
+    }
+}
+
+fn gen_slot() -> impl Strategy<Value = GenSlot> {
+    prop_oneof![
+        2 => Just(GenSlot::Empty),
+        1 => Just(GenSlot::Constant),
+        2 => (1u8..32, any::<bool>()).prop_map(|(b, r)| GenSlot::Powers(b, r)),
+        2 => (any::<bool>(), 0u32..5, 0u32..3, -500i32..500, 10i32..1000).prop_map(
+            |(c, d, f, lo, w)| GenSlot::Orthogonal(c, d, f, f64::from(lo), f64::from(w))
+        ),
+        2 => (0u32..4).prop_map(GenSlot::Fourier),
+    ]
+}
+
+fn gen_body() -> impl Strategy<Value = GenBody> {
+    (
+        any::<usize>(),
+        [-300i32..300, -300i32..300, -300i32..300],
+        prop::option::weighted(0.3, (0usize..3, -3.0f64..3.0)),
+        prop::option::weighted(0.85, (any::<bool>(), 0usize..3, any::<bool>())),
+        [
+            gen_slot(),
+            gen_slot(),
+            gen_slot(),
+            gen_slot(),
+            gen_slot(),
+            gen_slot(),
+        ],
+        any::<[bool; 6]>(),
+    )
+        .prop_map(
+            |(parent, offset, rotation, joint, errors, location)| GenBody {
+                parent,
+                offset: offset.map(f64::from),
+                rotation,
+                joint,
+                errors,
+                location,
+            },
+        )
+}
+
+fn gen_machine() -> impl Strategy<Value = GenMachine> {
+    (
+        prop::collection::vec(gen_body(), 2..=6),
+        0usize..6,
+        0usize..6,
+        [-200i32..200, -200i32..200, -200i32..200],
+        any::<bool>(),
+    )
+        .prop_map(|(bodies, workpiece, tool, tp, tool_frame)| GenMachine {
+            bodies,
+            workpiece,
+            tool,
+            tool_point: tp.map(f64::from),
+            tool_frame,
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+
+    /// Random tree machines with random function slots of every basis, as
+    /// machine files: the compiled model equals the finite difference of the
+    /// exact product, and the two derivation routes agree.
+    #[test]
+    fn random_machines_with_function_slots_match_the_exact_product(
+        g in gen_machine(),
+        seed in any::<u64>(),
+    ) {
+        let yaml = g.yaml();
+        let m = match chain_core::load_str(&yaml, "random.yaml") {
+            Ok(m) => m,
+            Err(d) => panic!("generated machine does not load:\n{d}\n---\n{yaml}"),
+        };
+        let range = |name: &str| {
+            let v = m.variable_index(name).expect("variable");
+            match m.variables[v].kind {
+                JointKind::Prismatic => [-300.0, 300.0],
+                JointKind::Rotary => [-PI, PI],
+            }
+        };
+        let model = chain_core::compile(&m);
+        let ex = Exact::new(&m);
+        let mut rng = Rng::new(seed);
+        for _ in 0..3 {
+            let q = random_q(&m, &mut rng, &range);
+            if let Err(msg) = ex.check_sensitivity(&model, &q, &[], 1e-6, 1e-9) {
+                panic!("{msg}\n---\n{yaml}");
+            }
+            let e = random_e(&m, &mut rng, &q);
+            if let Err(msg) = ex.check_error_and_nominal(&model, &q, &[], &e, 1e-10) {
+                panic!("{msg}\n---\n{yaml}");
+            }
+        }
+        // Arbitrary fixed rotations round differently along the two routes.
+        assert_routes_agree_to(&m, 1e-12);
+    }
+}
+
+// ------------------------------------------------------- generated code (macro)
+
+chain::machine!(pub Legendre5 = "examples/machines/legendre5.yaml");
+
+chain::machine! {
+    pub RotaryPolynomial {
+        parameters: { L: 100 },
+        bodies {
+            bed {},
+            table {
+                parent: bed,
+                joint: { type: rotary, axis: +z, variable: C },
+                errors: {
+                    dx: { name: F, powers: [1, 2] },
+                    dy: { name: H, basis: fourier, harmonics: 1 },
+                    ez: { name: G, basis: legendre, degree: 2, range: [-3.2, 3.2] },
+                },
+            },
+            tool { parent: bed, offset: [L, 0, 0] },
+        },
+        workpiece: table,
+        tool: tool,
+    }
+}
+
+const ROTARY_POLYNOMIAL: &str = "machine: rotary_polynomial\nparameters: {L: 100}\nbodies:\n  bed: {}\n  table:\n    parent: bed\n    joint: {type: rotary, axis: +z, variable: C}\n    errors:\n      dx: {name: F, powers: [1, 2]}\n      dy: {name: H, basis: fourier, harmonics: 1}\n      ez: {name: G, basis: legendre, degree: 2, range: [-3.2, 3.2]}\n  tool: {parent: bed, offset: [L, 0, 0]}\nworkpiece: table\ntool: tool\n";
+
+#[test]
+fn generated_types_of_function_slots_match_the_tape_and_the_exact_product() {
+    assert_eq!(
+        RotaryPolynomial::ERRORS,
+        ["F_1", "F_2", "H_0", "H_c1", "H_s1", "G_0", "G_1", "G_2"]
+    );
+    let m = chain_core::load_str(ROTARY_POLYNOMIAL, "rp.yaml").unwrap();
+    let tape = chain_core::compile(&m);
+    let ex = Exact::new(&m);
+    let mut rng = Rng::new(41);
+    for _ in 0..50 {
+        let c = rng.range(-PI, PI);
+        let s = RotaryPolynomial::sensitivity(&[c], &[100.0]);
+        let mut t = vec![0.0; 6 * 8];
+        tape.sensitivity(&[c], &[100.0], &mut t);
+        for (a, b) in s.iter().flatten().zip(&t) {
+            assert!(
+                (a - b).abs() <= 1e-12 * (1.0 + b.abs()),
+                "generated {a}, tape {b}"
+            );
+        }
+        // dpx/dF_2 = -C² (the generated code reads the angle itself).
+        assert!((s[0][1] + c * c).abs() < 1e-12, "{} at C = {c}", s[0][1]);
+        ex.check_sensitivity(&RotaryPolynomial, &[c], &[100.0], 1e-6, 1e-9)
+            .unwrap();
+    }
+    // The five-axis file: 131 errors, against the tape and the exact product.
+    let m = load_example("legendre5.yaml");
+    let tape = chain_core::compile(&m);
+    assert_eq!(Legendre5::ERRORS.len(), 131);
+    assert_eq!(Legendre5::ERRORS.as_slice(), tape.errors());
+    let ex = Exact::new(&m);
+    let p = ex.file_parameters();
+    for _ in 0..20 {
+        let q = [
+            rng.range(-400.0, 400.0),
+            rng.range(-2.1, 2.1),
+            rng.range(-PI, PI),
+            rng.range(-400.0, 400.0),
+            rng.range(-400.0, 400.0),
+        ];
+        assert_eq!(Legendre5::VARIABLES, ["y", "A", "C", "x", "z"]);
+        let s = Legendre5::sensitivity(&q, &[150.0, 200.0]);
+        let mut t = vec![0.0; 6 * 131];
+        tape.sensitivity(&q, &p, &mut t);
+        for (a, b) in s.iter().flatten().zip(&t) {
+            assert!(
+                (a - b).abs() <= 1e-10 * (1.0 + b.abs()),
+                "generated {a}, tape {b}"
+            );
+        }
+        ex.check_sensitivity(&Legendre5, &q, &p, 1e-6, 1e-9)
+            .unwrap();
+    }
+}
+
+/// Error values from a table that covers `C ∈ [−1, 1]` only.
+struct Covered;
+
+impl chain::core::ErrorValues for Covered {
+    fn values_at(&self, q: &[f64], out: &mut [f64]) -> Result<(), chain::core::OutOfRange> {
+        if q[0].abs() > 1.0 {
+            return Err(chain::core::OutOfRange {
+                name: "F".into(),
+                table: "points".into(),
+                variable: "C".into(),
+                value: q[0],
+                lo: -1.0,
+                hi: 1.0,
+            });
+        }
+        out.fill(1e-3);
+        Ok(())
+    }
+}
+
+#[test]
+fn error_at_takes_a_closure_or_any_error_values() {
+    // Values that vary along the axis: F_1 = 1e-3·(1 + C), the others fixed.
+    let values = |q: &[f64], e: &mut [f64]| {
+        for (j, v) in e.iter_mut().enumerate() {
+            *v = 1e-4 * (j as f64 + 1.0);
+        }
+        e[RotaryPolynomial::ERR_F_1] = 1e-3 * (1.0 + q[0]);
+    };
+    for c in [-2.0, 0.0, 0.7] {
+        let mut e = [0.0; 8];
+        values(&[c], &mut e);
+        let direct = RotaryPolynomial::error(&[c], &[100.0], &e);
+        let at = RotaryPolynomial::error_at(&[c], &[100.0], &values).unwrap();
+        assert_eq!(at, direct);
+        // The same through the trait, with the caller's scratch.
+        let (mut scratch, mut out) = ([0.0; 8], [0.0; 6]);
+        RotaryPolynomial
+            .error_with(&[c], &[100.0], &values, &mut scratch, &mut out)
+            .unwrap();
+        assert_eq!(out, direct);
+        // And it is S·e of the exact sensitivity.
+        let s = RotaryPolynomial::sensitivity(&[c], &[100.0]);
+        let px: f64 = (0..8).map(|j| s[0][j] * e[j]).sum();
+        assert!((at[0] - px).abs() < 1e-15, "{} vs {px}", at[0]);
+    }
+    // A table that does not cover the point: the error, not a number.
+    assert!(RotaryPolynomial::error_at(&[0.5], &[100.0], &Covered).is_ok());
+    let err = RotaryPolynomial::error_at(&[1.5], &[100.0], &Covered).unwrap_err();
+    assert_eq!(err.value, 1.5);
+    assert!(
+        err.to_string().contains("outside the table of `F`"),
+        "{err}"
+    );
+    let dynamic: &dyn chain::core::ErrorValues = &Covered;
+    assert!(RotaryPolynomial::error_at(&[-1.5], &[100.0], dynamic).is_err());
 }
