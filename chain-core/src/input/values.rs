@@ -1454,3 +1454,23 @@ fn cell_number(text: &str, origin: &Origin, bad: &mut Vec<(Origin, Problem)>) ->
     ));
     None
 }
+
+#[cfg(all(test, not(feature = "csv")))]
+mod without_csv {
+    use super::*;
+
+    #[test]
+    fn a_csv_table_needs_the_feature() {
+        let yaml = "machine: m\nbodies:\n  bed: {}\n  x_slide: {parent: bed, joint: {type: prismatic, axis: +x, variable: x}, errors: {dx: dxx}}\nworkpiece: bed\ntool: x_slide\n";
+        let machine = crate::load_str(yaml, "m.yaml").unwrap();
+        let text = "machine: m\nvalues:\n  dxx: {table: t.csv}\n";
+        let e = Values::parse(text, "v.yaml", Path::new("."), &machine).unwrap_err();
+        let first = e.diagnostics().first();
+        assert_eq!(first.problem.code(), "chain::values::csv_feature");
+        assert_eq!((first.origin.line, first.origin.column), (3, 16));
+        assert!(e.to_string().contains("`csv` feature"), "{e}");
+        // `points` need no feature.
+        let text = "machine: m\nvalues:\n  dxx: {points: [[0, 0], [1, 1]]}\n";
+        assert!(Values::parse(text, "v.yaml", Path::new("."), &machine).is_ok());
+    }
+}
