@@ -5,9 +5,13 @@
 //! [`Machine`] → [`derive()`] → [`SymbolicModel`] (exact coefficients as
 //! canonical polynomials) → export (text / JSON / LaTeX / Rust) or
 //! [`compile`] → [`CompiledModel`], an [`ErrorModel`] evaluated from a flat tape.
+//! A built machine ([`BuiltMachine`]) is such a model with the error values
+//! of one machine ([`values`]: a values file, measured or identified), whose
+//! error it evaluates at any axis values and maps over a grid.
 
 #![warn(missing_docs)]
 
+pub mod built;
 pub mod input;
 pub mod kinematics;
 mod model_trait;
@@ -16,13 +20,15 @@ pub mod symbolic;
 
 // The stages' modules under their historical flat paths (`chain_core::load`,
 // `chain_core::inverse`, ...), which downstream code and the docs use.
-pub use input::{diagnostic, expr, inline, load, model, settings, yaml};
+pub use input::{diagnostic, expr, inline, load, model, settings, values, yaml};
 pub use kinematics::{conversion, geometry, inverse, jet, motion};
 pub use symbolic::{algebra, derive, dmm, emit, eval, expand, export, geometric};
 
+pub use built::{BuiltMachine, MapResult};
 pub use derive::{derive, derive_in, SymbolicModel};
 pub use diagnostic::Diagnostics;
 pub use eval::{compile, CompiledModel};
 pub use load::{load_bytes, load_file, load_str};
 pub use model::Machine;
 pub use model_trait::{ErrorModel, ErrorValues, OutOfRange, Pose};
+pub use values::Values;

@@ -7,6 +7,7 @@ pub mod compensate;
 mod csv_input;
 pub mod derive;
 pub mod inverse;
+pub mod map;
 pub mod motion;
 pub mod path;
 pub mod plot;
@@ -41,6 +42,8 @@ enum Command {
     Inverse(inverse::InverseArgs),
     /// Error and reliability along a path (axis values or tool poses) at every instant.
     Path(path::PathArgs),
+    /// The volumetric error map of a built machine: its error values (a values file) through the model over a grid or a list of points.
+    Map(map::MapArgs),
     /// Motion conversion ("Precision Machining Technology of Jewelry on CNC Machine Tool", 2022): CNC axis motions reproducing a cradle-type generator's roll, and their Maclaurin series.
     Motion(motion::MotionArgs),
 }
@@ -56,5 +59,6 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Inverse(args) => inverse::exec(args),
         Command::Path(args) => path::exec(args),
         Command::Motion(args) => motion::exec(args),
+        Command::Map(args) => map::exec(args),
     }
 }

@@ -1,0 +1,318 @@
+//! The CSV tables of a values file (`{table: FILE.csv, column: NAME}`), read
+//! with the `csv` crate (feature `csv`).
+//!
+//! The conventions are the command line's (`chain compensate`'s records): a
+//! leading byte-order mark is dropped, lines starting with `#` and blank lines
+//! are skipped, fields are trimmed, the first record is the header, and every
+//! row has as many fields as the header. Every cell keeps its origin (byte
+//! span, line, column, and the header name as its key), so a bad cell is
+//! reported as `x_axis.csv:7:9: … at key `EBX``.
+
+use std::path::Path;
+
+use crate::diagnostic::{Diagnostics, Message, Problem};
+use crate::model::Origin;
+
+/// CSV tables larger than this are refused.
+pub const MAX_TABLE_BYTES: usize = 64 * 1024 * 1024;
+
+/// One CSV file, read once however many entries use it.
+#[derive(Debug, Clone)]
+pub(crate) struct CsvFile {
+    /// Its text (for the diagnostics' snippets).
+    pub(crate) text: String,
+    /// Header names with their origins.
+    pub(crate) header: Vec<(String, Origin)>,
+    /// Data rows: each cell's text and origin (key: its column's name).
+    pub(crate) rows: Vec<Vec<(String, Origin)>>,
+}
+
+/// Why a CSV file could not be used at all.
+#[derive(Debug)]
+pub(crate) enum CsvOpenError {
+    /// It cannot be read (missing, too large, a directory): reported in the
+    /// values file, at the `table` key.
+    Unreadable(String),
+    /// Its text is not a CSV table (located in the CSV file).
+    Invalid(Diagnostics),
+}
+
+impl CsvFile {
+    /// Reads the CSV file at `path`, named `name` in messages.
+    pub(crate) fn read(path: &Path, name: &str) -> Result<CsvFile, CsvOpenError> {
+        let bytes = crate::load::read_file(path, name, MAX_TABLE_BYTES)
+            .map_err(|d| CsvOpenError::Unreadable(d.first().problem.headline()))?;
+        let text = crate::load::decode(&bytes, name).map_err(CsvOpenError::Invalid)?;
+        CsvFile::parse(text, name).map_err(CsvOpenError::Invalid)
+    }
+
+    /// Parses CSV text.
+    pub(crate) fn parse(text: &str, name: &str) -> Result<CsvFile, Diagnostics> {
+        let bom = if text.starts_with('\u{feff}') { 3 } else { 0 };
+        let data = &text.as_bytes()[bom..];
+        let mut reader = ::csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .trim(::csv::Trim::All)
+            .comment(Some(b'#'))
+            .from_reader(data);
+        let located = |origin: Origin, message: Message| {
+            Diagnostics::single(name, text, origin, Problem::Message(message))
+        };
+        let mut header: Vec<(String, Origin)> = Vec::new();
+        let mut rows = Vec::new();
+        for record in reader.records() {
+            let record = record.map_err(|e| {
+                let line = e.position().map_or(1, ::csv::Position::line);
+                let message = match e.kind() {
+                    ::csv::ErrorKind::Utf8 { err, .. } => {
+                        format!("the line is not valid UTF-8 ({err})")
+                    }
+                    _ => e.to_string(),
+                };
+                let bad = Message::new(
+                    format!("malformed CSV: {message}"),
+                    "malformed",
+                    "chain::values::csv_malformed",
+                );
+                located(line_origin(text, line), bad)
+            })?;
+            let Some(pos) = record.position() else {
+                continue;
+            };
+            let (start, line) = record_start(data, pos);
+            let spans = field_spans(data, start);
+            let cell = |k: usize, key: &str| -> Origin {
+                let (offset, len) = spans.get(k).copied().unwrap_or((start, 0));
+                let line_start = data[..offset]
+                    .iter()
+                    .rposition(|&b| b == b'\n')
+                    .map_or(0, |p| p + 1);
+                let column = String::from_utf8_lossy(&data[line_start..offset])
+                    .chars()
+                    .count()
+                    + 1;
+                Origin {
+                    offset: offset + bom,
+                    len,
+                    line,
+                    column,
+                    key: key.to_string(),
+                }
+            };
+            if header.is_empty() {
+                for (k, field) in record.iter().enumerate() {
+                    let origin = cell(k, field);
+                    if field.is_empty() {
+                        let empty = Message::new(
+                            format!("column {} of the header has no name", k + 1),
+                            "no name",
+                            "chain::values::csv_header",
+                        )
+                        .help("the header names the axis variable and the value columns, e.g. `x,EXX,EYX`");
+                        return Err(located(origin, empty));
+                    }
+                    if let Some((_, first)) = header.iter().find(|(h, _)| h == field) {
+                        let twice = Message::new(
+                            format!(
+                                "column `{field}` appears twice in the header (first in column {})",
+                                first.column
+                            ),
+                            "repeated",
+                            "chain::values::csv_header",
+                        );
+                        return Err(located(origin, twice));
+                    }
+                    header.push((field.to_string(), origin));
+                }
+                continue;
+            }
+            if record.len() != header.len() {
+                let width = Message::new(
+                    format!(
+                        "this row has {} but the header has {} columns",
+                        plural(record.len(), "field"),
+                        header.len()
+                    ),
+                    "row",
+                    "chain::values::csv_row",
+                );
+                return Err(located(cell(0, ""), width));
+            }
+            rows.push(
+                record
+                    .iter()
+                    .zip(&header)
+                    .enumerate()
+                    .map(|(k, (field, (column, _)))| (field.to_string(), cell(k, column)))
+                    .collect(),
+            );
+        }
+        if header.is_empty() {
+            let empty = Message::new(
+                "the CSV file is empty; expected a header line",
+                "empty",
+                "chain::values::csv_empty",
+            )
+            .help("the header names the axis variable and the value columns, e.g. `x,EXX,EYX`");
+            return Err(located(line_origin(text, 1), empty));
+        }
+        Ok(CsvFile {
+            text: text.to_string(),
+            header,
+            rows,
+        })
+    }
+
+    /// The index of the column named `name`.
+    pub(crate) fn column(&self, name: &str) -> Option<usize> {
+        self.header.iter().position(|(h, _)| h == name)
+    }
+
+    /// The header names.
+    pub(crate) fn names(&self) -> impl Iterator<Item = &str> {
+        self.header.iter().map(|(h, _)| h.as_str())
+    }
+
+    /// The origin of the header line.
+    pub(crate) fn header_origin(&self) -> Origin {
+        let first = &self.header[0].1;
+        let last = &self.header[self.header.len() - 1].1;
+        Origin {
+            offset: first.offset,
+            len: last.offset + last.len - first.offset,
+            line: first.line,
+            column: first.column,
+            key: String::new(),
+        }
+    }
+}
+
+/// `1 field`, `3 fields`.
+fn plural(n: usize, what: &str) -> String {
+    if n == 1 {
+        format!("1 {what}")
+    } else {
+        format!("{n} {what}s")
+    }
+}
+
+/// The origin of a whole line (1-based) of `text`.
+fn line_origin(text: &str, line: u64) -> Origin {
+    let line = usize::try_from(line.max(1)).unwrap_or(1);
+    let start: usize = text
+        .split_inclusive('\n')
+        .take(line - 1)
+        .map(str::len)
+        .sum();
+    let len = text[start.min(text.len())..]
+        .split('\n')
+        .next()
+        .map_or(0, |l| l.trim_end_matches('\r').len());
+    Origin {
+        offset: start.min(text.len()),
+        len,
+        line,
+        column: 1,
+        key: String::new(),
+    }
+}
+
+/// Where a record really starts: the reader reports where it started
+/// reading, before any comment or blank lines it skipped. Returns the byte
+/// offset and the 1-based line.
+fn record_start(data: &[u8], pos: &::csv::Position) -> (usize, usize) {
+    let mut line = usize::try_from(pos.line()).unwrap_or(usize::MAX);
+    let mut i = usize::try_from(pos.byte()).unwrap_or(usize::MAX);
+    while let Some(&b) = data.get(i) {
+        match b {
+            b'#' => match data[i..].iter().position(|&c| c == b'\n') {
+                Some(end) => {
+                    i += end + 1;
+                    line += 1;
+                }
+                None => break,
+            },
+            b'\n' => {
+                i += 1;
+                line += 1;
+            }
+            b'\r' => {
+                i += 1;
+                if data.get(i) == Some(&b'\n') {
+                    i += 1;
+                }
+                line += 1;
+            }
+            _ => break,
+        }
+    }
+    (i.min(data.len()), line)
+}
+
+/// The byte spans of the fields of the record starting at `start`, trimmed
+/// of blanks (quotes included in a quoted field's span).
+fn field_spans(data: &[u8], start: usize) -> Vec<(usize, usize)> {
+    let mut spans = Vec::new();
+    let mut field = start;
+    let mut quoted = false;
+    let mut i = start;
+    let trimmed = |a: usize, b: usize| {
+        let s = &data[a..b];
+        let lead = s.iter().take_while(|c| c.is_ascii_whitespace()).count();
+        let tail = s[lead..]
+            .iter()
+            .rev()
+            .take_while(|c| c.is_ascii_whitespace())
+            .count();
+        (a + lead, s.len() - lead - tail)
+    };
+    while i < data.len() {
+        match data[i] {
+            b'"' => quoted = !quoted,
+            b',' if !quoted => {
+                spans.push(trimmed(field, i));
+                field = i + 1;
+            }
+            b'\n' | b'\r' if !quoted => break,
+            _ => {}
+        }
+        i += 1;
+    }
+    spans.push(trimmed(field, i));
+    spans
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cells_keep_their_line_column_and_column_name() {
+        let text = "\u{feff}# measured 2024-05-02\nx, EXX ,EYX\n\n0,1.5,2\n# note\n100,\"3\" ,4\n";
+        let f = CsvFile::parse(text, "t.csv").unwrap();
+        assert_eq!(f.names().collect::<Vec<_>>(), ["x", "EXX", "EYX"]);
+        assert_eq!(f.header[1].1.line, 2);
+        assert_eq!(f.header[1].1.column, 4);
+        assert_eq!(f.rows.len(), 2);
+        let (text0, o) = &f.rows[1][1];
+        assert_eq!(text0, "3");
+        assert_eq!((o.line, o.column, o.key.as_str()), (6, 5, "EXX"));
+        assert_eq!(&text[o.offset..o.offset + o.len], "\"3\"");
+        let (_, o) = &f.rows[0][2];
+        assert_eq!((o.line, o.column), (4, 7));
+    }
+
+    #[test]
+    fn refusals_name_the_line() {
+        let twice = CsvFile::parse("x,a,a\n1,2,3\n", "t.csv").unwrap_err();
+        assert_eq!(twice.first().origin.line, 1);
+        assert_eq!(twice.first().origin.column, 5);
+        assert!(twice.to_string().contains("appears twice"), "{twice}");
+        let short = CsvFile::parse("x,a\n1,2\n3\n", "t.csv").unwrap_err();
+        assert_eq!(short.first().origin.line, 3);
+        assert!(short.to_string().contains("has 1 field but"), "{short}");
+        let empty = CsvFile::parse("# only a comment\n", "t.csv").unwrap_err();
+        assert!(empty.to_string().contains("empty"), "{empty}");
+    }
+}

@@ -1,0 +1,586 @@
+//! `chain map FILE --values VALUES.yaml [--grid VAR=V1,V2,...|VAR=LO:HI:N]...
+//! [--axes AXES.csv] [--param NAME=VALUE]... [--format table|json|csv]
+//! [--plot DIR]`.
+//!
+//! The volumetric error of a built machine (measured-machines spec, section
+//! 3): `E(q) = Σ_j c_j(q)·v_j(q)` at every point of the machine file's
+//! `reliability.grid` (full factorial, each axis replaceable by `--grid`) or
+//! at every row of `--axes`, with the error values `v_j` of a values file
+//! (section 2), through [`chain_core::BuiltMachine::map`]. See `docs/map.md`.
+
+#[path = "map_plot.rs"]
+mod map_plot;
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use chain_core::built::{BuiltMachine, MapError, MapSummary, Points};
+use chain_core::model::Frame;
+use chain_core::values::{Entry, EntryKind, Given, Values};
+use chain_core::MapResult;
+use miette::MietteDiagnostic;
+use reliability::machine;
+use serde::Serialize;
+
+use super::args::ParamArgs;
+use super::csv_input::{numeric_rows, open_csv};
+use super::reliability::{parse_axis, Loaded};
+use super::report::{self, Csv, Report};
+
+/// Maps with at most this many points also list every point in the table
+/// format.
+const TABLE_POINTS: usize = 60;
+
+/// Maps with at least this many points show a progress bar (on a terminal).
+const PROGRESS_POINTS: usize = 200_000;
+
+/// Output formats of `chain map`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MapFormat {
+    /// The ISO 230-1-style summary (and the points of small maps).
+    Table,
+    /// The spec's JSON document.
+    Json,
+    /// One row per point.
+    Csv,
+}
+
+report::formats!(MapFormat: Table, Json, Csv);
+
+/// Arguments of `chain map`.
+#[derive(Debug, clap::Args)]
+pub struct MapArgs {
+    /// Machine file (YAML).
+    pub file: PathBuf,
+    /// The error values of the built machine: a values file (YAML; its
+    /// tables are relative to it).
+    #[arg(long, value_name = "VALUES.yaml")]
+    pub values: PathBuf,
+    /// Replace (or add) the grid values of one axis: `VAR=V1,V2,...`, or
+    /// `VAR=LO:HI:N` for N evenly spaced values from LO to HI (repeatable).
+    #[arg(long = "grid", value_name = "VAR=V1,V2,...|VAR=LO:HI:N", value_parser = parse_grid_axis)]
+    pub grid: Vec<(String, Vec<f64>)>,
+    /// Points from a CSV instead of the grid: a header naming every axis
+    /// variable (any order; rotary ones in radians), an optional leading
+    /// column `t`; `-` reads stdin.
+    #[arg(long, value_name = "AXES.csv", conflicts_with = "grid")]
+    pub axes: Option<PathBuf>,
+    #[command(flatten)]
+    pub param: ParamArgs,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "table")]
+    pub format: MapFormat,
+    /// Write heat maps of every component and a magnified distorted-grid
+    /// picture (PNG and SVG) into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+}
+
+/// Parses `VAR=V1,V2,...` or `VAR=LO:HI:N`.
+pub(crate) fn parse_grid_axis(s: &str) -> Result<(String, Vec<f64>), String> {
+    let Some((name, spec)) = s.split_once('=') else {
+        return Err(format!(
+            "expected VAR=V1,V2,... or VAR=LO:HI:N, found `{s}`"
+        ));
+    };
+    if !spec.contains(':') {
+        return parse_axis(s);
+    }
+    let parts: Vec<&str> = spec.split(':').map(str::trim).collect();
+    let [lo, hi, n] = parts[..] else {
+        return Err(format!("expected LO:HI:N after `{name}=`, found `{spec}`"));
+    };
+    let number = |t: &str| {
+        t.parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("`{t}` is not a finite number"))
+    };
+    let (lo, hi) = (number(lo)?, number(hi)?);
+    let n: usize = n
+        .parse()
+        .map_err(|_| format!("`{n}` is not a count of values (a whole number ≥ 2)"))?;
+    if n < 2 {
+        return Err(format!(
+            "LO:HI:N needs N ≥ 2 values, found {n} (one value is `{name}=V`)"
+        ));
+    }
+    if lo == hi {
+        return Err(format!("LO:HI:N needs LO ≠ HI, found {lo} twice"));
+    }
+    let step = (hi - lo) / (n - 1) as f64;
+    let values = (0..n)
+        .map(|k| if k == n - 1 { hi } else { lo + step * k as f64 })
+        .collect();
+    Ok((name.trim().to_string(), values))
+}
+
+/// Runs `chain map`.
+pub fn exec(args: MapArgs) -> miette::Result<()> {
+    let loaded = Loaded::new(&args.file)?;
+    let m = &loaded.machine;
+    let values = Values::read(&args.values, m)?;
+    let params = machine::parameters(m, &args.param.params).map_err(|e| loaded.report(e))?;
+    let (points, input) = match &args.axes {
+        Some(path) => {
+            let flat = axes_points(path, m)?;
+            let points = Points::list(m.variables.len(), flat)
+                .map_err(|e| miette::miette!("{}: {e}", path.display()))?;
+            (points, Input::Axes(path.display().to_string()))
+        }
+        None => {
+            let file = args.file.display().to_string();
+            let axes = grid_axes(m, &loaded, &file, &args.grid)?;
+            let values = axes.iter().map(|(_, v)| v.clone()).collect();
+            (Points::Grid(values), Input::Grid(axes))
+        }
+    };
+    let built = BuiltMachine::compile(m, values, params)
+        .map_err(|e| miette::miette!("{}: {e}", args.values.display()))?;
+    let count = points.len();
+    let bar = Progress::new(count, args.format);
+    // The table of a large map shows the summary only: it needs no point's
+    // error kept (the plots and the other formats do).
+    let keep = args.format != MapFormat::Table || args.plot.is_some() || count <= TABLE_POINTS;
+    let result = if keep {
+        built
+            .map_with_progress(points, &|n| bar.inc(n))
+            .map(Mapped::Full)
+    } else {
+        built
+            .summary(&points, &|n| bar.inc(n))
+            .map(|summary| Mapped::Summary { summary, points })
+    };
+    bar.finish();
+    let result = result.map_err(|e| map_error(e, &args.values))?;
+    // Error parameters the file gave a value: a function's table gives all
+    // its coefficients.
+    let given: usize = (built.values().entries().iter())
+        .map(|e| match e.kind {
+            EntryKind::Function => m
+                .function_index(&e.name)
+                .map_or(1, |f| m.functions[f].coefficients.len()),
+            _ => 1,
+        })
+        .sum();
+    let doc = MapDoc {
+        values_file: args.values.display().to_string(),
+        entries: built.values().entries().to_vec(),
+        errors: m.errors.len(),
+        unset: m.errors.len().saturating_sub(given),
+        machine: m.name.clone(),
+        frame: m.frame,
+        variables: built.variables().to_vec(),
+        input,
+        result,
+    };
+    if let Some(dir) = &args.plot {
+        for f in map_plot::write_all(dir, &doc, &built)? {
+            eprintln!("wrote {}", f.display());
+        }
+    }
+    report::emit(&doc, args.format.into())
+}
+
+/// A map error, rendered with its code and help.
+fn map_error(e: MapError, values: &std::path::Path) -> miette::Report {
+    let (code, help) = match &e {
+        MapError::OutOfRange { source, .. } => (
+            "chain::map::out_of_range",
+            format!(
+                "the table of `{}` in {} covers {} = {} to {}; map inside it (--grid), extend the table, or add `extrapolate: hold` to its entry to hold the end values",
+                source.name,
+                values.display(),
+                source.variable,
+                source.lo,
+                source.hi
+            ),
+        ),
+        MapError::NoPoints => (
+            "chain::map::no_points",
+            "give the points with --grid VAR=... or --axes AXES.csv".to_string(),
+        ),
+        _ => ("chain::map::points", String::new()),
+    };
+    let text = match &e {
+        MapError::OutOfRange { point, at, source } => format!(
+            "at point {} ({at}): {} = {} is outside the table of `{}` ({})",
+            point + 1,
+            source.variable,
+            source.value,
+            source.name,
+            source.table
+        ),
+        other => other.to_string(),
+    };
+    let mut d = MietteDiagnostic::new(text).with_code(code);
+    if !help.is_empty() {
+        d = d.with_help(help);
+    }
+    miette::Report::new(d)
+}
+
+/// The grid axes, in the machine's variable order: `reliability.grid`, each
+/// axis replaced by `--grid`; every variable must have values.
+fn grid_axes(
+    m: &chain_core::Machine,
+    loaded: &Loaded,
+    file: &str,
+    overrides: &[(String, Vec<f64>)],
+) -> miette::Result<Vec<(String, Vec<f64>)>> {
+    for (name, _) in overrides {
+        if m.variable_index(name).is_none() {
+            return Err(loaded.report(reliability::ReliabilityError::unknown(
+                "axis variable",
+                name,
+                m.variables.iter().map(|v| v.name.as_str()),
+            )));
+        }
+    }
+    let file_grid = m.reliability.as_ref().map(|r| &r.grid);
+    let mut axes = Vec::new();
+    for (k, v) in m.variables.iter().enumerate() {
+        let given = overrides.iter().rev().find(|(n, _)| *n == v.name);
+        let values = match given {
+            Some((_, values)) => values.clone(),
+            None => match file_grid.and_then(|g| g.iter().find(|(i, _)| *i == k)) {
+                Some((_, values)) => values.clone(),
+                None => {
+                    let diag = MietteDiagnostic::new(format!(
+                        "{file}: no grid values for axis variable `{}`",
+                        v.name
+                    ))
+                    .with_code("chain::map::missing_grid")
+                    .with_help(format!(
+                        "add `{0}: [...]` to `reliability.grid`, or pass --grid {0}=V1,V2,... or --grid {0}=LO:HI:N",
+                        v.name
+                    ));
+                    return Err(miette::Report::new(diag));
+                }
+            },
+        };
+        axes.push((v.name.clone(), values));
+    }
+    Ok(axes)
+}
+
+/// The points of `--axes`: every row, in the machine's variable order.
+fn axes_points(path: &std::path::Path, m: &chain_core::Machine) -> miette::Result<Vec<f64>> {
+    let mut input = open_csv(path)?;
+    let name = input.name.clone();
+    let has_t = input.header.first().is_some_and(|h| h == "t")
+        && (m.variable_index("t").is_none() || input.header[1..].iter().any(|h| h == "t"));
+    let skip = usize::from(has_t);
+    let mut column_of: Vec<Option<usize>> = vec![None; m.variables.len()];
+    for (k, h) in input.header.iter().enumerate().skip(skip) {
+        let Some(v) = m.variable_index(h) else {
+            let hint =
+                chain_core::diagnostic::closest(h, m.variables.iter().map(|v| v.name.as_str()))
+                    .map(|c| format!(" (did you mean `{c}`?)"))
+                    .unwrap_or_default();
+            miette::bail!(
+                "{name}:1: column `{h}` is not an axis variable of machine `{}`{hint}; expected `t` (optional, first) and {}",
+                m.name,
+                variable_list(m)
+            );
+        };
+        column_of[v] = Some(k);
+    }
+    let missing: Vec<String> = (m.variables.iter().zip(&column_of))
+        .filter(|(_, c)| c.is_none())
+        .map(|(v, _)| format!("`{}`", v.name))
+        .collect();
+    if !missing.is_empty() {
+        miette::bail!(
+            "{name}:1: no column for axis variable{} {}; the header names every axis variable ({})",
+            if missing.len() > 1 { "s" } else { "" },
+            missing.join(", "),
+            variable_list(m)
+        );
+    }
+    let rows = numeric_rows(&mut input)?;
+    let mut points = Vec::with_capacity(rows.len() * m.variables.len());
+    for (_, values) in rows {
+        points.extend(column_of.iter().map(|c| c.map_or(f64::NAN, |c| values[c])));
+    }
+    Ok(points)
+}
+
+fn variable_list(m: &chain_core::Machine) -> String {
+    m.variables
+        .iter()
+        .map(|v| format!("`{}`", v.name))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A progress bar on stderr for large maps, only when stderr is a terminal
+/// and the output is not JSON.
+struct Progress(Option<indicatif::ProgressBar>);
+
+impl Progress {
+    fn new(points: usize, format: MapFormat) -> Progress {
+        if points < PROGRESS_POINTS || format == MapFormat::Json || !std::io::stderr().is_terminal()
+        {
+            return Progress(None);
+        }
+        let bar = indicatif::ProgressBar::with_draw_target(
+            Some(points as u64),
+            indicatif::ProgressDrawTarget::stderr(),
+        );
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{spinner} mapping [{bar:40}] {percent:>3}% {human_pos}/{human_len} points, eta {eta}",
+        ) {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        Progress(Some(bar))
+    }
+
+    fn inc(&self, n: usize) {
+        if let Some(b) = &self.0 {
+            b.inc(n as u64);
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(b) = &self.0 {
+            b.finish_and_clear();
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Output.
+
+/// Where the points came from.
+pub(crate) enum Input {
+    /// The full-factorial grid of these axes (machine variable order).
+    Grid(Vec<(String, Vec<f64>)>),
+    /// The rows of this CSV file.
+    Axes(String),
+}
+
+/// What the map computed: every point's error, or the summary alone.
+pub(crate) enum Mapped {
+    /// The library's whole result.
+    Full(MapResult),
+    /// The summary, and the points it is of.
+    Summary { summary: MapSummary, points: Points },
+}
+
+impl Mapped {
+    fn summary(&self) -> &MapSummary {
+        match self {
+            Mapped::Full(r) => &r.summary,
+            Mapped::Summary { summary, .. } => summary,
+        }
+    }
+
+    fn points(&self) -> &Points {
+        match self {
+            Mapped::Full(r) => &r.points,
+            Mapped::Summary { points, .. } => points,
+        }
+    }
+}
+
+/// The report of `chain map`: the library's [`MapResult`] (its JSON is the
+/// spec's document) with what the command knows of its input.
+pub(crate) struct MapDoc {
+    values_file: String,
+    entries: Vec<Entry>,
+    errors: usize,
+    /// Error parameters the values file does not give (zero).
+    unset: usize,
+    pub(crate) machine: String,
+    frame: Frame,
+    variables: Vec<String>,
+    pub(crate) input: Input,
+    pub(crate) result: Mapped,
+}
+
+impl MapDoc {
+    /// The whole result (every format but a large map's table has it).
+    pub(crate) fn full(&self) -> Option<&MapResult> {
+        match &self.result {
+            Mapped::Full(r) => Some(r),
+            Mapped::Summary { .. } => None,
+        }
+    }
+}
+
+impl Serialize for MapDoc {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self.full() {
+            Some(r) => r.serialize(s),
+            None => Err(serde::ser::Error::custom("the map kept no point")),
+        }
+    }
+}
+
+/// mm → µm, rad → µrad, for the table.
+const MICRO: [f64; 6] = [1e3, 1e3, 1e3, 1e6, 1e6, 1e6];
+/// The table's units.
+const UNITS: [&str; 6] = ["µm", "µm", "µm", "µrad", "µrad", "µrad"];
+
+impl MapDoc {
+    fn point_text(&self, i: usize) -> String {
+        (self.variables.iter().zip(self.result.points().point(i)))
+            .map(|(n, x)| format!("{n} = {}", number(x)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// A coordinate: a whole number without decimals, else Rust's shortest form.
+fn number(x: f64) -> String {
+    match report::whole(x) {
+        Some(i) => i.to_string(),
+        None => format!("{x}"),
+    }
+}
+
+impl Report for MapDoc {
+    fn table(&self) -> String {
+        use std::fmt::Write;
+        let s = self.result.summary();
+        let count = self.result.points().len();
+        let mut out = String::new();
+        let _ = writeln!(
+            out,
+            "Error map of {} (frame: {}), values {}",
+            self.machine,
+            self.frame.name(),
+            self.values_file
+        );
+        let tables = (self.entries.iter())
+            .filter(|e| matches!(e.given, Given::Table { .. }))
+            .count();
+        let constants = self.entries.len() - tables;
+        let rest = match self.unset {
+            0 => format!("all {} error parameters given", self.errors),
+            n => format!(
+                "{n} of the {} error parameters not given (zero)",
+                self.errors
+            ),
+        };
+        let _ = writeln!(
+            out,
+            "values: {} tabulated error motion{}, {} constant{}; {rest}",
+            tables,
+            if tables == 1 { "" } else { "s" },
+            constants,
+            if constants == 1 { "" } else { "s" },
+        );
+        match &self.input {
+            Input::Grid(axes) => {
+                let desc: Vec<String> = axes
+                    .iter()
+                    .map(|(n, v)| match v.as_slice() {
+                        [one] => format!("{n} = {}", number(*one)),
+                        [first, .., last] => format!(
+                            "{n} {} … {} ({} values)",
+                            number(*first),
+                            number(*last),
+                            v.len()
+                        ),
+                        [] => format!("{n}: none"),
+                    })
+                    .collect();
+                let _ = writeln!(out, "{count} points: {}", desc.join(", "));
+            }
+            Input::Axes(file) => {
+                let _ = writeln!(out, "{count} points: the rows of {file}");
+            }
+        }
+        let _ = writeln!(out);
+        let _ = writeln!(
+            out,
+            "{:<12} {:>12} {:>12} {:>12}",
+            "component", "min", "max", "rms"
+        );
+        for c in 0..6 {
+            let cs = s.component(c);
+            let f = MICRO[c];
+            let _ = writeln!(
+                out,
+                "{:<12} {:>12.3} {:>12.3} {:>12.3}",
+                format!("{} ({})", ["px", "py", "pz", "ox", "oy", "oz"][c], UNITS[c]),
+                cs.min * f,
+                cs.max * f,
+                cs.rms * f
+            );
+        }
+        let _ = writeln!(out);
+        let _ = writeln!(
+            out,
+            "volumetric |p|: max {:.3} µm at {}; rms {:.3} µm",
+            s.volumetric.max * 1e3,
+            self.point_text(s.volumetric.index),
+            s.volumetric.rms * 1e3
+        );
+        if let Some(r) = self.full().filter(|r| r.len() <= TABLE_POINTS) {
+            let _ = writeln!(out);
+            let mut header: Vec<String> = r.variables.clone();
+            header
+                .extend((0..6).map(|c| {
+                    format!("{} ({})", ["px", "py", "pz", "ox", "oy", "oz"][c], UNITS[c])
+                }));
+            header.push("|p| (µm)".to_string());
+            let widths: Vec<usize> = header.iter().map(|h| h.chars().count().max(10)).collect();
+            let line = |cells: &[String]| {
+                cells
+                    .iter()
+                    .zip(&widths)
+                    .map(|(c, w)| format!("{c:>w$}"))
+                    .collect::<Vec<_>>()
+                    .join("  ")
+            };
+            let _ = writeln!(out, "{}", line(&header));
+            for i in 0..r.len() {
+                let mut cells: Vec<String> = r.point(i).iter().map(|x| number(*x)).collect();
+                cells.extend((0..6).map(|c| format!("{:.3}", r.errors[i][c] * MICRO[c])));
+                cells.push(format!("{:.3}", r.volumetric(i) * 1e3));
+                let _ = writeln!(out, "{}", line(&cells));
+            }
+        }
+        out
+    }
+
+    fn csv(&self) -> Option<Csv> {
+        let r = self.full()?;
+        let mut header: Vec<String> = r.variables.clone();
+        header.extend(["px", "py", "pz", "ox", "oy", "oz", "volumetric"].map(String::from));
+        let mut csv = Csv::new(header);
+        for i in 0..r.len() {
+            let mut row: Vec<String> = r.point(i).iter().map(|x| format!("{x}")).collect();
+            row.extend(r.errors[i].iter().map(|x| format!("{x}")));
+            row.push(format!("{}", r.volumetric(i)));
+            csv.row(row);
+        }
+        Some(csv)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_ranges_are_evenly_spaced_and_end_at_hi() {
+        let (n, v) = parse_grid_axis("x=0:1000:5").unwrap();
+        assert_eq!(n, "x");
+        assert_eq!(v, [0.0, 250.0, 500.0, 750.0, 1000.0]);
+        let (_, v) = parse_grid_axis("z = 1:0:3").unwrap();
+        assert_eq!(v, [1.0, 0.5, 0.0]);
+        let (_, v) = parse_grid_axis("y=0.1:0.7:7").unwrap();
+        assert_eq!(v.len(), 7);
+        assert_eq!(v[6], 0.7);
+        assert_eq!(parse_grid_axis("x=1,2").unwrap().1, [1.0, 2.0]);
+        assert!(parse_grid_axis("x=0:1:1").unwrap_err().contains("N ≥ 2"));
+        assert!(parse_grid_axis("x=0:1").unwrap_err().contains("LO:HI:N"));
+        assert!(parse_grid_axis("x=0:0:3").unwrap_err().contains("LO ≠ HI"));
+        assert!(parse_grid_axis("x=0:inf:3").is_err());
+        assert!(parse_grid_axis("x=0:1:2.5").is_err());
+    }
+}

@@ -1,0 +1,596 @@
+//! `--plot DIR` of `chain map` (PNG and SVG, see `docs/map.md`).
+//!
+//! On a grid with at least two axes of several values, the plotting plane is
+//! spanned by the two axes with the most values (the earlier axis when counts
+//! tie), the one with more values horizontal; every other axis is held at its
+//! middle value (the lower middle one for an even count), and the title says
+//! where. In that plane:
+//!
+//! - `map_<component>` for `px … oz` and `map_volumetric`: heat maps over
+//!   the two axes (µm, µrad), each cell centred on its grid node, a diverging
+//!   scale symmetric about zero for the signed components and viridis for
+//!   `|p|`;
+//! - `map_distortion`: the CMM-style picture, the nominal tool-point grid
+//!   (in the workpiece frame, projected on the coordinate plane in which it
+//!   spreads most) and the same grid displaced by the in-plane part of the
+//!   position error, magnified so that the largest displacement is about a
+//!   quarter of the smallest grid spacing (a 1-2-5 factor, stated in the
+//!   title).
+//!
+//! With one varying axis, or points from `--axes`, `map_position` and
+//! `map_orientation` chart the components along that axis (or the row).
+
+use std::path::{Path, PathBuf};
+
+use chain_core::model::Frame;
+use chain_core::{BuiltMachine, CompiledModel, ErrorModel, MapResult};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{Input, MapDoc};
+use crate::cli::plot::{ensure_fonts, Legend, Series, XyChart, GREY};
+
+const HEAT_SIZE: (u32, u32) = (1000, 760);
+const COMPONENTS: [&str; 6] = ["px", "py", "pz", "ox", "oy", "oz"];
+/// mm → µm, rad → µrad.
+const MICRO: [f64; 6] = [1e3, 1e3, 1e3, 1e6, 1e6, 1e6];
+const UNITS: [&str; 6] = ["µm", "µm", "µm", "µrad", "µrad", "µrad"];
+
+/// Writes every chart into `dir`; returns the files written.
+pub(super) fn write_all(
+    dir: &Path,
+    doc: &MapDoc,
+    built: &BuiltMachine<CompiledModel>,
+) -> miette::Result<Vec<PathBuf>> {
+    let Some(r) = doc.full() else {
+        return Ok(Vec::new());
+    };
+    std::fs::create_dir_all(dir)
+        .map_err(|e| miette::miette!("{}: cannot create the plot directory: {e}", dir.display()))?;
+    ensure_fonts();
+    match &doc.input {
+        Input::Grid(axes) => {
+            let mut by_count: Vec<usize> =
+                (0..axes.len()).filter(|&k| axes[k].1.len() > 1).collect();
+            by_count.sort_by_key(|&k| std::cmp::Reverse(axes[k].1.len()));
+            match by_count.as_slice() {
+                [a, b, ..] => plane(dir, r, built, axes, *a, *b),
+                [a] => {
+                    let lines = along_axis(axes, *a);
+                    lines_charts(dir, r, &axes[*a].0, &lines, &slice_text(axes, &[*a]))
+                }
+                [] => {
+                    eprintln!("note: the map has one point; no chart written");
+                    Ok(Vec::new())
+                }
+            }
+        }
+        Input::Axes(_) => {
+            let lines: Vec<(f64, usize)> = (0..r.len()).map(|i| ((i + 1) as f64, i)).collect();
+            lines_charts(dir, r, "row", &lines, "")
+        }
+    }
+}
+
+/// The flat index of a grid node (last axis fastest).
+fn flat(idx: &[usize], axes: &[(String, Vec<f64>)]) -> usize {
+    idx.iter()
+        .zip(axes)
+        .fold(0, |acc, (&i, (_, v))| acc * v.len() + i)
+}
+
+/// The index of every axis but the plotted ones: its middle value.
+fn middle(axes: &[(String, Vec<f64>)]) -> Vec<usize> {
+    axes.iter().map(|(_, v)| (v.len().max(1) - 1) / 2).collect()
+}
+
+/// `z = 200` for the held axes (not in `free`).
+fn slice_text(axes: &[(String, Vec<f64>)], free: &[usize]) -> String {
+    let mid = middle(axes);
+    axes.iter()
+        .enumerate()
+        .filter(|(k, _)| !free.contains(k))
+        .map(|(k, (n, v))| format!("{n} = {}", tick(v[mid[k]])))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// `(axis value, point index)` along axis `a`, the others held.
+fn along_axis(axes: &[(String, Vec<f64>)], a: usize) -> Vec<(f64, usize)> {
+    let mut idx = middle(axes);
+    axes[a]
+        .1
+        .iter()
+        .enumerate()
+        .map(|(i, &x)| {
+            idx[a] = i;
+            (x, flat(&idx, axes))
+        })
+        .collect()
+}
+
+/// Position and orientation components along one axis (or the row).
+fn lines_charts(
+    dir: &Path,
+    r: &MapResult,
+    x_label: &str,
+    points: &[(f64, usize)],
+    slice: &str,
+) -> miette::Result<Vec<PathBuf>> {
+    let at = if slice.is_empty() {
+        String::new()
+    } else {
+        format!(" at {slice}")
+    };
+    let mut files = Vec::new();
+    let mut position = XyChart::new(
+        format!("{}: position error{at}", r.machine),
+        x_label,
+        "error (µm)",
+    )
+    .legend(Legend::UpperLeft)
+    .hline(0.0);
+    for (c, name) in COMPONENTS.iter().enumerate().take(3) {
+        let pts = points
+            .iter()
+            .map(|&(x, i)| (x, r.errors[i][c] * 1e3))
+            .collect();
+        position = position.series(Series::line_points(*name, pts));
+    }
+    let vol = points
+        .iter()
+        .map(|&(x, i)| (x, r.volumetric(i) * 1e3))
+        .collect();
+    position = position.series(Series::line("|p|", vol).width(3));
+    files.extend(position.write(dir, "map_position")?);
+    let mut orientation = XyChart::new(
+        format!("{}: orientation error{at}", r.machine),
+        x_label,
+        "error (µrad)",
+    )
+    .legend(Legend::UpperLeft)
+    .hline(0.0);
+    for (c, name) in COMPONENTS.iter().enumerate().skip(3) {
+        let pts = points
+            .iter()
+            .map(|&(x, i)| (x, r.errors[i][c] * 1e6))
+            .collect();
+        orientation = orientation.series(Series::line_points(*name, pts));
+    }
+    files.extend(orientation.write(dir, "map_orientation")?);
+    Ok(files)
+}
+
+/// The heat maps and the distorted grid over axes `a` (columns) and `b`
+/// (rows).
+fn plane(
+    dir: &Path,
+    r: &MapResult,
+    built: &BuiltMachine<CompiledModel>,
+    axes: &[(String, Vec<f64>)],
+    a: usize,
+    b: usize,
+) -> miette::Result<Vec<PathBuf>> {
+    let slice = slice_text(axes, &[a, b]);
+    let at = if slice.is_empty() {
+        String::new()
+    } else {
+        format!(" at {slice}")
+    };
+    let mid = middle(axes);
+    let node = |i: usize, j: usize| {
+        let mut idx = mid.clone();
+        idx[a] = i;
+        idx[b] = j;
+        flat(&idx, axes)
+    };
+    let (na, nb) = (axes[a].1.len(), axes[b].1.len());
+    let mut files = Vec::new();
+    for c in 0..7 {
+        let values: Vec<Vec<f64>> = (0..nb)
+            .map(|j| {
+                (0..na)
+                    .map(|i| {
+                        let k = node(i, j);
+                        if c < 6 {
+                            r.errors[k][c] * MICRO[c]
+                        } else {
+                            r.volumetric(k) * 1e3
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        let (name, unit) = if c < 6 {
+            (COMPONENTS[c], UNITS[c])
+        } else {
+            ("|p|", "µm")
+        };
+        let heat = Heat {
+            title: format!("{}: {name} ({unit}){at}", r.machine),
+            cols: axes[a].clone(),
+            rows: axes[b].clone(),
+            values,
+            diverging: c < 6,
+            unit,
+        };
+        let stem = if c < 6 {
+            format!("map_{}", COMPONENTS[c])
+        } else {
+            "map_volumetric".to_string()
+        };
+        files.extend(write_both(dir, &stem, HEAT_SIZE, |area| match area {
+            Area::Bitmap(root) => heat_on(root, &heat),
+            Area::Svg(root) => heat_on(root, &heat),
+        })?);
+    }
+    files.extend(distortion(dir, r, built, axes, a, b, &at)?);
+    Ok(files)
+}
+
+/// The nominal and the magnified displaced grid.
+#[allow(clippy::too_many_arguments)]
+fn distortion(
+    dir: &Path,
+    r: &MapResult,
+    built: &BuiltMachine<CompiledModel>,
+    axes: &[(String, Vec<f64>)],
+    a: usize,
+    b: usize,
+    at: &str,
+) -> miette::Result<Vec<PathBuf>> {
+    let mid = middle(axes);
+    let (na, nb) = (axes[a].1.len(), axes[b].1.len());
+    // Nominal tool point and position error in the workpiece frame, per node.
+    let mut nominal = vec![vec![[0.0; 3]; na]; nb];
+    let mut error = vec![vec![[0.0; 3]; na]; nb];
+    for j in 0..nb {
+        for i in 0..na {
+            let mut idx = mid.clone();
+            idx[a] = i;
+            idx[b] = j;
+            let k = flat(&idx, axes);
+            let pose = built.model().nominal(&r.point(k), built.parameters());
+            let p = [r.errors[k][0], r.errors[k][1], r.errors[k][2]];
+            let p = match r.frame {
+                Frame::Workpiece => p,
+                Frame::Tool => {
+                    let m = &pose.rotation;
+                    std::array::from_fn(|row| (0..3).map(|col| m[row][col] * p[col]).sum())
+                }
+            };
+            nominal[j][i] = pose.position;
+            error[j][i] = p;
+        }
+    }
+    // The coordinate plane in which the nominal grid spreads most.
+    let spread = |d: usize| {
+        let (lo, hi) = nominal
+            .iter()
+            .flatten()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p[d]), hi.max(p[d]))
+            });
+        hi - lo
+    };
+    let mut dims = [0usize, 1, 2];
+    dims.sort_by(|&x, &y| spread(y).total_cmp(&spread(x)));
+    let (u, w) = (dims[0].min(dims[1]), dims[0].max(dims[1]));
+    let coord = ["X", "Y", "Z"];
+    // Magnification: the largest in-plane displacement about a quarter of
+    // the smallest spacing between neighbouring nodes.
+    let mut largest: f64 = 0.0;
+    let mut spacing = f64::INFINITY;
+    for j in 0..nb {
+        for i in 0..na {
+            let e = error[j][i];
+            largest = largest.max(e[u].hypot(e[w]));
+            let p = nominal[j][i];
+            for (di, dj) in [(1, 0), (0, 1)] {
+                if i + di < na && j + dj < nb {
+                    let q = nominal[j + dj][i + di];
+                    let d = (p[u] - q[u]).hypot(p[w] - q[w]);
+                    if d > 1e-9 {
+                        spacing = spacing.min(d);
+                    }
+                }
+            }
+        }
+    }
+    let magnification = if largest > 0.0 && spacing.is_finite() {
+        nice_below(0.25 * spacing / largest)
+    } else {
+        1.0
+    };
+    let shown =
+        |p: [f64; 3], e: [f64; 3]| (p[u] + magnification * e[u], p[w] + magnification * e[w]);
+    let mut chart = XyChart::new(
+        format!(
+            "{}: distorted grid{at}, displacement ×{} (grey: nominal)",
+            r.machine,
+            tick(magnification)
+        ),
+        format!("{} (mm, workpiece frame)", coord[u]),
+        format!("{} (mm, workpiece frame)", coord[w]),
+    );
+    let mut first = true;
+    let mut line = |pts: Vec<(usize, usize)>, chart: XyChart| {
+        let nominal_pts: Vec<(f64, f64)> = pts
+            .iter()
+            .map(|&(i, j)| (nominal[j][i][u], nominal[j][i][w]))
+            .collect();
+        let moved: Vec<(f64, f64)> = pts
+            .iter()
+            .map(|&(i, j)| shown(nominal[j][i], error[j][i]))
+            .collect();
+        let label = |s: &str| if first { s.to_string() } else { String::new() };
+        let c = chart
+            .series(
+                Series::line(label("nominal"), nominal_pts)
+                    .color(GREY)
+                    .width(1),
+            )
+            .series(
+                Series::line_points(label(&format!("displaced ×{}", tick(magnification))), moved)
+                    .color(crate::cli::plot::color(0))
+                    .width(2),
+            );
+        first = false;
+        c
+    };
+    let (order_a, order_b) = (sorted(&axes[a].1), sorted(&axes[b].1));
+    for &j in &order_b {
+        chart = line(order_a.iter().map(|&i| (i, j)).collect(), chart);
+    }
+    for &i in &order_a {
+        chart = line(order_b.iter().map(|&j| (i, j)).collect(), chart);
+    }
+    // Roughly equal scales on both axes.
+    let (su, sw) = (spread(u).max(1e-9), spread(w).max(1e-9));
+    let height = (1000.0 * sw / su + 120.0).clamp(500.0, 1300.0) as u32;
+    chart.size = (1000, height);
+    chart = chart.legend(Legend::UpperRight);
+    Ok(chart.write(dir, "map_distortion")?)
+}
+
+/// Indices of `values` by increasing value.
+fn sorted(values: &[f64]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..values.len()).collect();
+    order.sort_by(|&x, &y| values[x].total_cmp(&values[y]));
+    order
+}
+
+/// The largest 1, 2 or 5 × 10^k not above `x` (`x > 0`).
+fn nice_below(x: f64) -> f64 {
+    let e = x.log10().floor();
+    let base = 10f64.powf(e);
+    let f = x / base;
+    let m = if f >= 5.0 {
+        5.0
+    } else if f >= 2.0 {
+        2.0
+    } else {
+        1.0
+    };
+    // Round away the float noise of powf (×5000, not ×4999.999…).
+    let v = m * base;
+    let digits = (-(e as i32)).max(0) as usize;
+    format!("{v:.digits$}").parse().unwrap_or(v)
+}
+
+/// A number for a title or label: whole numbers without decimals.
+fn tick(v: f64) -> String {
+    if v == v.trunc() && v.abs() < 1e15 {
+        format!("{}", v as i64)
+    } else {
+        let rounded: f64 = format!("{v:.9e}").parse().unwrap_or(v);
+        format!("{rounded}")
+    }
+}
+
+/// A heat map to draw.
+struct Heat {
+    title: String,
+    /// The horizontal axis: name and values.
+    cols: (String, Vec<f64>),
+    /// The vertical axis.
+    rows: (String, Vec<f64>),
+    /// `values[row][col]`, in display units.
+    values: Vec<Vec<f64>>,
+    /// A scale symmetric about zero (signed components) or from zero
+    /// (`|p|`).
+    diverging: bool,
+    unit: &'static str,
+}
+
+/// The two backends behind one type, so each chart is written once.
+enum Area<'a> {
+    Bitmap(DrawingArea<BitMapBackend<'a>, Shift>),
+    Svg(DrawingArea<SVGBackend<'a>, Shift>),
+}
+
+/// Draws one chart as `stem.png` and `stem.svg`.
+fn write_both(
+    dir: &Path,
+    stem: &str,
+    size: (u32, u32),
+    draw: impl Fn(Area<'_>) -> Result<(), String>,
+) -> miette::Result<Vec<PathBuf>> {
+    let png = dir.join(format!("{stem}.png"));
+    let svg = dir.join(format!("{stem}.svg"));
+    let fail = |p: &Path, e: String| miette::miette!("{}: cannot draw the chart: {e}", p.display());
+    draw(Area::Bitmap(
+        BitMapBackend::new(&png, size).into_drawing_area(),
+    ))
+    .map_err(|e| fail(&png, e))?;
+    draw(Area::Svg(SVGBackend::new(&svg, size).into_drawing_area())).map_err(|e| fail(&svg, e))?;
+    Ok(vec![png, svg])
+}
+
+fn err<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+/// Cell edges around sorted values: midpoints, the ends half a step out.
+fn edges(sorted: &[f64]) -> Vec<f64> {
+    let n = sorted.len();
+    if n == 1 {
+        let half = if sorted[0] == 0.0 {
+            0.5
+        } else {
+            0.05 * sorted[0].abs()
+        };
+        return vec![sorted[0] - half, sorted[0] + half];
+    }
+    let mut e = Vec::with_capacity(n + 1);
+    e.push(sorted[0] - 0.5 * (sorted[1] - sorted[0]));
+    for k in 1..n {
+        e.push(0.5 * (sorted[k - 1] + sorted[k]));
+    }
+    e.push(sorted[n - 1] + 0.5 * (sorted[n - 1] - sorted[n - 2]));
+    e
+}
+
+/// Viridis, five stops, linearly interpolated (`t` in [0, 1]).
+fn viridis(t: f64) -> RGBColor {
+    const STOPS: [(f64, f64, f64); 5] = [
+        (68.0, 1.0, 84.0),
+        (59.0, 82.0, 139.0),
+        (33.0, 145.0, 140.0),
+        (94.0, 201.0, 98.0),
+        (253.0, 231.0, 37.0),
+    ];
+    ramp(&STOPS, t)
+}
+
+/// ColorBrewer's RdBu, blue for negative, white at zero, red for positive
+/// (`t` in [−1, 1]).
+fn diverging(t: f64) -> RGBColor {
+    const STOPS: [(f64, f64, f64); 5] = [
+        (33.0, 102.0, 172.0),
+        (146.0, 197.0, 222.0),
+        (247.0, 247.0, 247.0),
+        (244.0, 165.0, 130.0),
+        (178.0, 24.0, 43.0),
+    ];
+    ramp(&STOPS, 0.5 * (t + 1.0))
+}
+
+fn ramp(stops: &[(f64, f64, f64); 5], t: f64) -> RGBColor {
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = t * 4.0;
+    let i = (x.floor() as usize).min(3);
+    let f = x - i as f64;
+    let (a, b) = (stops[i], stops[i + 1]);
+    let mix = |p: f64, q: f64| (p + (q - p) * f).round().clamp(0.0, 255.0) as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+fn heat_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, heat: &Heat) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let (width, _) = root.dim_in_pixel();
+    let (left, right) = root.split_horizontally(width.saturating_sub(150));
+    let finite = || {
+        heat.values
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|v| v.is_finite())
+    };
+    let (lo, hi) = if heat.diverging {
+        let l = finite().fold(0.0f64, |m, v| m.max(v.abs()));
+        let l = if l > 0.0 { l } else { 1.0 };
+        (-l, l)
+    } else {
+        let h = finite().fold(0.0f64, f64::max);
+        (0.0, if h > 0.0 { h } else { 1.0 })
+    };
+    let colour = |v: f64| {
+        if heat.diverging {
+            diverging(v / hi)
+        } else {
+            viridis(v / hi)
+        }
+    };
+    let (oc, orow) = (sorted(&heat.cols.1), sorted(&heat.rows.1));
+    let sorted_cols: Vec<f64> = oc.iter().map(|&i| heat.cols.1[i]).collect();
+    let sorted_rows: Vec<f64> = orow.iter().map(|&j| heat.rows.1[j]).collect();
+    let (ec, er) = (edges(&sorted_cols), edges(&sorted_rows));
+    let mut chart = ChartBuilder::on(&left)
+        .caption(&heat.title, ("sans-serif", 22))
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(80)
+        .build_cartesian_2d(ec[0]..ec[ec.len() - 1], er[0]..er[er.len() - 1])
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(heat.cols.0.as_str())
+        .y_desc(heat.rows.0.as_str())
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
+        .label_style(("sans-serif", 15))
+        .axis_desc_style(("sans-serif", 18))
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(orow.iter().enumerate().flat_map(|(sj, &j)| {
+            let (er, ec) = (&er, &ec);
+            oc.iter().enumerate().map(move |(si, &i)| {
+                Rectangle::new(
+                    [(ec[si], er[sj]), (ec[si + 1], er[sj + 1])],
+                    colour(heat.values[j][i]).filled(),
+                )
+            })
+        }))
+        .map_err(err)?;
+    // The colour bar.
+    let mut bar = ChartBuilder::on(&right)
+        .margin_top(60)
+        .margin_bottom(70)
+        .margin_right(10)
+        .y_label_area_size(70)
+        .set_label_area_size(LabelAreaPosition::Right, 0)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(err)?;
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc(heat.unit)
+        .y_label_formatter(&|v| tick(*v))
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(err)?;
+    let steps = 120;
+    bar.draw_series((0..steps).map(|k| {
+        let y0 = lo + (hi - lo) * f64::from(k) / f64::from(steps);
+        let y1 = lo + (hi - lo) * f64::from(k + 1) / f64::from(steps);
+        Rectangle::new([(0.0, y0), (1.0, y1)], colour(0.5 * (y0 + y1)).filled())
+    }))
+    .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn magnifications_are_one_two_five() {
+        assert_eq!(nice_below(7300.0), 5000.0);
+        assert_eq!(nice_below(4999.0), 2000.0);
+        assert_eq!(nice_below(1.0), 1.0);
+        assert_eq!(nice_below(0.031), 0.02);
+        assert_eq!(edges(&[0.0, 100.0, 300.0]), [-50.0, 50.0, 200.0, 400.0]);
+    }
+}
