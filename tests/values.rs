@@ -862,6 +862,29 @@ fn csv_tables_are_located_by_file_and_line() {
 }
 
 #[test]
+fn a_csv_file_is_read_once_and_its_problems_reported_once() {
+    let dir = scratch("csv_once");
+    let m = chain_core::load_file(&write(&dir, "m.yaml", MACHINE)).unwrap();
+    write(&dir, "t.csv", "x,Ex,Shared\n0,0,0\n1\n");
+    let text = "machine: m\nvalues:\n  Ex: {table: t.csv}\n  EBX: {table: t.csv, column: Ex}\n";
+    match Values::read(&write(&dir, "v.yaml", text), &m) {
+        Err(chain_core::values::ValuesError::Table(d)) => {
+            assert_eq!(d.len(), 1, "{d:#}");
+            assert_eq!(d.first().origin.line, 3);
+        }
+        other => panic!("{other:?}"),
+    }
+    // A good file shared by two entries gives both their columns.
+    write(&dir, "u.csv", "x,Ex,B\n0,0,1\n10,1e-3,2e-3\n");
+    let text = "machine: m\nvalues:\n  Ex: {table: u.csv}\n  EBX: {table: u.csv, column: B}\n";
+    let v = Values::read(&write(&dir, "w.yaml", text), &m).unwrap();
+    let mut out = vec![0.0; m.errors.len()];
+    v.values_at(&[5.0, 0.0], &mut out).unwrap();
+    assert_eq!(out[m.error_index("Ex").unwrap()], 5e-4);
+    assert!((out[m.error_index("EBX_0").unwrap()] - 0.501).abs() < 1e-15);
+}
+
+#[test]
 fn an_empty_or_unreadable_values_file_is_an_error() {
     let (err, dir) = refused("empty", "", &[]);
     located(&err, &dir, "values.yaml", "1:1", "", "chain::values::empty");

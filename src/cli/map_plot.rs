@@ -13,9 +13,10 @@
 //! - `map_distortion`: the CMM-style picture, the nominal tool-point grid
 //!   (in the workpiece frame, projected on the coordinate plane in which it
 //!   spreads most) and the same grid displaced by the in-plane part of the
-//!   position error, magnified so that the largest displacement is about a
-//!   quarter of the smallest grid spacing (a 1-2-5 factor, stated in the
-//!   title).
+//!   position error, magnified so that the largest displacement is about
+//!   0.4 of the smallest spacing between drawn grid lines (a 1-2-5 factor,
+//!   stated in the title); at most 12 lines per direction are drawn, evenly
+//!   spread, each through every node along it.
 //!
 //! With one varying axis, or points from `--axes`, `map_position` and
 //! `map_orientation` chart the components along that axis (or the row).
@@ -277,28 +278,35 @@ fn distortion(
     dims.sort_by(|&x, &y| spread(y).total_cmp(&spread(x)));
     let (u, w) = (dims[0].min(dims[1]), dims[0].max(dims[1]));
     let coord = ["X", "Y", "Z"];
-    // Magnification: the largest in-plane displacement about a quarter of
-    // the smallest spacing between neighbouring nodes.
+    // The grid lines drawn: at most MAX_LINES per direction, evenly spread
+    // (the ends included), each through every node along it.
+    let (order_a, order_b) = (sorted(&axes[a].1), sorted(&axes[b].1));
+    let (lines_a, lines_b) = (thin(&order_a), thin(&order_b));
+    // Magnification: the largest in-plane displacement about 0.4 of the
+    // smallest distance between neighbouring drawn lines.
     let mut largest: f64 = 0.0;
-    let mut spacing = f64::INFINITY;
-    for j in 0..nb {
-        for i in 0..na {
-            let e = error[j][i];
+    for row in &error {
+        for e in row {
             largest = largest.max(e[u].hypot(e[w]));
-            let p = nominal[j][i];
-            for (di, dj) in [(1, 0), (0, 1)] {
-                if i + di < na && j + dj < nb {
-                    let q = nominal[j + dj][i + di];
-                    let d = (p[u] - q[u]).hypot(p[w] - q[w]);
-                    if d > 1e-9 {
-                        spacing = spacing.min(d);
-                    }
-                }
-            }
         }
     }
-    let magnification = if largest > 0.0 && spacing.is_finite() {
-        nice_below(0.25 * spacing / largest)
+    let distance = |(i, j): (usize, usize), (k, l): (usize, usize)| {
+        let (p, q) = (nominal[j][i], nominal[l][k]);
+        (p[u] - q[u]).hypot(p[w] - q[w])
+    };
+    let mut spacing = f64::INFINITY;
+    for pair in lines_a.windows(2) {
+        for &j in &order_b {
+            spacing = spacing.min(distance((pair[0], j), (pair[1], j)));
+        }
+    }
+    for pair in lines_b.windows(2) {
+        for &i in &order_a {
+            spacing = spacing.min(distance((i, pair[0]), (i, pair[1])));
+        }
+    }
+    let magnification = if largest > 0.0 && spacing.is_finite() && spacing > 1e-9 {
+        nice_below(0.4 * spacing / largest)
     } else {
         1.0
     };
@@ -313,37 +321,37 @@ fn distortion(
         format!("{} (mm, workpiece frame)", coord[u]),
         format!("{} (mm, workpiece frame)", coord[w]),
     );
-    let mut first = true;
-    let mut line = |pts: Vec<(usize, usize)>, chart: XyChart| {
-        let nominal_pts: Vec<(f64, f64)> = pts
+    // Every nominal line first, then every displaced one on top.
+    let lines: Vec<Vec<(usize, usize)>> = (lines_b.iter())
+        .map(|&j| order_a.iter().map(|&i| (i, j)).collect())
+        .chain(
+            lines_a
+                .iter()
+                .map(|&i| order_b.iter().map(|&j| (i, j)).collect()),
+        )
+        .collect();
+    for (k, pts) in lines.iter().enumerate() {
+        let label = if k == 0 { "nominal" } else { "" };
+        let nominal_pts = pts
             .iter()
             .map(|&(i, j)| (nominal[j][i][u], nominal[j][i][w]))
             .collect();
+        chart = chart.series(Series::line(label, nominal_pts).color(GREY).width(1));
+    }
+    let displaced = format!("displaced ×{}", tick(magnification));
+    for (k, pts) in lines.iter().enumerate() {
+        let label = if k == 0 { displaced.as_str() } else { "" };
         let moved: Vec<(f64, f64)> = pts
             .iter()
             .map(|&(i, j)| shown(nominal[j][i], error[j][i]))
             .collect();
-        let label = |s: &str| if first { s.to_string() } else { String::new() };
-        let c = chart
-            .series(
-                Series::line(label("nominal"), nominal_pts)
-                    .color(GREY)
-                    .width(1),
-            )
-            .series(
-                Series::line_points(label(&format!("displaced ×{}", tick(magnification))), moved)
-                    .color(crate::cli::plot::color(0))
-                    .width(2),
-            );
-        first = false;
-        c
-    };
-    let (order_a, order_b) = (sorted(&axes[a].1), sorted(&axes[b].1));
-    for &j in &order_b {
-        chart = line(order_a.iter().map(|&i| (i, j)).collect(), chart);
-    }
-    for &i in &order_a {
-        chart = line(order_b.iter().map(|&j| (i, j)).collect(), chart);
+        // Markers only where the line has few nodes.
+        let series = if moved.len() <= MAX_LINES {
+            Series::line_points(label, moved)
+        } else {
+            Series::line(label, moved)
+        };
+        chart = chart.series(series.color(crate::cli::plot::color(0)).width(2));
     }
     // Roughly equal scales on both axes.
     let (su, sw) = (spread(u).max(1e-9), spread(w).max(1e-9));
@@ -351,6 +359,22 @@ fn distortion(
     chart.size = (1000, height);
     chart = chart.legend(Legend::UpperRight);
     Ok(chart.write(dir, "map_distortion")?)
+}
+
+/// At most this many grid lines per direction in the distorted grid.
+const MAX_LINES: usize = 12;
+
+/// At most [`MAX_LINES`] of `order` (indices by increasing value), evenly
+/// spread, the first and the last included.
+fn thin(order: &[usize]) -> Vec<usize> {
+    let n = order.len();
+    if n <= MAX_LINES {
+        return order.to_vec();
+    }
+    // k·(n − 1)/(MAX_LINES − 1), rounded: distinct, since n > MAX_LINES.
+    (0..MAX_LINES)
+        .map(|k| order[(k * (n - 1) + (MAX_LINES - 1) / 2) / (MAX_LINES - 1)])
+        .collect()
 }
 
 /// Indices of `values` by increasing value.
@@ -592,5 +616,12 @@ mod tests {
         assert_eq!(nice_below(1.0), 1.0);
         assert_eq!(nice_below(0.031), 0.02);
         assert_eq!(edges(&[0.0, 100.0, 300.0]), [-50.0, 50.0, 200.0, 400.0]);
+        let order: Vec<usize> = (0..41).collect();
+        let t = thin(&order);
+        assert!(
+            t.len() <= MAX_LINES && t[0] == 0 && t[t.len() - 1] == 40,
+            "{t:?}"
+        );
+        assert_eq!(thin(&[2, 0, 1]), [2, 0, 1]);
     }
 }

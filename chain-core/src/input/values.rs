@@ -413,6 +413,8 @@ impl Values {
             tables: Vec::new(),
             base: base.to_path_buf(),
             file: file.to_string(),
+            #[cfg(feature = "csv")]
+            csv_files: Vec::new(),
         };
         let mut builder = ValuesBuilder::new(machine);
         builder.file = Some(file.to_string());
@@ -930,6 +932,18 @@ struct Reader {
     base: PathBuf,
     #[cfg_attr(not(feature = "csv"), allow(dead_code))]
     file: String,
+    /// The CSV files read so far.
+    #[cfg(feature = "csv")]
+    csv_files: Vec<(PathBuf, CsvRead)>,
+}
+
+/// What reading a CSV file gave.
+#[cfg(feature = "csv")]
+enum CsvRead {
+    Read(std::rc::Rc<csv::CsvFile>),
+    Unreadable(String),
+    /// Not a CSV table: its problems are reported already.
+    Invalid,
 }
 
 impl TreeReader for Reader {
@@ -1318,19 +1332,33 @@ impl Reader {
         use csv::{CsvFile, CsvOpenError};
         let path = self.base.join(file);
         let shown = path.display().to_string();
-        let csv = match CsvFile::read(&path, &shown) {
-            Ok(c) => c,
-            Err(CsvOpenError::Unreadable(why)) => {
+        // Each file is read once, however many entries use it.
+        let cached = match self.csv_files.iter().position(|(p, _)| *p == path) {
+            Some(k) => k,
+            None => {
+                let read = match CsvFile::read(&path, &shown) {
+                    Ok(c) => CsvRead::Read(std::rc::Rc::new(c)),
+                    Err(CsvOpenError::Unreadable(why)) => CsvRead::Unreadable(why),
+                    Err(CsvOpenError::Invalid(d)) => {
+                        // Its problems are reported once.
+                        self.tables.push(d);
+                        CsvRead::Invalid
+                    }
+                };
+                self.csv_files.push((path.clone(), read));
+                self.csv_files.len() - 1
+            }
+        };
+        let csv = match &self.csv_files[cached].1 {
+            CsvRead::Read(c) => std::rc::Rc::clone(c),
+            CsvRead::Unreadable(why) => {
                 let text = format!("cannot read the table `{file}` ({shown}): {why}");
                 let unread = Message::new(text, "table file", "chain::values::table_file")
                     .help("table paths are relative to the values file's directory");
                 self.report(table_node.span, fields.path("table"), unread.into());
                 return None;
             }
-            Err(CsvOpenError::Invalid(d)) => {
-                self.tables.push(d);
-                return None;
-            }
+            CsvRead::Invalid => return None,
         };
         let Some(qc) = csv.column(var_name) else {
             let text = format!(
@@ -1390,7 +1418,7 @@ impl Reader {
         Some((
             points,
             format!("{file}, column {column}"),
-            (shown, csv.text),
+            (shown, csv.text.clone()),
         ))
     }
 
