@@ -242,35 +242,11 @@ pub(crate) fn parse_records(name: &str, data: &[u8]) -> Result<Vec<RawRecord>, R
     Ok(out)
 }
 
-/// The line a record starts on. The reader reports where it started reading,
-/// which is before any comment or blank lines it skipped; skip them here too.
+/// The line a record starts on (after the comment and blank lines the
+/// reader skipped): the values files' rule, `chain_core::values::csv`.
 fn record_line(data: &[u8], pos: &csv::Position) -> u64 {
-    let mut line = pos.line();
-    let mut i = usize::try_from(pos.byte()).unwrap_or(usize::MAX);
-    while let Some(&b) = data.get(i) {
-        match b {
-            b'#' => match data[i..].iter().position(|&c| c == b'\n') {
-                Some(end) => {
-                    i += end + 1;
-                    line += 1;
-                }
-                None => break,
-            },
-            b'\n' => {
-                i += 1;
-                line += 1;
-            }
-            b'\r' => {
-                i += 1;
-                if data.get(i) == Some(&b'\n') {
-                    i += 1;
-                }
-                line += 1;
-            }
-            _ => break,
-        }
-    }
-    line
+    let (_, line) = chain_core::values::csv::record_start(data, pos);
+    u64::try_from(line).unwrap_or(u64::MAX)
 }
 
 fn csv_error_message(e: &csv::Error) -> String {

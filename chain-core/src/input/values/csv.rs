@@ -220,8 +220,8 @@ fn line_origin(text: &str, line: u64) -> Origin {
 
 /// Where a record really starts: the reader reports where it started
 /// reading, before any comment or blank lines it skipped. Returns the byte
-/// offset and the 1-based line.
-fn record_start(data: &[u8], pos: &::csv::Position) -> (usize, usize) {
+/// offset and the 1-based line. (Also the CLI's CSV inputs' line numbers.)
+pub fn record_start(data: &[u8], pos: &::csv::Position) -> (usize, usize) {
     let mut line = usize::try_from(pos.line()).unwrap_or(usize::MAX);
     let mut i = usize::try_from(pos.byte()).unwrap_or(usize::MAX);
     while let Some(&b) = data.get(i) {
