@@ -29,7 +29,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::{Input, MapDoc};
-use crate::cli::plot::{ensure_fonts, Legend, Series, XyChart, GREY};
+use crate::cli::plot::{ensure_fonts, ramp, Legend, Series, XyChart, GREY};
 
 const HEAT_SIZE: (u32, u32) = (1000, 760);
 const COMPONENTS: [&str; 6] = ["px", "py", "pz", "ox", "oy", "oz"];
@@ -498,20 +498,6 @@ fn diverging(t: f64) -> RGBColor {
         (178.0, 24.0, 43.0),
     ];
     ramp(&STOPS, 0.5 * (t + 1.0))
-}
-
-fn ramp(stops: &[(f64, f64, f64); 5], t: f64) -> RGBColor {
-    let t = if t.is_finite() {
-        t.clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let x = t * 4.0;
-    let i = (x.floor() as usize).min(3);
-    let f = x - i as f64;
-    let (a, b) = (stops[i], stops[i + 1]);
-    let mix = |p: f64, q: f64| (p + (q - p) * f).round().clamp(0.0, 255.0) as u8;
-    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
 fn heat_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, heat: &Heat) -> Result<(), String>

@@ -38,6 +38,22 @@ pub const PALETTE: [RGBColor; 7] = [
     RGBColor(0, 0, 0),
 ];
 
+/// A colour ramp through five stops, linearly interpolated; `t` in `[0, 1]`
+/// (a non-finite `t` gives the first stop). The heat maps' one colour rule.
+pub fn ramp(stops: &[(f64, f64, f64); 5], t: f64) -> RGBColor {
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = t * 4.0;
+    let i = (x.floor() as usize).min(3);
+    let f = x - i as f64;
+    let (a, b) = (stops[i], stops[i + 1]);
+    let mix = |p: f64, q: f64| (p + (q - p) * f).round().clamp(0.0, 255.0) as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
 /// The `i`-th colour of [`PALETTE`], cycling.
 pub fn color(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
