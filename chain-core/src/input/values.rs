@@ -35,7 +35,7 @@
 mod table;
 
 #[cfg(feature = "csv")]
-mod csv;
+pub(crate) mod csv;
 
 use std::path::{Path, PathBuf};
 
