@@ -14,6 +14,7 @@
 pub mod built;
 pub mod input;
 pub mod kinematics;
+pub mod measured;
 mod model_trait;
 pub mod named;
 pub mod symbolic;
@@ -29,6 +30,7 @@ pub use derive::{derive, derive_in, SymbolicModel};
 pub use diagnostic::Diagnostics;
 pub use eval::{compile, CompiledModel};
 pub use load::{load_bytes, load_file, load_str};
+pub use measured::{identify, measurements};
 pub use model::Machine;
 pub use model_trait::{ErrorModel, ErrorValues, OutOfRange, Pose};
 pub use values::Values;

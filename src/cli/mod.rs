@@ -6,6 +6,7 @@ mod args;
 pub mod compensate;
 mod csv_input;
 pub mod derive;
+pub mod identify;
 pub mod inverse;
 pub mod map;
 pub mod motion;
@@ -44,6 +45,8 @@ enum Command {
     Path(path::PathArgs),
     /// The volumetric error map of a built machine: its error values (a values file) through the model over a grid or a list of points.
     Map(map::MapArgs),
+    /// Identify the error parameters from measurements (tool-point deviations or deviations along directions): weighted least squares through an SVD, what the data cannot separate, residuals and outliers.
+    Identify(identify::IdentifyArgs),
     /// Motion conversion ("Precision Machining Technology of Jewelry on CNC Machine Tool", 2022): CNC axis motions reproducing a cradle-type generator's roll, and their Maclaurin series.
     Motion(motion::MotionArgs),
 }
@@ -60,5 +63,6 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Path(args) => path::exec(args),
         Command::Motion(args) => motion::exec(args),
         Command::Map(args) => map::exec(args),
+        Command::Identify(args) => identify::exec(args),
     }
 }

@@ -1,0 +1,597 @@
+//! Identification of the error parameters from measurements
+//! (measured-machines spec, section 4; `docs/identify.md`).
+//!
+//! # Formulas
+//!
+//! With the design `A` (rows: [`super::Design`]), the measured values `b`
+//! and each row's standard deviation `σ_i` (the `std` column; `1` without
+//! it), the weighted rows are `B = diag(1/σ) A`, `y = b/σ`. The columns are
+//! equilibrated, `D = diag(1/|B_j|)` (a zero column keeps `1`), so the
+//! singular values of `B D` do not depend on the units of the unknowns
+//! (mm against rad). `(B D)ᵀ(B D) = V Λ Vᵀ` (nalgebra's SVD of the
+//! symmetric `n × n` information matrix: its singular values are the
+//! squares of those of `B D`; `n` the unknowns).
+//!
+//! - **rank**: the count of singular values `s_i = √λ_i` of `B D` above
+//!   [`RANK_TOLERANCE`] `× s_max`; **condition**: `s_max / s_rank`, the
+//!   condition number of the equilibrated design on its identifiable part.
+//! - **null space**: `N` = an orthonormal basis of `span(D V_null)`, split
+//!   into the groups of unknowns it couples (see [`grouped_basis`]).
+//! - **estimate**: the minimum-norm least-squares solution
+//!   `x = P D V_r Λ_r⁻¹ V_rᵀ D Bᵀ y`, `P = I − N Nᵀ` (the unique solution
+//!   orthogonal to the null space, i.e. `B⁺ y`).
+//! - **covariance**: `(Aᵀ W A)⁺ = P D V_r Λ_r⁻¹ V_rᵀ D P` with a `std`
+//!   column (`W = diag(1/σ²)`, spec section 4); without one it is scaled by
+//!   `s² = RSS/(m − rank)` (`RSS = |b − A x|²`, `m` scalar rows).
+//! - **prior** (`statistics` as independent Gaussians `N(μ₀_j, σ₀_j²)`,
+//!   a uniform entry by its mean and standard deviation): the posterior
+//!   precision `Λ_post = Aᵀ W A + Σ₀⁻¹` and mean
+//!   `Λ_post⁻¹ (Aᵀ W b + Σ₀⁻¹ μ₀)` (Cholesky); without a `std` column
+//!   `W = I/s²` with `s²` of the least-squares fit. What the data did not
+//!   inform: the eigen-directions `w` of the prior-standardised data
+//!   information `L Aᵀ W A L` (`L = diag σ₀`) whose posterior standard
+//!   deviation along them is above [`UNINFORMED`] × the prior's
+//!   (eigenvalue below `1/0.9² − 1`), mapped back as `L w`.
+//! - **outliers**: the standardised residual `t_i = r_i / (σ_i √(1 − h_ii))`,
+//!   `h_ii = ã_i Σ ã_iᵀ` (`ã_i = a_i/σ_i`, `σ_i` the row's std or `s`,
+//!   `Σ` the reported covariance); `|t_i| >` [`OUTLIER_LIMIT`] flags a likely
+//!   outlier.
+
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+use super::measurements::Design;
+use crate::model::Machine;
+use crate::named::NameMap;
+
+/// Singular values of the equilibrated weighted design below this fraction
+/// of the largest count as zero. The singular values come from the
+/// information matrix, whose rounding is about `n ε λ_max` (`ε` = 2.2e-16),
+/// i.e. `√(n ε) ≈ 2e-7` relative on `s`; 1e-6 stays above that.
+pub const RANK_TOLERANCE: f64 = 1e-6;
+/// Null-space components below this are omitted from the reported vectors.
+pub const COMPONENT_CUTOFF: f64 = 1e-9;
+/// With a prior, a direction whose posterior std is above this fraction of
+/// its prior std is reported as not informed by the data.
+pub const UNINFORMED: f64 = 0.9;
+/// Standardised residuals above this in magnitude are flagged as likely
+/// outliers.
+pub const OUTLIER_LIMIT: f64 = 3.0;
+/// How many of the largest standardised residuals are reported.
+pub const LARGEST_RESIDUALS: usize = 10;
+
+/// Options of [`identify`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct IdentifyOptions {
+    /// Use the machine's `statistics` as a Gaussian prior.
+    pub prior: bool,
+}
+
+/// The Gaussian prior of the unknowns, in the design's error order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Prior {
+    /// Prior means.
+    pub mean: Vec<f64>,
+    /// Prior standard deviations (> 0).
+    pub std: Vec<f64>,
+}
+
+impl Prior {
+    /// The `statistics` section of `machine` as independent Gaussians for
+    /// `errors` (normal entries as given; uniform ones by their mean and
+    /// standard deviation). Every error needs an entry.
+    pub fn from_machine(machine: &Machine, errors: &[String]) -> Result<Prior, IdentifyError> {
+        let mut mean = Vec::with_capacity(errors.len());
+        let mut std = Vec::with_capacity(errors.len());
+        let mut missing = Vec::new();
+        for name in errors {
+            match machine.error_index(name).and_then(|j| machine.statistic(j)) {
+                Some(s) => {
+                    mean.push(s.distribution.mean());
+                    std.push(s.distribution.std());
+                }
+                None => missing.push(name.clone()),
+            }
+        }
+        if missing.is_empty() {
+            Ok(Prior { mean, std })
+        } else {
+            Err(IdentifyError::NoPrior {
+                machine: machine.name.clone(),
+                missing,
+            })
+        }
+    }
+}
+
+/// Why an identification could not be computed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
+#[non_exhaustive]
+pub enum IdentifyError {
+    /// No measurement at all and no prior.
+    #[error("there is no measurement to identify from")]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::identify::no_rows)))]
+    NoRows,
+    /// `--prior` on a machine whose `statistics` miss some errors.
+    #[error("--prior needs a statistics entry for every error parameter; machine `{machine}` has none for {}", missing.join(", "))]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(
+            code(chain::identify::no_prior),
+            help("add them to the machine file's `statistics`, or identify without --prior")
+        )
+    )]
+    NoPrior {
+        /// The machine.
+        machine: String,
+        /// The errors without a statistics entry.
+        missing: Vec<String>,
+    },
+    /// `--prior` without a `std` column and no residual degree of freedom
+    /// to estimate the noise from.
+    #[error("--prior without a `std` column estimates the measurement noise from the least-squares residual, but there are {rows} rows for rank {rank}")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(
+            code(chain::identify::no_noise_scale),
+            help("give each measurement its standard deviation (a `std` column), or more measurements")
+        )
+    )]
+    NoNoiseScale {
+        /// The scalar rows.
+        rows: usize,
+        /// The rank.
+        rank: usize,
+    },
+    /// A non-finite value in the design (a pose where the model is not
+    /// finite).
+    #[error("the design matrix or the measured values are not finite")]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::identify::not_finite)))]
+    NotFinite,
+    /// The prior's size does not match the design.
+    #[error("the prior has {prior} entries for {unknowns} unknowns")]
+    PriorSize {
+        /// The prior's entries.
+        prior: usize,
+        /// The unknowns.
+        unknowns: usize,
+    },
+}
+
+/// One estimate.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Estimate {
+    /// The estimated value (mm or rad).
+    pub value: f64,
+    /// Its standard deviation (`None`: without a `std` column and with as
+    /// many rows as the rank, the noise cannot be estimated).
+    pub std: Option<f64>,
+}
+
+/// The residual of the fit.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Residual {
+    /// Root mean square of `b − A x` over the scalar rows.
+    pub rms: f64,
+    /// The largest `|b − A x|`.
+    pub max: f64,
+    /// `Σ ((b − A x)/σ)²` (`σ = 1` without a `std` column).
+    pub rss: f64,
+    /// The residual degrees of freedom `m − rank`.
+    pub dof: usize,
+    /// The noise scale `s = √(RSS/dof)` (in the measurement units without a
+    /// `std` column; with one, the ratio of the scatter to the stated std).
+    pub scale: Option<f64>,
+}
+
+/// A standardised residual.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Standardised {
+    /// The scalar row (0-based) in the design.
+    pub row: usize,
+    /// The component (`dpx`, `dpy`, `dpz` or `d`).
+    pub component: &'static str,
+    /// `b − A x`.
+    pub residual: f64,
+    /// `t = r / (σ √(1 − h))`.
+    pub standardised: f64,
+    /// The row's leverage `h`.
+    pub leverage: f64,
+    /// `|t| >` [`OUTLIER_LIMIT`].
+    pub outlier: bool,
+}
+
+/// A group of unknowns the null space couples, and its basis vectors.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AliasGroup {
+    /// The unknowns of the group (indices into the errors).
+    pub members: Vec<usize>,
+    /// The group's size less its vectors: for a null space, the rank of
+    /// the design's columns of the group.
+    pub column_rank: usize,
+    /// The indices of the group's vectors in the basis.
+    pub vectors: Vec<usize>,
+}
+
+/// The result of [`identify`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Identification {
+    /// Scalar measurement rows `m`.
+    pub rows: usize,
+    /// Unknowns `n`.
+    pub parameters: usize,
+    /// The rank of the design.
+    pub rank: usize,
+    /// The condition number of the equilibrated design on its identifiable
+    /// part.
+    pub condition: f64,
+    /// The singular values of the equilibrated weighted design, largest
+    /// first.
+    pub singular_values: Vec<f64>,
+    /// Whether the rows had their standard deviations.
+    pub weighted: bool,
+    /// Whether a prior was used.
+    pub prior: bool,
+    /// The unknowns' names.
+    pub errors: Vec<String>,
+    /// The estimates, by name.
+    pub estimates: NameMap<String, Estimate>,
+    /// The covariance of the estimates (`n × n`; NaN where undefined).
+    #[serde(skip)]
+    pub covariance: DMatrix<f64>,
+    /// Orthonormal basis of what the data cannot tell (the null space; with
+    /// a prior, the directions it did not inform), `n × k`.
+    #[serde(skip)]
+    pub null_space: DMatrix<f64>,
+    /// The same as `{error: component}` maps, components below
+    /// [`COMPONENT_CUTOFF`] omitted.
+    pub unidentifiable: Vec<NameMap<String, f64>>,
+    /// The groups of unknowns the basis couples (each vector in one group).
+    pub groups: Vec<AliasGroup>,
+    /// The residual.
+    pub residual: Residual,
+    /// The residuals `b − A x`, one per row.
+    #[serde(skip)]
+    pub residuals: Vec<f64>,
+    /// The largest standardised residuals (at most [`LARGEST_RESIDUALS`]),
+    /// largest first.
+    pub largest_residuals: Vec<Standardised>,
+    /// How many standardised residuals exceed [`OUTLIER_LIMIT`].
+    pub outliers: usize,
+}
+
+/// Identifies the unknowns of `design` (spec section 4): the minimum-norm
+/// weighted least-squares estimate, or with `prior` the posterior mean and
+/// covariance. See the module's formulas.
+pub fn identify(design: &Design, prior: Option<&Prior>) -> Result<Identification, IdentifyError> {
+    let (m, n) = design.a.shape();
+    if m == 0 && prior.is_none() {
+        return Err(IdentifyError::NoRows);
+    }
+    if let Some(p) = prior {
+        if p.mean.len() != n || p.std.len() != n {
+            return Err(IdentifyError::PriorSize {
+                prior: p.mean.len(),
+                unknowns: n,
+            });
+        }
+    }
+    if design.a.iter().chain(&design.b).any(|v| !v.is_finite()) {
+        return Err(IdentifyError::NotFinite);
+    }
+    let weighted = design.std.is_some();
+    let inv_sigma: Vec<f64> = match &design.std {
+        Some(s) => s.iter().map(|s| 1.0 / s).collect(),
+        None => vec![1.0; m],
+    };
+    // B = diag(1/σ) A, y = b/σ.
+    let mut bm = design.a.clone();
+    for (i, w) in inv_sigma.iter().enumerate() {
+        bm.row_mut(i).scale_mut(*w);
+    }
+    let y = DVector::from_iterator(m, design.b.iter().zip(&inv_sigma).map(|(b, w)| b * w));
+    // Bᵀ B through an explicit transpose: the product then runs on
+    // nalgebra's blocked matrix multiplication (`tr_mul` is a dot product
+    // per entry, several times slower here).
+    let bt = bm.transpose();
+    let info = &bt * &bm;
+    let g = bm.tr_mul(&y);
+    let d: Vec<f64> = (0..n)
+        .map(|j| {
+            let c = info[(j, j)].sqrt();
+            if c > 0.0 {
+                1.0 / c
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let scaled = DMatrix::from_fn(n, n, |i, j| d[i] * info[(i, j)] * d[j]);
+    let (lambda, v) = symmetric_svd(&scaled);
+    let s_max = lambda.first().copied().unwrap_or(0.0).max(0.0).sqrt();
+    let singular: Vec<f64> = lambda.iter().map(|l| l.max(0.0).sqrt()).collect();
+    let rank = if s_max > 0.0 {
+        singular
+            .iter()
+            .filter(|s| **s > RANK_TOLERANCE * s_max)
+            .count()
+    } else {
+        0
+    };
+    let condition = if rank > 0 {
+        s_max / singular[rank - 1]
+    } else {
+        f64::INFINITY
+    };
+    // Null space in the unknowns' own coordinates: span(D V_null),
+    // orthonormalised.
+    let null_scaled = DMatrix::from_fn(n, n - rank, |i, k| d[i] * v[(i, rank + k)]);
+    let null = orthonormal(&null_scaled);
+    let project = |x: &DVector<f64>| -> DVector<f64> {
+        if null.ncols() == 0 {
+            x.clone()
+        } else {
+            x - &null * (null.tr_mul(x))
+        }
+    };
+    // x = P D V_r Λ_r⁻¹ V_rᵀ D g.
+    let dg = DVector::from_fn(n, |i, _| d[i] * g[i]);
+    let mut xs = DVector::zeros(n);
+    for (k, l) in lambda.iter().enumerate().take(rank) {
+        let vk = v.column(k);
+        xs += vk * (vk.dot(&dg) / l);
+    }
+    let x_ls = project(&DVector::from_fn(n, |i, _| d[i] * xs[i]));
+    // (Aᵀ W A)⁺ = P D V_r Λ_r⁻¹ V_rᵀ D P.
+    let vr = DMatrix::from_fn(n, rank, |i, k| d[i] * v[(i, k)] / lambda[k].sqrt());
+    let mut cov_unit = &vr * vr.transpose();
+    if null.ncols() > 0 {
+        let p = DMatrix::identity(n, n) - &null * null.transpose();
+        cov_unit = &p * cov_unit * &p;
+    }
+    let residuals_of = |x: &DVector<f64>| -> Vec<f64> {
+        let ax = &design.a * x;
+        design.b.iter().zip(ax.iter()).map(|(b, a)| b - a).collect()
+    };
+    let ls_residuals = residuals_of(&x_ls);
+    let ls_rss: f64 = (ls_residuals.iter().zip(&inv_sigma))
+        .map(|(r, w)| (r * w) * (r * w))
+        .sum();
+    let dof = m.saturating_sub(rank);
+    let ls_scale = (dof > 0).then(|| (ls_rss / dof as f64).sqrt());
+
+    let (x, cov, unidentifiable_basis, noise) = match prior {
+        None => {
+            let (cov, noise) = if weighted {
+                (cov_unit, Some(1.0))
+            } else {
+                match ls_scale {
+                    Some(s) => (cov_unit * (s * s), Some(s)),
+                    None => (DMatrix::from_element(n, n, f64::NAN), None),
+                }
+            };
+            (x_ls, cov, null, noise)
+        }
+        Some(p) => {
+            // The noise: the stated std, or s of the least-squares fit.
+            let s2 = if weighted || m == 0 {
+                1.0
+            } else {
+                match ls_scale {
+                    Some(s) => s * s,
+                    None => return Err(IdentifyError::NoNoiseScale { rows: m, rank }),
+                }
+            };
+            let fisher = &info / s2;
+            let mut precision = fisher.clone();
+            let mut rhs = &g / s2;
+            for j in 0..n {
+                let w0 = 1.0 / (p.std[j] * p.std[j]);
+                precision[(j, j)] += w0;
+                rhs[j] += w0 * p.mean[j];
+            }
+            // Equilibrated Cholesky of the (full-rank) posterior precision.
+            let e: Vec<f64> = (0..n).map(|j| 1.0 / precision[(j, j)].sqrt()).collect();
+            let scaled = DMatrix::from_fn(n, n, |i, j| e[i] * precision[(i, j)] * e[j]);
+            let chol = nalgebra::Cholesky::new(scaled).ok_or(IdentifyError::NotFinite)?;
+            let inv = chol.inverse();
+            let cov = DMatrix::from_fn(n, n, |i, j| e[i] * inv[(i, j)] * e[j]);
+            let x = &cov * rhs;
+            // Directions the data did not inform (prior-standardised).
+            let k = DMatrix::from_fn(n, n, |i, j| p.std[i] * fisher[(i, j)] * p.std[j]);
+            let (kappa, w) = symmetric_svd(&k);
+            let limit = 1.0 / (UNINFORMED * UNINFORMED) - 1.0;
+            let dirs: Vec<usize> = (0..n).filter(|&i| kappa[i] < limit).collect();
+            let raw = DMatrix::from_fn(n, dirs.len(), |i, c| p.std[i] * w[(i, dirs[c])]);
+            (x, cov, orthonormal(&raw), Some(s2.sqrt()))
+        }
+    };
+    let residuals = residuals_of(&x);
+    let rss: f64 = (residuals.iter().zip(&inv_sigma))
+        .map(|(r, w)| (r * w) * (r * w))
+        .sum();
+    let rms = if m > 0 {
+        (residuals.iter().map(|r| r * r).sum::<f64>() / m as f64).sqrt()
+    } else {
+        0.0
+    };
+    let max = residuals.iter().fold(0.0f64, |a, r| a.max(r.abs()));
+    // Standardised residuals: σ_i the row's std (times 1) or s.
+    let mut largest = Vec::new();
+    if let Some(s) = noise {
+        let unit = if weighted { 1.0 } else { s };
+        if unit > 0.0 && m > 0 {
+            let mut rows_scaled = bm.clone();
+            rows_scaled /= unit;
+            let t = &rows_scaled * &cov;
+            for i in 0..m {
+                let h = t.row(i).dot(&rows_scaled.row(i));
+                if h < 1.0 - 1e-10 && h.is_finite() {
+                    let sigma = unit / inv_sigma[i];
+                    let ti = residuals[i] / (sigma * (1.0 - h).sqrt());
+                    largest.push(Standardised {
+                        row: i,
+                        component: design.origin.get(i).map_or("", |o| o.1),
+                        residual: residuals[i],
+                        standardised: ti,
+                        leverage: h,
+                        outlier: ti.abs() > OUTLIER_LIMIT,
+                    });
+                }
+            }
+        }
+    }
+    let outliers = largest.iter().filter(|s| s.outlier).count();
+    largest.sort_by(|a, b| b.standardised.abs().total_cmp(&a.standardised.abs()));
+    largest.truncate(LARGEST_RESIDUALS);
+
+    let (basis, groups) = grouped_basis(&unidentifiable_basis);
+    let unidentifiable = (0..basis.ncols())
+        .map(|k| {
+            (0..n)
+                .filter(|&i| basis[(i, k)].abs() >= COMPONENT_CUTOFF)
+                .map(|i| (design.errors[i].clone(), basis[(i, k)]))
+                .collect()
+        })
+        .collect();
+    let estimates = (0..n)
+        .map(|j| {
+            let var = cov[(j, j)];
+            let std = var.is_finite().then(|| var.max(0.0).sqrt());
+            (design.errors[j].clone(), Estimate { value: x[j], std })
+        })
+        .collect();
+    Ok(Identification {
+        rows: m,
+        parameters: n,
+        rank,
+        condition,
+        singular_values: singular,
+        weighted,
+        prior: prior.is_some(),
+        errors: design.errors.clone(),
+        estimates,
+        covariance: cov,
+        null_space: basis,
+        unidentifiable,
+        groups,
+        residual: Residual {
+            rms,
+            max,
+            rss,
+            dof,
+            scale: if weighted {
+                ls_scale
+            } else {
+                noise.filter(|_| dof > 0)
+            },
+        },
+        residuals,
+        largest_residuals: largest,
+        outliers,
+    })
+}
+
+/// Eigenvalues (largest first) and eigenvectors of a symmetric positive
+/// semi-definite matrix, through nalgebra's SVD (for such a matrix the
+/// singular values are the eigenvalues and `U = V`).
+fn symmetric_svd(m: &DMatrix<f64>) -> (Vec<f64>, DMatrix<f64>) {
+    let n = m.nrows();
+    if n == 0 {
+        return (Vec::new(), DMatrix::zeros(0, 0));
+    }
+    let svd = nalgebra::SVD::new(m.clone(), true, false);
+    let u = svd.u.unwrap_or_else(|| DMatrix::identity(n, n));
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
+    let values = order.iter().map(|&k| svd.singular_values[k]).collect();
+    let vectors = DMatrix::from_fn(n, n, |i, c| u[(i, order[c])]);
+    (values, vectors)
+}
+
+/// An orthonormal basis of the column span of `m` (full column rank
+/// assumed: its columns come from an orthonormal set scaled by a positive
+/// diagonal), through nalgebra's SVD.
+fn orthonormal(m: &DMatrix<f64>) -> DMatrix<f64> {
+    let (n, k) = m.shape();
+    if k == 0 {
+        return DMatrix::zeros(n, 0);
+    }
+    let svd = nalgebra::SVD::new(m.clone(), true, false);
+    let u = svd.u.unwrap_or_else(|| DMatrix::zeros(n, k));
+    u.columns(0, k).into_owned()
+}
+
+/// Splits the span of the orthonormal `basis` into the groups of unknowns
+/// it couples: unknowns `i`, `j` are linked when the projector `N Nᵀ` has
+/// `|P_ij| ≥` [`COMPONENT_CUTOFF`]; the projector is block diagonal over
+/// the connected groups, and each block's eigenvectors of eigenvalue 1
+/// (nalgebra's SVD of the block) are the group's vectors. The vectors are
+/// orthonormal, span the same space, and each lives on one group; each has
+/// its largest component positive.
+pub fn grouped_basis(basis: &DMatrix<f64>) -> (DMatrix<f64>, Vec<AliasGroup>) {
+    let (n, k) = basis.shape();
+    if k == 0 {
+        return (DMatrix::zeros(n, 0), Vec::new());
+    }
+    let p = basis * basis.transpose();
+    let mut group = vec![usize::MAX; n];
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for start in 0..n {
+        if group[start] != usize::MAX || p[(start, start)] < COMPONENT_CUTOFF {
+            continue;
+        }
+        let id = groups.len();
+        let mut members = vec![start];
+        group[start] = id;
+        let mut at = 0;
+        while at < members.len() {
+            let i = members[at];
+            for j in 0..n {
+                if group[j] == usize::MAX && p[(i, j)].abs() >= COMPONENT_CUTOFF {
+                    group[j] = id;
+                    members.push(j);
+                }
+            }
+            at += 1;
+        }
+        members.sort_unstable();
+        groups.push(members);
+    }
+    let mut columns: Vec<DVector<f64>> = Vec::new();
+    let mut out = Vec::new();
+    for members in groups {
+        let block = DMatrix::from_fn(members.len(), members.len(), |a, b| {
+            p[(members[a], members[b])]
+        });
+        let dim = block.trace().round() as usize;
+        let (_, vecs) = symmetric_svd(&block);
+        let mut indices = Vec::new();
+        for c in 0..dim.min(members.len()) {
+            let mut full = DVector::zeros(n);
+            for (a, &i) in members.iter().enumerate() {
+                full[i] = vecs[(a, c)];
+            }
+            let big = full
+                .iter()
+                .fold(0.0f64, |m, v| if v.abs() > m.abs() { *v } else { m });
+            if big < 0.0 {
+                full.neg_mut();
+            }
+            indices.push(columns.len());
+            columns.push(full);
+        }
+        out.push(AliasGroup {
+            column_rank: members.len() - indices.len(),
+            members,
+            vectors: indices,
+        });
+    }
+    let m = if columns.is_empty() {
+        DMatrix::zeros(n, 0)
+    } else {
+        DMatrix::from_columns(&columns)
+    };
+    (m, out)
+}

@@ -1,0 +1,626 @@
+//! Measurement records of one machine and their design-matrix rows
+//! (measured-machines spec, section 4; `docs/identify.md`).
+//!
+//! A measurement CSV has one measurement a row. Its columns are
+//!
+//! - the machine's axis variables (every one of them: the pose; rotary in
+//!   radians);
+//! - any of the machine's parameters (that parameter's value for the row; a
+//!   parameter not given as a column takes `--param`'s value, then the
+//!   machine file's, and is refused if it has neither);
+//! - either `dpx,dpy,dpz` (a measured tool-point deviation in the machine
+//!   file's frame, as `derive` reports `px, py, pz`) or `ux,uy,uz,d` (a
+//!   deviation `d = u · p` along the unit direction `u`);
+//! - optionally `std` (that measurement's standard deviation, > 0, same
+//!   units).
+//!
+//! A candidate CSV of `chain plan` (spec section 5) has the same columns
+//! without the measured values (`dpx,dpy,dpz` and `d`): [`Layout::Candidates`].
+//!
+//! Every refusal is located in the CSV file (line, column, header name).
+//! The design rows of a record are [`design_rows`]: `S_p(q, p)`, the three
+//! position rows of the model's exact sensitivity (tool point), or
+//! `uᵀ S_p(q, p)` (one row along a direction).
+
+use serde::Serialize;
+
+use crate::diagnostic::Diagnostics;
+#[cfg(feature = "csv")]
+use crate::diagnostic::{closest, Message, Problem};
+use crate::model::Machine;
+#[cfg(feature = "csv")]
+use crate::model::Origin;
+use crate::ErrorModel;
+
+/// The measured columns of a tool-point deviation.
+pub const POINT_COLUMNS: [&str; 3] = ["dpx", "dpy", "dpz"];
+/// The direction columns of a deviation along a direction.
+pub const DIRECTION_COLUMNS: [&str; 3] = ["ux", "uy", "uz"];
+/// The measured column of a deviation along a direction.
+pub const DISTANCE_COLUMN: &str = "d";
+/// The column of a row's standard deviation.
+pub const STD_COLUMN: &str = "std";
+/// How far `|u|` may be from 1 (it is then normalised): direction cosines
+/// written with five or more digits pass.
+pub const UNIT_TOLERANCE: f64 = 1e-4;
+/// Measurement CSV files larger than this are refused.
+pub const MAX_MEASUREMENT_BYTES: usize = 256 * 1024 * 1024;
+
+/// What a CSV must hold besides the poses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Layout {
+    /// Measurements: `dpx,dpy,dpz` or `ux,uy,uz,d` (spec section 4).
+    Measurements,
+    /// Candidate poses of `chain plan` (spec section 5): no measured values;
+    /// `ux,uy,uz` optional (then every row is a direction).
+    Candidates,
+}
+
+/// What one record measures.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Observed {
+    /// The tool-point deviation `(px, py, pz)`: three design rows.
+    Point,
+    /// The deviation along the unit direction `u`: one design row `uᵀ S_p`.
+    Direction {
+        /// The unit direction (normalised).
+        u: [f64; 3],
+    },
+}
+
+impl Observed {
+    /// The number of design rows of one record (3 or 1).
+    pub fn rows(&self) -> usize {
+        match self {
+            Observed::Point => 3,
+            Observed::Direction { .. } => 1,
+        }
+    }
+}
+
+/// One measurement (or candidate pose).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Measurement {
+    /// The CSV line it came from (1-based; 0 when built from Rust).
+    pub line: usize,
+    /// The axis values, in the machine's variable order.
+    pub q: Vec<f64>,
+    /// The parameter values, in the machine's parameter order.
+    pub p: Vec<f64>,
+    /// What it measures.
+    pub observed: Observed,
+    /// The measured values: `[dpx, dpy, dpz]` or `[d]` (empty for a
+    /// candidate).
+    pub values: Vec<f64>,
+    /// Its standard deviation, if the CSV has a `std` column.
+    pub std: Option<f64>,
+}
+
+/// The measurements (or candidates) of one CSV file.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Measurements {
+    /// The file as named in messages.
+    pub file: String,
+    /// The machine they belong to.
+    pub machine: String,
+    /// Whether the file has a `std` column (every row then has a std).
+    pub weighted: bool,
+    /// The records in file order.
+    pub rows: Vec<Measurement>,
+}
+
+/// Why a measurement CSV was refused: its problems, located (file, line,
+/// column, header name).
+#[derive(Debug, thiserror::Error)]
+#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
+#[error(transparent)]
+#[cfg_attr(feature = "miette", diagnostic(transparent))]
+pub struct MeasurementsError(pub Diagnostics);
+
+impl MeasurementsError {
+    /// The located problems.
+    pub fn diagnostics(&self) -> &Diagnostics {
+        &self.0
+    }
+}
+
+impl Measurements {
+    /// The number of scalar design rows (3 per point, 1 per direction).
+    pub fn row_count(&self) -> usize {
+        self.rows.iter().map(|r| r.observed.rows()).sum()
+    }
+
+    /// Reads a measurement or candidate CSV for `machine`; `overrides` are
+    /// `--param NAME=VALUE` (later ones win), used for parameters the CSV has
+    /// no column for.
+    #[cfg(feature = "csv")]
+    pub fn read(
+        path: &std::path::Path,
+        machine: &Machine,
+        overrides: &[(String, f64)],
+        layout: Layout,
+    ) -> Result<Measurements, MeasurementsError> {
+        let file = path.display().to_string();
+        let bytes = crate::load::read_file(path, &file, MAX_MEASUREMENT_BYTES)
+            .map_err(MeasurementsError)?;
+        let text = crate::load::decode(&bytes, &file).map_err(MeasurementsError)?;
+        Measurements::parse(text, &file, machine, overrides, layout)
+    }
+
+    /// [`Measurements::read`] over CSV text named `file`.
+    #[cfg(feature = "csv")]
+    pub fn parse(
+        text: &str,
+        file: &str,
+        machine: &Machine,
+        overrides: &[(String, f64)],
+        layout: Layout,
+    ) -> Result<Measurements, MeasurementsError> {
+        let csv = crate::values::csv::CsvFile::parse(text, file).map_err(MeasurementsError)?;
+        let fail = |problems: Vec<(Origin, Problem)>| {
+            MeasurementsError(
+                Diagnostics::located(file, text, problems).expect("at least one problem"),
+            )
+        };
+        let columns = classify(
+            machine,
+            overrides,
+            layout,
+            &csv.header,
+            &csv.header_origin(),
+        )
+        .map_err(fail)?;
+        let mut problems = Vec::new();
+        let mut rows = Vec::with_capacity(csv.rows.len());
+        for cells in &csv.rows {
+            match columns.record(cells) {
+                Ok(row) => rows.push(row),
+                Err(p) => problems.push(*p),
+            }
+            if problems.len() >= 20 {
+                break;
+            }
+        }
+        if !problems.is_empty() {
+            return Err(fail(problems));
+        }
+        if rows.is_empty() {
+            let what = match layout {
+                Layout::Measurements => "measurement",
+                Layout::Candidates => "candidate pose",
+            };
+            let empty = Message::new(
+                format!("the file has a header but no {what} row"),
+                "no rows",
+                "chain::measurements::no_rows",
+            )
+            .help("each row after the header is one measurement");
+            return Err(fail(vec![(csv.header_origin(), empty.into())]));
+        }
+        Ok(Measurements {
+            file: file.to_string(),
+            machine: machine.name.clone(),
+            weighted: columns.std.is_some(),
+            rows,
+        })
+    }
+}
+
+/// Where each quantity is in a CSV's columns.
+#[cfg(feature = "csv")]
+struct Columns {
+    /// Per variable, its column.
+    q: Vec<usize>,
+    /// Per parameter, its column or its fixed value.
+    p: Vec<Result<usize, f64>>,
+    /// The measured value columns (3 for `dp*`, 1 for `d`, none).
+    values: Vec<usize>,
+    /// The direction columns, if any.
+    u: Option<[usize; 3]>,
+    std: Option<usize>,
+}
+
+#[cfg(feature = "csv")]
+fn located(origin: &Origin, text: String, label: &'static str, code: &'static str) -> Located {
+    Box::new((origin.clone(), Message::new(text, label, code).into()))
+}
+
+/// A located problem of a CSV cell or header.
+#[cfg(feature = "csv")]
+type Located = Box<(Origin, Problem)>;
+
+/// Classifies the header's columns.
+#[cfg(feature = "csv")]
+fn classify(
+    m: &Machine,
+    overrides: &[(String, f64)],
+    layout: Layout,
+    header: &[(String, Origin)],
+    header_origin: &Origin,
+) -> Result<Columns, Vec<(Origin, Problem)>> {
+    let mut problems = Vec::new();
+    let find = |name: &str| header.iter().position(|(h, _)| h == name);
+    let measured: &[&str] = match layout {
+        Layout::Measurements => &["dpx", "dpy", "dpz", "ux", "uy", "uz", "d", "std"],
+        Layout::Candidates => &["ux", "uy", "uz", "std"],
+    };
+    for (name, origin) in header {
+        let known = m.variable_index(name).is_some()
+            || m.parameter_index(name).is_some()
+            || measured.contains(&name.as_str());
+        if !known {
+            let names: Vec<&str> = (m.variables.iter().map(|v| v.name.as_str()))
+                .chain(m.parameters.iter().map(|p| p.name.as_str()))
+                .chain(measured.iter().copied())
+                .collect();
+            let text = format!(
+                "column `{name}` is neither an axis variable, a parameter of machine `{}`, nor a measurement column",
+                m.name
+            );
+            let message = Message::new(
+                text,
+                "unknown column",
+                "chain::measurements::unknown_column",
+            )
+            .suggest(closest(name, names.iter().copied()))
+            .help(format!(
+                "the columns are the axis variables ({}), parameters, {}",
+                m.variables
+                    .iter()
+                    .map(|v| v.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                match layout {
+                    Layout::Measurements => "`dpx,dpy,dpz` or `ux,uy,uz,d`, and optionally `std`",
+                    Layout::Candidates => "optionally `ux,uy,uz` and `std`",
+                }
+            ));
+            problems.push((origin.clone(), message.into()));
+        }
+    }
+    let mut q = Vec::new();
+    let missing: Vec<&str> = m
+        .variables
+        .iter()
+        .filter(|v| find(&v.name).is_none())
+        .map(|v| v.name.as_str())
+        .collect();
+    if missing.is_empty() {
+        q = m.variables.iter().filter_map(|v| find(&v.name)).collect();
+    } else {
+        problems.push(*located(
+            header_origin,
+            format!(
+                "the header has no column for the axis variable{} {}: every row needs the whole pose",
+                if missing.len() == 1 { "" } else { "s" },
+                missing.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+            ),
+            "missing pose column",
+            "chain::measurements::missing_pose",
+        ));
+    }
+    let mut p = Vec::new();
+    for param in &m.parameters {
+        match find(&param.name) {
+            Some(c) => p.push(Ok(c)),
+            None => {
+                let value = overrides
+                    .iter()
+                    .rev()
+                    .find(|(n, _)| *n == param.name)
+                    .map(|(_, v)| *v)
+                    .or(param.value);
+                match value {
+                    Some(v) => p.push(Err(v)),
+                    None => problems.push(*located(
+                        header_origin,
+                        format!(
+                            "parameter `{}` is symbolic in the machine file and the header has no column for it",
+                            param.name
+                        ),
+                        "missing parameter",
+                        "chain::measurements::missing_parameter",
+                    )),
+                }
+            }
+        }
+    }
+    let dp: Vec<Option<usize>> = POINT_COLUMNS.iter().map(|c| find(c)).collect();
+    let u: Vec<Option<usize>> = DIRECTION_COLUMNS.iter().map(|c| find(c)).collect();
+    let d = find(DISTANCE_COLUMN);
+    let set = |cols: &[Option<usize>]| cols.iter().all(Option::is_some);
+    let any = |cols: &[Option<usize>]| cols.iter().any(Option::is_some);
+    let mut values = Vec::new();
+    let mut direction = None;
+    let partial = |names: &str| {
+        located(
+            header_origin,
+            format!("the header has only some of `{names}`: give all of them"),
+            "partial columns",
+            "chain::measurements::partial_columns",
+        )
+    };
+    match layout {
+        Layout::Measurements => {
+            let point = any(&dp);
+            let along = any(&u) || d.is_some();
+            if point && along {
+                problems.push(*located(
+                    header_origin,
+                    "the header has both `dpx,dpy,dpz` and `ux,uy,uz,d`: a file holds one kind of measurement".into(),
+                    "two kinds",
+                    "chain::measurements::two_kinds",
+                ));
+            } else if point {
+                if set(&dp) {
+                    values = dp.iter().flatten().copied().collect();
+                } else {
+                    problems.push(*partial("dpx,dpy,dpz"));
+                }
+            } else if along {
+                if set(&u) && d.is_some() {
+                    values = vec![d.unwrap_or(0)];
+                    direction = Some([u[0].unwrap_or(0), u[1].unwrap_or(0), u[2].unwrap_or(0)]);
+                } else {
+                    problems.push(*partial("ux,uy,uz,d"));
+                }
+            } else if problems.is_empty() {
+                problems.push(*located(
+                    header_origin,
+                    "the header has no measured values: expected `dpx,dpy,dpz` or `ux,uy,uz,d`"
+                        .into(),
+                    "no measured values",
+                    "chain::measurements::no_values",
+                ));
+            }
+        }
+        Layout::Candidates => {
+            if any(&u) {
+                if set(&u) {
+                    direction = Some([u[0].unwrap_or(0), u[1].unwrap_or(0), u[2].unwrap_or(0)]);
+                } else {
+                    problems.push(*partial("ux,uy,uz"));
+                }
+            }
+        }
+    }
+    if problems.is_empty() {
+        Ok(Columns {
+            q,
+            p,
+            values,
+            u: direction,
+            std: find(STD_COLUMN),
+        })
+    } else {
+        Err(problems)
+    }
+}
+
+#[cfg(feature = "csv")]
+impl Columns {
+    /// One data row as a record.
+    fn record(&self, cells: &[(String, Origin)]) -> Result<Measurement, Located> {
+        let number = |c: usize| -> Result<f64, Located> {
+            let (text, origin) = &cells[c];
+            let column = &origin.key;
+            match text.parse::<f64>() {
+                Ok(x) if x.is_finite() => Ok(x),
+                Ok(_) => Err(located(
+                    origin,
+                    format!("`{text}` (column `{column}`) is not finite"),
+                    "not finite",
+                    "chain::measurements::not_finite",
+                )),
+                Err(_) if text.is_empty() => Err(located(
+                    origin,
+                    format!("the cell of column `{column}` is empty"),
+                    "empty",
+                    "chain::measurements::empty_cell",
+                )),
+                Err(_) => Err(located(
+                    origin,
+                    format!("`{text}` (column `{column}`) is not a number"),
+                    "not a number",
+                    "chain::measurements::not_a_number",
+                )),
+            }
+        };
+        let line = cells.first().map_or(0, |(_, o)| o.line);
+        let q = self
+            .q
+            .iter()
+            .map(|&c| number(c))
+            .collect::<Result<Vec<_>, _>>()?;
+        let p = (self.p.iter())
+            .map(|c| match c {
+                Ok(c) => number(*c),
+                Err(v) => Ok(*v),
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let values = self
+            .values
+            .iter()
+            .map(|&c| number(c))
+            .collect::<Result<Vec<_>, _>>()?;
+        let observed = match self.u {
+            None => Observed::Point,
+            Some(cols) => {
+                let u = [number(cols[0])?, number(cols[1])?, number(cols[2])?];
+                let norm = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+                if (norm - 1.0).abs() > UNIT_TOLERANCE {
+                    return Err(located(
+                        &cells[cols[0]].1,
+                        format!("the direction (ux, uy, uz) has length {norm}, not 1"),
+                        "not a unit vector",
+                        "chain::measurements::not_unit",
+                    ));
+                }
+                Observed::Direction {
+                    u: [u[0] / norm, u[1] / norm, u[2] / norm],
+                }
+            }
+        };
+        let std = match self.std {
+            None => None,
+            Some(c) => {
+                let s = number(c)?;
+                if s <= 0.0 {
+                    return Err(located(
+                        &cells[c].1,
+                        format!("the standard deviation must be positive, got {s}"),
+                        "not positive",
+                        "chain::measurements::std_not_positive",
+                    ));
+                }
+                Some(s)
+            }
+        };
+        Ok(Measurement {
+            line,
+            q,
+            p,
+            observed,
+            values,
+            std,
+        })
+    }
+}
+
+/// The design rows of one record at its pose: the position rows of the
+/// model's exact sensitivity `S(q, p)` (`∂(px, py, pz)/∂e`, 3 rows), or
+/// `uᵀ S_p(q, p)` along a direction (1 row). `out` receives
+/// `observed.rows() × N` values row-major, `N` the model's error count;
+/// `scratch` is `6 × N` long. `q` and `p` are in the model's orders.
+///
+/// The model's sensitivity is the design matrix of calibration (spec
+/// section 4): a measured deviation is `S_p · e` plus noise.
+pub fn design_rows<M: ErrorModel + ?Sized>(
+    model: &M,
+    q: &[f64],
+    p: &[f64],
+    observed: &Observed,
+    scratch: &mut [f64],
+    out: &mut [f64],
+) {
+    let n = model.errors().len();
+    model.sensitivity(q, p, scratch);
+    match observed {
+        Observed::Point => out[..3 * n].copy_from_slice(&scratch[..3 * n]),
+        Observed::Direction { u } => {
+            for j in 0..n {
+                out[j] = u[0] * scratch[j] + u[1] * scratch[n + j] + u[2] * scratch[2 * n + j];
+            }
+        }
+    }
+}
+
+/// The design matrix of a set of records, in the model's orders.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Design {
+    /// The error names (columns), the model's order.
+    pub errors: Vec<String>,
+    /// `A`, one row per scalar measurement (row-major, `rows × N`).
+    pub a: nalgebra::DMatrix<f64>,
+    /// The measured values, one per row.
+    pub b: Vec<f64>,
+    /// Each row's standard deviation, if the records have one.
+    pub std: Option<Vec<f64>>,
+    /// Each row's record (index into the records) and component
+    /// (`dpx`, `dpy`, `dpz` or `d`).
+    pub origin: Vec<(usize, &'static str)>,
+}
+
+/// Why a design could not be built from records.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum DesignError {
+    /// The model's variables or parameters are not the machine's.
+    #[error("the model's {what} ({model}) are not the measurements' machine's ({machine})")]
+    Order {
+        /// `variables` or `parameters`.
+        what: &'static str,
+        /// The model's names.
+        model: String,
+        /// The machine's names.
+        machine: String,
+    },
+    /// Some records have a std and others not.
+    #[error("some records have a standard deviation and others not")]
+    MixedStd,
+}
+
+impl Design {
+    /// The design of `records` (in `machine`'s orders) through `model`.
+    /// Candidates (no values) give `b = 0`.
+    pub fn new<M: ErrorModel + ?Sized>(
+        model: &M,
+        machine: &Machine,
+        records: &[Measurement],
+    ) -> Result<Design, DesignError> {
+        let order = |what: &'static str, model: &[&str], machine: Vec<&str>| {
+            if model == machine.as_slice() {
+                Ok(())
+            } else {
+                Err(DesignError::Order {
+                    what,
+                    model: model.join(", "),
+                    machine: machine.join(", "),
+                })
+            }
+        };
+        order(
+            "variables",
+            model.variables(),
+            machine.variables.iter().map(|v| v.name.as_str()).collect(),
+        )?;
+        order(
+            "parameters",
+            model.parameters(),
+            machine.parameters.iter().map(|p| p.name.as_str()).collect(),
+        )?;
+        let weighted = records.first().is_some_and(|r| r.std.is_some());
+        if records.iter().any(|r| r.std.is_some() != weighted) {
+            return Err(DesignError::MixedStd);
+        }
+        let n = model.errors().len();
+        let m: usize = records.iter().map(|r| r.observed.rows()).sum();
+        let mut flat = vec![0.0; m * n];
+        let mut scratch = vec![0.0; 6 * n];
+        let mut b = Vec::with_capacity(m);
+        let mut std = weighted.then(|| Vec::with_capacity(m));
+        let mut origin = Vec::with_capacity(m);
+        let mut at = 0;
+        for (i, r) in records.iter().enumerate() {
+            let k = r.observed.rows();
+            design_rows(
+                model,
+                &r.q,
+                &r.p,
+                &r.observed,
+                &mut scratch,
+                &mut flat[at * n..(at + k) * n],
+            );
+            let names: &[&'static str] = match r.observed {
+                Observed::Point => &["dpx", "dpy", "dpz"],
+                Observed::Direction { .. } => &["d"],
+            };
+            for (c, name) in names.iter().enumerate() {
+                b.push(r.values.get(c).copied().unwrap_or(0.0));
+                if let (Some(s), Some(v)) = (std.as_mut(), r.std) {
+                    s.push(v);
+                }
+                origin.push((i, *name));
+            }
+            at += k;
+        }
+        Ok(Design {
+            errors: model.errors().iter().map(|e| e.to_string()).collect(),
+            a: nalgebra::DMatrix::from_row_slice(m, n, &flat),
+            b,
+            std,
+            origin,
+        })
+    }
+}

@@ -1,0 +1,17 @@
+//! A machine as it is measured: measurement records, their design matrix
+//! and the identification of the error parameters from them
+//! (measured-machines spec, section 4; `docs/identify.md`).
+//!
+//! [`measurements`] reads a measurement (or `chain plan` candidate) CSV
+//! against a [`crate::Machine`] and gives each record's design rows from a
+//! model's exact sensitivity; [`identify`] solves the weighted least-squares
+//! problem (or its Gaussian-prior posterior) through an SVD.
+
+pub mod identify;
+pub mod measurements;
+
+pub use identify::{identify, Identification, IdentifyError, IdentifyOptions};
+pub use measurements::{
+    design_rows, Design, DesignError, Layout, Measurement, Measurements, MeasurementsError,
+    Observed,
+};
