@@ -570,6 +570,22 @@ impl Inputs {
         Inputs::correlated(names, marginals, &pairs)
     }
 
+    /// Which standard coordinates `u_j` a function of `x` depends on, given
+    /// which `x_j` it depends on: the same for independent inputs; in the
+    /// correlated block `u_{m_c}` moves `x_{m_i}` for every `i ≥ c`
+    /// (`L` is lower triangular).
+    pub fn standard_dependence(&self, x_depends: &[bool]) -> Vec<bool> {
+        let mut out = x_depends.to_vec();
+        if let Some(b) = &self.correlation {
+            let k = b.members.len();
+            for c in 0..k {
+                let any = (c..k).any(|i| x_depends[b.members[i]] && b.factor[i * k + c] != 0.0);
+                out[b.members[c]] = any;
+            }
+        }
+        out
+    }
+
     /// `x = T(u)`.
     #[inline]
     pub fn to_physical(&self, u: &[f64], x: &mut [f64]) {
