@@ -233,10 +233,7 @@ fn sampling_agrees_with_the_closed_form() {
         "z=1400",
     ];
     let run = |method: &str, samples: &str| {
-        let mut args = vec!["reliability", &*machine_path()]
-            .iter()
-            .map(|s| s.to_string())
-            .collect::<Vec<_>>();
+        let mut args = vec!["reliability".to_string(), machine_path()];
         args.extend(
             [
                 "--values",
@@ -258,7 +255,6 @@ fn sampling_agrees_with_the_closed_form() {
     };
     let mc = run("mc", "400000");
     let is = run("is", "2000");
-    let mut worst = 0.0f64;
     for (cm, ci) in mc["results"]
         .as_array()
         .unwrap()
@@ -283,7 +279,6 @@ fn sampling_agrees_with_the_closed_form() {
             "{} at {q:?}: MC {got} ± {se} vs {pf}",
             cm["component"]
         );
-        worst = worst.max((got - pf).abs() / se.max(1e-300));
         // The importance sampling on an affine limit state in normal inputs
         // (correlated or not) has zero variance: the closed form.
         assert!(
@@ -292,7 +287,6 @@ fn sampling_agrees_with_the_closed_form() {
             ci["pf"]
         );
     }
-    assert!(worst.is_finite());
 }
 
 #[test]
