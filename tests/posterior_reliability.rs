@@ -572,3 +572,97 @@ fn nominal_sizes_and_files_keep_their_kinds() {
     ]);
     assert!(doc.is_object());
 }
+
+/// A tolerance limit state that hides its affine view, so that FORM iterates
+/// (HL-RF through the correlated Jacobian), the importance sampling scans
+/// its lines and Monte Carlo samples `x = T(u)`: the general routes.
+struct Hidden(reliability::ToleranceLimitState);
+
+impl reliability::LimitState for Hidden {
+    fn dim(&self) -> usize {
+        self.0.dim()
+    }
+    fn branch(&self, b: usize, x: &[f64], gradient: Option<&mut [f64]>) -> f64 {
+        self.0.branch(b, x, gradient)
+    }
+    fn depends_on(&self, j: usize) -> bool {
+        self.0.depends_on(j)
+    }
+}
+
+#[test]
+fn the_general_routes_meet_the_closed_form_with_correlated_inputs() {
+    use reliability::{
+        sensitivity, Event, Form, ImportanceSampling, MonteCarlo, Posterior, SensitivityMethod,
+        ToleranceLimitState,
+    };
+    let m = load_example(MACHINE);
+    let law = Law::of(&m);
+    let dir = scratch("general");
+    let posterior = Posterior::read(&write(&dir, "p.yaml", POSTERIOR), &m).unwrap();
+    let inputs = posterior.inputs(&m).unwrap();
+    assert_eq!(inputs.correlations().len(), 3);
+    for (q, c) in [
+        ([1000.0, 1400.0, -1500.0], 0),
+        ([250.0, 800.0, 750.0], 1),
+        ([750.0, 1000.0, 0.0], 2),
+    ] {
+        let a = row(&m, &q, c);
+        let (want, beta) = law.reliability(&a);
+        let ls =
+            ToleranceLimitState::component(a.clone(), I, chain_core::model::Sided::Upper).unwrap();
+        let event = Event::new(&inputs, Hidden(ls)).unwrap();
+        let form = Form::default().run(&event).unwrap();
+        assert!(!form.exact && form.branches[0].iterations > 0);
+        assert!(
+            close(form.beta, beta, 1e-9),
+            "HL-RF β {} vs {beta}",
+            form.beta
+        );
+        assert!(close(1.0 - form.reliability, 1.0 - want, 1e-8));
+        let is = ImportanceSampling {
+            samples: 400,
+            seed: 5,
+            form: Form::default(),
+        }
+        .run(&event)
+        .unwrap();
+        assert!(
+            close(is.pf, 1.0 - want, 1e-8),
+            "IS {} vs {}",
+            is.pf,
+            1.0 - want
+        );
+        let mc = MonteCarlo {
+            samples: 200_000,
+            seed: 9,
+        }
+        .run(&event)
+        .unwrap();
+        assert!(
+            (mc.pf - (1.0 - want)).abs() <= 4.0 * mc.std_error + 1e-12,
+            "MC {} ± {} vs {}",
+            mc.pf,
+            mc.std_error,
+            1.0 - want
+        );
+        // The FORM-route sensitivities equal the exact ones on a linear g.
+        let s = sensitivity(&event, &form).unwrap();
+        assert_eq!(s.method, SensitivityMethod::Form);
+        let sd = law.variance(&a).sqrt();
+        let phi = (-0.5 * beta * beta).exp() / (2.0 * std::f64::consts::PI).sqrt();
+        for (j, e) in s.inputs.iter().enumerate() {
+            let dsd = -phi * beta * a[j] * law.weight(&a, j) / (sd * sd);
+            let dmu = -phi * a[j] / sd;
+            let scale = phi / sd * 1e-7;
+            assert!(
+                (e.dr_dstd - dsd).abs() <= 1e-6 * dsd.abs() + scale,
+                "{j}: {} vs {dsd}",
+                e.dr_dstd
+            );
+            assert!((e.dr_dmean - dmu).abs() <= 1e-6 * dmu.abs() + scale, "{j}");
+        }
+        let total: f64 = s.inputs.iter().map(|e| e.importance).sum();
+        assert!((total - 1.0).abs() < 1e-12);
+    }
+}
