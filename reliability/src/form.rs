@@ -7,7 +7,9 @@
 //! - Eq. 21: `β = μ_ZL/σ_ZL`, the distance from the origin to the linearised
 //!   surface; in standard space `β = α·u*` with
 //! - Eq. 22: `α = −∇_u g/|∇_u g|`, the unit normal pointing into failure;
-//!   the importance factors are `α_j²` (they sum to 1);
+//!   the importance factors are `α_j²` (they sum to 1; for correlated
+//!   normal inputs, the squares of Der Kiureghian's importance vector
+//!   `γ = L⁻ᵀα`, normalised: [`Inputs::importance`](crate::Inputs::importance));
 //! - Eq. 31: `R = Φ(β)`, `p_f = Φ(−β)` (computed with `erfc`, see
 //!   [`crate::normal`]).
 //!
@@ -125,7 +127,8 @@ pub struct FormResult {
     pub design_point_x: Vec<f64>,
     /// `α = −∇_u g/|∇_u g|` at `u*` (Eq. 22), pointing into failure.
     pub alpha: Vec<f64>,
-    /// Importance factors `α_j²`.
+    /// Importance factors `α_j²` (independent inputs) or `γ_j²` (with
+    /// correlated normals, [`crate::Inputs::importance`]); they sum to 1.
     pub importance: Vec<f64>,
     /// `|∇_u g(u*)|`, the scale of the FORM sensitivities.
     pub gradient_norm: f64,
@@ -217,7 +220,7 @@ impl Form {
             reliability: normal::cdf(*beta),
             design_point_u: u.clone(),
             design_point_x: x,
-            importance: alpha.iter().map(|a| a * a).collect(),
+            importance: event.inputs.importance(alpha),
             alpha: alpha.clone(),
             gradient_norm: *gradient_norm,
             branch: best,
@@ -376,7 +379,6 @@ fn closed_form(a: &[f64], m: f64, tolerance: f64, sign: f64) -> Branch {
 struct Work {
     x: Vec<f64>,
     grad_x: Vec<f64>,
-    jac: Vec<f64>,
     grad_u: Vec<f64>,
 }
 
@@ -385,12 +387,11 @@ impl Work {
         Work {
             x: vec![0.0; n],
             grad_x: vec![0.0; n],
-            jac: vec![0.0; n],
             grad_u: vec![0.0; n],
         }
     }
 
-    /// `g_b(T(u))` and `∇_u g_b = ∇_x g_b ∘ dx/du` (into `grad_u`).
+    /// `g_b(T(u))` and `∇_u g_b = (∂x/∂u)ᵀ·∇_x g_b` (into `grad_u`).
     fn eval<L: LimitState>(
         &mut self,
         event: &Event<'_, L>,
@@ -399,13 +400,10 @@ impl Work {
         calls: &mut Calls,
     ) -> f64 {
         event.inputs.to_physical(u, &mut self.x);
-        event.inputs.jacobian(u, &mut self.jac);
         let g = event.limit_state.branch(b, &self.x, Some(&mut self.grad_x));
         calls.values += 1;
         calls.gradients += 1;
-        for ((gu, gx), j) in self.grad_u.iter_mut().zip(&self.grad_x).zip(&self.jac) {
-            *gu = gx * j;
-        }
+        event.inputs.gradient_u(u, &self.grad_x, &mut self.grad_u);
         g
     }
 }

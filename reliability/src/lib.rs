@@ -55,6 +55,7 @@ pub mod machine;
 pub mod normal;
 mod par;
 pub mod path;
+pub mod posterior;
 pub mod rng;
 pub mod sensitivity;
 pub mod simulation;
@@ -71,6 +72,7 @@ pub use path::{
     Extreme, InstantResult, PathInstant, PathRecord, PathResult, PathStudy, PathTarget, Quantity,
     TargetSummary,
 };
+pub use posterior::{Posterior, PosteriorError};
 pub use sensitivity::{sensitivity, InputSensitivity, SensitivityMethod, SensitivityResult};
 pub use simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult};
 pub use study::{

@@ -524,7 +524,8 @@ impl<'a, L: LimitState> Event<'a, L> {
 
 /// An affine limit state over normal inputs, seen in standard space:
 /// `E_c(u) = m_c + a_c·u` with `m_c = Σ_j S_cj·μ_j` and `a_cj = S_cj·σ_j`
-/// (the `μ_ZL` and `σ_ZL` ingredients of Eq. 21).
+/// (the `μ_ZL` and `σ_ZL` ingredients of Eq. 21); with correlated normal
+/// inputs `a_c = S_cᵀ·D·L`, so `|a_c| = √(S_cᵀΣS_c)` ([`Inputs::project`]).
 #[derive(Debug, Clone)]
 pub struct Affine<'l> {
     /// The limit state's affine view.
@@ -542,11 +543,8 @@ impl<'l> Affine<'l> {
         let mut mean = vec![0.0; k];
         let mut a = vec![0.0; k * n];
         for c in 0..k {
-            for (j, m) in inputs.marginals().iter().enumerate() {
-                let s = ls.row(c)[j];
-                mean[c] += s * m.mean();
-                a[c * n + j] = s * m.std();
-            }
+            // a_c = S_cᵀ·∂x/∂u (S_cj·σ_j for independent inputs).
+            mean[c] = inputs.project(ls.row(c), &mut a[c * n..(c + 1) * n]);
         }
         Affine { view: ls, mean, a }
     }

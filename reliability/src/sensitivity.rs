@@ -14,6 +14,12 @@
 //! two-sided tolerance in normal inputs also has an exact closed form,
 //! `R = Φ((I − m)/s) − Φ((−I − m)/s)`, differentiated the same way.
 //!
+//! With correlated normal inputs (`x_B = μ_B + D_B·L·u_B`) the derivatives
+//! are taken with the correlation matrix `R` held fixed: `σ_ZL² = SᵀD R D S`
+//! gives `∂σ_ZL/∂σ_j = S_j·(R D S)_j/σ_ZL`, and at fixed `u`
+//! `∂x_j/∂σ_j = (L·u_B)_j` ([`crate::Inputs::dx_dstd`]). The importance
+//! factors are then Der Kiureghian's `γ_j²` ([`crate::Inputs::importance`]).
+//!
 //! Otherwise ([`SensitivityMethod::Form`]) the derivative of the FORM index
 //! at the design point `u*` of the nearest branch is used:
 //! `∂β/∂θ = (∂g(T(u*; θ))/∂θ) / |∇_u g(u*)|`, and `∂R/∂θ = φ(β)·∂β/∂θ`.
@@ -131,12 +137,15 @@ pub fn sensitivity<L: LimitState>(
                 };
                 let inputs = (0..n)
                     .map(|j| InputSensitivity {
-                        // ∂m/∂μ_j = S_j; ∂s/∂σ_j = S_j²σ_j/s.
+                        // ∂m/∂μ_j = S_j; ∂s/∂σ_j = S_j²σ_j/s, and with
+                        // correlated normals (R fixed) S_j·(R·D·S)_j/s.
                         dr_dmean: dr_dm * row[j],
-                        dr_dstd: if s > 0.0 {
-                            dr_ds * row[j] * row[j] * stds[j] / s
-                        } else {
+                        dr_dstd: if s <= 0.0 {
                             0.0
+                        } else if event.inputs.is_correlated(j) {
+                            dr_ds * row[j] * event.inputs.covariance_weight(row, j) / s
+                        } else {
+                            dr_ds * row[j] * row[j] * stds[j] / s
                         },
                         importance: importance(j),
                     })
@@ -164,18 +173,16 @@ pub fn sensitivity<L: LimitState>(
     } else {
         0.0
     };
+    let u = &form.design_point_u;
     let inputs = event
         .inputs
         .marginals()
         .iter()
         .enumerate()
-        .map(|(j, m)| {
-            let u = form.design_point_u[j];
-            InputSensitivity {
-                dr_dmean: scale * grad[j] * m.dx_dmean(u),
-                dr_dstd: scale * grad[j] * m.dx_dstd(u),
-                importance: importance(j),
-            }
+        .map(|(j, m)| InputSensitivity {
+            dr_dmean: scale * grad[j] * m.dx_dmean(u[j]),
+            dr_dstd: scale * grad[j] * event.inputs.dx_dstd(j, u),
+            importance: importance(j),
         })
         .collect();
     Ok(SensitivityResult {

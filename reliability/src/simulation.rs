@@ -417,7 +417,11 @@ impl Kernel {
     fn new<L: LimitState>(event: &Event<'_, L>, form: &FormResult) -> Kernel {
         let n = event.inputs.len();
         let ls = &event.limit_state;
-        let active: Vec<usize> = (0..n).filter(|&j| ls.depends_on(j)).collect();
+        // The standard coordinates g depends on (with correlated inputs,
+        // u_j moves every later member of the block, not x_j only).
+        let depends: Vec<bool> = (0..n).map(|j| ls.depends_on(j)).collect();
+        let depends = event.inputs.standard_dependence(&depends);
+        let active: Vec<usize> = (0..n).filter(|&j| depends[j]).collect();
         if form.termination == Termination::Degenerate
             || active.is_empty()
             || !form.beta.is_finite()

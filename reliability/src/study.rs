@@ -382,8 +382,9 @@ pub struct TargetSensitivity {
 }
 
 /// The first two moments of the six error components at one point,
-/// propagated exactly through the linear model `E = S(q)·e` with independent
-/// inputs of means `μ_j` and standard deviations `σ_j` (any marginals).
+/// propagated exactly through the linear model `E = S(q)·e` with inputs of
+/// means `μ_j` and standard deviations `σ_j` (any marginals), independent
+/// or with correlated normals (`Cov(E_a, E_b) = S_aᵀΣS_b`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ErrorMoments {
     /// `E[E_c] = Σ_j S_cj·μ_j`, in `px, py, pz, ox, oy, oz` order.
@@ -693,6 +694,9 @@ impl Study {
     /// The mean and covariance of the six error components at point `p`
     /// (exact linear propagation of the inputs' means and variances).
     pub fn moments(&self, p: usize) -> ErrorMoments {
+        if !self.inputs.correlations().is_empty() {
+            return self.correlated_moments(p);
+        }
         let means = self.inputs.means();
         let vars: Vec<f64> = self.inputs.stds().iter().map(|s| s * s).collect();
         let mut mean = [0.0; 6];
@@ -708,6 +712,21 @@ impl Study {
                     .zip(&vars)
                     .map(|((x, y), v)| x * y * v)
                     .sum();
+            }
+        }
+        ErrorMoments { mean, covariance }
+    }
+
+    /// [`Study::moments`] with correlated inputs: `Cov(E_a, E_b) = S_aᵀΣS_b`.
+    fn correlated_moments(&self, p: usize) -> ErrorMoments {
+        let means = self.inputs.means();
+        let mut mean = [0.0; 6];
+        let mut covariance = [[0.0; 6]; 6];
+        for a in Component::ALL {
+            let ra = self.row(p, a);
+            mean[a.index()] = ra.iter().zip(means).map(|(s, m)| s * m).sum();
+            for b in Component::ALL {
+                covariance[a.index()][b.index()] = self.inputs.covariance(ra, self.row(p, b));
             }
         }
         ErrorMoments { mean, covariance }
@@ -1024,16 +1043,15 @@ fn checked_inputs<M: ErrorModel + ?Sized>(
             found: parameters.len(),
         });
     }
-    let mut names = Vec::with_capacity(errors.len());
-    let mut marginals = Vec::with_capacity(errors.len());
-    for e in errors {
-        let j = inputs
-            .index(e)
-            .ok_or_else(|| ReliabilityError::MissingInput((*e).to_string()))?;
-        names.push((*e).to_string());
-        marginals.push(inputs.marginals()[j]);
-    }
-    let inputs = Inputs::new(names, marginals)?;
+    let order = errors
+        .iter()
+        .map(|e| {
+            inputs
+                .index(e)
+                .ok_or_else(|| ReliabilityError::MissingInput((*e).to_string()))
+        })
+        .collect::<Result<Vec<usize>, _>>()?;
+    let inputs = inputs.select(&order)?;
     let variables = model.variables().iter().map(|v| v.to_string()).collect();
     Ok((inputs, variables))
 }

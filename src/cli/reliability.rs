@@ -1,5 +1,10 @@
-//! `chain reliability FILE [--method form|is|mc] [--samples N] [--seed S]
-//! [--format table|json|csv] [--plot DIR]`.
+//! `chain reliability FILE [--values VALUES.yaml] [--method form|is|mc]
+//! [--samples N] [--seed S] [--format table|json|csv] [--plot DIR]`.
+//!
+//! With `--values` the inputs are the posterior of a calibration
+//! (`docs/posterior.md`, [`reliability::Posterior`]): the values file's
+//! constants as means, their `std` and `correlation` as a correlated normal,
+//! the `statistics` section for the errors the file does not give.
 //!
 //! Machining-accuracy reliability of every listed component (and optionally
 //! a series or volumetric system) over the file's grid, like Tables 2-4 of
@@ -15,8 +20,8 @@ use std::path::{Path, PathBuf};
 use chain_core::model::{Machine, Origin, Sided};
 use miette::{LabeledSpan, MietteDiagnostic, NamedSource};
 use reliability::{
-    machine, Algorithm, Calls, Form, FormCase, ImportanceSampling, Method, MonteCarlo,
-    ReliabilityError, Study, StudyResult, System, Target, Termination,
+    machine, Algorithm, Calls, Form, FormCase, ImportanceSampling, Method, MonteCarlo, Posterior,
+    PosteriorError, ReliabilityError, Study, StudyResult, System, Target, Termination,
 };
 use serde::Serialize;
 
@@ -131,6 +136,11 @@ pub struct ReliabilityArgs {
     pub grid: Vec<(String, Vec<f64>)>,
     #[command(flatten)]
     pub system: SystemArgs,
+    /// A values file with the posterior of a calibration (means, `std` per
+    /// constant, `correlation: [[NAME, NAME, rho], ...]`); errors it does not
+    /// give keep their `statistics` (docs/posterior.md).
+    #[arg(long, value_name = "VALUES.yaml")]
+    pub values: Option<PathBuf>,
 }
 
 /// Runs `chain reliability`.
@@ -138,11 +148,13 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let system = system_of(&loaded.machine, args.system.system, args.system.tolerance)
         .map_err(|e| loaded.report(e))?;
-    let (study, _model) = loaded.study(
+    let posterior = loaded.posterior(args.values.as_deref())?;
+    let (study, _model) = loaded.study_with(
         &args.model.param.params,
         &args.grid,
         args.model.sided,
         system,
+        posterior.as_ref(),
     )?;
     let samples = args.algorithm.method.samples(args.algorithm.samples);
     let bar = if args.algorithm.method == MethodArg::Form {
@@ -172,7 +184,8 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
             eprintln!("wrote {}", f.display());
         }
     }
-    let doc = ReliabilityDoc::new(&loaded.machine.name, &study, &result);
+    let mut doc = ReliabilityDoc::new(&loaded.machine.name, &study, &result);
+    doc.posterior = posterior.as_ref();
     report::emit(&doc, args.format.into())
 }
 
@@ -267,6 +280,32 @@ impl Loaded {
         sided: Option<SidedArg>,
         system: Option<System>,
     ) -> miette::Result<(Study, chain_core::CompiledModel)> {
+        self.study_with(params, grid, sided, system, None)
+    }
+
+    /// The posterior of `--values`, if given (its refusals located in the
+    /// values file).
+    pub(crate) fn posterior(&self, values: Option<&Path>) -> miette::Result<Option<Posterior>> {
+        let Some(path) = values else {
+            return Ok(None);
+        };
+        match Posterior::read(path, &self.machine) {
+            Ok(p) => Ok(Some(p)),
+            Err(PosteriorError::Reliability(e)) => Err(self.report(e)),
+            Err(e) => Err(e.into()),
+        }
+    }
+
+    /// [`Loaded::study`] with the inputs of a posterior (`None`: the
+    /// `statistics` section).
+    pub(crate) fn study_with(
+        &self,
+        params: &[(String, f64)],
+        grid: &[(String, Vec<f64>)],
+        sided: Option<SidedArg>,
+        system: Option<System>,
+        posterior: Option<&Posterior>,
+    ) -> miette::Result<(Study, chain_core::CompiledModel)> {
         let m = &self.machine;
         let mut spec = machine::spec(m, system).map_err(|e| self.report(e))?;
         if let Some(s) = sided {
@@ -285,7 +324,13 @@ impl Loaded {
                 None => spec.grid.axes.push((name.clone(), values.clone())),
             }
         }
-        let inputs = machine::inputs(m).map_err(|e| self.report(e))?;
+        let inputs = match posterior {
+            None => machine::inputs(m).map_err(|e| self.report(e))?,
+            Some(p) => p.inputs(m).map_err(|e| match e {
+                PosteriorError::Reliability(e) => self.report(e),
+                other => other.into(),
+            })?,
+        };
         let values = machine::parameters(m, params).map_err(|e| self.report(e))?;
         let model = chain_core::compile(m);
         let study = Study::new(&model, &values, inputs, spec).map_err(|e| self.report(e))?;
@@ -465,6 +510,9 @@ pub(crate) struct ReliabilityDoc<'a> {
     summary: Pairs<Target, SummaryDoc>,
     #[serde(skip_serializing_if = "Option::is_none")]
     requirement: Option<RequirementDoc>,
+    /// The posterior of `--values`, when given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(crate) posterior: Option<&'a Posterior>,
     #[serde(skip)]
     study: &'a Study,
     #[serde(skip)]
@@ -570,6 +618,7 @@ impl<'a> ReliabilityDoc<'a> {
             results,
             summary,
             requirement: RequirementDoc::of(r),
+            posterior: None,
             study,
             result: r,
         }
@@ -578,7 +627,11 @@ impl<'a> ReliabilityDoc<'a> {
 
 impl Report for ReliabilityDoc<'_> {
     fn table(&self) -> String {
-        to_table(self.machine, self.study, self.result)
+        let table = to_table(self.machine, self.study, self.result);
+        match self.posterior {
+            None => table,
+            Some(p) => format!("{}{table}", posterior_lines(p)),
+        }
     }
 
     fn csv(&self) -> Option<Csv> {
@@ -627,6 +680,37 @@ impl Report for ReliabilityDoc<'_> {
         }
         Some(csv)
     }
+}
+
+/// The lines saying which inputs come from a posterior (before the table).
+pub(crate) fn posterior_lines(p: &Posterior) -> String {
+    let with_std = p.values.iter().filter(|v| v.std.is_some()).count();
+    let mut out = format!(
+        "posterior: {} ({} errors given, {with_std} with std, {} correlations; the others from `statistics`)\n",
+        p.file.as_deref().unwrap_or("values"),
+        p.values.len(),
+        p.correlations.len()
+    );
+    for v in &p.values {
+        match v.std {
+            Some(s) => out.push_str(&format!(
+                "  {:<12} mean {:>12} std {}\n",
+                v.name,
+                fmt_num(v.mean),
+                fmt_num(s)
+            )),
+            None => out.push_str(&format!(
+                "  {:<12} mean {:>12} (statistics spread)\n",
+                v.name,
+                fmt_num(v.mean)
+            )),
+        }
+    }
+    for c in &p.correlations {
+        out.push_str(&format!("  rho({}, {}) = {}\n", c.a, c.b, fmt_num(c.rho)));
+    }
+    out.push('\n');
+    out
 }
 
 /// Warns on stderr about the cases on which FORM did not converge (their

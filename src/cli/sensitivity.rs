@@ -21,7 +21,9 @@ use std::path::PathBuf;
 
 use chain_core::geometric::{self, Coefficient, GeometricSensitivity, NominalSizes};
 use chain_core::model::Component;
-use reliability::{machine, Form, ReliabilityError, SensitivityMethod, Target, TargetSensitivity};
+use reliability::{
+    machine, Form, Posterior, ReliabilityError, SensitivityMethod, Target, TargetSensitivity,
+};
 use serde::Serialize;
 
 use super::args::ModelArgs;
@@ -65,10 +67,13 @@ pub struct SensitivityArgs {
     /// What to compute.
     #[arg(long, value_enum, default_value = "reliability")]
     pub kind: SensitivityKind,
-    /// Nominal error sizes for `--kind geometric`: `linear=MM,angular=ANGLE[,squareness=ANGLE]`,
+    /// `--kind reliability`: a values file with the posterior of a calibration
+    /// (means, `std`, `correlation`; docs/posterior.md). `--kind geometric`:
+    /// nominal error sizes `linear=MM,angular=ANGLE[,squareness=ANGLE]`,
     /// angles in radians or with a `deg` suffix (default `linear=0.001,angular=0.001deg`).
-    #[arg(long, value_name = "KIND=VALUE,...", value_parser = parse_values)]
-    pub values: Option<NominalSizes>,
+    /// An argument with `=` is nominal sizes, any other a values file.
+    #[arg(long, value_name = "VALUES.yaml | KIND=VALUE,...", value_parser = parse_values)]
+    pub values: Option<ValuesArg>,
     /// Replace the grid values of one axis for the grid mean, `VAR=v1,v2,...` (repeatable).
     #[arg(long = "grid", value_name = "VAR=V1,V2,...", value_parser = parse_axis)]
     pub grid: Vec<(String, Vec<f64>)>,
@@ -79,9 +84,22 @@ pub struct SensitivityArgs {
     pub plot: Option<PathBuf>,
 }
 
-/// Parses `--values`.
-fn parse_values(s: &str) -> Result<NominalSizes, String> {
-    NominalSizes::default().parse(s)
+/// What `--values` gives.
+#[derive(Debug, Clone)]
+pub enum ValuesArg {
+    /// Nominal error sizes (`--kind geometric`).
+    Nominal(NominalSizes),
+    /// A values file: the posterior (`--kind reliability`).
+    File(PathBuf),
+}
+
+/// Parses `--values`: nominal sizes when it has a `=`, a values file otherwise.
+fn parse_values(s: &str) -> Result<ValuesArg, String> {
+    if s.contains('=') {
+        NominalSizes::default().parse(s).map(ValuesArg::Nominal)
+    } else {
+        Ok(ValuesArg::File(PathBuf::from(s)))
+    }
 }
 
 /// The coordinates of `--at`, `(variable, value)` in the order given.
@@ -102,15 +120,25 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
     if args.kind == SensitivityKind::Geometric {
         return exec_geometric(args);
     }
-    if args.values.is_some() {
-        return Err(miette::miette!(
-            help = "add --kind geometric",
-            "--values applies only to --kind geometric"
-        ));
-    }
+    let file = match &args.values {
+        Some(ValuesArg::Nominal(_)) => {
+            return Err(miette::miette!(
+                help = "add --kind geometric, or give a values file for the posterior",
+                "--values applies only to --kind geometric when it gives nominal sizes (KIND=VALUE)"
+            ))
+        }
+        Some(ValuesArg::File(f)) => Some(f.as_path()),
+        None => None,
+    };
     let loaded = Loaded::new(&args.file)?;
-    let (study, model) =
-        loaded.study(&args.model.param.params, &args.grid, args.model.sided, None)?;
+    let posterior = loaded.posterior(file)?;
+    let (study, model) = loaded.study_with(
+        &args.model.param.params,
+        &args.grid,
+        args.model.sided,
+        None,
+        posterior.as_ref(),
+    )?;
     let form = Form::default();
     let (at, result) = match &args.at {
         None => (
@@ -155,7 +183,8 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
             eprintln!("wrote {}", f.display());
         }
     }
-    let doc = SensitivityDoc::new(&loaded.machine.name, at, &result);
+    let mut doc = SensitivityDoc::new(&loaded.machine.name, at, &result);
+    doc.posterior = posterior.as_ref();
     report::emit(&doc, args.format.into())
 }
 
@@ -180,6 +209,9 @@ struct SensitivityDoc<'a> {
     at: Option<Pairs<String, f64>>,
     methods: Pairs<Target, SensitivityMethod>,
     components: Pairs<Target, Vec<ErrorDoc<'a>>>,
+    /// The posterior of `--values`, when given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    posterior: Option<&'a Posterior>,
     #[serde(skip)]
     result: &'a [TargetSensitivity],
 }
@@ -225,6 +257,7 @@ impl<'a> SensitivityDoc<'a> {
             at: at.map(Pairs),
             methods: Pairs(result.iter().map(|t| (t.target, t.method)).collect()),
             components: Pairs(result.iter().map(|t| (t.target, errors(t))).collect()),
+            posterior: None,
             result,
         }
     }
@@ -243,6 +276,15 @@ impl Report for SensitivityDoc<'_> {
             "{}: reliability sensitivity (Eq. 32-33), {where_}",
             self.machine
         );
+        if let Some(p) = self.posterior {
+            let _ = write!(out, "{}", super::reliability::posterior_lines(p));
+            if !p.correlations.is_empty() {
+                let _ = writeln!(
+                    out,
+                    "dR/dstd with the correlations held fixed; importance: Der Kiureghian's gamma^2 (docs/posterior.md)"
+                );
+            }
+        }
         for t in self.result {
             let _ = writeln!(
                 out,
@@ -322,7 +364,17 @@ fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {
     let m = &loaded.machine;
     let params = machine::parameters(m, &args.model.param.params).map_err(|e| loaded.report(e))?;
     let model = chain_core::compile(m);
-    let nominal = args.values.unwrap_or_default();
+    let nominal = match args.values {
+        None => NominalSizes::default(),
+        Some(ValuesArg::Nominal(n)) => n,
+        Some(ValuesArg::File(f)) => {
+            return Err(miette::miette!(
+                help = "give nominal sizes, e.g. --values linear=0.001,angular=0.001deg, or use --kind reliability for a posterior",
+                "--values {}: a values file applies to --kind reliability (the posterior of a calibration)",
+                f.display()
+            ))
+        }
+    };
     let sizes = nominal.of(m);
     let vars: Vec<&str> = m.variables.iter().map(|v| v.name.as_str()).collect();
     let (where_, result) = match &args.at {

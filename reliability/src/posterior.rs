@@ -1,0 +1,451 @@
+//! The posterior of a calibration as reliability inputs (`docs/posterior.md`;
+//! issue 13, point 2).
+//!
+//! A values file (measured-machines spec, section 2) read by
+//! [`chain_core::values::Values`], plus the two extras the spec lets
+//! `chain identify --values-out` write and other readers ignore: a `std` per
+//! constant, and a `correlation` list of triples
+//!
+//! ```yaml
+//! machine: gantry_grinder
+//! values:
+//!   dxx: {value: 0.0012, std: 0.0001}
+//!   dxz: {value: -0.0004, std: 0.00008}
+//!   eyx: 2.0e-6                          # a mean only: the statistics spread kept
+//! correlation:
+//!   - [dxx, dxz, -0.45]                  # [NAME, NAME, ρ], ρ in (−1, 1)
+//! ```
+//!
+//! The inputs of a study ([`Posterior::inputs`]), error by error in the
+//! machine's order:
+//!
+//! - a constant with `std`: normal with the value as mean and that std;
+//! - a constant without `std`: the `statistics` marginal of the error, same
+//!   family and spread, its mean moved to the value;
+//! - an error the file does not give: its `statistics` marginal, unchanged;
+//! - the errors named in `correlation` (each with a `std` in the file) form
+//!   one correlated normal block, `x_B = μ_B + D_B·L·u_B` with `L` the
+//!   Cholesky factor of the correlation matrix ([`crate::Inputs::correlated`]);
+//!   pairs not listed are uncorrelated; every other input independent.
+//!
+//! Refused, located in the values file (file, line, column, key; codes
+//! `chain::posterior::*`): a table (an error motion varies along its axis,
+//! a posterior mean is a constant), a `std` of 0, a correlation entry that
+//! is not `[NAME, NAME, ρ]`, an unknown name (with the closest), a name with
+//! no `std` in the file, a name paired with itself, a pair given twice,
+//! `|ρ| ≥ 1` or a non-finite `ρ`, and a correlation matrix that is not
+//! positive definite (at `correlation`, naming the errors and the smallest
+//! eigenvalue). Everything the values file itself refuses is refused first
+//! ([`PosteriorError::Values`]).
+
+use std::path::Path;
+
+use chain_core::diagnostic::{closest, Message, Problem};
+use chain_core::model::{Distribution, Machine, Origin};
+use chain_core::values::{EntryKind, Given, Values, ValuesError};
+use chain_core::yaml::{self, Node};
+use chain_core::Diagnostics;
+use serde::Serialize;
+
+use crate::error::ReliabilityError;
+use crate::inputs::{Correlation, Inputs, Marginal};
+
+/// Why a posterior could not be read or used.
+#[derive(Debug, thiserror::Error)]
+#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
+pub enum PosteriorError {
+    /// The values file itself is refused (its own rules, spec section 2).
+    #[error(transparent)]
+    #[cfg_attr(feature = "miette", diagnostic(transparent))]
+    Values(ValuesError),
+    /// The posterior's problems, located in the values file.
+    #[error(transparent)]
+    #[cfg_attr(feature = "miette", diagnostic(transparent))]
+    File(Diagnostics),
+    /// The inputs cannot be built (an error without statistics, ...).
+    #[error(transparent)]
+    #[cfg_attr(feature = "miette", diagnostic(transparent))]
+    Reliability(ReliabilityError),
+}
+
+/// One error parameter the posterior gives.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PosteriorValue {
+    /// The error parameter (or coefficient).
+    pub name: String,
+    /// The mean, in the machine's units.
+    pub mean: f64,
+    /// Its standard deviation, if the file gives one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub std: Option<f64>,
+}
+
+/// One correlation coefficient of the posterior.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PosteriorCorrelation {
+    /// The first error.
+    pub a: String,
+    /// The second error.
+    pub b: String,
+    /// `ρ`.
+    pub rho: f64,
+}
+
+/// The posterior of a calibration: means, standard deviations and
+/// correlations of some error parameters (module docs).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Posterior {
+    /// The values file, if read from one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// The errors given, in the file's order.
+    pub values: Vec<PosteriorValue>,
+    /// The correlations, in the file's order.
+    pub correlations: Vec<PosteriorCorrelation>,
+}
+
+/// Codes of the posterior's refusals.
+const CODE_TABLE: &str = "chain::posterior::table";
+const CODE_STD: &str = "chain::posterior::zero_std";
+const CODE_SHAPE: &str = "chain::posterior::correlation_entry";
+const CODE_UNKNOWN: &str = "chain::posterior::unknown_name";
+const CODE_NO_STD: &str = "chain::posterior::no_std";
+const CODE_SELF: &str = "chain::posterior::self_correlation";
+const CODE_TWICE: &str = "chain::posterior::duplicate_pair";
+const CODE_RHO: &str = "chain::posterior::correlation_range";
+const CODE_PD: &str = "chain::posterior::not_positive_definite";
+
+impl Posterior {
+    /// Reads a values file for `machine` as a posterior.
+    pub fn read(path: &Path, machine: &Machine) -> Result<Posterior, PosteriorError> {
+        let values = Values::read(path, machine).map_err(PosteriorError::Values)?;
+        let file = path.display().to_string();
+        // `Values::read` has read and decoded it: it exists and is UTF-8.
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            let m = Message::new(
+                format!("cannot read `{file}`: {e}"),
+                "unreadable",
+                "chain::posterior::read",
+            );
+            PosteriorError::File(Diagnostics::single(
+                file.clone(),
+                "",
+                origin_at(0, ""),
+                m.into(),
+            ))
+        })?;
+        Posterior::from_values(&values, &text, &file, machine)
+    }
+
+    /// The posterior of values-file text named `file` (`base`: the
+    /// directory its tables are relative to).
+    pub fn parse(
+        text: &str,
+        file: &str,
+        base: &Path,
+        machine: &Machine,
+    ) -> Result<Posterior, PosteriorError> {
+        let values = Values::parse(text, file, base, machine).map_err(PosteriorError::Values)?;
+        Posterior::from_values(&values, text, file, machine)
+    }
+
+    /// The posterior of `values` (already read from `text`, named `file`):
+    /// the constants and the `correlation` list.
+    fn from_values(
+        values: &Values,
+        text: &str,
+        file: &str,
+        machine: &Machine,
+    ) -> Result<Posterior, PosteriorError> {
+        let mut problems: Vec<(Origin, Problem)> = Vec::new();
+        let mut given = Vec::new();
+        for e in values.entries() {
+            let origin = e.origin.clone().unwrap_or_else(|| origin_at(0, "values"));
+            match (&e.given, e.kind) {
+                (Given::Constant { value, std }, EntryKind::Error | EntryKind::Coefficient) => {
+                    if *std == Some(0.0) {
+                        let m = Message::new(
+                            format!("`{}` has std 0: a posterior standard deviation must be positive", e.name),
+                            "std 0",
+                            CODE_STD,
+                        )
+                        .help("leave `std` out to keep the statistics spread around the value, or give the identified std");
+                        problems.push((origin, m.into()));
+                    }
+                    given.push(PosteriorValue {
+                        name: e.name.clone(),
+                        mean: *value,
+                        std: *std,
+                    });
+                }
+                _ => {
+                    let m = Message::new(
+                        format!(
+                            "`{}` is a table: reliability takes a posterior of constants (a mean per error parameter or coefficient)",
+                            e.name
+                        ),
+                        "a table",
+                        CODE_TABLE,
+                    )
+                    .help("give the identified constants or function-slot coefficients (`chain identify --values-out` writes them)");
+                    problems.push((origin, m.into()));
+                }
+            }
+        }
+        let parsed = yaml::parse(text);
+        let mut correlations = Vec::new();
+        let node = parsed.root.as_ref().and_then(|r| {
+            r.as_mapping()?
+                .iter()
+                .find(|(k, _)| k.as_str() == Some("correlation"))
+        });
+        if let Some((key, list)) = node {
+            correlations = read_correlation(key, list, &given, machine, &mut problems);
+            if problems.is_empty() {
+                if let Err(m) = positive_definite(&given, &correlations) {
+                    problems.push((key.span.origin("correlation"), m.into()));
+                }
+            }
+        }
+        if let Some(d) = Diagnostics::located(file, text, problems) {
+            return Err(PosteriorError::File(d));
+        }
+        Ok(Posterior {
+            file: Some(file.to_string()),
+            values: given,
+            correlations,
+        })
+    }
+
+    /// The value of error `name`, if the posterior gives it.
+    pub fn value(&self, name: &str) -> Option<&PosteriorValue> {
+        self.values.iter().find(|v| v.name == name)
+    }
+
+    /// The inputs of every error of `machine`, in [`Machine::errors`] order
+    /// (module docs): the posterior where it speaks, the `statistics`
+    /// section elsewhere. An error the posterior gives without `std`, or
+    /// does not give, needs a `statistics` entry
+    /// ([`ReliabilityError::MissingStatistic`]).
+    pub fn inputs(&self, machine: &Machine) -> Result<Inputs, PosteriorError> {
+        let err = PosteriorError::Reliability;
+        let mut names = Vec::with_capacity(machine.errors.len());
+        let mut marginals = Vec::with_capacity(machine.errors.len());
+        for (j, e) in machine.errors.iter().enumerate() {
+            let given = self.value(&e.name);
+            let marginal = match given {
+                Some(PosteriorValue {
+                    mean,
+                    std: Some(std),
+                    ..
+                }) => Marginal::normal(*mean, *std),
+                _ => {
+                    let stat =
+                        machine
+                            .statistic(j)
+                            .ok_or_else(|| ReliabilityError::MissingStatistic {
+                                name: e.name.clone(),
+                                origin: e.origin.clone(),
+                            });
+                    let stat = stat.map_err(err)?;
+                    let prior = match stat.distribution {
+                        Distribution::Normal { mean, std } => Marginal::normal(mean, std),
+                        Distribution::Uniform { min, max } => Marginal::uniform(min, max),
+                    };
+                    match (prior, given) {
+                        (Ok(p), Some(v)) => p.with_moments(v.mean, p.std()),
+                        (p, _) => p,
+                    }
+                }
+            }
+            .map_err(|e2| match e2 {
+                ReliabilityError::InvalidDistribution(msg) => {
+                    ReliabilityError::InvalidDistribution(format!("`{}`: {msg}", e.name))
+                }
+                other => other,
+            })
+            .map_err(err)?;
+            names.push(e.name.clone());
+            marginals.push(marginal);
+        }
+        let index = |n: &str| names.iter().position(|x| x == n);
+        let pairs: Vec<Correlation> = self
+            .correlations
+            .iter()
+            .filter_map(|c| {
+                Some(Correlation {
+                    a: index(&c.a)?,
+                    b: index(&c.b)?,
+                    rho: c.rho,
+                })
+            })
+            .collect();
+        Inputs::correlated(names, marginals, &pairs).map_err(err)
+    }
+}
+
+fn origin_at(offset: usize, key: &str) -> Origin {
+    Origin {
+        offset,
+        len: 0,
+        line: 1,
+        column: 1,
+        key: key.to_string(),
+    }
+}
+
+/// Reads `correlation: [[NAME, NAME, ρ], ...]`, every problem located.
+fn read_correlation(
+    key: &Node,
+    list: &Node,
+    given: &[PosteriorValue],
+    machine: &Machine,
+    problems: &mut Vec<(Origin, Problem)>,
+) -> Vec<PosteriorCorrelation> {
+    let mut out: Vec<PosteriorCorrelation> = Vec::new();
+    if list.is_null() {
+        return out;
+    }
+    let Some(items) = list.as_sequence() else {
+        let m = Message::new(
+            format!(
+                "`correlation` is {}: expected a list of `[NAME, NAME, rho]`",
+                list.describe()
+            ),
+            "not a list",
+            CODE_SHAPE,
+        );
+        problems.push((key.span.origin("correlation"), m.into()));
+        return out;
+    };
+    let names = || machine.errors.iter().map(|e| e.name.as_str());
+    for (i, item) in items.iter().enumerate() {
+        let path = format!("correlation[{i}]");
+        let shape = || {
+            Message::new(
+                format!(
+                    "`{path}` is {}: expected `[NAME, NAME, rho]`",
+                    item.describe()
+                ),
+                "not [NAME, NAME, rho]",
+                CODE_SHAPE,
+            )
+            .help("e.g. `correlation: [[dxx, dxz, -0.45]]`")
+        };
+        let Some([a, b, r]) = item
+            .as_sequence()
+            .and_then(|s| <&[Node; 3]>::try_from(s).ok())
+        else {
+            problems.push((item.span.origin(path.clone()), shape().into()));
+            continue;
+        };
+        let mut ok = true;
+        let mut name_of = |node: &Node, k: usize| -> Option<String> {
+            let p = format!("{path}[{k}]");
+            let Some(n) = node.as_str() else {
+                problems.push((node.span.origin(p), shape().into()));
+                return None;
+            };
+            if !names().any(|x| x == n) {
+                let m = Message::new(format!("unknown name `{n}`"), "unknown name", CODE_UNKNOWN)
+                    .suggest(closest(n, names()))
+                    .help("correlation names the error parameters and coefficients given in `values` with a `std`");
+                problems.push((node.span.origin(p), m.into()));
+                return None;
+            }
+            if !given.iter().any(|v| v.name == n && v.std.is_some()) {
+                let m = Message::new(
+                    format!("`{n}` has no `std` in this values file: a correlation needs the standard deviations of both errors"),
+                    "no std",
+                    CODE_NO_STD,
+                )
+                .help(format!("give it as `{n}: {{value: V, std: S}}` under `values`"));
+                problems.push((node.span.origin(p), m.into()));
+                return None;
+            }
+            Some(n.to_string())
+        };
+        let (na, nb) = (name_of(a, 0), name_of(b, 1));
+        let rho = r
+            .as_scalar()
+            .filter(|_| r.as_sequence().is_none())
+            .and_then(|s| chain_core::expr::parse(&s.text).ok())
+            .and_then(|ast| chain_core::expr::eval_const(&ast).ok());
+        let rpath = format!("{path}[2]");
+        match rho {
+            None => {
+                problems.push((r.span.origin(rpath), shape().into()));
+                ok = false;
+            }
+            Some(v) if !v.is_finite() || v.abs() >= 1.0 => {
+                let m = Message::new(
+                    format!("correlation {v} is out of range: it must be strictly between -1 and 1"),
+                    "out of range",
+                    CODE_RHO,
+                )
+                .help("ρ = ±1 makes one error a copy of the other: drop one of them, or give its std alone");
+                problems.push((r.span.origin(rpath), m.into()));
+                ok = false;
+            }
+            Some(_) => {}
+        }
+        let (Some(na), Some(nb), Some(rho), true) = (na, nb, rho, ok) else {
+            continue;
+        };
+        if na == nb {
+            let m = Message::new(
+                format!("`{na}` is correlated with itself"),
+                "the same name twice",
+                CODE_SELF,
+            )
+            .help("a correlation pairs two different errors (an error's own is 1)");
+            problems.push((item.span.origin(path), m.into()));
+            continue;
+        }
+        if out
+            .iter()
+            .any(|c| (c.a == na && c.b == nb) || (c.a == nb && c.b == na))
+        {
+            let m = Message::new(
+                format!("the correlation of `{na}` and `{nb}` is given twice"),
+                "given before",
+                CODE_TWICE,
+            );
+            problems.push((item.span.origin(path), m.into()));
+            continue;
+        }
+        out.push(PosteriorCorrelation { a: na, b: nb, rho });
+    }
+    out
+}
+
+/// Refuses a correlation matrix that is not positive definite (the
+/// Cholesky factorisation fails), naming its errors and smallest eigenvalue.
+fn positive_definite(
+    given: &[PosteriorValue],
+    correlations: &[PosteriorCorrelation],
+) -> Result<(), Message> {
+    let names: Vec<String> = given.iter().map(|v| v.name.clone()).collect();
+    let marginals = vec![Marginal::normal(0.0, 1.0).expect("unit normal"); names.len()];
+    let index = |n: &str| names.iter().position(|x| x == n).unwrap_or_default();
+    let pairs: Vec<Correlation> = correlations
+        .iter()
+        .map(|c| Correlation {
+            a: index(&c.a),
+            b: index(&c.b),
+            rho: c.rho,
+        })
+        .collect();
+    match Inputs::correlated(names, marginals, &pairs) {
+        Ok(_) => Ok(()),
+        Err(e) => Err(Message::new(
+            match e {
+                ReliabilityError::InvalidDistribution(msg) => msg,
+                other => other.to_string(),
+            },
+            "not positive definite",
+            CODE_PD,
+        )
+        .help("a correlation matrix must be positive definite: a rank-deficient identification (see `unidentifiable`) needs `chain identify --prior`, or correlations that are consistent with each other")),
+    }
+}
