@@ -16,6 +16,7 @@ pub mod input;
 pub mod kinematics;
 mod model_trait;
 pub mod named;
+pub mod plan;
 pub mod symbolic;
 
 // The stages' modules under their historical flat paths (`chain_core::load`,
