@@ -10,6 +10,7 @@ pub mod inverse;
 pub mod map;
 pub mod motion;
 pub mod path;
+pub mod plan;
 pub mod plot;
 pub mod reliability;
 pub mod report;
@@ -44,6 +45,8 @@ enum Command {
     Path(path::PathArgs),
     /// The volumetric error map of a built machine: its error values (a values file) through the model over a grid or a list of points.
     Map(map::MapArgs),
+    /// Where to measure: the D-optimal K of a set of candidate poses, against K taken evenly (greedy + Fedorov exchange).
+    Plan(plan::PlanArgs),
     /// Motion conversion ("Precision Machining Technology of Jewelry on CNC Machine Tool", 2022): CNC axis motions reproducing a cradle-type generator's roll, and their Maclaurin series.
     Motion(motion::MotionArgs),
 }
@@ -60,5 +63,6 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Path(args) => path::exec(args),
         Command::Motion(args) => motion::exec(args),
         Command::Map(args) => map::exec(args),
+        Command::Plan(args) => plan::exec(args),
     }
 }
