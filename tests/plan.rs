@@ -333,3 +333,122 @@ fn library_refusals() {
         })
     ));
 }
+
+// ---------------------------------------------------------------------------
+// The command line.
+
+const GANTRY: &str = "examples/machines/gantry_grinder.yaml";
+
+fn grid_csv() -> String {
+    let mut s = String::from("x,y,z\n");
+    for q in gantry_grid() {
+        s.push_str(&format!("{},{},{}\n", q[0], q[1], q[2]));
+    }
+    s
+}
+
+#[test]
+fn cli_json_is_the_library_plan() {
+    let dir = common::cli::scratch("json");
+    let c = common::cli::write(&dir, "c.csv", &grid_csv());
+    let doc = common::cli::ok_json(&[
+        "plan",
+        GANTRY,
+        "--candidates",
+        c.to_str().unwrap(),
+        "--count",
+        "8",
+        "--format",
+        "json",
+    ]);
+    let m = load_example("gantry_grinder.yaml");
+    let model = chain::core::compile(&m);
+    let design = Design::new(
+        &model,
+        &candidates(&m, &model, &gantry_grid(), &[], None),
+        Kind::Point,
+    )
+    .unwrap();
+    let want = plan::plan(&design, 8).unwrap();
+    assert_eq!(doc["rank"], want.rank);
+    assert_eq!(doc["kind"], "point");
+    let chosen: Vec<usize> = (doc["optimal"]["candidates"].as_array().unwrap().iter())
+        .map(|v| v.as_u64().unwrap() as usize)
+        .collect();
+    assert_eq!(chosen, want.optimal.candidates);
+    // Full factorial corners: the 8 corners of the box are the D-optimal
+    // choice of a model affine in q.
+    for i in chosen {
+        let q = &gantry_grid()[i];
+        assert!(q[0] == 0.0 || q[0] == 1000.0, "{q:?}");
+        assert!(q[1].abs() == 1500.0, "{q:?}");
+        assert!(q[2] == 600.0 || q[2] == 1400.0, "{q:?}");
+    }
+    let table = common::cli::ok_stdout(&[
+        "plan",
+        GANTRY,
+        "--candidates",
+        c.to_str().unwrap(),
+        "--count",
+        "8",
+    ]);
+    assert!(table.contains("rank 8 of 21"), "{table}");
+}
+
+#[test]
+fn cli_bad_input_is_located() {
+    let dir = common::cli::scratch("bad");
+    let run = |name: &str, text: &str, count: &str| {
+        let c = common::cli::write(&dir, name, text);
+        common::cli::unwrapped(&common::cli::fails(&[
+            "plan",
+            GANTRY,
+            "--candidates",
+            c.to_str().unwrap(),
+            "--count",
+            count,
+        ]))
+    };
+    let e = run("unknown.csv", "x,y,z,w\n0,0,600,1\n", "1");
+    assert!(e.contains("unknown.csv:1: column `w`"), "{e}");
+    let e = run("missing.csv", "x,y\n0,0\n", "1");
+    assert!(
+        e.contains("missing.csv:1: no column for axis variable `z`"),
+        "{e}"
+    );
+    let e = run("nan.csv", "x,y,z\n0,0,600\n1,NaN,600\n", "1");
+    assert!(
+        e.contains("nan.csv:3: `NaN` (column `y`) is not finite"),
+        "{e}"
+    );
+    let e = run("word.csv", "x,y,z\n0,zero,600\n", "1");
+    assert!(
+        e.contains("word.csv:2: `zero` (column `y`) is not a number"),
+        "{e}"
+    );
+    let e = run("big.csv", &grid_csv(), "126");
+    assert!(
+        e.contains("--count 126 is not a count of candidates: choose 1 to 125"),
+        "{e}"
+    );
+    let e = run("zero.csv", &grid_csv(), "0");
+    assert!(e.contains("--count 0"), "{e}");
+    let e = run("few.csv", &grid_csv(), "2");
+    assert!(e.contains("fewer than the 8 dimensions"), "{e}");
+    let e = run("measured.csv", "x,y,z,dpx\n0,0,600,1\n", "1");
+    assert!(
+        e.contains("measured.csv:1: column `dpx` is a measured value"),
+        "{e}"
+    );
+    let e = run("dir.csv", "x,y,z,ux,uy,uz\n0,0,600,1,1,0\n", "1");
+    assert!(e.contains("dir.csv:2: the direction"), "{e}");
+    let e = run("ux.csv", "x,y,z,ux\n0,0,600,1\n", "1");
+    assert!(
+        e.contains("ux.csv:1: a direction needs all of `ux,uy,uz`"),
+        "{e}"
+    );
+    let e = run("empty.csv", "", "1");
+    assert!(e.contains("empty.csv:1: the file is empty"), "{e}");
+    let e = run("wide.csv", "x,y,z\n0,0,600\n1,2,3,4\n", "1");
+    assert!(e.contains("wide.csv:3"), "{e}");
+}
