@@ -40,7 +40,8 @@ fn candidates(model: &dyn ErrorModel, p: &[f64], n: usize) -> Vec<Candidate> {
 
 fn bench(c: &mut Criterion) {
     for file in ["gantry_grinder.yaml", "legendre5.yaml"] {
-        let m = chain::core::load_file(format!("examples/machines/{file}")).unwrap();
+        let m = chain::core::load_file(std::path::Path::new(&format!("examples/machines/{file}")))
+            .unwrap();
         let model = chain::core::compile(&m);
         let p: Vec<f64> = m
             .parameters
