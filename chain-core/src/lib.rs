@@ -17,6 +17,7 @@ pub mod kinematics;
 pub mod measured;
 mod model_trait;
 pub mod named;
+pub mod plan;
 pub mod symbolic;
 
 // The stages' modules under their historical flat paths (`chain_core::load`,

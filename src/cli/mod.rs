@@ -11,6 +11,7 @@ pub mod inverse;
 pub mod map;
 pub mod motion;
 pub mod path;
+pub mod plan;
 pub mod plot;
 pub mod reliability;
 pub mod report;
@@ -47,6 +48,8 @@ enum Command {
     Map(map::MapArgs),
     /// Identify the error parameters from measurements (tool-point deviations or deviations along directions): weighted least squares through an SVD, what the data cannot separate, residuals and outliers.
     Identify(identify::IdentifyArgs),
+    /// Where to measure: the D-optimal K of a set of candidate poses, against K taken evenly (greedy + Fedorov exchange).
+    Plan(plan::PlanArgs),
     /// Motion conversion ("Precision Machining Technology of Jewelry on CNC Machine Tool", 2022): CNC axis motions reproducing a cradle-type generator's roll, and their Maclaurin series.
     Motion(motion::MotionArgs),
 }
@@ -64,5 +67,6 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Motion(args) => motion::exec(args),
         Command::Map(args) => map::exec(args),
         Command::Identify(args) => identify::exec(args),
+        Command::Plan(args) => plan::exec(args),
     }
 }

@@ -1,0 +1,65 @@
+//! `chain plan`'s library: K = 50 of 10⁴ candidate poses (issue 13: under
+//! 1 s), on the gantry grinder (21 errors) and the cubic-Legendre 5-axis
+//! machine. Rerun: `cargo bench --offline --bench plan`.
+
+use chain::core::plan::{self, Candidate, Design, Kind};
+use chain::core::ErrorModel;
+use criterion::{criterion_group, criterion_main, Criterion};
+
+fn candidates(model: &dyn ErrorModel, p: &[f64], n: usize) -> Vec<Candidate> {
+    // A deterministic spread (a Weyl sequence) over ±500 mm and ±1 rad.
+    let golden = [
+        0.754_877_666,
+        0.569_840_291,
+        0.430_159_709,
+        0.324_717_957,
+        0.245_122_334,
+        0.185_037_6,
+    ];
+    (0..n)
+        .map(|i| Candidate {
+            q: (0..model.variables().len())
+                .map(|k| {
+                    let t = ((i as f64 + 0.5) * golden[k % 6]).fract() * 2.0 - 1.0;
+                    if model.variables()[k]
+                        .chars()
+                        .next()
+                        .is_some_and(char::is_uppercase)
+                    {
+                        t
+                    } else {
+                        500.0 * t
+                    }
+                })
+                .collect(),
+            p: p.to_vec(),
+            direction: None,
+        })
+        .collect()
+}
+
+fn bench(c: &mut Criterion) {
+    for file in ["gantry_grinder.yaml", "legendre5.yaml"] {
+        let m = chain::core::load_file(std::path::Path::new(&format!("examples/machines/{file}")))
+            .unwrap();
+        let model = chain::core::compile(&m);
+        let p: Vec<f64> = m
+            .parameters
+            .iter()
+            .map(|p| p.value.unwrap_or(0.0))
+            .collect();
+        let cands = candidates(&model, &p, 10_000);
+        let mut g = c.benchmark_group("plan");
+        g.sample_size(10);
+        g.bench_function(format!("{file} K=50 of 10^4 (rows + plan)"), |b| {
+            b.iter(|| {
+                let d = Design::new(&model, &cands, Kind::Point).unwrap();
+                plan::plan(&d, 50).unwrap()
+            })
+        });
+        g.finish();
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
