@@ -16,6 +16,7 @@ use chain::core::measured::identify::Prior;
 use chain::core::measured::{identify, Design, Measurement, Observed};
 use chain::core::values::{Values, ValuesBuilder};
 use chain::core::{ErrorModel, Machine};
+use chain::reliability::Posterior;
 use common::cli::{fails, ok_json, ok_stdout, scratch, unwrapped, write};
 use common::{load_example, Exact, Rng};
 use nalgebra::DMatrix;
@@ -473,11 +474,43 @@ fn values_out_reads_back_and_maps_like_the_estimates() {
             "{last:?} vs {direct:?}"
         );
     }
-    let text = std::fs::read_to_string(&out).unwrap();
-    assert!(
-        text.contains("correlation:") && text.contains("std:"),
-        "{text}"
-    );
+    // The posterior `chain reliability --values` reads from the same file:
+    // each std and each correlation is the library's covariance (to the
+    // 17 digits written), and together they are positive definite.
+    let post = Posterior::read(&out, &m).expect("the posterior reads the written file");
+    let n = lib.errors.len();
+    let sd: Vec<f64> = (0..n).map(|j| lib.covariance[(j, j)].sqrt()).collect();
+    for (j, name) in lib.errors.iter().enumerate() {
+        let v = post.value(name).expect("every unknown is written");
+        assert_eq!(v.mean, lib.estimates.0[j].1.value, "{name}");
+        assert_eq!(v.std, Some(sd[j]), "{name}");
+    }
+    let index = |x: &str| lib.errors.iter().position(|e| e == x).unwrap();
+    let mut seen = vec![vec![false; n]; n];
+    for c in &post.correlations {
+        let (i, j) = (index(&c.a), index(&c.b));
+        let rho = lib.covariance[(i, j)] / (sd[i] * sd[j]);
+        assert!(
+            (c.rho - rho).abs() < 1e-15,
+            "{} {}: {} vs {rho}",
+            c.a,
+            c.b,
+            c.rho
+        );
+        seen[i][j] = true;
+    }
+    for i in 0..n {
+        for j in i + 1..n {
+            assert!(
+                seen[i][j] || lib.covariance[(i, j)] == 0.0,
+                "pair {} {} missing",
+                lib.errors[i],
+                lib.errors[j]
+            );
+        }
+    }
+    post.inputs(&m)
+        .expect("a full-rank posterior is positive definite");
 }
 
 /// A bad measurement CSV: located message, non-zero exit, nothing on stdout.
@@ -595,4 +628,277 @@ fn directions_identify_like_points() {
         assert!((est.value - e[j]).abs() < 4.0 * est.std.unwrap(), "{name}");
     }
     let _ = model.errors();
+}
+
+/// Records as a measurement CSV: the pose by `vars`, the parameters by
+/// `params`, then `dpx,dpy,dpz` or `ux,uy,uz,d`, and `std` when the records
+/// have one (every value in full precision).
+fn records_csv(records: &[Measurement], vars: &[&str], params: &[&str]) -> String {
+    let direction = matches!(records[0].observed, Observed::Direction { .. });
+    let weighted = records[0].std.is_some();
+    let mut head: Vec<&str> = vars.iter().chain(params).copied().collect();
+    head.extend(if direction {
+        &["ux", "uy", "uz", "d"][..]
+    } else {
+        &["dpx", "dpy", "dpz"][..]
+    });
+    if weighted {
+        head.push("std");
+    }
+    let mut csv = head.join(",") + "\n";
+    for r in records {
+        let mut cells: Vec<f64> = r.q.iter().chain(&r.p).copied().collect();
+        if let Observed::Direction { u } = r.observed {
+            cells.extend(u);
+        }
+        cells.extend(&r.values);
+        cells.extend(r.std);
+        let cells: Vec<String> = cells.iter().map(|v| format!("{v:?}")).collect();
+        csv.push_str(&(cells.join(",") + "\n"));
+    }
+    csv
+}
+
+/// Every CLI estimate equals the library's to round-off.
+#[track_caller]
+fn same_estimates(json: &serde_json::Value, lib: &chain::core::measured::Identification) {
+    assert_eq!(json["rank"].as_u64().unwrap() as usize, lib.rank);
+    for (name, est) in &lib.estimates.0 {
+        let value = json["estimates"][name]["value"].as_f64().unwrap();
+        let std = json["estimates"][name]["std"].as_f64().unwrap();
+        let tol = 1e-9 * (est.value.abs() + est.std.unwrap());
+        assert!(
+            (value - est.value).abs() <= tol,
+            "{name}: {value} vs {}",
+            est.value
+        );
+        assert!(
+            (std / est.std.unwrap() - 1.0).abs() < 1e-9,
+            "{name}: std {std} vs {:?}",
+            est.std
+        );
+    }
+}
+
+#[test]
+fn a_planted_outlier_is_flagged_first() {
+    // 120 point records with σ = 1e-3 mm; one component of record 37 is
+    // shifted by 20 σ. Its standardised residual is the largest, above the
+    // limit, and flagged; at most a few of the other 359 rows pass |t| > 3
+    // by chance (expected 360 · 0.0027 ≈ 1).
+    let m = xyz();
+    let model = chain::core::compile(&m);
+    let e: Vec<f64> = m.errors.iter().map(|x| truth(&x.name)).collect();
+    let mut rng = Rng::new(21);
+    let mut records = simulate(&m, &poses(120), &e, 1e-3, &mut rng);
+    records[37].values[1] += 20e-3;
+    let r = identify(&Design::new(&model, &m, &records).unwrap(), None).unwrap();
+    let first = &r.largest_residuals[0];
+    assert_eq!((first.row / 3, first.component), (37, "dpy"), "{first:?}");
+    assert!(
+        first.outlier && first.standardised.abs() > 10.0,
+        "{first:?}"
+    );
+    assert!((1..=4).contains(&r.outliers), "{} flagged", r.outliers);
+    // Without the planted error the same data flag at most a few rows and
+    // none of them is that row.
+    records[37].values[1] -= 20e-3;
+    let clean = identify(&Design::new(&model, &m, &records).unwrap(), None).unwrap();
+    assert!(clean.outliers <= 3, "{} flagged", clean.outliers);
+    assert!(clean
+        .largest_residuals
+        .iter()
+        .all(|s| !(s.outlier && s.row / 3 == 37 && s.component == "dpy")));
+}
+
+#[test]
+fn cli_directions_and_prior_without_std_are_the_library_answer() {
+    let m = xyz();
+    let model = chain::core::compile(&m);
+    let e: Vec<f64> = m.errors.iter().map(|x| truth(&x.name)).collect();
+    let exact = Exact::new(&m);
+    let dir = scratch("cli-directions");
+    let machine = write(&dir, "xyz3.yaml", XYZ);
+    // Directions `ux,uy,uz,d` with a std column (one axis or a face
+    // diagonal per record, written with unit norm).
+    let s2 = 0.5f64.sqrt();
+    let dirs = [
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [s2, 0.0, s2],
+        [0.0, s2, -s2],
+    ];
+    let mut rng = Rng::new(17);
+    let mut records = Vec::new();
+    for (k, (q, p)) in poses(200).into_iter().enumerate() {
+        let u = dirs[k % dirs.len()];
+        let err = exact.exact_error(&q, &p, &e);
+        records.push(Measurement {
+            line: k + 2,
+            q,
+            p,
+            observed: Observed::Direction { u },
+            values: vec![u[0] * err[0] + u[1] * err[1] + u[2] * err[2] + 1e-3 * gauss(&mut rng)],
+            std: Some(1e-3),
+        });
+    }
+    let csv = write(
+        &dir,
+        "d.csv",
+        &records_csv(&records, &["x", "y"], &["tx", "ty", "tz"]),
+    );
+    let args = |file: &std::path::Path, prior: bool| {
+        let mut a = vec![
+            "identify".to_string(),
+            machine.to_str().unwrap().to_string(),
+            "--measurements".to_string(),
+            file.to_str().unwrap().to_string(),
+            "--format".to_string(),
+            "json".to_string(),
+        ];
+        if prior {
+            a.push("--prior".to_string());
+        }
+        a
+    };
+    let run = |a: Vec<String>| ok_json(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let lib = identify(&Design::new(&model, &m, &records).unwrap(), None).unwrap();
+    assert_eq!(lib.rank, 14);
+    let json = run(args(&csv, false));
+    same_estimates(&json, &lib);
+    assert_eq!(json["measurements"].as_u64(), Some(200));
+
+    // `--prior` on points without a std column: the noise is the
+    // least-squares fit's s, the prior the machine file's statistics.
+    let mut rng = Rng::new(19);
+    let mut points = simulate(&m, &poses(40), &e, 2e-3, &mut rng);
+    for r in &mut points {
+        r.std = None;
+    }
+    let csv = write(
+        &dir,
+        "p.csv",
+        &records_csv(&points, &["x", "y"], &["tx", "ty", "tz"]),
+    );
+    let names: Vec<String> = m.errors.iter().map(|x| x.name.clone()).collect();
+    let prior = Prior::from_machine(&m, &names).unwrap();
+    let lib = identify(&Design::new(&model, &m, &points).unwrap(), Some(&prior)).unwrap();
+    let json = run(args(&csv, true));
+    same_estimates(&json, &lib);
+    assert_eq!(json["prior"].as_bool(), Some(true));
+    let scale = lib.residual.scale.unwrap();
+    assert!((scale / 2e-3 - 1.0).abs() < 0.25, "s = {scale}");
+}
+
+#[test]
+fn reliability_after_calibration_reads_the_identified_posterior() {
+    // The whole workflow on the gantry grinder: measure tool-point
+    // deviations (tool point 0, position only: rank deficient), identify,
+    // write the values, run `chain reliability --values`. Without a prior
+    // the covariance is singular and the posterior is refused with a hint;
+    // with `--prior` it is full rank and the reliability runs on it.
+    let m = load_example("gantry_grinder.yaml");
+    let means: Vec<f64> = m
+        .errors
+        .iter()
+        .map(|x| x.name.len() as f64 * 1e-4)
+        .collect();
+    let mut rng = Rng::new(23);
+    let q: Vec<(Vec<f64>, Vec<f64>)> = (0..60)
+        .map(|_| {
+            let q = vec![
+                rng.range(0.0, 1000.0),
+                rng.range(600.0, 1400.0),
+                rng.range(-1500.0, 1500.0),
+            ];
+            (q, vec![])
+        })
+        .collect();
+    let records = simulate(&m, &q, &means, 1e-3, &mut rng);
+    let vars: Vec<&str> = m.variables.iter().map(|v| v.name.as_str()).collect();
+    let dir = scratch("after-calibration");
+    let csv = write(&dir, "g.csv", &records_csv(&records, &vars, &[]));
+    let machine = common::example_path("gantry_grinder.yaml");
+    let identify_to = |out: &std::path::Path, prior: bool| {
+        let mut a = vec![
+            "identify",
+            machine.to_str().unwrap(),
+            "--measurements",
+            csv.to_str().unwrap(),
+            "--format",
+            "json",
+            "--values-out",
+            out.to_str().unwrap(),
+        ];
+        if prior {
+            a.push("--prior");
+        }
+        ok_json(&a)
+    };
+    let ls = dir.join("ls.yaml");
+    let json = identify_to(&ls, false);
+    assert!(json["rank"].as_u64().unwrap() < m.errors.len() as u64);
+    let err = unwrapped(&fails(&[
+        "reliability",
+        machine.to_str().unwrap(),
+        "--values",
+        ls.to_str().unwrap(),
+    ]));
+    assert!(err.contains("--prior"), "{err}");
+
+    let post = dir.join("post.yaml");
+    let json = identify_to(&post, true);
+    assert_eq!(json["prior"].as_bool(), Some(true));
+    let out = ok_json(&[
+        "reliability",
+        machine.to_str().unwrap(),
+        "--values",
+        post.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    let posterior = Posterior::read(&post, &m).unwrap();
+    posterior.inputs(&m).expect("full rank with the prior");
+    // Each case's β is the closed form of the correlated normal posterior:
+    // g = t − a·e (upper-sided, t = 0.03 mm), β = (t − a·μ) / √(aᵀ Σ a),
+    // Σ = D R D from the file's std and correlation triples.
+    let n = m.errors.len();
+    let index = |x: &str| m.errors.iter().position(|e| e.name == x).unwrap();
+    let mu: Vec<f64> = m
+        .errors
+        .iter()
+        .map(|x| posterior.value(&x.name).unwrap().mean)
+        .collect();
+    let sd: Vec<f64> = m
+        .errors
+        .iter()
+        .map(|x| posterior.value(&x.name).unwrap().std.unwrap())
+        .collect();
+    let mut cov = DMatrix::from_fn(n, n, |i, j| if i == j { sd[i] * sd[i] } else { 0.0 });
+    for c in &posterior.correlations {
+        let (i, j) = (index(&c.a), index(&c.b));
+        cov[(i, j)] = c.rho * sd[i] * sd[j];
+        cov[(j, i)] = cov[(i, j)];
+    }
+    let model = chain::core::compile(&m);
+    let results = out["results"].as_array().unwrap();
+    assert_eq!(results.len(), 3 * 125);
+    let mut s = vec![0.0; 6 * n];
+    for r in results {
+        let c = ["px", "py", "pz"]
+            .iter()
+            .position(|c| r["component"] == *c)
+            .unwrap();
+        let q: Vec<f64> = vars
+            .iter()
+            .map(|v| r["point"][*v].as_f64().unwrap())
+            .collect();
+        model.sensitivity(&q, &[], &mut s);
+        let a = nalgebra::DVector::from_column_slice(&s[c * n..(c + 1) * n]);
+        let mean: f64 = (0..n).map(|j| a[j] * mu[j]).sum();
+        let beta = (0.03 - mean) / (a.dot(&(&cov * &a))).sqrt();
+        let got = r["beta"].as_f64().unwrap();
+        assert!((got / beta - 1.0).abs() < 1e-9, "{r}: β {got} vs {beta}");
+    }
 }

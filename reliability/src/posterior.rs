@@ -383,7 +383,7 @@ fn read_correlation(
                     "out of range",
                     CODE_RHO,
                 )
-                .help("ρ = ±1 makes one error a copy of the other: drop one of them, or give its std alone");
+                .help("ρ = ±1 makes one error a copy of the other: drop one of them, or give its std alone; from a rank-deficient `chain identify` (errors that only act together), identify with `--prior`");
                 problems.push((r.span.origin(rpath), m.into()));
                 ok = false;
             }

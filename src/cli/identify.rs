@@ -53,7 +53,8 @@ pub struct IdentifyArgs {
     #[arg(long, value_enum, default_value = "table")]
     pub format: IdentifyFormat,
     /// Write the estimates as a values file (with `std` per constant and a
-    /// `correlation` matrix) that `chain map --values` reads.
+    /// `correlation` list) that `chain map --values` and `chain reliability
+    /// --values` read.
     #[arg(long, value_name = "VALUES.yaml")]
     pub values_out: Option<PathBuf>,
 }
@@ -389,7 +390,8 @@ impl Report for IdentifyDoc {
 }
 
 /// The estimates as a values file (spec section 2, plus `std` per constant
-/// and the `correlation` matrix in the order of `values`).
+/// and the `correlation` list, one `[NAME, NAME, ρ]` per pair with ρ ≠ 0:
+/// the form `chain reliability --values` reads, docs/posterior.md).
 pub(crate) fn values_file(m: &Machine, source: &Path, r: &Identification) -> String {
     let mut s = String::new();
     let _ = writeln!(
@@ -426,26 +428,30 @@ pub(crate) fn values_file(m: &Machine, source: &Path, r: &Identification) -> Str
         }
     }
     if all_std {
-        let _ = writeln!(s, "# rows and columns in the order of `values`");
-        let _ = writeln!(s, "correlation:");
         let n = r.parameters;
         let sd: Vec<f64> = (0..n)
             .map(|j| r.covariance[(j, j)].max(0.0).sqrt())
             .collect();
+        let mut pairs = Vec::new();
         for i in 0..n {
-            let row: Vec<String> = (0..n)
-                .map(|j| {
-                    let c = if i == j {
-                        1.0
-                    } else if sd[i] > 0.0 && sd[j] > 0.0 {
-                        (r.covariance[(i, j)] / (sd[i] * sd[j])).clamp(-1.0, 1.0)
-                    } else {
-                        0.0
-                    };
-                    format!("{c:?}")
-                })
-                .collect();
-            let _ = writeln!(s, "  - [{}]", row.join(", "));
+            for j in i + 1..n {
+                if sd[i] > 0.0 && sd[j] > 0.0 {
+                    let rho = (r.covariance[(i, j)] / (sd[i] * sd[j])).clamp(-1.0, 1.0);
+                    if rho != 0.0 {
+                        pairs.push((i, j, rho));
+                    }
+                }
+            }
+        }
+        if !pairs.is_empty() {
+            let _ = writeln!(
+                s,
+                "# the correlation of each pair of estimates (pairs not listed: exactly 0)"
+            );
+            let _ = writeln!(s, "correlation:");
+            for (i, j, rho) in pairs {
+                let _ = writeln!(s, "  - [{}, {}, {rho:?}]", r.errors[i], r.errors[j]);
+            }
         }
     }
     s
