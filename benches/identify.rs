@@ -10,7 +10,11 @@
 //!   model, build the design and identify (SVD, null space, covariance,
 //!   leverages);
 //! - `identify/design_1e4`, `identify/solve_1e4`: the design matrix and the
-//!   identification alone.
+//!   identification alone;
+//! - the same three with the suffix `_173`: the machine with degree-5
+//!   Legendre series on the linear axes and degree 4 on C (18·6 + 6·4 +
+//!   6·5 + 11 = 173 unknowns, above the 170), the same 10⁴
+//!   measurements.
 
 use std::hint::black_box;
 use std::path::Path;
@@ -24,10 +28,35 @@ fn machine_path() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/machines/legendre5.yaml")
 }
 
+/// The machine file's text: legendre5 as it is (131 unknowns), or with
+/// degree 5 on the linear axes and degree 4 on C (173 unknowns).
+fn machine_text(large: bool) -> String {
+    let text = std::fs::read_to_string(machine_path()).unwrap();
+    if !large {
+        return text;
+    }
+    text.lines()
+        .map(|l| {
+            if l.contains("range: [-400, 400]") {
+                l.replace("degree: 3", "degree: 5")
+            } else if l.contains("range: [-3.14") {
+                l.replace("degree: 3", "degree: 4")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+fn load(text: &str) -> chain::core::Machine {
+    chain::core::load_str(text, "legendre5.yaml").unwrap()
+}
+
 /// 10⁴ measurements as CSV text: the poses on a deterministic pseudo-random
 /// spread of the travel, the deviations of fixed errors.
-fn csv_text(count: usize) -> String {
-    let machine = chain::core::load_file(&machine_path()).unwrap();
+fn csv_text(machine_text: &str, count: usize) -> String {
+    let machine = load(machine_text);
     let model = chain::core::compile(&machine);
     let n = model.errors().len();
     let e: Vec<f64> = (0..n)
@@ -68,29 +97,33 @@ fn csv_text(count: usize) -> String {
 }
 
 fn bench(c: &mut Criterion) {
-    let text = csv_text(10_000);
-    let path = machine_path();
     let mut g = c.benchmark_group("identify");
     g.sample_size(10).measurement_time(Duration::from_secs(20));
-    g.bench_function("end_to_end_1e4", |b| {
-        b.iter(|| {
-            let m = chain::core::load_file(&path).unwrap();
-            let meas = Measurements::parse(&text, "m.csv", &m, &[], Layout::Measurements).unwrap();
-            let model = chain::core::compile(&m);
-            let design = Design::new(&model, &m, &meas.rows).unwrap();
-            black_box(identify(&design, None).unwrap())
-        })
-    });
-    let m = chain::core::load_file(&path).unwrap();
-    let meas = Measurements::parse(&text, "m.csv", &m, &[], Layout::Measurements).unwrap();
-    let model = chain::core::compile(&m);
-    g.bench_function("design_1e4", |b| {
-        b.iter(|| black_box(Design::new(&model, &m, &meas.rows).unwrap()))
-    });
-    let design = Design::new(&model, &m, &meas.rows).unwrap();
-    g.bench_function("solve_1e4", |b| {
-        b.iter(|| black_box(identify(&design, None).unwrap()))
-    });
+    for (large, suffix) in [(false, ""), (true, "_173")] {
+        let machine = machine_text(large);
+        let text = csv_text(&machine, 10_000);
+        let m = load(&machine);
+        assert_eq!(m.errors.len(), if large { 173 } else { 131 });
+        g.bench_function(format!("end_to_end_1e4{suffix}"), |b| {
+            b.iter(|| {
+                let m = load(&machine);
+                let meas =
+                    Measurements::parse(&text, "m.csv", &m, &[], Layout::Measurements).unwrap();
+                let model = chain::core::compile(&m);
+                let design = Design::new(&model, &m, &meas.rows).unwrap();
+                black_box(identify(&design, None).unwrap())
+            })
+        });
+        let meas = Measurements::parse(&text, "m.csv", &m, &[], Layout::Measurements).unwrap();
+        let model = chain::core::compile(&m);
+        g.bench_function(format!("design_1e4{suffix}"), |b| {
+            b.iter(|| black_box(Design::new(&model, &m, &meas.rows).unwrap()))
+        });
+        let design = Design::new(&model, &m, &meas.rows).unwrap();
+        g.bench_function(format!("solve_1e4{suffix}"), |b| {
+            b.iter(|| black_box(identify(&design, None).unwrap()))
+        });
+    }
     g.finish();
 }
 
