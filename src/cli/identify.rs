@@ -334,7 +334,24 @@ impl Report for IdentifyDoc {
         let _ = writeln!(s, "\n{:<width$}  {:>14}  {:>14}", "error", "value", "std");
         for (name, e) in &self.estimates.0 {
             let std = e.std.map_or("—".to_string(), num);
-            let _ = writeln!(s, "{name:<width$}  {:>14}  {std:>14}", num(e.value));
+            // Without a prior, an unknown in the null space has the
+            // minimum-norm value and the std of that solution only.
+            let note = if self.prior {
+                ""
+            } else {
+                match self
+                    .unidentifiable
+                    .iter()
+                    .filter(|v| v.0.iter().any(|(n, _)| n == name))
+                    .map(|v| v.0.len())
+                    .min()
+                {
+                    Some(1) => "  not seen by the data",
+                    Some(_) => "  aliased (see below)",
+                    None => "",
+                }
+            };
+            let _ = writeln!(s, "{name:<width$}  {:>14}  {std:>14}{note}", num(e.value));
         }
         if !self.groups.is_empty() {
             let _ = writeln!(

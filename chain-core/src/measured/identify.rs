@@ -373,7 +373,21 @@ pub fn identify(design: &Design, prior: Option<&Prior>) -> Result<Identification
                     None => (DMatrix::from_element(n, n, f64::NAN), None),
                 }
             };
-            (x_ls, cov, null, noise)
+            // An unknown the data cannot see at all (its unit vector lies in
+            // the null space) has exactly 0 in the minimum-norm solution
+            // and in its covariance; set it so, not the projection's
+            // round-off (1e-20).
+            let mut x = x_ls;
+            let mut cov = cov;
+            for j in 0..n {
+                let inside: f64 = (0..null.ncols()).map(|k| null[(j, k)] * null[(j, k)]).sum();
+                if inside > 1.0 - 1e-12 {
+                    x[j] = 0.0;
+                    cov.row_mut(j).fill(0.0);
+                    cov.column_mut(j).fill(0.0);
+                }
+            }
+            (x, cov, null, noise)
         }
         Some(p) => {
             // The noise: the stated std, or s of the least-squares fit.
