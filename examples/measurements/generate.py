@@ -240,7 +240,7 @@ def main():
         f.write("# Placements: " + "; ".join(f"{i} = {n}" for i, n in enumerate(names)) + "\n")
         f.write(f"# Noise: Gaussian, std {SIGMA_BALL} mm per coordinate, seed {SEED}.\n")
         f.write("x,y,z,tx,ty,tz,dpx,dpy,dpz,std\n")
-        c.write("# Every ball of ballplate.csv with both styli, as candidates for chain plan.\n")
+        # No comment line: chain plan's candidate reader does not skip them.
         c.write("x,y,z,tx,ty,tz\n")
         rows = 0
         for pi, bi, centre in ball_points():
