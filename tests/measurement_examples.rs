@@ -637,13 +637,23 @@ fn interferometer_lines_identify_what_they_can() {
     }
 
     let (individual, _) = check_recovery(&m, &json, &out, &e);
-    // The cubic positioning terms EXX_3, EYY_3, EZZ_3 (each seen by its
-    // axis line alone) and the few others outside every group.
-    assert!(individual >= 3, "{individual}");
-    for name in ["EXX_3", "EYY_3", "EZZ_3"] {
-        let j = m.error_index(name).unwrap();
-        assert!(null.iter().all(|v| v[j] == 0.0), "{name} is aliased");
-    }
+    // Outside every group, recovered one by one: EZZ_1..3 (along the Z line
+    // pz = EZZ(z) + a constant: no lever of another axis changes along z in
+    // pz), EXX_3 and EYY_3 (along the X and Y lines the angular motions
+    // enter with constant levers, one degree below the cubic), and EBY_1
+    // (the pitch slope of Y, from the diagonals).
+    let alone: Vec<&str> = m
+        .errors
+        .iter()
+        .enumerate()
+        .filter(|(j, _)| null.iter().all(|v| v[*j] == 0.0))
+        .map(|(_, e)| e.name.as_str())
+        .collect();
+    assert_eq!(
+        alone,
+        ["EYY_3", "EBY_1", "EXX_3", "EZZ_1", "EZZ_2", "EZZ_3"]
+    );
+    assert_eq!(individual, alone.len());
     check_residual(&json, &rows);
 
     // The map along the measured lines: u·p is what the lines determine
