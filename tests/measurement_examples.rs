@@ -228,18 +228,27 @@ fn covariance(m: &Machine, file: &Path, value: &[f64]) -> Vec<Vec<f64>> {
         .expect("a mapping")
         .iter()
         .find(|(k, _)| k.as_str() == Some("correlation"))
-        .expect("a correlation matrix");
-    let rows = corr.as_sequence().expect("correlation rows");
-    let n = order.len();
-    assert_eq!(rows.len(), n);
+        .expect("a correlation list");
+    let n = m.errors.len();
+    assert_eq!(order.len(), n);
+    // Σ = D R D: the diagonal from each std, each `[NAME, NAME, ρ]` entry
+    // off it (pairs not listed have ρ = 0).
+    let mut sd = vec![0.0; n];
+    for (k, &j) in order.iter().enumerate() {
+        sd[j] = std[k];
+    }
     let mut c = vec![vec![0.0; n]; n];
-    for (a, row) in rows.iter().enumerate() {
-        let row = row.as_sequence().expect("a row");
-        assert_eq!(row.len(), n);
-        for (b, rho) in row.iter().enumerate() {
-            let rho: f64 = rho.as_str().expect("a number").parse().expect("a number");
-            c[order[a]][order[b]] = rho * std[a] * std[b];
-        }
+    for j in 0..n {
+        c[j][j] = sd[j] * sd[j];
+    }
+    for entry in corr.as_sequence().expect("correlation entries") {
+        let e = entry.as_sequence().expect("an entry [NAME, NAME, rho]");
+        assert_eq!(e.len(), 3);
+        let a = m.error_index(e[0].as_str().unwrap()).expect("an error");
+        let b = m.error_index(e[1].as_str().unwrap()).expect("an error");
+        let rho: f64 = e[2].as_str().expect("a number").parse().expect("a number");
+        c[a][b] = rho * sd[a] * sd[b];
+        c[b][a] = c[a][b];
     }
     c
 }
