@@ -193,8 +193,8 @@ fn null_space(m: &Machine, json: &Value) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// The covariance of the `--values-out` file (its `std` and `correlation`
-/// matrix, rows in the order of `values`), in `machine.errors` order; also
+/// The covariance of the `--values-out` file (its `std` and its
+/// `correlation` list of `[NAME, NAME, ρ]`), in `machine.errors` order; also
 /// checks that its values are the JSON's estimates.
 fn covariance(m: &Machine, file: &Path, value: &[f64]) -> Vec<Vec<f64>> {
     let values = Values::read(file, m).expect("the written values file reads back");
