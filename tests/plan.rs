@@ -14,7 +14,8 @@
 
 mod common;
 
-use chain::core::plan::{self, Candidate, Design, Kind, Plan, PlanError};
+use chain::core::measured::{Measurement, Observed};
+use chain::core::plan::{self, Plan, PlanError, Rows};
 use chain::core::{ErrorModel, Machine};
 use common::{load_example, Exact, Rng};
 use nalgebra::DMatrix;
@@ -52,20 +53,20 @@ fn exact_rows(
     a
 }
 
-/// The candidates of machine-ordered poses, in the model's orders.
-fn candidates(
-    m: &Machine,
-    model: &dyn ErrorModel,
-    qs: &[Vec<f64>],
-    p: &[f64],
-    dirs: Option<&[[f64; 3]]>,
-) -> Vec<Candidate> {
-    let ex = Exact::new(m);
+/// The candidate records of machine-ordered poses (as
+/// `Measurements::read` gives them from a candidate CSV).
+fn candidates(qs: &[Vec<f64>], p: &[f64], dirs: Option<&[[f64; 3]]>) -> Vec<Measurement> {
     (qs.iter().enumerate())
-        .map(|(i, q)| Candidate {
-            q: ex.q_for(model, q),
-            p: ex.p_for(model, p),
-            direction: dirs.map(|d| d[i]),
+        .map(|(i, q)| Measurement {
+            line: i + 2,
+            q: q.clone(),
+            p: p.to_vec(),
+            observed: match dirs {
+                None => Observed::Point,
+                Some(d) => Observed::Direction { u: d[i] },
+            },
+            values: vec![],
+            std: None,
         })
         .collect()
 }
@@ -109,8 +110,8 @@ fn log_pdet(a: &DMatrix<f64>, r: usize) -> f64 {
 }
 
 /// Every check of one planning problem: returns the plan.
-fn check_plan(a_exact: &DMatrix<f64>, design: &Design, count: usize, seed: u64) -> Plan {
-    let rows = design.kind().rows();
+fn check_plan(a_exact: &DMatrix<f64>, design: &Rows, count: usize, seed: u64) -> Plan {
+    let rows = design.per_candidate();
     let n = design.len();
     let result = plan::plan(design, count).expect("plan");
     // The rank is the test's own.
@@ -218,7 +219,7 @@ fn gantry_point_plan_beats_even_and_random_and_is_a_local_optimum() {
     let qs = gantry_grid();
     let p: Vec<f64> = vec![];
     let a = exact_rows(&m, &model, &qs, &p, None);
-    let design = Design::new(&model, &candidates(&m, &model, &qs, &p, None), Kind::Point).unwrap();
+    let design = Rows::of(&model, &m, &candidates(&qs, &p, None)).unwrap();
     let r = check_plan(&a, &design, 8, 1);
     // Position-only data cannot see every angular error of a machine with
     // one tool point: the rank is below the 21 errors.
@@ -245,12 +246,7 @@ fn gantry_direction_plan_along_the_body_diagonals() {
         }
     }
     let a = exact_rows(&m, &model, &qs, &[], Some(&dirs));
-    let design = Design::new(
-        &model,
-        &candidates(&m, &model, &qs, &[], Some(&dirs)),
-        Kind::Direction,
-    )
-    .unwrap();
+    let design = Rows::of(&model, &m, &candidates(&qs, &[], Some(&dirs))).unwrap();
     check_plan(&a, &design, 30, 2);
 }
 
@@ -273,7 +269,7 @@ fn five_axis_point_plan_beats_even_and_random_and_is_a_local_optimum() {
         })
         .collect();
     let a = exact_rows(&m, &model, &qs, &p, None);
-    let design = Design::new(&model, &candidates(&m, &model, &qs, &p, None), Kind::Point).unwrap();
+    let design = Rows::of(&model, &m, &candidates(&qs, &p, None)).unwrap();
     check_plan(&a, &design, 20, 3);
 }
 
@@ -285,7 +281,7 @@ fn full_rank_std_is_the_inverse_of_the_information() {
     let (n, p) = (60, 7);
     let a = DMatrix::from_fn(n, p, |_, j| rng.range(-1.0, 1.0) * 10f64.powi(j as i32 - 3));
     let names: Vec<String> = (0..p).map(|j| format!("e{j}")).collect();
-    let design = Design::from_rows(Kind::Direction, names, a.clone());
+    let design = Rows::new(1, names, a.clone(), false).unwrap();
     let r = plan::plan(&design, 12).unwrap();
     assert_eq!(r.rank, p);
     assert!(r.aliased.iter().all(|&x| !x));
@@ -308,7 +304,7 @@ fn full_rank_std_is_the_inverse_of_the_information() {
 #[test]
 fn library_refusals() {
     let a = DMatrix::from_fn(6, 2, |i, j| (i + j) as f64 + 1.0);
-    let d = Design::from_rows(Kind::Point, vec!["a".into(), "b".into()], a);
+    let d = Rows::new(3, vec!["a".into(), "b".into()], a, false).unwrap();
     assert_eq!(
         plan::plan(&d, 0),
         Err(PlanError::Count {
@@ -317,13 +313,15 @@ fn library_refusals() {
         })
     );
     assert!(matches!(plan::plan(&d, 3), Err(PlanError::Count { .. })));
-    let zero = Design::from_rows(Kind::Direction, vec!["a".into()], DMatrix::zeros(4, 1));
+    let zero = Rows::new(1, vec!["a".into()], DMatrix::zeros(4, 1), false).unwrap();
     assert_eq!(plan::plan(&zero, 2), Err(PlanError::Uninformative));
-    let full = Design::from_rows(
-        Kind::Direction,
+    let full = Rows::new(
+        1,
         vec!["a".into(), "b".into(), "c".into()],
         DMatrix::from_fn(5, 3, |i, j| ((i + 1) as f64).powi(j as i32)),
-    );
+        false,
+    )
+    .unwrap();
     assert!(matches!(
         plan::plan(&full, 2),
         Err(PlanError::TooFew {
@@ -363,12 +361,7 @@ fn cli_json_is_the_library_plan() {
     ]);
     let m = load_example("gantry_grinder.yaml");
     let model = chain::core::compile(&m);
-    let design = Design::new(
-        &model,
-        &candidates(&m, &model, &gantry_grid(), &[], None),
-        Kind::Point,
-    )
-    .unwrap();
+    let design = Rows::of(&model, &m, &candidates(&gantry_grid(), &[], None)).unwrap();
     let want = plan::plan(&design, 8).unwrap();
     assert_eq!(doc["rank"], want.rank);
     assert_eq!(doc["kind"], "point");
@@ -395,60 +388,151 @@ fn cli_json_is_the_library_plan() {
     assert!(table.contains("rank 8 of 21"), "{table}");
 }
 
+/// A bad candidate file or argument: located message, non-zero exit,
+/// nothing on stdout (`fails` checks the last two).
+#[track_caller]
+fn refused(machine: &str, name: &str, text: &str, extra: &[&str], wants: &[&str]) {
+    let dir = common::cli::scratch("bad");
+    let c = common::cli::write(&dir, name, text);
+    let mut args = vec!["plan", machine, "--candidates", c.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let e = common::cli::unwrapped(&common::cli::fails(&args));
+    for w in wants {
+        assert!(e.contains(w), "missing `{w}` in\n{e}");
+    }
+}
+
 #[test]
 fn cli_bad_input_is_located() {
-    let dir = common::cli::scratch("bad");
-    let run = |name: &str, text: &str, count: &str| {
-        let c = common::cli::write(&dir, name, text);
-        common::cli::unwrapped(&common::cli::fails(&[
-            "plan",
-            GANTRY,
-            "--candidates",
-            c.to_str().unwrap(),
-            "--count",
-            count,
-        ]))
+    let bad = |name: &str, text: &str, count: &str, wants: &[&str]| {
+        refused(GANTRY, name, text, &["--count", count], wants)
     };
-    let e = run("unknown.csv", "x,y,z,w\n0,0,600,1\n", "1");
-    assert!(e.contains("unknown.csv:1: column `w`"), "{e}");
-    let e = run("missing.csv", "x,y\n0,0\n", "1");
-    assert!(
-        e.contains("missing.csv:1: no column for axis variable `z`"),
-        "{e}"
+    // The spec's and the bad inputs of a candidate file.
+    bad(
+        "unknown.csv",
+        "x,y,z,w\n0,0,600,1\n",
+        "1",
+        &["unknown.csv:1:", "column `w` is neither an axis variable"],
     );
-    let e = run("nan.csv", "x,y,z\n0,0,600\n1,NaN,600\n", "1");
-    assert!(
-        e.contains("nan.csv:3: `NaN` (column `y`) is not finite"),
-        "{e}"
+    bad(
+        "missing.csv",
+        "x,y\n0,0\n",
+        "1",
+        &["missing.csv:1:", "no column for the axis variable `z`"],
     );
-    let e = run("word.csv", "x,y,z\n0,zero,600\n", "1");
-    assert!(
-        e.contains("word.csv:2: `zero` (column `y`) is not a number"),
-        "{e}"
+    bad(
+        "nan.csv",
+        "x,y,z\n0,0,600\n1,NaN,600\n",
+        "1",
+        &["nan.csv:3:", "`NaN` (column `y`) is not finite"],
     );
-    let e = run("big.csv", &grid_csv(), "126");
-    assert!(
-        e.contains("--count 126 is not a count of candidates: choose 1 to 125"),
-        "{e}"
+    bad(
+        "inf.csv",
+        "x,y,z\n0,0,inf\n",
+        "1",
+        &["inf.csv:2:", "`inf` (column `z`) is not finite"],
     );
-    let e = run("zero.csv", &grid_csv(), "0");
-    assert!(e.contains("--count 0"), "{e}");
-    let e = run("few.csv", &grid_csv(), "2");
-    assert!(e.contains("fewer than the 8 dimensions"), "{e}");
-    let e = run("measured.csv", "x,y,z,dpx\n0,0,600,1\n", "1");
-    assert!(
-        e.contains("measured.csv:1: column `dpx` is a measured value"),
-        "{e}"
+    bad("empty.csv", "", "1", &["empty.csv:1:", "empty"]);
+    bad(
+        "header.csv",
+        "x,y,z\n",
+        "1",
+        &["header.csv:1:", "no candidate pose row"],
     );
-    let e = run("dir.csv", "x,y,z,ux,uy,uz\n0,0,600,1,1,0\n", "1");
-    assert!(e.contains("dir.csv:2: the direction"), "{e}");
-    let e = run("ux.csv", "x,y,z,ux\n0,0,600,1\n", "1");
-    assert!(
-        e.contains("ux.csv:1: a direction needs all of `ux,uy,uz`"),
-        "{e}"
+    bad(
+        "wide.csv",
+        "x,y,z\n0,0,600\n1,2,3,4\n",
+        "1",
+        &["wide.csv:3:", "has 4 fields but the header has 3 columns"],
     );
-    let e = run("empty.csv", "", "1");
-    assert!(e.contains("empty.csv:1: the file is empty"), "{e}");
-    let e = run("wide.csv", "x,y,z\n0,0,600\n1,2,3,4\n", "1");
-    assert!(e.contains("wide.csv:3"), "{e}");
+    bad(
+        "narrow.csv",
+        "x,y,z\n0,0,600\n1,2\n",
+        "1",
+        &["narrow.csv:3:", "has 2 fields but the header has 3 columns"],
+    );
+    // The rest of what a candidate file can get wrong.
+    bad(
+        "word.csv",
+        "x,y,z\n0,zero,600\n",
+        "1",
+        &["word.csv:2:", "`zero` (column `y`) is not a number"],
+    );
+    bad(
+        "measured.csv",
+        "x,y,z,dpx\n0,0,600,1\n",
+        "1",
+        &["measured.csv:1:", "column `dpx` is a measured value"],
+    );
+    bad(
+        "d.csv",
+        "x,y,z,ux,uy,uz,d\n0,0,600,1,0,0,1\n",
+        "1",
+        &["d.csv:1:", "column `d` is a measured value"],
+    );
+    bad(
+        "dir.csv",
+        "x,y,z,ux,uy,uz\n0,0,600,1,1,0\n",
+        "1",
+        &["dir.csv:2:", "the direction (ux, uy, uz) has length"],
+    );
+    bad(
+        "ux.csv",
+        "x,y,z,ux\n0,0,600,1\n",
+        "1",
+        &["ux.csv:1:", "only some of `ux,uy,uz`"],
+    );
+    bad(
+        "std.csv",
+        "x,y,z,std\n0,0,600,0.001\n1,0,600,0\n",
+        "1",
+        &["std.csv:3:", "standard deviation must be positive"],
+    );
+    // The count.
+    bad(
+        "big.csv",
+        &grid_csv(),
+        "126",
+        &["big.csv: --count 126 is not a count of candidates: choose 1 to 125"],
+    );
+    bad("zero.csv", &grid_csv(), "0", &["--count 0"]);
+    bad(
+        "few.csv",
+        &grid_csv(),
+        "2",
+        &["few.csv:", "fewer than the 8 dimensions"],
+    );
+    // --kind against the file.
+    refused(
+        GANTRY,
+        "kindp.csv",
+        "x,y,z,ux,uy,uz\n0,0,600,1,0,0\n",
+        &["--count", "1", "--kind", "point"],
+        &["kindp.csv:1:", "--kind point"],
+    );
+    refused(
+        GANTRY,
+        "kindd.csv",
+        &grid_csv(),
+        &["--count", "8", "--kind", "direction"],
+        &[
+            "kindd.csv:1:",
+            "--kind direction needs the columns `ux,uy,uz`",
+        ],
+    );
+    // Parameters: an unknown --param, a symbolic one without a column.
+    refused(
+        GANTRY,
+        "param.csv",
+        &grid_csv(),
+        &["--count", "8", "--param", "tq=1"],
+        &["--param tq: machine `gantry_grinder` has no parameter `tq`"],
+    );
+    refused(
+        "examples/machines/cradle_generator.yaml",
+        "symbolic.csv",
+        "q,j,i,gamma_m,phi_p,S_d,E_m,X_b\n0,0,0,0,0,1,2,3\n",
+        &["--count", "1"],
+        &["symbolic.csv:1:", "parameter `X_1` is symbolic"],
+    );
 }
