@@ -274,6 +274,40 @@ fn five_axis_point_plan_beats_even_and_random_and_is_a_local_optimum() {
 }
 
 #[test]
+fn weighted_candidates_plan_on_the_rows_divided_by_their_std() {
+    // A `std` per candidate (two instruments): the information is AᵀWA,
+    // W = diag(1/std²); the test's rows are the exact ones divided by the
+    // std, and every check of `check_plan` (rank, log det, even, random,
+    // local optimum, std) holds on them; the std are absolute.
+    let m = load_example("gantry_grinder.yaml");
+    let model = chain::core::compile(&m);
+    let qs = gantry_grid();
+    let std: Vec<f64> = (0..qs.len())
+        .map(|i| if i % 3 == 0 { 0.001 } else { 0.004 })
+        .collect();
+    let mut a = exact_rows(&m, &model, &qs, &[], None);
+    for i in 0..qs.len() {
+        for c in 0..3 {
+            a.row_mut(3 * i + c).scale_mut(1.0 / std[i]);
+        }
+    }
+    let mut recs = candidates(&qs, &[], None);
+    for (r, s) in recs.iter_mut().zip(&std) {
+        r.std = Some(*s);
+    }
+    let design = Rows::of(&model, &m, &recs).unwrap();
+    assert!(design.weighted());
+    let r = check_plan(&a, &design, 10, 5);
+    assert!(r.weighted);
+    // Weighting changes the choice: the precise instrument's candidates
+    // (every third) are preferred.
+    let precise = (r.optimal.candidates.iter())
+        .filter(|&&i| i % 3 == 0)
+        .count();
+    assert!(precise > 10 / 3 + 1, "{:?}", r.optimal.candidates);
+}
+
+#[test]
 fn full_rank_std_is_the_inverse_of_the_information() {
     // A design of full column rank: the std is sqrt(diag((AᵀA)⁻¹)) by
     // nalgebra's plain inverse, and the log det that of AᵀA itself.
@@ -315,6 +349,43 @@ fn library_refusals() {
     assert!(matches!(plan::plan(&d, 3), Err(PlanError::Count { .. })));
     let zero = Rows::new(1, vec!["a".into()], DMatrix::zeros(4, 1), false).unwrap();
     assert_eq!(plan::plan(&zero, 2), Err(PlanError::Uninformative));
+    // Rows that are not whole candidates, or not one column per name, or
+    // not finite; candidates of two kinds.
+    let names = vec!["a".to_string(), "b".to_string()];
+    assert!(matches!(
+        Rows::new(3, names.clone(), DMatrix::zeros(4, 2), false),
+        Err(PlanError::RowsPerCandidate { rows: 4, per: 3 })
+    ));
+    assert!(matches!(
+        Rows::new(4, names.clone(), DMatrix::zeros(4, 2), false),
+        Err(PlanError::RowsPerCandidate { .. })
+    ));
+    assert!(matches!(
+        Rows::new(1, names.clone(), DMatrix::zeros(4, 3), false),
+        Err(PlanError::Columns {
+            columns: 3,
+            errors: 2
+        })
+    ));
+    let mut nan = DMatrix::zeros(6, 2);
+    nan[(4, 1)] = f64::NAN;
+    assert_eq!(
+        Rows::new(1, names, nan, false),
+        Err(PlanError::NonFinite { index: 4 })
+    );
+    let m = load_example("gantry_grinder.yaml");
+    let model = chain::core::compile(&m);
+    let mut mixed = candidates(&gantry_grid()[..3], &[], None);
+    mixed[2].observed = Observed::Direction { u: [1.0, 0.0, 0.0] };
+    assert_eq!(
+        Rows::of(&model, &m, &mixed),
+        Err(PlanError::MixedRows {
+            index: 2,
+            found: 1,
+            expected: 3
+        })
+    );
+    assert_eq!(Rows::of(&model, &m, &[]), Err(PlanError::NoCandidates));
     let full = Rows::new(
         1,
         vec!["a".into(), "b".into(), "c".into()],
@@ -400,6 +471,68 @@ fn refused(machine: &str, name: &str, text: &str, extra: &[&str], wants: &[&str]
     for w in wants {
         assert!(e.contains(w), "missing `{w}` in\n{e}");
     }
+}
+
+#[test]
+fn cli_directions_from_stdin_and_kind() {
+    // A direction file read from stdin plans the same as the library on the
+    // same records; `--kind direction` agrees with the file.
+    let s = 1.0 / 3f64.sqrt();
+    let mut text = String::from("x,y,z,ux,uy,uz\n");
+    let mut qs = Vec::new();
+    let mut dirs = Vec::new();
+    for (k, q) in gantry_grid().iter().enumerate() {
+        let u = [[s, s, s], [-s, s, s], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]][k % 4];
+        text.push_str(&format!(
+            "{},{},{},{},{},{}\n",
+            q[0], q[1], q[2], u[0], u[1], u[2]
+        ));
+        qs.push(q.clone());
+        dirs.push(u);
+    }
+    let out = common::cli::success_json(common::cli::chain_stdin(
+        &[
+            "plan",
+            GANTRY,
+            "--candidates",
+            "-",
+            "--count",
+            "20",
+            "--kind",
+            "direction",
+            "--format",
+            "json",
+        ],
+        text.as_bytes(),
+    ));
+    assert_eq!(out["kind"], "direction");
+    assert_eq!(out["candidates_file"], "<stdin>");
+    assert_eq!(out["rows_per_candidate"], 1);
+    let m = load_example("gantry_grinder.yaml");
+    let model = chain::core::compile(&m);
+    let want = plan::plan(
+        &Rows::of(&model, &m, &candidates(&qs, &[], Some(&dirs))).unwrap(),
+        20,
+    )
+    .unwrap();
+    // The grid is symmetric: many subsets tie, and a difference of 1e-16 in
+    // `u` (the reader normalises it) can lead the search to another local
+    // optimum; on the reader's own records the choice is the same.
+    let recs = chain::core::measured::Measurements::parse(
+        &text,
+        "<stdin>",
+        &m,
+        &[],
+        chain::core::measured::Layout::Candidates,
+    )
+    .unwrap();
+    let same = plan::plan(&Rows::of(&model, &m, &recs.rows).unwrap(), 20).unwrap();
+    let chosen: Vec<usize> = (out["optimal"]["candidates"].as_array().unwrap().iter())
+        .map(|v| v.as_u64().unwrap() as usize)
+        .collect();
+    assert_eq!(chosen, same.optimal.candidates);
+    assert_eq!(same.rank, want.rank);
+    assert_eq!(out["rank"], want.rank);
 }
 
 #[test]
