@@ -14,7 +14,8 @@
 
 mod common;
 
-use chain::core::plan::{self, Candidate, Design, Kind, Plan, PlanError};
+use chain::core::measured::{Measurement, Observed};
+use chain::core::plan::{self, Plan, PlanError, Rows};
 use chain::core::{ErrorModel, Machine};
 use common::{load_example, Exact, Rng};
 use nalgebra::DMatrix;
@@ -52,20 +53,20 @@ fn exact_rows(
     a
 }
 
-/// The candidates of machine-ordered poses, in the model's orders.
-fn candidates(
-    m: &Machine,
-    model: &dyn ErrorModel,
-    qs: &[Vec<f64>],
-    p: &[f64],
-    dirs: Option<&[[f64; 3]]>,
-) -> Vec<Candidate> {
-    let ex = Exact::new(m);
+/// The candidate records of machine-ordered poses (as
+/// `Measurements::read` gives them from a candidate CSV).
+fn candidates(qs: &[Vec<f64>], p: &[f64], dirs: Option<&[[f64; 3]]>) -> Vec<Measurement> {
     (qs.iter().enumerate())
-        .map(|(i, q)| Candidate {
-            q: ex.q_for(model, q),
-            p: ex.p_for(model, p),
-            direction: dirs.map(|d| d[i]),
+        .map(|(i, q)| Measurement {
+            line: i + 2,
+            q: q.clone(),
+            p: p.to_vec(),
+            observed: match dirs {
+                None => Observed::Point,
+                Some(d) => Observed::Direction { u: d[i] },
+            },
+            values: vec![],
+            std: None,
         })
         .collect()
 }
@@ -109,8 +110,8 @@ fn log_pdet(a: &DMatrix<f64>, r: usize) -> f64 {
 }
 
 /// Every check of one planning problem: returns the plan.
-fn check_plan(a_exact: &DMatrix<f64>, design: &Design, count: usize, seed: u64) -> Plan {
-    let rows = design.kind().rows();
+fn check_plan(a_exact: &DMatrix<f64>, design: &Rows, count: usize, seed: u64) -> Plan {
+    let rows = design.per_candidate();
     let n = design.len();
     let result = plan::plan(design, count).expect("plan");
     // The rank is the test's own.
@@ -218,7 +219,7 @@ fn gantry_point_plan_beats_even_and_random_and_is_a_local_optimum() {
     let qs = gantry_grid();
     let p: Vec<f64> = vec![];
     let a = exact_rows(&m, &model, &qs, &p, None);
-    let design = Design::new(&model, &candidates(&m, &model, &qs, &p, None), Kind::Point).unwrap();
+    let design = Rows::of(&model, &m, &candidates(&qs, &p, None)).unwrap();
     let r = check_plan(&a, &design, 8, 1);
     // Position-only data cannot see every angular error of a machine with
     // one tool point: the rank is below the 21 errors.
@@ -245,12 +246,7 @@ fn gantry_direction_plan_along_the_body_diagonals() {
         }
     }
     let a = exact_rows(&m, &model, &qs, &[], Some(&dirs));
-    let design = Design::new(
-        &model,
-        &candidates(&m, &model, &qs, &[], Some(&dirs)),
-        Kind::Direction,
-    )
-    .unwrap();
+    let design = Rows::of(&model, &m, &candidates(&qs, &[], Some(&dirs))).unwrap();
     check_plan(&a, &design, 30, 2);
 }
 
@@ -273,8 +269,42 @@ fn five_axis_point_plan_beats_even_and_random_and_is_a_local_optimum() {
         })
         .collect();
     let a = exact_rows(&m, &model, &qs, &p, None);
-    let design = Design::new(&model, &candidates(&m, &model, &qs, &p, None), Kind::Point).unwrap();
+    let design = Rows::of(&model, &m, &candidates(&qs, &p, None)).unwrap();
     check_plan(&a, &design, 20, 3);
+}
+
+#[test]
+fn weighted_candidates_plan_on_the_rows_divided_by_their_std() {
+    // A `std` per candidate (two instruments): the information is AᵀWA,
+    // W = diag(1/std²); the test's rows are the exact ones divided by the
+    // std, and every check of `check_plan` (rank, log det, even, random,
+    // local optimum, std) holds on them; the std are absolute.
+    let m = load_example("gantry_grinder.yaml");
+    let model = chain::core::compile(&m);
+    let qs = gantry_grid();
+    let std: Vec<f64> = (0..qs.len())
+        .map(|i| if i % 3 == 0 { 0.001 } else { 0.004 })
+        .collect();
+    let mut a = exact_rows(&m, &model, &qs, &[], None);
+    for i in 0..qs.len() {
+        for c in 0..3 {
+            a.row_mut(3 * i + c).scale_mut(1.0 / std[i]);
+        }
+    }
+    let mut recs = candidates(&qs, &[], None);
+    for (r, s) in recs.iter_mut().zip(&std) {
+        r.std = Some(*s);
+    }
+    let design = Rows::of(&model, &m, &recs).unwrap();
+    assert!(design.weighted());
+    let r = check_plan(&a, &design, 10, 5);
+    assert!(r.weighted);
+    // Weighting changes the choice: the precise instrument's candidates
+    // (every third) are preferred.
+    let precise = (r.optimal.candidates.iter())
+        .filter(|&&i| i % 3 == 0)
+        .count();
+    assert!(precise > 10 / 3 + 1, "{:?}", r.optimal.candidates);
 }
 
 #[test]
@@ -285,7 +315,7 @@ fn full_rank_std_is_the_inverse_of_the_information() {
     let (n, p) = (60, 7);
     let a = DMatrix::from_fn(n, p, |_, j| rng.range(-1.0, 1.0) * 10f64.powi(j as i32 - 3));
     let names: Vec<String> = (0..p).map(|j| format!("e{j}")).collect();
-    let design = Design::from_rows(Kind::Direction, names, a.clone());
+    let design = Rows::new(1, names, a.clone(), false).unwrap();
     let r = plan::plan(&design, 12).unwrap();
     assert_eq!(r.rank, p);
     assert!(r.aliased.iter().all(|&x| !x));
@@ -308,7 +338,7 @@ fn full_rank_std_is_the_inverse_of_the_information() {
 #[test]
 fn library_refusals() {
     let a = DMatrix::from_fn(6, 2, |i, j| (i + j) as f64 + 1.0);
-    let d = Design::from_rows(Kind::Point, vec!["a".into(), "b".into()], a);
+    let d = Rows::new(3, vec!["a".into(), "b".into()], a, false).unwrap();
     assert_eq!(
         plan::plan(&d, 0),
         Err(PlanError::Count {
@@ -317,13 +347,52 @@ fn library_refusals() {
         })
     );
     assert!(matches!(plan::plan(&d, 3), Err(PlanError::Count { .. })));
-    let zero = Design::from_rows(Kind::Direction, vec!["a".into()], DMatrix::zeros(4, 1));
+    let zero = Rows::new(1, vec!["a".into()], DMatrix::zeros(4, 1), false).unwrap();
     assert_eq!(plan::plan(&zero, 2), Err(PlanError::Uninformative));
-    let full = Design::from_rows(
-        Kind::Direction,
+    // Rows that are not whole candidates, or not one column per name, or
+    // not finite; candidates of two kinds.
+    let names = vec!["a".to_string(), "b".to_string()];
+    assert!(matches!(
+        Rows::new(3, names.clone(), DMatrix::zeros(4, 2), false),
+        Err(PlanError::RowsPerCandidate { rows: 4, per: 3 })
+    ));
+    assert!(matches!(
+        Rows::new(4, names.clone(), DMatrix::zeros(4, 2), false),
+        Err(PlanError::RowsPerCandidate { .. })
+    ));
+    assert!(matches!(
+        Rows::new(1, names.clone(), DMatrix::zeros(4, 3), false),
+        Err(PlanError::Columns {
+            columns: 3,
+            errors: 2
+        })
+    ));
+    let mut nan = DMatrix::zeros(6, 2);
+    nan[(4, 1)] = f64::NAN;
+    assert_eq!(
+        Rows::new(1, names, nan, false),
+        Err(PlanError::NonFinite { index: 4 })
+    );
+    let m = load_example("gantry_grinder.yaml");
+    let model = chain::core::compile(&m);
+    let mut mixed = candidates(&gantry_grid()[..3], &[], None);
+    mixed[2].observed = Observed::Direction { u: [1.0, 0.0, 0.0] };
+    assert_eq!(
+        Rows::of(&model, &m, &mixed),
+        Err(PlanError::MixedRows {
+            index: 2,
+            found: 1,
+            expected: 3
+        })
+    );
+    assert_eq!(Rows::of(&model, &m, &[]), Err(PlanError::NoCandidates));
+    let full = Rows::new(
+        1,
         vec!["a".into(), "b".into(), "c".into()],
         DMatrix::from_fn(5, 3, |i, j| ((i + 1) as f64).powi(j as i32)),
-    );
+        false,
+    )
+    .unwrap();
     assert!(matches!(
         plan::plan(&full, 2),
         Err(PlanError::TooFew {
@@ -363,12 +432,7 @@ fn cli_json_is_the_library_plan() {
     ]);
     let m = load_example("gantry_grinder.yaml");
     let model = chain::core::compile(&m);
-    let design = Design::new(
-        &model,
-        &candidates(&m, &model, &gantry_grid(), &[], None),
-        Kind::Point,
-    )
-    .unwrap();
+    let design = Rows::of(&model, &m, &candidates(&gantry_grid(), &[], None)).unwrap();
     let want = plan::plan(&design, 8).unwrap();
     assert_eq!(doc["rank"], want.rank);
     assert_eq!(doc["kind"], "point");
@@ -395,60 +459,213 @@ fn cli_json_is_the_library_plan() {
     assert!(table.contains("rank 8 of 21"), "{table}");
 }
 
-#[test]
-fn cli_bad_input_is_located() {
+/// A bad candidate file or argument: located message, non-zero exit,
+/// nothing on stdout (`fails` checks the last two).
+#[track_caller]
+fn refused(machine: &str, name: &str, text: &str, extra: &[&str], wants: &[&str]) {
     let dir = common::cli::scratch("bad");
-    let run = |name: &str, text: &str, count: &str| {
-        let c = common::cli::write(&dir, name, text);
-        common::cli::unwrapped(&common::cli::fails(&[
+    let c = common::cli::write(&dir, name, text);
+    let mut args = vec!["plan", machine, "--candidates", c.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let e = common::cli::unwrapped(&common::cli::fails(&args));
+    for w in wants {
+        assert!(e.contains(w), "missing `{w}` in\n{e}");
+    }
+}
+
+#[test]
+fn cli_directions_from_stdin_and_kind() {
+    // A direction file read from stdin plans the same as the library on the
+    // same records; `--kind direction` agrees with the file.
+    let s = 1.0 / 3f64.sqrt();
+    let mut text = String::from("x,y,z,ux,uy,uz\n");
+    let mut qs = Vec::new();
+    let mut dirs = Vec::new();
+    for (k, q) in gantry_grid().iter().enumerate() {
+        let u = [[s, s, s], [-s, s, s], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]][k % 4];
+        text.push_str(&format!(
+            "{},{},{},{},{},{}\n",
+            q[0], q[1], q[2], u[0], u[1], u[2]
+        ));
+        qs.push(q.clone());
+        dirs.push(u);
+    }
+    let out = common::cli::success_json(common::cli::chain_stdin(
+        &[
             "plan",
             GANTRY,
             "--candidates",
-            c.to_str().unwrap(),
+            "-",
             "--count",
-            count,
-        ]))
+            "20",
+            "--kind",
+            "direction",
+            "--format",
+            "json",
+        ],
+        text.as_bytes(),
+    ));
+    assert_eq!(out["kind"], "direction");
+    assert_eq!(out["candidates_file"], "<stdin>");
+    assert_eq!(out["rows_per_candidate"], 1);
+    let m = load_example("gantry_grinder.yaml");
+    let model = chain::core::compile(&m);
+    let want = plan::plan(
+        &Rows::of(&model, &m, &candidates(&qs, &[], Some(&dirs))).unwrap(),
+        20,
+    )
+    .unwrap();
+    // The grid is symmetric: many subsets tie, and a difference of 1e-16 in
+    // `u` (the reader normalises it) can lead the search to another local
+    // optimum; on the reader's own records the choice is the same.
+    let recs = chain::core::measured::Measurements::parse(
+        &text,
+        "<stdin>",
+        &m,
+        &[],
+        chain::core::measured::Layout::Candidates,
+    )
+    .unwrap();
+    let same = plan::plan(&Rows::of(&model, &m, &recs.rows).unwrap(), 20).unwrap();
+    let chosen: Vec<usize> = (out["optimal"]["candidates"].as_array().unwrap().iter())
+        .map(|v| v.as_u64().unwrap() as usize)
+        .collect();
+    assert_eq!(chosen, same.optimal.candidates);
+    assert_eq!(same.rank, want.rank);
+    assert_eq!(out["rank"], want.rank);
+}
+
+#[test]
+fn cli_bad_input_is_located() {
+    let bad = |name: &str, text: &str, count: &str, wants: &[&str]| {
+        refused(GANTRY, name, text, &["--count", count], wants)
     };
-    let e = run("unknown.csv", "x,y,z,w\n0,0,600,1\n", "1");
-    assert!(e.contains("unknown.csv:1: column `w`"), "{e}");
-    let e = run("missing.csv", "x,y\n0,0\n", "1");
-    assert!(
-        e.contains("missing.csv:1: no column for axis variable `z`"),
-        "{e}"
+    // The spec's and the bad inputs of a candidate file.
+    bad(
+        "unknown.csv",
+        "x,y,z,w\n0,0,600,1\n",
+        "1",
+        &["unknown.csv:1:", "column `w` is neither an axis variable"],
     );
-    let e = run("nan.csv", "x,y,z\n0,0,600\n1,NaN,600\n", "1");
-    assert!(
-        e.contains("nan.csv:3: `NaN` (column `y`) is not finite"),
-        "{e}"
+    bad(
+        "missing.csv",
+        "x,y\n0,0\n",
+        "1",
+        &["missing.csv:1:", "no column for the axis variable `z`"],
     );
-    let e = run("word.csv", "x,y,z\n0,zero,600\n", "1");
-    assert!(
-        e.contains("word.csv:2: `zero` (column `y`) is not a number"),
-        "{e}"
+    bad(
+        "nan.csv",
+        "x,y,z\n0,0,600\n1,NaN,600\n",
+        "1",
+        &["nan.csv:3:", "`NaN` (column `y`) is not finite"],
     );
-    let e = run("big.csv", &grid_csv(), "126");
-    assert!(
-        e.contains("--count 126 is not a count of candidates: choose 1 to 125"),
-        "{e}"
+    bad(
+        "inf.csv",
+        "x,y,z\n0,0,inf\n",
+        "1",
+        &["inf.csv:2:", "`inf` (column `z`) is not finite"],
     );
-    let e = run("zero.csv", &grid_csv(), "0");
-    assert!(e.contains("--count 0"), "{e}");
-    let e = run("few.csv", &grid_csv(), "2");
-    assert!(e.contains("fewer than the 8 dimensions"), "{e}");
-    let e = run("measured.csv", "x,y,z,dpx\n0,0,600,1\n", "1");
-    assert!(
-        e.contains("measured.csv:1: column `dpx` is a measured value"),
-        "{e}"
+    bad("empty.csv", "", "1", &["empty.csv:1:", "empty"]);
+    bad(
+        "header.csv",
+        "x,y,z\n",
+        "1",
+        &["header.csv:1:", "no candidate pose row"],
     );
-    let e = run("dir.csv", "x,y,z,ux,uy,uz\n0,0,600,1,1,0\n", "1");
-    assert!(e.contains("dir.csv:2: the direction"), "{e}");
-    let e = run("ux.csv", "x,y,z,ux\n0,0,600,1\n", "1");
-    assert!(
-        e.contains("ux.csv:1: a direction needs all of `ux,uy,uz`"),
-        "{e}"
+    bad(
+        "wide.csv",
+        "x,y,z\n0,0,600\n1,2,3,4\n",
+        "1",
+        &["wide.csv:3:", "has 4 fields but the header has 3 columns"],
     );
-    let e = run("empty.csv", "", "1");
-    assert!(e.contains("empty.csv:1: the file is empty"), "{e}");
-    let e = run("wide.csv", "x,y,z\n0,0,600\n1,2,3,4\n", "1");
-    assert!(e.contains("wide.csv:3"), "{e}");
+    bad(
+        "narrow.csv",
+        "x,y,z\n0,0,600\n1,2\n",
+        "1",
+        &["narrow.csv:3:", "has 2 fields but the header has 3 columns"],
+    );
+    // The rest of what a candidate file can get wrong.
+    bad(
+        "word.csv",
+        "x,y,z\n0,zero,600\n",
+        "1",
+        &["word.csv:2:", "`zero` (column `y`) is not a number"],
+    );
+    bad(
+        "measured.csv",
+        "x,y,z,dpx\n0,0,600,1\n",
+        "1",
+        &["measured.csv:1:", "column `dpx` is a measured value"],
+    );
+    bad(
+        "d.csv",
+        "x,y,z,ux,uy,uz,d\n0,0,600,1,0,0,1\n",
+        "1",
+        &["d.csv:1:", "column `d` is a measured value"],
+    );
+    bad(
+        "dir.csv",
+        "x,y,z,ux,uy,uz\n0,0,600,1,1,0\n",
+        "1",
+        &["dir.csv:2:", "the direction (ux, uy, uz) has length"],
+    );
+    bad(
+        "ux.csv",
+        "x,y,z,ux\n0,0,600,1\n",
+        "1",
+        &["ux.csv:1:", "only some of `ux,uy,uz`"],
+    );
+    bad(
+        "std.csv",
+        "x,y,z,std\n0,0,600,0.001\n1,0,600,0\n",
+        "1",
+        &["std.csv:3:", "standard deviation must be positive"],
+    );
+    // The count.
+    bad(
+        "big.csv",
+        &grid_csv(),
+        "126",
+        &["big.csv: --count 126 is not a count of candidates: choose 1 to 125"],
+    );
+    bad("zero.csv", &grid_csv(), "0", &["--count 0"]);
+    bad(
+        "few.csv",
+        &grid_csv(),
+        "2",
+        &["few.csv:", "fewer than the 8 dimensions"],
+    );
+    // --kind against the file.
+    refused(
+        GANTRY,
+        "kindp.csv",
+        "x,y,z,ux,uy,uz\n0,0,600,1,0,0\n",
+        &["--count", "1", "--kind", "point"],
+        &["kindp.csv:1:", "--kind point"],
+    );
+    refused(
+        GANTRY,
+        "kindd.csv",
+        &grid_csv(),
+        &["--count", "8", "--kind", "direction"],
+        &[
+            "kindd.csv:1:",
+            "--kind direction needs the columns `ux,uy,uz`",
+        ],
+    );
+    // Parameters: an unknown --param, a symbolic one without a column.
+    refused(
+        GANTRY,
+        "param.csv",
+        &grid_csv(),
+        &["--count", "8", "--param", "tq=1"],
+        &["--param tq: machine `gantry_grinder` has no parameter `tq`"],
+    );
+    refused(
+        "examples/machines/cradle_generator.yaml",
+        "symbolic.csv",
+        "q,j,i,gamma_m,phi_p,S_d,E_m,X_b\n0,0,0,0,0,1,2,3\n",
+        &["--count", "1"],
+        &["symbolic.csv:1:", "parameter `X_1` is symbolic"],
+    );
 }

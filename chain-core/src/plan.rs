@@ -4,10 +4,14 @@
 //! The exact sensitivity rows of a machine are the design matrix of its
 //! calibration (spec section 4): a tool-point measurement at a pose gives the
 //! three rows `px, py, pz` of `S(q, p)`; a 1-D measurement along a unit
-//! direction `u` gives the one row `u · (px, py, pz)`. [`Design`] holds those
-//! rows for every candidate pose; [`plan`] chooses `K` of them that maximise
-//! the information `det(AᵀA)` on the identifiable subspace (D-optimal design),
-//! and compares the choice with `K` candidates taken evenly.
+//! direction `u` gives the one row `u · (px, py, pz)`. The candidates are
+//! read and their rows built by `chain identify`'s own mechanism
+//! ([`crate::measured::Measurements`] with
+//! [`crate::measured::Layout::Candidates`], [`crate::measured::Design`]);
+//! [`Rows`] holds them (weighted by `1/std` when the candidates have a std),
+//! and [`plan`] chooses `K` candidates that maximise the information
+//! `det(AᵀA)` on the identifiable subspace (D-optimal design), and compares
+//! the choice with `K` candidates taken evenly.
 //!
 //! # The identifiable subspace
 //!
@@ -27,21 +31,30 @@
 //! # The search
 //!
 //! Greedy: starting from a ridge `ε I` (`ε =` [`RIDGE`]` · K/n`), add the
-//! candidate with the largest `det(I + B_j M⁻¹ B_jᵀ)` (the matrix determinant
-//! lemma), updating `M⁻¹` and every candidate's `B_j M⁻¹` by Woodbury's
-//! identity. Then Fedorov's exchange (Fedorov 1972; Cook & Nachtsheim 1980's
-//! sequential form): for each chosen candidate `i` in turn, the best
-//! unchosen `j` by
+//! candidate with the largest `det(I + H_j)`, `H_j = B_j M⁻¹ B_jᵀ` (the
+//! matrix determinant lemma), updating `M⁻¹` by Woodbury's identity and
+//! every `H_l` by the rank-k term `G_l (I + H_j)⁻¹ G_lᵀ`,
+//! `G = B M⁻¹ B_jᵀ` (one thin product per step, `O(m·r·k)`). Then Fedorov's
+//! exchange (Fedorov 1972; Cook & Nachtsheim 1980's sequential form): for
+//! each chosen candidate `i` in turn, the best unchosen `j` by
 //!
 //! ```text
 //! det(M − B_iᵀB_i + B_jᵀB_j) / det(M) = det [ I + B_j M⁻¹ B_jᵀ    B_j M⁻¹ B_iᵀ ]
 //!                                           [ −B_i M⁻¹ B_jᵀ     I − B_i M⁻¹ B_iᵀ ]
+//!     = det(I − H_i) · det(I + H_j + C_ji (I − H_i)⁻¹ C_jiᵀ)
 //! ```
 //!
-//! (the determinant lemma for the rank-2r update `Uᵀ Σ U`, `U = [B_j; B_i]`,
-//! `Σ = diag(I, −I)`), swapped when it improves the determinant by more than
-//! [`SWAP_GAIN`]; until one whole sweep swaps nothing: then no single swap
-//! improves the design by more than that factor (a local optimum).
+//! (the determinant lemma for the rank-2k update `Uᵀ Σ U`, `U = [B_j; B_i]`,
+//! `Σ = diag(I, −I)`, then the Schur complement of `I − H_i`), with the
+//! `H_j` and the cross terms `C = B M⁻¹ B_Sᵀ` (one gemm) kept from the
+//! last refresh and updated by Woodbury after each accepted swap
+//! (`X M⁻¹ Yᵀ ← X M⁻¹ Yᵀ − (X M⁻¹ Uᵀ) W (U M⁻¹ Yᵀ)`,
+//! `W = (Σ + U M⁻¹ Uᵀ)⁻¹`): an evaluation costs `O(k³)`, a swap
+//! `O(m·(r + K)·k)`. A swap is taken when it improves the determinant by
+//! more than [`SWAP_GAIN`]; the search ends when a whole sweep on state
+//! recomputed from the chosen rows (Cholesky, no drift) swaps nothing: then
+//! no single swap improves the design by more than that factor (a local
+//! optimum).
 //!
 //! # Expected standard deviations
 //!
@@ -49,9 +62,11 @@
 //! estimate (spec section 4) is `sqrt((M_S⁺)_jj)` with the pseudo-inverse
 //! `M_S⁺ = V (Vᵀ M_S V)⁻¹ Vᵀ`; with full rank, `(AᵀA)⁻¹`.
 
-use nalgebra::{DMatrix, DVector, Matrix6, SymmetricEigen};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix3x6, Matrix6, SymmetricEigen};
 use serde::Serialize;
 
+use crate::measured::{Design, DesignError, Measurement};
+use crate::model::Machine;
 use crate::model_trait::ErrorModel;
 
 /// Eigenvalues of the equilibrated information below this fraction of the
@@ -71,41 +86,6 @@ pub const SWAP_GAIN: f64 = 1e-9;
 /// (each swap multiplies the determinant by more than `1 + SWAP_GAIN`, so
 /// the sweeps end; this bounds the time).
 pub const MAX_SWEEPS: usize = 1000;
-
-/// A direction `u` must be of unit length to this tolerance.
-pub const UNIT_TOLERANCE: f64 = 1e-6;
-
-/// What one candidate measures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Kind {
-    /// The tool-point deviation `px, py, pz` (three rows).
-    Point,
-    /// The deviation `u · p` along a unit direction (one row).
-    Direction,
-}
-
-impl Kind {
-    /// Design rows per candidate.
-    pub fn rows(self) -> usize {
-        match self {
-            Kind::Point => 3,
-            Kind::Direction => 1,
-        }
-    }
-}
-
-/// One candidate measurement: a pose, the parameter values of its row, and
-/// for [`Kind::Direction`] its direction.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Candidate {
-    /// Axis values, in the model's variable order (rotary in radians).
-    pub q: Vec<f64>,
-    /// Parameter values, in the model's parameter order.
-    pub p: Vec<f64>,
-    /// The unit direction `u` of a 1-D measurement.
-    pub direction: Option<[f64; 3]>,
-}
 
 /// Why a plan cannot be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -138,37 +118,40 @@ pub enum PlanError {
     /// The candidates inform nothing.
     #[error("the candidates identify nothing: every design row is zero")]
     Uninformative,
-    /// A candidate of the wrong dimension.
-    #[error("candidate {index}: {found} {what} for a model of {expected}")]
-    Dimension {
+    /// The candidates' design could not be built (`measured::Design`).
+    #[error(transparent)]
+    Design(#[from] DesignError),
+    /// The candidates do not all give the same number of design rows.
+    #[error("candidate {index} gives {found} design rows, candidate 0 gives {expected}: plan points and directions separately")]
+    MixedRows {
         /// The candidate (0-based).
         index: usize,
-        /// `axis values` or `parameter values`.
-        what: &'static str,
-        /// Given.
+        /// Its rows.
         found: usize,
-        /// Expected.
+        /// The first candidate's rows.
         expected: usize,
     },
-    /// A non-finite pose, parameter or direction.
-    #[error("candidate {index}: a value is not finite")]
+    /// A row matrix that is not whole candidates of 1 to 3 rows.
+    #[error("{rows} design rows of {per} per candidate: a candidate has 1 to 3 rows and the rows are whole candidates")]
+    RowsPerCandidate {
+        /// The matrix's rows.
+        rows: usize,
+        /// Rows per candidate asked for.
+        per: usize,
+    },
+    /// A row matrix whose columns are not the error names.
+    #[error("{columns} design columns for {errors} error names")]
+    Columns {
+        /// The matrix's columns.
+        columns: usize,
+        /// The names given.
+        errors: usize,
+    },
+    /// A design row with a non-finite entry.
+    #[error("candidate {index}: a design row is not finite")]
     NonFinite {
         /// The candidate (0-based).
         index: usize,
-    },
-    /// A direction candidate without a direction.
-    #[error("candidate {index}: no direction (ux, uy, uz) for a direction measurement")]
-    NoDirection {
-        /// The candidate (0-based).
-        index: usize,
-    },
-    /// A direction that is not of unit length.
-    #[error("candidate {index}: the direction (ux, uy, uz) has length {length}, not 1 (to 1e-6)")]
-    NotUnit {
-        /// The candidate (0-based).
-        index: usize,
-        /// Its length.
-        length: f64,
     },
     /// No subset of the asked size gives a non-singular information.
     #[error("no {count} of the candidates found inform every identifiable direction")]
@@ -178,88 +161,99 @@ pub enum PlanError {
     },
 }
 
-/// The design rows of every candidate.
+/// The design rows of every candidate: `per` consecutive rows a candidate
+/// (3 for a tool-point measurement, 1 for one along a direction), weighted
+/// by `1/std` when the candidates have a standard deviation.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Design {
-    kind: Kind,
+pub struct Rows {
+    per: usize,
+    weighted: bool,
     errors: Vec<String>,
-    /// `(n · rows) × N`, candidate `i`'s rows at `rows·i ..`.
+    /// `(n · per) × N`, candidate `i`'s rows at `per·i ..`.
     a: DMatrix<f64>,
 }
 
-impl Design {
-    /// The rows of `candidates` through `model`'s exact sensitivity.
-    pub fn new<M: ErrorModel + ?Sized>(
-        model: &M,
-        candidates: &[Candidate],
-        kind: Kind,
-    ) -> Result<Design, PlanError> {
-        let (nv, np, ne) = (
-            model.variables().len(),
-            model.parameters().len(),
-            model.errors().len(),
-        );
-        let r = kind.rows();
-        let mut a = DMatrix::zeros(candidates.len() * r, ne);
-        let mut s = vec![0.0; 6 * ne];
-        for (i, c) in candidates.iter().enumerate() {
-            for (what, found, expected) in [
-                ("axis values", c.q.len(), nv),
-                ("parameter values", c.p.len(), np),
-            ] {
-                if found != expected {
-                    return Err(PlanError::Dimension {
-                        index: i,
-                        what,
-                        found,
-                        expected,
-                    });
-                }
-            }
-            if !c.q.iter().chain(&c.p).all(|x| x.is_finite()) {
-                return Err(PlanError::NonFinite { index: i });
-            }
-            model.sensitivity(&c.q, &c.p, &mut s);
-            match kind {
-                Kind::Point => {
-                    for k in 0..3 {
-                        for j in 0..ne {
-                            a[(3 * i + k, j)] = s[k * ne + j];
-                        }
-                    }
-                }
-                Kind::Direction => {
-                    let u = c.direction.ok_or(PlanError::NoDirection { index: i })?;
-                    if !u.iter().all(|x| x.is_finite()) {
-                        return Err(PlanError::NonFinite { index: i });
-                    }
-                    let length = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
-                    if (length - 1.0).abs() > UNIT_TOLERANCE {
-                        return Err(PlanError::NotUnit { index: i, length });
-                    }
-                    for j in 0..ne {
-                        a[(i, j)] = (0..3).map(|k| u[k] / length * s[k * ne + j]).sum();
-                    }
-                }
-            }
+impl Rows {
+    /// Rows already computed: `a` is `(n · per) × N`, one column per error
+    /// name, `per` in 1..=3; `weighted` says the rows are already divided by
+    /// their measurement std (the reported std are then absolute).
+    pub fn new(
+        per: usize,
+        errors: Vec<String>,
+        a: DMatrix<f64>,
+        weighted: bool,
+    ) -> Result<Rows, PlanError> {
+        if !(1..=3).contains(&per) || a.nrows() % per != 0 {
+            return Err(PlanError::RowsPerCandidate {
+                rows: a.nrows(),
+                per,
+            });
         }
-        Ok(Design {
-            kind,
-            errors: model.errors().iter().map(|e| e.to_string()).collect(),
+        if a.ncols() != errors.len() {
+            return Err(PlanError::Columns {
+                columns: a.ncols(),
+                errors: errors.len(),
+            });
+        }
+        if let Some(i) = (0..a.nrows()).find(|&i| !a.row(i).iter().all(|x| x.is_finite())) {
+            return Err(PlanError::NonFinite { index: i / per });
+        }
+        Ok(Rows {
+            per,
+            weighted,
+            errors,
             a,
         })
     }
 
-    /// A design from rows already computed: `a` is `(n · kind.rows()) × N`.
-    pub fn from_rows(kind: Kind, errors: Vec<String>, a: DMatrix<f64>) -> Design {
-        assert_eq!(a.nrows() % kind.rows(), 0, "whole candidates");
-        assert_eq!(a.ncols(), errors.len(), "one column per error");
-        Design { kind, errors, a }
+    /// The rows of a candidate design built by [`crate::measured::Design`]
+    /// (the one row rule of `chain identify`: `S_p` for a point, `uᵀ S_p`
+    /// along a direction), each row divided by its record's std when the
+    /// records have one (weighted D-optimality: the information is
+    /// `AᵀWA`, `W = diag(1/std²)`, spec section 4).
+    pub fn from_design(design: &Design) -> Result<Rows, PlanError> {
+        // Rows per record, from each row's record index.
+        let mut counts: Vec<usize> = Vec::new();
+        for &(record, _) in &design.origin {
+            if counts.len() <= record {
+                counts.resize(record + 1, 0);
+            }
+            counts[record] += 1;
+        }
+        let Some(&per) = counts.first() else {
+            return Err(PlanError::NoCandidates);
+        };
+        if let Some((index, &found)) = counts.iter().enumerate().find(|(_, &c)| c != per) {
+            return Err(PlanError::MixedRows {
+                index,
+                found,
+                expected: per,
+            });
+        }
+        let mut a = design.a.clone();
+        if let Some(std) = &design.std {
+            for (i, s) in std.iter().enumerate() {
+                a.row_mut(i).scale_mut(1.0 / s);
+            }
+        }
+        Rows::new(per, design.errors.clone(), a, design.std.is_some())
+    }
+
+    /// The rows of candidate records (in `machine`'s orders, as
+    /// [`crate::measured::Measurements`] reads them with
+    /// [`crate::measured::Layout::Candidates`]) through `model`'s exact
+    /// sensitivity: [`Design::new`] then [`Rows::from_design`].
+    pub fn of<M: ErrorModel + ?Sized>(
+        model: &M,
+        machine: &Machine,
+        records: &[Measurement],
+    ) -> Result<Rows, PlanError> {
+        Rows::from_design(&Design::new(model, machine, records)?)
     }
 
     /// The number of candidates.
     pub fn len(&self) -> usize {
-        self.a.nrows() / self.kind.rows()
+        self.a.nrows() / self.per
     }
 
     /// Whether there is no candidate.
@@ -267,14 +261,19 @@ impl Design {
         self.a.nrows() == 0
     }
 
-    /// The design rows, candidate `i`'s at `kind.rows() · i ..`.
-    pub fn rows(&self) -> &DMatrix<f64> {
-        &self.a
+    /// Design rows per candidate (3 for a point, 1 for a direction).
+    pub fn per_candidate(&self) -> usize {
+        self.per
     }
 
-    /// What each candidate measures.
-    pub fn kind(&self) -> Kind {
-        self.kind
+    /// Whether the rows are weighted by `1/std`.
+    pub fn weighted(&self) -> bool {
+        self.weighted
+    }
+
+    /// The design rows, candidate `i`'s at `per · i ..`.
+    pub fn matrix(&self) -> &DMatrix<f64> {
+        &self.a
     }
 
     /// The error parameters (the columns).
@@ -299,8 +298,11 @@ pub struct Subset {
 /// The plan: the D-optimal choice and the even spread.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Plan {
-    /// What the candidates measure.
-    pub kind: Kind,
+    /// Design rows per candidate (3: a tool point, 1: along a direction).
+    pub rows_per_candidate: usize,
+    /// Whether the rows were weighted by `1/std` (the std below are then
+    /// absolute, in the errors' units; else per unit measurement std).
+    pub weighted: bool,
     /// The number of candidates.
     pub candidates: usize,
     /// The count chosen.
@@ -324,21 +326,22 @@ pub struct Plan {
 }
 
 /// The identifiable subspace of a design, in whitened coordinates.
-struct Subspace {
+struct Subspace<'a> {
     rank: usize,
     /// `V` (N × r): an orthonormal basis of the identifiable subspace.
     v: DMatrix<f64>,
-    /// The rows in its coordinates, `A V` ((n·rows) × r).
-    av: DMatrix<f64>,
+    /// The design rows (`A`, (n·rows) × N).
+    a: &'a DMatrix<f64>,
     /// Whitened rows `A T` ((n·rows) × r).
     b: DMatrix<f64>,
     aliased: Vec<bool>,
 }
 
-fn subspace(design: &Design) -> Result<Subspace, PlanError> {
+fn subspace(design: &Rows) -> Result<Subspace<'_>, PlanError> {
     let a = &design.a;
     let n_e = a.ncols();
-    let info = a.tr_mul(a);
+    // AᵀA as one gemm (nalgebra's `tr_mul` is a dot product per entry).
+    let info = a.transpose() * a;
     let scale: Vec<f64> = (0..n_e)
         .map(|j| {
             let d = info[(j, j)].sqrt();
@@ -390,12 +393,11 @@ fn subspace(design: &Design) -> Result<Subspace, PlanError> {
         let cols: Vec<usize> = (0..n_e).filter(|&k| pe.eigenvalues[k] > 0.5).collect();
         DMatrix::from_fn(n_e, cols.len(), |j, c| pe.eigenvectors[(j, cols[c])])
     };
-    let av = a * &v;
     let b = a * &t;
     Ok(Subspace {
         rank,
         v,
-        av,
+        a,
         b,
         aliased,
     })
@@ -408,7 +410,7 @@ fn log_det(m: &DMatrix<f64>) -> Option<f64> {
     let mut s = 0.0;
     for k in 0..m.nrows() {
         let x = l[(k, k)];
-        if !(x > 0.0) {
+        if x.is_nan() || x <= 0.0 {
             return None;
         }
         s += 2.0 * x.ln();
@@ -416,7 +418,7 @@ fn log_det(m: &DMatrix<f64>) -> Option<f64> {
     Some(s)
 }
 
-impl Subspace {
+impl Subspace<'_> {
     /// The whitened information of a subset, `Tᵀ A_Sᵀ A_S T`.
     fn info(&self, rows: usize, chosen: &[usize]) -> DMatrix<f64> {
         let mut g = DMatrix::zeros(self.rank, self.rank);
@@ -443,11 +445,13 @@ impl Subspace {
             .fold(f64::INFINITY, f64::min);
         let regular = self.rank > 0 && min > 1e-12 * max.max(f64::MIN_POSITIVE);
         // Vᵀ M_S V, its log det and inverse.
-        let mut h = DMatrix::zeros(self.rank, self.rank);
-        for &i in &chosen {
-            let block = self.av.rows(rows * i, rows);
-            h += block.tr_mul(&block);
+        let mut a_s = DMatrix::zeros(chosen.len() * rows, self.a.ncols());
+        for (t, &i) in chosen.iter().enumerate() {
+            a_s.rows_mut(t * rows, rows)
+                .copy_from(&self.a.rows(rows * i, rows));
         }
+        let av = a_s * &self.v;
+        let h = av.transpose() * &av;
         let ld = if regular { log_det(&h) } else { None };
         match ld.and_then(|ld| h.cholesky().map(|c| (ld, c))) {
             Some((ld, c)) => {
@@ -478,7 +482,7 @@ pub fn even(n: usize, count: usize) -> Vec<usize> {
 /// Chooses `count` candidates of `design` maximising `det(AᵀA)` on the
 /// identifiable subspace (greedy, then Fedorov exchange to a local optimum),
 /// and reports them against the even spread of the same count.
-pub fn plan(design: &Design, count: usize) -> Result<Plan, PlanError> {
+pub fn plan(design: &Rows, count: usize) -> Result<Plan, PlanError> {
     let n = design.len();
     if n == 0 {
         return Err(PlanError::NoCandidates);
@@ -489,7 +493,7 @@ pub fn plan(design: &Design, count: usize) -> Result<Plan, PlanError> {
             candidates: n,
         });
     }
-    let rows = design.kind.rows();
+    let rows = design.per;
     let sub = subspace(design)?;
     let r = sub.rank;
     if count * rows < r {
@@ -508,7 +512,8 @@ pub fn plan(design: &Design, count: usize) -> Result<Plan, PlanError> {
     }
     let even = sub.subset(rows, even(n, count));
     Ok(Plan {
-        kind: design.kind,
+        rows_per_candidate: rows,
+        weighted: design.weighted,
         candidates: n,
         count,
         errors: design.errors.clone(),
@@ -521,142 +526,256 @@ pub fn plan(design: &Design, count: usize) -> Result<Plan, PlanError> {
     })
 }
 
-/// The greedy and exchange search in whitened coordinates.
+/// The greedy and exchange search in whitened coordinates `B` (m × r, `k`
+/// rows a candidate, column-major). The state is `M⁻¹` (of
+/// `M = εI + B_Sᵀ B_S`), every candidate's `H_l = B_l M⁻¹ B_lᵀ` (k × k, in
+/// the top-left of a 3 × 3) and, in the exchange, the cross terms
+/// `C = B M⁻¹ B_Sᵀ` (m × K·k, slot `s`'s columns at `k·s ..`), all kept
+/// current by low-rank (Woodbury) updates after each accepted step, so a
+/// step costs `O(m·r·k)` in thin products and an evaluation `O(k³)`.
 struct Search<'b> {
     b: &'b DMatrix<f64>,
-    rows: usize,
+    k: usize,
     n: usize,
-    /// `M⁻¹` (r × r).
-    m_inv: DMatrix<f64>,
-    /// `B M⁻¹` for every candidate ((n·rows) × r).
-    z: DMatrix<f64>,
     ridge: f64,
+    m_inv: DMatrix<f64>,
+    h: Vec<Matrix3<f64>>,
+    c: DMatrix<f64>,
 }
 
-/// A `rows × rows` block embedded in a 6 × 6 identity.
-fn small(rows: usize, f: impl Fn(usize, usize) -> f64) -> Matrix6<f64> {
-    let mut m = Matrix6::identity();
-    for i in 0..rows {
-        for j in 0..rows {
-            m[(i, j)] = f(i, j);
+/// The `k × k` block of `m` at `(r0, c0)`, in the top-left of a 3 × 3 of
+/// zeros.
+fn block(m: &DMatrix<f64>, r0: usize, c0: usize, k: usize) -> Matrix3<f64> {
+    let (rows, data) = (m.nrows(), m.as_slice());
+    let mut x = Matrix3::zeros();
+    for col in 0..k {
+        let src = &data[(c0 + col) * rows + r0..][..k];
+        for (row, v) in src.iter().enumerate() {
+            x[(row, col)] = *v;
         }
     }
-    m
+    x
+}
+
+/// `I_k` in the top-left of a 3 × 3 of zeros.
+fn eye(k: usize) -> Matrix3<f64> {
+    Matrix3::from_fn(|a, c| if a == c && a < k { 1.0 } else { 0.0 })
+}
+
+/// `b · zᵀ` for a thin `z` (`t × r`, t ≤ 6): one pass over `b`'s columns
+/// (nalgebra's generic product streams `b` once per column of the result
+/// when a dimension is below its gemm threshold).
+fn thin_product(b: &DMatrix<f64>, z: &DMatrix<f64>) -> DMatrix<f64> {
+    if z.nrows() > 5 {
+        return b * z.transpose();
+    }
+    let mut g = DMatrix::zeros(b.nrows(), z.nrows());
+    for c in 0..b.ncols() {
+        let col = b.column(c);
+        for a in 0..z.nrows() {
+            g.column_mut(a).axpy(z[(a, c)], &col, 1.0);
+        }
+    }
+    g
 }
 
 impl<'b> Search<'b> {
-    fn new(b: &'b DMatrix<f64>, rows: usize, n: usize, count: usize) -> Search<'b> {
+    fn new(b: &'b DMatrix<f64>, k: usize, n: usize, count: usize) -> Search<'b> {
         let r = b.ncols();
         let ridge = RIDGE * count as f64 / n as f64;
-        let m_inv = DMatrix::identity(r, r) / ridge;
-        let z = b / ridge;
-        Search {
-            b,
-            rows,
-            n,
-            m_inv,
-            z,
-            ridge,
-        }
-    }
-
-    /// `B_j M⁻¹ B_kᵀ` (rows × rows, embedded).
-    fn cross(&self, j: usize, k: usize, sign: f64) -> Matrix6<f64> {
-        let (rows, r) = (self.rows, self.b.ncols());
-        let mut m = Matrix6::zeros();
-        for a in 0..rows {
-            let zr = self.z.row(rows * j + a);
-            for c in 0..rows {
-                let br = self.b.row(rows * k + c);
-                let mut s = 0.0;
-                for x in 0..r {
-                    s += zr[x] * br[x];
+        let mut h = vec![Matrix3::zeros(); n];
+        // H_l = B_l B_lᵀ / ε, one pass over B's columns.
+        for col in 0..r {
+            let x = b.column(col);
+            for (l, hl) in h.iter_mut().enumerate() {
+                for c in 0..k {
+                    let xc = x[k * l + c];
+                    for a in 0..k {
+                        hl[(a, c)] += x[k * l + a] * xc / ridge;
+                    }
                 }
-                m[(a, c)] = sign * s;
             }
         }
-        m
+        Search {
+            b,
+            k,
+            n,
+            ridge,
+            m_inv: DMatrix::identity(r, r) / ridge,
+            h,
+            c: DMatrix::zeros(0, 0),
+        }
     }
 
-    /// `M ← M + σ B_jᵀ B_j` (σ = ±1): Woodbury on `M⁻¹` and `Z = B M⁻¹`.
-    fn update(&mut self, j: usize, sigma: f64) {
-        let rows = self.rows;
-        let bj = self.b.rows(rows * j, rows).into_owned();
-        let zj = self.z.rows(rows * j, rows).into_owned(); // B_j M⁻¹
-                                                           // (σ⁻¹ I + B_j M⁻¹ B_jᵀ)⁻¹
-        let mut core = &zj * bj.transpose();
-        for k in 0..rows {
-            core[(k, k)] += sigma;
+    /// The rows of candidates `list` stacked.
+    fn stack(&self, list: &[usize]) -> DMatrix<f64> {
+        let (k, r) = (self.k, self.b.ncols());
+        let mut out = DMatrix::zeros(list.len() * k, r);
+        for (t, &i) in list.iter().enumerate() {
+            out.rows_mut(t * k, k).copy_from(&self.b.rows(i * k, k));
         }
-        let Some(core_inv) = core.try_inverse() else {
-            return;
+        out
+    }
+
+    /// `M ← M + B_jᵀ B_j` (the greedy step): Woodbury on `M⁻¹`, the
+    /// rank-k update `H_l ← H_l − G_l (I + H_j)⁻¹ G_lᵀ`,
+    /// `G = B M⁻¹ B_jᵀ`.
+    fn add(&mut self, j: usize) -> bool {
+        let k = self.k;
+        let z = self.stack(&[j]) * &self.m_inv; // B_j M⁻¹, k × r
+        let g = thin_product(self.b, &z); // B M⁻¹ B_jᵀ, m × k
+        let Some(core) = (Matrix3::identity() + block(&g, k * j, 0, k)).try_inverse() else {
+            return false;
         };
-        // M⁻¹ ← M⁻¹ − (M⁻¹B_jᵀ) core⁻¹ (B_j M⁻¹)
-        let left = zj.transpose() * &core_inv; // r × rows
-        self.m_inv -= &left * &zj;
-        // Z ← Z − (Z B_jᵀ) core⁻¹ (B_j M⁻¹)
-        let zb = &self.z * bj.transpose(); // (n·rows) × rows
-        self.z -= zb * core_inv * zj;
+        let core = core - (Matrix3::identity() - eye(k)); // k × k block only
+        for (l, hl) in self.h.iter_mut().enumerate() {
+            let gl = block(&g, k * l, 0, k);
+            *hl -= gl * core * gl.transpose();
+        }
+        let core = DMatrix::from_fn(k, k, |a, c| core[(a, c)]);
+        self.m_inv -= z.transpose() * core * z;
+        true
+    }
+
+    /// `M⁻¹`, every `H_l` and the cross terms recomputed from the chosen
+    /// rows (no drift).
+    fn refresh(&mut self, chosen: &[usize]) -> bool {
+        let (k, r) = (self.k, self.b.ncols());
+        let bs = self.stack(chosen);
+        let m = DMatrix::identity(r, r) * self.ridge + bs.transpose() * &bs;
+        let Some(ch) = m.cholesky() else {
+            return false;
+        };
+        self.m_inv = ch.inverse();
+        let z = self.b * &self.m_inv; // B M⁻¹, m × r
+        for hl in self.h.iter_mut() {
+            *hl = Matrix3::zeros();
+        }
+        for col in 0..r {
+            let (zc, bc) = (z.column(col), self.b.column(col));
+            for (l, hl) in self.h.iter_mut().enumerate() {
+                for c in 0..k {
+                    let x = bc[k * l + c];
+                    for a in 0..k {
+                        hl[(a, c)] += zc[k * l + a] * x;
+                    }
+                }
+            }
+        }
+        self.c = z * bs.transpose();
+        true
+    }
+
+    /// The swap of slot `s` (candidate `i`) for candidate `j`:
+    /// `M ← M + B_jᵀB_j − B_iᵀB_i`, with `U = [B_j; B_i]`,
+    /// `Σ = diag(I, −I)`, `W = (Σ + U M⁻¹ Uᵀ)⁻¹`:
+    /// `M⁻¹ ← M⁻¹ − M⁻¹Uᵀ W U M⁻¹` (Woodbury), so for any rows `X, Y`,
+    /// `X M⁻¹ Yᵀ ← X M⁻¹ Yᵀ − (X M⁻¹ Uᵀ) W (U M⁻¹ Yᵀ)`.
+    fn swap(&mut self, s: usize, i: usize, j: usize) -> bool {
+        let k = self.k;
+        let zu = self.stack(&[j, i]) * &self.m_inv; // U M⁻¹, 2k × r
+        let g = thin_product(self.b, &zu); // B M⁻¹ Uᵀ, m × 2k
+        let mut umu = DMatrix::zeros(2 * k, 2 * k);
+        for t in 0..2 * k {
+            let row = if t < k { k * j + t } else { k * i + t - k };
+            umu.row_mut(t).copy_from(&g.row(row));
+        }
+        let mut sigma = umu.clone();
+        for t in 0..2 * k {
+            sigma[(t, t)] += if t < k { 1.0 } else { -1.0 };
+        }
+        let Some(w) = sigma.try_inverse() else {
+            return false;
+        };
+        // H_l ← H_l − G_l W G_lᵀ (fixed-size, zero-padded to 3 × 6).
+        let w6 = Matrix6::from_fn(|a, c| {
+            if a < 2 * k && c < 2 * k {
+                w[(a, c)]
+            } else {
+                0.0
+            }
+        });
+        let (m, gs) = (g.nrows(), g.as_slice());
+        for (l, hl) in self.h.iter_mut().enumerate() {
+            let mut gl = Matrix3x6::zeros();
+            for c in 0..2 * k {
+                for a in 0..k {
+                    gl[(a, c)] = gs[c * m + k * l + a];
+                }
+            }
+            *hl -= gl * w6 * gl.transpose();
+        }
+        // C ← C − G W (U M⁻¹ B_Sᵀ); slot s's columns become B M'⁻¹ B_jᵀ.
+        let mut us = DMatrix::zeros(2 * k, self.c.ncols());
+        for t in 0..2 * k {
+            let row = if t < k { k * j + t } else { k * i + t - k };
+            us.row_mut(t).copy_from(&self.c.row(row));
+        }
+        let new_j = g.columns(0, k) - &g * (&w * umu.columns(0, k));
+        // In place (one gemm; a temporary of C's size would cost more in
+        // page faults than the product).
+        self.c.gemm(-1.0, &g, &(&w * us), 1.0);
+        self.c.columns_mut(k * s, k).copy_from(&new_j);
+        self.m_inv -= zu.transpose() * &w * zu;
+        true
     }
 
     fn run(mut self, count: usize) -> Result<(Vec<usize>, usize, usize), PlanError> {
-        let rows = self.rows;
+        let k = self.k;
+        let id = Matrix3::identity();
         let mut chosen: Vec<usize> = Vec::with_capacity(count);
         let mut in_set = vec![false; self.n];
+        // Greedy: the largest det(I + H_j) (the matrix determinant lemma).
         for _ in 0..count {
             let mut best = (f64::NEG_INFINITY, usize::MAX);
             for j in (0..self.n).filter(|&j| !in_set[j]) {
-                let h = self.cross(j, j, 1.0);
-                let g = small(rows, |a, c| h[(a, c)] + if a == c { 1.0 } else { 0.0 });
-                let det = g.determinant();
+                let det = (id + self.h[j]).determinant();
                 if det > best.0 {
                     best = (det, j);
                 }
             }
             let j = best.1;
-            if j == usize::MAX {
+            if j == usize::MAX || !self.add(j) {
                 return Err(PlanError::Singular { count });
             }
             chosen.push(j);
             in_set[j] = true;
-            self.update(j, 1.0);
         }
         // The exchange, on the same information `M_S + εI` (the ridge is
         // 10⁻⁹ of an average candidate's share: it decides nothing but
-        // keeps an uninformed start invertible).
+        // keeps an uninformed start invertible), from exact state.
+        if !self.refresh(&chosen) {
+            return Err(PlanError::Singular { count });
+        }
         let mut swaps = 0;
         let mut sweeps = 0;
+        // Whether the state is exact (just refreshed) or carried through
+        // Woodbury updates.
+        let mut fresh = true;
         loop {
             sweeps += 1;
             let mut swapped = false;
+            // `chosen[slot]` is replaced inside the loop.
+            #[allow(clippy::needless_range_loop)]
             for slot in 0..count {
                 let i = chosen[slot];
-                let hii = self.cross(i, i, 1.0);
+                // det [I + H_j, C_ji; −C_ij, I − H_i]
+                //   = det(I − H_i) · det(I + H_j + C_ji (I − H_i)⁻¹ C_ij).
+                let d = id - self.h[i];
+                let det_d = d.determinant();
+                let Some(p) = d.try_inverse().filter(|_| det_d > 0.0) else {
+                    continue;
+                };
                 let mut best = (1.0 + SWAP_GAIN, usize::MAX);
                 for j in (0..self.n).filter(|&j| !in_set[j]) {
-                    let hjj = self.cross(j, j, 1.0);
-                    let cji = self.cross(j, i, 1.0);
-                    let mut m = Matrix6::zeros();
-                    for a in 0..rows {
-                        for c in 0..rows {
-                            m[(a, c)] = hjj[(a, c)] + if a == c { 1.0 } else { 0.0 };
-                            m[(a, rows + c)] = cji[(a, c)];
-                            m[(rows + a, c)] = -cji[(c, a)];
-                            m[(rows + a, rows + c)] = -hii[(a, c)] + if a == c { 1.0 } else { 0.0 };
-                        }
-                    }
-                    for k in 2 * rows..6 {
-                        m[(k, k)] = 1.0;
-                    }
-                    let det = m.determinant();
+                    let x = block(&self.c, k * j, k * slot, k); // B_j M⁻¹ B_iᵀ
+                    let det = det_d * (id + self.h[j] + x * p * x.transpose()).determinant();
                     if det > best.0 {
                         best = (det, j);
                     }
                 }
-                if best.1 != usize::MAX {
+                if best.1 != usize::MAX && self.swap(slot, i, best.1) {
                     let j = best.1;
-                    self.update(j, 1.0);
-                    self.update(i, -1.0);
                     in_set[i] = false;
                     in_set[j] = true;
                     chosen[slot] = j;
@@ -664,26 +783,21 @@ impl<'b> Search<'b> {
                     swapped = true;
                 }
             }
-            if !swapped || sweeps >= MAX_SWEEPS {
+            if sweeps >= MAX_SWEEPS || (!swapped && fresh) {
                 break;
             }
-            // Refresh M⁻¹ and Z from the chosen rows (no drift).
-            self.refresh(&chosen);
+            if !swapped {
+                // A sweep without a swap on updated state: confirm it on
+                // state recomputed from the chosen rows (no drift) before
+                // calling the design a local optimum.
+                if !self.refresh(&chosen) {
+                    return Err(PlanError::Singular { count });
+                }
+                fresh = true;
+            } else {
+                fresh = false;
+            }
         }
         Ok((chosen, swaps, sweeps))
-    }
-
-    /// `M⁻¹` and `Z` recomputed from the chosen rows.
-    fn refresh(&mut self, chosen: &[usize]) {
-        let r = self.b.ncols();
-        let mut m = DMatrix::identity(r, r) * self.ridge;
-        for &i in chosen {
-            let block = self.b.rows(self.rows * i, self.rows);
-            m += block.tr_mul(&block);
-        }
-        if let Some(c) = m.cholesky() {
-            self.m_inv = c.inverse();
-            self.z = self.b * &self.m_inv;
-        }
     }
 }

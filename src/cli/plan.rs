@@ -10,13 +10,14 @@
 
 use std::path::{Path, PathBuf};
 
-use chain_core::plan::{self, Candidate, Design, Kind, Plan, PlanError};
+use chain_core::diagnostic::closest;
+use chain_core::measured::{Layout, Measurements, Observed};
+use chain_core::plan::{self, Plan, PlanError, Rows};
 use chain_core::ErrorModel;
 use miette::MietteDiagnostic;
 use serde::Serialize;
 
 use super::args::ParamArgs;
-use super::csv_input::{numeric_rows, open_csv};
 use super::reliability::Loaded;
 use super::report::{self, Report};
 
@@ -32,11 +33,14 @@ pub enum PlanFormat {
 report::formats!(PlanFormat: Table, Json);
 
 /// What each candidate measures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum KindArg {
-    /// The tool-point deviation `px, py, pz` (three rows per candidate).
+    /// The tool-point deviation `px, py, pz` (three rows per candidate); the
+    /// file must not have `ux,uy,uz`.
     Point,
-    /// The deviation along the candidate's `ux, uy, uz` (one row).
+    /// The deviation along the candidate's `ux, uy, uz` (one row); the file
+    /// must have them.
     Direction,
 }
 
@@ -45,16 +49,18 @@ pub enum KindArg {
 pub struct PlanArgs {
     /// Machine file (YAML).
     pub file: PathBuf,
-    /// Candidate poses (CSV): a column per axis variable (rotary in
-    /// radians), optional columns of parameters given per row, and
-    /// `ux,uy,uz` for direction measurements; `-` reads stdin.
+    /// Candidate poses (CSV): the measurement CSV's columns without the
+    /// measured values: a column per axis variable (rotary in radians),
+    /// optional columns of parameters given per row, `ux,uy,uz` for
+    /// direction measurements, optionally `std`; `-` reads stdin.
     #[arg(long, value_name = "C.csv")]
     pub candidates: PathBuf,
     /// How many candidates to choose.
     #[arg(long, value_name = "K")]
     pub count: usize,
     /// What each candidate measures (default: `direction` when the file has
-    /// `ux,uy,uz`, else `point`).
+    /// `ux,uy,uz`, else `point`; a `--kind` that contradicts the file is
+    /// refused).
     #[arg(long, value_enum)]
     pub kind: Option<KindArg>,
     #[command(flatten)]
@@ -64,26 +70,64 @@ pub struct PlanArgs {
     pub format: PlanFormat,
 }
 
-/// The measured-value columns of a measurement CSV, which a candidate file
-/// does not have.
-const MEASURED: [&str; 5] = ["dpx", "dpy", "dpz", "d", "std"];
-/// The direction columns.
-const DIRECTION: [&str; 3] = ["ux", "uy", "uz"];
-
 /// Runs `chain plan`.
 pub fn exec(args: PlanArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
-    let model = chain_core::compile(m);
-    let (rows, kind) = read_candidates(&args.candidates, m, &model, &args)?;
+    for (name, _) in &args.param.params {
+        if m.parameter_index(name).is_none() {
+            let suggestion = closest(name, m.parameters.iter().map(|p| p.name.as_str()))
+                .map(|s| format!(" (did you mean `{s}`?)"))
+                .unwrap_or_default();
+            miette::bail!(
+                "--param {name}: machine `{}` has no parameter `{name}`{suggestion}",
+                m.name
+            );
+        }
+    }
     let name = display(&args.candidates);
-    let design = Design::new(&model, &rows, kind).map_err(|e| plan_error(e, &name))?;
-    let result = plan::plan(&design, args.count).map_err(|e| plan_error(e, &name))?;
+    let candidates = if args.candidates.as_os_str() == "-" {
+        let mut text = String::new();
+        std::io::Read::read_to_string(&mut std::io::stdin(), &mut text)
+            .map_err(|e| miette::miette!("cannot read {name}: {e}"))?;
+        Measurements::parse(&text, &name, m, &args.param.params, Layout::Candidates)?
+    } else {
+        Measurements::read(&args.candidates, m, &args.param.params, Layout::Candidates)?
+    };
+    // The file decides what each candidate measures (`ux,uy,uz` present:
+    // every row a direction); `--kind` must agree with it.
+    let kind = match candidates.rows[0].observed {
+        Observed::Point => KindArg::Point,
+        Observed::Direction { .. } => KindArg::Direction,
+    };
+    match (args.kind, kind) {
+        (Some(KindArg::Point), KindArg::Direction) => miette::bail!(
+            "{name}:1: columns `ux,uy,uz` give directions, but --kind point measures px, py, pz; pass --kind direction or remove them"
+        ),
+        (Some(KindArg::Direction), KindArg::Point) => miette::bail!(
+            "{name}:1: --kind direction needs the columns `ux,uy,uz` (the unit direction of each measurement)"
+        ),
+        _ => {}
+    }
+    if args.count == 0 || args.count > candidates.rows.len() {
+        return Err(plan_error(
+            PlanError::Count {
+                count: args.count,
+                candidates: candidates.rows.len(),
+            },
+            &name,
+        ));
+    }
+    let model = chain_core::compile(m);
+    let rows = Rows::of(&model, m, &candidates.rows).map_err(|e| plan_error(e, &name))?;
+    let result = plan::plan(&rows, args.count).map_err(|e| plan_error(e, &name))?;
     let doc = PlanDoc {
         machine: m.name.clone(),
         candidates_file: name,
+        kind,
         variables: model.variables().iter().map(|v| v.to_string()).collect(),
-        poses: rows.iter().map(|c| c.q.clone()).collect(),
+        lines: candidates.rows.iter().map(|c| c.line).collect(),
+        poses: candidates.rows.iter().map(|c| c.q.clone()).collect(),
         plan: result,
     };
     report::emit(&doc, args.format.into())
@@ -121,163 +165,6 @@ fn plan_error(e: PlanError, file: &str) -> miette::Report {
     miette::Report::new(d)
 }
 
-/// Reads the candidate CSV: every row's pose, parameters and direction, in
-/// the model's orders.
-fn read_candidates(
-    path: &Path,
-    m: &chain_core::Machine,
-    model: &chain_core::CompiledModel,
-    args: &PlanArgs,
-) -> miette::Result<(Vec<Candidate>, Kind)> {
-    let mut input = open_csv(path)?;
-    let name = input.name.clone();
-    let vars = model.variables();
-    let pars = model.parameters();
-    let mut var_col: Vec<Option<usize>> = vec![None; vars.len()];
-    let mut par_col: Vec<Option<usize>> = vec![None; pars.len()];
-    let mut dir_col: [Option<usize>; 3] = [None; 3];
-    for (k, h) in input.header.iter().enumerate() {
-        if let Some(v) = vars.iter().position(|v| v == h) {
-            var_col[v] = Some(k);
-        } else if let Some(p) = pars.iter().position(|p| p == h) {
-            par_col[p] = Some(k);
-        } else if let Some(d) = DIRECTION.iter().position(|d| d == h) {
-            dir_col[d] = Some(k);
-        } else if MEASURED.contains(&h.as_str()) {
-            miette::bail!(
-                "{name}:1: column `{h}` is a measured value; a candidate file gives only where to measure (the axis variables, parameters per row, and `ux,uy,uz` for direction measurements)"
-            );
-        } else {
-            let known = vars
-                .iter()
-                .chain(pars.iter())
-                .copied()
-                .chain(DIRECTION.iter().copied());
-            let hint = chain_core::diagnostic::closest(h, known)
-                .map(|c| format!(" (did you mean `{c}`?)"))
-                .unwrap_or_default();
-            miette::bail!(
-                "{name}:1: column `{h}` is neither an axis variable, a parameter of machine `{}` nor a direction column{hint}; expected {}{}, and `ux,uy,uz` for direction measurements",
-                m.name,
-                list(vars),
-                if pars.is_empty() {
-                    String::new()
-                } else {
-                    format!(", optionally parameters {}", list(pars))
-                }
-            );
-        }
-    }
-    let missing: Vec<String> = (vars.iter().zip(&var_col))
-        .filter(|(_, c)| c.is_none())
-        .map(|(v, _)| format!("`{v}`"))
-        .collect();
-    if !missing.is_empty() {
-        miette::bail!(
-            "{name}:1: no column for axis variable{} {}; the header names every axis variable ({})",
-            if missing.len() > 1 { "s" } else { "" },
-            missing.join(", "),
-            list(vars)
-        );
-    }
-    let given = dir_col.iter().filter(|c| c.is_some()).count();
-    let kind = match (args.kind, given) {
-        (_, 1 | 2) => {
-            let absent: Vec<&str> = (DIRECTION.iter().zip(&dir_col))
-                .filter(|(_, c)| c.is_none())
-                .map(|(d, _)| *d)
-                .collect();
-            miette::bail!(
-                "{name}:1: a direction needs all of `ux,uy,uz`; `{}` missing",
-                absent.join("`, `")
-            );
-        }
-        (Some(KindArg::Point), 3) => miette::bail!(
-            "{name}:1: columns `ux,uy,uz` give directions, but --kind point measures px, py, pz; pass --kind direction or remove them"
-        ),
-        (Some(KindArg::Direction), 0) => miette::bail!(
-            "{name}:1: --kind direction needs the columns `ux,uy,uz` (the unit direction of each measurement)"
-        ),
-        (Some(KindArg::Direction), _) | (None, 3) => Kind::Direction,
-        _ => Kind::Point,
-    };
-    // Parameters without a column: --param, else the file's value.
-    for (n, _) in &args.param.params {
-        if m.parameter_index(n).is_none() {
-            miette::bail!(
-                "{}: --param {n}: machine `{}` has no parameter `{n}`",
-                args.file.display(),
-                m.name
-            );
-        }
-    }
-    let fixed: Vec<Option<f64>> = (m.parameters.iter())
-        .map(|p| {
-            (args.param.params.iter().rev())
-                .find(|(n, _)| *n == p.name)
-                .map(|(_, v)| *v)
-                .or(p.value)
-        })
-        .collect();
-    let mut par_value: Vec<Option<f64>> = Vec::with_capacity(pars.len());
-    for (k, p) in pars.iter().enumerate() {
-        let v = m.parameter_index(p).and_then(|i| fixed[i]);
-        if par_col[k].is_none() && v.is_none() {
-            miette::bail!(
-                "{}: parameter `{p}` has no value: give it a column in {name} (one value per row) or pass --param {p}=VALUE",
-                args.file.display()
-            );
-        }
-        par_value.push(v);
-    }
-    let rows = numeric_rows(&mut input)?;
-    let mut out = Vec::with_capacity(rows.len());
-    for (line, values) in rows {
-        let direction = (kind == Kind::Direction)
-            .then(|| std::array::from_fn(|d| dir_col[d].map_or(f64::NAN, |c| values[c])));
-        if let Some(u) = direction {
-            let length = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
-            if (length - 1.0).abs() > plan::UNIT_TOLERANCE {
-                miette::bail!(
-                    "{name}:{line}: the direction (ux, uy, uz) = ({}, {}, {}) has length {length}, not 1 (to {:e})",
-                    u[0],
-                    u[1],
-                    u[2],
-                    plan::UNIT_TOLERANCE
-                );
-            }
-        }
-        out.push(Candidate {
-            q: var_col
-                .iter()
-                .map(|c| c.map_or(f64::NAN, |c| values[c]))
-                .collect(),
-            p: (par_col.iter().zip(&par_value))
-                .map(|(c, v)| c.map_or(v.unwrap_or(f64::NAN), |c| values[c]))
-                .collect(),
-            direction,
-        });
-    }
-    if args.count == 0 || args.count > out.len() {
-        return Err(plan_error(
-            PlanError::Count {
-                count: args.count,
-                candidates: out.len(),
-            },
-            &name,
-        ));
-    }
-    Ok((out, kind))
-}
-
-fn list(names: &[&str]) -> String {
-    names
-        .iter()
-        .map(|v| format!("`{v}`"))
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
 // ---------------------------------------------------------------------------
 // Output.
 
@@ -286,7 +173,12 @@ fn list(names: &[&str]) -> String {
 pub(crate) struct PlanDoc {
     machine: String,
     candidates_file: String,
+    /// What each candidate measures.
+    kind: KindArg,
     variables: Vec<String>,
+    /// Each candidate's CSV line.
+    #[serde(skip)]
+    lines: Vec<usize>,
     #[serde(skip)]
     poses: Vec<Vec<f64>>,
     #[serde(flatten)]
@@ -305,9 +197,9 @@ impl Report for PlanDoc {
             p.count,
             p.candidates,
             self.candidates_file,
-            match p.kind {
-                Kind::Point => "tool-point px, py, pz",
-                Kind::Direction => "1-D, along each candidate's direction",
+            match self.kind {
+                KindArg::Point => "tool-point px, py, pz",
+                KindArg::Direction => "1-D, along each candidate's direction",
             }
         );
         let aliased = p.aliased.iter().filter(|&&a| a).count();
@@ -346,8 +238,16 @@ impl Report for PlanDoc {
         let _ = writeln!(out);
         let _ = writeln!(
             out,
-            "expected std per unit measurement std:\n{:<14} {:>14} {:>14} {:>8}",
-            "parameter", "D-optimal", "even", "ratio"
+            "expected std {}:\n{:<14} {:>14} {:>14} {:>8}",
+            if p.weighted {
+                "(the candidates' std column: in the errors' units)"
+            } else {
+                "per unit measurement std"
+            },
+            "parameter",
+            "D-optimal",
+            "even",
+            "ratio"
         );
         for (j, e) in p.errors.iter().enumerate() {
             let (a, b) = (p.optimal.std[j], p.even.std[j]);
@@ -367,8 +267,8 @@ impl Report for PlanDoc {
             );
         }
         let _ = writeln!(out);
-        let _ = writeln!(out, "chosen candidates (row of {}):", self.candidates_file);
-        let header: Vec<String> = std::iter::once("row".to_string())
+        let _ = writeln!(out, "chosen candidates (line of {}):", self.candidates_file);
+        let header: Vec<String> = std::iter::once("line".to_string())
             .chain(self.variables.iter().cloned())
             .collect();
         let _ = writeln!(
@@ -381,7 +281,7 @@ impl Report for PlanDoc {
                 .join(" ")
         );
         for &i in &p.optimal.candidates {
-            let mut cells = vec![format!("{:>12}", i + 2)];
+            let mut cells = vec![format!("{:>12}", self.lines[i])];
             cells.extend(self.poses[i].iter().map(|x| format!("{:>12}", number(*x))));
             let _ = writeln!(out, "{}", cells.join(" "));
         }

@@ -249,7 +249,21 @@ fn classify(
         let known = m.variable_index(name).is_some()
             || m.parameter_index(name).is_some()
             || measured.contains(&name.as_str());
-        if !known {
+        let measured_value = layout == Layout::Candidates
+            && (POINT_COLUMNS.contains(&name.as_str()) || name == DISTANCE_COLUMN);
+        if measured_value {
+            let message = Message::new(
+                format!(
+                    "column `{name}` is a measured value: a candidate file gives only where to measure"
+                ),
+                "measured value",
+                "chain::measurements::measured_in_candidates",
+            )
+            .help(
+                "the candidate columns are the axis variables, parameters per row, `ux,uy,uz` for measurements along a direction, and optionally `std`",
+            );
+            problems.push((origin.clone(), message.into()));
+        } else if !known {
             let names: Vec<&str> = (m.variables.iter().map(|v| v.name.as_str()))
                 .chain(m.parameters.iter().map(|p| p.name.as_str()))
                 .chain(measured.iter().copied())
