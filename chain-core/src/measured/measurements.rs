@@ -157,7 +157,16 @@ impl Measurements {
         overrides: &[(String, f64)],
         layout: Layout,
     ) -> Result<Measurements, MeasurementsError> {
-        let csv = crate::values::csv::CsvFile::parse(text, file).map_err(MeasurementsError)?;
+        let header_help = match layout {
+            Layout::Measurements => {
+                "the header names the pose variables, any per-row parameters, then `dpx,dpy,dpz` or `ux,uy,uz,d`, and optionally `std`"
+            }
+            Layout::Candidates => {
+                "the header names the pose variables, any per-row parameters, and optionally `ux,uy,uz` and `std`"
+            }
+        };
+        let csv = crate::values::csv::CsvFile::parse_with(text, file, header_help)
+            .map_err(MeasurementsError)?;
         let fail = |problems: Vec<(Origin, Problem)>| {
             MeasurementsError(
                 Diagnostics::located(file, text, problems).expect("at least one problem"),
@@ -195,7 +204,10 @@ impl Measurements {
                 "no rows",
                 "chain::measurements::no_rows",
             )
-            .help("each row after the header is one measurement");
+            .help(match layout {
+                Layout::Measurements => "each row after the header is one measurement",
+                Layout::Candidates => "each row after the header is one candidate pose",
+            });
             return Err(fail(vec![(csv.header_origin(), empty.into())]));
         }
         Ok(Measurements {

@@ -37,6 +37,10 @@ pub(crate) enum CsvOpenError {
     Invalid(Diagnostics),
 }
 
+/// What a values table's header names (the help of an empty table).
+const TABLE_HEADER: &str =
+    "the header names the axis variable and the value columns, e.g. `x,EXX,EYX`";
+
 impl CsvFile {
     /// Reads the CSV file at `path`, named `name` in messages.
     pub(crate) fn read(path: &Path, name: &str) -> Result<CsvFile, CsvOpenError> {
@@ -46,8 +50,18 @@ impl CsvFile {
         CsvFile::parse(text, name).map_err(CsvOpenError::Invalid)
     }
 
-    /// Parses CSV text.
+    /// Parses the CSV text of a values table.
     pub(crate) fn parse(text: &str, name: &str) -> Result<CsvFile, Diagnostics> {
+        CsvFile::parse_with(text, name, TABLE_HEADER)
+    }
+
+    /// Parses CSV text; `header_help` says what the header of this kind of
+    /// file names (the help of an empty file or an unnamed column).
+    pub(crate) fn parse_with(
+        text: &str,
+        name: &str,
+        header_help: &'static str,
+    ) -> Result<CsvFile, Diagnostics> {
         let bom = if text.starts_with('\u{feff}') { 3 } else { 0 };
         let data = &text.as_bytes()[bom..];
         let mut reader = ::csv::ReaderBuilder::new()
@@ -109,7 +123,7 @@ impl CsvFile {
                             "no name",
                             "chain::values::csv_header",
                         )
-                        .help("the header names the axis variable and the value columns, e.g. `x,EXX,EYX`");
+                        .help(header_help);
                         return Err(located(origin, empty));
                     }
                     if let Some((_, first)) = header.iter().find(|(h, _)| h == field) {
@@ -154,7 +168,7 @@ impl CsvFile {
                 "empty",
                 "chain::values::csv_empty",
             )
-            .help("the header names the axis variable and the value columns, e.g. `x,EXX,EYX`");
+            .help(header_help);
             return Err(located(line_origin(text, 1), empty));
         }
         Ok(CsvFile {
