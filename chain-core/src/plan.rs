@@ -19,8 +19,9 @@
 //! `A` (the span of its right singular vectors with non-negligible singular
 //! values). The rank is decided on the column-equilibrated information
 //! `Dₛ AᵀA Dₛ` (`Dₛ = diag(1/‖a_j‖)`, so that a linear error in mm and an
-//! angular one in rad weigh alike): eigenvalues above [`RANK_TOLERANCE`]
-//! times the largest count. With `Vₛ, Λₛ` the retained eigenpairs, the
+//! angular one in rad weigh alike), by `identify`'s rule (one spectrum
+//! function for both): singular values above [`RANK_TOLERANCE`] times the
+//! largest count. With `Vₛ, Λₛ` the retained eigenpairs, the
 //! candidates' rows are taken to the whitened coordinates `b = Tᵀ a`,
 //! `T = Dₛ Vₛ Λₛ^{-1/2}`, in which the whole candidate set's information is
 //! the identity: the search works there. The reported quantities are the
@@ -62,17 +63,17 @@
 //! estimate (spec section 4) is `sqrt((M_S⁺)_jj)` with the pseudo-inverse
 //! `M_S⁺ = V (Vᵀ M_S V)⁻¹ Vᵀ`; with full rank, `(AᵀA)⁻¹`.
 
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix3x6, Matrix6, SymmetricEigen};
+use nalgebra::{DMatrix, Matrix3, Matrix3x6, Matrix6, SymmetricEigen};
 use serde::Serialize;
 
+use crate::measured::identify::{gram, spectrum};
 use crate::measured::{Design, DesignError, Measurement};
 use crate::model::Machine;
 use crate::model_trait::ErrorModel;
 
-/// Eigenvalues of the equilibrated information below this fraction of the
-/// largest are taken as zero (singular values below about 3·10⁻⁶ of the
-/// largest).
-pub const RANK_TOLERANCE: f64 = 1e-11;
+/// The rank rule is `identify`'s: singular values of the equilibrated
+/// design below this fraction of the largest are taken as zero.
+pub use crate::measured::identify::RANK_TOLERANCE;
 
 /// The ridge of the greedy start, relative to `K/n` (the information of `K`
 /// average candidates in whitened coordinates).
@@ -340,37 +341,18 @@ struct Subspace<'a> {
 fn subspace(design: &Rows) -> Result<Subspace<'_>, PlanError> {
     let a = &design.a;
     let n_e = a.ncols();
-    // AᵀA as one gemm (nalgebra's `tr_mul` is a dot product per entry).
-    let info = a.transpose() * a;
-    let scale: Vec<f64> = (0..n_e)
-        .map(|j| {
-            let d = info[(j, j)].sqrt();
-            if d > 0.0 {
-                1.0 / d
-            } else {
-                1.0
-            }
-        })
-        .collect();
-    let d = DMatrix::from_diagonal(&DVector::from_vec(scale));
-    let eq = &d * &info * &d;
-    let eigen = SymmetricEigen::new(eq);
-    let max = eigen.eigenvalues.iter().copied().fold(0.0, f64::max);
-    if max <= 0.0 {
+    // AᵀA over row blocks in parallel, and the rank rule of `identify`
+    // (one spectrum for both).
+    let spec = spectrum(&gram(a));
+    if spec.rank == 0 {
         return Err(PlanError::Uninformative);
     }
-    let keep: Vec<usize> = (0..n_e)
-        .filter(|&k| eigen.eigenvalues[k] > RANK_TOLERANCE * max)
-        .collect();
-    let null: Vec<usize> = (0..n_e).filter(|k| !keep.contains(k)).collect();
-    let rank = keep.len();
-    let mut t = DMatrix::zeros(n_e, rank);
-    for (c, &k) in keep.iter().enumerate() {
-        let s = eigen.eigenvalues[k].sqrt();
-        for j in 0..n_e {
-            t[(j, c)] = d[(j, j)] * eigen.eigenvectors[(j, k)] / s;
-        }
-    }
+    let rank = spec.rank;
+    let d = &spec.d;
+    let t = DMatrix::from_fn(n_e, rank, |j, c| {
+        d[j] * spec.vectors[(j, c)] / spec.lambda[c].sqrt()
+    });
+    let null: Vec<usize> = (rank..n_e).collect();
     // The null space of A is Dₛ times the equilibrated one's; V is an
     // orthonormal basis of its orthogonal complement (the eigenvectors of
     // I − QQᵀ of eigenvalue 1).
@@ -381,7 +363,7 @@ fn subspace(design: &Rows) -> Result<Subspace<'_>, PlanError> {
         let mut z = DMatrix::zeros(n_e, null.len());
         for (c, &k) in null.iter().enumerate() {
             for j in 0..n_e {
-                z[(j, c)] = d[(j, j)] * eigen.eigenvectors[(j, k)];
+                z[(j, c)] = d[j] * spec.vectors[(j, k)];
             }
         }
         let q = z.qr().q();

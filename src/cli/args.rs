@@ -11,6 +11,29 @@ pub struct ParamArgs {
     pub params: Vec<(String, f64)>,
 }
 
+impl ParamArgs {
+    /// Refuses a `--param` naming no parameter of `m` (with the closest
+    /// name), for the commands whose parameters may also come per CSV row
+    /// (`identify`, `plan`): their values are checked where they are used.
+    pub fn check_names(&self, m: &chain_core::Machine) -> miette::Result<()> {
+        for (name, _) in &self.params {
+            if m.parameter_index(name).is_none() {
+                let suggestion = chain_core::diagnostic::closest(
+                    name,
+                    m.parameters.iter().map(|p| p.name.as_str()),
+                )
+                .map(|s| format!(" (did you mean `{s}`?)"))
+                .unwrap_or_default();
+                miette::bail!(
+                    "--param {name}: machine `{}` has no parameter `{name}`{suggestion}",
+                    m.name
+                );
+            }
+        }
+        Ok(())
+    }
+}
+
 /// `--param` and `--sided`: the model of a machine file with `statistics`.
 #[derive(Debug, clap::Args)]
 pub struct ModelArgs {

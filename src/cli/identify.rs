@@ -11,7 +11,6 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use chain_core::diagnostic::closest;
 use chain_core::measured::identify::{Estimate, Prior, Residual};
 use chain_core::measured::{identify, Design, Identification, Layout, Measurements};
 use chain_core::named::NameMap;
@@ -63,17 +62,7 @@ pub struct IdentifyArgs {
 pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
-    for (name, _) in &args.param.params {
-        if m.parameter_index(name).is_none() {
-            let suggestion = closest(name, m.parameters.iter().map(|p| p.name.as_str()))
-                .map(|s| format!(" (did you mean `{s}`?)"))
-                .unwrap_or_default();
-            miette::bail!(
-                "--param {name}: machine `{}` has no parameter `{name}`{suggestion}",
-                m.name
-            );
-        }
-    }
+    args.param.check_names(m)?;
     let measurements = Measurements::read(
         &args.measurements,
         m,

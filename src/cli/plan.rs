@@ -10,7 +10,6 @@
 
 use std::path::{Path, PathBuf};
 
-use chain_core::diagnostic::closest;
 use chain_core::measured::{Layout, Measurements, Observed};
 use chain_core::plan::{self, Plan, PlanError, Rows};
 use chain_core::ErrorModel;
@@ -74,17 +73,7 @@ pub struct PlanArgs {
 pub fn exec(args: PlanArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
-    for (name, _) in &args.param.params {
-        if m.parameter_index(name).is_none() {
-            let suggestion = closest(name, m.parameters.iter().map(|p| p.name.as_str()))
-                .map(|s| format!(" (did you mean `{s}`?)"))
-                .unwrap_or_default();
-            miette::bail!(
-                "--param {name}: machine `{}` has no parameter `{name}`{suggestion}",
-                m.name
-            );
-        }
-    }
+    args.param.check_names(m)?;
     let name = display(&args.candidates);
     let candidates = if args.candidates.as_os_str() == "-" {
         let mut text = String::new();

@@ -299,28 +299,14 @@ pub fn identify(design: &Design, prior: Option<&Prior>) -> Result<Identification
     let y = DVector::from_iterator(m, design.b.iter().zip(&inv_sigma).map(|(b, w)| b * w));
     let info = gram(&bm);
     let g = bm.tr_mul(&y);
-    let d: Vec<f64> = (0..n)
-        .map(|j| {
-            let c = info[(j, j)].sqrt();
-            if c > 0.0 {
-                1.0 / c
-            } else {
-                1.0
-            }
-        })
-        .collect();
-    let scaled = DMatrix::from_fn(n, n, |i, j| d[i] * info[(i, j)] * d[j]);
-    let (lambda, v) = symmetric_svd(&scaled);
+    let Spectrum {
+        d,
+        lambda,
+        vectors: v,
+        rank,
+    } = spectrum(&info);
     let s_max = lambda.first().copied().unwrap_or(0.0).max(0.0).sqrt();
     let singular: Vec<f64> = lambda.iter().map(|l| l.max(0.0).sqrt()).collect();
-    let rank = if s_max > 0.0 {
-        singular
-            .iter()
-            .filter(|s| **s > RANK_TOLERANCE * s_max)
-            .count()
-    } else {
-        0
-    };
     let condition = if rank > 0 {
         s_max / singular[rank - 1]
     } else {
@@ -536,7 +522,7 @@ fn per_block<T: Send>(m: usize, f: impl Fn(usize, usize) -> T + Sync) -> Vec<T> 
 /// explicit transpose so that its product runs on nalgebra's blocked matrix
 /// multiplication (`tr_mul` is a dot product per entry, several times
 /// slower here), the blocks in parallel.
-fn gram(b: &DMatrix<f64>) -> DMatrix<f64> {
+pub(crate) fn gram(b: &DMatrix<f64>) -> DMatrix<f64> {
     let (m, n) = b.shape();
     per_block(m, |r0, r1| {
         let block = b.rows(r0, r1 - r0);
@@ -559,6 +545,54 @@ fn leverages(b: &DMatrix<f64>, cov: &DMatrix<f64>) -> Vec<f64> {
             .collect::<Vec<f64>>()
     })
     .concat()
+}
+
+/// The spectrum of a column-equilibrated information matrix: the one rank
+/// rule of `identify` and `plan`.
+pub(crate) struct Spectrum {
+    /// The equilibration `d_j = 1/√(AᵀWA)_jj` (1 for a zero column).
+    pub d: Vec<f64>,
+    /// The eigenvalues of `D AᵀWA D`, largest first (the squared singular
+    /// values of `B D`).
+    pub lambda: Vec<f64>,
+    /// Its eigenvectors, in the same order.
+    pub vectors: DMatrix<f64>,
+    /// The count of singular values above [`RANK_TOLERANCE`] `× s_max`.
+    pub rank: usize,
+}
+
+/// [`Spectrum`] of the information matrix `info = AᵀWA`: equilibrated by
+/// its diagonal (a linear error in mm and an angular one in rad weigh
+/// alike), decomposed through nalgebra's SVD.
+pub(crate) fn spectrum(info: &DMatrix<f64>) -> Spectrum {
+    let n = info.nrows();
+    let d: Vec<f64> = (0..n)
+        .map(|j| {
+            let c = info[(j, j)].sqrt();
+            if c > 0.0 {
+                1.0 / c
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let scaled = DMatrix::from_fn(n, n, |i, j| d[i] * info[(i, j)] * d[j]);
+    let (lambda, vectors) = symmetric_svd(&scaled);
+    let s_max = lambda.first().copied().unwrap_or(0.0).max(0.0).sqrt();
+    let rank = if s_max > 0.0 {
+        lambda
+            .iter()
+            .filter(|l| l.max(0.0).sqrt() > RANK_TOLERANCE * s_max)
+            .count()
+    } else {
+        0
+    };
+    Spectrum {
+        d,
+        lambda,
+        vectors,
+        rank,
+    }
 }
 
 /// Eigenvalues (largest first) and eigenvectors of a symmetric positive
