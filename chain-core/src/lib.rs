@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 
 pub mod built;
+pub mod compensation;
 pub mod input;
 pub mod kinematics;
 pub mod measured;
