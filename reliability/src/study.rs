@@ -692,33 +692,10 @@ impl Study {
     }
 
     /// The mean and covariance of the six error components at point `p`
-    /// (exact linear propagation of the inputs' means and variances).
+    /// (exact linear propagation of the inputs' means and covariance:
+    /// `Cov(E_a, E_b) = S_aᵀΣS_b`, [`Inputs::covariance`], the diagonal sum
+    /// alone for independent inputs).
     pub fn moments(&self, p: usize) -> ErrorMoments {
-        if !self.inputs.correlations().is_empty() {
-            return self.correlated_moments(p);
-        }
-        let means = self.inputs.means();
-        let vars: Vec<f64> = self.inputs.stds().iter().map(|s| s * s).collect();
-        let mut mean = [0.0; 6];
-        let mut covariance = [[0.0; 6]; 6];
-        for a in Component::ALL {
-            let ra = self.row(p, a);
-            mean[a.index()] = ra.iter().zip(means).map(|(s, m)| s * m).sum();
-            for b in Component::ALL {
-                let rb = self.row(p, b);
-                covariance[a.index()][b.index()] = ra
-                    .iter()
-                    .zip(rb)
-                    .zip(&vars)
-                    .map(|((x, y), v)| x * y * v)
-                    .sum();
-            }
-        }
-        ErrorMoments { mean, covariance }
-    }
-
-    /// [`Study::moments`] with correlated inputs: `Cov(E_a, E_b) = S_aᵀΣS_b`.
-    fn correlated_moments(&self, p: usize) -> ErrorMoments {
         let means = self.inputs.means();
         let mut mean = [0.0; 6];
         let mut covariance = [[0.0; 6]; 6];
