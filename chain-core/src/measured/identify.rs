@@ -530,7 +530,10 @@ pub(crate) fn gram(b: &DMatrix<f64>) -> DMatrix<f64> {
         bt * block
     })
     .into_iter()
-    .fold(DMatrix::zeros(n, n), |acc, g| acc + g)
+    .fold(DMatrix::zeros(n, n), |mut acc, g| {
+        acc += g;
+        acc
+    })
 }
 
 /// The leverages `h_i = b_iᵀ Σ b_i` of the rows of `b` (the diagonal of the
