@@ -222,7 +222,7 @@ fn map_error(e: MapError, values: &std::path::Path) -> miette::Report {
 
 /// The grid axes, in the machine's variable order: `reliability.grid`, each
 /// axis replaced by `--grid`; every variable must have values.
-fn grid_axes(
+pub(crate) fn grid_axes(
     m: &chain_core::Machine,
     loaded: &Loaded,
     file: &str,
@@ -265,7 +265,10 @@ fn grid_axes(
 }
 
 /// The points of `--axes`: every row, in the machine's variable order.
-fn axes_points(path: &std::path::Path, m: &chain_core::Machine) -> miette::Result<Vec<f64>> {
+pub(crate) fn axes_points(
+    path: &std::path::Path,
+    m: &chain_core::Machine,
+) -> miette::Result<Vec<f64>> {
     let mut input = open_csv(path)?;
     let name = input.name.clone();
     let has_t = input.header.first().is_some_and(|h| h == "t")

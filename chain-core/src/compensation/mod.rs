@@ -103,37 +103,47 @@ impl CompensationError {
     }
 }
 
-/// The built machine's error values at `q`, into `out`. When `q` leaves a
-/// table by a correction (a node at a table's end commanded `δq` beyond
-/// it), the values are continued linearly over `|δq|` from `base`, the
-/// values at the uncorrected command `q0`: `v(q) ≈ 2·v(q0) − v(2·q0 − q)`
-/// (exact to first order in `δq`, so the residual it enters stays exact to
-/// second order in the errors; `docs/export.md`). Returns whether that
-/// continuation was used. `q0` itself outside a table is an error.
+/// The built machine's error values at `q = q0 + δq`, into `out`. When `q`
+/// leaves a table by the correction (a node at a table's end commanded
+/// `δq` beyond it), the tables of each axis variable `k` that `q_k` leaves
+/// are continued linearly over `|δq_k|` from the uncorrected command `q0`:
+/// `v(q0_k + δ_k) ≈ 2·v(q0_k) − v(q0_k − δ_k)` (exact to first order in
+/// `δq`, so the residual it enters stays exact to second order in the
+/// errors; `docs/export.md`). Every table depends on one axis variable, so
+/// with `a` (the variables that leave a table mirrored to `q0 − δq`, the
+/// others at `q`) and `b` (those at `q0`, the others at `q`),
+/// `v = 2·v(b) − v(a)` is that continuation for the tables of the
+/// variables that left, and `v(q)` for every other entry. Returns whether
+/// the continuation was used. `q0 − δq` outside a table too is the error
+/// of `q`.
 pub(crate) fn values_near<M: ErrorModel>(
     built: &BuiltMachine<M>,
     q0: &[f64],
-    base: &[f64],
     q: &[f64],
-    mirror: &mut [f64],
+    s: &mut ResidualScratch,
     out: &mut [f64],
 ) -> Result<bool, OutOfRange> {
     let values = built.values();
-    match crate::ErrorValues::values_at(values, q, out) {
-        Ok(()) => Ok(false),
-        Err(e) => {
-            for ((m, &a), &b) in mirror.iter_mut().zip(q0).zip(q) {
-                *m = 2.0 * a - b;
-            }
-            if crate::ErrorValues::values_at(values, mirror, out).is_err() {
-                return Err(e);
-            }
-            for (o, &b) in out.iter_mut().zip(base) {
-                *o = 2.0 * b - *o;
-            }
-            Ok(true)
-        }
+    let Err(first) = crate::ErrorValues::values_at(values, q, out) else {
+        return Ok(false);
+    };
+    // Which variables take q out of a table: move them one at a time.
+    s.mirror.copy_from_slice(q0);
+    s.half.copy_from_slice(q0);
+    for k in 0..q.len() {
+        s.mirror[k] = q[k];
+        let leaves = crate::ErrorValues::values_at(values, &s.mirror, out).is_err();
+        s.mirror[k] = if leaves { 2.0 * q0[k] - q[k] } else { q[k] };
+        s.half[k] = if leaves { q0[k] } else { q[k] };
     }
+    if crate::ErrorValues::values_at(values, &s.mirror, &mut s.base).is_err() {
+        return Err(first);
+    }
+    crate::ErrorValues::values_at(values, &s.half, out).map_err(|_| first)?;
+    for (o, &a) in out.iter_mut().zip(&s.base) {
+        *o = 2.0 * *o - a;
+    }
+    Ok(true)
 }
 
 /// Scratch space of [`Residual::at`], one per thread.
@@ -143,6 +153,7 @@ pub struct ResidualScratch {
     values: Vec<f64>,
     q: Vec<f64>,
     mirror: Vec<f64>,
+    half: Vec<f64>,
 }
 
 /// What is left of the error when the controller adds `δq` to the command:
@@ -177,6 +188,7 @@ impl<'b, M: ErrorModel> Residual<'b, M> {
             values: vec![0.0; n],
             q: vec![0.0; nv],
             mirror: vec![0.0; nv],
+            half: vec![0.0; nv],
         }
     }
 
@@ -192,11 +204,15 @@ impl<'b, M: ErrorModel> Residual<'b, M> {
         let built = self.built;
         let model = built.model();
         let p = built.parameters();
-        crate::ErrorValues::values_at(built.values(), q, &mut s.base)?;
         for ((c, &a), &d) in s.q.iter_mut().zip(q).zip(delta) {
             *c = a + d;
         }
-        let mirrored = values_near(built, q, &s.base, &s.q, &mut s.mirror, &mut s.values)?;
+        let mut values = std::mem::take(&mut s.values);
+        let qd = std::mem::take(&mut s.q);
+        let mirrored = values_near(built, q, &qd, s, &mut values);
+        s.q = qd;
+        s.values = values;
+        let mirrored = mirrored?;
         let mut e = [0.0; 6];
         model.error(&s.q, p, &s.values, &mut e);
         let at = model.nominal(&s.q, p);
