@@ -147,14 +147,19 @@ fn solve_rows(
 ) -> usize {
     let m = a.len();
     let dot = |u: &[f64], v: &[f64]| -> f64 { u.iter().zip(v).map(|(a, b)| a * b).sum() };
-    for _sweep in 0..60 {
+    for _sweep in 0..30 {
         let mut rotated = false;
         for i in 0..m {
             for j in i + 1..m {
                 let alpha = dot(&a[i], &a[i]);
                 let beta = dot(&a[j], &a[j]);
                 let gamma = dot(&a[i], &a[j]);
-                if gamma == 0.0 || gamma.abs() <= 1e-15 * (alpha * beta).sqrt() {
+                // Orthogonal to rounding, or a row that is zero to the rank
+                // tolerance (rotating it against another only moves noise).
+                if gamma == 0.0
+                    || gamma.abs() <= 4.0 * f64::EPSILON * (alpha * beta).sqrt()
+                    || alpha.min(beta) <= tol * tol
+                {
                     continue;
                 }
                 rotated = true;
