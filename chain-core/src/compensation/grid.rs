@@ -66,11 +66,8 @@ impl Scalar for Dual {
     }
     fn times(&self, other: &Dual) -> Dual {
         let (a, b) = (self.0[0], other.0[0]);
-        let mut d = [0.0; LANES];
+        let mut d: [f64; LANES] = std::array::from_fn(|i| a * other.0[i] + b * self.0[i]);
         d[0] = a * b;
-        for i in 1..LANES {
-            d[i] = a * other.0[i] + b * self.0[i];
-        }
         Dual(d)
     }
     fn times_f64(&self, k: f64) -> Dual {
@@ -296,8 +293,8 @@ impl Solver {
             self.x2.iter_mut().for_each(|v| *v = 0.0);
             0
         };
-        for k in 0..n {
-            delta[k] = self.x1[k] + self.x2[k];
+        for ((d, a), b) in delta[..n].iter_mut().zip(&self.x1).zip(&self.x2) {
+            *d = a + b;
         }
         Ranks {
             position: rank_p,
@@ -832,14 +829,13 @@ impl Correction for GridCorrection {
         'corner: for c in 0..corners {
             let mut w = 1.0;
             let mut flat = 0;
-            for a in 0..nv {
+            for (a, (&(k, t), axis)) in cells.iter().zip(&self.axes).enumerate() {
                 let up = (c >> a) & 1 == 1;
-                let (k, t) = cells[a];
-                if self.axes[a].len() == 1 && up {
+                if axis.len() == 1 && up {
                     continue 'corner;
                 }
                 w *= if up { t } else { 1.0 - t };
-                flat = flat * self.axes[a].len() + k + usize::from(up);
+                flat = flat * axis.len() + k + usize::from(up);
             }
             if w == 0.0 {
                 continue;
