@@ -495,3 +495,96 @@ fn map_compensated_shows_the_export_residual_next_to_the_error() {
 fn same(a: f64, b: f64) -> bool {
     (a - b).abs() <= 4.0 * f64::EPSILON * b.abs()
 }
+
+#[test]
+fn the_correction_does_not_depend_on_the_frame_of_the_error() {
+    // ac_trunnion with `frame: tool`: E is reported in the tool frame, the
+    // solve turns it back; δq and the residual are the same.
+    let dir = scratch("frame");
+    let text = std::fs::read_to_string(common::example_path("ac_trunnion.yaml")).unwrap();
+    assert!(text.contains("frame: workpiece"));
+    let tool = write(
+        &dir,
+        "ac_tool.yaml",
+        &text.replace("frame: workpiece", "frame: tool"),
+    );
+    let mw = load_example("ac_trunnion.yaml");
+    let mt = chain::core::load_file(&tool).unwrap();
+    let values = values_file(&dir, &mw, 1.0);
+    let grid: Vec<Vec<f64>> = (mw.variables.iter())
+        .map(|v| match v.name.as_str() {
+            "A" => vec![-0.6, 0.4],
+            "C" => vec![-1.0, 2.0],
+            "x" => vec![100.0, 700.0],
+            _ => vec![-100.0, 50.0],
+        })
+        .collect();
+    let a = library(&mw, &values, &grid);
+    let b = library(&mt, &values, &grid);
+    assert_eq!(b.frame, chain::core::model::Frame::Tool);
+    for i in 0..a.len() {
+        for (x, y) in a.delta(i).iter().zip(b.delta(i)) {
+            assert!(
+                (x - y).abs() <= 1e-12 * x.abs().max(1e-9),
+                "node {i}: {x} {y}"
+            );
+        }
+        assert!((a.residuals[i] - b.residuals[i]).abs() <= 1e-9 * a.summary.before.max);
+    }
+    // The compensated map in the tool frame: the residual's norm is frame-free.
+    let v = Values::read(&values, &mt).unwrap();
+    let built = BuiltMachine::compile(&mt, v, Exact::new(&mt).file_parameters()).unwrap();
+    let map = built
+        .compensated_map(&b.correction().unwrap(), b.points.clone())
+        .unwrap();
+    for i in 0..b.len() {
+        assert!((map.volumetric(i) - b.residuals[i]).abs() <= 1e-15);
+    }
+}
+
+#[test]
+fn axes_rows_give_the_grid_nodes_corrections() {
+    let dir = scratch("axes");
+    let rows = "t,x,y,z\n0,0,0,0\n1,800,500,500\n2,300,200,100\n";
+    let axes = write(&dir, "axes.csv", rows);
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "export",
+            "examples/machines/vmc3.yaml",
+            "--values",
+            "examples/values/vmc3.yaml",
+            "--controller",
+            "grid",
+        ];
+        a.extend_from_slice(extra);
+        ok_stdout(&a)
+    };
+    let (header, listed) = parse(&args(&["--axes", axes.to_str().unwrap()]));
+    assert_eq!(header[..3], ["y", "x", "z"]);
+    assert_eq!(listed.len(), 3);
+    // The same nodes from the grid: the same numbers (machine order y, x, z).
+    let (_, all) = parse(&args(&[]));
+    for row in &listed {
+        let same_node = all.iter().find(|r| r[..3] == row[..3]).unwrap();
+        assert_eq!(row, same_node);
+    }
+    // A list of poses has no grid to interpolate: map --compensated with
+    // --axes takes the machine file's grid for the correction.
+    let doc: serde_json::Value = serde_json::from_str(&ok_stdout(&[
+        "map",
+        "examples/machines/vmc3.yaml",
+        "--values",
+        "examples/values/vmc3.yaml",
+        "--axes",
+        axes.to_str().unwrap(),
+        "--format",
+        "json",
+        "--compensated",
+        "grid",
+    ]))
+    .unwrap();
+    let pts = doc["compensated"]["points"].as_array().unwrap();
+    for (p, row) in pts.iter().zip(&listed) {
+        assert!(same(p["volumetric"].as_f64().unwrap(), row[6]));
+    }
+}
