@@ -207,7 +207,7 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
         }
         if let Some(c) = &doc.compensated {
             let mut r = c.result.clone();
-            r.machine = format!("{} after {} compensation", doc.machine, c.controller);
+            r.machine = format!("{} compensated ({})", doc.machine, c.controller);
             let after = MapDoc {
                 values_file: doc.values_file.clone(),
                 entries: Vec::new(),
