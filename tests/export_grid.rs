@@ -386,6 +386,9 @@ fn out_writes_the_file_and_the_summary_goes_to_stdout() {
         "json",
     ]);
     let doc: serde_json::Value = serde_json::from_str(&json).unwrap();
+    // One key each (serde_json would keep the last of two silently).
+    assert_eq!(json.matches("\"controller\"").count(), 1, "{json}");
+    assert_eq!(doc["controller"], "grid");
     assert_eq!(doc["files"][0], "vmc3_grid.csv");
     assert_eq!(doc["summary"]["nodes"], 324);
     let text = std::fs::read_to_string(dir.join("vmc3_grid.csv")).unwrap();

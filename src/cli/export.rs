@@ -183,6 +183,8 @@ pub(crate) fn export_error(e: CompensationError, values: &std::path::Path) -> mi
 /// The report of `chain export`.
 #[derive(Serialize)]
 struct ExportDoc {
+    /// The controller (the table's; JSON has the export's own).
+    #[serde(skip)]
     controller: &'static str,
     values_file: String,
     /// The files written (with --out) or that would be.
