@@ -824,16 +824,21 @@ impl Correction for GridCorrection {
             cells[a] = (k, t);
         }
         delta.iter_mut().for_each(|d| *d = 0.0);
-        // Σ over the 2^nv corners (axes of one value have one corner).
-        let corners = 1usize << nv;
-        'corner: for c in 0..corners {
+        // Σ over the corners of the cell: two per axis strictly inside an
+        // interval (t > 0), one per axis on a node (t = 0, or one value),
+        // so a node costs one corner and a point on a grid line 2^(free axes).
+        let free = cells.iter().filter(|(_, t)| *t > 0.0).count();
+        for c in 0..1usize << free {
             let mut w = 1.0;
             let mut flat = 0;
-            for (a, (&(k, t), axis)) in cells.iter().zip(&self.axes).enumerate() {
-                let up = (c >> a) & 1 == 1;
-                if axis.len() == 1 && up {
-                    continue 'corner;
-                }
+            let mut bit = 0;
+            for (&(k, t), axis) in cells.iter().zip(&self.axes) {
+                let up = if t > 0.0 {
+                    bit += 1;
+                    (c >> (bit - 1)) & 1 == 1
+                } else {
+                    false
+                };
                 w *= if up { t } else { 1.0 - t };
                 flat = flat * axis.len() + k + usize::from(up);
             }
