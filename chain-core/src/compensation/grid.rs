@@ -15,9 +15,11 @@
 //!              u₁, u₂ an orthonormal basis of the plane ⊥ z   (2 rows)
 //! ```
 //!
-//! solved in that priority (hierarchical least squares, Siciliano &
-//! Slotine 1991, "A general framework for managing multiple tasks in highly
-//! redundant robotic systems", eq. 9): `δ₁ = J_p⁺(−e_p)` (minimum norm), then
+//! solved in that priority (the task-priority solution of Nakamura,
+//! Hanafusa & Yoshikawa 1987, "Task-priority based redundancy control of
+//! robot manipulators", and Siciliano & Slotine 1991, "A general framework
+//! for managing multiple tasks in highly redundant robotic systems"):
+//! `δ₁ = J_p⁺(−e_p)` (minimum norm), then
 //! `δq = δ₁ + (A_o P)⁺ (b_o − A_o δ₁)` with `A_o = [u₁ᵀ; u₂ᵀ] J_ω`,
 //! `b_o = −[u₁ᵀ; u₂ᵀ] e_o` and `P = I − J_p⁺ J_p` the projector onto the
 //! motions that leave the tool point where it is. When the five rows can be
