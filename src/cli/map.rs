@@ -1,12 +1,19 @@
 //! `chain map FILE --values VALUES.yaml [--grid VAR=V1,V2,...|VAR=LO:HI:N]...
 //! [--axes AXES.csv] [--param NAME=VALUE]... [--format table|json|csv]
-//! [--plot DIR]`.
+//! [--plot DIR] [--compensated CONTROLLER [--compensation-grid VAR=...]...]`.
 //!
 //! The volumetric error of a built machine (measured-machines spec, section
 //! 3): `E(q) = Σ_j c_j(q)·v_j(q)` at every point of the machine file's
 //! `reliability.grid` (full factorial, each axis replaceable by `--grid`) or
 //! at every row of `--axes`, with the error values `v_j` of a values file
 //! (section 2), through [`chain_core::BuiltMachine::map`]. See `docs/map.md`.
+//!
+//! `--compensated CONTROLLER` adds the map after compensation (issue 14,
+//! point 4; `docs/export.md`): the controller's correction
+//! ([`chain_core::compensation::Correction`]) added to every commanded point,
+//! the residual through [`chain_core::BuiltMachine::compensated_map`], shown
+//! next to the uncompensated map (table, JSON `compensated`, CSV columns
+//! `*_after`, plots in `DIR/compensated/`).
 
 #[path = "map_plot.rs"]
 mod map_plot;
@@ -24,6 +31,7 @@ use serde::Serialize;
 
 use super::args::ParamArgs;
 use super::csv_input::{numeric_rows, open_csv};
+use super::export::{export_error, ControllerName};
 use super::reliability::{parse_axis, Loaded};
 use super::report::{self, Csv, Report};
 
@@ -74,6 +82,14 @@ pub struct MapArgs {
     /// picture (PNG and SVG) into DIR.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    /// Also map the error left after this controller's compensation
+    /// (exported from the same values; see docs/export.md).
+    #[arg(long, value_enum, value_name = "CONTROLLER")]
+    pub compensated: Option<ControllerName>,
+    /// The grid the `grid` correction is exported on, per axis (default:
+    /// the map's grid, or the machine file's with --axes; repeatable).
+    #[arg(long = "compensation-grid", value_name = "VAR=V1,V2,...|VAR=LO:HI:N", value_parser = parse_grid_axis, requires = "compensated")]
+    pub compensation_grid: Vec<(String, Vec<f64>)>,
 }
 
 /// Parses `VAR=V1,V2,...` or `VAR=LO:HI:N`.
@@ -137,6 +153,16 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
     };
     let built = BuiltMachine::compile(m, values, params)
         .map_err(|e| miette::miette!("{}: {e}", args.values.display()))?;
+    let compensated = match args.compensated {
+        Some(controller) => Some(compensate(
+            &args,
+            controller,
+            &loaded,
+            &built,
+            points.clone(),
+        )?),
+        None => None,
+    };
     let count = points.len();
     let bar = Progress::new(count, args.format);
     // The table of a large map shows the summary only: it needs no point's
@@ -173,13 +199,75 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
         variables: built.variables().to_vec(),
         input,
         result,
+        compensated,
     };
     if let Some(dir) = &args.plot {
         for f in map_plot::write_all(dir, &doc, &built)? {
             eprintln!("wrote {}", f.display());
         }
+        if let Some(c) = &doc.compensated {
+            let mut r = c.result.clone();
+            r.machine = format!("{} compensated ({})", doc.machine, c.controller);
+            let after = MapDoc {
+                values_file: doc.values_file.clone(),
+                entries: Vec::new(),
+                errors: doc.errors,
+                unset: doc.unset,
+                machine: r.machine.clone(),
+                frame: doc.frame,
+                variables: doc.variables.clone(),
+                input: doc.input.clone(),
+                result: Mapped::Full(r),
+                compensated: None,
+            };
+            for f in map_plot::write_all(&dir.join("compensated"), &after, &built)? {
+                eprintln!("wrote {}", f.display());
+            }
+        }
     }
     report::emit(&doc, args.format.into())
+}
+
+/// The map after `controller`'s compensation, at the map's points.
+fn compensate(
+    args: &MapArgs,
+    controller: ControllerName,
+    loaded: &Loaded,
+    built: &BuiltMachine,
+    points: Points,
+) -> miette::Result<Compensated> {
+    let m = &loaded.machine;
+    if controller != ControllerName::Grid {
+        let d = MietteDiagnostic::new(format!(
+            "--compensated {} is not in this build yet",
+            controller.name()
+        ))
+        .with_code("chain::export::not_in_this_build")
+        .with_help("this build compensates with --compensated grid (docs/export.md)");
+        return Err(miette::Report::new(d));
+    }
+    // The correction grid: the map's (or the file's), each axis replaceable.
+    let mut overrides = args.grid.clone();
+    overrides.extend(args.compensation_grid.iter().cloned());
+    let file = args.file.display().to_string();
+    let axes = grid_axes(m, loaded, &file, &overrides)?;
+    let nodes: usize = axes.iter().map(|(_, v)| v.len()).product();
+    let kin = chain_core::kinematics::Kinematics::from_machine(m);
+    let grid = chain_core::compensation::grid::export(
+        built,
+        &kin,
+        Points::Grid(axes.iter().map(|(_, v)| v.clone()).collect()),
+    )
+    .map_err(|e| export_error(e, &args.values))?;
+    let correction = grid.correction().map_err(miette::Report::new)?;
+    let result = built
+        .compensated_map(&correction, points)
+        .map_err(|e| export_error(e, &args.values))?;
+    Ok(Compensated {
+        controller: controller.name(),
+        nodes,
+        result,
+    })
 }
 
 /// A map error, rendered with its code and help.
@@ -222,7 +310,7 @@ fn map_error(e: MapError, values: &std::path::Path) -> miette::Report {
 
 /// The grid axes, in the machine's variable order: `reliability.grid`, each
 /// axis replaced by `--grid`; every variable must have values.
-fn grid_axes(
+pub(crate) fn grid_axes(
     m: &chain_core::Machine,
     loaded: &Loaded,
     file: &str,
@@ -265,7 +353,10 @@ fn grid_axes(
 }
 
 /// The points of `--axes`: every row, in the machine's variable order.
-fn axes_points(path: &std::path::Path, m: &chain_core::Machine) -> miette::Result<Vec<f64>> {
+pub(crate) fn axes_points(
+    path: &std::path::Path,
+    m: &chain_core::Machine,
+) -> miette::Result<Vec<f64>> {
     let mut input = open_csv(path)?;
     let name = input.name.clone();
     let has_t = input.header.first().is_some_and(|h| h == "t")
@@ -353,6 +444,7 @@ impl Progress {
 // Output.
 
 /// Where the points came from.
+#[derive(Clone)]
 pub(crate) enum Input {
     /// The full-factorial grid of these axes (machine variable order).
     Grid(Vec<(String, Vec<f64>)>),
@@ -397,6 +489,35 @@ pub(crate) struct MapDoc {
     variables: Vec<String>,
     pub(crate) input: Input,
     pub(crate) result: Mapped,
+    /// The map after compensation (`--compensated`).
+    compensated: Option<Compensated>,
+}
+
+/// The error left after a controller's compensation, at the map's points.
+pub(crate) struct Compensated {
+    /// The controller's name.
+    controller: &'static str,
+    /// The nodes of the correction grid.
+    nodes: usize,
+    /// The residual map.
+    result: MapResult,
+}
+
+/// `compensated` of the JSON document.
+#[derive(Serialize)]
+struct CompensatedDoc<'a> {
+    controller: &'a str,
+    correction_nodes: usize,
+    #[serde(flatten)]
+    map: &'a MapResult,
+}
+
+/// The spec's JSON document with `compensated` added.
+#[derive(Serialize)]
+struct WithCompensated<'a> {
+    #[serde(flatten)]
+    map: &'a MapResult,
+    compensated: CompensatedDoc<'a>,
 }
 
 impl MapDoc {
@@ -411,9 +532,18 @@ impl MapDoc {
 
 impl Serialize for MapDoc {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        match self.full() {
-            Some(r) => r.serialize(s),
-            None => Err(serde::ser::Error::custom("the map kept no point")),
+        match (self.full(), &self.compensated) {
+            (Some(r), None) => r.serialize(s),
+            (Some(r), Some(c)) => WithCompensated {
+                map: r,
+                compensated: CompensatedDoc {
+                    controller: c.controller,
+                    correction_nodes: c.nodes,
+                    map: &c.result,
+                },
+            }
+            .serialize(s),
+            (None, _) => Err(serde::ser::Error::custom("the map kept no point")),
         }
     }
 }
@@ -519,6 +649,44 @@ impl Report for MapDoc {
             self.point_text(s.volumetric.index),
             s.volumetric.rms * 1e3
         );
+        if let Some(c) = &self.compensated {
+            let a = &c.result.summary;
+            let _ = writeln!(out);
+            let _ = writeln!(
+                out,
+                "After {} compensation ({} correction nodes, docs/export.md):",
+                c.controller, c.nodes
+            );
+            let _ = writeln!(
+                out,
+                "{:<12} {:>12} {:>12} {:>12}   {:>12} {:>12} {:>12}",
+                "component", "min", "max", "rms", "min after", "max after", "rms after"
+            );
+            for k in 0..6 {
+                let (b, f) = (s.component(k), MICRO[k]);
+                let ac = a.component(k);
+                let _ = writeln!(
+                    out,
+                    "{:<12} {:>12.3} {:>12.3} {:>12.3}   {:>12.4} {:>12.4} {:>12.4}",
+                    format!("{} ({})", ["px", "py", "pz", "ox", "oy", "oz"][k], UNITS[k]),
+                    b.min * f,
+                    b.max * f,
+                    b.rms * f,
+                    ac.min * f,
+                    ac.max * f,
+                    ac.rms * f
+                );
+            }
+            let _ = writeln!(
+                out,
+                "volumetric |p| after: max {:.4} µm at {}; rms {:.4} µm (before: max {:.3} µm, rms {:.3} µm)",
+                a.volumetric.max * 1e3,
+                self.point_text(a.volumetric.index),
+                a.volumetric.rms * 1e3,
+                s.volumetric.max * 1e3,
+                s.volumetric.rms * 1e3
+            );
+        }
         if let Some(r) = self.full().filter(|r| r.len() <= TABLE_POINTS) {
             let _ = writeln!(out);
             let mut header: Vec<String> = r.variables.clone();
@@ -551,11 +719,21 @@ impl Report for MapDoc {
         let r = self.full()?;
         let mut header: Vec<String> = r.variables.clone();
         header.extend(["px", "py", "pz", "ox", "oy", "oz", "volumetric"].map(String::from));
+        let after = self.compensated.as_ref().map(|c| &c.result);
+        if after.is_some() {
+            header.extend(
+                ["px", "py", "pz", "ox", "oy", "oz", "volumetric"].map(|c| format!("{c}_after")),
+            );
+        }
         let mut csv = Csv::new(header);
         for i in 0..r.len() {
             let mut row: Vec<String> = r.point(i).iter().map(|x| format!("{x}")).collect();
             row.extend(r.errors[i].iter().map(|x| format!("{x}")));
             row.push(format!("{}", r.volumetric(i)));
+            if let Some(a) = after {
+                row.extend(a.errors[i].iter().map(|x| format!("{x}")));
+                row.push(format!("{}", a.volumetric(i)));
+            }
             csv.row(row);
         }
         Some(csv)

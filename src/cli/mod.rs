@@ -6,6 +6,7 @@ mod args;
 pub mod compensate;
 mod csv_input;
 pub mod derive;
+pub mod export;
 pub mod identify;
 pub mod inverse;
 pub mod map;
@@ -50,6 +51,8 @@ enum Command {
     Identify(identify::IdentifyArgs),
     /// Where to measure: the D-optimal K of a set of candidate poses, against K taken evenly (greedy + Fedorov exchange).
     Plan(plan::PlanArgs),
+    /// Compensation for a controller: the axis corrections that cancel a built machine's error (the universal grid CSV; controller formats), with the residual they leave.
+    Export(export::ExportArgs),
     /// Motion conversion ("Precision Machining Technology of Jewelry on CNC Machine Tool", 2022): CNC axis motions reproducing a cradle-type generator's roll, and their Maclaurin series.
     Motion(motion::MotionArgs),
 }
@@ -68,5 +71,6 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Map(args) => map::exec(args),
         Command::Identify(args) => identify::exec(args),
         Command::Plan(args) => plan::exec(args),
+        Command::Export(args) => export::exec(args),
     }
 }
