@@ -34,3 +34,4 @@ pub struct ExportedFile {
     /// The file's text.
     pub text: String,
 }
+pub mod controllers;
