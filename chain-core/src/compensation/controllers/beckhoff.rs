@@ -16,6 +16,8 @@
 //! linearly (`Interpolation GRID`); that ISG's model and sign equal chain's
 //! is UNCONFIRMED (`negate XYZ` in the list file flips it).
 
+#![allow(clippy::needless_range_loop)] // component loops read best with indices
+
 use super::{num, Context, ControllerError, Export, FormatReport, AXIS, SLOT_LETTER};
 use crate::built::BuiltMachine;
 use crate::compensation::{Correction, ExportedFile};

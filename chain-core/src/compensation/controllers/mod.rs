@@ -755,7 +755,7 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
     /// (`None`: none of it) as a 6-vector; the residual is `E(q)` minus
     /// their sum, plus `extra(q)` (a share the format removes that is not
     /// one part's, such as Klipper's shear, negative).
-    #[allow(clippy::type_complexity)]
+    #[allow(clippy::type_complexity, clippy::needless_range_loop)]
     pub fn account(
         &self,
         expressed: &dyn Fn(&[f64], &crate::built::Part) -> Option<[f64; 6]>,
