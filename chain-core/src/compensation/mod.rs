@@ -35,6 +35,7 @@ pub struct ExportedFile {
     pub text: String,
 }
 
+pub mod controllers;
 pub mod grid;
 
 use crate::built::{
