@@ -1,5 +1,5 @@
 //! `chain export FILE --values VALUES.yaml --controller NAME
-//! [--grid VAR=V1,V2,...|VAR=LO:HI[:N]]... [--axes AXES.csv] [--step MM]
+//! [--grid VAR=V1,V2,...|VAR=LO:HI:N]... [--axes AXES.csv] [--step MM]
 //! [--param NAME=VALUE]... [--out DIR] [--format table|json|csv]`.
 //!
 //! Compensation for a controller (measured-machines spec, section 6).
@@ -182,7 +182,7 @@ fn check_options(args: &ExportArgs) -> miette::Result<()> {
         if args.axes.is_some() {
             return refuse(
                 "--axes",
-                "a per-axis table samples each axis over its travel: give the travel with --grid VAR=LO:HI and the table step with --step; --axes gives the nodes of --controller grid",
+                "a per-axis table samples each axis over its travel: give the travel with --grid VAR=LO,HI and the table step with --step; --axes gives the nodes of --controller grid",
             );
         }
         if args.format == Some(ExportFormat::Csv) {
@@ -256,7 +256,14 @@ fn exec_tables(
             .beckhoff_max_records
             .unwrap_or(BECKHOFF_DEFAULT_MAX_RECORDS),
     };
-    let export = table_export(controller, built, loaded, &options, &args.grid, &args.values)?;
+    let export = table_export(
+        controller,
+        built,
+        loaded,
+        &options,
+        &args.grid,
+        &args.values,
+    )?;
     let doc = TablesDoc {
         values_file: args.values.display().to_string(),
         report: export.report,
@@ -325,7 +332,7 @@ pub(crate) fn table_export(
             ))
             .with_code("chain::export::grid_nodes")
             .with_help(
-                "give the travel alone (--grid VAR=LO:HI) and the table step with --step",
+                "give the travel alone (--grid VAR=LO,HI) and the table step with --step",
             );
             return Err(miette::Report::new(d));
         }
@@ -368,12 +375,12 @@ pub(crate) fn controller_error(e: ControllerError, values: &std::path::Path) -> 
             source,
         } => {
             let d = MietteDiagnostic::new(format!(
-                "exporting axis `{variable}` over its travel {lo} to {hi}: {} = {} is outside the table of `{}` ({}, {} = {} to {})",
-                source.variable, source.value, source.name, source.table, source.variable, source.lo, source.hi
+                "the table of `{}` ({}) covers {} = {} to {}, and the export needs {} = {} (sampling axis `{variable}` over {lo} to {hi}, the other axes at their travel's start)",
+                source.name, source.table, source.variable, source.lo, source.hi, source.variable, source.value
             ))
             .with_code("chain::export::out_of_table")
             .with_help(format!(
-                "the values file {} does not cover the travel: give a travel inside the table (--grid {}={}:{}), measure the table over the whole travel, or add `extrapolate: hold` to its entry; nothing is extrapolated",
+                "the values file {} does not cover the travel: give a travel inside the table (--grid {}={},{}), measure the table over the whole travel, or add `extrapolate: hold` to its entry; nothing is extrapolated",
                 values.display(),
                 source.variable,
                 source.lo,
@@ -562,7 +569,11 @@ impl Report for TablesDoc {
             "expressed (removed by the controller), largest effect over the check grid:",
             &r.expressed,
         );
-        terms(&mut out, "remaining (not expressed by the format):", &r.remaining);
+        terms(
+            &mut out,
+            "remaining (not expressed by the format):",
+            &r.remaining,
+        );
         let _ = writeln!(out);
         let _ = writeln!(
             out,

@@ -22,6 +22,7 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use chain_core::built::{BuiltMachine, MapError, MapSummary, Points};
+use chain_core::compensation::controllers::{Controller, ExportOptions, DEFAULT_STEP};
 use chain_core::model::Frame;
 use chain_core::values::{Entry, EntryKind, Given, Values};
 use chain_core::MapResult;
@@ -87,9 +88,20 @@ pub struct MapArgs {
     #[arg(long, value_enum, value_name = "CONTROLLER")]
     pub compensated: Option<ControllerName>,
     /// The grid the `grid` correction is exported on, per axis (default:
-    /// the map's grid, or the machine file's with --axes; repeatable).
+    /// the map's grid, or the machine file's with --axes; repeatable). For
+    /// the per-axis table formats: the travel of the axis's table (its
+    /// smallest and largest value; default: the map's grid range, else the
+    /// machine file's).
     #[arg(long = "compensation-grid", value_name = "VAR=V1,V2,...|VAR=LO:HI:N", value_parser = parse_grid_axis, requires = "compensated")]
     pub compensation_grid: Vec<(String, Vec<f64>)>,
+    /// The largest table step (mm) of a per-axis table format's
+    /// compensation (as `chain export --step`) [default: 10].
+    #[arg(
+        long = "compensation-step",
+        value_name = "MM",
+        requires = "compensated"
+    )]
+    pub compensation_step: Option<f64>,
 }
 
 /// Parses `VAR=V1,V2,...` or `VAR=LO:HI:N`.
@@ -237,13 +249,59 @@ fn compensate(
     points: Points,
 ) -> miette::Result<Compensated> {
     let m = &loaded.machine;
-    if controller != ControllerName::Grid {
-        let d = MietteDiagnostic::new(format!(
-            "--compensated {} is not in this build yet",
-            controller.name()
-        ))
-        .with_code("chain::export::not_in_this_build")
-        .with_help("this build compensates with --compensated grid (docs/export.md)");
+    if let Some(tables) = controller.tables() {
+        // The map's own range of an axis, where it is one (a single value
+        // keeps the machine file's travel); --compensation-grid over it.
+        let mut travel = super::export::travel_of(&args.grid);
+        travel.retain(|(_, [lo, hi])| lo < hi);
+        for t in super::export::travel_of(&args.compensation_grid) {
+            travel.retain(|(n, _)| *n != t.0);
+            travel.push(t);
+        }
+        let options = ExportOptions {
+            step: args.compensation_step.unwrap_or(DEFAULT_STEP),
+            travel,
+            ..ExportOptions::default()
+        };
+        let export = super::export::table_export(
+            tables,
+            built,
+            loaded,
+            &options,
+            &args.compensation_grid,
+            &args.values,
+        )?;
+        let result = built
+            .compensated_map(export.correction.as_ref(), points)
+            .map_err(|e| export_error(e, &args.values))?;
+        let (nodes, source) = match tables {
+            Controller::Klipper => (0, "shear factors, docs/export-controllers.md".to_string()),
+            _ => {
+                let points: Vec<String> = (export.report.axes.iter())
+                    .map(|a| format!("{} {}", a.variable, a.points))
+                    .collect();
+                (
+                    export.report.axes.iter().map(|a| a.points).sum(),
+                    format!(
+                        "table points {}, docs/export-controllers.md",
+                        points.join(", ")
+                    ),
+                )
+            }
+        };
+        return Ok(Compensated {
+            controller: controller.name(),
+            nodes,
+            source,
+            result,
+        });
+    }
+    if args.compensation_step.is_some() {
+        let d = MietteDiagnostic::new("--compensated grid does not take --compensation-step")
+            .with_code("chain::map::option")
+            .with_help(
+                "the grid correction is exported at the nodes of --compensation-grid VAR=LO:HI:N",
+            );
         return Err(miette::Report::new(d));
     }
     // The correction grid: the map's (or the file's), each axis replaceable.
@@ -252,6 +310,7 @@ fn compensate(
     let file = args.file.display().to_string();
     let axes = grid_axes(m, loaded, &file, &overrides)?;
     let nodes: usize = axes.iter().map(|(_, v)| v.len()).product();
+    let source = format!("{nodes} correction nodes, docs/export.md");
     let kin = chain_core::kinematics::Kinematics::from_machine(m);
     let grid = chain_core::compensation::grid::export(
         built,
@@ -266,6 +325,7 @@ fn compensate(
     Ok(Compensated {
         controller: controller.name(),
         nodes,
+        source,
         result,
     })
 }
@@ -497,8 +557,11 @@ pub(crate) struct MapDoc {
 pub(crate) struct Compensated {
     /// The controller's name.
     controller: &'static str,
-    /// The nodes of the correction grid.
+    /// The nodes of the correction grid (`grid`), or the points of the
+    /// tables (per-axis formats; 0 for Klipper's factors).
     nodes: usize,
+    /// Where the correction comes from, in words (the table's heading).
+    source: String,
     /// The residual map.
     result: MapResult,
 }
@@ -652,11 +715,7 @@ impl Report for MapDoc {
         if let Some(c) = &self.compensated {
             let a = &c.result.summary;
             let _ = writeln!(out);
-            let _ = writeln!(
-                out,
-                "After {} compensation ({} correction nodes, docs/export.md):",
-                c.controller, c.nodes
-            );
+            let _ = writeln!(out, "After {} compensation ({}):", c.controller, c.source);
             let _ = writeln!(
                 out,
                 "{:<12} {:>12} {:>12} {:>12}   {:>12} {:>12} {:>12}",
