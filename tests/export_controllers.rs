@@ -464,9 +464,21 @@ fn klipper_round_trip_removes_the_squareness_errors() {
     // 1.5e-10 (the X table's turn EC0Y carries the Z tilt −EA0Z·z into x:
     // xz's slope is EB0Z − EC0Y·EA0Z).
     let second = 2e-10;
-    assert!((xy - slope("y", 0)).abs() < second, "{xy} {}", slope("y", 0));
-    assert!((xz - slope("z", 0)).abs() < second, "{xz} {}", slope("z", 0));
-    assert!((yz - slope("z", 1)).abs() < second, "{yz} {}", slope("z", 1));
+    assert!(
+        (xy - slope("y", 0)).abs() < second,
+        "{xy} {}",
+        slope("y", 0)
+    );
+    assert!(
+        (xz - slope("z", 0)).abs() < second,
+        "{xz} {}",
+        slope("z", 0)
+    );
+    assert!(
+        (yz - slope("z", 1)).abs() < second,
+        "{yz} {}",
+        slope("z", 1)
+    );
     assert!((slope("z", 0) - (-10e-6 - 15e-6 * 8e-6)).abs() < 1e-14);
     // The named mapping for vmc3, in closed form. EC0Y (on the Y saddle,
     // after the Y joint) rotates the X table about +z: the tool relative to

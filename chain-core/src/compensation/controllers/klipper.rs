@@ -88,7 +88,12 @@ impl Correction for KlipperCorrection {
 fn squareness_errors<'m>(machine: &'m Machine, bodies: &[usize]) -> Vec<&'m str> {
     let located: Vec<usize> = bodies
         .iter()
-        .flat_map(|&b| machine.bodies[b].location_errors.slots[3..].iter().flatten().copied())
+        .flat_map(|&b| {
+            machine.bodies[b].location_errors.slots[3..]
+                .iter()
+                .flatten()
+                .copied()
+        })
         .collect();
     machine
         .errors
