@@ -459,17 +459,50 @@ fn klipper_round_trip_removes_the_squareness_errors() {
         q[var(&machine, v)] = 500.0;
         (only_sq(&q)[c] - o[c]) / 500.0
     };
-    assert!((xy - slope("y", 0)).abs() < 1e-10, "{xy} {}", slope("y", 0));
-    assert!((xz - slope("z", 0)).abs() < 1e-10, "{xz} {}", slope("z", 0));
-    assert!((yz - slope("z", 1)).abs() < 1e-10, "{yz} {}", slope("z", 1));
-    // The named mapping for vmc3 (the file's comment): xy = EC0Y (15 µrad),
-    // xz = −EB0Z, yz = EA0Z, to the values file's numbers.
-    // vmc3's EC0Y tilts the X motion against Y: a shear, xy = EC0Y. Its
-    // EA0Z and EB0Z sit after the Z joint and tilt the tool only (a
-    // constant offset, not a shear), so xz = yz = 0 by the numeric product
-    // too (checked above) and they stay in the residual.
+    // The product is exact and the factors are first order: the slopes
+    // differ by products of two of the angles, at most 15 · 10 µrad² =
+    // 1.5e-10 (the X table's turn EC0Y carries the Z tilt −EA0Z·z into x:
+    // xz's slope is EB0Z − EC0Y·EA0Z).
+    let second = 2e-10;
+    assert!(
+        (xy - slope("y", 0)).abs() < second,
+        "{xy} {}",
+        slope("y", 0)
+    );
+    assert!(
+        (xz - slope("z", 0)).abs() < second,
+        "{xz} {}",
+        slope("z", 0)
+    );
+    assert!(
+        (yz - slope("z", 1)).abs() < second,
+        "{yz} {}",
+        slope("z", 1)
+    );
+    assert!((slope("z", 0) - (-10e-6 - 15e-6 * 8e-6)).abs() < 1e-14);
+    // The named mapping for vmc3, in closed form. EC0Y (on the Y saddle,
+    // after the Y joint) rotates the X table about +z: the tool relative to
+    // the table is at x + EC0Y·y, so xy = EC0Y. EA0Z and EB0Z are location
+    // errors of the Z head (before the Z joint): the head's frame is
+    // rotated by (EA0Z, EB0Z, 0) about the column's point (0, 0, 250), and
+    // the tool point, (0, 0, z − L) from there, moves by
+    // (EA0Z, EB0Z, 0) × (0, 0, z − L) = ((z − L)·EB0Z, −(z − L)·EA0Z, 0):
+    // xz = EB0Z, yz = −EA0Z (the constants −L·EB0Z, L·EA0Z stay). With the
+    // values file's 15, 8, −10 µrad: xy = 15e-6, xz = −10e-6, yz = −8e-6;
+    // the file's comment names the same mapping.
     assert!((xy - 15e-6).abs() < 1e-15, "{xy}");
+    assert!((xz + 10e-6).abs() < 1e-15, "{xz}");
+    assert!((yz + 8e-6).abs() < 1e-15, "{yz}");
+    assert!(text.contains("#   xy_skew = 1·EC0Y\n"), "{text}");
+    assert!(text.contains("#   xz_skew = 1·EB0Z\n"), "{text}");
+    assert!(text.contains("#   yz_skew = -1·EA0Z\n"), "{text}");
     assert!(slope("x", 0).abs() < 1e-12);
+    assert!(slope("x", 1).abs() < second && slope("y", 1).abs() < second);
+    // The constant part left: the tilted tool, o = (−L·EB0Z, L·EA0Z, 0)
+    // with L = 150 (y = 0 puts EC0Y's part at 0), to second order in the
+    // angles times L: 150 mm · 1.5e-10 = 2.25e-8 mm.
+    assert!((o[0] - 150.0 * 10e-6).abs() < 150.0 * second, "{o:?}");
+    assert!((o[1] - 150.0 * 8e-6).abs() < 150.0 * second, "{o:?}");
     // The SET_SKEW lines give the same factors through Klipper's formula.
     for (plane, f) in [("XY", xy), ("XZ", xz), ("YZ", yz)] {
         let line = text

@@ -514,6 +514,51 @@ fn outside_a_table_is_an_error_unless_it_holds() {
     assert!(last > 0.01, "{last}");
 }
 
+/// The squareness errors alone, in closed form (ISO 230-1: the squareness of
+/// Z to X and Y is a tilt of the Z travel, an X / Y error proportional to
+/// z). EC0Y on the Y saddle turns the X table about +z: `px = y·EC0Y`,
+/// `oz = −EC0Y`. EA0Z, EB0Z before the Z joint turn the head and its travel
+/// about the column's point: the tool point, `(0, 0, z − L)` from there,
+/// moves by `(EA0Z, EB0Z, 0) × (0, 0, z − L)`, `px = (z − L)·EB0Z`,
+/// `py = −(z − L)·EA0Z`, and the tool turns with them, `ox = EA0Z`,
+/// `oy = EB0Z`. With L = 150 and 15, 8, −10 µrad.
+#[test]
+fn the_squareness_errors_tilt_the_z_travel() {
+    let dir = scratch("squareness");
+    let values = write(
+        &dir,
+        "squareness.yaml",
+        "machine: vmc3\nunits: {angular: urad}\nvalues:\n  EC0Y: 15\n  EA0Z: 8\n  EB0Z: -10\n",
+    );
+    let doc = map_json(
+        values.to_str().unwrap(),
+        &[
+            "--grid",
+            "x=0,800",
+            "--grid",
+            "y=0,500",
+            "--grid",
+            "z=0,150,500",
+        ],
+    );
+    let points = doc["points"].as_array().unwrap();
+    assert_eq!(points.len(), 12);
+    let (c, a, b) = (15e-6, 8e-6, -10e-6);
+    for p in points {
+        let at = |v: &str| p["point"][v].as_f64().unwrap();
+        let (y, z) = (at("y"), at("z"));
+        let want = [y * c + (z - 150.0) * b, -(z - 150.0) * a, 0.0, a, b, -c];
+        let got = components(&p["error"]);
+        for k in 0..6 {
+            assert!(
+                (got[k] - want[k]).abs() <= 1e-15,
+                "at {}: {got:?} vs {want:?}",
+                p["point"]
+            );
+        }
+    }
+}
+
 #[test]
 fn units_do_not_change_the_map() {
     let dir = scratch("units");

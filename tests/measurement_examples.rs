@@ -560,6 +560,47 @@ fn ball_plate_identifies_the_truth() {
         "the head-rotation null vector: cos {cos}"
     );
 
+    // The Z squareness errors are location errors of the Z head: they tilt
+    // the Z travel, so in the table frame EB0Z moves the tool point by
+    // ((z + tz)·EB0Z, 0, −tx·EB0Z), which is the constant head tilt EBZ_0
+    // (ε × tool: (tz, 0, −tx)·EBZ_0) plus z·EB0Z, and z = 250·(1 + t),
+    // t = (2z − 500)/500, is EXZ_0 + EXZ_1 with coefficients 250 mm (P_0 = 1,
+    // P_1 = t). Likewise EA0Z: (0, −(z + tz), ty)·EA0Z = the head tilt EAZ_0
+    // minus 250·(EYZ_0 + EYZ_1). So (mm and rad, the unknowns' units)
+    // EB0Z − EBZ_0 − 250 (EXZ_0 + EXZ_1) and EA0Z − EAZ_0 + 250 (EYZ_0 +
+    // EYZ_1) move no tool point: both lie in the reported null space (a
+    // squareness placed after the joint, a tool tilt only, would give
+    // EB0Z − EBZ_0 instead, which does not).
+    for combination in [
+        [
+            ("EB0Z", 1.0),
+            ("EBZ_0", -1.0),
+            ("EXZ_0", -250.0),
+            ("EXZ_1", -250.0),
+        ],
+        [
+            ("EA0Z", 1.0),
+            ("EAZ_0", -1.0),
+            ("EYZ_0", 250.0),
+            ("EYZ_1", 250.0),
+        ],
+    ] {
+        let mut v = vec![0.0; m.errors.len()];
+        for (name, c) in combination {
+            v[m.error_index(name).unwrap()] = c;
+        }
+        let norm2: f64 = v.iter().map(|c| c * c).sum();
+        let in_null: f64 = null
+            .iter()
+            .map(|n| n.iter().zip(&v).map(|(a, b)| a * b).sum::<f64>().powi(2))
+            .sum();
+        assert!(
+            (in_null / norm2 - 1.0).abs() < 1e-9,
+            "{combination:?}: {} of it in the null space",
+            (in_null / norm2).sqrt()
+        );
+    }
+
     let (individual, worst) = check_recovery(&m, &json, &out, &e);
     // 66 − 30 − 5: every cubic and quadratic coefficient outside the head's
     // quadratic group, the positioning slopes and the angular slopes of X, Y.

@@ -15,7 +15,7 @@ writes, beside this script:
 Python 3 standard library only. The deviations are computed here, NOT by chain:
 this script has its own model of the machine, the exact 4x4 product
 
-  T(parent -> body) = Trans(offset) . J(q) . E(errors + squareness)
+  T(parent -> body) = Trans(offset) . E(location_errors) . J(q) . E(errors + squareness)
   E(d, eps) = [exp([eps x]) (Rodrigues), d]  (to first order the spec's small-angle matrix)
   T_wt = inv(P(x_table)) . P(tool),   p = T_wt(q, e) . tp - T_wt(q, 0) . tp
 
@@ -45,7 +45,11 @@ STROKE = {"x": (0.0, 800.0), "y": (0.0, 500.0), "z": (0.0, 500.0)}
 # The known errors: Legendre coefficients (um for translational motions, urad
 # for angular ones) of the assumed error motions of examples/values/README.md
 # (a lead error of X, bows, a nodding head, ...), and the three squareness
-# errors (urad). Each motion: (axis variable, slot, coefficients).
+# errors (urad). Each motion: (axis variable, slot, coefficients). Each
+# squareness error: (axis variable, slot, value, where): "after" the joint of
+# that axis (vmc3_probe.yaml's `squareness`: EC0Y on the Y saddle tilts the X
+# travel of the table hanging below it) or "before" it (`location_errors`:
+# EA0Z, EB0Z tilt the Z travel direction itself).
 MOTIONS = {
     "EXY": ("y", "dx", [1.3, 0.5, -1.3, 0.2]),
     "EYY": ("y", "dy", [3.0, 3.0, 0.3, -0.2]),
@@ -66,7 +70,11 @@ MOTIONS = {
     "EBZ": ("z", "ey", [-3.67, 0.3, 4.67]),
     "ECZ": ("z", "ez", [1.27, 0.0, -1.33]),
 }
-SQUARENESS = {"EC0Y": ("y", "ez", 15.0), "EA0Z": ("z", "ex", 8.0), "EB0Z": ("z", "ey", -10.0)}
+SQUARENESS = {
+    "EC0Y": ("y", "ez", 15.0, "after"),
+    "EA0Z": ("z", "ex", 8.0, "before"),
+    "EB0Z": ("z", "ey", -10.0, "before"),
+}
 SLOTS = ["dx", "dy", "dz", "ex", "ey", "ez"]
 
 
@@ -81,7 +89,8 @@ def legendre(k, t):
 
 
 def slot_values(var, q, errors_on):
-    """The six slot values (mm, rad) of the body moved by `var` at q[var]."""
+    """The six slot values (mm, rad) after the joint of the body moved by `var`
+    at q[var]: its error motions and the squareness errors placed "after"."""
     lo, hi = STROKE[var]
     t = (2.0 * q[var] - lo - hi) / (hi - lo)
     v = [0.0] * 6
@@ -92,8 +101,20 @@ def slot_values(var, q, errors_on):
             continue
         unit = 1e-3 if slot.startswith("d") else 1e-6
         v[SLOTS.index(slot)] += unit * sum(c * legendre(k, t) for k, c in enumerate(coeffs))
-    for name, (sv, slot, value) in SQUARENESS.items():
-        if sv == var:
+    for name, (sv, slot, value, where) in SQUARENESS.items():
+        if sv == var and where == "after":
+            v[SLOTS.index(slot)] += 1e-6 * value
+    return v
+
+
+def location_values(var, errors_on):
+    """The six slot values (mm, rad) before the joint of the body moved by
+    `var`: the squareness errors placed "before" (position-independent)."""
+    v = [0.0] * 6
+    if not errors_on:
+        return v
+    for name, (sv, slot, value, where) in SQUARENESS.items():
+        if sv == var and where == "before":
             v[SLOTS.index(slot)] += 1e-6 * value
     return v
 
@@ -139,10 +160,14 @@ def t_wt(q, errors_on):
     y_saddle = matmul(translation([0.0, -q["y"], 0.0]), error_transform(slot_values("y", q, errors_on)))
     x_table = matmul(translation([-q["x"], 0.0, 0.0]), error_transform(slot_values("x", q, errors_on)))
     workpiece = matmul(y_saddle, x_table)
-    # Tool chain: bed -> column (offset) -> z_head (offset, joint +z) -> tool.
+    # Tool chain: bed -> column (offset) -> z_head (offset, location errors,
+    # joint +z, error motions) -> tool.
     column = translation([0.0, -500.0, 0.0])
     z_head = matmul(
-        matmul(translation([0.0, 500.0, 250.0]), translation([0.0, 0.0, q["z"]])),
+        matmul(
+            matmul(translation([0.0, 500.0, 250.0]), error_transform(location_values("z", errors_on))),
+            translation([0.0, 0.0, q["z"]]),
+        ),
         error_transform(slot_values("z", q, errors_on)),
     )
     tool = matmul(column, z_head)
@@ -217,7 +242,7 @@ def write_truth(path):
         "units: {linear: um, angular: urad}",
         "values:",
     ]
-    for name, (_, _, value) in SQUARENESS.items():
+    for name, (_, _, value, _) in SQUARENESS.items():
         lines.append(f"  {name}: {value}")
     for name, (_, _, coeffs) in MOTIONS.items():
         for k, c in enumerate(coeffs):

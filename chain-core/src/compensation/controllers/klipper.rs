@@ -7,17 +7,21 @@
 //! `(K_x + xy·K_y + xz·K_z, K_y + yz·K_z, K_z)`, and `calc_skew`, its exact
 //! inverse, is applied to every commanded position. chain's coordinates
 //! `K` are the tool point's nominal motion, `K = J q` (the axis variables,
-//! each along its frame axis with its sign). chain's squareness errors enter
-//! its model as small rotations (`E(errors + squareness)` after the joint),
-//! whose tool-point error is affine in `q`; the factors are its shear part,
+//! each along its frame axis with its sign). chain's squareness errors are
+//! constant small rotations of the axes' bodies: a `squareness` term (after
+//! the joint: it tilts the travel of the axes below the body, vmc3's `EC0Y`
+//! tilts X against Y) or an angular `location_errors` term (before the joint:
+//! it tilts the body's own travel, vmc3's `EA0Z`, `EB0Z` tilt Z). Their
+//! tool-point error is affine in `q`; the factors are its shear part,
 //! `xy = ∂e_x/∂K_y`, `xz = ∂e_x/∂K_z`, `yz = ∂e_y/∂K_z` (derived from the
 //! model's exact coefficients, so the mapping to each squareness name is the
 //! model's own and is written into the file). The rest of the squareness
-//! error (an offset, the other shear entries) stays.
+//! error (an offset such as a tilted tool's `−L·EB0Z`, the other shear
+//! entries, the orientation) stays.
 
 use super::{num, Context, ControllerError, Export, FormatReport};
 use crate::compensation::{Correction, ExportedFile};
-use crate::model::ErrorKind;
+use crate::model::{ErrorKind, Machine};
 use crate::model_trait::{ErrorModel, OutOfRange};
 use serde::Serialize;
 
@@ -76,6 +80,33 @@ impl Correction for KlipperCorrection {
     }
 }
 
+/// The errors Klipper's factors are made of, in the machine's error order:
+/// every `squareness` term, and the angular `location_errors` (`ex, ey, ez`
+/// before the joint: a tilt of the travel direction) of the axes' `bodies`.
+/// Translational location errors are offsets (no shear); a function slot's
+/// coefficient is not a constant angle.
+fn squareness_errors<'m>(machine: &'m Machine, bodies: &[usize]) -> Vec<&'m str> {
+    let located: Vec<usize> = bodies
+        .iter()
+        .flat_map(|&b| {
+            machine.bodies[b].location_errors.slots[3..]
+                .iter()
+                .flatten()
+                .copied()
+        })
+        .collect();
+    machine
+        .errors
+        .iter()
+        .enumerate()
+        .filter(|(j, e)| {
+            machine.coefficient_of(*j).is_none()
+                && (e.kind == ErrorKind::Squareness || located.contains(j))
+        })
+        .map(|(_, e)| e.name.as_str())
+        .collect()
+}
+
 pub(super) fn export<M: ErrorModel + Sync>(
     ctx: &Context<'_, M>,
 ) -> Result<Export, ControllerError> {
@@ -92,13 +123,8 @@ pub(super) fn export<M: ErrorModel + Sync>(
             .expect("three aligned axes, one per frame axis");
         (a.variable, a.sign)
     });
-    let squareness: Vec<&str> = ctx
-        .machine
-        .errors
-        .iter()
-        .filter(|e| e.kind == ErrorKind::Squareness)
-        .map(|e| e.name.as_str())
-        .collect();
+    let bodies: Vec<usize> = ctx.axes.iter().map(|a| a.body).collect();
+    let squareness = squareness_errors(ctx.machine, &bodies);
     if squareness.is_empty() {
         return Err(ControllerError::NothingToExport {
             controller: ctx.name(),
