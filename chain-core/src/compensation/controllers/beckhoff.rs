@@ -18,7 +18,7 @@
 
 #![allow(clippy::needless_range_loop)] // component loops read best with indices
 
-use super::{num, Context, ControllerError, Export, FormatReport, AXIS, SLOT_LETTER};
+use super::{num, Context, ControllerError, Export, AXIS, SLOT_LETTER};
 use crate::built::BuiltMachine;
 use crate::compensation::{Correction, ExportedFile};
 use crate::eval::CompiledModel;
@@ -337,7 +337,7 @@ pub(super) fn export<M: ErrorModel + Sync>(
             resampling = resampling.max((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt());
         }
     }
-    let (expressed, remaining, residual, check_grid) = ctx.account(
+    let accounting = ctx.account(
         &|_, part| {
             exported
                 .contains(&part.name)
@@ -345,19 +345,5 @@ pub(super) fn export<M: ErrorModel + Sync>(
         },
         &|_, _| None,
     )?;
-    Ok(Export {
-        report: FormatReport {
-            controller: ctx.controller,
-            machine: m.name.clone(),
-            files: files.iter().map(|f| f.name.clone()).collect(),
-            axes: ctx.sampling(),
-            expressed,
-            remaining,
-            residual,
-            resampling,
-            check_grid,
-        },
-        files,
-        correction: Box::new(correction),
-    })
+    Ok(ctx.finish(files, accounting, resampling, Box::new(correction)))
 }

@@ -19,7 +19,7 @@
 //! error (an offset such as a tilted tool's `−L·EB0Z`, the other shear
 //! entries, the orientation) stays.
 
-use super::{num, Context, ControllerError, Export, FormatReport};
+use super::{num, Context, ControllerError, Export};
 use crate::compensation::{Correction, ExportedFile};
 use crate::model::{ErrorKind, Machine};
 use crate::model_trait::{ErrorModel, OutOfRange};
@@ -228,7 +228,7 @@ pub(super) fn export<M: ErrorModel + Sync>(
         name: "skew_correction.cfg".into(),
         text,
     }];
-    let (expressed, remaining, residual, check_grid) = ctx.account(
+    let accounting = ctx.account(
         &|q, part| {
             let (_, u) = units.iter().find(|(n, _)| *n == part.name)?;
             let k: [f64; 3] = std::array::from_fn(|i| axes[i].1 * q[axes[i].0]);
@@ -244,19 +244,6 @@ pub(super) fn export<M: ErrorModel + Sync>(
         },
         &|_, _| None,
     )?;
-    Ok(Export {
-        report: FormatReport {
-            controller: ctx.controller,
-            machine: ctx.machine.name.clone(),
-            files: files.iter().map(|f| f.name.clone()).collect(),
-            axes: ctx.sampling(),
-            expressed,
-            remaining,
-            residual,
-            resampling: 0.0,
-            check_grid,
-        },
-        files,
-        correction: Box::new(KlipperCorrection { axes, factors: f }),
-    })
+    let correction = KlipperCorrection { axes, factors: f };
+    Ok(ctx.finish(files, accounting, 0.0, Box::new(correction)))
 }

@@ -12,7 +12,7 @@
 //! data). LinuxCNC stops reading at the first line that is not three numbers,
 //! so the comments (units, sign) come after the data.
 
-use super::{interpolate_held, num, Context, ControllerError, Export, FormatReport, AXIS};
+use super::{interpolate_held, num, Context, ControllerError, Export, AXIS};
 use crate::compensation::{Correction, ExportedFile};
 use crate::model_trait::{ErrorModel, OutOfRange};
 
@@ -138,35 +138,10 @@ pub(super) fn export<M: ErrorModel + Sync>(
         name: "linuxcnc-README.txt".into(),
         text: readme,
     });
-    let (expressed, remaining, residual, check_grid) = ctx.account(
-        &|_, part| {
-            exported
-                .iter()
-                .find(|(n, _)| *n == part.name)
-                .map(|(_, k)| {
-                    let mut s = [0.0; 6];
-                    s[*k] = part.error[*k];
-                    s
-                })
-        },
-        &|_, _| None,
-    )?;
-    Ok(Export {
-        report: FormatReport {
-            controller: ctx.controller,
-            machine: ctx.machine.name.clone(),
-            files: files.iter().map(|f| f.name.clone()).collect(),
-            axes: ctx.sampling(),
-            expressed,
-            remaining,
-            residual,
-            resampling,
-            check_grid,
-        },
-        files,
-        correction: Box::new(LinuxcncCorrection {
-            variables: ctx.axes.len(),
-            tables,
-        }),
-    })
+    let accounting = ctx.account(&|_, part| super::slot_share(&exported, part), &|_, _| None)?;
+    let correction = LinuxcncCorrection {
+        variables: ctx.axes.len(),
+        tables,
+    };
+    Ok(ctx.finish(files, accounting, resampling, Box::new(correction)))
 }

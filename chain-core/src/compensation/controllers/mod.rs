@@ -760,7 +760,7 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
         &self,
         expressed: &dyn Fn(&[f64], &crate::built::Part) -> Option<[f64; 6]>,
         whole: &dyn Fn(&[f64], &[crate::built::Part]) -> Option<(String, [f64; 6])>,
-    ) -> Result<(Vec<Term>, Vec<Term>, Term, Vec<(String, Vec<f64>)>), ControllerError> {
+    ) -> Result<Accounting, ControllerError> {
         let grid = self.check_grid();
         let total: usize = grid.iter().map(|g| g.1.len()).product();
         let mut expr_terms: Vec<Term> = Vec::new();
@@ -830,8 +830,64 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
             residual.orientation = residual.orientation.max(o);
         }
         rem_terms.retain(|t| t.position > 0.0 || t.orientation > 0.0);
-        Ok((expr_terms, rem_terms, residual, grid))
+        Ok(Accounting {
+            expressed: expr_terms,
+            remaining: rem_terms,
+            residual,
+            check_grid: grid,
+        })
     }
+
+    /// The [`Export`] of `files`, with the report of `accounting` and
+    /// `resampling`, and the controller's `correction`.
+    pub fn finish(
+        &self,
+        files: Vec<ExportedFile>,
+        accounting: Accounting,
+        resampling: f64,
+        correction: Box<dyn Correction + Send>,
+    ) -> Export {
+        Export {
+            report: FormatReport {
+                controller: self.controller,
+                machine: self.machine.name.clone(),
+                files: files.iter().map(|f| f.name.clone()).collect(),
+                axes: self.sampling(),
+                expressed: accounting.expressed,
+                remaining: accounting.remaining,
+                residual: accounting.residual,
+                resampling,
+                check_grid: accounting.check_grid,
+            },
+            files,
+            correction,
+        }
+    }
+}
+
+/// What [`Context::account`] finds over the check grid.
+pub(crate) struct Accounting {
+    /// The terms the format expresses.
+    pub expressed: Vec<Term>,
+    /// The terms it leaves.
+    pub remaining: Vec<Term>,
+    /// The error left.
+    pub residual: Term,
+    /// The check grid.
+    pub check_grid: Vec<(String, Vec<f64>)>,
+}
+
+/// The share a per-slot table removes from a part: the one slot `k` of
+/// the part's error where `exported` lists the part as `(name, k)`
+/// (LinuxCNC's positioning errors, CEC's straightness errors).
+pub(crate) fn slot_share(
+    exported: &[(String, usize)],
+    part: &crate::built::Part,
+) -> Option<[f64; 6]> {
+    let (_, k) = exported.iter().find(|(n, _)| *n == part.name)?;
+    let mut s = [0.0; 6];
+    s[*k] = part.error[*k];
+    Some(s)
 }
 
 /// `v` linearly interpolated in the equidistant table `values` over

@@ -14,7 +14,7 @@
 //! machine axis to move in the negative direction"); for CEC this is
 //! UNCONFIRMED and the file says so.
 
-use super::{interpolate_held, num, Context, ControllerError, Export, FormatReport, AXIS};
+use super::{interpolate_held, num, Context, ControllerError, Export, AXIS};
 use crate::compensation::{Correction, ExportedFile};
 use crate::model_trait::{ErrorModel, OutOfRange};
 
@@ -159,32 +159,7 @@ pub(super) fn export<M: ErrorModel + Sync>(
         name: "NC_CEC.INI".into(),
         text,
     }];
-    let (expressed, remaining, residual, check_grid) = ctx.account(
-        &|_, part| {
-            exported
-                .iter()
-                .find(|(n, _)| *n == part.name)
-                .map(|(_, k)| {
-                    let mut s = [0.0; 6];
-                    s[*k] = part.error[*k];
-                    s
-                })
-        },
-        &|_, _| None,
-    )?;
-    Ok(Export {
-        report: FormatReport {
-            controller: ctx.controller,
-            machine: ctx.machine.name.clone(),
-            files: files.iter().map(|f| f.name.clone()).collect(),
-            axes: ctx.sampling(),
-            expressed,
-            remaining,
-            residual,
-            resampling,
-            check_grid,
-        },
-        files,
-        correction: Box::new(CecCorrection { tables }),
-    })
+    let accounting = ctx.account(&|_, part| super::slot_share(&exported, part), &|_, _| None)?;
+    let correction = CecCorrection { tables };
+    Ok(ctx.finish(files, accounting, resampling, Box::new(correction)))
 }
