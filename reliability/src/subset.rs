@@ -346,8 +346,15 @@ impl SubsetSimulation {
             let (threshold, p) = if last {
                 (0.0, failing as f64 / n_level as f64)
             } else {
-                order.sort_unstable_by(|&a, &b| g[a].total_cmp(&g[b]));
-                (0.5 * (g[order[nc - 1]] + g[order[nc]]), self.p0)
+                // The nc lowest first (a selection, not a sort): the
+                // threshold halves the gap between the nc-th and the next.
+                order.select_nth_unstable_by(nc - 1, |&a, &b| g[a].total_cmp(&g[b]));
+                let below = g[order[nc - 1]];
+                let above = order[nc..]
+                    .iter()
+                    .map(|&i| g[i])
+                    .fold(f64::INFINITY, f64::min);
+                (0.5 * (below + above), self.p0)
             };
             let gamma = if chains {
                 gamma_factor(&g, threshold, nc, ns, p)
