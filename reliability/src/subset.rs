@@ -238,7 +238,7 @@ impl SubsetSimulation {
                     };
                     combine(vec![r], stop, None)
                 }
-                Some(target) => self.to_cov(&std, case_id, nc, ns, target, progress),
+                Some(target) => self.until_cov(&std, case_id, nc, ns, target, progress),
             }
         };
         if events.len() == 1 {
@@ -250,7 +250,7 @@ impl SubsetSimulation {
     /// Independent runs until the target CoV or the budget; runs go in
     /// parallel batches, the rule is checked after each run in run order
     /// (so the result does not depend on the thread count).
-    fn to_cov<L: LimitState>(
+    fn until_cov<L: LimitState>(
         &self,
         std: &Standard<'_, '_, L>,
         case_id: u32,
