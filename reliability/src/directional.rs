@@ -348,7 +348,7 @@ mod tests {
         // n = 3: Q(3/2, r²/2) = 2Φ(−r) + √(2/π)·r·e^{−r²/2};
         // n = 5: … + √(2/π)·r³/3·e^{−r²/2} (Abramowitz & Stegun 26.4.5).
         let c = (2.0 / std::f64::consts::PI).sqrt();
-        for r in [0.3, 1.0, 2.5, 5.0, 7.5, 9.0] {
+        for r in [0.3f64, 1.0, 2.5, 5.0, 7.5, 9.0] {
             let e = (-0.5 * r * r).exp();
             let q3 = 2.0 * normal::sf(r) + c * r * e;
             let q5 = q3 + c * r * r * r / 3.0 * e;
