@@ -12,6 +12,7 @@ toolchain; run from the repository root:
 Both sides run on one thread (OpenTURNS: ot.TBB.SetThreadsNumber(1); chain:
 a one-thread rayon pool) and report the best of three runs. Results go to
 docs/performance.md.
+Subset simulation against OpenTURNS' SubsetSampling: openturns_subset.py.
 """
 
 import json

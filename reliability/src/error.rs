@@ -119,6 +119,18 @@ pub enum ReliabilityError {
         /// The largest allowed.
         max: u64,
     },
+    /// A target coefficient of variation outside `(0, 1]` (or not finite).
+    #[error("the target coefficient of variation must be in (0, 1] (found {0})")]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::reliability::invalid_cov)))]
+    InvalidTargetCov(f64),
+    /// A sampler's settings are inconsistent (e.g. subset simulation's
+    /// samples per level not a multiple of `1/p0`).
+    #[error("invalid sampler settings: {0}")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::reliability::invalid_sampler))
+    )]
+    InvalidSampler(String),
 }
 
 impl ReliabilityError {

@@ -47,6 +47,7 @@
 #![warn(missing_docs)]
 
 pub mod allocate;
+pub mod directional;
 pub mod error;
 pub mod form;
 pub mod inputs;
@@ -59,11 +60,14 @@ pub mod posterior;
 pub mod rng;
 pub mod sensitivity;
 pub mod simulation;
+mod standard;
 pub mod study;
+pub mod subset;
 mod util;
 
 pub use allocate::{AllocateError, Allocation, ErrorBounds, Kkt, Optimal, Paper, Step};
 pub use chain_core::ErrorModel;
+pub use directional::DirectionalSimulation;
 pub use error::ReliabilityError;
 pub use form::{BranchResult, Calls, Form, FormResult, Termination};
 pub use inputs::{Inputs, Marginal};
@@ -74,8 +78,9 @@ pub use path::{
 };
 pub use posterior::{Posterior, PosteriorError};
 pub use sensitivity::{sensitivity, InputSensitivity, SensitivityMethod, SensitivityResult};
-pub use simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult};
+pub use simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult, Stop, Stopping};
 pub use study::{
     Algorithm, CaseResult, ErrorMoments, ErrorSensitivity, FormCase, FormLimit, Grid, Method,
     Study, StudyResult, StudySpec, Summary, System, Target, TargetSensitivity, VolumetricMoments,
 };
+pub use subset::{SubsetLevel, SubsetResult, SubsetSimulation};

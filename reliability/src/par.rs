@@ -63,6 +63,20 @@ pub(crate) mod prelude {
     impl<I: Iterator> MapInit for I {}
 }
 
+/// The number of worker threads (1 without the `parallel` feature): the
+/// width of the batches of the samplers' stopping rules (their results do
+/// not depend on it).
+pub(crate) fn threads() -> usize {
+    #[cfg(feature = "parallel")]
+    {
+        rayon::current_num_threads()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        1
+    }
+}
+
 #[cfg(all(test, not(feature = "parallel")))]
 mod tests {
     use super::prelude::*;

@@ -81,6 +81,83 @@ pub struct SimulationResult {
     /// The FORM result that centred the importance sampling.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub form: Option<FormResult>,
+    /// How the sampling stopped, when a stopping rule other than the plain
+    /// sample count was in force (a target coefficient of variation) or the
+    /// method always reports it (directional simulation).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopping: Option<Stopping>,
+}
+
+/// What stopped a sampler.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stop {
+    /// The requested number of samples was drawn (no target in force).
+    Samples,
+    /// The target coefficient of variation was reached.
+    TargetCov,
+    /// The sample budget ran out before the target was reached: the
+    /// estimate has not converged.
+    Budget,
+    /// Subset simulation used its largest number of levels without reaching
+    /// the failure set: the estimate has not converged.
+    Levels,
+}
+
+impl Stop {
+    /// `samples`, `target_cov`, `budget` or `levels`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stop::Samples => "samples",
+            Stop::TargetCov => "target_cov",
+            Stop::Budget => "budget",
+            Stop::Levels => "levels",
+        }
+    }
+
+    /// Whether a result stopped this way is converged.
+    pub fn converged(self) -> bool {
+        matches!(self, Stop::Samples | Stop::TargetCov)
+    }
+}
+
+impl std::fmt::Display for Stop {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// How a sampler stopped and whether its estimate converged.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Stopping {
+    /// False when the sampler stopped without meeting its rule (budget or
+    /// levels exhausted): the estimate is not a converged result.
+    pub converged: bool,
+    /// Which rule stopped it.
+    pub stopped_by: Stop,
+    /// The target coefficient of variation, when one was set.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub target_cov: Option<f64>,
+}
+
+impl Stopping {
+    /// The account of a run stopped by `stop` with target `target_cov`.
+    pub fn new(stop: Stop, target_cov: Option<f64>) -> Stopping {
+        Stopping {
+            converged: stop.converged(),
+            stopped_by: stop,
+            target_cov,
+        }
+    }
+}
+
+/// Checks a target coefficient of variation: finite, in `(0, 1]`.
+pub fn check_cov(cov: f64) -> Result<(), ReliabilityError> {
+    if cov.is_finite() && cov > 0.0 && cov <= 1.0 {
+        Ok(())
+    } else {
+        Err(ReliabilityError::InvalidTargetCov(cov))
+    }
 }
 
 /// Crude Monte Carlo: `p_f ≈ (1/N)·Σ 1[g(x_i) ≤ 0]` with `x_i` drawn from the
@@ -137,61 +214,100 @@ impl MonteCarlo {
         events: &[Event<'_, L>],
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
+        self.run_rule(events, None, progress)
+    }
+
+    /// Runs several events until the coefficient of variation of each
+    /// case's estimate is at most `target` (checked after every block of
+    /// [`BLOCK`] samples, in block order), `self.samples` being the budget:
+    /// a case that uses it up first is marked not converged
+    /// ([`Stop::Budget`]). A case with no failure yet has no CoV and goes on.
+    /// The estimate is bit-identical to a run of the same seed with the
+    /// number of samples it stopped at.
+    pub fn run_cases_to_cov<L: LimitState>(
+        &self,
+        events: &[Event<'_, L>],
+        target: f64,
+        progress: &dyn Progress,
+    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
+        check_cov(target)?;
+        self.run_rule(events, Some(target), progress)
+    }
+
+    fn run_rule<L: LimitState>(
+        &self,
+        events: &[Event<'_, L>],
+        target: Option<f64>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
         check_samples(self.samples)?;
         let width = events.iter().map(|e| e.inputs.len()).max().unwrap_or(0);
         // Tolerance limit states in normal inputs are evaluated on the
         // standard normal draws directly, E_c = m_c + a_c·z: the same samples
         // (all n inputs drawn) without the x = μ + σ·z pass.
         let affine: Vec<Option<AffineMc>> = events.iter().map(AffineMc::new).collect();
-        let sums = drive(
-            events.len(),
-            self.samples,
-            width,
-            progress,
-            |case, block, count, x| {
-                let event = &events[case];
-                let x = &mut x[..event.inputs.len()];
-                let mut rng = CaseRng::new(self.seed, case_id(case), block);
-                let mut fails = 0u64;
-                if let Some(a) = &affine[case] {
-                    for _ in 0..count {
-                        rng.fill_normal(x);
-                        fails += u64::from(a.fails(x));
-                    }
-                } else {
-                    for _ in 0..count {
-                        event.inputs.sample(&mut rng, x);
-                        if event.limit_state.value(x) <= 0.0 {
-                            fails += 1;
-                        }
+        let block = |case: usize, block: u32, count: u64, x: &mut [f64]| {
+            let event = &events[case];
+            let x = &mut x[..event.inputs.len()];
+            let mut rng = CaseRng::new(self.seed, case_id(case), block);
+            let mut fails = 0u64;
+            if let Some(a) = &affine[case] {
+                for _ in 0..count {
+                    rng.fill_normal(x);
+                    fails += u64::from(a.fails(x));
+                }
+            } else {
+                for _ in 0..count {
+                    event.inputs.sample(&mut rng, x);
+                    if event.limit_state.value(x) <= 0.0 {
+                        fails += 1;
                     }
                 }
-                let f = fails as f64;
-                Sums {
-                    s1: f,
-                    s2: f,
-                    calls: count,
-                }
-            },
-        );
-        Ok(sums
+            }
+            let f = fails as f64;
+            Sums {
+                s1: f,
+                s2: f,
+                calls: count,
+            }
+        };
+        let estimate = |s: &Sums, samples: u64| {
+            let n = samples as f64;
+            let pf = s.s1 / n;
+            let var = if samples > 1 {
+                (pf * (1.0 - pf) * n / (n - 1.0)).max(0.0)
+            } else {
+                0.0
+            };
+            (pf, (var / n).sqrt())
+        };
+        let runs = match target {
+            None => drive(events.len(), self.samples, width, progress, block)
+                .into_iter()
+                .map(|s| (s, self.samples, None))
+                .collect::<Vec<_>>(),
+            Some(t) => drive_to_cov(
+                events.len(),
+                self.samples,
+                width,
+                progress,
+                block,
+                |_, s, n| {
+                    let (pf, se) = estimate(s, n);
+                    s.s1 > 0.0 && se <= t * pf
+                },
+            )
             .into_iter()
-            .map(|s| {
-                let n = self.samples as f64;
-                let pf = s.s1 / n;
-                let var = if self.samples > 1 {
-                    (pf * (1.0 - pf) * n / (n - 1.0)).max(0.0)
-                } else {
-                    0.0
-                };
-                finish(
-                    Method::MonteCarlo,
-                    pf,
-                    (var / n).sqrt(),
-                    self.samples,
-                    s.calls,
-                    None,
-                )
+            .map(|(s, n, stop)| (s, n, Some(Stopping::new(stop, Some(t)))))
+            .collect(),
+        };
+        Ok(runs
+            .into_iter()
+            .map(|(s, samples, stopping)| {
+                let (pf, se) = estimate(&s, samples);
+                let mut r = finish(Method::MonteCarlo, pf, se, samples, s.calls, None);
+                r.stopping = stopping;
+                r
             })
             .collect())
     }
@@ -227,6 +343,32 @@ impl ImportanceSampling {
         forms: Vec<FormResult>,
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
+        self.run_rule(events, forms, None, progress)
+    }
+
+    /// [`ImportanceSampling::run_cases_with`] until each case's coefficient
+    /// of variation is at most `target` (checked after every block of
+    /// [`BLOCK`] samples, in block order), `self.samples` being the budget
+    /// ([`Stop::Budget`]: not converged). A zero-variance estimate (the
+    /// linear-normal case) stops after its first block.
+    pub fn run_cases_with_to_cov<L: LimitState>(
+        &self,
+        events: &[Event<'_, L>],
+        forms: Vec<FormResult>,
+        target: f64,
+        progress: &dyn Progress,
+    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
+        check_cov(target)?;
+        self.run_rule(events, forms, Some(target), progress)
+    }
+
+    fn run_rule<L: LimitState>(
+        &self,
+        events: &[Event<'_, L>],
+        forms: Vec<FormResult>,
+        target: Option<f64>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
         check_samples(self.samples)?;
         if forms.len() != events.len() {
             return Err(ReliabilityError::Dimension {
@@ -241,43 +383,65 @@ impl ImportanceSampling {
             .map(|(e, f)| Kernel::new(e, f))
             .collect();
         let width = kernels.iter().map(Kernel::scratch).max().unwrap_or(0);
-        let sums = drive(
-            events.len(),
-            self.samples,
-            width,
-            progress,
-            |case, block, count, scratch| {
-                let mut rng = CaseRng::new(self.seed, case_id(case), block);
-                kernels[case].block(&events[case], &mut rng, count, scratch)
-            },
-        );
-        Ok(sums
+        let block = |case: usize, block: u32, count: u64, scratch: &mut [f64]| {
+            let mut rng = CaseRng::new(self.seed, case_id(case), block);
+            kernels[case].block(&events[case], &mut rng, count, scratch)
+        };
+        let estimate = |k: &Kernel, s: &Sums, samples: u64| {
+            let n = samples as f64;
+            let mean = s.s1 / n;
+            let pf = k.shift + mean;
+            let var = if samples > 1 {
+                ((s.s2 - s.s1 * mean) / (n - 1.0)).max(0.0)
+            } else {
+                0.0
+            };
+            (pf.clamp(0.0, 1.0), (var / n).sqrt())
+        };
+        let runs = match target {
+            None => drive(events.len(), self.samples, width, progress, block)
+                .into_iter()
+                .map(|s| (s, self.samples, None))
+                .collect::<Vec<_>>(),
+            Some(t) => drive_to_cov(
+                events.len(),
+                self.samples,
+                width,
+                progress,
+                block,
+                |case, s, n| {
+                    let (pf, se) = estimate(&kernels[case], s, n);
+                    // A zero-variance estimate (a linear limit state in
+                    // normal inputs, or p_f = 0 or 1 exactly) is exact.
+                    se == 0.0 || se <= t * pf
+                },
+            )
             .into_iter()
-            .zip(kernels)
+            .map(|(s, n, stop)| (s, n, Some(Stopping::new(stop, Some(t)))))
+            .collect(),
+        };
+        Ok(runs
+            .into_iter()
+            .zip(&kernels)
             .zip(forms)
-            .map(|((s, k), form)| {
-                let n = self.samples as f64;
-                let mean = s.s1 / n;
-                let pf = k.shift + mean;
-                let var = if self.samples > 1 {
-                    ((s.s2 - s.s1 * mean) / (n - 1.0)).max(0.0)
-                } else {
-                    0.0
-                };
-                finish(
+            .map(|(((s, samples, stopping), k), form)| {
+                let (pf, se) = estimate(k, &s, samples);
+                let mut r = finish(
                     Method::ImportanceSampling,
-                    pf.clamp(0.0, 1.0),
-                    (var / n).sqrt(),
-                    self.samples,
+                    pf,
+                    se,
+                    samples,
                     s.calls,
                     Some(form),
-                )
+                );
+                r.stopping = stopping;
+                r
             })
             .collect())
     }
 }
 
-fn finish(
+pub(crate) fn finish(
     method: Method,
     pf: f64,
     std_error: f64,
@@ -295,6 +459,7 @@ fn finish(
         samples,
         calls,
         form,
+        stopping: None,
     }
 }
 
@@ -333,6 +498,65 @@ where
                 s2: a.s2 + b.s2,
                 calls: a.calls + b.calls,
             })
+        })
+        .collect()
+}
+
+/// [`drive`] with a stopping rule: per case, blocks run in parallel batches
+/// (as wide as the thread pool) and are added in block order; `done(case,
+/// sums, samples)` is asked after each block, and the first block after
+/// which it holds ends the case ([`Stop::TargetCov`]; blocks of its batch
+/// beyond it are dropped, so the result does not depend on the thread
+/// count). Running out of `samples` first is [`Stop::Budget`].
+fn drive_to_cov<F, D>(
+    cases: usize,
+    samples: u64,
+    width: usize,
+    progress: &dyn Progress,
+    run: F,
+    done: D,
+) -> Vec<(Sums, u64, Stop)>
+where
+    F: Fn(usize, u32, u64, &mut [f64]) -> Sums + Sync,
+    D: Fn(usize, &Sums, u64) -> bool + Sync,
+{
+    let blocks = samples.div_ceil(BLOCK);
+    let batch = crate::par::threads().max(1) as u64;
+    (0..cases)
+        .into_par_iter()
+        .map(|case| {
+            let mut total = Sums::default();
+            let mut used = 0u64;
+            let mut next = 0u64;
+            while next < blocks {
+                let end = (next + batch).min(blocks);
+                let parts: Vec<(Sums, u64)> = (next..end)
+                    .into_par_iter()
+                    .map_init(
+                        || vec![0.0; width + 16],
+                        |scratch, block| {
+                            let count = BLOCK.min(samples - block * BLOCK);
+                            let block_id = u32::try_from(block).unwrap_or(u32::MAX);
+                            let s = run(case, block_id, count, &mut scratch[8..8 + width]);
+                            progress.advance(count);
+                            (s, count)
+                        },
+                    )
+                    .collect();
+                next = end;
+                for (b, count) in parts {
+                    total = Sums {
+                        s1: total.s1 + b.s1,
+                        s2: total.s2 + b.s2,
+                        calls: total.calls + b.calls,
+                    };
+                    used += count;
+                    if done(case, &total, used) {
+                        return (total, used, Stop::TargetCov);
+                    }
+                }
+            }
+            (total, used, Stop::Budget)
         })
         .collect()
 }
@@ -713,7 +937,7 @@ fn line_pf_scan(f: &mut impl FnMut(f64) -> f64, beta: f64) -> f64 {
 
 /// A root of `f` in `[a, b]` with `f(a)·f(b) < 0`: regula falsi with the
 /// Illinois modification (the bracket is kept, so it cannot escape).
-fn illinois(
+pub(crate) fn illinois(
     f: &mut impl FnMut(f64) -> f64,
     mut a: f64,
     mut fa: f64,

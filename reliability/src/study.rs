@@ -17,6 +17,7 @@ use chain_core::model::{Component, Requirement, Sided};
 use chain_core::ErrorModel;
 use serde::Serialize;
 
+use crate::directional::DirectionalSimulation;
 use crate::error::ReliabilityError;
 use crate::form::{Calls, Form, FormResult, Termination};
 use crate::inputs::Inputs;
@@ -24,7 +25,8 @@ use crate::limit_state::{Criterion, Event, ToleranceLimitState};
 use crate::normal;
 use crate::par::prelude::*;
 use crate::sensitivity::{sensitivity, SensitivityMethod, SensitivityResult};
-use crate::simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult};
+use crate::simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult, Stopping};
+use crate::subset::{SubsetLevel, SubsetSimulation};
 
 /// The axis values to evaluate: the cartesian product of the axes, first axis
 /// slowest.
@@ -152,6 +154,13 @@ pub enum Method {
     /// Crude Monte Carlo.
     #[serde(rename = "mc")]
     MonteCarlo,
+    /// Subset simulation with adaptive conditional sampling
+    /// ([`crate::subset`]).
+    #[serde(rename = "subset")]
+    Subset,
+    /// Directional simulation ([`crate::directional`]).
+    #[serde(rename = "directional")]
+    Directional,
 }
 
 impl Method {
@@ -161,6 +170,8 @@ impl Method {
             Method::Form => "form",
             Method::ImportanceSampling => "is",
             Method::MonteCarlo => "mc",
+            Method::Subset => "subset",
+            Method::Directional => "directional",
         }
     }
 
@@ -170,6 +181,8 @@ impl Method {
             Method::Form => "FORM",
             Method::ImportanceSampling => "importance sampling",
             Method::MonteCarlo => "Monte Carlo",
+            Method::Subset => "subset simulation",
+            Method::Directional => "directional simulation",
         }
     }
 }
@@ -189,6 +202,16 @@ pub enum Algorithm {
     ImportanceSampling(ImportanceSampling),
     /// Crude Monte Carlo.
     MonteCarlo(MonteCarlo),
+    /// Crude Monte Carlo until a target coefficient of variation (its
+    /// `samples` the budget per case).
+    MonteCarloToCov(MonteCarlo, f64),
+    /// The importance sampling until a target coefficient of variation (its
+    /// `samples` the budget per case).
+    ImportanceSamplingToCov(ImportanceSampling, f64),
+    /// Subset simulation ([`crate::subset`]).
+    Subset(SubsetSimulation),
+    /// Directional simulation ([`crate::directional`]).
+    Directional(DirectionalSimulation),
 }
 
 impl Algorithm {
@@ -197,7 +220,10 @@ impl Algorithm {
         match self {
             Algorithm::Form(_) => Method::Form,
             Algorithm::ImportanceSampling(_) => Method::ImportanceSampling,
-            Algorithm::MonteCarlo(_) => Method::MonteCarlo,
+            Algorithm::MonteCarlo(_) | Algorithm::MonteCarloToCov(..) => Method::MonteCarlo,
+            Algorithm::ImportanceSamplingToCov(..) => Method::ImportanceSampling,
+            Algorithm::Subset(_) => Method::Subset,
+            Algorithm::Directional(_) => Method::Directional,
         }
     }
 }
@@ -294,13 +320,27 @@ pub struct CaseResult {
     /// Every limit-state call of the case (FORM's and the sampler's; a
     /// sampler's calls count as values).
     pub calls: Calls,
+    /// How the sampler stopped and whether it converged (subset and
+    /// directional simulation, and any sampler run to a target CoV).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopping: Option<Stopping>,
+    /// Subset simulation's levels (of its first run).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub levels: Option<Vec<SubsetLevel>>,
 }
 
 impl CaseResult {
     /// False when FORM did not converge on this case (its reliability is
-    /// then not a FORM result but the last iterate's).
+    /// then not a FORM result but the last iterate's), or when its sampler
+    /// stopped without meeting its rule ([`CaseResult::stopping`]).
     pub fn converged(&self) -> bool {
-        self.form.is_none_or(|f| f.converged)
+        self.form.is_none_or(|f| f.converged) && self.sampler_converged()
+    }
+
+    /// False when the sampler stopped without meeting its rule (budget or
+    /// levels exhausted); true for FORM and plain sample counts.
+    pub fn sampler_converged(&self) -> bool {
+        self.stopping.is_none_or(|s| s.converged)
     }
 }
 
@@ -818,7 +858,52 @@ impl Study {
             Algorithm::Form(form) => self.form(form),
             Algorithm::ImportanceSampling(is) => self.importance_sampling(is, progress),
             Algorithm::MonteCarlo(mc) => self.monte_carlo(mc, progress),
+            Algorithm::MonteCarloToCov(mc, cov) => {
+                let events = self.events()?;
+                let results = mc.run_cases_to_cov(&events, *cov, progress)?;
+                Ok(self.finish(Method::MonteCarlo, self.sampled(&results)))
+            }
+            Algorithm::ImportanceSamplingToCov(is, cov) => {
+                let events = self.events()?;
+                let forms = self.run_form(&events, &is.form)?;
+                let results = is.run_cases_with_to_cov(&events, forms, *cov, progress)?;
+                Ok(self.finish(Method::ImportanceSampling, self.sampled(&results)))
+            }
+            Algorithm::Subset(ss) => self.subset(ss, progress),
+            Algorithm::Directional(ds) => {
+                let events = self.events()?;
+                let results = ds.run_cases(&events, progress)?;
+                Ok(self.finish(Method::Directional, self.sampled(&results)))
+            }
         }
+    }
+
+    /// Subset simulation on every case.
+    pub fn subset(
+        &self,
+        ss: &SubsetSimulation,
+        progress: &dyn Progress,
+    ) -> Result<StudyResult, ReliabilityError> {
+        let events = self.events()?;
+        let results = ss.run_cases(&events, progress)?;
+        let cases = results
+            .into_iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let mut c = self.case(i, r.reliability, r.pf, r.beta);
+                c.std_error = Some(r.std_error);
+                c.cov = Some(r.cov);
+                c.samples = Some(r.samples);
+                c.calls = Calls {
+                    values: r.calls,
+                    gradients: 0,
+                };
+                c.stopping = Some(r.stopping);
+                c.levels = Some(r.levels);
+                c
+            })
+            .collect();
+        Ok(self.finish(Method::Subset, cases))
     }
 
     fn run_form(
@@ -843,6 +928,7 @@ impl Study {
                 c.cov = Some(r.cov);
                 c.samples = Some(r.samples);
                 c.form = r.form.as_ref().map(FormCase::of);
+                c.stopping = r.stopping;
                 let form_calls = r.form.as_ref().map(|f| f.calls).unwrap_or_default();
                 c.calls = Calls {
                     values: form_calls.values + r.calls,
@@ -866,6 +952,8 @@ impl Study {
             samples: None,
             form: None,
             calls: Calls::default(),
+            stopping: None,
+            levels: None,
         }
     }
 

@@ -57,6 +57,31 @@ pub struct AlgorithmArgs {
     /// Seed of the random streams (results do not depend on the thread count).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Target coefficient of variation of each case's p_f, in (0, 1]: the
+    /// sampler stops when it is reached, `--samples` being the budget (mc:
+    /// 10^7, is and directional: 10^6 by default; subset: `--samples` per
+    /// level, at most 1000 levels' worth); a case that runs out is marked
+    /// not converged.
+    #[arg(long, value_name = "C", value_parser = super::reliability::parse_cov, allow_negative_numbers = true)]
+    pub cov: Option<f64>,
+}
+
+impl AlgorithmArgs {
+    /// Refuses `--cov` with FORM (it draws no samples).
+    pub fn check(&self) -> miette::Result<()> {
+        if self.cov.is_some() && self.method == MethodArg::Form {
+            miette::bail!(
+                "--cov: FORM draws no samples; a target coefficient of variation needs --method mc, is, subset or directional"
+            );
+        }
+        Ok(())
+    }
+
+    /// The library's algorithm for these options.
+    pub fn algorithm(&self) -> reliability::Algorithm {
+        let samples = self.method.samples(self.samples, self.cov.is_some());
+        self.method.algorithm_with(samples, self.seed, self.cov)
+    }
 }
 
 /// `--system`, `--system-tolerance`: a system target besides the components.

@@ -120,15 +120,9 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
             }
         }
     }
-    let samples = args.algorithm.method.samples(args.algorithm.samples);
+    args.algorithm.check()?;
     let result = path
-        .run(
-            &args
-                .algorithm
-                .method
-                .algorithm(samples, args.algorithm.seed),
-            &(),
-        )
+        .run(&args.algorithm.algorithm(), &())
         .map_err(|e| loaded.report(e))?;
     if let (Some(study), Some(r)) = (path.study(), &result.study) {
         warn_unconverged(r, study.variables());

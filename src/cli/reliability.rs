@@ -20,25 +20,14 @@ use std::path::{Path, PathBuf};
 use chain_core::model::{Machine, Origin, Sided};
 use miette::{LabeledSpan, MietteDiagnostic, NamedSource};
 use reliability::{
-    machine, Algorithm, Calls, Form, FormCase, ImportanceSampling, Method, MonteCarlo, Posterior,
-    PosteriorError, ReliabilityError, Study, StudyResult, System, Target, Termination,
+    machine, Algorithm, Calls, DirectionalSimulation, Form, FormCase, ImportanceSampling, Method,
+    MonteCarlo, Posterior, PosteriorError, ReliabilityError, Stopping, Study, StudyResult,
+    SubsetLevel, SubsetSimulation, System, Target, Termination,
 };
 use serde::Serialize;
 
 use super::args::{AlgorithmArgs, ModelArgs, SystemArgs};
 use super::report::{self, Csv, Report};
-
-/// Runs the chosen algorithm over every case of a study (`samples` is
-/// ignored by FORM); `progress` receives the samples done.
-pub(crate) fn run_study(
-    study: &Study,
-    method: MethodArg,
-    samples: u64,
-    seed: u64,
-    progress: &dyn reliability::Progress,
-) -> Result<StudyResult, ReliabilityError> {
-    study.run(&method.algorithm(samples, seed), progress)
-}
 
 /// Algorithms of `--method`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -49,12 +38,43 @@ pub enum MethodArg {
     Is,
     /// Crude Monte Carlo.
     Mc,
+    /// Subset simulation (Au & Beck 2001) with adaptive conditional
+    /// sampling, p0 = 0.1; `--samples` per level.
+    Subset,
+    /// Directional simulation (Bjerager 1988).
+    Directional,
 }
 
 impl MethodArg {
-    /// The library's algorithm with these samples per case and seed
-    /// (FORM ignores both).
-    pub(crate) fn algorithm(self, samples: u64, seed: u64) -> Algorithm {
+    /// The library's algorithm with these samples per case and seed (FORM
+    /// ignores both) and an optional target coefficient of variation
+    /// (`samples` is then the budget; for subset the samples per level).
+    pub(crate) fn algorithm_with(self, samples: u64, seed: u64, cov: Option<f64>) -> Algorithm {
+        match (self, cov) {
+            (MethodArg::Mc, Some(c)) => {
+                return Algorithm::MonteCarloToCov(MonteCarlo { samples, seed }, c)
+            }
+            (MethodArg::Is, Some(c)) => {
+                return Algorithm::ImportanceSamplingToCov(
+                    ImportanceSampling {
+                        samples,
+                        seed,
+                        form: Form::default(),
+                    },
+                    c,
+                )
+            }
+            (MethodArg::Subset, _) => {
+                let mut s = SubsetSimulation::new(samples, seed);
+                s.cov = cov;
+                s.budget = samples.saturating_mul(SUBSET_BUDGET_LEVELS);
+                return Algorithm::Subset(s);
+            }
+            (MethodArg::Directional, _) => {
+                return Algorithm::Directional(DirectionalSimulation { samples, seed, cov })
+            }
+            _ => {}
+        }
         match self {
             MethodArg::Form => Algorithm::Form(Form::default()),
             MethodArg::Is => Algorithm::ImportanceSampling(ImportanceSampling {
@@ -63,17 +83,47 @@ impl MethodArg {
                 form: Form::default(),
             }),
             MethodArg::Mc => Algorithm::MonteCarlo(MonteCarlo { samples, seed }),
+            MethodArg::Subset | MethodArg::Directional => unreachable!("handled above"),
         }
     }
 
     /// The samples per case: `--samples` or the method's default (is:
     /// 10,000, mc: 100,000; 0 for FORM, which draws none).
-    pub(crate) fn samples(self, given: Option<u64>) -> u64 {
-        match self {
-            MethodArg::Form => 0,
-            MethodArg::Is => given.unwrap_or(10_000),
-            MethodArg::Mc => given.unwrap_or(100_000),
+    pub(crate) fn samples(self, given: Option<u64>, to_cov: bool) -> u64 {
+        match (self, to_cov) {
+            (MethodArg::Form, _) => 0,
+            (MethodArg::Is, false) => given.unwrap_or(10_000),
+            (MethodArg::Mc, false) => given.unwrap_or(100_000),
+            (MethodArg::Is, true) => given.unwrap_or(1_000_000),
+            (MethodArg::Mc, true) => given.unwrap_or(10_000_000),
+            (MethodArg::Subset, _) => given.unwrap_or(1_000),
+            (MethodArg::Directional, false) => given.unwrap_or(10_000),
+            (MethodArg::Directional, true) => given.unwrap_or(1_000_000),
         }
+    }
+}
+
+/// Subset simulation's sample budget with `--cov`, in levels of `--samples`.
+const SUBSET_BUDGET_LEVELS: u64 = 1000;
+
+/// Parses `--cov`: a finite number in (0, 1].
+pub(crate) fn parse_cov(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    if !v.is_finite() || v <= 0.0 || v > 1.0 {
+        return Err(format!(
+            "the target coefficient of variation must be in (0, 1] (found `{s}`)"
+        ));
+    }
+    Ok(v)
+}
+
+impl MethodArg {
+    /// Whether the method samples (all but FORM).
+    pub(crate) fn samples_anything(self) -> bool {
+        self != MethodArg::Form
     }
 }
 
@@ -145,6 +195,7 @@ pub struct ReliabilityArgs {
 
 /// Runs `chain reliability`.
 pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
+    args.algorithm.check()?;
     let loaded = Loaded::new(&args.file)?;
     let system = system_of(&loaded.machine, args.system.system, args.system.tolerance)
         .map_err(|e| loaded.report(e))?;
@@ -156,19 +207,16 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
         system,
         posterior.as_ref(),
     )?;
-    let samples = args.algorithm.method.samples(args.algorithm.samples);
-    let bar = if args.algorithm.method == MethodArg::Form {
+    let samples = args
+        .algorithm
+        .method
+        .samples(args.algorithm.samples, args.algorithm.cov.is_some());
+    let bar = if !args.algorithm.method.samples_anything() {
         ProgressBar(None)
     } else {
         ProgressBar::new(samples, study_cases(&study), args.format)
     };
-    let result = run_study(
-        &study,
-        args.algorithm.method,
-        samples,
-        args.algorithm.seed,
-        &|n| bar.inc(n),
-    );
+    let result = study.run(&args.algorithm.algorithm(), &|n| bar.inc(n));
     bar.finish();
     let result = result.map_err(|e| loaded.report(e))?;
     if args.algorithm.method == MethodArg::Form {
@@ -536,7 +584,17 @@ struct CaseDoc<'a> {
     cov: Option<f64>,
     #[serde(flatten)]
     form: Option<FormCase>,
+    /// The sampler's convergence where FORM's does not occupy the key
+    /// (subset, directional, mc with `--cov`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    converged: Option<bool>,
     calls: Calls,
+    /// How the sampler stopped (subset, directional, or `--cov`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    sampling: Option<Stopping>,
+    /// Subset simulation's levels.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    levels: Option<&'a [SubsetLevel]>,
 }
 
 /// One target's summary of [`ReliabilityDoc`].
@@ -594,7 +652,13 @@ impl<'a> ReliabilityDoc<'a> {
                 samples: c.samples,
                 cov: c.cov,
                 form: c.form,
+                converged: match (&c.form, &c.stopping) {
+                    (None, Some(st)) => Some(st.converged),
+                    _ => None,
+                },
                 calls: c.calls,
+                sampling: c.stopping,
+                levels: c.levels.as_deref(),
             })
             .collect();
         let summary = Pairs(
@@ -655,6 +719,15 @@ impl Report for ReliabilityDoc<'_> {
             ]
             .map(String::from),
         );
+        // The sampler's stopping rule, when it reports one (v1 runs do not).
+        let stopped = r.cases.iter().any(|c| c.stopping.is_some());
+        let leveled = r.cases.iter().any(|c| c.levels.is_some());
+        if stopped {
+            header.extend(["stopped_by", "sampler_converged"].map(String::from));
+        }
+        if leveled {
+            header.push("levels".to_string());
+        }
         let mut csv = Csv::new(header);
         for c in &r.cases {
             let mut row = vec![c.target.to_string()];
@@ -676,6 +749,19 @@ impl Report for ReliabilityDoc<'_> {
             }
             row.push(c.calls.values.to_string());
             row.push(c.calls.gradients.to_string());
+            if stopped {
+                match &c.stopping {
+                    Some(st) => row.extend([st.stopped_by.to_string(), st.converged.to_string()]),
+                    None => row.extend([String::new(), String::new()]),
+                }
+            }
+            if leveled {
+                row.push(
+                    c.levels
+                        .as_ref()
+                        .map_or(String::new(), |l| l.len().to_string()),
+                );
+            }
             csv.row(row);
         }
         Some(csv)
@@ -716,7 +802,12 @@ pub(crate) fn posterior_lines(p: &Posterior) -> String {
 /// Warns on stderr about the cases on which FORM did not converge (their
 /// reliability is the last iterate's, not a FORM result).
 pub(crate) fn warn_unconverged(r: &StudyResult, variables: &[String]) {
-    let bad: Vec<&reliability::CaseResult> = r.unconverged().collect();
+    warn_sampler_unconverged(r, variables);
+    let bad: Vec<&reliability::CaseResult> = r
+        .cases
+        .iter()
+        .filter(|c| c.form.is_some_and(|f| !f.converged))
+        .collect();
     if let Some(first) = bad.first() {
         let at = variables
             .iter()
@@ -726,6 +817,33 @@ pub(crate) fn warn_unconverged(r: &StudyResult, variables: &[String]) {
             .join(", ");
         eprintln!(
             "warning: FORM did not converge on {} of {} cases (first: {} at {at}); their reliabilities are the last iterates' (listed under the table, `converged: false` in JSON and CSV)",
+            bad.len(),
+            r.cases.len(),
+            first.target
+        );
+    }
+}
+
+/// Warns on stderr about the cases whose sampler stopped without meeting
+/// its rule (the `--cov` target not reached within the budget, or subset
+/// simulation out of levels).
+fn warn_sampler_unconverged(r: &StudyResult, variables: &[String]) {
+    let bad: Vec<&reliability::CaseResult> =
+        r.cases.iter().filter(|c| !c.sampler_converged()).collect();
+    if let Some(first) = bad.first() {
+        let at = variables
+            .iter()
+            .zip(&first.point)
+            .map(|(v, x)| format!("{v} = {x}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let why = first.stopping.map_or("", |s| match s.stopped_by {
+            reliability::Stop::Levels => "subset simulation ran out of levels",
+            _ => "the sample budget ran out before the target coefficient of variation",
+        });
+        eprintln!(
+            "warning: the {} did not converge on {} of {} cases (first: {} at {at}: {why}); their values are not converged estimates (listed under the table, `converged: false` in JSON and CSV)",
+            r.method.title(),
             bad.len(),
             r.cases.len(),
             first.target
@@ -954,22 +1072,84 @@ fn to_table(machine: &str, study: &Study, r: &StudyResult) -> String {
             .iter()
             .filter_map(|c| c.std_error)
             .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))));
-        if let (Some(se), Some(n)) = (se, cases.first().and_then(|c| c.samples)) {
-            let _ = writeln!(
-                out,
-                "  sampling: {n} samples per point, largest standard error {:.2e}",
-                se
-            );
+        let rule = cases.iter().filter_map(|c| c.stopping).next();
+        match (se, cases.first().and_then(|c| c.samples), rule) {
+            (Some(se), Some(n), None) => {
+                let _ = writeln!(
+                    out,
+                    "  sampling: {n} samples per point, largest standard error {:.2e}",
+                    se
+                );
+            }
+            (Some(se), Some(_), Some(rule)) => {
+                let _ = writeln!(out, "  {}", sampling_text(cases, rule, se));
+            }
+            _ => {}
         }
         let _ = writeln!(out, "  {}", calls_text(cases.iter(), r.method));
     }
     if marked {
-        let _ = writeln!(
-            out,
-            "\n* FORM stopped at the iteration limit there: the value shown is the last iterate's, not a converged reliability"
-        );
+        let sampler = r.cases.iter().any(|c| !c.sampler_converged());
+        let form = r.cases.iter().any(|c| c.form.is_some_and(|f| !f.converged));
+        if form {
+            let _ = writeln!(
+                out,
+                "\n* FORM stopped at the iteration limit there: the value shown is the last iterate's, not a converged reliability"
+            );
+        }
+        if sampler {
+            let _ = writeln!(
+                out,
+                "\n* the {} stopped there without meeting its rule (sample budget or levels exhausted): the value shown is not a converged estimate",
+                r.method.title()
+            );
+        }
     }
     out
+}
+
+/// The table line of a sampler that reports its stopping: the samples used
+/// (a range when the rule stopped the points apart), the target and how
+/// many points met it, the largest standard error; for subset simulation
+/// the levels and the chains' mean acceptance rate.
+fn sampling_text(cases: &[reliability::CaseResult], rule: Stopping, se: f64) -> String {
+    let ns: Vec<u64> = cases.iter().filter_map(|c| c.samples).collect();
+    let (lo, hi) = (
+        ns.iter().copied().min().unwrap_or(0),
+        ns.iter().copied().max().unwrap_or(0),
+    );
+    let samples = if lo == hi {
+        format!("{lo} samples per point")
+    } else {
+        format!("{lo} to {hi} samples per point")
+    };
+    let met = cases.iter().filter(|c| c.sampler_converged()).count();
+    let target = match rule.target_cov {
+        Some(t) => format!(", target CoV {t} met at {met} of {} points", cases.len()),
+        None if met < cases.len() => format!(", converged at {met} of {} points", cases.len()),
+        None => String::new(),
+    };
+    let mut text = format!("sampling: {samples}{target}, largest standard error {se:.2e}");
+    let levels: Vec<&Vec<SubsetLevel>> = cases.iter().filter_map(|c| c.levels.as_ref()).collect();
+    if !levels.is_empty() {
+        let counts = levels.iter().map(|l| l.len());
+        let (lmin, lmax) = (counts.clone().min().unwrap_or(0), counts.max().unwrap_or(0));
+        let rates: Vec<f64> = levels
+            .iter()
+            .flat_map(|l| l.iter().filter_map(|x| x.acceptance_rate))
+            .collect();
+        let levels = if lmin == lmax {
+            format!("{lmin} levels")
+        } else {
+            format!("{lmin} to {lmax} levels")
+        };
+        text.push_str(&format!("; subset: {levels}"));
+        if !rates.is_empty() {
+            let mean = rates.iter().sum::<f64>() / rates.len() as f64;
+            text.push_str(&format!(", mean acceptance {mean:.2}"));
+        }
+    }
+    text
 }
 
 /// `upper` or `two-sided`: how the tables name [`Sided`] (the JSON has
