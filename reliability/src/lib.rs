@@ -46,6 +46,7 @@
 
 #![warn(missing_docs)]
 
+pub mod acceptance;
 pub mod allocate;
 pub mod error;
 pub mod form;
@@ -62,6 +63,9 @@ pub mod simulation;
 pub mod study;
 mod util;
 
+pub use acceptance::{
+    Acceptance, AcceptanceMethod, AcceptanceResult, AcceptanceSensitivity, Rectangles,
+};
 pub use allocate::{AllocateError, Allocation, ErrorBounds, Kkt, Optimal, Paper, Step};
 pub use chain_core::ErrorModel;
 pub use error::ReliabilityError;
