@@ -401,3 +401,107 @@ fn bad_settings_are_refused() {
     .unwrap_err();
     assert!(e.to_string().contains("samples"), "{e}");
 }
+
+/// `chain allocate --target acceptance --level 0.9` reaches the level: the
+/// allocated standard deviations, re-evaluated here with another seed and
+/// a tighter tolerance, give `P ≥ 0.9` (within 3 standard errors); the
+/// least-cost strategy costs less than the paper's rounds.
+#[test]
+fn allocate_reaches_the_acceptance_level() {
+    let file = example_path("gantry_grinder.yaml");
+    let file = file.to_str().unwrap();
+    let (_, _, study) = gantry();
+    let system = Rectangles::from_study(&study).unwrap();
+    let mut costs = Vec::new();
+    for strategy in ["optimal", "paper"] {
+        let doc = common::cli::ok_json(&[
+            "allocate",
+            file,
+            "--target",
+            "acceptance",
+            "--level",
+            "0.9",
+            "--strategy",
+            strategy,
+            "--format",
+            "json",
+        ]);
+        let stds = doc["final"]["std"].as_object().unwrap();
+        let mut inputs = system.inputs().clone();
+        for (j, name) in system.inputs().names().to_vec().iter().enumerate() {
+            let s = stds[name.as_str()].as_f64().unwrap();
+            inputs = inputs.with_moments(j, inputs.means()[j], s).unwrap();
+        }
+        let r = Acceptance {
+            tolerance: 2e-4,
+            seed: 99,
+            sensitivity: false,
+            ..Acceptance::default()
+        }
+        .run(&system.with_inputs(inputs).unwrap())
+        .unwrap();
+        assert!(
+            r.probability >= 0.9 - 3.0 * r.std_error,
+            "{strategy}: {r:?}"
+        );
+        assert_eq!(doc["final"]["met"], true);
+        assert_eq!(doc["acceptance"]["level"], 0.9);
+        costs.push(doc["final"]["cost"].as_f64().unwrap());
+    }
+    assert!(costs[0] < costs[1], "{costs:?}");
+}
+
+/// Bad input is refused with the option or key named, nothing on stdout.
+#[test]
+fn bad_acceptance_input_is_located() {
+    let file = example_path("gantry_grinder.yaml");
+    let file = file.to_str().unwrap();
+    for level in ["0", "1", "1.5", "-0.2"] {
+        let level = format!("--level={level}");
+        let e = common::cli::fails(&["allocate", file, "--target", "acceptance", &level]);
+        assert!(e.contains("--level"), "{e}");
+    }
+    let e = common::cli::fails(&["allocate", file, "--target", "acceptance"]);
+    assert!(e.contains("--level"), "{e}");
+    let e = common::cli::fails(&[
+        "reliability",
+        file,
+        "--acceptance",
+        "--acceptance-tolerance",
+        "0",
+    ]);
+    assert!(e.contains("--acceptance-tolerance"), "{e}");
+    // `acceptance: 3` in the machine file: file:line:column and the key.
+    let text = std::fs::read_to_string(example_path("gantry_grinder.yaml")).unwrap();
+    let bad = text.replace("  sided: upper\n", "  sided: upper\n  acceptance: 3\n");
+    let line = bad.lines().position(|l| l == "  acceptance: 3").unwrap() + 1;
+    let path = common::cli::scratch_file("acceptance_bad.yaml", &bad);
+    let e = common::cli::fails(&["reliability", path.to_str().unwrap()]);
+    assert!(
+        e.contains(&format!(":{line}:15")) && e.contains("reliability.acceptance"),
+        "{e}"
+    );
+    assert!(e.contains("true or false"), "{e}");
+}
+
+/// `reliability.acceptance: true` in the file is `--acceptance`: the JSON
+/// gains the spec's object; without it the output has no `acceptance` key.
+#[test]
+fn the_machine_key_adds_the_acceptance_object() {
+    let file = example_path("gantry_grinder.yaml");
+    let plain = common::cli::ok_json(&["reliability", file.to_str().unwrap(), "--format", "json"]);
+    assert!(plain.get("acceptance").is_none());
+    let text = std::fs::read_to_string(&file).unwrap();
+    let on = text.replace("  sided: upper\n", "  sided: upper\n  acceptance: true\n");
+    let path = common::cli::scratch_file("acceptance_on.yaml", &on);
+    let doc = common::cli::ok_json(&["reliability", path.to_str().unwrap(), "--format", "json"]);
+    let a = &doc["acceptance"];
+    for key in ["probability", "std_error", "method", "sensitivity"] {
+        assert!(a.get(key).is_some(), "{key}: {a}");
+    }
+    assert_eq!(a["method"], "genz_qmc");
+    assert_eq!(a["converged"], true);
+    let s = &a["sensitivity"][0];
+    assert!(s["error"].is_string() && s["dr_dstd"].is_f64() && s["dr_dmean"].is_f64());
+    assert_eq!(doc["results"], plain["results"]);
+}
