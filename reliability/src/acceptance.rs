@@ -143,8 +143,8 @@ impl Rectangles {
         }
         if rows.iter().any(|v| !v.is_finite())
             || lower.iter().chain(&upper).any(|v| v.is_nan())
-            || lower.iter().any(|&v| v == f64::INFINITY)
-            || upper.iter().any(|&v| v == f64::NEG_INFINITY)
+            || lower.contains(&f64::INFINITY)
+            || upper.contains(&f64::NEG_INFINITY)
         {
             return Err(ReliabilityError::NonFinite("the acceptance constraints"));
         }
