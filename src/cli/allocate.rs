@@ -107,10 +107,12 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
     };
     let level = match (args.target, args.level) {
         (TargetArg::Acceptance, Some(l)) if l > 0.0 && l < 1.0 => Some(l),
-        (TargetArg::Acceptance, Some(l)) => return Err(miette::miette!(
+        (TargetArg::Acceptance, Some(l)) => {
+            return Err(miette::miette!(
             code = "chain::allocate::invalid_level",
             "invalid value for `--level`: {l} (an acceptance probability strictly between 0 and 1)"
-        )),
+        ))
+        }
         (TargetArg::Acceptance, None) => {
             return Err(miette::miette!(
                 code = "chain::allocate::missing_level",
