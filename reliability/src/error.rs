@@ -131,6 +131,18 @@ pub enum ReliabilityError {
         diagnostic(code(chain::reliability::invalid_sampler))
     )]
     InvalidSampler(String),
+    /// A setting of an algorithm is out of range.
+    #[error("{option}: {message}")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::reliability::invalid_option))
+    )]
+    InvalidOption {
+        /// The setting.
+        option: &'static str,
+        /// What is wrong with it.
+        message: String,
+    },
 }
 
 impl ReliabilityError {

@@ -46,6 +46,7 @@
 
 #![warn(missing_docs)]
 
+pub mod acceptance;
 pub mod allocate;
 pub mod directional;
 pub mod error;
@@ -65,6 +66,9 @@ pub mod study;
 pub mod subset;
 mod util;
 
+pub use acceptance::{
+    Acceptance, AcceptanceMethod, AcceptanceResult, AcceptanceSensitivity, Rectangles,
+};
 pub use allocate::{AllocateError, Allocation, ErrorBounds, Kkt, Optimal, Paper, Step};
 pub use chain_core::ErrorModel;
 pub use directional::DirectionalSimulation;

@@ -37,6 +37,15 @@ pub enum RankArg {
     Pooled,
 }
 
+/// `--target`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TargetArg {
+    /// The reliability section's `requirement` (minimum and mean over the grid, per component).
+    Requirement,
+    /// The whole-machine acceptance probability reaches `--level` (docs/acceptance.md).
+    Acceptance,
+}
+
 /// Output formats of `chain allocate`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum AllocateFormat {
@@ -66,6 +75,12 @@ pub struct AllocateArgs {
     /// Ranking of `--strategy paper`.
     #[arg(long, value_enum, default_value = "component")]
     pub rank: RankArg,
+    /// What to allocate for.
+    #[arg(long, value_enum, default_value = "requirement")]
+    pub target: TargetArg,
+    /// The acceptance probability to reach with `--target acceptance`, in (0, 1).
+    #[arg(long, value_name = "L")]
+    pub level: Option<f64>,
     /// Output format.
     #[arg(long, value_enum, default_value = "table")]
     pub format: AllocateFormat,
@@ -84,22 +99,53 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
     let values = reliability::machine::parameters(&loaded.machine, &args.model.param.params)
         .map_err(|e| loaded.report(e))?;
     let bounds = allocate::bounds(&loaded.machine, &study).map_err(|e| loaded.report(e))?;
-    let result = match args.strategy {
-        StrategyArg::Optimal => {
-            allocate::optimal(&model, &values, &study, &bounds, &Optimal::default())
+    let paper_options = Paper {
+        step: args.step,
+        threshold: args.threshold,
+        pooled: args.rank == RankArg::Pooled,
+        ..Paper::default()
+    };
+    let level = match (args.target, args.level) {
+        (TargetArg::Acceptance, Some(l)) if l > 0.0 && l < 1.0 => Some(l),
+        (TargetArg::Acceptance, Some(l)) => {
+            return Err(miette::miette!(
+            code = "chain::allocate::invalid_level",
+            "invalid value for `--level`: {l} (an acceptance probability strictly between 0 and 1)"
+        ))
         }
-        StrategyArg::Paper => allocate::paper(
+        (TargetArg::Acceptance, None) => {
+            return Err(miette::miette!(
+                code = "chain::allocate::missing_level",
+                help = "e.g. --target acceptance --level 0.9",
+                "`--target acceptance` needs `--level L`"
+            ))
+        }
+        (TargetArg::Requirement, Some(_)) => {
+            return Err(miette::miette!(
+                code = "chain::allocate::invalid_level",
+                "`--level` applies to `--target acceptance` only"
+            ))
+        }
+        (TargetArg::Requirement, None) => None,
+    };
+    let result = match (level, args.strategy) {
+        (Some(level), strategy) => allocate::acceptance(
             &model,
             &values,
             &study,
             &bounds,
-            &Paper {
-                step: args.step,
-                threshold: args.threshold,
-                pooled: args.rank == RankArg::Pooled,
-                ..Paper::default()
+            level,
+            match strategy {
+                StrategyArg::Optimal => allocate::AcceptanceStrategy::Optimal,
+                StrategyArg::Paper => allocate::AcceptanceStrategy::Paper(paper_options),
             },
         ),
+        (None, StrategyArg::Optimal) => {
+            allocate::optimal(&model, &values, &study, &bounds, &Optimal::default())
+        }
+        (None, StrategyArg::Paper) => {
+            allocate::paper(&model, &values, &study, &bounds, &paper_options)
+        }
     };
     let result = result.map_err(|e| failure(&loaded, e))?;
     if let Some(dir) = &args.plot {
@@ -131,10 +177,18 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
     report::emit(&doc, args.format.into())?;
     if !result.met {
         return Err(miette::Report::new(
-            MietteDiagnostic::new(format!(
-                "the requirement is not met after {} rounds",
-                result.steps.len()
-            ))
+            MietteDiagnostic::new(match &result.acceptance {
+                Some(a) => format!(
+                    "the acceptance level {} is not reached after {} rounds (P = {})",
+                    a.level,
+                    result.steps.len(),
+                    a.probability
+                ),
+                None => format!(
+                    "the requirement is not met after {} rounds",
+                    result.steps.len()
+                ),
+            })
             .with_code("chain::allocate::not_met"),
         ));
     }
@@ -299,6 +353,9 @@ struct AllocationDoc<'a> {
     last: FinalDoc<'a>,
     #[serde(skip_serializing_if = "Option::is_none")]
     kkt: Option<KktDoc<'a>>,
+    /// `--target acceptance`: level, initial and allocated probability.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    acceptance: Option<&'a allocate::AcceptanceAllocation>,
 }
 
 #[derive(Serialize)]
@@ -406,6 +463,7 @@ impl AllocationReport<'_> {
                     })
                     .collect(),
             }),
+            acceptance: r.acceptance.as_ref(),
         }
     }
 }
@@ -494,6 +552,19 @@ fn to_table(
         r.cost,
         if r.met { "met" } else { "NOT met" }
     );
+    if let Some(a) = &r.acceptance {
+        let _ = writeln!(
+            out,
+            "whole-machine acceptance: {:.4} % → {:.4} % ± {:.4} % (level {:.4} %, {}; independent re-evaluation{}; {} evaluations)",
+            a.initial * 100.0,
+            a.probability * 100.0,
+            a.std_error * 100.0,
+            a.level * 100.0,
+            if r.met { "reached" } else { "NOT reached" },
+            if a.converged { "" } else { ", NOT CONVERGED" },
+            a.evaluations
+        );
+    }
     if let Some(k) = &r.kkt {
         let _ = writeln!(
             out,

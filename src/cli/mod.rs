@@ -1,6 +1,7 @@
 //! Subcommands of the `chain` binary: one file per subcommand, each a thin
 //! `exec` over the libraries.
 
+mod acceptance;
 pub mod allocate;
 mod args;
 pub mod compensate;

@@ -191,6 +191,14 @@ pub struct ReliabilityArgs {
     /// give keep their `statistics` (docs/posterior.md).
     #[arg(long, value_name = "VALUES.yaml")]
     pub values: Option<PathBuf>,
+    /// Also the whole-machine acceptance probability: every toleranced
+    /// component within tolerance at every grid point at once, with its
+    /// sensitivities (as `reliability.acceptance: true`; docs/acceptance.md).
+    #[arg(long)]
+    pub acceptance: bool,
+    /// Absolute error of the acceptance probability (three standard errors).
+    #[arg(long, value_name = "ABS", default_value_t = 1e-3)]
+    pub acceptance_tolerance: f64,
 }
 
 /// Runs `chain reliability`.
@@ -232,8 +240,25 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
             eprintln!("wrote {}", f.display());
         }
     }
+    let wanted = args.acceptance
+        || loaded
+            .machine
+            .reliability
+            .as_ref()
+            .is_some_and(|r| r.acceptance);
+    let acceptance = if wanted {
+        Some(super::acceptance::run(
+            &loaded,
+            &study,
+            args.acceptance_tolerance,
+            args.algorithm.seed,
+        )?)
+    } else {
+        None
+    };
     let mut doc = ReliabilityDoc::new(&loaded.machine.name, &study, &result);
     doc.posterior = posterior.as_ref();
+    doc.acceptance = acceptance.as_ref();
     report::emit(&doc, args.format.into())
 }
 
@@ -561,6 +586,12 @@ pub(crate) struct ReliabilityDoc<'a> {
     /// The posterior of `--values`, when given.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub(crate) posterior: Option<&'a Posterior>,
+    /// The whole-machine acceptance probability (`--acceptance`).
+    #[serde(
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "super::acceptance::serialize"
+    )]
+    pub(crate) acceptance: Option<&'a reliability::AcceptanceResult>,
     #[serde(skip)]
     study: &'a Study,
     #[serde(skip)]
@@ -683,6 +714,7 @@ impl<'a> ReliabilityDoc<'a> {
             summary,
             requirement: RequirementDoc::of(r),
             posterior: None,
+            acceptance: None,
             study,
             result: r,
         }
@@ -691,7 +723,10 @@ impl<'a> ReliabilityDoc<'a> {
 
 impl Report for ReliabilityDoc<'_> {
     fn table(&self) -> String {
-        let table = to_table(self.machine, self.study, self.result);
+        let mut table = to_table(self.machine, self.study, self.result);
+        if let Some(a) = self.acceptance {
+            table.push_str(&super::acceptance::table(self.study, a));
+        }
         match self.posterior {
             None => table,
             Some(p) => format!("{}{table}", posterior_lines(p)),
@@ -701,7 +736,10 @@ impl Report for ReliabilityDoc<'_> {
     fn csv(&self) -> Option<Csv> {
         let (study, r) = (self.study, self.result);
         let ax = axes(study);
-        let sampled = r.cases.first().is_some_and(|c| c.samples.is_some());
+        // With the acceptance row, the sampling columns are always there
+        // (empty for FORM cases).
+        let sampled =
+            r.cases.first().is_some_and(|c| c.samples.is_some()) || self.acceptance.is_some();
         let mut header = vec!["component".to_string()];
         header.extend(ax.iter().map(|(n, _)| n.clone()));
         header.extend(["reliability", "pf", "beta"].map(String::from));
@@ -733,7 +771,11 @@ impl Report for ReliabilityDoc<'_> {
             let mut row = vec![c.target.to_string()];
             row.extend(ax.iter().map(|(_, i)| fmt_num(c.point[*i])));
             row.extend([c.reliability, c.pf, c.beta].map(|v| format!("{v:?}")));
-            if sampled {
+            if sampled && self.acceptance.is_some() {
+                row.push(c.std_error.map_or(String::new(), |v| format!("{v:?}")));
+                row.push(c.cov.map_or(String::new(), |v| format!("{v:?}")));
+                row.push(c.samples.map_or(String::new(), |v| v.to_string()));
+            } else if sampled {
                 row.push(format!("{:?}", c.std_error.unwrap_or(0.0)));
                 row.push(format!("{:?}", c.cov.unwrap_or(0.0)));
                 row.push(c.samples.unwrap_or(0).to_string());
@@ -763,6 +805,9 @@ impl Report for ReliabilityDoc<'_> {
                 );
             }
             csv.row(row);
+        }
+        if let Some(a) = self.acceptance {
+            csv.row(super::acceptance::csv_row(a, ax.len()));
         }
         Some(csv)
     }

@@ -627,6 +627,10 @@ pub struct ReliabilitySpec {
     pub grid: Vec<(usize, Vec<f64>)>,
     /// Required minimum and mean reliability over the grid.
     pub requirement: Option<Requirement>,
+    /// `acceptance: true`: also report the whole-machine acceptance
+    /// probability (reliability-v2 §4).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub acceptance: bool,
     /// Where the section was declared.
     pub origin: Origin,
 }

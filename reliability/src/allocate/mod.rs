@@ -43,9 +43,11 @@ use crate::form::Form;
 use crate::inputs::{Inputs, Marginal};
 use crate::study::{Study, StudyResult, Summary, Target};
 
+mod acceptance;
 mod optimal;
 mod paper;
 
+pub use acceptance::{acceptance, AcceptanceAllocation, Strategy as AcceptanceStrategy};
 pub use optimal::optimal;
 pub use paper::paper;
 
@@ -205,6 +207,9 @@ pub struct Allocation {
     pub summaries: Vec<Summary>,
     /// The KKT check (optimal strategy).
     pub kkt: Option<Kkt>,
+    /// The acceptance target's outcome (`--target acceptance`; then `met`
+    /// is whether the level is reached).
+    pub acceptance: Option<AcceptanceAllocation>,
 }
 
 impl Allocation {
@@ -233,6 +238,7 @@ impl Allocation {
             met: all_met(&summaries),
             summaries,
             kkt,
+            acceptance: None,
         }
     }
 }

@@ -25,7 +25,7 @@ pub const STATISTICS_KEYS: &[&str] = &[
 /// Distributions.
 pub const DISTRIBUTIONS: &[&str] = &["normal", "uniform"];
 /// Keys of the reliability section.
-pub const RELIABILITY_KEYS: &[&str] = &["tolerance", "sided", "grid", "requirement"];
+pub const RELIABILITY_KEYS: &[&str] = &["tolerance", "sided", "grid", "requirement", "acceptance"];
 /// Keys of a reliability requirement.
 pub const REQUIREMENT_KEYS: &[&str] = &["min", "mean"];
 /// Component names.
@@ -428,6 +428,20 @@ impl Loader {
             None => None,
         };
 
+        // `acceptance: true|false` (reliability-v2 §4): also the
+        // whole-machine acceptance probability.
+        let acceptance = match f.get("acceptance") {
+            Some(n) => match n.as_scalar().map(|s| (s.style, s.text.as_str())) {
+                Some((crate::yaml::ScalarStyle::Plain, "true" | "True" | "TRUE")) => true,
+                Some((crate::yaml::ScalarStyle::Plain, "false" | "False" | "FALSE")) => false,
+                _ => {
+                    self.wrong_type(n, &f.path("acceptance"), "true or false");
+                    false
+                }
+            },
+            None => false,
+        };
+
         if self.errors.len() != before {
             return None;
         }
@@ -436,6 +450,7 @@ impl Loader {
             sided,
             grid,
             requirement,
+            acceptance,
             origin: key.span.origin("reliability"),
         })
     }
