@@ -59,6 +59,7 @@ pub mod posterior;
 pub mod rng;
 pub mod sensitivity;
 pub mod simulation;
+pub mod sobol;
 pub mod study;
 mod util;
 
@@ -75,6 +76,7 @@ pub use path::{
 pub use posterior::{Posterior, PosteriorError};
 pub use sensitivity::{sensitivity, InputSensitivity, SensitivityMethod, SensitivityResult};
 pub use simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult};
+pub use sobol::{Sobol, SobolError, SobolResult};
 pub use study::{
     Algorithm, CaseResult, ErrorMoments, ErrorSensitivity, FormCase, FormLimit, Grid, Method,
     Study, StudyResult, StudySpec, Summary, System, Target, TargetSensitivity, VolumetricMoments,
