@@ -314,7 +314,9 @@ fn dot(a: &[f64], x: &[f64]) -> f64 {
 }
 
 impl Sobol {
-    fn check(&self) -> Result<(), SobolError> {
+    /// Checks the settings: `samples ≥ 2` (and below 2³²), `bootstrap` in
+    /// `[10, 10⁶]`, `confidence` in `(0, 1)`.
+    pub fn validate(&self) -> Result<(), SobolError> {
         if self.samples < 2 {
             return Err(SobolError::InvalidSetting {
                 what: "samples",
@@ -374,7 +376,7 @@ impl Sobol {
         rows: &[Vec<f64>],
         outputs: &[Target],
     ) -> Result<SobolResult, SobolError> {
-        self.check()?;
+        self.validate()?;
         let k = inputs.len();
         let correlated: Vec<String> = (0..k)
             .filter(|&j| inputs.is_correlated(j))
