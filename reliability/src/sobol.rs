@@ -241,6 +241,9 @@ pub fn study_outputs(study: &Study) -> Vec<Target> {
     out
 }
 
+/// `(S_i per input, T_i per input, V)` of one output.
+type Indices = (Vec<f64>, Vec<f64>, f64);
+
 /// Per block: the sums of every output.
 #[derive(Debug, Clone)]
 struct BlockSums {
@@ -284,7 +287,7 @@ impl BlockSums {
     }
 
     /// The indices of every output: `(S_i, T_i)` per input and `V`.
-    fn indices(&self) -> Vec<(Vec<f64>, Vec<f64>, f64)> {
+    fn indices(&self) -> Vec<Indices> {
         let n = self.rows as f64;
         let two_n = 2.0 * n;
         (0..self.first.len())
@@ -512,7 +515,7 @@ impl Sobol {
         }
         let point = all.indices();
         for (o, (_, _, v)) in point.iter().enumerate() {
-            if !(*v > 0.0) {
+            if v.is_nan() || *v <= 0.0 {
                 return Err(SobolError::ZeroVariance {
                     output: outputs[o].name().into(),
                     where_,
@@ -520,7 +523,7 @@ impl Sobol {
             }
         }
         // Bootstrap replicates over the blocks.
-        let replicates: Vec<Vec<(Vec<f64>, Vec<f64>, f64)>> = (0..self.bootstrap)
+        let replicates: Vec<Vec<Indices>> = (0..self.bootstrap)
             .into_par_iter()
             .map(|r| {
                 let mut rng = CaseRng::new(self.seed, u32::MAX, r as u32);
