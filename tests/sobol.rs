@@ -443,3 +443,80 @@ fn bad_input_is_refused_with_its_location() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+chain::machine!(GantryGenerated = "examples/machines/gantry_grinder.yaml");
+
+/// The `machine!`-generated model gives the runtime model's indices (the
+/// same sensitivities to rounding, the same samples): within 1e-9.
+#[test]
+fn generated_model_equals_runtime_model() {
+    let (m, model) = gantry();
+    let s = Sobol {
+        samples: 4_000,
+        seed: 4,
+        bootstrap: 100,
+        confidence: 0.95,
+    };
+    let runtime = s
+        .run_study(&machine::study(&m, &model, &[], None).unwrap())
+        .unwrap();
+    let generated = s
+        .run_study(&machine::study(&m, &GantryGenerated, &[], None).unwrap())
+        .unwrap();
+    for (a, b) in runtime.outputs.iter().zip(&generated.outputs) {
+        assert_eq!(a.output, b.output);
+        for (x, y) in a.errors.iter().zip(&b.errors) {
+            assert_eq!(x.error, y.error);
+            for (u, v) in [
+                (x.first.value, y.first.value),
+                (x.total.value, y.total.value),
+                (x.first.low, y.first.low),
+                (x.total.high, y.total.high),
+            ] {
+                assert!((u - v).abs() < 1e-9, "{}: {u} vs {v}", x.error);
+            }
+        }
+    }
+}
+
+/// Non-normal inputs: the gantry's errors as uniforms of the same standard
+/// deviations (half-width √3·σ). The closed form a_i² σ_i² / Σ a_j² σ_j² holds
+/// for any independent marginals (the variance of a sum of independent
+/// terms); px at the point within 0.01 (first order) and 4 standard errors
+/// `4·T·√(3/N)` (total). That bound is the normal one; for uniforms it is
+/// conservative: `B_i − A_i` is triangular (kurtosis 2.4 against 3), so
+/// Jansen's numerator has relative standard error √(1.4/N) < √(2/N).
+#[test]
+fn uniform_inputs_follow_the_closed_form() {
+    let (m, model, study) = study_at_point();
+    let rows = rows_at_point(&m, &model);
+    let normal = study.inputs();
+    let marginals = normal
+        .stds()
+        .iter()
+        .zip(normal.means())
+        .map(|(s, mu)| {
+            let h = 3f64.sqrt() * s;
+            reliability::Marginal::uniform(mu - h, mu + h).unwrap()
+        })
+        .collect();
+    let uniform = reliability::Inputs::new(normal.names().to_vec(), marginals).unwrap();
+    let n = 100_000;
+    let r = Sobol {
+        samples: n,
+        seed: 8,
+        ..Sobol::default()
+    }
+    .run(
+        &uniform,
+        &[rows.clone()],
+        &[Target::Component(Component::Px)],
+    )
+    .unwrap();
+    let exact = closed_form(&rows, uniform.stds(), Component::Px);
+    for (e, x) in r.outputs[0].errors.iter().zip(&exact) {
+        assert!((e.first.value - x).abs() < 0.01, "{e:?} vs {x}");
+        let se = x * (3.0 / n as f64).sqrt();
+        assert!((e.total.value - x).abs() < 4.0 * se + 1e-15, "{e:?} vs {x}");
+    }
+}
