@@ -12,6 +12,8 @@ toolchain; run from the repository root:
 Both sides run on one thread (OpenTURNS: ot.TBB.SetThreadsNumber(1); chain:
 a one-thread rayon pool) and report the best of three runs. Results go to
 docs/performance.md.
+
+Sobol indices (SaltelliSensitivityAlgorithm) side by side: openturns_sobol.py.
 """
 
 import json
