@@ -13,6 +13,7 @@ Both sides run on one thread (OpenTURNS: ot.TBB.SetThreadsNumber(1); chain:
 a one-thread rayon pool) and report the best of three runs. Results go to
 docs/performance.md.
 Subset simulation against OpenTURNS' SubsetSampling: openturns_subset.py.
+Sobol indices (SaltelliSensitivityAlgorithm) side by side: openturns_sobol.py.
 """
 
 import json

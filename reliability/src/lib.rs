@@ -62,6 +62,7 @@ pub mod rng;
 pub mod sensitivity;
 pub mod simulation;
 mod standard;
+pub mod sobol;
 pub mod study;
 pub mod subset;
 mod util;
@@ -83,6 +84,7 @@ pub use path::{
 pub use posterior::{Posterior, PosteriorError};
 pub use sensitivity::{sensitivity, InputSensitivity, SensitivityMethod, SensitivityResult};
 pub use simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult, Stop, Stopping};
+pub use sobol::{Sobol, SobolError, SobolResult};
 pub use study::{
     Algorithm, CaseResult, ErrorMoments, ErrorSensitivity, FormCase, FormLimit, Grid, Method,
     Study, StudyResult, StudySpec, Summary, System, Target, TargetSensitivity, VolumetricMoments,

@@ -18,6 +18,7 @@ pub mod plot;
 pub mod reliability;
 pub mod report;
 pub mod sensitivity;
+pub mod sobol;
 
 use clap::{Parser, Subcommand};
 
@@ -38,6 +39,8 @@ enum Command {
     Reliability(reliability::ReliabilityArgs),
     /// Reliability sensitivity (default) or geometric sensitivity coefficients (`--kind geometric`, Fan et al. 2020).
     Sensitivity(sensitivity::SensitivityArgs),
+    /// Global sensitivity: first-order and total Sobol indices (Saltelli 2010, Jansen) of each toleranced component and of |p|, with bootstrap intervals, at a point or pooled over the grid.
+    Sobol(sobol::SobolArgs),
     /// Precision allocation: Wang & Yuan 2021's tightening or the least-cost tolerances.
     Allocate(allocate::AllocateArgs),
     /// Identify and compensate a swing-angle error from tool-tip heights (Xiao et al. 2020).
@@ -64,6 +67,7 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Derive(args) => derive::exec(args),
         Command::Reliability(args) => reliability::exec(args),
         Command::Sensitivity(args) => sensitivity::exec(args),
+        Command::Sobol(args) => sobol::exec(args),
         Command::Allocate(args) => allocate::exec(args),
         Command::Compensate(args) => compensate::exec(args),
         Command::Inverse(args) => inverse::exec(args),

@@ -107,7 +107,7 @@ fn parse_values(s: &str) -> Result<ValuesArg, String> {
 pub struct AtPoint(pub Vec<(String, f64)>);
 
 /// Parses `x=0,y=1500,z=600`.
-fn parse_point(s: &str) -> Result<AtPoint, String> {
+pub(crate) fn parse_point(s: &str) -> Result<AtPoint, String> {
     s.split(',')
         .filter(|p| !p.trim().is_empty())
         .map(parse_assignment)
@@ -331,7 +331,7 @@ fn unknown_variable(loaded: &Loaded, name: &str) -> miette::Report {
 
 /// The values of `--at` in the machine's variable order: every axis
 /// variable once (a repeated name: the last value), no unknown name.
-fn resolve_at(coords: &[(String, f64)], loaded: &Loaded) -> miette::Result<Vec<f64>> {
+pub(crate) fn resolve_at(coords: &[(String, f64)], loaded: &Loaded) -> miette::Result<Vec<f64>> {
     let vars: Vec<&str> = loaded
         .machine
         .variables
