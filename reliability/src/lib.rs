@@ -48,6 +48,7 @@
 
 pub mod allocate;
 pub mod error;
+mod families;
 pub mod form;
 pub mod inputs;
 pub mod limit_state;

@@ -23,11 +23,7 @@ pub fn inputs(machine: &Machine) -> Result<Inputs, ReliabilityError> {
                 name: e.name.clone(),
                 origin: e.origin.clone(),
             })?;
-        let m = match stat.distribution {
-            Distribution::Normal { mean, std } => Marginal::normal(mean, std),
-            Distribution::Uniform { min, max } => Marginal::uniform(min, max),
-        }
-        .map_err(|err| match err {
+        let m = marginal(&stat.distribution).map_err(|err| match err {
             ReliabilityError::InvalidDistribution(msg) => {
                 ReliabilityError::InvalidDistribution(format!("`{}`: {msg}", e.name))
             }
@@ -37,6 +33,30 @@ pub fn inputs(machine: &Machine) -> Result<Inputs, ReliabilityError> {
         marginals.push(m);
     }
     Inputs::new(names, marginals)
+}
+
+/// The [`Marginal`] of a loaded [`Distribution`] (every family of
+/// `reliability-v2.md` §1).
+pub fn marginal(d: &Distribution) -> Result<Marginal, ReliabilityError> {
+    match *d {
+        Distribution::Normal { mean, std } => Marginal::normal(mean, std),
+        Distribution::Uniform { min, max } => Marginal::uniform(min, max),
+        Distribution::Lognormal { mean, std, shift } => Marginal::lognormal(mean, std, shift),
+        Distribution::TruncatedNormal {
+            mean,
+            std,
+            min,
+            max,
+        } => Marginal::truncated_normal(mean, std, min, max),
+        Distribution::Weibull {
+            scale,
+            shape,
+            shift,
+        } => Marginal::weibull(scale, shape, shift),
+        Distribution::Gumbel { mode, scale } => Marginal::gumbel(mode, scale),
+        Distribution::Triangular { min, mode, max } => Marginal::triangular(min, mode, max),
+        Distribution::Rayleigh { scale, shift } => Marginal::rayleigh(scale, shift),
+    }
 }
 
 /// The parameter values: the file's, overridden by `overrides` (name, value).

@@ -240,6 +240,14 @@ pub enum Problem {
         /// Upper bound.
         max: f64,
     },
+    /// Parameters of a distribution that do not define one (`min ≥ max`, a
+    /// mode outside `[min, max]`, a mean not above the shift, …).
+    DistributionParameters {
+        /// The distribution.
+        dist: &'static str,
+        /// What is wrong, with the values.
+        detail: String,
+    },
     /// Two keys that exclude each other.
     Conflict {
         /// The key given first.
@@ -736,6 +744,11 @@ impl Problem {
                 "chain::uniform_bounds",
                 "out of range",
                 format!("a uniform distribution needs min < max, got min = {min}, max = {max}"),
+            ),
+            Problem::DistributionParameters { dist, detail } => D::new(
+                "chain::distribution_parameters",
+                "out of range",
+                format!("a {dist} distribution needs {detail}"),
             ),
             Problem::Conflict { first, second } => D::new(
                 "chain::conflicting_keys",
