@@ -431,7 +431,33 @@ pub struct Correlation {
     pub rho: f64,
 }
 
-/// The correlated normal block of an [`Inputs`]: `x_B = μ_B + D_B·L·u_B`.
+/// The lower Cholesky factor of the `k × k` row-major `r`, or the
+/// `(row, column)` of the given pair that makes it fail: the pivot of `row`
+/// is not positive, named by its largest given coefficient `column < row`.
+fn cholesky(r: &[f64], k: usize) -> Result<Vec<f64>, (usize, usize)> {
+    let mut l = vec![0.0; k * k];
+    for i in 0..k {
+        for j in 0..=i {
+            let dot: f64 = (0..j).map(|c| l[i * k + c] * l[j * k + c]).sum();
+            if i == j {
+                let d = r[i * k + i] - dot;
+                if d.is_nan() || d <= 1e-14 {
+                    let col = (0..i)
+                        .max_by(|&a, &b| r[i * k + a].abs().total_cmp(&r[i * k + b].abs()))
+                        .unwrap_or(0);
+                    return Err((i, col));
+                }
+                l[i * k + i] = d.sqrt();
+            } else {
+                l[i * k + j] = (r[i * k + j] - dot) / l[j * k + j];
+            }
+        }
+    }
+    Ok(l)
+}
+
+/// The correlated block of an [`Inputs`]: `x_i = F_i⁻¹(Φ(z_i))`, `z = L·u_B`
+/// (for normal members `x_B = μ_B + D_B·L·u_B`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 struct Block {
     /// The coefficients as given (serialised).
@@ -442,10 +468,14 @@ struct Block {
     /// Per input, its position in `members`.
     #[serde(skip)]
     position: Vec<Option<usize>>,
-    /// `R`, `k × k` row-major.
+    /// `R`, `k × k` row-major: the physical (Pearson) correlations.
     #[serde(skip)]
     matrix: Vec<f64>,
-    /// The lower Cholesky factor `L` of `R`, `k × k` row-major (zero above
+    /// `R₀`, the Nataf-adjusted correlations of the normal images
+    /// (`crate::nataf`; `R₀ = R` when every member is normal).
+    #[serde(skip)]
+    adjusted: Vec<f64>,
+    /// The lower Cholesky factor `L` of `R₀`, `k × k` row-major (zero above
     /// the diagonal).
     #[serde(skip)]
     factor: Vec<f64>,
@@ -485,16 +515,20 @@ impl Inputs {
         })
     }
 
-    /// Inputs with the given marginals and correlation coefficients between
-    /// normal ones: the inputs named in `pairs` form one block of correlated
-    /// normals `x_B = μ_B + D_B·L·u_B` (module docs), every other input stays
-    /// independent. Pairs not listed within the block are uncorrelated.
+    /// Inputs with the given marginals and physical (Pearson) correlation
+    /// coefficients: the inputs named in `pairs` form one correlated block,
+    /// the Nataf model `x_i = F_i⁻¹(Φ(z_i))`, `z_B = L·u_B`, `R₀ = L·Lᵀ` the
+    /// adjusted correlations of [`crate::nataf::adjusted_correlation`]
+    /// (`reliability-v2.md` §2; for normal members `x_B = μ_B + D_B·L·u_B`,
+    /// module docs). Every other input stays independent; pairs not listed
+    /// within the block are uncorrelated.
     ///
     /// Refused ([`ReliabilityError::InvalidDistribution`]): a pair naming an
     /// input out of range or an input with itself, a pair given twice, a
-    /// non-finite `ρ` or `|ρ| ≥ 1`, a non-normal input in a pair, and a
-    /// correlation matrix that is not positive definite (its smallest
-    /// eigenvalue is named). No pairs give [`Inputs::new`]'s inputs.
+    /// non-finite `ρ` or `|ρ| ≥ 1`, a `ρ` the two marginals cannot attain,
+    /// and an adjusted matrix that is not positive definite (its smallest
+    /// eigenvalue and the pair where the factorisation fails are named). No
+    /// pairs give [`Inputs::new`]'s inputs.
     ///
     /// ```
     /// use reliability::{Inputs, Marginal};
@@ -540,12 +574,6 @@ impl Inputs {
                 ));
             }
             for j in [p.a, p.b] {
-                if !inputs.marginals[j].is_normal() {
-                    return bad(format!(
-                        "`{}` is correlated but not normal: correlations apply to normal inputs",
-                        inputs.names[j]
-                    ));
-                }
                 if !members.contains(&j) {
                     members.push(j);
                 }
@@ -561,6 +589,7 @@ impl Inputs {
         for i in 0..k {
             matrix[i * k + i] = 1.0;
         }
+        let mut adjusted = matrix.clone();
         let mut given = vec![false; k * k];
         for p in pairs {
             let (i, j) = (
@@ -577,28 +606,41 @@ impl Inputs {
             given[j * k + i] = true;
             matrix[i * k + j] = p.rho;
             matrix[j * k + i] = p.rho;
+            let (ma, mb) = (&inputs.marginals[p.a], &inputs.marginals[p.b]);
+            let r0 = crate::nataf::adjusted_correlation(ma, mb, p.rho).map_err(|e| {
+                ReliabilityError::InvalidDistribution(format!(
+                    "correlation of `{}` and `{}`: {e}",
+                    inputs.names[p.a], inputs.names[p.b]
+                ))
+            })?;
+            adjusted[i * k + j] = r0;
+            adjusted[j * k + i] = r0;
         }
-        let r = nalgebra::DMatrix::from_row_slice(k, k, &matrix);
-        let Some(chol) = nalgebra::Cholesky::new(r.clone()) else {
-            let smallest = r.symmetric_eigenvalues().min();
-            let names: Vec<&str> = members.iter().map(|&m| inputs.names[m].as_str()).collect();
-            return bad(format!(
-                "the correlation matrix of {} is not positive definite (smallest eigenvalue {smallest:.3e})",
-                names.join(", ")
-            ));
-        };
-        let l = chol.l();
-        let mut factor = vec![0.0; k * k];
-        for i in 0..k {
-            for j in 0..=i {
-                factor[i * k + j] = l[(i, j)];
+        let factor = match cholesky(&adjusted, k) {
+            Ok(f) => f,
+            Err((row, col)) => {
+                let r = nalgebra::DMatrix::from_row_slice(k, k, &adjusted);
+                let smallest = r.symmetric_eigenvalues().min();
+                let names: Vec<&str> = members.iter().map(|&m| inputs.names[m].as_str()).collect();
+                let kind = if adjusted == matrix {
+                    "correlation matrix"
+                } else {
+                    "Nataf-adjusted correlation matrix"
+                };
+                return bad(format!(
+                    "the {kind} of {} is not positive definite (smallest eigenvalue {smallest:.3e}); it fails at the pair `{}`–`{}`",
+                    names.join(", "),
+                    inputs.names[members[col]],
+                    inputs.names[members[row]],
+                ));
             }
-        }
+        };
         inputs.correlation = Some(Block {
             pairs: pairs.to_vec(),
             members,
             position,
             matrix,
+            adjusted,
             factor,
         });
         Ok(inputs)
@@ -742,7 +784,9 @@ impl Inputs {
         })?;
         *m = m.with_moments(mean, std)?;
         let mut out = Inputs::new(self.names.clone(), marginals)?;
-        // The correlation matrix (and its factor) does not depend on σ.
+        // The correlation matrix and its factor are held (for non-normal
+        // members the Gaussian-copula matrix R₀, so the derivatives at fixed
+        // u are those of `dx_dstd`).
         out.correlation = self.correlation.clone();
         Ok(out)
     }
@@ -801,7 +845,7 @@ impl Inputs {
         }
         if let Some(b) = &self.correlation {
             for (i, &m) in b.members.iter().enumerate() {
-                x[m] = self.means[m] + self.stds[m] * b.z(i, u);
+                x[m] = self.marginals[m].to_physical(b.z(i, u));
             }
         }
     }
@@ -815,7 +859,7 @@ impl Inputs {
             let k = b.members.len();
             for i in 0..k {
                 let m = b.members[i];
-                let y = (x[m] - self.means[m]) / self.stds[m];
+                let y = self.marginals[m].to_standard(x[m]);
                 let partial: f64 = (0..i).map(|c| b.factor[i * k + c] * u[b.members[c]]).sum();
                 u[m] = (y - partial) / b.factor[i * k + i];
             }
@@ -832,7 +876,7 @@ impl Inputs {
         if let Some(b) = &self.correlation {
             let k = b.members.len();
             for (i, &m) in b.members.iter().enumerate() {
-                out[m] = self.stds[m] * b.factor[i * k + i];
+                out[m] = self.marginals[m].dx_du(b.z(i, u)) * b.factor[i * k + i];
             }
         }
     }
@@ -846,25 +890,96 @@ impl Inputs {
         }
         if let Some(b) = &self.correlation {
             let k = b.members.len();
+            // dx_m/dz of each member (σ for a normal one).
+            let slope: Vec<f64> = if b.members.iter().all(|&m| self.marginals[m].is_normal()) {
+                b.members.iter().map(|&m| self.stds[m]).collect()
+            } else {
+                (0..k)
+                    .map(|i| self.marginals[b.members[i]].dx_du(b.z(i, u)))
+                    .collect()
+            };
             for c in 0..k {
                 out[b.members[c]] = (c..k)
                     .map(|i| {
                         let m = b.members[i];
-                        grad_x[m] * self.stds[m] * b.factor[i * k + c]
+                        grad_x[m] * slope[i] * b.factor[i * k + c]
                     })
                     .sum();
             }
         }
     }
 
+    /// The whole Jacobian `∂x/∂u` at `u`, `n × n` row-major (`out[j·n + c] =
+    /// ∂x_j/∂u_c`): diagonal for independent inputs, `dx_i/dz_i·L_ic` in the
+    /// correlated block.
+    pub fn jacobian_matrix(&self, u: &[f64], out: &mut [f64]) {
+        let n = self.len();
+        out.iter_mut().for_each(|v| *v = 0.0);
+        let mut diag = vec![0.0; n];
+        self.jacobian(u, &mut diag);
+        for j in 0..n {
+            out[j * n + j] = diag[j];
+        }
+        if let Some(b) = &self.correlation {
+            let k = b.members.len();
+            for i in 0..k {
+                let m = b.members[i];
+                let slope = self.marginals[m].dx_du(b.z(i, u));
+                for c in 0..=i {
+                    out[m * n + b.members[c]] = slope * b.factor[i * k + c];
+                }
+            }
+        }
+    }
+
+    /// Adds `Σ_j w_j·∇²_u x_j` at `u` to the `n × n` row-major `hess`: the
+    /// second-order term of `∇²_u g = Jᵀ·∇²_x g·J + Σ_j ∂g/∂x_j·∇²_u x_j`
+    /// (`w = ∇_x g`). Independent inputs: `w_j·d²x_j/du_j²` on the diagonal;
+    /// in the block `∂²x_i/∂u_p∂u_q = d²x_i/dz_i²·L_ip·L_iq`.
+    pub fn add_second_derivatives(&self, u: &[f64], w: &[f64], hess: &mut [f64]) {
+        let n = self.len();
+        for j in 0..n {
+            if !self.is_correlated(j) {
+                hess[j * n + j] += w[j] * self.marginals[j].d2x_du2(u[j]);
+            }
+        }
+        if let Some(b) = &self.correlation {
+            let k = b.members.len();
+            for i in 0..k {
+                let m = b.members[i];
+                let c2 = w[m] * self.marginals[m].d2x_du2(b.z(i, u));
+                if c2 == 0.0 {
+                    continue;
+                }
+                for p in 0..=i {
+                    for q in 0..=i {
+                        hess[b.members[p] * n + b.members[q]] +=
+                            c2 * b.factor[i * k + p] * b.factor[i * k + q];
+                    }
+                }
+            }
+        }
+    }
+
+    /// `∂x_j/∂μ_j` at fixed `u` (every other `x` is unmoved): the
+    /// marginal's [`Marginal::dx_dmean`] at `u_j`, or at `z_j` in the block.
+    pub fn dx_dmean(&self, j: usize, u: &[f64]) -> f64 {
+        if let Some(b) = &self.correlation {
+            if let Some(i) = b.position[j] {
+                return self.marginals[j].dx_dmean(b.z(i, u));
+            }
+        }
+        self.marginals[j].dx_dmean(u[j])
+    }
+
     /// `∂x_j/∂σ_j` at fixed `u` (every other `x` is unmoved): the
-    /// marginal's [`Marginal::dx_dstd`], and for the correlated block the
-    /// standardised coordinate `z_j = (L·u_B)_j` (the correlation matrix
-    /// held fixed).
+    /// marginal's [`Marginal::dx_dstd`], in the correlated block at the
+    /// coordinate `z_j = (L·u_B)_j` (`z_j` itself for a normal member), the
+    /// Gaussian-copula matrix `R₀` held fixed.
     pub fn dx_dstd(&self, j: usize, u: &[f64]) -> f64 {
         if let Some(b) = &self.correlation {
             if let Some(i) = b.position[j] {
-                return b.z(i, u);
+                return self.marginals[j].dx_dstd(b.z(i, u));
             }
         }
         self.marginals[j].dx_dstd(u[j])
@@ -907,7 +1022,7 @@ impl Inputs {
             rng.fill_normal(x);
             for i in (0..b.members.len()).rev() {
                 let m = b.members[i];
-                x[m] = self.means[m] + self.stds[m] * b.z(i, x);
+                x[m] = self.marginals[m].to_physical(b.z(i, x));
             }
             for (j, (x, m)) in x.iter_mut().zip(&self.marginals).enumerate() {
                 if b.position[j].is_none() {
@@ -1124,8 +1239,10 @@ mod tests {
             e.contains("not positive definite") && e.contains("a, b, c"),
             "{e}"
         );
-        let u = vec![Marginal::uniform(0.0, 1.0).unwrap(); 3];
-        let e = Inputs::correlated(names.clone(), u, &[c(0, 1, 0.5)]).unwrap_err();
-        assert!(e.to_string().contains("not normal"));
+        // Two lognormals cannot reach ρ = −0.9 (Liu & Der Kiureghian's
+        // bound ln(1 − 0.9·δ²)/ζ² < −1 at δ = 1).
+        let l = vec![Marginal::lognormal(1.0, 1.0, 0.0).unwrap(); 3];
+        let e = Inputs::correlated(names.clone(), l, &[c(0, 1, -0.9)]).unwrap_err();
+        assert!(e.to_string().contains("not attainable"), "{e}");
     }
 }

@@ -53,6 +53,7 @@ pub mod form;
 pub mod inputs;
 pub mod limit_state;
 pub mod machine;
+pub mod nataf;
 pub mod normal;
 mod par;
 pub mod path;
