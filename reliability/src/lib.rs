@@ -61,6 +61,7 @@ pub mod posterior;
 pub mod rng;
 pub mod sensitivity;
 pub mod simulation;
+pub mod sorm;
 pub mod study;
 mod util;
 
