@@ -214,3 +214,80 @@ fn non_positive_definite_after_adjustment_names_the_pair() {
         "{e}"
     );
 }
+
+// ------------------------------------------------------------------ loading
+
+const MACHINE: &str = "\
+machine: m
+bodies:
+  bed: {}
+  x_slide:
+    parent: bed
+    joint: {type: prismatic, axis: +x, variable: x}
+    errors: {dx: dxx, ey: eyx, dz: dzx}
+workpiece: bed
+tool: x_slide
+statistics:
+  dxx: {dist: lognormal, mean: 1.0e-3, std: 0.8e-3}
+  eyx: {dist: lognormal, mean: 1.0e-3, std: 0.8e-3}
+  dzx: {dist: lognormal, mean: 1.0e-3, std: 0.8e-3}
+";
+
+fn load_err(corr: &str) -> String {
+    let text = format!("{MACHINE}correlation:\n{corr}");
+    match chain_core::load_str(&text, "bad.yaml") {
+        Ok(_) => panic!("loaded: {corr}"),
+        Err(d) => {
+            assert_eq!(d.len(), 1, "{corr}: {d:#}");
+            d.to_string()
+        }
+    }
+}
+
+/// The `correlation` list loads into the Nataf inputs; each of the spec's
+/// bad cases is one located error (`bad.yaml:LINE:COL`, the key).
+#[test]
+fn the_correlation_list_is_loaded_and_checked() {
+    let text = format!("{MACHINE}correlation:\n  - [dxx, eyx, 0.6]\n  - [eyx, dzx, '-0.1 * 2']\n");
+    let m = chain_core::load_str(&text, "ok.yaml").unwrap();
+    assert_eq!(m.correlations.len(), 2);
+    assert_eq!(m.correlations[1].rho, -0.2);
+    assert_eq!(m.correlations[0].origin.line, 15);
+    let inputs = reliability::machine::inputs(&m).unwrap();
+    let ix = |n: &str| inputs.index(n).unwrap();
+    assert_eq!(inputs.correlation(ix("dxx"), ix("eyx")), 0.6);
+    assert_eq!(inputs.correlation(ix("dzx"), ix("eyx")), -0.2);
+    let cases = [
+        // Not an error of the machine.
+        ("  - [dxx, exy, 0.5]\n", 15, 11, "exy"),
+        // Outside (−1, 1).
+        ("  - [dxx, eyx, 1.0]\n", 15, 16, "strictly between"),
+        // With itself.
+        ("  - [dxx, dxx, 0.5]\n", 15, 11, "itself"),
+        // Twice.
+        ("  - [dxx, eyx, 0.5]\n  - [eyx, dxx, 0.2]\n", 16, 5, "twice"),
+        // Not a triple.
+        ("  - [dxx, eyx]\n", 15, 5, "3"),
+    ];
+    for (corr, line, col, needle) in cases {
+        let msg = load_err(corr);
+        let prefix = format!("bad.yaml:{line}:{col}: ");
+        assert!(
+            msg.starts_with(&prefix),
+            "{corr}: expected {prefix}, got\n{msg}"
+        );
+        assert!(msg.contains("at key `correlation["), "{corr}: {msg}");
+        assert!(msg.contains(needle), "{corr}: {needle}\n{msg}");
+    }
+    // Positive definite as given, not after the Nataf adjustment (ρ₀ =
+    // ln(1 − 0.45·0.64)/ln 1.64 = −0.687): located at the failing pair.
+    let text = format!(
+        "{MACHINE}correlation:\n  - [dxx, eyx, -0.45]\n  - [eyx, dzx, -0.45]\n  - [dxx, dzx, -0.45]\n"
+    );
+    let m = chain_core::load_str(&text, "nataf.yaml").unwrap();
+    let e = reliability::machine::inputs(&m).unwrap_err().to_string();
+    assert!(
+        e.contains("not positive definite") && e.contains(":16:5:") && e.contains("correlation[1]"),
+        "{e}"
+    );
+}

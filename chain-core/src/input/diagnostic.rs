@@ -248,6 +248,11 @@ pub enum Problem {
         /// What is wrong, with the values.
         detail: String,
     },
+    /// A `correlation` entry that does not define one.
+    BadCorrelation {
+        /// What is wrong.
+        detail: String,
+    },
     /// Two keys that exclude each other.
     Conflict {
         /// The key given first.
@@ -750,6 +755,9 @@ impl Problem {
                 "out of range",
                 format!("a {dist} distribution needs {detail}"),
             ),
+            Problem::BadCorrelation { detail } => {
+                D::new("chain::correlation", "bad correlation", detail.clone())
+            }
             Problem::Conflict { first, second } => D::new(
                 "chain::conflicting_keys",
                 "conflicting key",

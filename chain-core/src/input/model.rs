@@ -810,6 +810,22 @@ pub struct Machine {
     pub statistics: Vec<Statistic>,
     /// The reliability section, if any.
     pub reliability: Option<ReliabilitySpec>,
+    /// The top-level `correlation` list (`reliability-v2.md` §2): physical
+    /// correlations between errors with statistics, in file order.
+    pub correlations: Vec<CorrelationEntry>,
+}
+
+/// One `[name, name, rho]` entry of the `correlation` list.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CorrelationEntry {
+    /// Index into [`Machine::errors`] of the first error.
+    pub a: usize,
+    /// Index of the second error.
+    pub b: usize,
+    /// The physical (Pearson) correlation, in `(−1, 1)`.
+    pub rho: f64,
+    /// Where the entry was declared (its `correlation[i]` key).
+    pub origin: Origin,
 }
 
 impl Machine {

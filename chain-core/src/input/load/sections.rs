@@ -6,7 +6,8 @@ use super::bodies::Tree;
 use super::{join, Fields, Loader, TreeReader};
 use crate::diagnostic::{closest, Problem};
 use crate::model::{
-    Component, Distribution, Parameter, ReliabilitySpec, Requirement, Sided, Statistic,
+    Component, CorrelationEntry, Distribution, Parameter, ReliabilitySpec, Requirement, Sided,
+    Statistic,
 };
 use crate::yaml::Node;
 
@@ -518,6 +519,118 @@ impl Loader {
             _ => None,
         };
         out
+    }
+
+    /// `correlation: [[name, name, rho], …]` (`reliability-v2.md` §2): each
+    /// name an error with statistics, `ρ ∈ (−1, 1)`, no error with itself,
+    /// no pair twice. `None` if any entry is invalid (reported).
+    pub(super) fn correlation_section(
+        &mut self,
+        node: &Node,
+        statistics: Option<&[crate::model::Statistic]>,
+        tree: Option<&Tree>,
+    ) -> Option<Vec<CorrelationEntry>> {
+        let before = self.errors.len();
+        let Some(items) = node.as_sequence() else {
+            self.report(
+                node.span,
+                "correlation",
+                Problem::WrongType {
+                    expected: "a list of [error, error, rho]",
+                    found: node.describe(),
+                },
+            );
+            return None;
+        };
+        let mut out: Vec<CorrelationEntry> = Vec::new();
+        for (i, item) in items.iter().enumerate() {
+            let path = format!("correlation[{i}]");
+            let Some([na, nb, nr]) = self.items::<3>(item, &path, "a list [error, error, rho]")
+            else {
+                continue;
+            };
+            let index = |l: &mut Loader, n: &Node| -> Option<usize> {
+                let name = l.name(n, &path, "an error name")?;
+                let t = tree?;
+                let Some(j) = t.errors.iter().position(|e| e.name == name) else {
+                    let suggestion = closest(&name, t.errors.iter().map(|e| e.name.as_str()))
+                        .map(str::to_string);
+                    l.report(
+                        n.span,
+                        path.clone(),
+                        Problem::UnknownError { name, suggestion },
+                    );
+                    return None;
+                };
+                if statistics.is_some_and(|s| !s.iter().any(|st| st.error == j)) {
+                    l.report(
+                        n.span,
+                        path.clone(),
+                        Problem::BadCorrelation {
+                            detail: format!("`{name}` has no `statistics` entry: only errors with statistics can be correlated"),
+                        },
+                    );
+                    return None;
+                }
+                Some(j)
+            };
+            let a = index(self, na);
+            let b = index(self, nb);
+            let rho = self.finite(nr, &path, "a correlation");
+            let (Some(a), Some(b), Some(rho)) = (a, b, rho) else {
+                continue;
+            };
+            let names = tree.map_or((String::new(), String::new()), |t| {
+                (t.errors[a].name.clone(), t.errors[b].name.clone())
+            });
+            if a == b {
+                self.report(
+                    nb.span,
+                    path,
+                    Problem::BadCorrelation {
+                        detail: format!("`{}` is correlated with itself", names.0),
+                    },
+                );
+                continue;
+            }
+            if rho.abs() >= 1.0 {
+                self.report(
+                    nr.span,
+                    path,
+                    Problem::BadCorrelation {
+                        detail: format!(
+                            "the correlation of `{}` and `{}` is {rho}: it must be strictly between -1 and 1",
+                            names.0, names.1
+                        ),
+                    },
+                );
+                continue;
+            }
+            if let Some(first) = out
+                .iter()
+                .find(|c| (c.a, c.b) == (a, b) || (c.a, c.b) == (b, a))
+            {
+                let line = first.origin.line;
+                self.report(
+                    item.span,
+                    path,
+                    Problem::BadCorrelation {
+                        detail: format!(
+                            "the pair `{}`, `{}` is given twice (first on line {line})",
+                            names.0, names.1
+                        ),
+                    },
+                );
+                continue;
+            }
+            out.push(CorrelationEntry {
+                a,
+                b,
+                rho,
+                origin: item.span.origin(path),
+            });
+        }
+        (self.errors.len() == before).then_some(out)
     }
 
     /// `reliability: {tolerance, sided, grid, requirement}`.
