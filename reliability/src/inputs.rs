@@ -616,8 +616,23 @@ impl Inputs {
             adjusted[i * k + j] = r0;
             adjusted[j * k + i] = r0;
         }
-        let factor = match cholesky(&adjusted, k) {
-            Ok(f) => f,
+        // nalgebra's factor (the v1 one, to the last bit); the hand-written
+        // one only to name the pair where a failing factorisation stops.
+        let factor = match nalgebra::Cholesky::new(nalgebra::DMatrix::from_row_slice(
+            k, k, &adjusted,
+        ))
+        .map(|c| c.l())
+        .ok_or_else(|| cholesky(&adjusted, k).err().unwrap_or((k - 1, 0)))
+        {
+            Ok(l) => {
+                let mut factor = vec![0.0; k * k];
+                for i in 0..k {
+                    for j in 0..=i {
+                        factor[i * k + j] = l[(i, j)];
+                    }
+                }
+                factor
+            }
             Err((row, col)) => {
                 let r = nalgebra::DMatrix::from_row_slice(k, k, &adjusted);
                 let smallest = r.symmetric_eigenvalues().min();
