@@ -4,6 +4,8 @@ case: px of the gantry grinder (seed 000) at the worst corner
 (x, y, z) = (1000, 1500, 1400), 21 independent normal errors (Table 1 as
 standard deviations), g = 0.03 - px (Eq. 34 with the -y*ezz term of Eq. 17).
 
+SORM against OpenTURNS (issue 15, part A): reliability/benches/openturns_sorm.py.
+
 Not part of the test suite. Needs `pip install openturns` and a Rust
 toolchain; run from the repository root:
 

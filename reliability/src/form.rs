@@ -110,6 +110,9 @@ pub struct BranchResult {
     pub iterations: usize,
     /// Why the search stopped.
     pub termination: Termination,
+    /// Its design point in standard normal space (for SORM; not serialised).
+    #[serde(skip)]
+    pub design_point_u: Vec<f64>,
 }
 
 /// The result of [`Form::run`].
@@ -212,6 +215,7 @@ impl Form {
                 pf: normal::sf(br.beta),
                 iterations: br.iterations,
                 termination: br.termination,
+                design_point_u: br.u.clone(),
             })
             .collect();
         Ok(FormResult {

@@ -22,6 +22,7 @@
 use serde::Serialize;
 
 use crate::error::ReliabilityError;
+use crate::families::{Gumbel, Lognormal, Rayleigh, Triangular, TruncatedNormal, Weibull};
 use crate::normal;
 use crate::rng::CaseRng;
 
@@ -49,23 +50,47 @@ pub struct Marginal(Law);
 
 /// The family of a [`Marginal`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "lowercase")]
+#[serde(rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum Family {
     /// Normal: `x = μ + σ·u`.
     Normal,
     /// Uniform on `[min, max]`: `x = min + (max − min)·Φ(u)`.
     Uniform,
+    /// Lognormal with the mean and std of the variable and a shift.
+    Lognormal,
+    /// Normal truncated to `[min, max]` (either bound may be infinite).
+    TruncatedNormal,
+    /// Weibull (scale, shape, shift).
+    Weibull,
+    /// Gumbel, maximum type (mode, scale).
+    Gumbel,
+    /// Triangular (min, mode, max).
+    Triangular,
+    /// Rayleigh (scale, shift).
+    Rayleigh,
 }
 
 /// The validated law behind a [`Marginal`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-#[serde(tag = "dist", rename_all = "lowercase")]
+#[serde(tag = "dist", rename_all = "snake_case")]
 enum Law {
     /// Normal with mean `μ` and standard deviation `σ > 0`.
     Normal { mean: f64, std: f64 },
     /// Uniform on `[min, max]`, `min < max`.
     Uniform { min: f64, max: f64 },
+    /// `reliability-v2.md` §1 (`crate::families`).
+    Lognormal(Lognormal),
+    /// Truncated normal (parent mean and std, bounds).
+    TruncatedNormal(TruncatedNormal),
+    /// Weibull.
+    Weibull(Weibull),
+    /// Gumbel (maximum).
+    Gumbel(Gumbel),
+    /// Triangular.
+    Triangular(Triangular),
+    /// Rayleigh.
+    Rayleigh(Rayleigh),
 }
 
 impl Marginal {
@@ -89,11 +114,51 @@ impl Marginal {
         Ok(Marginal(Law::Uniform { min, max }))
     }
 
+    /// A validated lognormal marginal: `mean` and `std` of the variable
+    /// itself, support `(shift, ∞)` (`mean > shift`).
+    pub fn lognormal(mean: f64, std: f64, shift: f64) -> Result<Marginal, ReliabilityError> {
+        Ok(Marginal(Law::Lognormal(Lognormal::new(mean, std, shift)?)))
+    }
+
+    /// A validated truncated normal: the parent's `mean` and `std`, truncated
+    /// to `[min, max]` (either bound may be absent, not both).
+    pub fn truncated_normal(
+        mean: f64,
+        std: f64,
+        min: Option<f64>,
+        max: Option<f64>,
+    ) -> Result<Marginal, ReliabilityError> {
+        Ok(Marginal(Law::TruncatedNormal(TruncatedNormal::new(
+            mean, std, min, max,
+        )?)))
+    }
+
+    /// A validated Weibull: `F(x) = 1 − exp(−((x − shift)/scale)^shape)`.
+    pub fn weibull(scale: f64, shape: f64, shift: f64) -> Result<Marginal, ReliabilityError> {
+        Ok(Marginal(Law::Weibull(Weibull::new(scale, shape, shift)?)))
+    }
+
+    /// A validated Gumbel (maximum type): `F(x) = exp(−exp(−(x − mode)/scale))`.
+    pub fn gumbel(mode: f64, scale: f64) -> Result<Marginal, ReliabilityError> {
+        Ok(Marginal(Law::Gumbel(Gumbel::new(mode, scale)?)))
+    }
+
+    /// A validated triangular on `[min, max]` with its mode in between.
+    pub fn triangular(min: f64, mode: f64, max: f64) -> Result<Marginal, ReliabilityError> {
+        Ok(Marginal(Law::Triangular(Triangular::new(min, mode, max)?)))
+    }
+
+    /// A validated Rayleigh: `F(x) = 1 − exp(−(x − shift)²/(2·scale²))`.
+    pub fn rayleigh(scale: f64, shift: f64) -> Result<Marginal, ReliabilityError> {
+        Ok(Marginal(Law::Rayleigh(Rayleigh::new(scale, shift)?)))
+    }
+
     /// The mean.
     pub fn mean(&self) -> f64 {
         match self.0 {
             Law::Normal { mean, .. } => mean,
             Law::Uniform { min, max } => 0.5 * (min + max),
+            _ => self.moments()[0],
         }
     }
 
@@ -102,24 +167,94 @@ impl Marginal {
         match self.0 {
             Law::Normal { std, .. } => std,
             Law::Uniform { min, max } => (max - min) / (2.0 * SQRT_3),
+            _ => self.moments()[1],
         }
     }
 
-    /// The family (normal or uniform).
+    /// `[mean, std]`.
+    fn moments(&self) -> [f64; 2] {
+        match &self.0 {
+            Law::Normal { mean, std } => [*mean, *std],
+            Law::Uniform { .. } => [self.mean(), self.std()],
+            Law::Lognormal(l) => [l.mean, l.std],
+            Law::TruncatedNormal(t) => t.moments(),
+            Law::Weibull(w) => w.moments(),
+            Law::Gumbel(g) => g.moments(),
+            Law::Triangular(t) => t.moments(),
+            Law::Rayleigh(r) => r.moments(),
+        }
+    }
+
+    /// The family.
     pub fn family(&self) -> Family {
         match self.0 {
             Law::Normal { .. } => Family::Normal,
             Law::Uniform { .. } => Family::Uniform,
+            Law::Lognormal(_) => Family::Lognormal,
+            Law::TruncatedNormal(_) => Family::TruncatedNormal,
+            Law::Weibull(_) => Family::Weibull,
+            Law::Gumbel(_) => Family::Gumbel,
+            Law::Triangular(_) => Family::Triangular,
+            Law::Rayleigh(_) => Family::Rayleigh,
         }
     }
 
-    /// The support `(lower, upper)`: `(−∞, +∞)` for a normal, `(min, max)`
-    /// for a uniform.
+    /// The support `(lower, upper)`: `(−∞, +∞)` for a normal and a Gumbel,
+    /// `(min, max)` for a uniform and a triangular, `(shift, ∞)` for a
+    /// lognormal, Weibull and Rayleigh, the bounds of a truncated normal.
     pub fn support(&self) -> (f64, f64) {
+        let inf = f64::INFINITY;
         match self.0 {
-            Law::Normal { .. } => (f64::NEG_INFINITY, f64::INFINITY),
+            Law::Normal { .. } | Law::Gumbel(_) => (-inf, inf),
             Law::Uniform { min, max } => (min, max),
+            Law::Lognormal(l) => (l.shift, inf),
+            Law::TruncatedNormal(t) => (t.lo(), t.hi()),
+            Law::Weibull(w) => (w.shift, inf),
+            Law::Triangular(t) => (t.min, t.max),
+            Law::Rayleigh(r) => (r.shift, inf),
         }
+    }
+
+    /// The distribution function `F(x)`; see [`Marginal::sf`] for the upper
+    /// tail.
+    pub fn cdf(&self, x: f64) -> f64 {
+        match self.0 {
+            Law::Uniform { min, max } => ((x - min) / (max - min)).clamp(0.0, 1.0),
+            _ => normal::cdf(self.to_standard(x)),
+        }
+    }
+
+    /// The upper tail `1 − F(x)`, computed without cancellation.
+    pub fn sf(&self, x: f64) -> f64 {
+        match self.0 {
+            Law::Uniform { min, max } => ((max - x) / (max - min)).clamp(0.0, 1.0),
+            _ => normal::sf(self.to_standard(x)),
+        }
+    }
+
+    /// The density `f(x)`.
+    pub fn pdf(&self, x: f64) -> f64 {
+        match &self.0 {
+            Law::Normal { mean, std } => normal::pdf((x - mean) / std) / std,
+            Law::Uniform { min, max } => {
+                if (*min..=*max).contains(&x) {
+                    1.0 / (max - min)
+                } else {
+                    0.0
+                }
+            }
+            Law::Lognormal(l) => l.pdf(x),
+            Law::TruncatedNormal(t) => t.pdf(x),
+            Law::Weibull(w) => w.pdf(x),
+            Law::Gumbel(g) => g.pdf(x),
+            Law::Triangular(t) => t.pdf(x),
+            Law::Rayleigh(r) => r.pdf(x),
+        }
+    }
+
+    /// The quantile `F⁻¹(p)`, `p ∈ (0, 1)` (= `T(Φ⁻¹(p))`).
+    pub fn quantile(&self, p: f64) -> f64 {
+        self.to_physical(normal::inverse_cdf(p))
     }
 
     /// True for a normal marginal (its transformation is affine).
@@ -128,59 +263,131 @@ impl Marginal {
     }
 
     /// The same family with another mean and standard deviation.
+    ///
+    /// Location-scale families (uniform, Gumbel, triangular, Rayleigh) are
+    /// translated and scaled; the lognormal and Weibull keep their shift,
+    /// the truncated normal its bounds (its parent is solved for; an
+    /// unreachable pair of moments is refused).
     pub fn with_moments(&self, mean: f64, std: f64) -> Result<Marginal, ReliabilityError> {
-        match self.0 {
-            Law::Normal { .. } => Marginal::normal(mean, std),
-            Law::Uniform { .. } => Marginal::uniform(mean - SQRT_3 * std, mean + SQRT_3 * std),
+        if !(mean.is_finite() && std.is_finite() && std > 0.0) {
+            return Err(ReliabilityError::InvalidDistribution(format!(
+                "{:?} with mean {mean} and std {std}: the mean must be finite and the std positive",
+                self.family()
+            )));
         }
+        Ok(Marginal(match &self.0 {
+            Law::Normal { .. } => return Marginal::normal(mean, std),
+            Law::Uniform { .. } => {
+                return Marginal::uniform(mean - SQRT_3 * std, mean + SQRT_3 * std)
+            }
+            Law::Lognormal(l) => Law::Lognormal(Lognormal::new(mean, std, l.shift)?),
+            Law::TruncatedNormal(t) => Law::TruncatedNormal(t.with_moments(mean, std)?),
+            Law::Weibull(w) => Law::Weibull(w.with_moments(mean, std)?),
+            Law::Gumbel(_) => Law::Gumbel(Gumbel::with_moments(mean, std)?),
+            Law::Triangular(t) => Law::Triangular(t.with_moments(mean, std)?),
+            Law::Rayleigh(_) => Law::Rayleigh(Rayleigh::with_moments(mean, std)?),
+        }))
     }
 
     /// `x = T(u)`, the physical value of a standard normal coordinate.
     #[inline]
     pub fn to_physical(&self, u: f64) -> f64 {
-        match self.0 {
+        match &self.0 {
             Law::Normal { mean, std } => mean + std * u,
             Law::Uniform { min, max } => min + (max - min) * normal::cdf(u),
+            Law::Lognormal(l) => l.x(u),
+            Law::TruncatedNormal(t) => t.x(u),
+            Law::Weibull(w) => w.x(u),
+            Law::Gumbel(g) => g.x(u),
+            Law::Triangular(t) => t.x(u),
+            Law::Rayleigh(r) => r.x(u),
         }
     }
 
-    /// `u = T⁻¹(x)`.
+    /// `u = T⁻¹(x) = Φ⁻¹(F(x))`, from whichever tail does not cancel.
     pub fn to_standard(&self, x: f64) -> f64 {
-        match self.0 {
+        match &self.0 {
             Law::Normal { mean, std } => (x - mean) / std,
             Law::Uniform { min, max } => normal::inverse_cdf((x - min) / (max - min)),
+            Law::Lognormal(l) => l.u(x),
+            Law::TruncatedNormal(t) => t.u(x),
+            Law::Weibull(w) => w.u(x),
+            Law::Gumbel(g) => g.u(x),
+            Law::Triangular(t) => t.u(x),
+            Law::Rayleigh(r) => r.u(x),
         }
     }
 
     /// `dx/du` at `u`.
     #[inline]
     pub fn dx_du(&self, u: f64) -> f64 {
-        match self.0 {
-            Law::Normal { std, .. } => std,
+        match &self.0 {
+            Law::Normal { std, .. } => *std,
             Law::Uniform { min, max } => (max - min) * normal::pdf(u),
+            Law::Lognormal(l) => l.dx_du(u),
+            Law::TruncatedNormal(t) => t.dx_du(u),
+            Law::Weibull(w) => w.dx_du(u),
+            Law::Gumbel(g) => g.dx_du(u),
+            Law::Triangular(t) => t.dx_du(u),
+            Law::Rayleigh(r) => r.dx_du(u),
         }
     }
 
-    /// `∂x/∂μ` at fixed `u` (the marginal parametrised by mean and std).
-    pub fn dx_dmean(&self, _u: f64) -> f64 {
-        1.0
+    /// `d²x/du²` at `u` (0 for a normal; `−(max − min)·u·φ(u)` for a
+    /// uniform; `crate::families` for the others).
+    #[inline]
+    pub fn d2x_du2(&self, u: f64) -> f64 {
+        match &self.0 {
+            Law::Normal { .. } => 0.0,
+            Law::Uniform { min, max } => -(max - min) * u * normal::pdf(u),
+            Law::Lognormal(l) => l.d2x_du2(u),
+            Law::TruncatedNormal(t) => t.d2x_du2(u),
+            Law::Weibull(w) => w.d2x_du2(u),
+            Law::Gumbel(g) => g.d2x_du2(u),
+            Law::Triangular(t) => t.d2x_du2(u),
+            Law::Rayleigh(r) => r.d2x_du2(u),
+        }
     }
 
-    /// `∂x/∂σ` at fixed `u` (the marginal parametrised by mean and std):
-    /// `u` for a normal, `√3·(2Φ(u) − 1)` for a uniform.
+    /// `∂x/∂μ` at fixed `u` (the marginal parametrised by mean and std, the
+    /// family and the std held): 1 for the location-scale families,
+    /// `crate::families` for the lognormal, Weibull and truncated normal.
+    pub fn dx_dmean(&self, u: f64) -> f64 {
+        match &self.0 {
+            Law::Lognormal(l) => l.dx_dmoments(u)[0],
+            Law::TruncatedNormal(t) => t.dx_dmoments(u)[0],
+            Law::Weibull(w) => w.dx_dmoments(u)[0],
+            _ => 1.0,
+        }
+    }
+
+    /// `∂x/∂σ` at fixed `u` (the marginal parametrised by mean and std, the
+    /// mean held): `u` for a normal, `√3·(2Φ(u) − 1)` for a uniform,
+    /// `(x − μ)/σ` for the other location-scale families.
     pub fn dx_dstd(&self, u: f64) -> f64 {
-        match self.0 {
+        match &self.0 {
             Law::Normal { .. } => u,
             Law::Uniform { .. } => SQRT_3 * (2.0 * normal::cdf(u) - 1.0),
+            Law::Lognormal(l) => l.dx_dmoments(u)[1],
+            Law::TruncatedNormal(t) => t.dx_dmoments(u)[1],
+            Law::Weibull(w) => w.dx_dmoments(u)[1],
+            Law::Gumbel(g) => g.dx_dstd(u),
+            Law::Triangular(t) => {
+                let [m, s] = t.moments();
+                (t.x(u) - m) / s
+            }
+            Law::Rayleigh(r) => r.dx_dstd(u),
         }
     }
 
-    /// One physical sample.
+    /// One physical sample (`T(u)` of a standard normal draw for the v2
+    /// families).
     #[inline]
     pub fn sample(&self, rng: &mut CaseRng) -> f64 {
         match self.0 {
             Law::Normal { mean, std } => mean + std * rng.normal(),
             Law::Uniform { min, max } => min + (max - min) * rng.uniform(),
+            _ => self.to_physical(rng.normal()),
         }
     }
 }
@@ -224,7 +431,33 @@ pub struct Correlation {
     pub rho: f64,
 }
 
-/// The correlated normal block of an [`Inputs`]: `x_B = μ_B + D_B·L·u_B`.
+/// The lower Cholesky factor of the `k × k` row-major `r`, or the
+/// `(row, column)` of the given pair that makes it fail: the pivot of `row`
+/// is not positive, named by its largest given coefficient `column < row`.
+fn cholesky(r: &[f64], k: usize) -> Result<Vec<f64>, (usize, usize)> {
+    let mut l = vec![0.0; k * k];
+    for i in 0..k {
+        for j in 0..=i {
+            let dot: f64 = (0..j).map(|c| l[i * k + c] * l[j * k + c]).sum();
+            if i == j {
+                let d = r[i * k + i] - dot;
+                if d.is_nan() || d <= 1e-14 {
+                    let col = (0..i)
+                        .max_by(|&a, &b| r[i * k + a].abs().total_cmp(&r[i * k + b].abs()))
+                        .unwrap_or(0);
+                    return Err((i, col));
+                }
+                l[i * k + i] = d.sqrt();
+            } else {
+                l[i * k + j] = (r[i * k + j] - dot) / l[j * k + j];
+            }
+        }
+    }
+    Ok(l)
+}
+
+/// The correlated block of an [`Inputs`]: `x_i = F_i⁻¹(Φ(z_i))`, `z = L·u_B`
+/// (for normal members `x_B = μ_B + D_B·L·u_B`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 struct Block {
     /// The coefficients as given (serialised).
@@ -235,10 +468,14 @@ struct Block {
     /// Per input, its position in `members`.
     #[serde(skip)]
     position: Vec<Option<usize>>,
-    /// `R`, `k × k` row-major.
+    /// `R`, `k × k` row-major: the physical (Pearson) correlations.
     #[serde(skip)]
     matrix: Vec<f64>,
-    /// The lower Cholesky factor `L` of `R`, `k × k` row-major (zero above
+    /// `R₀`, the Nataf-adjusted correlations of the normal images
+    /// (`crate::nataf`; `R₀ = R` when every member is normal).
+    #[serde(skip)]
+    adjusted: Vec<f64>,
+    /// The lower Cholesky factor `L` of `R₀`, `k × k` row-major (zero above
     /// the diagonal).
     #[serde(skip)]
     factor: Vec<f64>,
@@ -278,16 +515,20 @@ impl Inputs {
         })
     }
 
-    /// Inputs with the given marginals and correlation coefficients between
-    /// normal ones: the inputs named in `pairs` form one block of correlated
-    /// normals `x_B = μ_B + D_B·L·u_B` (module docs), every other input stays
-    /// independent. Pairs not listed within the block are uncorrelated.
+    /// Inputs with the given marginals and physical (Pearson) correlation
+    /// coefficients: the inputs named in `pairs` form one correlated block,
+    /// the Nataf model `x_i = F_i⁻¹(Φ(z_i))`, `z_B = L·u_B`, `R₀ = L·Lᵀ` the
+    /// adjusted correlations of [`crate::nataf::adjusted_correlation`]
+    /// (`reliability-v2.md` §2; for normal members `x_B = μ_B + D_B·L·u_B`,
+    /// module docs). Every other input stays independent; pairs not listed
+    /// within the block are uncorrelated.
     ///
     /// Refused ([`ReliabilityError::InvalidDistribution`]): a pair naming an
     /// input out of range or an input with itself, a pair given twice, a
-    /// non-finite `ρ` or `|ρ| ≥ 1`, a non-normal input in a pair, and a
-    /// correlation matrix that is not positive definite (its smallest
-    /// eigenvalue is named). No pairs give [`Inputs::new`]'s inputs.
+    /// non-finite `ρ` or `|ρ| ≥ 1`, a `ρ` the two marginals cannot attain,
+    /// and an adjusted matrix that is not positive definite (its smallest
+    /// eigenvalue and the pair where the factorisation fails are named). No
+    /// pairs give [`Inputs::new`]'s inputs.
     ///
     /// ```
     /// use reliability::{Inputs, Marginal};
@@ -333,12 +574,6 @@ impl Inputs {
                 ));
             }
             for j in [p.a, p.b] {
-                if !inputs.marginals[j].is_normal() {
-                    return bad(format!(
-                        "`{}` is correlated but not normal: correlations apply to normal inputs",
-                        inputs.names[j]
-                    ));
-                }
                 if !members.contains(&j) {
                     members.push(j);
                 }
@@ -354,6 +589,7 @@ impl Inputs {
         for i in 0..k {
             matrix[i * k + i] = 1.0;
         }
+        let mut adjusted = matrix.clone();
         let mut given = vec![false; k * k];
         for p in pairs {
             let (i, j) = (
@@ -370,28 +606,56 @@ impl Inputs {
             given[j * k + i] = true;
             matrix[i * k + j] = p.rho;
             matrix[j * k + i] = p.rho;
+            let (ma, mb) = (&inputs.marginals[p.a], &inputs.marginals[p.b]);
+            let r0 = crate::nataf::adjusted_correlation(ma, mb, p.rho).map_err(|e| {
+                ReliabilityError::InvalidDistribution(format!(
+                    "correlation of `{}` and `{}`: {e}",
+                    inputs.names[p.a], inputs.names[p.b]
+                ))
+            })?;
+            adjusted[i * k + j] = r0;
+            adjusted[j * k + i] = r0;
         }
-        let r = nalgebra::DMatrix::from_row_slice(k, k, &matrix);
-        let Some(chol) = nalgebra::Cholesky::new(r.clone()) else {
-            let smallest = r.symmetric_eigenvalues().min();
-            let names: Vec<&str> = members.iter().map(|&m| inputs.names[m].as_str()).collect();
-            return bad(format!(
-                "the correlation matrix of {} is not positive definite (smallest eigenvalue {smallest:.3e})",
-                names.join(", ")
-            ));
-        };
-        let l = chol.l();
-        let mut factor = vec![0.0; k * k];
-        for i in 0..k {
-            for j in 0..=i {
-                factor[i * k + j] = l[(i, j)];
+        // nalgebra's factor (the v1 one, to the last bit); the hand-written
+        // one only to name the pair where a failing factorisation stops.
+        let factor = match nalgebra::Cholesky::new(nalgebra::DMatrix::from_row_slice(
+            k, k, &adjusted,
+        ))
+        .map(|c| c.l())
+        .ok_or_else(|| cholesky(&adjusted, k).err().unwrap_or((k - 1, 0)))
+        {
+            Ok(l) => {
+                let mut factor = vec![0.0; k * k];
+                for i in 0..k {
+                    for j in 0..=i {
+                        factor[i * k + j] = l[(i, j)];
+                    }
+                }
+                factor
             }
-        }
+            Err((row, col)) => {
+                let r = nalgebra::DMatrix::from_row_slice(k, k, &adjusted);
+                let smallest = r.symmetric_eigenvalues().min();
+                let names: Vec<&str> = members.iter().map(|&m| inputs.names[m].as_str()).collect();
+                let kind = if adjusted == matrix {
+                    "correlation matrix"
+                } else {
+                    "Nataf-adjusted correlation matrix"
+                };
+                return bad(format!(
+                    "the {kind} of {} is not positive definite (smallest eigenvalue {smallest:.3e}); it fails at the pair `{}`–`{}`",
+                    names.join(", "),
+                    inputs.names[members[col]],
+                    inputs.names[members[row]],
+                ));
+            }
+        };
         inputs.correlation = Some(Block {
             pairs: pairs.to_vec(),
             members,
             position,
             matrix,
+            adjusted,
             factor,
         });
         Ok(inputs)
@@ -535,7 +799,9 @@ impl Inputs {
         })?;
         *m = m.with_moments(mean, std)?;
         let mut out = Inputs::new(self.names.clone(), marginals)?;
-        // The correlation matrix (and its factor) does not depend on σ.
+        // The correlation matrix and its factor are held (for non-normal
+        // members the Gaussian-copula matrix R₀, so the derivatives at fixed
+        // u are those of `dx_dstd`).
         out.correlation = self.correlation.clone();
         Ok(out)
     }
@@ -594,7 +860,7 @@ impl Inputs {
         }
         if let Some(b) = &self.correlation {
             for (i, &m) in b.members.iter().enumerate() {
-                x[m] = self.means[m] + self.stds[m] * b.z(i, u);
+                x[m] = self.marginals[m].to_physical(b.z(i, u));
             }
         }
     }
@@ -608,7 +874,7 @@ impl Inputs {
             let k = b.members.len();
             for i in 0..k {
                 let m = b.members[i];
-                let y = (x[m] - self.means[m]) / self.stds[m];
+                let y = self.marginals[m].to_standard(x[m]);
                 let partial: f64 = (0..i).map(|c| b.factor[i * k + c] * u[b.members[c]]).sum();
                 u[m] = (y - partial) / b.factor[i * k + i];
             }
@@ -625,7 +891,7 @@ impl Inputs {
         if let Some(b) = &self.correlation {
             let k = b.members.len();
             for (i, &m) in b.members.iter().enumerate() {
-                out[m] = self.stds[m] * b.factor[i * k + i];
+                out[m] = self.marginals[m].dx_du(b.z(i, u)) * b.factor[i * k + i];
             }
         }
     }
@@ -639,25 +905,96 @@ impl Inputs {
         }
         if let Some(b) = &self.correlation {
             let k = b.members.len();
+            // dx_m/dz of each member (σ for a normal one).
+            let slope: Vec<f64> = if b.members.iter().all(|&m| self.marginals[m].is_normal()) {
+                b.members.iter().map(|&m| self.stds[m]).collect()
+            } else {
+                (0..k)
+                    .map(|i| self.marginals[b.members[i]].dx_du(b.z(i, u)))
+                    .collect()
+            };
             for c in 0..k {
                 out[b.members[c]] = (c..k)
                     .map(|i| {
                         let m = b.members[i];
-                        grad_x[m] * self.stds[m] * b.factor[i * k + c]
+                        grad_x[m] * slope[i] * b.factor[i * k + c]
                     })
                     .sum();
             }
         }
     }
 
+    /// The whole Jacobian `∂x/∂u` at `u`, `n × n` row-major (`out[j·n + c] =
+    /// ∂x_j/∂u_c`): diagonal for independent inputs, `dx_i/dz_i·L_ic` in the
+    /// correlated block.
+    pub fn jacobian_matrix(&self, u: &[f64], out: &mut [f64]) {
+        let n = self.len();
+        out.iter_mut().for_each(|v| *v = 0.0);
+        let mut diag = vec![0.0; n];
+        self.jacobian(u, &mut diag);
+        for j in 0..n {
+            out[j * n + j] = diag[j];
+        }
+        if let Some(b) = &self.correlation {
+            let k = b.members.len();
+            for i in 0..k {
+                let m = b.members[i];
+                let slope = self.marginals[m].dx_du(b.z(i, u));
+                for c in 0..=i {
+                    out[m * n + b.members[c]] = slope * b.factor[i * k + c];
+                }
+            }
+        }
+    }
+
+    /// Adds `Σ_j w_j·∇²_u x_j` at `u` to the `n × n` row-major `hess`: the
+    /// second-order term of `∇²_u g = Jᵀ·∇²_x g·J + Σ_j ∂g/∂x_j·∇²_u x_j`
+    /// (`w = ∇_x g`). Independent inputs: `w_j·d²x_j/du_j²` on the diagonal;
+    /// in the block `∂²x_i/∂u_p∂u_q = d²x_i/dz_i²·L_ip·L_iq`.
+    pub fn add_second_derivatives(&self, u: &[f64], w: &[f64], hess: &mut [f64]) {
+        let n = self.len();
+        for j in 0..n {
+            if !self.is_correlated(j) {
+                hess[j * n + j] += w[j] * self.marginals[j].d2x_du2(u[j]);
+            }
+        }
+        if let Some(b) = &self.correlation {
+            let k = b.members.len();
+            for i in 0..k {
+                let m = b.members[i];
+                let c2 = w[m] * self.marginals[m].d2x_du2(b.z(i, u));
+                if c2 == 0.0 {
+                    continue;
+                }
+                for p in 0..=i {
+                    for q in 0..=i {
+                        hess[b.members[p] * n + b.members[q]] +=
+                            c2 * b.factor[i * k + p] * b.factor[i * k + q];
+                    }
+                }
+            }
+        }
+    }
+
+    /// `∂x_j/∂μ_j` at fixed `u` (every other `x` is unmoved): the
+    /// marginal's [`Marginal::dx_dmean`] at `u_j`, or at `z_j` in the block.
+    pub fn dx_dmean(&self, j: usize, u: &[f64]) -> f64 {
+        if let Some(b) = &self.correlation {
+            if let Some(i) = b.position[j] {
+                return self.marginals[j].dx_dmean(b.z(i, u));
+            }
+        }
+        self.marginals[j].dx_dmean(u[j])
+    }
+
     /// `∂x_j/∂σ_j` at fixed `u` (every other `x` is unmoved): the
-    /// marginal's [`Marginal::dx_dstd`], and for the correlated block the
-    /// standardised coordinate `z_j = (L·u_B)_j` (the correlation matrix
-    /// held fixed).
+    /// marginal's [`Marginal::dx_dstd`], in the correlated block at the
+    /// coordinate `z_j = (L·u_B)_j` (`z_j` itself for a normal member), the
+    /// Gaussian-copula matrix `R₀` held fixed.
     pub fn dx_dstd(&self, j: usize, u: &[f64]) -> f64 {
         if let Some(b) = &self.correlation {
             if let Some(i) = b.position[j] {
-                return b.z(i, u);
+                return self.marginals[j].dx_dstd(b.z(i, u));
             }
         }
         self.marginals[j].dx_dstd(u[j])
@@ -700,7 +1037,7 @@ impl Inputs {
             rng.fill_normal(x);
             for i in (0..b.members.len()).rev() {
                 let m = b.members[i];
-                x[m] = self.means[m] + self.stds[m] * b.z(i, x);
+                x[m] = self.marginals[m].to_physical(b.z(i, x));
             }
             for (j, (x, m)) in x.iter_mut().zip(&self.marginals).enumerate() {
                 if b.position[j].is_none() {
@@ -917,8 +1254,10 @@ mod tests {
             e.contains("not positive definite") && e.contains("a, b, c"),
             "{e}"
         );
-        let u = vec![Marginal::uniform(0.0, 1.0).unwrap(); 3];
-        let e = Inputs::correlated(names.clone(), u, &[c(0, 1, 0.5)]).unwrap_err();
-        assert!(e.to_string().contains("not normal"));
+        // Two lognormals cannot reach ρ = −0.9 (Liu & Der Kiureghian's
+        // bound ln(1 − 0.9·δ²)/ζ² < −1 at δ = 1).
+        let l = vec![Marginal::lognormal(1.0, 1.0, 0.0).unwrap(); 3];
+        let e = Inputs::correlated(names.clone(), l, &[c(0, 1, -0.9)]).unwrap_err();
+        assert!(e.to_string().contains("not attainable"), "{e}");
     }
 }

@@ -6,7 +6,7 @@ use chain_core::model::{Distribution, Machine};
 use chain_core::ErrorModel;
 
 use crate::error::ReliabilityError;
-use crate::inputs::{Inputs, Marginal};
+use crate::inputs::{Correlation, Inputs, Marginal};
 use crate::study::{Grid, Study, StudySpec, System};
 
 /// The inputs of every error of the machine, in [`Machine::errors`] order.
@@ -23,11 +23,7 @@ pub fn inputs(machine: &Machine) -> Result<Inputs, ReliabilityError> {
                 name: e.name.clone(),
                 origin: e.origin.clone(),
             })?;
-        let m = match stat.distribution {
-            Distribution::Normal { mean, std } => Marginal::normal(mean, std),
-            Distribution::Uniform { min, max } => Marginal::uniform(min, max),
-        }
-        .map_err(|err| match err {
+        let m = marginal(&stat.distribution).map_err(|err| match err {
             ReliabilityError::InvalidDistribution(msg) => {
                 ReliabilityError::InvalidDistribution(format!("`{}`: {msg}", e.name))
             }
@@ -36,7 +32,68 @@ pub fn inputs(machine: &Machine) -> Result<Inputs, ReliabilityError> {
         names.push(e.name.clone());
         marginals.push(m);
     }
-    Inputs::new(names, marginals)
+    if machine.correlations.is_empty() {
+        return Inputs::new(names, marginals);
+    }
+    // The `correlation` list: the Nataf model (`reliability-v2.md` §2). A
+    // refusal (a ρ the marginals cannot attain, a matrix not positive
+    // definite after the adjustment) is located at the pair it names.
+    let pairs: Vec<Correlation> = machine
+        .correlations
+        .iter()
+        .map(|c| Correlation {
+            a: c.a,
+            b: c.b,
+            rho: c.rho,
+        })
+        .collect();
+    let named = names.clone();
+    Inputs::correlated(names, marginals, &pairs).map_err(|err| match err {
+        ReliabilityError::InvalidDistribution(msg) => {
+            let pair = machine.correlations.iter().find(|c| {
+                let (a, b) = (&named[c.a], &named[c.b]);
+                [format!("`{a}`–`{b}`"), format!("`{b}`–`{a}`")]
+                    .iter()
+                    .chain(&[format!("`{a}` and `{b}`"), format!("`{b}` and `{a}`")])
+                    .any(|p| msg.contains(p.as_str()))
+            });
+            match pair {
+                Some(c) => ReliabilityError::InvalidDistribution(format!(
+                    "{}:{}:{}: {msg} (at key `{}`)",
+                    machine.file.as_deref().unwrap_or("<input>"),
+                    c.origin.line,
+                    c.origin.column,
+                    c.origin.key
+                )),
+                None => ReliabilityError::InvalidDistribution(msg),
+            }
+        }
+        other => other,
+    })
+}
+
+/// The [`Marginal`] of a loaded [`Distribution`] (every family of
+/// `reliability-v2.md` §1).
+pub fn marginal(d: &Distribution) -> Result<Marginal, ReliabilityError> {
+    match *d {
+        Distribution::Normal { mean, std } => Marginal::normal(mean, std),
+        Distribution::Uniform { min, max } => Marginal::uniform(min, max),
+        Distribution::Lognormal { mean, std, shift } => Marginal::lognormal(mean, std, shift),
+        Distribution::TruncatedNormal {
+            mean,
+            std,
+            min,
+            max,
+        } => Marginal::truncated_normal(mean, std, min, max),
+        Distribution::Weibull {
+            scale,
+            shape,
+            shift,
+        } => Marginal::weibull(scale, shape, shift),
+        Distribution::Gumbel { mode, scale } => Marginal::gumbel(mode, scale),
+        Distribution::Triangular { min, mode, max } => Marginal::triangular(min, mode, max),
+        Distribution::Rayleigh { scale, shift } => Marginal::rayleigh(scale, shift),
+    }
 }
 
 /// The parameter values: the file's, overridden by `overrides` (name, value).

@@ -41,7 +41,7 @@
 use std::path::Path;
 
 use chain_core::diagnostic::{closest, Message, Problem};
-use chain_core::model::{Distribution, Machine, Origin};
+use chain_core::model::{Machine, Origin};
 use chain_core::values::{EntryKind, Given, Values, ValuesError};
 use chain_core::yaml::{self, Node};
 use chain_core::Diagnostics;
@@ -248,10 +248,7 @@ impl Posterior {
                                 origin: e.origin.clone(),
                             });
                     let stat = stat.map_err(err)?;
-                    let prior = match stat.distribution {
-                        Distribution::Normal { mean, std } => Marginal::normal(mean, std),
-                        Distribution::Uniform { min, max } => Marginal::uniform(min, max),
-                    };
+                    let prior = crate::machine::marginal(&stat.distribution);
                     match (prior, given) {
                         (Ok(p), Some(v)) => p.with_moments(v.mean, p.std()),
                         (p, _) => p,

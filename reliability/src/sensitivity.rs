@@ -179,8 +179,8 @@ pub fn sensitivity<L: LimitState>(
         .marginals()
         .iter()
         .enumerate()
-        .map(|(j, m)| InputSensitivity {
-            dr_dmean: scale * grad[j] * m.dx_dmean(u[j]),
+        .map(|(j, _)| InputSensitivity {
+            dr_dmean: scale * grad[j] * event.inputs.dx_dmean(j, u),
             dr_dstd: scale * grad[j] * event.inputs.dx_dstd(j, u),
             importance: importance(j),
         })

@@ -240,6 +240,19 @@ pub enum Problem {
         /// Upper bound.
         max: f64,
     },
+    /// Parameters of a distribution that do not define one (`min ≥ max`, a
+    /// mode outside `[min, max]`, a mean not above the shift, …).
+    DistributionParameters {
+        /// The distribution.
+        dist: &'static str,
+        /// What is wrong, with the values.
+        detail: String,
+    },
+    /// A `correlation` entry that does not define one.
+    BadCorrelation {
+        /// What is wrong.
+        detail: String,
+    },
     /// Two keys that exclude each other.
     Conflict {
         /// The key given first.
@@ -737,6 +750,14 @@ impl Problem {
                 "out of range",
                 format!("a uniform distribution needs min < max, got min = {min}, max = {max}"),
             ),
+            Problem::DistributionParameters { dist, detail } => D::new(
+                "chain::distribution_parameters",
+                "out of range",
+                format!("a {dist} distribution needs {detail}"),
+            ),
+            Problem::BadCorrelation { detail } => {
+                D::new("chain::correlation", "bad correlation", detail.clone())
+            }
             Problem::Conflict { first, second } => D::new(
                 "chain::conflicting_keys",
                 "conflicting key",

@@ -497,9 +497,10 @@ impl Frame {
     }
 }
 
-/// The input distribution of one error parameter.
+/// The input distribution of one error parameter (`machine-format.md`
+/// v1 and `reliability-v2.md` §1).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-#[serde(tag = "dist", rename_all = "lowercase")]
+#[serde(tag = "dist", rename_all = "snake_case")]
 pub enum Distribution {
     /// Normal with mean and standard deviation (`std > 0`).
     Normal {
@@ -515,24 +516,160 @@ pub enum Distribution {
         /// Upper bound.
         max: f64,
     },
+    /// Lognormal: `ln(x − shift)` is normal; `mean > shift` and `std > 0`
+    /// are the moments of `x` itself.
+    Lognormal {
+        /// Mean of the variable.
+        mean: f64,
+        /// Standard deviation of the variable.
+        std: f64,
+        /// The lower end of the support (0 unless given).
+        shift: f64,
+    },
+    /// A normal with mean `mean` and standard deviation `std` (of the parent)
+    /// truncated to `[min, max]` (either bound may be absent, not both).
+    TruncatedNormal {
+        /// Mean of the parent normal.
+        mean: f64,
+        /// Standard deviation of the parent normal.
+        std: f64,
+        /// Lower bound, if any.
+        min: Option<f64>,
+        /// Upper bound, if any.
+        max: Option<f64>,
+    },
+    /// Weibull: `F(x) = 1 − exp(−((x − shift)/scale)^shape)`.
+    Weibull {
+        /// Scale `λ > 0`.
+        scale: f64,
+        /// Shape `k > 0`.
+        shape: f64,
+        /// The lower end of the support (0 unless given).
+        shift: f64,
+    },
+    /// Gumbel (maximum type): `F(x) = exp(−exp(−(x − mode)/scale))`.
+    Gumbel {
+        /// The mode (location).
+        mode: f64,
+        /// Scale `> 0`.
+        scale: f64,
+    },
+    /// Triangular on `[min, max]` with its mode in `[min, max]`.
+    Triangular {
+        /// Lower bound.
+        min: f64,
+        /// The mode.
+        mode: f64,
+        /// Upper bound.
+        max: f64,
+    },
+    /// Rayleigh: `F(x) = 1 − exp(−(x − shift)²/(2·scale²))`, the size of a
+    /// radial error.
+    Rayleigh {
+        /// Scale `σ > 0`.
+        scale: f64,
+        /// The lower end of the support (0 unless given).
+        shift: f64,
+    },
 }
 
+/// Euler–Mascheroni constant `γ`.
+const EULER_GAMMA: f64 = 0.577_215_664_901_532_9;
+
 impl Distribution {
-    /// The mean.
+    /// The family's name as written in the file (`normal`, `truncated_normal`, …).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Distribution::Normal { .. } => "normal",
+            Distribution::Uniform { .. } => "uniform",
+            Distribution::Lognormal { .. } => "lognormal",
+            Distribution::TruncatedNormal { .. } => "truncated_normal",
+            Distribution::Weibull { .. } => "weibull",
+            Distribution::Gumbel { .. } => "gumbel",
+            Distribution::Triangular { .. } => "triangular",
+            Distribution::Rayleigh { .. } => "rayleigh",
+        }
+    }
+
+    /// The mean of the variable.
     pub fn mean(&self) -> f64 {
         match *self {
             Distribution::Normal { mean, .. } => mean,
             Distribution::Uniform { min, max } => 0.5 * (min + max),
+            Distribution::Lognormal { mean, .. } => mean,
+            Distribution::TruncatedNormal {
+                mean,
+                std,
+                min,
+                max,
+            } => {
+                let (m1, _) = truncated_moments(mean, std, min, max);
+                mean + std * m1
+            }
+            Distribution::Weibull {
+                scale,
+                shape,
+                shift,
+            } => shift + scale * libm::tgamma(1.0 + 1.0 / shape),
+            Distribution::Gumbel { mode, scale } => mode + EULER_GAMMA * scale,
+            Distribution::Triangular { min, mode, max } => (min + mode + max) / 3.0,
+            Distribution::Rayleigh { scale, shift } => {
+                shift + scale * (0.5 * std::f64::consts::PI).sqrt()
+            }
         }
     }
 
-    /// The standard deviation.
+    /// The standard deviation of the variable.
     pub fn std(&self) -> f64 {
         match *self {
             Distribution::Normal { std, .. } => std,
             Distribution::Uniform { min, max } => (max - min) / 12f64.sqrt(),
+            Distribution::Lognormal { std, .. } => std,
+            Distribution::TruncatedNormal {
+                mean,
+                std,
+                min,
+                max,
+            } => {
+                let (m1, m2) = truncated_moments(mean, std, min, max);
+                std * (m2 - m1 * m1).max(0.0).sqrt()
+            }
+            Distribution::Weibull { scale, shape, .. } => {
+                let g1 = libm::tgamma(1.0 + 1.0 / shape);
+                let g2 = libm::tgamma(1.0 + 2.0 / shape);
+                scale * (g2 - g1 * g1).max(0.0).sqrt()
+            }
+            Distribution::Gumbel { scale, .. } => scale * std::f64::consts::PI / 6f64.sqrt(),
+            Distribution::Triangular { min, mode, max } => {
+                let (a, c, b) = (min, mode, max);
+                ((a * a + b * b + c * c - a * b - a * c - b * c) / 18.0).sqrt()
+            }
+            Distribution::Rayleigh { scale, .. } => {
+                scale * (0.5 * (4.0 - std::f64::consts::PI)).sqrt()
+            }
         }
     }
+}
+
+/// `(E Z, E Z²)` of the standard normal truncated to `[(min − μ)/σ, (max − μ)/σ]`
+/// (Johnson, Kotz & Balakrishnan, *Continuous Univariate Distributions* 1,
+/// §10.1, Eq. 13.134-13.135).
+fn truncated_moments(mean: f64, std: f64, min: Option<f64>, max: Option<f64>) -> (f64, f64) {
+    let pdf = |z: f64| (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    let cdf = |z: f64| 0.5 * libm::erfc(-z / std::f64::consts::SQRT_2);
+    let a = min.map_or(f64::NEG_INFINITY, |v| (v - mean) / std);
+    let b = max.map_or(f64::INFINITY, |v| (v - mean) / std);
+    // The mass, on the side of zero where it does not cancel.
+    let z = if a >= 0.0 {
+        cdf(-a) - cdf(-b)
+    } else {
+        cdf(b) - cdf(a)
+    };
+    let (pa, pb) = (pdf(a), pdf(b));
+    let apa = if a.is_finite() { a * pa } else { 0.0 };
+    let bpb = if b.is_finite() { b * pb } else { 0.0 };
+    let m1 = (pa - pb) / z;
+    (m1, 1.0 + (apa - bpb) / z)
 }
 
 /// The statistics entry of one error parameter.
@@ -677,6 +814,22 @@ pub struct Machine {
     pub statistics: Vec<Statistic>,
     /// The reliability section, if any.
     pub reliability: Option<ReliabilitySpec>,
+    /// The top-level `correlation` list (`reliability-v2.md` §2): physical
+    /// correlations between errors with statistics, in file order.
+    pub correlations: Vec<CorrelationEntry>,
+}
+
+/// One `[name, name, rho]` entry of the `correlation` list.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CorrelationEntry {
+    /// Index into [`Machine::errors`] of the first error.
+    pub a: usize,
+    /// Index of the second error.
+    pub b: usize,
+    /// The physical (Pearson) correlation, in `(−1, 1)`.
+    pub rho: f64,
+    /// Where the entry was declared (its `correlation[i]` key).
+    pub origin: Origin,
 }
 
 impl Machine {

@@ -454,6 +454,7 @@ mod tests {
             frame: Frame::Workpiece,
             statistics: vec![],
             reliability: None,
+            correlations: Vec::new(),
             functions: vec![],
         }
     }

@@ -52,6 +52,7 @@ pub const TOP_KEYS: &[&str] = &[
     "tool_point",
     "frame",
     "statistics",
+    "correlation",
     "reliability",
 ];
 
@@ -406,6 +407,10 @@ impl Loader {
             Some(n) => self.statistics_section(n, tree.as_ref()),
             None => Some(Vec::new()),
         };
+        let correlations = match top.get("correlation") {
+            Some(n) => self.correlation_section(n, statistics.as_deref(), tree.as_ref()),
+            None => Some(Vec::new()),
+        };
         let reliability = match top.entry("reliability") {
             Some((k, v)) => self.reliability_section(k, v, tree.as_ref()).map(Some),
             None => Some(None),
@@ -429,6 +434,7 @@ impl Loader {
             frame: frame?,
             statistics: statistics?,
             reliability: reliability?,
+            correlations: correlations?,
         })
     }
 

@@ -6,7 +6,8 @@ use super::bodies::Tree;
 use super::{join, Fields, Loader, TreeReader};
 use crate::diagnostic::{closest, Problem};
 use crate::model::{
-    Component, Distribution, Parameter, ReliabilitySpec, Requirement, Sided, Statistic,
+    Component, CorrelationEntry, Distribution, Parameter, ReliabilitySpec, Requirement, Sided,
+    Statistic,
 };
 use crate::yaml::Node;
 
@@ -19,11 +20,41 @@ pub const STATISTICS_KEYS: &[&str] = &[
     "sigma_rule",
     "min",
     "max",
+    "shift",
+    "scale",
+    "shape",
+    "mode",
     "cost_weight",
     "min_std",
 ];
-/// Distributions.
-pub const DISTRIBUTIONS: &[&str] = &["normal", "uniform"];
+/// Distributions (`machine-format.md` v1 and `reliability-v2.md` §1).
+pub const DISTRIBUTIONS: &[&str] = &[
+    "normal",
+    "uniform",
+    "lognormal",
+    "truncated_normal",
+    "weibull",
+    "gumbel",
+    "triangular",
+    "rayleigh",
+];
+/// The keys of each v2 family (besides `dist`, `cost_weight`, `min_std`).
+const FAMILY_KEYS: &[(&str, &[&str])] = &[
+    (
+        "lognormal",
+        &["mean", "std", "tolerance", "sigma_rule", "shift"],
+    ),
+    (
+        "truncated_normal",
+        &["mean", "std", "tolerance", "sigma_rule", "min", "max"],
+    ),
+    ("weibull", &["scale", "shape", "shift"]),
+    ("gumbel", &["mode", "scale"]),
+    ("triangular", &["min", "mode", "max"]),
+    ("rayleigh", &["scale", "shift"]),
+];
+/// The keys of the v2 families that neither `normal` nor `uniform` takes.
+const V2_KEYS: &[&str] = &["shift", "scale", "shape", "mode"];
 /// Keys of the reliability section.
 pub const RELIABILITY_KEYS: &[&str] = &["tolerance", "sided", "grid", "requirement", "acceptance"];
 /// Keys of a reliability requirement.
@@ -35,6 +66,21 @@ pub const SIDED: &[&str] = &["upper", "two"];
 
 /// `sigma_rule` when `tolerance` is given without it.
 pub const DEFAULT_SIGMA_RULE: f64 = 6.0;
+
+/// The numeric keys of one statistics entry, as read (`None` absent,
+/// `Some(None)` invalid and reported).
+#[derive(Clone, Copy)]
+struct Given {
+    mean: Option<Option<f64>>,
+    /// `std`, or `tolerance / sigma_rule`.
+    spread: Option<Option<f64>>,
+    min: Option<Option<f64>>,
+    max: Option<Option<f64>>,
+    shift: Option<Option<f64>>,
+    scale: Option<Option<f64>>,
+    shape: Option<Option<f64>>,
+    mode: Option<Option<f64>>,
+}
 
 impl Loader {
     /// `parameters: {name: value | null}`.
@@ -176,8 +222,23 @@ impl Loader {
         let sigma_rule = self.opt_num(&f, "sigma_rule", true);
         let min = self.opt_num(&f, "min", false);
         let max = self.opt_num(&f, "max", false);
+        let shift = self.opt_num(&f, "shift", false);
+        let scale = self.opt_num(&f, "scale", true);
+        let shape = self.opt_num(&f, "shape", true);
+        let mode = self.opt_num(&f, "mode", false);
         let cost_weight = self.opt_num(&f, "cost_weight", true);
         let min_std = self.opt_num(&f, "min_std", true);
+        if let Some(d @ ("normal" | "uniform")) = dist {
+            for key in V2_KEYS {
+                if let Some((k, _)) = f.entry(key) {
+                    self.report(
+                        k.span,
+                        f.path(key),
+                        Problem::KeyNotForDistribution { key, dist: d },
+                    );
+                }
+            }
+        }
 
         let conflict = |l: &mut Loader, first: &'static str, second: &'static str| {
             let span = Self::key_span(&f, second);
@@ -255,6 +316,19 @@ impl Loader {
                     None
                 }
             }
+            Some(d) if d != "normal" => {
+                let given = Given {
+                    mean,
+                    spread,
+                    min,
+                    max,
+                    shift,
+                    scale,
+                    shape,
+                    mode,
+                };
+                self.v2_distribution(&f, d, given, misspelt_spread)
+            }
             Some(_) => {
                 for key in ["min", "max"] {
                     if let Some((k, _)) = f.entry(key) {
@@ -289,6 +363,274 @@ impl Loader {
         }
         let min_std = min_std.filter(|v| !v.is_nan());
         Some((distribution?, cost_weight?, min_std))
+    }
+
+    /// A v2 family (`reliability-v2.md` §1): its keys only, the required
+    /// ones present, the values defining a distribution. `None` when
+    /// anything was reported.
+    fn v2_distribution(
+        &mut self,
+        f: &Fields<'_>,
+        dist: &'static str,
+        g: Given,
+        misspelt_spread: bool,
+    ) -> Option<Distribution> {
+        let allowed = FAMILY_KEYS
+            .iter()
+            .find(|(d, _)| *d == dist)
+            .map_or(&[][..], |(_, k)| *k);
+        for key in STATISTICS_KEYS {
+            if matches!(*key, "dist" | "cost_weight" | "min_std") || allowed.contains(key) {
+                continue;
+            }
+            if let Some((k, _)) = f.entry(key) {
+                self.report(
+                    k.span,
+                    f.path(key),
+                    Problem::KeyNotForDistribution { key, dist },
+                );
+            }
+        }
+        // A required key: its value (`None` if absent, reported, or invalid).
+        // (What was reported makes the caller drop the entry.)
+        let need = |l: &mut Loader, key: &'static str, v: Option<Option<f64>>| match v {
+            Some(v) => v,
+            None => {
+                l.missing(f, key);
+                None
+            }
+        };
+        let spread = |l: &mut Loader| match g.spread {
+            Some(s) => s,
+            None => {
+                if !misspelt_spread {
+                    l.report(f.owner, f.path.clone(), Problem::MissingSpread { dist });
+                }
+                None
+            }
+        };
+        let bad = |l: &mut Loader, key: &str, detail: String| {
+            let span = f.get(key).map_or(f.owner, |n| n.span);
+            l.report(
+                span,
+                f.path(key),
+                Problem::DistributionParameters { dist, detail },
+            );
+            None
+        };
+        let out = match dist {
+            "lognormal" => {
+                let mean = need(self, "mean", g.mean);
+                let std = spread(self);
+                let shift = g.shift.unwrap_or(Some(0.0));
+                match (mean, std, shift) {
+                    (Some(mean), Some(std), Some(shift)) if mean > shift => {
+                        Some(Distribution::Lognormal { mean, std, shift })
+                    }
+                    (Some(mean), Some(_), Some(shift)) => bad(
+                        self,
+                        "mean",
+                        format!("mean > shift (the support is (shift, ∞)), got mean = {mean}, shift = {shift}"),
+                    ),
+                    _ => None,
+                }
+            }
+            "truncated_normal" => {
+                let mean = g.mean.unwrap_or(Some(0.0));
+                let std = spread(self);
+                if g.min.is_none() && g.max.is_none() {
+                    need(self, "min", None);
+                }
+                let (lo, hi) = (
+                    g.min.unwrap_or(Some(f64::NEG_INFINITY)),
+                    g.max.unwrap_or(Some(f64::INFINITY)),
+                );
+                match (mean, std, lo, hi) {
+                    (Some(mean), Some(std), Some(lo), Some(hi)) if lo < hi => {
+                        Some(Distribution::TruncatedNormal {
+                            mean,
+                            std,
+                            min: g.min.flatten(),
+                            max: g.max.flatten(),
+                        })
+                    }
+                    (Some(_), Some(_), Some(lo), Some(hi))
+                        if g.min.is_some() || g.max.is_some() =>
+                    {
+                        bad(
+                            self,
+                            "max",
+                            format!("min < max, got min = {lo}, max = {hi}"),
+                        )
+                    }
+                    _ => None,
+                }
+            }
+            "weibull" => {
+                let scale = need(self, "scale", g.scale);
+                let shape = need(self, "shape", g.shape);
+                let shift = g.shift.unwrap_or(Some(0.0));
+                match (scale, shape, shift) {
+                    (Some(scale), Some(shape), Some(shift)) => Some(Distribution::Weibull {
+                        scale,
+                        shape,
+                        shift,
+                    }),
+                    _ => None,
+                }
+            }
+            "gumbel" => {
+                let mode = need(self, "mode", g.mode);
+                let scale = need(self, "scale", g.scale);
+                match (mode, scale) {
+                    (Some(mode), Some(scale)) => Some(Distribution::Gumbel { mode, scale }),
+                    _ => None,
+                }
+            }
+            "triangular" => {
+                let lo = need(self, "min", g.min);
+                let mode = need(self, "mode", g.mode);
+                let hi = need(self, "max", g.max);
+                match (lo, mode, hi) {
+                    (Some(lo), Some(_), Some(hi)) if lo >= hi => bad(
+                        self,
+                        "max",
+                        format!("min < max, got min = {lo}, max = {hi}"),
+                    ),
+                    (Some(lo), Some(mode), Some(hi)) if !(lo..=hi).contains(&mode) => bad(
+                        self,
+                        "mode",
+                        format!("min ≤ mode ≤ max, got min = {lo}, mode = {mode}, max = {hi}"),
+                    ),
+                    (Some(min), Some(mode), Some(max)) => {
+                        Some(Distribution::Triangular { min, mode, max })
+                    }
+                    _ => None,
+                }
+            }
+            "rayleigh" => {
+                let scale = need(self, "scale", g.scale);
+                let shift = g.shift.unwrap_or(Some(0.0));
+                match (scale, shift) {
+                    (Some(scale), Some(shift)) => Some(Distribution::Rayleigh { scale, shift }),
+                    _ => None,
+                }
+            }
+            _ => None,
+        };
+        out
+    }
+
+    /// `correlation: [[name, name, rho], …]` (`reliability-v2.md` §2): each
+    /// name an error with statistics, `ρ ∈ (−1, 1)`, no error with itself,
+    /// no pair twice. `None` if any entry is invalid (reported).
+    pub(super) fn correlation_section(
+        &mut self,
+        node: &Node,
+        statistics: Option<&[crate::model::Statistic]>,
+        tree: Option<&Tree>,
+    ) -> Option<Vec<CorrelationEntry>> {
+        let before = self.errors.len();
+        let Some(items) = node.as_sequence() else {
+            self.report(
+                node.span,
+                "correlation",
+                Problem::WrongType {
+                    expected: "a list of [error, error, rho]",
+                    found: node.describe(),
+                },
+            );
+            return None;
+        };
+        let mut out: Vec<CorrelationEntry> = Vec::new();
+        for (i, item) in items.iter().enumerate() {
+            let path = format!("correlation[{i}]");
+            let Some([na, nb, nr]) = self.items::<3>(item, &path, "a list [error, error, rho]")
+            else {
+                continue;
+            };
+            let index = |l: &mut Loader, n: &Node| -> Option<usize> {
+                let name = l.name(n, &path, "an error name")?;
+                let t = tree?;
+                let Some(j) = t.errors.iter().position(|e| e.name == name) else {
+                    let suggestion = closest(&name, t.errors.iter().map(|e| e.name.as_str()))
+                        .map(str::to_string);
+                    l.report(
+                        n.span,
+                        path.clone(),
+                        Problem::UnknownError { name, suggestion },
+                    );
+                    return None;
+                };
+                if statistics.is_some_and(|s| !s.iter().any(|st| st.error == j)) {
+                    l.report(
+                        n.span,
+                        path.clone(),
+                        Problem::BadCorrelation {
+                            detail: format!("`{name}` has no `statistics` entry: only errors with statistics can be correlated"),
+                        },
+                    );
+                    return None;
+                }
+                Some(j)
+            };
+            let a = index(self, na);
+            let b = index(self, nb);
+            let rho = self.finite(nr, &path, "a correlation");
+            let (Some(a), Some(b), Some(rho)) = (a, b, rho) else {
+                continue;
+            };
+            let names = tree.map_or((String::new(), String::new()), |t| {
+                (t.errors[a].name.clone(), t.errors[b].name.clone())
+            });
+            if a == b {
+                self.report(
+                    nb.span,
+                    path,
+                    Problem::BadCorrelation {
+                        detail: format!("`{}` is correlated with itself", names.0),
+                    },
+                );
+                continue;
+            }
+            if rho.abs() >= 1.0 {
+                self.report(
+                    nr.span,
+                    path,
+                    Problem::BadCorrelation {
+                        detail: format!(
+                            "the correlation of `{}` and `{}` is {rho}: it must be strictly between -1 and 1",
+                            names.0, names.1
+                        ),
+                    },
+                );
+                continue;
+            }
+            if let Some(first) = out
+                .iter()
+                .find(|c| (c.a, c.b) == (a, b) || (c.a, c.b) == (b, a))
+            {
+                let line = first.origin.line;
+                self.report(
+                    item.span,
+                    path,
+                    Problem::BadCorrelation {
+                        detail: format!(
+                            "the pair `{}`, `{}` is given twice (first on line {line})",
+                            names.0, names.1
+                        ),
+                    },
+                );
+                continue;
+            }
+            out.push(CorrelationEntry {
+                a,
+                b,
+                rho,
+                origin: item.span.origin(path),
+            });
+        }
+        (self.errors.len() == before).then_some(out)
     }
 
     /// `reliability: {tolerance, sided, grid, requirement}`.

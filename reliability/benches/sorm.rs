@@ -1,0 +1,60 @@
+//! Criterion benchmark of FORM + SORM on the 375 cases of the gantry grinder
+//! (`examples/machines/gantry_grinder.yaml`) with non-normal inputs and one
+//! correlation: `dxx` lognormal (mean 0.002, std 0.05/6, shift −0.03), `dyy`
+//! truncated normal on [−0.01, 0.012], and `dxx`–`dyx` correlated 0.5 (Nataf).
+//!
+//! Run with `cargo bench -p reliability --bench sorm`; the figure is recorded
+//! in `docs/performance.md` (part A of issue 15).
+
+use std::hint::black_box;
+use std::path::Path;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use reliability::machine;
+use reliability::sorm::Sorm;
+
+fn gantry() -> (chain_core::Machine, chain_core::CompiledModel) {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/machines/gantry_grinder.yaml");
+    let text = std::fs::read_to_string(&path)
+        .expect("gantry_grinder.yaml")
+        .replace(
+            "  dxx: {dist: normal, mean: 0, std: 0.05/6}",
+            "  dxx: {dist: lognormal, mean: 0.002, std: 0.05/6, shift: -0.03}",
+        )
+        .replace(
+            "  dyy: {dist: normal, mean: 0, std: 0.05/6}",
+            "  dyy: {dist: truncated_normal, mean: 0, std: 0.05/6, min: -0.01, max: 0.012}",
+        );
+    let text = format!("{text}\ncorrelation:\n  - [dxx, dyx, 0.5]\n");
+    let machine = chain_core::load_str(&text, "gantry_nonnormal.yaml").expect("machine");
+    let model = chain_core::compile(&machine);
+    (machine, model)
+}
+
+fn benches(c: &mut Criterion) {
+    let (machine, model) = gantry();
+    let study = machine::study(&machine, &model, &[], None).expect("study");
+    let events = study.events().expect("events");
+    assert_eq!(events.len(), 375);
+    let sorm = Sorm::default();
+    let mut g = c.benchmark_group("sorm");
+    g.throughput(Throughput::Elements(375));
+    g.bench_function("375_cases_nonnormal", |b| {
+        b.iter(|| {
+            for e in &events {
+                let r = sorm.run(e).expect("sorm");
+                assert!(r.converged);
+                black_box(r);
+            }
+        })
+    });
+    g.finish();
+}
+
+criterion_group! {
+    name = group;
+    config = Criterion::default().sample_size(10);
+    targets = benches
+}
+criterion_main!(group);
