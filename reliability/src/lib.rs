@@ -47,6 +47,7 @@
 #![warn(missing_docs)]
 
 pub mod allocate;
+pub mod document;
 pub mod error;
 pub mod form;
 pub mod inputs;
