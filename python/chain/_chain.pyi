@@ -43,6 +43,9 @@ class Model:
     def nominal(
         self, q: npt.NDArray[np.float64], params: Sequence[Tuple[str, float]]
     ) -> npt.NDArray[np.float64]: ...
+    def tape_per_point(
+        self, q: npt.NDArray[np.float64], params: Sequence[Tuple[str, float]]
+    ) -> Tuple[float, float]: ...
     def reliability_json(
         self,
         method: str,

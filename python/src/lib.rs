@@ -351,6 +351,33 @@ impl Model {
         Ok(PyArray1::from_vec(py, out))
     }
 
+    /// The benchmark's reference (python/benches/sensitivity.py): the runtime
+    /// tape's sensitivity at each row of `q`, one point after another on one
+    /// thread into one reused 6×N_err buffer (no output array, no threads).
+    /// Returns the seconds it took and the sum of all entries.
+    #[pyo3(signature = (q, params))]
+    fn tape_per_point<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray2<'py, f64>,
+        params: Vec<(String, f64)>,
+    ) -> PyResult<(f64, f64)> {
+        let p = self.parameter_vector(py, &params)?;
+        let (q, n) = self.points(&q)?;
+        let (v, ne) = (self.model.variables().len(), self.model.errors().len());
+        let model = &self.model;
+        Ok(py.allow_threads(|| {
+            let mut out = vec![0.0; 6 * ne];
+            let mut sum = 0.0;
+            let start = std::time::Instant::now();
+            for i in 0..n {
+                model.sensitivity(&q[i * v..(i + 1) * v], &p, &mut out);
+                sum += out.iter().sum::<f64>();
+            }
+            (start.elapsed().as_secs_f64(), sum)
+        }))
+    }
+
     /// `chain reliability --format json`: the study of the file's
     /// reliability section (`method`: `"form"`, `"is"`, `"mc"`; `samples`
     /// per case, `None` for the method's default; `grid`: axes replacing the
