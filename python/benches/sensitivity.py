@@ -44,7 +44,7 @@ assert abs(S[:1000].sum() - ref_sum) <= 1e-9 * max(1.0, abs(ref_sum))
 M = m.to_sympy()
 symbols = [sympy.Symbol(v) for v in m.variables]
 subs = {sympy.Symbol(k): v for k, v in m.parameters.items()}
-f = sympy.lambdify(symbols, M.subs(subs), modules="numpy")
+f = sympy.lambdify(symbols, M.subs(subs).tolist(), modules="numpy")
 cols = [q[:, i] for i in range(5)]
 chunk = 100_000
 t = time.perf_counter()
