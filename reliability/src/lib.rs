@@ -49,6 +49,7 @@
 pub mod acceptance;
 pub mod allocate;
 pub mod directional;
+pub mod document;
 pub mod error;
 mod families;
 pub mod form;
@@ -63,9 +64,9 @@ pub mod posterior;
 pub mod rng;
 pub mod sensitivity;
 pub mod simulation;
-mod standard;
 pub mod sobol;
 pub mod sorm;
+mod standard;
 pub mod study;
 pub mod subset;
 mod util;

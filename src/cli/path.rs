@@ -19,6 +19,7 @@ use std::path::{Path, PathBuf};
 
 use chain_core::inverse::{Inverse, Status};
 use chain_core::model::{Machine, Sided};
+use reliability::document::RequirementDocument;
 use reliability::{
     machine, Calls, Extreme, FormCase, InstantResult, Method, PathInstant, PathResult, PathStudy,
     Quantity, Target,
@@ -30,7 +31,7 @@ use super::csv_input::{numeric_rows, open_csv, read_poses};
 use super::inverse::solve_rows;
 use super::reliability::{
     calls_text, note_form_limits, parse_assignment, requirement_text, resolve_fixed, sided_title,
-    system_of, warn_unconverged, Loaded, MethodArg, Pairs, RequirementDoc,
+    system_of, warn_unconverged, Loaded, MethodArg, Pairs,
 };
 use super::report::{self, Csv, Report};
 
@@ -363,7 +364,7 @@ struct SummaryDoc {
     reliability: Pairs<Target, Option<TargetDoc>>,
     error: Pairs<Quantity, Option<ErrorDoc>>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    requirement: Option<RequirementDoc>,
+    requirement: Option<RequirementDocument>,
     /// How many cases FORM solved and how (FORM and the importance sampling).
     #[serde(skip_serializing_if = "Option::is_none")]
     form: Option<FormSummaryDoc>,
@@ -513,7 +514,7 @@ impl PathDoc {
             singular: r.count(Status::Singular),
             reliability,
             error,
-            requirement: r.study.as_ref().and_then(RequirementDoc::of),
+            requirement: r.study.as_ref().and_then(RequirementDocument::of),
             form,
             calls,
         };

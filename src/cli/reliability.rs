@@ -17,12 +17,13 @@ pub(crate) mod reliability_plot;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use chain_core::model::{Machine, Origin, Sided};
+use chain_core::model::{Machine, Sided};
 use miette::{LabeledSpan, MietteDiagnostic, NamedSource};
+use reliability::document::ReliabilityDocument;
 use reliability::{
-    machine, Algorithm, Calls, DirectionalSimulation, Form, FormCase, ImportanceSampling, Method,
+    machine, Algorithm, DirectionalSimulation, Form, FormCase, ImportanceSampling, Method,
     MonteCarlo, Posterior, PosteriorError, ReliabilityError, Stopping, Study, StudyResult,
-    SubsetLevel, SubsetSimulation, System, Target, Termination,
+    SubsetLevel, SubsetSimulation, System, Termination,
 };
 use serde::Serialize;
 
@@ -257,7 +258,7 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
         None
     };
     let mut doc = ReliabilityDoc::new(&loaded.machine.name, &study, &result);
-    doc.posterior = posterior.as_ref();
+    doc.doc.posterior = posterior.as_ref();
     doc.acceptance = acceptance.as_ref();
     report::emit(&doc, args.format.into())
 }
@@ -410,68 +411,28 @@ impl Loaded {
         Ok((study, model))
     }
 
-    /// A located, rendered diagnostic for a reliability error.
+    /// A located, rendered diagnostic for a reliability error (worded by
+    /// [`reliability::document::describe`]).
     pub(crate) fn report(&self, err: ReliabilityError) -> miette::Report {
-        let file = &self.file;
-        let (message, origin, label, help): (String, Option<&Origin>, &str, String) = match &err {
-            ReliabilityError::MissingStatistic { name, origin } => (
-                format!(
-                    "{file}{}: missing key `statistics.{name}`: error parameter `{name}` has no statistics entry",
-                    at(origin)
-                ),
-                Some(origin),
-                "used here",
-                format!(
-                    "every error needs a distribution for reliability, e.g.\nstatistics:\n  {name}: {{dist: normal, mean: 0, std: 0.01}}"
-                ),
-            ),
-            ReliabilityError::NoReliabilitySection => (
-                format!("{file}: missing key `reliability`: the machine has no reliability section"),
-                None,
-                "",
-                "add, e.g.\nreliability:\n  tolerance: {px: 0.03, py: 0.03, pz: 0.03}\n  sided: upper\n  grid: {x: [0, 500, 1000]}"
-                    .to_string(),
-            ),
-            ReliabilityError::SymbolicParameter { name, origin } => (
-                format!(
-                    "{file}{}: parameter `{name}` is symbolic (null) and has no value",
-                    at(origin)
-                ),
-                Some(origin),
-                "declared without a value",
-                format!("give it one on the command line: --param {name}=VALUE"),
-            ),
-            ReliabilityError::MissingCoordinate(v) => (
-                format!("{file}: the reliability grid has no values for axis variable `{v}` (key `reliability.grid.{v}`)"),
-                None,
-                "",
-                format!("add `{v}: [...]` to reliability.grid, or pass --grid {v}=VALUE"),
-            ),
-            other => (format!("{file}: {other}"), None, "", String::new()),
-        };
-        let mut diag = MietteDiagnostic::new(message);
+        let d = reliability::document::describe(&err, &self.file);
+        let mut diag = MietteDiagnostic::new(d.message);
         if let Some(code) = miette::Diagnostic::code(&err) {
             diag = diag.with_code(code.to_string());
         }
-        if !help.is_empty() {
-            diag = diag.with_help(help);
+        if !d.help.is_empty() {
+            diag = diag.with_help(d.help);
         }
-        if let Some(o) = origin.filter(|o| o.line > 0 && o.offset <= self.source.len()) {
+        if let Some(o) = d
+            .origin
+            .filter(|o| o.line > 0 && o.offset <= self.source.len())
+        {
             let len = o.len.min(self.source.len() - o.offset);
-            diag = diag.with_label(LabeledSpan::at(o.offset..o.offset + len, label));
+            diag = diag.with_label(LabeledSpan::at(o.offset..o.offset + len, d.label));
             return miette::Report::new(diag).with_source_code(
-                NamedSource::new(file.clone(), self.source.clone()).with_language("yaml"),
+                NamedSource::new(self.file.clone(), self.source.clone()).with_language("yaml"),
             );
         }
         miette::Report::new(diag)
-    }
-}
-
-fn at(origin: &Origin) -> String {
-    if origin.line > 0 {
-        format!(":{}:{}", origin.line, origin.column)
-    } else {
-        String::new()
     }
 }
 
@@ -573,19 +534,12 @@ pub(crate) fn axes(study: &Study) -> Vec<(String, usize)> {
         .collect()
 }
 
-/// The document of `chain reliability` (the spec's JSON; its table and CSV).
+/// The document of `chain reliability`: the library's
+/// [`ReliabilityDocument`] (the spec's JSON) with its table and CSV.
 #[derive(Serialize)]
 pub(crate) struct ReliabilityDoc<'a> {
-    machine: &'a str,
-    method: Method,
-    sided: Sided,
-    results: Vec<CaseDoc<'a>>,
-    summary: Pairs<Target, SummaryDoc>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    requirement: Option<RequirementDoc>,
-    /// The posterior of `--values`, when given.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub(crate) posterior: Option<&'a Posterior>,
+    #[serde(flatten)]
+    pub(crate) doc: ReliabilityDocument<'a>,
     /// The whole-machine acceptance probability (`--acceptance`).
     #[serde(
         skip_serializing_if = "Option::is_none",
@@ -598,122 +552,11 @@ pub(crate) struct ReliabilityDoc<'a> {
     result: &'a StudyResult,
 }
 
-/// One case of [`ReliabilityDoc`].
-#[derive(Serialize)]
-struct CaseDoc<'a> {
-    component: Target,
-    point: Pairs<&'a str, f64>,
-    reliability: f64,
-    pf: f64,
-    /// Infinite for a component the errors do not reach: JSON `null`.
-    beta: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    std_error: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    samples: Option<u64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    cov: Option<f64>,
-    #[serde(flatten)]
-    form: Option<FormCase>,
-    /// The sampler's convergence where FORM's does not occupy the key
-    /// (subset, directional, mc with `--cov`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    converged: Option<bool>,
-    calls: Calls,
-    /// How the sampler stopped (subset, directional, or `--cov`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    sampling: Option<Stopping>,
-    /// Subset simulation's levels.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    levels: Option<&'a [SubsetLevel]>,
-}
-
-/// One target's summary of [`ReliabilityDoc`].
-#[derive(Serialize)]
-struct SummaryDoc {
-    mean: f64,
-    min: f64,
-    max: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    met: Option<bool>,
-}
-
-/// The requirement and whether every target meets it.
-#[derive(Serialize)]
-pub(crate) struct RequirementDoc {
-    min: f64,
-    mean: f64,
-    met: bool,
-}
-
-impl RequirementDoc {
-    /// The requirement of a study result, if it has one.
-    pub(crate) fn of(r: &StudyResult) -> Option<RequirementDoc> {
-        r.requirement.map(|req| RequirementDoc {
-            min: req.min,
-            mean: req.mean,
-            met: r.requirement_met(),
-        })
-    }
-}
-
 impl<'a> ReliabilityDoc<'a> {
     /// The document of a study's result.
     pub(crate) fn new(machine: &'a str, study: &'a Study, r: &'a StudyResult) -> Self {
-        let ax: Vec<(&'a str, usize)> = study
-            .spec()
-            .grid
-            .axes
-            .iter()
-            .filter_map(|(n, _)| {
-                let i = study.variables().iter().position(|v| v == n)?;
-                Some((n.as_str(), i))
-            })
-            .collect();
-        let results = r
-            .cases
-            .iter()
-            .map(|c| CaseDoc {
-                component: c.target,
-                point: Pairs(ax.iter().map(|&(n, i)| (n, c.point[i])).collect()),
-                reliability: c.reliability,
-                pf: c.pf,
-                beta: c.beta,
-                std_error: c.std_error,
-                samples: c.samples,
-                cov: c.cov,
-                form: c.form,
-                converged: match (&c.form, &c.stopping) {
-                    (None, Some(st)) => Some(st.converged),
-                    _ => None,
-                },
-                calls: c.calls,
-                sampling: c.stopping,
-                levels: c.levels.as_deref(),
-            })
-            .collect();
-        let summary = Pairs(
-            r.summaries
-                .iter()
-                .map(|s| {
-                    let doc = SummaryDoc {
-                        mean: s.mean,
-                        min: s.min,
-                        max: s.max,
-                        met: s.met,
-                    };
-                    (s.target, doc)
-                })
-                .collect(),
-        );
         ReliabilityDoc {
-            machine,
-            method: r.method,
-            sided: study.spec().sided,
-            results,
-            summary,
-            requirement: RequirementDoc::of(r),
-            posterior: None,
+            doc: ReliabilityDocument::new(machine, study, r),
             acceptance: None,
             study,
             result: r,
@@ -723,11 +566,11 @@ impl<'a> ReliabilityDoc<'a> {
 
 impl Report for ReliabilityDoc<'_> {
     fn table(&self) -> String {
-        let mut table = to_table(self.machine, self.study, self.result);
+        let mut table = to_table(self.doc.machine, self.study, self.result);
         if let Some(a) = self.acceptance {
             table.push_str(&super::acceptance::table(self.study, a));
         }
-        match self.posterior {
+        match self.doc.posterior {
             None => table,
             Some(p) => format!("{}{table}", posterior_lines(p)),
         }

@@ -1,0 +1,28 @@
+"""chain: exact geometric-error models of machine tools and their machining-accuracy reliability.
+
+The engine is Rust (the ``chain`` crates); arrays go in and out as numpy::
+
+    import chain
+    m = chain.Machine.load("examples/machines/ac_trunnion.yaml")
+    S = m.sensitivity(q)          # q: (N, V) -> (N, 6, N_err), float64
+    r = m.reliability(method="form")
+    r.summary, r.to_dict(), r.to_dataframe()
+
+Every result's ``to_dict()`` is the document the ``chain`` CLI prints with
+``--format json`` for the same input. See docs/python.md.
+"""
+
+from ._chain import MachineError
+from ._machine import Machine, Nominal
+from ._results import Derivation, ReliabilityResult, Result
+
+__all__ = [
+    "Derivation",
+    "Machine",
+    "MachineError",
+    "Nominal",
+    "ReliabilityResult",
+    "Result",
+]
+
+__version__ = "0.1.0"

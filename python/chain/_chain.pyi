@@ -1,0 +1,57 @@
+"""Type stubs of the compiled core ``chain._chain`` (python/src/lib.rs)."""
+
+from typing import List, Optional, Sequence, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+class MachineError(ValueError):
+    """A problem in a machine file: the CLI's message, located."""
+
+    message: str
+    file: str
+    line: int
+    column: int
+    key: str
+    errors: List[str]
+
+class Model:
+    @staticmethod
+    def load(path: str) -> "Model": ...
+    @staticmethod
+    def from_yaml(text: str, file: str) -> "Model": ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def file(self) -> str: ...
+    @property
+    def variables(self) -> List[str]: ...
+    @property
+    def parameters(self) -> List[Tuple[str, Optional[float]]]: ...
+    @property
+    def errors(self) -> List[str]: ...
+    def derive_json(self, frame: Optional[str] = None) -> str: ...
+    def sensitivity(
+        self, q: npt.NDArray[np.float64], params: Sequence[Tuple[str, float]]
+    ) -> npt.NDArray[np.float64]: ...
+    def error(
+        self,
+        q: npt.NDArray[np.float64],
+        e: npt.NDArray[np.float64],
+        params: Sequence[Tuple[str, float]],
+    ) -> npt.NDArray[np.float64]: ...
+    def nominal(
+        self, q: npt.NDArray[np.float64], params: Sequence[Tuple[str, float]]
+    ) -> npt.NDArray[np.float64]: ...
+    def tape_per_point(
+        self, q: npt.NDArray[np.float64], params: Sequence[Tuple[str, float]]
+    ) -> Tuple[float, float]: ...
+    def reliability_json(
+        self,
+        method: str,
+        samples: Optional[int],
+        seed: int,
+        grid: Sequence[Tuple[str, Sequence[float]]],
+        params: Sequence[Tuple[str, float]],
+        sided: Optional[str],
+    ) -> str: ...

@@ -1,0 +1,109 @@
+"""Result objects: a CLI JSON document with attributes, ``to_dict()`` and ``to_dataframe()``.
+
+Every result wraps the document the CLI prints with ``--format json`` for the
+same input (``to_dict()`` returns it, a fresh copy each call). Its top-level
+keys are attributes (``result.summary``, ``result.method``). A new result type
+is a subclass naming its command and, where it has rows, the rows of its
+data frame: see ``ReliabilityResult``.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+from typing import Any, Dict, Iterator, List
+
+
+class Result:
+    """A result document of one ``chain`` command (``command`` names it)."""
+
+    command: str = ""
+
+    def __init__(self, document: Dict[str, Any]) -> None:
+        self._document = document
+
+    @classmethod
+    def _from_json(cls, text: str) -> "Result":
+        return cls(json.loads(text))
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The document as the CLI's JSON gives it (``json.loads`` of ``--format json``)."""
+        return copy.deepcopy(self._document)
+
+    def keys(self) -> List[str]:
+        """The document's top-level keys (each is also an attribute)."""
+        return list(self._document)
+
+    def __getattr__(self, name: str) -> Any:
+        document = self.__dict__.get("_document")
+        if document is not None and name in document:
+            return document[name]
+        raise AttributeError(f"{type(self).__name__} has no attribute {name!r} (keys: {', '.join(document or [])})")
+
+    def __getitem__(self, key: str) -> Any:
+        return self._document[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._document)
+
+    def __dir__(self) -> List[str]:
+        return sorted(set(super().__dir__()) | set(self._document))
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} of `chain {self.command}`: {', '.join(self._document)}>"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        raise TypeError(f"{type(self).__name__} has no tabular form")
+
+    def to_dataframe(self) -> Any:
+        """The result's rows as a pandas DataFrame (pandas must be installed)."""
+        try:
+            import pandas
+        except ImportError as e:  # pragma: no cover - depends on the environment
+            raise ImportError("to_dataframe() needs pandas: pip install pandas") from e
+        return pandas.DataFrame(self._rows())
+
+
+class Derivation(Result):
+    """``chain derive --format json``: the exact first-order model.
+
+    Rows of ``to_dataframe()``: one per non-zero coefficient (component,
+    error, expression).
+    """
+
+    command = "derive"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        rows = []
+        for component, entries in self._document["components"].items():
+            for error, expression in entries.items():
+                rows.append({"component": component, "error": error, "coefficient": expression})
+        return rows
+
+
+class ReliabilityResult(Result):
+    """``chain reliability --format json``: reliability of each target over the grid.
+
+    Attributes: ``machine``, ``method``, ``sided``, ``results`` (one dict per
+    case), ``summary`` (per target: mean, min, max, met), ``requirement``
+    when the file sets one. Rows of ``to_dataframe()``: one per case, the
+    grid coordinates as columns.
+    """
+
+    command = "reliability"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        rows = []
+        for case in self._document["results"]:
+            row = {"component": case["component"]}
+            row.update(case["point"])
+            for key, value in case.items():
+                if key in ("component", "point"):
+                    continue
+                if isinstance(value, dict):
+                    for k, v in value.items():
+                        row[f"{key}_{k}"] = v
+                else:
+                    row[key] = value
+            rows.append(row)
+        return rows

@@ -1,0 +1,485 @@
+//! `chain._chain`: the compiled core of the `chain` Python package.
+//!
+//! A thin layer over the libraries (`chain_core`, `reliability`, the `chain`
+//! facade): [`Model`] holds a loaded machine and its compiled tape; the batch
+//! evaluations ([`Model::sensitivity`], [`Model::error`], [`Model::nominal`])
+//! take C-contiguous float64 arrays and run over all cores with the GIL
+//! released; every other capability returns its result document as JSON
+//! text, the document the CLI prints for the same input (`json.loads` on the
+//! Python side). Adding a capability is one method here returning
+//! `PyResult<String>` from the library's document, plus its Python method
+//! and stub entry (`python/chain/`).
+//!
+//! Nothing panics on bad input: shapes, non-finite values and names are
+//! checked before any evaluation and refused with `ValueError`; machine-file
+//! problems raise `MachineError` (a `ValueError`) with `file`, `line`,
+//! `column` and `key`.
+
+use chain_core::model::{Machine, Origin};
+use chain_core::{CompiledModel, Diagnostics, ErrorModel};
+use numpy::{PyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use rayon::prelude::*;
+use reliability::document::{describe, ReliabilityDocument};
+use reliability::{Algorithm, Form, ImportanceSampling, MonteCarlo, ReliabilityError, Study};
+
+create_exception!(
+    _chain,
+    MachineError,
+    PyValueError,
+    "A problem in a machine file (or a value given for it): `file`, `line`, `column` (0 when not located) and `key`."
+);
+
+/// Points per parallel block of the batch evaluations.
+const BLOCK: usize = 1024;
+
+/// A `MachineError` with its location attributes set.
+fn machine_error(
+    py: Python<'_>,
+    message: String,
+    file: &str,
+    origin: Option<&Origin>,
+    errors: Vec<String>,
+) -> PyErr {
+    let err = MachineError::new_err(message.clone());
+    let value = err.value(py);
+    let (line, column, key) =
+        origin.map_or((0, 0, String::new()), |o| (o.line, o.column, o.key.clone()));
+    let set = || -> PyResult<()> {
+        value.setattr("message", message)?;
+        value.setattr("file", file)?;
+        value.setattr("line", line)?;
+        value.setattr("column", column)?;
+        value.setattr("key", key)?;
+        value.setattr("errors", errors)?;
+        Ok(())
+    };
+    match set() {
+        Ok(()) => err,
+        Err(e) => e,
+    }
+}
+
+/// The loader's diagnostics as a `MachineError`: the CLI's message (the
+/// first error, and how many more), located at the first error.
+fn load_error(py: Python<'_>, d: &Diagnostics) -> PyErr {
+    let first = d.first();
+    let all = d.iter().map(|e| e.to_string()).collect();
+    machine_error(py, d.to_string(), d.file(), Some(&first.origin), all)
+}
+
+/// A reliability error as a `MachineError`, worded as the CLI words it.
+fn study_error(py: Python<'_>, err: &ReliabilityError, file: &str) -> PyErr {
+    let d = describe(err, file);
+    let origin = d.origin.filter(|o| o.line > 0);
+    let mut message = d.message.clone();
+    if !d.help.is_empty() {
+        message = format!("{message}\nhelp: {}", d.help);
+    }
+    machine_error(py, message, file, origin, vec![d.message])
+}
+
+fn value_error(message: impl Into<String>) -> PyErr {
+    PyValueError::new_err(message.into())
+}
+
+/// The serialised document (non-finite numbers become `null`, as in the CLI).
+fn to_json<T: serde::Serialize>(doc: &T) -> PyResult<String> {
+    serde_json::to_string(doc).map_err(|e| value_error(format!("cannot serialise the result: {e}")))
+}
+
+/// Refuses the first non-finite value of `values` (`what` names the array).
+fn check_finite(values: &[f64], width: usize, what: &str) -> PyResult<()> {
+    let bad = values.par_iter().position_first(|v| !v.is_finite());
+    match bad {
+        None => Ok(()),
+        Some(i) if width > 0 => Err(value_error(format!(
+            "{what} has a non-finite value ({}) at row {}, column {}",
+            values[i],
+            i / width,
+            i % width
+        ))),
+        Some(i) => Err(value_error(format!(
+            "{what} has a non-finite value ({}) at index {i}",
+            values[i]
+        ))),
+    }
+}
+
+/// A loaded machine file and its compiled error model.
+#[pyclass(module = "chain._chain", frozen)]
+struct Model {
+    machine: Machine,
+    model: CompiledModel,
+    /// The file name diagnostics name.
+    file: String,
+}
+
+impl Model {
+    fn new(machine: Machine, file: String) -> Model {
+        let model = chain_core::compile(&machine);
+        Model {
+            machine,
+            model,
+            file,
+        }
+    }
+
+    /// The parameter values: the file's, overridden by `overrides`; every
+    /// symbolic parameter needs one.
+    fn parameter_vector(&self, py: Python<'_>, overrides: &[(String, f64)]) -> PyResult<Vec<f64>> {
+        for (name, v) in overrides {
+            if !v.is_finite() {
+                return Err(value_error(format!(
+                    "parameter `{name}` = {v} is not finite"
+                )));
+            }
+        }
+        reliability::machine::parameters(&self.machine, overrides)
+            .map_err(|e| study_error(py, &e, &self.file))
+    }
+
+    /// The points of `q` (rows of `V` values) as a flat slice and their count.
+    fn points<'a>(&self, q: &'a PyReadonlyArray2<'_, f64>) -> PyResult<(&'a [f64], usize)> {
+        let v = self.model.variables().len();
+        let shape = q.shape();
+        if shape[1] != v {
+            return Err(value_error(format!(
+                "q must have {v} values per point (the variables {}), found {}",
+                self.model.variables().join(", "),
+                shape[1]
+            )));
+        }
+        let flat = q
+            .as_slice()
+            .map_err(|_| value_error("q must be a C-contiguous float64 array"))?;
+        check_finite(flat, v, "q")?;
+        Ok((flat, shape[0]))
+    }
+}
+
+#[pymethods]
+impl Model {
+    /// Loads a machine file.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: &str) -> PyResult<Model> {
+        let machine =
+            chain_core::load_file(std::path::Path::new(path)).map_err(|d| load_error(py, &d))?;
+        let file = machine.file.clone().unwrap_or_else(|| path.to_string());
+        Ok(Model::new(machine, file))
+    }
+
+    /// Loads a machine from YAML text (`file` names it in diagnostics).
+    #[staticmethod]
+    fn from_yaml(py: Python<'_>, text: &str, file: &str) -> PyResult<Model> {
+        let machine = chain_core::load_str(text, file).map_err(|d| load_error(py, &d))?;
+        Ok(Model::new(machine, file.to_string()))
+    }
+
+    /// The machine's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.machine.name.clone()
+    }
+
+    /// The file name diagnostics use.
+    #[getter]
+    fn file(&self) -> String {
+        self.file.clone()
+    }
+
+    /// The axis variables, in model order.
+    #[getter]
+    fn variables(&self) -> Vec<String> {
+        self.model
+            .variables()
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    }
+
+    /// The parameters and their file values (`None`: symbolic).
+    #[getter]
+    fn parameters(&self) -> Vec<(String, Option<f64>)> {
+        self.model
+            .parameters()
+            .iter()
+            .zip(self.model.parameter_values())
+            .map(|(n, v)| (n.to_string(), *v))
+            .collect()
+    }
+
+    /// The error parameters, in model order.
+    #[getter]
+    fn errors(&self) -> Vec<String> {
+        self.model.errors().iter().map(|s| s.to_string()).collect()
+    }
+
+    /// `chain derive --format json` (frame: `None` for the file's, or
+    /// `"tool"` / `"workpiece"`).
+    #[pyo3(signature = (frame=None))]
+    fn derive_json(&self, frame: Option<&str>) -> PyResult<String> {
+        use chain_core::model::Frame;
+        let frame = match frame {
+            None => self.machine.frame,
+            Some("tool") => Frame::Tool,
+            Some("workpiece") => Frame::Workpiece,
+            Some(other) => {
+                return Err(value_error(format!(
+                    "frame must be \"tool\" or \"workpiece\", not {other:?}"
+                )))
+            }
+        };
+        let model = chain_core::derive_in(&self.machine, frame);
+        to_json(&chain_core::export::to_json(&model))
+    }
+
+    /// The sensitivity `∂E/∂e` at each row of `q` (`(N, V)`): a flat
+    /// `N·6·N_err` array (row-major `(N, 6, N_err)`), computed in parallel
+    /// blocks with the GIL released.
+    #[pyo3(signature = (q, params))]
+    fn sensitivity<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray2<'py, f64>,
+        params: Vec<(String, f64)>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let p = self.parameter_vector(py, &params)?;
+        let (q, n) = self.points(&q)?;
+        let (v, ne) = (self.model.variables().len(), self.model.errors().len());
+        let width = 6 * ne;
+        let model = &self.model;
+        let out = py.allow_threads(|| {
+            let mut out = vec![0.0; n * width];
+            if width > 0 {
+                out.par_chunks_mut(width * BLOCK)
+                    .enumerate()
+                    .for_each(|(b, chunk)| {
+                        for (k, row) in chunk.chunks_mut(width).enumerate() {
+                            let i = b * BLOCK + k;
+                            model.sensitivity(&q[i * v..(i + 1) * v], &p, row);
+                        }
+                    });
+            }
+            out
+        });
+        Ok(PyArray1::from_vec(py, out))
+    }
+
+    /// The error `E = S·e` at each row of `q` (`(N, V)`) with the errors of
+    /// the matching row of `e` (`(N, N_err)`, or `(1, N_err)` for all rows):
+    /// a flat `N·6` array, in parallel with the GIL released.
+    #[pyo3(signature = (q, e, params))]
+    fn error<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray2<'py, f64>,
+        e: PyReadonlyArray2<'py, f64>,
+        params: Vec<(String, f64)>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let p = self.parameter_vector(py, &params)?;
+        let (q, n) = self.points(&q)?;
+        let (v, ne) = (self.model.variables().len(), self.model.errors().len());
+        let shape = e.shape();
+        if shape[1] != ne {
+            return Err(value_error(format!(
+                "e must have {ne} values per point (the errors of the model), found {}",
+                shape[1]
+            )));
+        }
+        if shape[0] != n && shape[0] != 1 {
+            return Err(value_error(format!(
+                "e has {} rows for {n} points of q (give one row, or one per point)",
+                shape[0]
+            )));
+        }
+        let e_rows = shape[0];
+        let e = e
+            .as_slice()
+            .map_err(|_| value_error("e must be a C-contiguous float64 array"))?;
+        check_finite(e, ne, "e")?;
+        let model = &self.model;
+        let out = py.allow_threads(|| {
+            let mut out = vec![0.0; n * 6];
+            out.par_chunks_mut(6 * BLOCK)
+                .enumerate()
+                .for_each(|(b, chunk)| {
+                    let mut r = [0.0; 6];
+                    for (k, row) in chunk.chunks_mut(6).enumerate() {
+                        let i = b * BLOCK + k;
+                        let j = if e_rows == 1 { 0 } else { i };
+                        model.error(&q[i * v..(i + 1) * v], &p, &e[j * ne..(j + 1) * ne], &mut r);
+                        row.copy_from_slice(&r);
+                    }
+                });
+            out
+        });
+        Ok(PyArray1::from_vec(py, out))
+    }
+
+    /// The nominal pose at each row of `q`: a flat `N·12` array, per point
+    /// the rotation (row-major 3×3) then the position.
+    #[pyo3(signature = (q, params))]
+    fn nominal<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray2<'py, f64>,
+        params: Vec<(String, f64)>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let p = self.parameter_vector(py, &params)?;
+        let (q, n) = self.points(&q)?;
+        let v = self.model.variables().len();
+        let model = &self.model;
+        let out = py.allow_threads(|| {
+            let mut out = vec![0.0; n * 12];
+            out.par_chunks_mut(12 * BLOCK)
+                .enumerate()
+                .for_each(|(b, chunk)| {
+                    for (k, row) in chunk.chunks_mut(12).enumerate() {
+                        let i = b * BLOCK + k;
+                        let pose = model.nominal(&q[i * v..(i + 1) * v], &p);
+                        for r in 0..3 {
+                            row[3 * r..3 * r + 3].copy_from_slice(&pose.rotation[r]);
+                        }
+                        row[9..12].copy_from_slice(&pose.position);
+                    }
+                });
+            out
+        });
+        Ok(PyArray1::from_vec(py, out))
+    }
+
+    /// The benchmark's reference (python/benches/sensitivity.py): the runtime
+    /// tape's sensitivity at each row of `q`, one point after another on one
+    /// thread into one reused 6×N_err buffer (no output array, no threads).
+    /// Returns the seconds it took and the sum of all entries.
+    #[pyo3(signature = (q, params))]
+    fn tape_per_point<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray2<'py, f64>,
+        params: Vec<(String, f64)>,
+    ) -> PyResult<(f64, f64)> {
+        let p = self.parameter_vector(py, &params)?;
+        let (q, n) = self.points(&q)?;
+        let (v, ne) = (self.model.variables().len(), self.model.errors().len());
+        let model = &self.model;
+        Ok(py.allow_threads(|| {
+            let mut out = vec![0.0; 6 * ne];
+            let mut sum = 0.0;
+            let start = std::time::Instant::now();
+            for i in 0..n {
+                model.sensitivity(&q[i * v..(i + 1) * v], &p, &mut out);
+                sum += out.iter().sum::<f64>();
+            }
+            (start.elapsed().as_secs_f64(), sum)
+        }))
+    }
+
+    /// `chain reliability --format json`: the study of the file's
+    /// reliability section (`method`: `"form"`, `"is"`, `"mc"`; `samples`
+    /// per case, `None` for the method's default; `grid`: axes replacing the
+    /// file's; `sided`: `None`, `"upper"` or `"two"`).
+    #[pyo3(signature = (method, samples, seed, grid, params, sided))]
+    #[allow(clippy::too_many_arguments)]
+    fn reliability_json(
+        &self,
+        py: Python<'_>,
+        method: &str,
+        samples: Option<u64>,
+        seed: u64,
+        grid: Vec<(String, Vec<f64>)>,
+        params: Vec<(String, f64)>,
+        sided: Option<&str>,
+    ) -> PyResult<String> {
+        let algorithm = match method {
+            "form" => Algorithm::Form(Form::default()),
+            "is" => Algorithm::ImportanceSampling(ImportanceSampling {
+                samples: samples.unwrap_or(10_000),
+                seed,
+                form: Form::default(),
+            }),
+            "mc" => Algorithm::MonteCarlo(MonteCarlo {
+                samples: samples.unwrap_or(100_000),
+                seed,
+            }),
+            other => {
+                return Err(value_error(format!(
+                    "method must be \"form\", \"is\" or \"mc\", not {other:?}"
+                )))
+            }
+        };
+        if samples == Some(0) && method != "form" {
+            return Err(value_error("samples must be at least 1"));
+        }
+        let study = self.study(py, &grid, &params, sided)?;
+        let result = py
+            .allow_threads(|| study.run(&algorithm, &|_| {}))
+            .map_err(|e| study_error(py, &e, &self.file))?;
+        to_json(&ReliabilityDocument::new(
+            &self.machine.name,
+            &study,
+            &result,
+        ))
+    }
+}
+
+impl Model {
+    /// The study of the reliability section, as `chain reliability` builds it.
+    fn study(
+        &self,
+        py: Python<'_>,
+        grid: &[(String, Vec<f64>)],
+        params: &[(String, f64)],
+        sided: Option<&str>,
+    ) -> PyResult<Study> {
+        use chain_core::model::Sided;
+        let m = &self.machine;
+        let err = |e: ReliabilityError| study_error(py, &e, &self.file);
+        let mut spec = reliability::machine::spec(m, None).map_err(err)?;
+        match sided {
+            None => {}
+            Some("upper") => spec.sided = Sided::Upper,
+            Some("two") => spec.sided = Sided::Two,
+            Some(other) => {
+                return Err(value_error(format!(
+                    "sided must be \"upper\" or \"two\", not {other:?}"
+                )))
+            }
+        }
+        for (name, values) in grid {
+            if m.variable_index(name).is_none() {
+                return Err(err(ReliabilityError::unknown(
+                    "axis variable",
+                    name,
+                    m.variables.iter().map(|v| v.name.as_str()),
+                )));
+            }
+            if values.is_empty() {
+                return Err(value_error(format!("grid axis `{name}` has no value")));
+            }
+            if let Some(x) = values.iter().find(|x| !x.is_finite()) {
+                return Err(value_error(format!(
+                    "grid axis `{name}` has a non-finite value ({x})"
+                )));
+            }
+            match spec.grid.axes.iter_mut().find(|(n, _)| n == name) {
+                Some(axis) => axis.1 = values.clone(),
+                None => spec.grid.axes.push((name.clone(), values.clone())),
+            }
+        }
+        let inputs = reliability::machine::inputs(m).map_err(err)?;
+        let values = self.parameter_vector(py, params)?;
+        Study::new(&self.model, &values, inputs, spec).map_err(err)
+    }
+}
+
+/// The compiled core of the `chain` package.
+#[pymodule]
+fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Model>()?;
+    m.add("MachineError", m.py().get_type::<MachineError>())?;
+    Ok(())
+}

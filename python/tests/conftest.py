@@ -1,0 +1,46 @@
+"""Shared fixtures: the repository, the example machines and the CLI binary."""
+
+import json
+import os
+import pathlib
+import subprocess
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+MACHINES = sorted((ROOT / "examples" / "machines").glob("*.yaml"))
+
+
+def cli_binary() -> pathlib.Path:
+    """The release `chain` binary (built by test.sh's cargo test; built here if absent)."""
+    exe = pathlib.Path(os.environ.get("CHAIN_CLI", ROOT / "target" / "release" / "chain"))
+    if not exe.exists():
+        subprocess.run(["cargo", "build", "--release", "--quiet"], cwd=ROOT, check=True)
+    return exe
+
+
+@pytest.fixture(scope="session")
+def cli():
+    """Runs `chain ARGS --format json` from the repository root and returns the parsed JSON."""
+    exe = cli_binary()
+
+    def run(*args):
+        out = subprocess.run([str(exe), *map(str, args), "--format", "json"], cwd=ROOT,
+                             check=True, capture_output=True, text=True)
+        return json.loads(out.stdout)
+
+    return run
+
+
+@pytest.fixture(scope="session")
+def cli_error():
+    """Runs `chain ARGS` expecting failure; returns its stderr."""
+    exe = cli_binary()
+
+    def run(*args):
+        out = subprocess.run([str(exe), *map(str, args)], cwd=ROOT, capture_output=True, text=True,
+                             env={**os.environ, "NO_COLOR": "1"})
+        assert out.returncode != 0
+        return out.stderr
+
+    return run
