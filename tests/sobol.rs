@@ -509,7 +509,7 @@ fn uniform_inputs_follow_the_closed_form() {
     }
     .run(
         &uniform,
-        &[rows.clone()],
+        std::slice::from_ref(&rows),
         &[Target::Component(Component::Px)],
     )
     .unwrap();

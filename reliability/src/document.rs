@@ -15,7 +15,7 @@ use chain_core::named::NameMap;
 use serde::Serialize;
 
 use crate::{
-    Calls, FormCase, Method, Posterior, ReliabilityError, Stopping, Study, StudyResult,
+    Calls, FormCase, Method, Posterior, ReliabilityError, SormCase, Stopping, Study, StudyResult,
     SubsetLevel, Target,
 };
 
@@ -77,6 +77,9 @@ pub struct CaseDocument<'a> {
     /// Subset simulation's levels.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub levels: Option<&'a [SubsetLevel]>,
+    /// SORM's three formulas and curvatures (`--method sorm`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sorm: Option<&'a SormCase>,
 }
 
 /// One target's summary of a [`ReliabilityDocument`].
@@ -149,6 +152,7 @@ impl<'a> ReliabilityDocument<'a> {
                 calls: c.calls,
                 sampling: c.stopping,
                 levels: c.levels.as_deref(),
+                sorm: c.sorm.as_ref(),
             })
             .collect();
         let summary = NameMap(

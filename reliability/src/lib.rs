@@ -91,6 +91,7 @@ pub use simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult,
 pub use sobol::{Sobol, SobolError, SobolResult};
 pub use study::{
     Algorithm, CaseResult, ErrorMoments, ErrorSensitivity, FormCase, FormLimit, Grid, Method,
-    Study, StudyResult, StudySpec, Summary, System, Target, TargetSensitivity, VolumetricMoments,
+    SormCase, Study, StudyResult, StudySpec, Summary, System, Target, TargetSensitivity,
+    VolumetricMoments,
 };
 pub use subset::{SubsetLevel, SubsetResult, SubsetSimulation};

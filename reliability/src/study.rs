@@ -26,6 +26,7 @@ use crate::normal;
 use crate::par::prelude::*;
 use crate::sensitivity::{sensitivity, SensitivityMethod, SensitivityResult};
 use crate::simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult, Stopping};
+use crate::sorm::{Sorm, SormResult};
 use crate::subset::{SubsetLevel, SubsetSimulation};
 
 /// The axis values to evaluate: the cartesian product of the axes, first axis
@@ -161,6 +162,10 @@ pub enum Method {
     /// Directional simulation ([`crate::directional`]).
     #[serde(rename = "directional")]
     Directional,
+    /// SORM ([`crate::sorm`]): FORM's design point and the exact
+    /// curvatures; the answer is Tvedt's.
+    #[serde(rename = "sorm")]
+    Sorm,
 }
 
 impl Method {
@@ -172,6 +177,7 @@ impl Method {
             Method::MonteCarlo => "mc",
             Method::Subset => "subset",
             Method::Directional => "directional",
+            Method::Sorm => "sorm",
         }
     }
 
@@ -183,6 +189,7 @@ impl Method {
             Method::MonteCarlo => "Monte Carlo",
             Method::Subset => "subset simulation",
             Method::Directional => "directional simulation",
+            Method::Sorm => "SORM (Tvedt)",
         }
     }
 }
@@ -212,6 +219,8 @@ pub enum Algorithm {
     Subset(SubsetSimulation),
     /// Directional simulation ([`crate::directional`]).
     Directional(DirectionalSimulation),
+    /// SORM ([`crate::sorm`]).
+    Sorm(Sorm),
 }
 
 impl Algorithm {
@@ -224,6 +233,7 @@ impl Algorithm {
             Algorithm::ImportanceSamplingToCov(..) => Method::ImportanceSampling,
             Algorithm::Subset(_) => Method::Subset,
             Algorithm::Directional(_) => Method::Directional,
+            Algorithm::Sorm(_) => Method::Sorm,
         }
     }
 }
@@ -327,6 +337,44 @@ pub struct CaseResult {
     /// Subset simulation's levels (of its first run).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub levels: Option<Vec<SubsetLevel>>,
+    /// SORM's account of the case (`--method sorm`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sorm: Option<SormCase>,
+}
+
+/// SORM's account of one case: the three asymptotic formulas and the
+/// nearest branch's curvatures ([`crate::sorm::SormResult`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SormCase {
+    /// Breitung's generalised index.
+    pub beta_breitung: f64,
+    /// Hohenbichler–Rackwitz's generalised index.
+    pub beta_hohenbichler_rackwitz: f64,
+    /// Tvedt's generalised index (the case's `beta`).
+    pub beta_tvedt: f64,
+    /// Breitung's `p_f`.
+    pub pf_breitung: f64,
+    /// Hohenbichler–Rackwitz's `p_f`.
+    pub pf_hohenbichler_rackwitz: f64,
+    /// The nearest branch's main curvatures, ascending.
+    pub curvatures: Vec<f64>,
+    /// FORM converged on the nearest branch and every `1 + β·κ_i > 0`.
+    pub converged: bool,
+}
+
+impl SormCase {
+    /// The account of a SORM result.
+    pub fn of(r: &SormResult) -> SormCase {
+        SormCase {
+            beta_breitung: r.beta_breitung,
+            beta_hohenbichler_rackwitz: r.beta_hohenbichler_rackwitz,
+            beta_tvedt: r.beta_tvedt,
+            pf_breitung: r.pf_breitung,
+            pf_hohenbichler_rackwitz: r.pf_hohenbichler_rackwitz,
+            curvatures: r.curvatures.clone(),
+            converged: r.converged,
+        }
+    }
 }
 
 impl CaseResult {
@@ -334,7 +382,9 @@ impl CaseResult {
     /// then not a FORM result but the last iterate's), or when its sampler
     /// stopped without meeting its rule ([`CaseResult::stopping`]).
     pub fn converged(&self) -> bool {
-        self.form.is_none_or(|f| f.converged) && self.sampler_converged()
+        self.form.is_none_or(|f| f.converged)
+            && self.sampler_converged()
+            && self.sorm.as_ref().is_none_or(|s| s.converged)
     }
 
     /// False when the sampler stopped without meeting its rule (budget or
@@ -824,6 +874,35 @@ impl Study {
         Ok(self.finish(Method::Form, cases))
     }
 
+    /// SORM on every case: FORM, then the exact curvatures at its design
+    /// point ([`crate::sorm`]); the case's probability is Tvedt's.
+    pub fn sorm(&self, sorm: &Sorm) -> Result<StudyResult, ReliabilityError> {
+        let events = self.events()?;
+        let results: Vec<SormResult> = if events.len() < 64 {
+            events
+                .iter()
+                .map(|e| sorm.run(e))
+                .collect::<Result<_, _>>()?
+        } else {
+            events
+                .par_iter()
+                .map(|e| sorm.run(e))
+                .collect::<Result<_, _>>()?
+        };
+        let cases = results
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let mut c = self.case(i, r.reliability, r.pf, r.beta);
+                c.form = Some(FormCase::of(&r.form));
+                c.calls = r.form.calls;
+                c.sorm = Some(SormCase::of(r));
+                c
+            })
+            .collect();
+        Ok(self.finish(Method::Sorm, cases))
+    }
+
     /// The importance sampling on every case.
     pub fn importance_sampling(
         &self,
@@ -856,6 +935,7 @@ impl Study {
     ) -> Result<StudyResult, ReliabilityError> {
         match algorithm {
             Algorithm::Form(form) => self.form(form),
+            Algorithm::Sorm(sorm) => self.sorm(sorm),
             Algorithm::ImportanceSampling(is) => self.importance_sampling(is, progress),
             Algorithm::MonteCarlo(mc) => self.monte_carlo(mc, progress),
             Algorithm::MonteCarloToCov(mc, cov) => {
@@ -954,6 +1034,7 @@ impl Study {
             calls: Calls::default(),
             stopping: None,
             levels: None,
+            sorm: None,
         }
     }
 

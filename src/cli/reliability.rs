@@ -44,6 +44,10 @@ pub enum MethodArg {
     Subset,
     /// Directional simulation (Bjerager 1988).
     Directional,
+    /// SORM: FORM, then the exact curvatures at its design point;
+    /// Breitung, Hohenbichler–Rackwitz and Tvedt reported, Tvedt's the
+    /// answer.
+    Sorm,
 }
 
 impl MethodArg {
@@ -78,6 +82,7 @@ impl MethodArg {
         }
         match self {
             MethodArg::Form => Algorithm::Form(Form::default()),
+            MethodArg::Sorm => Algorithm::Sorm(reliability::sorm::Sorm::default()),
             MethodArg::Is => Algorithm::ImportanceSampling(ImportanceSampling {
                 samples,
                 seed,
@@ -92,7 +97,7 @@ impl MethodArg {
     /// 10,000, mc: 100,000; 0 for FORM, which draws none).
     pub(crate) fn samples(self, given: Option<u64>, to_cov: bool) -> u64 {
         match (self, to_cov) {
-            (MethodArg::Form, _) => 0,
+            (MethodArg::Form | MethodArg::Sorm, _) => 0,
             (MethodArg::Is, false) => given.unwrap_or(10_000),
             (MethodArg::Mc, false) => given.unwrap_or(100_000),
             (MethodArg::Is, true) => given.unwrap_or(1_000_000),
@@ -124,7 +129,7 @@ pub(crate) fn parse_cov(s: &str) -> Result<f64, String> {
 impl MethodArg {
     /// Whether the method samples (all but FORM).
     pub(crate) fn samples_anything(self) -> bool {
-        self != MethodArg::Form
+        !matches!(self, MethodArg::Form | MethodArg::Sorm)
     }
 }
 
@@ -609,6 +614,20 @@ impl Report for ReliabilityDoc<'_> {
         if leveled {
             header.push("levels".to_string());
         }
+        // SORM's three formulas (`--method sorm`), last.
+        let sorm = r.cases.iter().any(|c| c.sorm.is_some());
+        if sorm {
+            header.extend(
+                [
+                    "beta_breitung",
+                    "beta_hohenbichler_rackwitz",
+                    "beta_tvedt",
+                    "sorm_converged",
+                ]
+                .map(String::from),
+            );
+        }
+        let width = header.len();
         let mut csv = Csv::new(header);
         for c in &r.cases {
             let mut row = vec![c.target.to_string()];
@@ -647,10 +666,28 @@ impl Report for ReliabilityDoc<'_> {
                         .map_or(String::new(), |l| l.len().to_string()),
                 );
             }
+            if sorm {
+                match &c.sorm {
+                    Some(so) => {
+                        row.extend(
+                            [
+                                so.beta_breitung,
+                                so.beta_hohenbichler_rackwitz,
+                                so.beta_tvedt,
+                            ]
+                            .map(|v| format!("{v:?}")),
+                        );
+                        row.push(so.converged.to_string());
+                    }
+                    None => row.extend((0..4).map(|_| String::new())),
+                }
+            }
             csv.row(row);
         }
         if let Some(a) = self.acceptance {
-            csv.row(super::acceptance::csv_row(a, ax.len()));
+            let mut row = super::acceptance::csv_row(a, ax.len());
+            row.resize(width.max(row.len()), String::new());
+            csv.row(row);
         }
         Some(csv)
     }
@@ -856,10 +893,10 @@ pub(crate) fn calls_text<'a>(
         return calls;
     }
     let converged = forms.iter().filter(|f| f.converged).count();
-    let what = if method == Method::Form {
-        "FORM"
-    } else {
-        "FORM (centring)"
+    let what = match method {
+        Method::Form => "FORM",
+        Method::Sorm => "FORM (SORM's design points)",
+        _ => "FORM (centring)",
     };
     format!(
         "{what}: {converged} of {} cases converged ({}); {calls}",
