@@ -816,6 +816,7 @@ pub struct Machine {
     pub reliability: Option<ReliabilitySpec>,
     /// The top-level `correlation` list (`reliability-v2.md` §2): physical
     /// correlations between errors with statistics, in file order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub correlations: Vec<CorrelationEntry>,
 }
 
