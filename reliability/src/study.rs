@@ -878,17 +878,7 @@ impl Study {
     /// point ([`crate::sorm`]); the case's probability is Tvedt's.
     pub fn sorm(&self, sorm: &Sorm) -> Result<StudyResult, ReliabilityError> {
         let events = self.events()?;
-        let results: Vec<SormResult> = if events.len() < 64 {
-            events
-                .iter()
-                .map(|e| sorm.run(e))
-                .collect::<Result<_, _>>()?
-        } else {
-            events
-                .par_iter()
-                .map(|e| sorm.run(e))
-                .collect::<Result<_, _>>()?
-        };
+        let results: Vec<SormResult> = per_event(&events, |e| sorm.run(e))?;
         let cases = results
             .iter()
             .enumerate()
@@ -991,11 +981,7 @@ impl Study {
         events: &[Event<'_>],
         form: &Form,
     ) -> Result<Vec<FormResult>, ReliabilityError> {
-        if events.len() < 64 {
-            events.iter().map(|e| form.run(e)).collect()
-        } else {
-            events.par_iter().map(|e| form.run(e)).collect()
-        }
+        per_event(events, |e| form.run(e))
     }
 
     fn sampled(&self, results: &[SimulationResult]) -> Vec<CaseResult> {
@@ -1242,6 +1228,19 @@ fn grid_points(grid: &Grid, variables: &[String]) -> Result<Vec<Vec<f64>>, Relia
 /// zero-mean normal component with standard deviation `σ_E` (Eq. 21, 31).
 pub fn closed_form_reliability(tolerance: f64, sigma_e: f64) -> f64 {
     normal::cdf(tolerance / sigma_e)
+}
+
+/// `f` on every event: in parallel from 64 events on (below that the
+/// threads cost more than they save); results in event order.
+fn per_event<T: Send>(
+    events: &[Event<'_>],
+    f: impl Fn(&Event<'_>) -> Result<T, ReliabilityError> + Sync + Send,
+) -> Result<Vec<T>, ReliabilityError> {
+    if events.len() < 64 {
+        events.iter().map(f).collect()
+    } else {
+        events.par_iter().map(f).collect()
+    }
 }
 
 #[cfg(test)]
