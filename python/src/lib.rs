@@ -6,9 +6,10 @@
 //! take C-contiguous float64 arrays and run over all cores with the GIL
 //! released; every other capability returns its result document as JSON
 //! text, the document the CLI prints for the same input (`json.loads` on the
-//! Python side). Adding a capability is one method here returning
-//! `PyResult<String>` from the library's document, plus its Python method
-//! and stub entry (`python/chain/`).
+//! Python side). Adding a capability is a `#[pyfunction]` taking
+//! `&Model` and returning `PyResult<String>` from the library's document, in
+//! the module of its group (one file per group of commands, registered in
+//! [`_chain`] below), plus its Python method and stub entry (`python/chain/`).
 //!
 //! Nothing panics on bad input: shapes, non-finite values and names are
 //! checked before any evaluation and refused with `ValueError`; machine-file
@@ -36,7 +37,7 @@ create_exception!(
 const BLOCK: usize = 1024;
 
 /// A `MachineError` with its location attributes set.
-fn machine_error(
+pub(crate) fn machine_error(
     py: Python<'_>,
     message: String,
     file: &str,
@@ -64,14 +65,14 @@ fn machine_error(
 
 /// The loader's diagnostics as a `MachineError`: the CLI's message (the
 /// first error, and how many more), located at the first error.
-fn load_error(py: Python<'_>, d: &Diagnostics) -> PyErr {
+pub(crate) fn load_error(py: Python<'_>, d: &Diagnostics) -> PyErr {
     let first = d.first();
     let all = d.iter().map(|e| e.to_string()).collect();
     machine_error(py, d.to_string(), d.file(), Some(&first.origin), all)
 }
 
 /// A reliability error as a `MachineError`, worded as the CLI words it.
-fn study_error(py: Python<'_>, err: &ReliabilityError, file: &str) -> PyErr {
+pub(crate) fn study_error(py: Python<'_>, err: &ReliabilityError, file: &str) -> PyErr {
     let d = describe(err, file);
     let origin = d.origin.filter(|o| o.line > 0);
     let mut message = d.message.clone();
@@ -81,17 +82,17 @@ fn study_error(py: Python<'_>, err: &ReliabilityError, file: &str) -> PyErr {
     machine_error(py, message, file, origin, vec![d.message])
 }
 
-fn value_error(message: impl Into<String>) -> PyErr {
+pub(crate) fn value_error(message: impl Into<String>) -> PyErr {
     PyValueError::new_err(message.into())
 }
 
 /// The serialised document (non-finite numbers become `null`, as in the CLI).
-fn to_json<T: serde::Serialize>(doc: &T) -> PyResult<String> {
+pub(crate) fn to_json<T: serde::Serialize>(doc: &T) -> PyResult<String> {
     serde_json::to_string(doc).map_err(|e| value_error(format!("cannot serialise the result: {e}")))
 }
 
 /// Refuses the first non-finite value of `values` (`what` names the array).
-fn check_finite(values: &[f64], width: usize, what: &str) -> PyResult<()> {
+pub(crate) fn check_finite(values: &[f64], width: usize, what: &str) -> PyResult<()> {
     let bad = values.par_iter().position_first(|v| !v.is_finite());
     match bad {
         None => Ok(()),
@@ -110,11 +111,11 @@ fn check_finite(values: &[f64], width: usize, what: &str) -> PyResult<()> {
 
 /// A loaded machine file and its compiled error model.
 #[pyclass(module = "chain._chain", frozen)]
-struct Model {
-    machine: Machine,
-    model: CompiledModel,
+pub(crate) struct Model {
+    pub(crate) machine: Machine,
+    pub(crate) model: CompiledModel,
     /// The file name diagnostics name.
-    file: String,
+    pub(crate) file: String,
 }
 
 impl Model {
@@ -129,7 +130,11 @@ impl Model {
 
     /// The parameter values: the file's, overridden by `overrides`; every
     /// symbolic parameter needs one.
-    fn parameter_vector(&self, py: Python<'_>, overrides: &[(String, f64)]) -> PyResult<Vec<f64>> {
+    pub(crate) fn parameter_vector(
+        &self,
+        py: Python<'_>,
+        overrides: &[(String, f64)],
+    ) -> PyResult<Vec<f64>> {
         for (name, v) in overrides {
             if !v.is_finite() {
                 return Err(value_error(format!(
@@ -142,7 +147,10 @@ impl Model {
     }
 
     /// The points of `q` (rows of `V` values) as a flat slice and their count.
-    fn points<'a>(&self, q: &'a PyReadonlyArray2<'_, f64>) -> PyResult<(&'a [f64], usize)> {
+    pub(crate) fn points<'a>(
+        &self,
+        q: &'a PyReadonlyArray2<'_, f64>,
+    ) -> PyResult<(&'a [f64], usize)> {
         let v = self.model.variables().len();
         let shape = q.shape();
         if shape[1] != v {
@@ -428,7 +436,7 @@ impl Model {
 
 impl Model {
     /// The study of the reliability section, as `chain reliability` builds it.
-    fn study(
+    pub(crate) fn study(
         &self,
         py: Python<'_>,
         grid: &[(String, Vec<f64>)],
