@@ -57,6 +57,9 @@ struct Doc<'a> {
     tolerance: Option<f64>,
     constraints: usize,
     rank: usize,
+    /// Levels, CoV and pilot of subset simulation (method `subset` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    subset: Option<&'a reliability::acceptance::AcceptanceSubset>,
 }
 
 #[derive(Serialize)]
@@ -89,6 +92,7 @@ fn doc(a: &AcceptanceResult) -> Doc<'_> {
         tolerance: a.tolerance,
         constraints: a.constraints,
         rank: a.rank,
+        subset: a.subset.as_ref(),
     }
 }
 
@@ -140,6 +144,19 @@ pub(crate) fn table(study: &Study, a: &AcceptanceResult) -> String {
         a.method.title(),
         a.samples
     );
+    if let Some(r) = &a.subset {
+        let _ = writeln!(
+            out,
+            "  {} side by subset simulation: {:.4e}, CoV {:.1} %, {} levels, {} runs (pilot: {} of {} samples on it)",
+            r.side.name(),
+            r.probability,
+            r.cov * 100.0,
+            r.levels.len(),
+            r.runs,
+            r.pilot_events,
+            r.pilot_samples
+        );
+    }
     let stds = study.inputs().stds();
     let mut order: Vec<usize> = (0..a.sensitivity.len()).collect();
     order.sort_by(|&i, &j| {

@@ -82,6 +82,10 @@ use crate::rng::CaseRng;
 use crate::study::Study;
 use crate::util::dot;
 
+mod rare;
+
+pub use rare::{AcceptanceSubset, RareSide};
+
 /// The series system of linear constraints `lower_i ≤ S_i·x ≤ upper_i`
 /// over the inputs (every point × every toleranced component of a study).
 ///
@@ -255,6 +259,23 @@ pub enum AcceptanceMethod {
     /// Crude Monte Carlo, conditional derivatives (other marginals).
     #[serde(rename = "mc")]
     MonteCarlo,
+    /// Subset simulation of the small side (other marginals, when a crude
+    /// Monte Carlo pilot finds fewer than [`RARE_EVENTS`] samples on it);
+    /// the derivatives from the pilot's conditional Monte Carlo.
+    #[serde(rename = "subset")]
+    Subset,
+}
+
+/// How the acceptance probability of non-normal inputs is sampled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sampler {
+    /// Crude Monte Carlo, or subset simulation when the pilot's small side
+    /// has fewer than [`RARE_EVENTS`] samples.
+    Auto,
+    /// Crude Monte Carlo only.
+    MonteCarlo,
+    /// Subset simulation of the smaller side of the pilot, always.
+    Subset,
 }
 
 impl AcceptanceMethod {
@@ -263,6 +284,7 @@ impl AcceptanceMethod {
         match self {
             AcceptanceMethod::GenzQmc => "genz_qmc",
             AcceptanceMethod::MonteCarlo => "mc",
+            AcceptanceMethod::Subset => "subset",
         }
     }
 
@@ -271,6 +293,7 @@ impl AcceptanceMethod {
         match self {
             AcceptanceMethod::GenzQmc => "Genz separation of variables, randomised QMC",
             AcceptanceMethod::MonteCarlo => "Monte Carlo",
+            AcceptanceMethod::Subset => "subset simulation",
         }
     }
 }
@@ -323,6 +346,9 @@ pub struct AcceptanceResult {
     pub pivots: Vec<usize>,
     /// Per input, in input order (empty unless asked for).
     pub sensitivity: Vec<AcceptanceSensitivity>,
+    /// The subset-simulation account (method `subset` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subset: Option<AcceptanceSubset>,
 }
 
 /// Settings of the acceptance probability.
@@ -347,6 +373,15 @@ pub struct Acceptance {
     /// runs at nearby parameters use the same integrand (finite
     /// differences with fixed QMC points).
     pub pivots: Option<Vec<usize>>,
+    /// Crude Monte Carlo or subset simulation for non-normal inputs
+    /// ([`Sampler::Auto`]).
+    pub sampler: Sampler,
+    /// Subset simulation: samples per level (2,000).
+    pub subset_samples: u64,
+    /// Subset simulation: the target coefficient of variation of the small
+    /// side (0.1); runs repeat until it is reached or
+    /// [`Acceptance::max_samples`] are spent.
+    pub rare_cov: f64,
 }
 
 impl Default for Acceptance {
@@ -359,12 +394,25 @@ impl Default for Acceptance {
             seed: 1,
             sensitivity: true,
             pivots: None,
+            sampler: Sampler::Auto,
+            subset_samples: 2000,
+            rare_cov: 0.1,
         }
     }
 }
 
 /// Monte Carlo block size.
 const BLOCK: u64 = 8192;
+/// Blocks of the crude Monte Carlo pilot (16 · 8,192 = 131,072 samples).
+pub const PILOT_BLOCKS: u64 = 16;
+/// Fewer pilot samples than this on the small side (rejected, or accepted
+/// when `P < 1/2`) select subset simulation under [`Sampler::Auto`]: the
+/// pilot's coefficient of variation of that side is then above 10 %
+/// (`√((1 − q)/m)`), the small side below `100/131,072 ≈ 7.6·10⁻⁴`, and crude
+/// Monte Carlo would need `100/q` samples for 10 % (10⁷ at `q = 10⁻⁵`), while
+/// subset simulation at `p0 = 0.1` needs about `N·log₁₀(1/q)` per run
+/// (docs/acceptance.md).
+pub const RARE_EVENTS: u64 = 100;
 /// A residual row this small relative to its row is in the span.
 const SPAN_TOL: f64 = 1e-9;
 
@@ -422,6 +470,7 @@ impl Acceptance {
             rank: r,
             pivots: plan.pivots.clone(),
             sensitivity: Vec::new(),
+            subset: None,
         };
         let names = inputs.names();
         let zero_sens = || {
@@ -547,36 +596,18 @@ impl Acceptance {
         let inputs = &system.inputs;
         let n = inputs.len();
         let k = system.distinct();
-        // How each input's derivatives are estimated.
-        let block: Vec<usize> = (0..n).filter(|&j| inputs.is_correlated(j)).collect();
-        if self.sensitivity {
-            if let Some(&j) = block.iter().find(|&&j| !inputs.marginals()[j].is_normal()) {
-                return Err(ReliabilityError::InvalidOption {
-                    option: "acceptance sensitivity",
-                    message: format!(
-                        "`{}` is correlated and not normal: its acceptance sensitivities are not available",
-                        inputs.names()[j]
-                    ),
-                });
-            }
+        if self.sampler != Sampler::MonteCarlo
+            && !(self.rare_cov.is_finite() && self.rare_cov > 0.0 && self.rare_cov < 1.0)
+        {
+            return Err(ReliabilityError::InvalidOption {
+                option: "acceptance rare_cov",
+                message: format!("must be in (0, 1), found {}", self.rare_cov),
+            });
         }
-        let precision = if self.sensitivity && !block.is_empty() {
-            let kb = block.len();
-            let mut cov = nalgebra::DMatrix::zeros(kb, kb);
-            let mut ea = vec![0.0; n];
-            let mut eb = vec![0.0; n];
-            for (a, &ja) in block.iter().enumerate() {
-                for (b, &jb) in block.iter().enumerate() {
-                    ea.iter_mut().for_each(|v| *v = 0.0);
-                    eb.iter_mut().for_each(|v| *v = 0.0);
-                    ea[ja] = 1.0;
-                    eb[jb] = 1.0;
-                    cov[(a, b)] = inputs.covariance(&ea, &eb);
-                }
-            }
-            Some(cov.try_inverse().ok_or(ReliabilityError::NonFinite(
-                "the inverse of the correlated block",
-            ))?)
+        // The Gaussian copula of the correlated block: z_B = Φ⁻¹(F(x_B)) is
+        // N(0, R₀); given the other z, z_j is N(μ_c, s_c²).
+        let copula = if self.sensitivity {
+            Copula::new(inputs)?
         } else {
             None
         };
@@ -586,9 +617,8 @@ impl Acceptance {
             let mut out = vec![0.0; width];
             let mut x = vec![0.0; n];
             let mut v = vec![0.0; k];
+            let mut z = copula.as_ref().map(|c| vec![0.0; c.members.len()]);
             let mut bad: Vec<usize> = Vec::new();
-            let means = inputs.means();
-            let stds = inputs.stds();
             for _ in 0..BLOCK {
                 inputs.sample(&mut rng, &mut x);
                 bad.clear();
@@ -599,22 +629,23 @@ impl Acceptance {
                         bad.push(i);
                     }
                 }
-                let safe = bad.is_empty();
-                if safe {
+                if bad.is_empty() {
                     out[0] += 1.0;
                 }
                 if !self.sensitivity {
                     continue;
                 }
-                for j in 0..n {
-                    if inputs.is_correlated(j) {
-                        continue;
+                if let (Some(c), Some(z)) = (&copula, z.as_mut()) {
+                    for (zi, &m) in z.iter_mut().zip(&c.members) {
+                        *zi = inputs.marginals()[m].to_standard(x[m]);
                     }
+                }
+                for j in 0..n {
                     let mj = inputs.marginals()[j];
                     if bad.iter().any(|&i| system.row(i).0[j] == 0.0) {
                         continue;
                     }
-                    // The safe interval of x_j given the others.
+                    // The safe interval of x_j given the other inputs.
                     let (mut a, mut bb) = (f64::NEG_INFINITY, f64::INFINITY);
                     for i in 0..k {
                         let (row, lo, hi) = system.row(i);
@@ -631,21 +662,15 @@ impl Acceptance {
                     if a >= bb {
                         continue;
                     }
-                    let (dm_b, ds_b) = cdf_derivatives(&mj, bb);
-                    let (dm_a, ds_a) = cdf_derivatives(&mj, a);
+                    // The law of u_j = Φ⁻¹(F_j(x_j)) given the others.
+                    let (centre, spread) = match (&copula, &z) {
+                        (Some(c), Some(z)) => c.conditional(j, z),
+                        _ => (0.0, 1.0),
+                    };
+                    let (dm_b, ds_b) = cdf_derivatives(&mj, bb, centre, spread);
+                    let (dm_a, ds_a) = cdf_derivatives(&mj, a, centre, spread);
                     out[1 + j] += dm_b - dm_a;
                     out[1 + n + j] += ds_b - ds_a;
-                }
-                if let (Some(prec), true) = (&precision, safe) {
-                    for (a, &ja) in block.iter().enumerate() {
-                        let s: f64 = block
-                            .iter()
-                            .enumerate()
-                            .map(|(b, &jb)| prec[(a, b)] * (x[jb] - means[jb]))
-                            .sum();
-                        out[1 + ja] += s;
-                        out[1 + n + ja] += (s * (x[ja] - means[ja]) - 1.0) / stds[ja];
-                    }
                 }
             }
             out
@@ -656,8 +681,9 @@ impl Acceptance {
         let max_blocks = self.max_samples.div_ceil(BLOCK).max(1);
         let mut batch: u64 = match self.samples {
             Some(s) => s.div_ceil(BLOCK),
-            None => 8,
+            None => PILOT_BLOCKS.min(max_blocks),
         };
+        let mut rare: Option<AcceptanceSubset> = None;
         loop {
             let end = (blocks + batch).min(max_blocks);
             let sums: Vec<Vec<f64>> = (blocks..end).into_par_iter().map(run_block).collect();
@@ -669,18 +695,73 @@ impl Acceptance {
                     acc2[w] += s[w] * s[w] / BLOCK as f64;
                 }
             }
+            let first = blocks == 0;
             blocks = end;
             let total = (blocks * BLOCK) as f64;
             let p = acc[0] / total;
             let se = (p * (1.0 - p) / total).sqrt();
+            if first && self.samples.is_none() && self.sampler != Sampler::MonteCarlo {
+                let accepted = acc[0] as u64;
+                let drawn = blocks * BLOCK;
+                let (side, events) = if 2 * accepted < drawn {
+                    (RareSide::Acceptance, accepted)
+                } else {
+                    (RareSide::Rejection, drawn - accepted)
+                };
+                if self.sampler == Sampler::Subset || events < RARE_EVENTS {
+                    let budget = self
+                        .max_samples
+                        .saturating_sub(drawn)
+                        .max(self.subset_samples);
+                    let (_, _, mut account) = rare::run(
+                        system,
+                        side,
+                        self.subset_samples,
+                        self.rare_cov,
+                        budget,
+                        self.seed,
+                    )?;
+                    account.pilot_samples = drawn;
+                    account.pilot_events = events;
+                    rare = Some(account);
+                    break;
+                }
+            }
             if self.samples.is_some() || 3.0 * se <= self.tolerance || blocks >= max_blocks {
                 break;
             }
             batch = blocks;
         }
         let total = (blocks * BLOCK) as f64;
-        let p = acc[0] / total;
-        let se = (p * (1.0 - p) / total).sqrt();
+        let (p, se, method, samples, converged) = match &rare {
+            None => {
+                let p = acc[0] / total;
+                let se = (p * (1.0 - p) / total).sqrt();
+                let converged = self.samples.is_some() || 3.0 * se <= self.tolerance;
+                (
+                    p,
+                    se,
+                    AcceptanceMethod::MonteCarlo,
+                    blocks * BLOCK,
+                    converged,
+                )
+            }
+            Some(s) => {
+                let p = match s.side {
+                    RareSide::Rejection => 1.0 - s.probability,
+                    RareSide::Acceptance => s.probability,
+                };
+                let se = s.probability * s.cov;
+                let converged = s.stopping.converged && 3.0 * se <= self.tolerance;
+                (
+                    p,
+                    se,
+                    AcceptanceMethod::Subset,
+                    s.pilot_samples + s.samples,
+                    converged,
+                )
+            }
+        };
         let se_of = |w: usize| {
             // The per-sample variance from the block means `T_b/B`:
             // `B·Var(T_b/B) = Σ_b T_b²/(B·n_b) − B·mean²`.
@@ -704,23 +785,86 @@ impl Acceptance {
         Ok(AcceptanceResult {
             probability: p,
             std_error: se,
-            method: AcceptanceMethod::MonteCarlo,
-            samples: blocks * BLOCK,
-            converged: self.samples.is_some() || 3.0 * se <= self.tolerance,
+            method,
+            samples,
+            converged,
             tolerance: self.tolerance(),
             constraints: system.constraints,
             distinct: k,
             rank: 0,
             pivots: Vec::new(),
             sensitivity,
+            subset: rare,
         })
     }
 }
 
-/// `(∂F/∂μ, ∂F/∂σ)` of a marginal's cdf at a fixed physical `x`:
-/// `−f(x)·∂x/∂θ` at `u = T⁻¹(x)`, zero outside the interior of the support
-/// and at infinite `x`.
-fn cdf_derivatives(m: &Marginal, x: f64) -> (f64, f64) {
+/// The Gaussian copula of the correlated block as the conditional
+/// estimator needs it: the members and the precision `R₀⁻¹` of
+/// `z_B = Φ⁻¹(F(x_B))` (`R₀` the Nataf-adjusted matrix, `L·Lᵀ`).
+#[derive(Debug, Clone)]
+struct Copula {
+    /// The inputs of the block, ascending.
+    members: Vec<usize>,
+    /// Per input, its position in `members`.
+    position: Vec<Option<usize>>,
+    /// `R₀⁻¹`, `k × k`.
+    precision: nalgebra::DMatrix<f64>,
+}
+
+impl Copula {
+    /// `None` for independent inputs. `L` is read off the Jacobian at
+    /// `u = 0`: `∂x_m/∂u_c = (dx_m/dz)(0)·L_ic` ([`Inputs::jacobian_matrix`]).
+    fn new(inputs: &Inputs) -> Result<Option<Copula>, ReliabilityError> {
+        let n = inputs.len();
+        let members: Vec<usize> = (0..n).filter(|&j| inputs.is_correlated(j)).collect();
+        if members.is_empty() {
+            return Ok(None);
+        }
+        let kb = members.len();
+        let mut jac = vec![0.0; n * n];
+        inputs.jacobian_matrix(&vec![0.0; n], &mut jac);
+        let mut l = nalgebra::DMatrix::zeros(kb, kb);
+        for (i, &m) in members.iter().enumerate() {
+            let slope = inputs.marginals()[m].dx_du(0.0);
+            for (c, &mc) in members.iter().enumerate().take(i + 1) {
+                l[(i, c)] = jac[m * n + mc] / slope;
+            }
+        }
+        let r0 = &l * l.transpose();
+        let precision = r0.try_inverse().ok_or(ReliabilityError::NonFinite(
+            "the inverse of the correlated block's copula matrix",
+        ))?;
+        let mut position = vec![None; n];
+        for (i, &m) in members.iter().enumerate() {
+            position[m] = Some(i);
+        }
+        Ok(Some(Copula {
+            members,
+            position,
+            precision,
+        }))
+    }
+
+    /// `(μ_c, s_c)` of `z_j` given the other members' `z`:
+    /// `μ_c = z_j − (R₀⁻¹z)_j/(R₀⁻¹)_jj`, `s_c = (R₀⁻¹)_jj^{−1/2}`; `(0, 1)`
+    /// outside the block.
+    #[inline]
+    fn conditional(&self, j: usize, z: &[f64]) -> (f64, f64) {
+        let Some(a) = self.position[j] else {
+            return (0.0, 1.0);
+        };
+        let pjj = self.precision[(a, a)];
+        let pz: f64 = (0..z.len()).map(|b| self.precision[(a, b)] * z[b]).sum();
+        (z[a] - pz / pjj, 1.0 / pjj.sqrt())
+    }
+}
+
+/// `(∂/∂μ, ∂/∂σ)` of `Φ((T⁻¹(x) − c)/s)` at a fixed physical `x` (the
+/// conditional cdf of `x_j` when `u_j ~ N(c, s²)`; `F_j(x)` itself for
+/// `c = 0`, `s = 1`): `−φ((u − c)/s)/s·(∂x/∂θ)/(dx/du)` at `u = T⁻¹(x)`,
+/// zero outside the interior of the support and at infinite `x`.
+fn cdf_derivatives(m: &Marginal, x: f64, centre: f64, spread: f64) -> (f64, f64) {
     let (lo, hi) = m.support();
     if !x.is_finite() || x <= lo || x >= hi {
         return (0.0, 0.0);
@@ -730,7 +874,7 @@ fn cdf_derivatives(m: &Marginal, x: f64) -> (f64, f64) {
     if !(u.is_finite() && dxdu > 0.0) {
         return (0.0, 0.0);
     }
-    let f = normal::pdf(u) / dxdu;
+    let f = normal::pdf((u - centre) / spread) / (spread * dxdu);
     (-f * m.dx_dmean(u), -f * m.dx_dstd(u))
 }
 
