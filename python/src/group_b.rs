@@ -37,7 +37,9 @@ fn check_param_names(m: &Machine, params: &[(String, f64)]) -> PyResult<()> {
             )));
         }
         if !v.is_finite() {
-            return Err(value_error(format!("parameter `{name}` = {v} is not finite")));
+            return Err(value_error(format!(
+                "parameter `{name}` = {v} is not finite"
+            )));
         }
     }
     Ok(())
@@ -57,7 +59,11 @@ fn read_measurements(
     let read = match (path, text) {
         (Some(path), None) => Measurements::read(Path::new(path), m, params, layout),
         (None, Some(text)) => Measurements::parse(text, file, m, params, layout),
-        _ => return Err(value_error("give the CSV as a path or as its text, not both")),
+        _ => {
+            return Err(value_error(
+                "give the CSV as a path or as its text, not both",
+            ))
+        }
     };
     read.map_err(|e: MeasurementsError| load_error(py, e.diagnostics()))
 }
@@ -76,7 +82,11 @@ fn read_values(
         (None, Some(text)) => {
             Values::parse(text, file, Path::new("."), m).map(|v| (v, file.to_string()))
         }
-        _ => return Err(value_error("give the values as a path or as their text, not both")),
+        _ => {
+            return Err(value_error(
+                "give the values as a path or as their text, not both",
+            ))
+        }
     };
     read.map_err(|e: ValuesError| load_error(py, e.diagnostics()))
 }
