@@ -783,3 +783,110 @@ impl<'b> Search<'b> {
         Ok((chosen, swaps, sweeps))
     }
 }
+
+// ---------------------------------------------------------------------------
+// The document of `chain plan`.
+
+/// What each candidate measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Kind {
+    /// The tool-point deviation `px, py, pz` (three rows per candidate).
+    Point,
+    /// The deviation along the candidate's `ux, uy, uz` (one row).
+    Direction,
+}
+
+/// A `kind` asked for that the candidate file contradicts.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
+pub enum KindError {
+    /// Point asked for, the file has directions.
+    #[error("{file}:1: columns `ux,uy,uz` give directions, but --kind point measures px, py, pz; pass --kind direction or remove them")]
+    PointWithDirections {
+        /// The candidate file.
+        file: String,
+    },
+    /// Direction asked for, the file has none.
+    #[error("{file}:1: --kind direction needs the columns `ux,uy,uz` (the unit direction of each measurement)")]
+    DirectionWithout {
+        /// The candidate file.
+        file: String,
+    },
+}
+
+impl Kind {
+    /// What the candidates of `file` measure (`ux,uy,uz` present: every row
+    /// a direction), checked against `asked` (`--kind`). `None` when there
+    /// is no candidate.
+    pub fn of(
+        candidates: &crate::measured::Measurements,
+        asked: Option<Kind>,
+    ) -> Result<Option<Kind>, KindError> {
+        let Some(first) = candidates.rows.first() else {
+            return Ok(None);
+        };
+        let kind = match first.observed {
+            crate::measured::Observed::Point => Kind::Point,
+            crate::measured::Observed::Direction { .. } => Kind::Direction,
+        };
+        let file = candidates.file.clone();
+        match (asked, kind) {
+            (Some(Kind::Point), Kind::Direction) => Err(KindError::PointWithDirections { file }),
+            (Some(Kind::Direction), Kind::Point) => Err(KindError::DirectionWithout { file }),
+            _ => Ok(Some(kind)),
+        }
+    }
+}
+
+/// The document of `chain plan` (`--format json`, and what the Python
+/// package returns): the library's [`Plan`] with what the command knows of
+/// its input; `lines` and `poses` are for the table only.
+#[derive(Debug, Clone, Serialize)]
+pub struct PlanDocument {
+    /// The machine's name.
+    pub machine: String,
+    /// The candidate file as named in messages.
+    pub candidates_file: String,
+    /// What each candidate measures.
+    pub kind: Kind,
+    /// The axis variables, in model order.
+    pub variables: Vec<String>,
+    /// Each candidate's CSV line.
+    #[serde(skip)]
+    pub lines: Vec<usize>,
+    /// Each candidate's pose.
+    #[serde(skip)]
+    pub poses: Vec<Vec<f64>>,
+    /// The plan.
+    #[serde(flatten)]
+    pub plan: Plan,
+}
+
+/// `chain plan`: `count` of `candidates` (read for `machine` with
+/// [`crate::measured::Layout::Candidates`]) by [`plan`], as its document.
+pub fn plan_document(
+    machine: &Machine,
+    candidates: &crate::measured::Measurements,
+    count: usize,
+    kind: Kind,
+) -> Result<PlanDocument, PlanError> {
+    if count == 0 || count > candidates.rows.len() {
+        return Err(PlanError::Count {
+            count,
+            candidates: candidates.rows.len(),
+        });
+    }
+    let model = crate::compile(machine);
+    let rows = Rows::of(&model, machine, &candidates.rows)?;
+    let result = plan(&rows, count)?;
+    Ok(PlanDocument {
+        machine: machine.name.clone(),
+        candidates_file: candidates.file.clone(),
+        kind,
+        variables: model.variables().iter().map(|v| v.to_string()).collect(),
+        lines: candidates.rows.iter().map(|c| c.line).collect(),
+        poses: candidates.rows.iter().map(|c| c.q.clone()).collect(),
+        plan: result,
+    })
+}

@@ -15,9 +15,13 @@ Every result's ``to_dict()`` is the document the ``chain`` CLI prints with
 from ._chain import MachineError
 from ._machine import Machine, Nominal
 from ._results import Derivation, ReliabilityResult, Result
+from ._results import IdentifyResult, MapResult, PlanResult
 
 __all__ = [
     "Derivation",
+    "IdentifyResult",
+    "MapResult",
+    "PlanResult",
     "Machine",
     "MachineError",
     "Nominal",

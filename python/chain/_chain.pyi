@@ -55,3 +55,32 @@ class Model:
         params: Sequence[Tuple[str, float]],
         sided: Optional[str],
     ) -> str: ...
+
+# -- group B: the measured machine (python/src/group_b.rs) --------------------
+
+def identify_json(
+    model: Model,
+    path: Optional[str],
+    text: Optional[str],
+    file: str,
+    params: Sequence[Tuple[str, float]],
+    prior: bool,
+) -> Tuple[str, str]: ...
+def plan_json(
+    model: Model,
+    path: Optional[str],
+    text: Optional[str],
+    file: str,
+    count: int,
+    kind: Optional[str],
+    params: Sequence[Tuple[str, float]],
+) -> str: ...
+def map_json(
+    model: Model,
+    values_path: Optional[str],
+    values_text: Optional[str],
+    values_file: str,
+    grid: Sequence[Tuple[str, Sequence[float]]],
+    points: Optional[npt.NDArray[np.float64]],
+    params: Sequence[Tuple[str, float]],
+) -> str: ...

@@ -203,3 +203,146 @@ class Machine:
             axes.append((str(name), [float(v) for v in a]))
         text = self._model.reliability_json(method, samples, seed, axes, _params(params), sided)
         return ReliabilityResult._from_json(text)
+
+    # -- the measured machine (group B: map, identify, plan) -----------------
+
+    def map(
+        self,
+        values: Union[str, "os.PathLike[str]", Mapping[str, Any]],
+        grid: Optional[Mapping[str, Sequence[float]]] = None,
+        points: Optional[ArrayLike] = None,
+        params: Params = None,
+    ) -> "MapResult":
+        """The error map of the built machine, ``chain map --values VALUES --format json``.
+
+        ``values``: a values file's path, a values document as a dict
+        (``{"units": ..., "values": {...}}``), or a plain ``{error: value}``
+        dict (mm and rad). ``grid``: axes replacing the file's
+        ``reliability.grid`` (``--grid``); ``points``: an ``(N, V)`` array of
+        axis values in ``variables`` order instead (``--axes``).
+        """
+        from ._results import MapResult
+
+        path, text, name = _values_input(self, values)
+        q = None
+        if points is not None:
+            q, _ = _rows(points, "points", len(self.variables), "the variables " + ", ".join(self.variables))
+        text_json = _chain.map_json(self._model, path, text, name, _grid_axes(grid), q, _params(params))
+        return MapResult._from_json(text_json)
+
+    def identify(
+        self,
+        measurements: Union[str, "os.PathLike[str]", Mapping[str, ArrayLike]],
+        prior: bool = False,
+        params: Params = None,
+        values_out: Optional[Union[str, "os.PathLike[str]"]] = None,
+        name: str = "<measurements>",
+    ) -> "IdentifyResult":
+        """The error parameters from measurements, ``chain identify --measurements M --format json``.
+
+        ``measurements``: the CSV's path, or its columns as a dict of 1-D
+        arrays (a pandas DataFrame works too) named as the CSV's header:
+        the axis variables, any per-row parameters, ``dpx, dpy, dpz`` or
+        ``ux, uy, uz, d``, optionally ``std``; ``name`` names them in
+        messages and in the document's ``file``. ``prior``: the
+        ``statistics`` as a Gaussian prior (``--prior``); ``values_out``:
+        also write the estimates as a values file (``--values-out``).
+        """
+        from ._results import IdentifyResult
+
+        path, text = _csv_input(measurements, "measurements")
+        doc, values_text = _chain.identify_json(self._model, path, text, name, _params(params), bool(prior))
+        if values_out is not None:
+            with open(os.fspath(values_out), "w", encoding="utf-8") as f:
+                f.write(values_text)
+        import json
+
+        return IdentifyResult(json.loads(doc), values_text)
+
+    def plan(
+        self,
+        candidates: Union[str, "os.PathLike[str]", Mapping[str, ArrayLike]],
+        k: int,
+        kind: Optional[str] = None,
+        params: Params = None,
+        name: str = "<candidates>",
+    ) -> "PlanResult":
+        """Where to measure, ``chain plan --candidates C --count K --format json``.
+
+        ``candidates``: the candidate CSV's path or its columns as a dict of
+        1-D arrays (the axis variables, any per-row parameters, ``ux, uy,
+        uz`` for directions, optionally ``std``); ``k``: how many to choose
+        (``--count``); ``kind``: ``"point"`` or ``"direction"`` (``--kind``).
+        """
+        from ._results import PlanResult
+
+        if not isinstance(k, int) or isinstance(k, bool) or k < 1:
+            raise ValueError(f"k must be a positive integer (the count of candidates to choose), not {k!r}")
+        path, text = _csv_input(candidates, "candidates")
+        return PlanResult._from_json(_chain.plan_json(self._model, path, text, name, k, kind, _params(params)))
+
+
+# -- group B helpers ----------------------------------------------------------
+
+
+def _grid_axes(grid: Optional[Mapping[str, Sequence[float]]]) -> List[Tuple[str, List[float]]]:
+    if grid is None:
+        return []
+    if not isinstance(grid, Mapping):
+        raise ValueError(f"grid must be a mapping of axis variable to values, not {type(grid).__name__}")
+    axes = []
+    for name, values in grid.items():
+        a = _float_array(values, f"grid[{name!r}]").ravel()
+        axes.append((str(name), [float(v) for v in a]))
+    return axes
+
+
+def _values_input(machine: "Machine", values: Any) -> Tuple[Optional[str], Optional[str], str]:
+    """A values file's path, or a dict as the values file's text (JSON is YAML)."""
+    import json
+
+    if isinstance(values, (str, os.PathLike)):
+        return os.fspath(values), None, os.fspath(values)
+    if not isinstance(values, Mapping):
+        raise ValueError(f"values must be a values file's path or a dict, not {type(values).__name__}")
+    if "values" in values:
+        doc = dict(values)
+    else:
+        doc = {"units": {"linear": "mm", "angular": "rad"}, "values": dict(values)}
+    doc.setdefault("machine", machine.name)
+    try:
+        text = json.dumps(doc, allow_nan=False)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"values: {e}") from None
+    return None, text, "<values>"
+
+
+def _csv_input(data: Any, what: str) -> Tuple[Optional[str], Optional[str]]:
+    """A CSV path, or columns (a dict of 1-D arrays, or a DataFrame) as the CSV's text."""
+    if isinstance(data, (str, os.PathLike)):
+        return os.fspath(data), None
+    if hasattr(data, "columns") and hasattr(data, "__getitem__") and not isinstance(data, Mapping):
+        data = {str(c): data[c].to_numpy() for c in data.columns}
+    if not isinstance(data, Mapping):
+        raise ValueError(f"{what} must be a CSV path or a dict of columns, not {type(data).__name__}")
+    if not data:
+        raise ValueError(f"{what} has no column")
+    names = [str(n) for n in data]
+    columns = []
+    n = None
+    for name, values in zip(names, data.values()):
+        a = _float_array(values, f"{what}[{name!r}]")
+        if a.ndim != 1:
+            raise ValueError(f"{what}[{name!r}] of shape {a.shape}: expected a 1-D column")
+        if n is None:
+            n = a.shape[0]
+        elif a.shape[0] != n:
+            raise ValueError(f"{what}[{name!r}] has {a.shape[0]} values, {names[0]!r} has {n}")
+        bad = np.flatnonzero(~np.isfinite(a))
+        if bad.size:
+            raise ValueError(f"{what}[{name!r}] has a non-finite value ({a[bad[0]]}) at row {bad[0]}")
+        columns.append(a)
+    lines = [",".join(names)]
+    for i in range(n or 0):
+        lines.append(",".join(repr(float(c[i])) for c in columns))
+    return None, "\n".join(lines) + "\n"

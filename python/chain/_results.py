@@ -107,3 +107,66 @@ class ReliabilityResult(Result):
                     row[key] = value
             rows.append(row)
         return rows
+
+
+# -- group B: the measured machine (map, identify, plan, compensate) ---------
+
+
+class MapResult(Result):
+    """``chain map --format json``: the volumetric error of a built machine at every point.
+
+    Attributes: ``machine``, ``frame``, ``points`` (one dict per point:
+    ``point``, ``error`` px..oz, ``volumetric``), ``summary`` (the ISO
+    230-1-style summary). Rows of ``to_dataframe()``: one per point, the
+    axis variables, px..oz and ``volumetric`` as columns.
+    """
+
+    command = "map"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        rows = []
+        for p in self._document["points"]:
+            row = dict(p["point"])
+            row.update(p["error"])
+            row["volumetric"] = p["volumetric"]
+            rows.append(row)
+        return rows
+
+
+class IdentifyResult(Result):
+    """``chain identify --format json``: the error parameters estimated from measurements.
+
+    Attributes: ``machine``, ``measurements``, ``parameters``, ``rank``,
+    ``condition``, ``estimates`` (per error: value, std), ``unidentifiable``,
+    ``residual``, ``groups``, ``largest_residuals``, ... ``values_text`` is
+    the values file ``--values-out`` writes (also written to ``values_out``
+    when given). Rows of ``to_dataframe()``: one per error (error, value, std).
+    """
+
+    command = "identify"
+
+    def __init__(self, document: Dict[str, Any], values_text: str = "") -> None:
+        super().__init__(document)
+        self.__dict__["values_text"] = values_text
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        return [{"error": name, "value": e["value"], "std": e["std"]} for name, e in self._document["estimates"].items()]
+
+
+class PlanResult(Result):
+    """``chain plan --format json``: where to measure (D-optimal choice of candidates).
+
+    Attributes: ``machine``, ``candidates_file``, ``kind``, ``variables``,
+    ``rank``, ``errors``, ``aliased``, ``optimal`` and ``even`` (candidates,
+    log_det, std), ``swaps``, ``sweeps``, ... Rows of ``to_dataframe()``: one
+    per error parameter (aliased, expected std D-optimal and even).
+    """
+
+    command = "plan"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        d = self._document
+        return [
+            {"error": e, "aliased": d["aliased"][j], "optimal_std": d["optimal"]["std"][j], "even_std": d["even"]["std"][j]}
+            for j, e in enumerate(d["errors"])
+        ]

@@ -16,6 +16,8 @@
 //! problems raise `MachineError` (a `ValueError`) with `file`, `line`,
 //! `column` and `key`.
 
+mod group_b;
+
 use chain_core::model::{Machine, Origin};
 use chain_core::{CompiledModel, Diagnostics, ErrorModel};
 use numpy::{PyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -489,5 +491,8 @@ impl Model {
 fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Model>()?;
     m.add("MachineError", m.py().get_type::<MachineError>())?;
+    m.add_function(wrap_pyfunction!(group_b::identify_json, m)?)?;
+    m.add_function(wrap_pyfunction!(group_b::plan_json, m)?)?;
+    m.add_function(wrap_pyfunction!(group_b::map_json, m)?)?;
     Ok(())
 }

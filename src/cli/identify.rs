@@ -9,13 +9,12 @@
 //! posterior of the `statistics` prior). See `docs/identify.md`.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use chain_core::measured::identify::{Estimate, Prior, Residual};
-use chain_core::measured::{identify, Design, Identification, Layout, Measurements};
-use chain_core::named::NameMap;
-use chain_core::{ErrorModel, Machine};
-use serde::Serialize;
+use chain_core::measured::document::{
+    identify_document, values_file, DocumentError, IdentifyDocument,
+};
+use chain_core::measured::{Layout, Measurements};
 
 use super::args::ParamArgs;
 use super::reliability::Loaded;
@@ -69,202 +68,18 @@ pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
         &args.param.params,
         Layout::Measurements,
     )?;
-    let model = chain_core::compile(m);
-    let design = Design::new(&model, m, &measurements.rows)
-        .map_err(|e| miette::miette!("{}: {e}", args.measurements.display()))?;
-    let prior = if args.prior {
-        Some(Prior::from_machine(m, &design.errors)?)
-    } else {
-        None
-    };
-    let result = identify(&design, prior.as_ref())?;
-    let doc = IdentifyDoc::new(m, &args, &measurements, &design, &result);
+    let (doc, result) = identify_document(m, &measurements, args.prior).map_err(|e| match e {
+        DocumentError::Design { .. } => miette::miette!("{e}"),
+        DocumentError::Identify(e) => miette::Report::new(e),
+    })?;
     if let Some(path) = &args.values_out {
-        let text = values_file(m, &args.measurements, &result);
+        let source = args.measurements.display().to_string();
+        let text = values_file(m, &source, &result);
         std::fs::write(path, text)
             .map_err(|e| miette::miette!("cannot write {}: {e}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }
-    // The model is the machine's: its error names are the design's.
-    debug_assert_eq!(model.errors().len(), design.errors.len());
     report::emit(&doc, args.format.into())
-}
-
-/// One group of unknowns the data cannot separate.
-#[derive(Debug, Serialize)]
-struct GroupDoc {
-    /// The unknowns of the group.
-    errors: Vec<String>,
-    /// How many independent combinations of them the data cannot tell.
-    vectors: usize,
-    /// The same in words.
-    explanation: String,
-}
-
-/// One of the largest standardised residuals.
-#[derive(Debug, Serialize)]
-struct ResidualDoc {
-    /// The CSV line of its measurement.
-    line: usize,
-    /// `dpx`, `dpy`, `dpz` or `d`.
-    component: &'static str,
-    residual: f64,
-    standardised: f64,
-    leverage: f64,
-    outlier: bool,
-}
-
-/// The result document (spec section 4's keys first, then additions).
-#[derive(Debug, Serialize)]
-struct IdentifyDoc {
-    machine: String,
-    /// Measurement records (CSV rows).
-    measurements: usize,
-    parameters: usize,
-    rank: usize,
-    condition: f64,
-    estimates: NameMap<String, Estimate>,
-    unidentifiable: Vec<NameMap<String, f64>>,
-    residual: Residual,
-    // --- additions ---
-    file: String,
-    /// Scalar rows of the design (3 per point, 1 per direction).
-    rows: usize,
-    weighted: bool,
-    prior: bool,
-    frame: &'static str,
-    groups: Vec<GroupDoc>,
-    largest_residuals: Vec<ResidualDoc>,
-    outliers: usize,
-}
-
-impl IdentifyDoc {
-    fn new(
-        m: &Machine,
-        args: &IdentifyArgs,
-        measurements: &Measurements,
-        design: &Design,
-        r: &Identification,
-    ) -> IdentifyDoc {
-        let groups = r
-            .groups
-            .iter()
-            .map(|g| {
-                let errors: Vec<String> = g.members.iter().map(|&j| r.errors[j].clone()).collect();
-                GroupDoc {
-                    explanation: explain(design, r, &g.members, g.vectors.len()),
-                    vectors: g.vectors.len(),
-                    errors,
-                }
-            })
-            .collect();
-        IdentifyDoc {
-            machine: m.name.clone(),
-            measurements: measurements.rows.len(),
-            parameters: r.parameters,
-            rank: r.rank,
-            condition: r.condition,
-            estimates: r.estimates.clone(),
-            unidentifiable: r.unidentifiable.clone(),
-            residual: r.residual,
-            file: args.measurements.display().to_string(),
-            rows: r.rows,
-            weighted: r.weighted,
-            prior: r.prior,
-            frame: m.frame.name(),
-            groups,
-            largest_residuals: (r.largest_residuals.iter())
-                .map(|s| ResidualDoc {
-                    line: measurements.rows[design.origin[s.row].0].line,
-                    component: s.component,
-                    residual: s.residual,
-                    standardised: s.standardised,
-                    leverage: s.leverage,
-                    outlier: s.outlier,
-                })
-                .collect(),
-            outliers: r.outliers,
-        }
-    }
-}
-
-/// `a`, `a and b`, `a, b and c`.
-fn and_list(names: &[String]) -> String {
-    match names {
-        [] => String::new(),
-        [one] => one.clone(),
-        [init @ .., last] => format!("{} and {last}", init.join(", ")),
-    }
-}
-
-/// The measured component's name in words (`dpx` → `px`).
-fn component_name(c: &str) -> &str {
-    c.strip_prefix("d").filter(|s| !s.is_empty()).unwrap_or(c)
-}
-
-/// A group of the null space in words, derived from the design's columns
-/// of its members: when they are all parallel (column rank 1), which
-/// measured components they act on and whether as a constant (an offset);
-/// otherwise how many independent combinations they act through.
-fn explain(design: &Design, r: &Identification, members: &[usize], vectors: usize) -> String {
-    let names: Vec<String> = members.iter().map(|&j| r.errors[j].clone()).collect();
-    let list = and_list(&names);
-    if r.prior {
-        return format!(
-            "the measurements leave {} of {list} at the prior (posterior std above {} × the prior std along {})",
-            if vectors == 1 { "one combination".to_string() } else { format!("{vectors} combinations") },
-            chain_core::measured::identify::UNINFORMED,
-            if vectors == 1 { "it" } else { "them" }
-        );
-    }
-    let rank = members.len() - vectors;
-    if rank == 0 {
-        return if names.len() == 1 {
-            format!("{list} has no effect on these measurements")
-        } else {
-            format!("{list} have no effect on these measurements")
-        };
-    }
-    if rank == 1 {
-        // The member whose column is largest stands for the group.
-        let a = &design.a;
-        let best = members
-            .iter()
-            .copied()
-            .max_by(|&i, &j| a.column(i).norm().total_cmp(&a.column(j).norm()))
-            .unwrap_or(members[0]);
-        let col = a.column(best);
-        let scale = col.amax();
-        let mut components: Vec<&'static str> = Vec::new();
-        let mut constant = true;
-        for comp in ["dpx", "dpy", "dpz", "d"] {
-            let values: Vec<f64> = (0..a.nrows())
-                .filter(|&i| design.origin[i].1 == comp)
-                .map(|i| col[i])
-                .collect();
-            if values.iter().any(|v| v.abs() > 1e-9 * scale) {
-                components.push(comp);
-                let first = values[0];
-                if values.iter().any(|v| (v - first).abs() > 1e-9 * scale) {
-                    constant = false;
-                }
-            }
-        }
-        let on: Vec<String> = components
-            .iter()
-            .map(|c| component_name(c).to_string())
-            .collect();
-        let what = if constant {
-            format!("one offset in {}", and_list(&on))
-        } else {
-            format!("one combined error in {}", and_list(&on))
-        };
-        return format!("{list} only act as {what}");
-    }
-    format!(
-        "{list} only act through {rank} independent combinations; {vectors} combination{} of them cannot be seen in these measurements",
-        if vectors == 1 { "" } else { "s" }
-    )
 }
 
 /// `v` for a table: 4 significant digits.
@@ -283,7 +98,7 @@ fn num(v: f64) -> String {
     }
 }
 
-impl Report for IdentifyDoc {
+impl Report for IdentifyDocument {
     fn table(&self) -> String {
         let mut s = String::new();
         let _ = writeln!(
@@ -393,72 +208,4 @@ impl Report for IdentifyDoc {
         }
         s
     }
-}
-
-/// The estimates as a values file (spec section 2, plus `std` per constant
-/// and the `correlation` list, one `[NAME, NAME, ρ]` per pair with ρ ≠ 0:
-/// the form `chain reliability --values` reads, docs/posterior.md).
-pub(crate) fn values_file(m: &Machine, source: &Path, r: &Identification) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "# written by chain identify from {}: {} rows, rank {} of {} unknowns{}",
-        source.display(),
-        r.rows,
-        r.rank,
-        r.parameters,
-        if r.prior {
-            ", posterior with the statistics prior"
-        } else {
-            ""
-        }
-    );
-    if !r.unidentifiable.is_empty() && !r.prior {
-        let _ = writeln!(
-            s,
-            "# rank deficient: the values are the minimum-norm solution; see `chain identify` for what cannot be separated"
-        );
-    }
-    let _ = writeln!(s, "machine: {}", m.name);
-    let _ = writeln!(s, "units: {{linear: mm, angular: rad}}");
-    let _ = writeln!(s, "values:");
-    let all_std = r.estimates.0.iter().all(|(_, e)| e.std.is_some());
-    for (name, e) in &r.estimates.0 {
-        match e.std {
-            Some(std) => {
-                let _ = writeln!(s, "  {name}: {{value: {:?}, std: {:?}}}", e.value, std);
-            }
-            None => {
-                let _ = writeln!(s, "  {name}: {:?}", e.value);
-            }
-        }
-    }
-    if all_std {
-        let n = r.parameters;
-        let sd: Vec<f64> = (0..n)
-            .map(|j| r.covariance[(j, j)].max(0.0).sqrt())
-            .collect();
-        let mut pairs = Vec::new();
-        for i in 0..n {
-            for j in i + 1..n {
-                if sd[i] > 0.0 && sd[j] > 0.0 {
-                    let rho = (r.covariance[(i, j)] / (sd[i] * sd[j])).clamp(-1.0, 1.0);
-                    if rho != 0.0 {
-                        pairs.push((i, j, rho));
-                    }
-                }
-            }
-        }
-        if !pairs.is_empty() {
-            let _ = writeln!(
-                s,
-                "# the correlation of each pair of estimates (pairs not listed: exactly 0)"
-            );
-            let _ = writeln!(s, "correlation:");
-            for (i, j, rho) in pairs {
-                let _ = writeln!(s, "  - [{}, {}, {rho:?}]", r.errors[i], r.errors[j]);
-            }
-        }
-    }
-    s
 }

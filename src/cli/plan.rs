@@ -10,11 +10,9 @@
 
 use std::path::{Path, PathBuf};
 
-use chain_core::measured::{Layout, Measurements, Observed};
-use chain_core::plan::{self, Plan, PlanError, Rows};
-use chain_core::ErrorModel;
+use chain_core::measured::{Layout, Measurements};
+use chain_core::plan::{self, Kind, PlanDocument, PlanError};
 use miette::MietteDiagnostic;
-use serde::Serialize;
 
 use super::args::ParamArgs;
 use super::reliability::Loaded;
@@ -32,8 +30,7 @@ pub enum PlanFormat {
 report::formats!(PlanFormat: Table, Json);
 
 /// What each candidate measures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum KindArg {
     /// The tool-point deviation `px, py, pz` (three rows per candidate); the
     /// file must not have `ux,uy,uz`.
@@ -85,40 +82,15 @@ pub fn exec(args: PlanArgs) -> miette::Result<()> {
     };
     // The file decides what each candidate measures (`ux,uy,uz` present:
     // every row a direction); `--kind` must agree with it.
-    let kind = match candidates.rows[0].observed {
-        Observed::Point => KindArg::Point,
-        Observed::Direction { .. } => KindArg::Direction,
-    };
-    match (args.kind, kind) {
-        (Some(KindArg::Point), KindArg::Direction) => miette::bail!(
-            "{name}:1: columns `ux,uy,uz` give directions, but --kind point measures px, py, pz; pass --kind direction or remove them"
-        ),
-        (Some(KindArg::Direction), KindArg::Point) => miette::bail!(
-            "{name}:1: --kind direction needs the columns `ux,uy,uz` (the unit direction of each measurement)"
-        ),
-        _ => {}
-    }
-    if args.count == 0 || args.count > candidates.rows.len() {
-        return Err(plan_error(
-            PlanError::Count {
-                count: args.count,
-                candidates: candidates.rows.len(),
-            },
-            &name,
-        ));
-    }
-    let model = chain_core::compile(m);
-    let rows = Rows::of(&model, m, &candidates.rows).map_err(|e| plan_error(e, &name))?;
-    let result = plan::plan(&rows, args.count).map_err(|e| plan_error(e, &name))?;
-    let doc = PlanDoc {
-        machine: m.name.clone(),
-        candidates_file: name,
-        kind,
-        variables: model.variables().iter().map(|v| v.to_string()).collect(),
-        lines: candidates.rows.iter().map(|c| c.line).collect(),
-        poses: candidates.rows.iter().map(|c| c.q.clone()).collect(),
-        plan: result,
-    };
+    let asked = args.kind.map(|k| match k {
+        KindArg::Point => Kind::Point,
+        KindArg::Direction => Kind::Direction,
+    });
+    let kind = Kind::of(&candidates, asked)
+        .map_err(|e| miette::miette!("{e}"))?
+        .unwrap_or(Kind::Point);
+    let doc =
+        plan::plan_document(m, &candidates, args.count, kind).map_err(|e| plan_error(e, &name))?;
     report::emit(&doc, args.format.into())
 }
 
@@ -157,24 +129,7 @@ fn plan_error(e: PlanError, file: &str) -> miette::Report {
 // ---------------------------------------------------------------------------
 // Output.
 
-/// The report of `chain plan`: the library's [`Plan`] with the chosen poses.
-#[derive(Debug, Serialize)]
-pub(crate) struct PlanDoc {
-    machine: String,
-    candidates_file: String,
-    /// What each candidate measures.
-    kind: KindArg,
-    variables: Vec<String>,
-    /// Each candidate's CSV line.
-    #[serde(skip)]
-    lines: Vec<usize>,
-    #[serde(skip)]
-    poses: Vec<Vec<f64>>,
-    #[serde(flatten)]
-    plan: Plan,
-}
-
-impl Report for PlanDoc {
+impl Report for PlanDocument {
     fn table(&self) -> String {
         use std::fmt::Write;
         let p = &self.plan;
@@ -187,8 +142,8 @@ impl Report for PlanDoc {
             p.candidates,
             self.candidates_file,
             match self.kind {
-                KindArg::Point => "tool-point px, py, pz",
-                KindArg::Direction => "1-D, along each candidate's direction",
+                Kind::Point => "tool-point px, py, pz",
+                Kind::Direction => "1-D, along each candidate's direction",
             }
         );
         let aliased = p.aliased.iter().filter(|&&a| a).count();

@@ -7,6 +7,7 @@
 //! model's exact sensitivity; [`identify`] solves the weighted least-squares
 //! problem (or its Gaussian-prior posterior) through an SVD.
 
+pub mod document;
 pub mod identify;
 pub mod measurements;
 

@@ -1,0 +1,324 @@
+//! The result document of `chain identify` (measured-machines spec,
+//! section 4, plus the additions of `docs/identify.md`): what the CLI prints
+//! with `--format json` and the Python package returns, and the values file
+//! `--values-out` writes. Assembled here, from the library's typed results,
+//! so that every front end gives the same document for the same input.
+
+use std::fmt::Write as _;
+
+use serde::Serialize;
+
+use super::identify::{Estimate, Prior, Residual};
+use super::{identify, Design, DesignError, Identification, IdentifyError, Measurements};
+use crate::model::Machine;
+use crate::named::NameMap;
+
+/// Why the identification document could not be made.
+#[derive(Debug, thiserror::Error)]
+#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
+pub enum DocumentError {
+    /// The records do not give a design (named by their file).
+    #[error("{file}: {source}")]
+    Design {
+        /// The measurement file.
+        file: String,
+        /// The design's refusal.
+        source: DesignError,
+    },
+    /// The prior or the solve refused.
+    #[error(transparent)]
+    #[cfg_attr(feature = "miette", diagnostic(transparent))]
+    Identify(#[from] IdentifyError),
+}
+
+/// One group of unknowns the data cannot separate.
+#[derive(Debug, Clone, Serialize)]
+pub struct GroupDoc {
+    /// The unknowns of the group.
+    pub errors: Vec<String>,
+    /// How many independent combinations of them the data cannot tell.
+    pub vectors: usize,
+    /// The same in words.
+    pub explanation: String,
+}
+
+/// One of the largest standardised residuals.
+#[derive(Debug, Clone, Serialize)]
+pub struct ResidualDoc {
+    /// The CSV line of its measurement.
+    pub line: usize,
+    /// `dpx`, `dpy`, `dpz` or `d`.
+    pub component: &'static str,
+    /// `b − A x`.
+    pub residual: f64,
+    /// `t = r / (σ √(1 − h))`.
+    pub standardised: f64,
+    /// The row's leverage `h`.
+    pub leverage: f64,
+    /// `|t|` above [`super::identify::OUTLIER_LIMIT`].
+    pub outlier: bool,
+}
+
+/// The result document (spec section 4's keys first, then additions).
+#[derive(Debug, Clone, Serialize)]
+pub struct IdentifyDocument {
+    /// The machine's name.
+    pub machine: String,
+    /// Measurement records (CSV rows).
+    pub measurements: usize,
+    /// Unknowns.
+    pub parameters: usize,
+    /// The rank of the design.
+    pub rank: usize,
+    /// The condition of the equilibrated design on its identifiable part.
+    pub condition: f64,
+    /// The estimates, by name.
+    pub estimates: NameMap<String, Estimate>,
+    /// The null-space vectors as `{error: component}` maps.
+    pub unidentifiable: Vec<NameMap<String, f64>>,
+    /// The residual.
+    pub residual: Residual,
+    // --- additions ---
+    /// The measurement file as named in messages.
+    pub file: String,
+    /// Scalar rows of the design (3 per point, 1 per direction).
+    pub rows: usize,
+    /// Whether the rows had a `std`.
+    pub weighted: bool,
+    /// Whether the statistics prior was used.
+    pub prior: bool,
+    /// The machine's frame.
+    pub frame: &'static str,
+    /// The groups of the null space, in words.
+    pub groups: Vec<GroupDoc>,
+    /// The largest standardised residuals.
+    pub largest_residuals: Vec<ResidualDoc>,
+    /// How many of them are flagged as likely outliers.
+    pub outliers: usize,
+}
+
+/// `chain identify`: the design of `measurements` through the machine's
+/// exact sensitivity, the weighted least-squares solve (or the posterior of
+/// the `statistics` prior when `prior`), and its document. Returns the
+/// typed identification too (for [`values_file`]).
+pub fn identify_document(
+    machine: &Machine,
+    measurements: &Measurements,
+    prior: bool,
+) -> Result<(IdentifyDocument, Identification), DocumentError> {
+    let model = crate::compile(machine);
+    let design = Design::new(&model, machine, &measurements.rows).map_err(|source| {
+        DocumentError::Design {
+            file: measurements.file.clone(),
+            source,
+        }
+    })?;
+    let prior = if prior {
+        Some(Prior::from_machine(machine, &design.errors)?)
+    } else {
+        None
+    };
+    let result = identify(&design, prior.as_ref())?;
+    let doc = IdentifyDocument::new(machine, &measurements.file, measurements, &design, &result);
+    Ok((doc, result))
+}
+
+impl IdentifyDocument {
+    /// The document of `r`, the identification from `measurements` (named
+    /// `file`) through `design`.
+    pub fn new(
+        m: &Machine,
+        file: &str,
+        measurements: &Measurements,
+        design: &Design,
+        r: &Identification,
+    ) -> IdentifyDocument {
+        let groups = r
+            .groups
+            .iter()
+            .map(|g| {
+                let errors: Vec<String> = g.members.iter().map(|&j| r.errors[j].clone()).collect();
+                GroupDoc {
+                    explanation: explain(design, r, &g.members, g.vectors.len()),
+                    vectors: g.vectors.len(),
+                    errors,
+                }
+            })
+            .collect();
+        IdentifyDocument {
+            machine: m.name.clone(),
+            measurements: measurements.rows.len(),
+            parameters: r.parameters,
+            rank: r.rank,
+            condition: r.condition,
+            estimates: r.estimates.clone(),
+            unidentifiable: r.unidentifiable.clone(),
+            residual: r.residual,
+            file: file.to_string(),
+            rows: r.rows,
+            weighted: r.weighted,
+            prior: r.prior,
+            frame: m.frame.name(),
+            groups,
+            largest_residuals: (r.largest_residuals.iter())
+                .map(|s| ResidualDoc {
+                    line: measurements.rows[design.origin[s.row].0].line,
+                    component: s.component,
+                    residual: s.residual,
+                    standardised: s.standardised,
+                    leverage: s.leverage,
+                    outlier: s.outlier,
+                })
+                .collect(),
+            outliers: r.outliers,
+        }
+    }
+}
+
+/// `a`, `a and b`, `a, b and c`.
+fn and_list(names: &[String]) -> String {
+    match names {
+        [] => String::new(),
+        [one] => one.clone(),
+        [init @ .., last] => format!("{} and {last}", init.join(", ")),
+    }
+}
+
+/// The measured component's name in words (`dpx` → `px`).
+fn component_name(c: &str) -> &str {
+    c.strip_prefix("d").filter(|s| !s.is_empty()).unwrap_or(c)
+}
+
+/// A group of the null space in words, derived from the design's columns
+/// of its members: when they are all parallel (column rank 1), which
+/// measured components they act on and whether as a constant (an offset);
+/// otherwise how many independent combinations they act through.
+fn explain(design: &Design, r: &Identification, members: &[usize], vectors: usize) -> String {
+    let names: Vec<String> = members.iter().map(|&j| r.errors[j].clone()).collect();
+    let list = and_list(&names);
+    if r.prior {
+        return format!(
+            "the measurements leave {} of {list} at the prior (posterior std above {} × the prior std along {})",
+            if vectors == 1 { "one combination".to_string() } else { format!("{vectors} combinations") },
+            super::identify::UNINFORMED,
+            if vectors == 1 { "it" } else { "them" }
+        );
+    }
+    let rank = members.len() - vectors;
+    if rank == 0 {
+        return if names.len() == 1 {
+            format!("{list} has no effect on these measurements")
+        } else {
+            format!("{list} have no effect on these measurements")
+        };
+    }
+    if rank == 1 {
+        // The member whose column is largest stands for the group.
+        let a = &design.a;
+        let best = members
+            .iter()
+            .copied()
+            .max_by(|&i, &j| a.column(i).norm().total_cmp(&a.column(j).norm()))
+            .unwrap_or(members[0]);
+        let col = a.column(best);
+        let scale = col.amax();
+        let mut components: Vec<&'static str> = Vec::new();
+        let mut constant = true;
+        for comp in ["dpx", "dpy", "dpz", "d"] {
+            let values: Vec<f64> = (0..a.nrows())
+                .filter(|&i| design.origin[i].1 == comp)
+                .map(|i| col[i])
+                .collect();
+            if values.iter().any(|v| v.abs() > 1e-9 * scale) {
+                components.push(comp);
+                let first = values[0];
+                if values.iter().any(|v| (v - first).abs() > 1e-9 * scale) {
+                    constant = false;
+                }
+            }
+        }
+        let on: Vec<String> = components
+            .iter()
+            .map(|c| component_name(c).to_string())
+            .collect();
+        let what = if constant {
+            format!("one offset in {}", and_list(&on))
+        } else {
+            format!("one combined error in {}", and_list(&on))
+        };
+        return format!("{list} only act as {what}");
+    }
+    format!(
+        "{list} only act through {rank} independent combinations; {vectors} combination{} of them cannot be seen in these measurements",
+        if vectors == 1 { "" } else { "s" }
+    )
+}
+
+/// The estimates as a values file (spec section 2, plus `std` per constant
+/// and the `correlation` list, one `[NAME, NAME, ρ]` per pair with ρ ≠ 0:
+/// the form `chain reliability --values` reads, docs/posterior.md);
+/// `source` names the measurement file in its first comment.
+pub fn values_file(m: &Machine, source: &str, r: &Identification) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# written by chain identify from {}: {} rows, rank {} of {} unknowns{}",
+        source,
+        r.rows,
+        r.rank,
+        r.parameters,
+        if r.prior {
+            ", posterior with the statistics prior"
+        } else {
+            ""
+        }
+    );
+    if !r.unidentifiable.is_empty() && !r.prior {
+        let _ = writeln!(
+            s,
+            "# rank deficient: the values are the minimum-norm solution; see `chain identify` for what cannot be separated"
+        );
+    }
+    let _ = writeln!(s, "machine: {}", m.name);
+    let _ = writeln!(s, "units: {{linear: mm, angular: rad}}");
+    let _ = writeln!(s, "values:");
+    let all_std = r.estimates.0.iter().all(|(_, e)| e.std.is_some());
+    for (name, e) in &r.estimates.0 {
+        match e.std {
+            Some(std) => {
+                let _ = writeln!(s, "  {name}: {{value: {:?}, std: {:?}}}", e.value, std);
+            }
+            None => {
+                let _ = writeln!(s, "  {name}: {:?}", e.value);
+            }
+        }
+    }
+    if all_std {
+        let n = r.parameters;
+        let sd: Vec<f64> = (0..n)
+            .map(|j| r.covariance[(j, j)].max(0.0).sqrt())
+            .collect();
+        let mut pairs = Vec::new();
+        for i in 0..n {
+            for j in i + 1..n {
+                if sd[i] > 0.0 && sd[j] > 0.0 {
+                    let rho = (r.covariance[(i, j)] / (sd[i] * sd[j])).clamp(-1.0, 1.0);
+                    if rho != 0.0 {
+                        pairs.push((i, j, rho));
+                    }
+                }
+            }
+        }
+        if !pairs.is_empty() {
+            let _ = writeln!(
+                s,
+                "# the correlation of each pair of estimates (pairs not listed: exactly 0)"
+            );
+            let _ = writeln!(s, "correlation:");
+            for (i, j, rho) in pairs {
+                let _ = writeln!(s, "  - [{}, {}, {rho:?}]", r.errors[i], r.errors[j]);
+            }
+        }
+    }
+    s
+}

@@ -1,0 +1,239 @@
+//! Bindings group B, the measured machine (measured-machines spec):
+//! `chain map`, `chain identify`, `chain plan` and `chain compensate`, each
+//! returning the document the CLI prints with `--format json` for the same
+//! input, built by the same library function.
+//!
+//! Inputs the CLI reads from files come as a path or as their text (the
+//! Python side writes numpy arrays as the CSV the CLI would read, so that
+//! one parser checks both); every refusal is the CLI's message, located
+//! (`MachineError` with file, line, column, key) where the library locates
+//! it, a `ValueError` otherwise.
+
+use std::path::Path;
+
+use chain_core::built::{BuiltMachine, Points};
+use chain_core::measured::document::{identify_document, values_file, DocumentError};
+use chain_core::measured::{Layout, Measurements, MeasurementsError};
+use chain_core::model::Machine;
+use chain_core::plan::{self, Kind};
+use chain_core::values::{Values, ValuesError};
+use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+
+use crate::{check_finite, load_error, study_error, to_json, value_error, Model};
+
+/// `--param NAME=VALUE` names checked against the machine (the CLI's
+/// `ParamArgs::check_names` wording).
+fn check_param_names(m: &Machine, params: &[(String, f64)]) -> PyResult<()> {
+    for (name, v) in params {
+        if m.parameter_index(name).is_none() {
+            let suggestion =
+                chain_core::diagnostic::closest(name, m.parameters.iter().map(|p| p.name.as_str()))
+                    .map(|s| format!(" (did you mean `{s}`?)"))
+                    .unwrap_or_default();
+            return Err(value_error(format!(
+                "--param {name}: machine `{}` has no parameter `{name}`{suggestion}",
+                m.name
+            )));
+        }
+        if !v.is_finite() {
+            return Err(value_error(format!(
+                "parameter `{name}` = {v} is not finite"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A measurement or candidate CSV: read from `path`, or parsed from `text`
+/// named `file`.
+fn read_measurements(
+    py: Python<'_>,
+    m: &Machine,
+    path: Option<&str>,
+    text: Option<&str>,
+    file: &str,
+    params: &[(String, f64)],
+    layout: Layout,
+) -> PyResult<Measurements> {
+    let read = match (path, text) {
+        (Some(path), None) => Measurements::read(Path::new(path), m, params, layout),
+        (None, Some(text)) => Measurements::parse(text, file, m, params, layout),
+        _ => {
+            return Err(value_error(
+                "give the CSV as a path or as its text, not both",
+            ))
+        }
+    };
+    read.map_err(|e: MeasurementsError| load_error(py, e.diagnostics()))
+}
+
+/// A values file: read from `path` (tables relative to it), or parsed from
+/// `text` named `file` (tables relative to the working directory).
+fn read_values(
+    py: Python<'_>,
+    m: &Machine,
+    path: Option<&str>,
+    text: Option<&str>,
+    file: &str,
+) -> PyResult<(Values, String)> {
+    let read = match (path, text) {
+        (Some(path), None) => Values::read(Path::new(path), m).map(|v| (v, path.to_string())),
+        (None, Some(text)) => {
+            Values::parse(text, file, Path::new("."), m).map(|v| (v, file.to_string()))
+        }
+        _ => {
+            return Err(value_error(
+                "give the values as a path or as their text, not both",
+            ))
+        }
+    };
+    read.map_err(|e: ValuesError| load_error(py, e.diagnostics()))
+}
+
+/// `chain identify --format json` (and the values file `--values-out`
+/// writes): the measurements from `path` or `text` (named `file`).
+#[pyfunction]
+#[pyo3(signature = (model, path, text, file, params, prior))]
+pub(crate) fn identify_json(
+    py: Python<'_>,
+    model: &Model,
+    path: Option<&str>,
+    text: Option<&str>,
+    file: &str,
+    params: Vec<(String, f64)>,
+    prior: bool,
+) -> PyResult<(String, String)> {
+    let m = &model.machine;
+    check_param_names(m, &params)?;
+    let measurements = read_measurements(py, m, path, text, file, &params, Layout::Measurements)?;
+    let (doc, result) = py
+        .allow_threads(|| identify_document(m, &measurements, prior))
+        .map_err(|e| match e {
+            DocumentError::Design { .. } => value_error(e.to_string()),
+            DocumentError::Identify(e) => value_error(e.to_string()),
+        })?;
+    let values = values_file(m, &measurements.file, &result);
+    Ok((to_json(&doc)?, values))
+}
+
+/// `chain plan --format json`: `count` of the candidates from `path` or
+/// `text` (named `file`); `kind`: `None`, `"point"` or `"direction"`.
+#[pyfunction]
+#[pyo3(signature = (model, path, text, file, count, kind, params))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn plan_json(
+    py: Python<'_>,
+    model: &Model,
+    path: Option<&str>,
+    text: Option<&str>,
+    file: &str,
+    count: usize,
+    kind: Option<&str>,
+    params: Vec<(String, f64)>,
+) -> PyResult<String> {
+    let m = &model.machine;
+    let asked = match kind {
+        None => None,
+        Some("point") => Some(Kind::Point),
+        Some("direction") => Some(Kind::Direction),
+        Some(other) => {
+            return Err(value_error(format!(
+                "kind must be \"point\" or \"direction\", not {other:?}"
+            )))
+        }
+    };
+    check_param_names(m, &params)?;
+    let candidates = read_measurements(py, m, path, text, file, &params, Layout::Candidates)?;
+    let kind = Kind::of(&candidates, asked)
+        .map_err(|e| value_error(e.to_string()))?
+        .unwrap_or(Kind::Point);
+    let doc = py
+        .allow_threads(|| plan::plan_document(m, &candidates, count, kind))
+        .map_err(|e| value_error(format!("{}: {e}", candidates.file)))?;
+    to_json(&doc)
+}
+
+/// The grid of `chain map` (`--grid` over the file's `reliability.grid`, in
+/// the machine's variable order), as the CLI resolves it.
+fn grid_axes(
+    py: Python<'_>,
+    model: &Model,
+    overrides: &[(String, Vec<f64>)],
+) -> PyResult<Vec<Vec<f64>>> {
+    let m = &model.machine;
+    for (name, values) in overrides {
+        if m.variable_index(name).is_none() {
+            return Err(study_error(
+                py,
+                &reliability::ReliabilityError::unknown(
+                    "axis variable",
+                    name,
+                    m.variables.iter().map(|v| v.name.as_str()),
+                ),
+                &model.file,
+            ));
+        }
+        if values.is_empty() {
+            return Err(value_error(format!("grid axis `{name}` has no value")));
+        }
+        check_finite(values, 0, &format!("grid axis `{name}`"))?;
+    }
+    let file_grid = m.reliability.as_ref().map(|r| &r.grid);
+    let mut axes = Vec::new();
+    for (k, v) in m.variables.iter().enumerate() {
+        let given = overrides.iter().rev().find(|(n, _)| *n == v.name);
+        let values = match given {
+            Some((_, values)) => values.clone(),
+            None => match file_grid.and_then(|g| g.iter().find(|(i, _)| *i == k)) {
+                Some((_, values)) => values.clone(),
+                None => {
+                    return Err(value_error(format!(
+                        "{}: no grid values for axis variable `{}`; add `{1}: [...]` to `reliability.grid`, or pass grid={{\"{1}\": [...]}}",
+                        model.file, v.name
+                    )))
+                }
+            },
+        };
+        axes.push(values);
+    }
+    Ok(axes)
+}
+
+/// `chain map --format json`: the error map of the built machine (values
+/// from `values_path` or `values_text` named `values_file`) over the grid
+/// (`grid` overriding the file's) or at the rows of `points` (`(N, V)`).
+#[pyfunction]
+#[pyo3(signature = (model, values_path, values_text, values_file, grid, points, params))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn map_json(
+    py: Python<'_>,
+    model: &Model,
+    values_path: Option<&str>,
+    values_text: Option<&str>,
+    values_file: &str,
+    grid: Vec<(String, Vec<f64>)>,
+    points: Option<PyReadonlyArray2<'_, f64>>,
+    params: Vec<(String, f64)>,
+) -> PyResult<String> {
+    let m = &model.machine;
+    let (values, name) = read_values(py, m, values_path, values_text, values_file)?;
+    let p = model.parameter_vector(py, &params)?;
+    let points = match &points {
+        Some(q) => {
+            if !grid.is_empty() {
+                return Err(value_error("give grid or points, not both"));
+            }
+            let (flat, _) = model.points(q)?;
+            let v = q.shape()[1];
+            Points::list(v, flat.to_vec()).map_err(|e| value_error(format!("points: {e}")))?
+        }
+        None => Points::Grid(grid_axes(py, model, &grid)?),
+    };
+    let built =
+        BuiltMachine::compile(m, values, p).map_err(|e| value_error(format!("{name}: {e}")))?;
+    let result = py
+        .allow_threads(|| built.map(points))
+        .map_err(|e| value_error(e.to_string()))?;
+    to_json(&result)
+}

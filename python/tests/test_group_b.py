@@ -1,0 +1,132 @@
+"""Group B (the measured machine): map, identify and plan return the CLI's JSON for the same input."""
+
+import csv
+
+import numpy as np
+import pytest
+
+import chain
+from conftest import MACHINES, ROOT
+
+MEAS = ROOT / "examples/measurements"
+PROBE = MEAS / "vmc3_probe.yaml"
+VMC3 = ROOT / "examples/machines/vmc3.yaml"
+VALUES = ROOT / "examples/values/vmc3.yaml"
+TOOL = {"tx": 0, "ty": 0, "tz": -150}
+
+
+def _columns(path):
+    with open(path) as f:
+        rows = list(csv.reader(line for line in f if not line.startswith("#")))
+    header, data = rows[0], np.array(rows[1:], dtype=float)
+    return {name: data[:, j] for j, name in enumerate(header)}
+
+
+@pytest.mark.parametrize("values", [VALUES, ROOT / "examples/values/vmc3_legendre.yaml"], ids=["tables", "legendre"])
+def test_map_is_the_cli_json(values, cli):
+    m = chain.Machine.load(VMC3)
+    assert m.map(values).to_dict() == cli("map", VMC3, "--values", values)
+    r = m.map(values, grid={"x": [0, 400, 800], "z": [100]})
+    assert r.to_dict() == cli("map", VMC3, "--values", values, "--grid", "x=0,400,800", "--grid", "z=100")
+    assert len(r.to_dataframe()) == len(r.points)
+
+
+def test_map_at_points_is_the_cli_axes_csv(cli, tmp_path):
+    m = chain.Machine.load(VMC3)
+    q = np.random.default_rng(1).uniform(0, 500, size=(7, 3))
+    path = tmp_path / "axes.csv"
+    path.write_text(",".join(m.variables) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n" for row in q))
+    assert m.map(VALUES, points=q).to_dict() == cli("map", VMC3, "--values", VALUES, "--axes", path)
+
+
+@pytest.mark.parametrize("path", MACHINES, ids=[p.stem for p in MACHINES])
+def test_map_of_a_dict_of_values_is_the_cli_json(path, cli, tmp_path):
+    """Every example machine: constant errors from a dict, against the same values file through the CLI."""
+    m = chain.Machine.load(path)
+    values = {e: 1e-3 * (k % 5 + 1) for k, e in enumerate(m.errors) if not e.startswith("E") or "_" not in e}
+    grid = {v: [0.0, 0.25] for v in m.variables}
+    params = {n: 100.0 for n, v in m.parameters.items() if v is None}
+    try:
+        got = m.map(values, grid=grid, params=params).to_dict()
+    except ValueError as e:  # a function slot's coefficients need a table or all coefficients
+        pytest.skip(str(e))
+    vfile = tmp_path / "values.yaml"
+    vfile.write_text(f"machine: {m.name}\nunits: {{linear: mm, angular: rad}}\nvalues:\n"
+                     + "".join(f"  {k}: {v!r}\n" for k, v in values.items()))
+    args = ["map", path, "--values", vfile] + [a for v in m.variables for a in ("--grid", f"{v}=0,0.25")]
+    args += [a for n, v in params.items() for a in ("--param", f"{n}={v}")]
+    assert got == cli(*args)
+
+
+def test_map_bad_input():
+    m = chain.Machine.load(VMC3)
+    with pytest.raises(ValueError, match="points of shape"):
+        m.map(VALUES, points=np.zeros((3, 2)))
+    with pytest.raises(ValueError, match="non-finite"):
+        m.map(VALUES, points=np.array([[0.0, np.nan, 0.0]]))
+    with pytest.raises(chain.MachineError) as info:
+        m.map({"NOT_AN_ERROR": 1.0})
+    assert info.value.file == "<values>" and "NOT_AN_ERROR" in str(info.value)
+    with pytest.raises(chain.MachineError):
+        m.map(VALUES, grid={"w": [1.0]})
+
+
+@pytest.mark.parametrize("name", ["ballplate.csv", "interferometer.csv"])
+def test_identify_is_the_cli_json(name, cli, tmp_path):
+    m = chain.Machine.load(PROBE)
+    out = tmp_path / "identified.yaml"
+    r = m.identify(MEAS / name, values_out=out)
+    assert r.to_dict() == cli("identify", PROBE, "--measurements", MEAS / name)
+    cli_out = tmp_path / "cli.yaml"
+    cli("identify", PROBE, "--measurements", MEAS / name, "--values-out", cli_out)
+    assert out.read_text() == cli_out.read_text() == r.values_text
+    # the same measurements as arrays: the same numbers (the file name aside); the lines
+    # are those of the CSV the arrays make (a header, then one row per record, no comments)
+    a = m.identify(_columns(MEAS / name), name=str(MEAS / name)).to_dict()
+    b = r.to_dict()
+    data_lines = [i + 1 for i, line in enumerate((MEAS / name).read_text().splitlines()) if not line.startswith("#")][1:]
+    for x, y in zip(a["largest_residuals"], b["largest_residuals"]):
+        assert data_lines[x.pop("line") - 2] == y.pop("line")
+    assert a == b
+    assert [row["error"] for row in r._rows()] == list(r.estimates)
+
+
+def test_identify_bad_input():
+    m = chain.Machine.load(PROBE)
+    cols = _columns(MEAS / "ballplate.csv")
+    cols["dpx"] = cols["dpx"][:-1]
+    with pytest.raises(ValueError, match="has 449 values"):
+        m.identify(cols)
+    cols = _columns(MEAS / "ballplate.csv")
+    cols["dpy"][3] = np.inf
+    with pytest.raises(ValueError, match=r"non-finite value \(inf\) at row 3"):
+        m.identify(cols)
+    cols = _columns(MEAS / "ballplate.csv")
+    cols["bogus"] = cols.pop("dpz")
+    with pytest.raises(chain.MachineError) as info:
+        m.identify(cols)
+    assert info.value.file == "<measurements>" and info.value.line == 1
+    with pytest.raises(ValueError, match="has no parameter `tw`"):
+        m.identify(MEAS / "ballplate.csv", params={"tw": 1.0})
+
+
+@pytest.mark.parametrize("k", [40, 66])
+def test_plan_is_the_cli_json(k, cli):
+    m = chain.Machine.load(PROBE)
+    r = m.plan(MEAS / "candidates.csv", k)
+    assert r.to_dict() == cli("plan", PROBE, "--candidates", MEAS / "candidates.csv", "--count", k)
+    a = m.plan(_columns(MEAS / "candidates.csv"), k, name=str(MEAS / "candidates.csv"))
+    assert a.to_dict() == r.to_dict()
+    assert len(r._rows()) == len(r.errors)
+
+
+def test_plan_bad_input():
+    m = chain.Machine.load(PROBE)
+    with pytest.raises(ValueError, match="--kind direction needs the columns"):
+        m.plan(MEAS / "candidates.csv", 40, kind="direction")
+    with pytest.raises(ValueError, match="kind must be"):
+        m.plan(MEAS / "candidates.csv", 40, kind="line")
+    with pytest.raises(ValueError, match="--count 451 is not a count"):
+        m.plan(MEAS / "candidates.csv", 451)
+    with pytest.raises(ValueError, match="positive integer"):
+        m.plan(MEAS / "candidates.csv", 0)
