@@ -45,11 +45,17 @@ chain::machine!(pub Bc = "chain-macro/benches/machines/bc_head_table.yaml");
 
 const FILES: [(&str, &str); 6] = [
     ("examples/machines/gantry_grinder.yaml", "gantry_grinder"),
-    ("examples/machines/internal_grinder.yaml", "internal_grinder"),
+    (
+        "examples/machines/internal_grinder.yaml",
+        "internal_grinder",
+    ),
     ("examples/machines/cnc5_bevel.yaml", "cnc5_bevel"),
     ("examples/machines/ac_trunnion.yaml", "ac_trunnion"),
     ("examples/machines/head_head_bc.yaml", "head_head_bc"),
-    ("chain-macro/benches/machines/bc_head_table.yaml", "bc_head_table"),
+    (
+        "chain-macro/benches/machines/bc_head_table.yaml",
+        "bc_head_table",
+    ),
 ];
 
 fn root() -> &'static std::path::Path {
@@ -101,8 +107,7 @@ macro_rules! compare {
         const P: usize = <$new>::PARAMETERS.len();
         const N: usize = <$new>::ERRORS.len();
         const K: usize = <$new>::NONZEROS.len();
-        let machine =
-            chain::core::load_file(&root().join($file)).unwrap_or_else(|d| panic!("{d}"));
+        let machine = chain::core::load_file(&root().join($file)).unwrap_or_else(|d| panic!("{d}"));
         let model = chain::core::derive(&machine);
         // NONZEROS is exactly the symbolic derivation's non-zero entries, row-major.
         let symbolic: Vec<(usize, usize)> = model
@@ -144,8 +149,16 @@ macro_rules! compare {
             for c in 0..6 {
                 for j in 0..N {
                     let o = old[c][j];
-                    assert!(same(o, new[c][j]), "sensitivity [{c}][{j}]: {o} vs {}", new[c][j]);
-                    assert!(same(o, into[c][j]), "into [{c}][{j}]: {o} vs {}", into[c][j]);
+                    assert!(
+                        same(o, new[c][j]),
+                        "sensitivity [{c}][{j}]: {o} vs {}",
+                        new[c][j]
+                    );
+                    assert!(
+                        same(o, into[c][j]),
+                        "into [{c}][{j}]: {o} vs {}",
+                        into[c][j]
+                    );
                     assert!(same(o, flat[c * N + j]), "flat [{c}][{j}]");
                     assert!(same(o, via_trait[c * N + j]), "ErrorModel [{c}][{j}]");
                 }
@@ -169,7 +182,12 @@ macro_rules! compare {
             let mut trait_e = [f64::NAN; 6];
             ErrorModel::error(&<$new>::default(), &q, &p, &e, &mut trait_e);
             for c in 0..6 {
-                assert!(same(old_e[c], new_e[c]), "error[{c}]: {} vs {}", old_e[c], new_e[c]);
+                assert!(
+                    same(old_e[c], new_e[c]),
+                    "error[{c}]: {} vs {}",
+                    old_e[c],
+                    new_e[c]
+                );
                 assert!(same(old_e[c], into_e[c]), "error_into[{c}]");
                 assert!(same(old_e[c], trait_e[c]), "ErrorModel::error[{c}]");
             }
@@ -179,7 +197,10 @@ macro_rules! compare {
         let mut short = vec![7.0; 5];
         ErrorModel::sensitivity(&<$new>::default(), &[0.0; V], &[1.0; P], &mut short);
         let full = <$new>::sensitivity(&[0.0; V], &[1.0; P]);
-        assert!(short.iter().zip(full.iter().flatten()).all(|(a, b)| same(*a, *b)));
+        assert!(short
+            .iter()
+            .zip(full.iter().flatten())
+            .all(|(a, b)| same(*a, *b)));
         let mut out = vec![0.0; 6 * N];
         ErrorModel::sensitivity(&<$new>::default(), &[0.0; 0], &[1.0; P], &mut out);
         assert!(out.iter().all(|x| x.is_nan()));
@@ -215,4 +236,24 @@ fn head_head_bc() {
 #[test]
 fn bc_head_table() {
     compare!(Bc, v1::bc::BcHeadTable, FILES[5].0);
+}
+
+/// `chain-macro/benches/sympy/bc_head_table.json`, the input of the SymPy
+/// benchmark code (`benches/sympy/generate.py`), is the current derivation of
+/// the benchmark machine: when it is not, regenerate both files as that
+/// script's header says.
+#[test]
+fn sympy_bench_input_is_current() {
+    let machine =
+        chain::core::load_file(&root().join(FILES[5].0)).unwrap_or_else(|d| panic!("{d}"));
+    let model = chain::core::derive(&machine);
+    let now = serde_json::to_value(chain::core::export::to_json(&model)).unwrap();
+    let path = root().join("chain-macro/benches/sympy/bc_head_table.json");
+    let recorded: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    assert!(
+        now == recorded,
+        "{} is not the current derivation: rerun chain-macro/benches/sympy/generate.py",
+        path.display()
+    );
 }

@@ -210,11 +210,14 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
             let k = lit(k);
             quote!(out[#k] = #value;)
         });
-        let nonzero_stores = sens_entries.iter().enumerate().map(|(k, (_, _, negative, e))| {
-            let value = signed_value(*negative, e);
-            let k = lit(k);
-            quote!(out[#k] = #value;)
-        });
+        let nonzero_stores = sens_entries
+            .iter()
+            .enumerate()
+            .map(|(k, (_, _, negative, e))| {
+                let value = signed_value(*negative, e);
+                let k = lit(k);
+                quote!(out[#k] = #value;)
+            });
         let nonzeros = sens_entries.iter().map(|(c, j, _, _)| {
             let (c, j) = (lit(*c), lit(*j));
             quote!((#c, #j))
