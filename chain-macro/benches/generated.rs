@@ -14,6 +14,7 @@ chain::machine!(BcHeadTable = "benches/machines/bc_head_table.yaml");
 
 /// The v1 emission of the same machine (`chain derive --format rust`, the
 /// bodies before issue 17), committed for `tests/generated_into.rs`.
+#[allow(dead_code)]
 mod v1 {
     include!("../../tests/generated_v1/bc_head_table.rs");
 }
