@@ -100,6 +100,18 @@ fn same(a: f64, b: f64) -> bool {
     a == b && (a == 0.0 || a.to_bits() == b.to_bits())
 }
 
+/// The runtime tape has no sparsity: the trait's defaults.
+#[test]
+fn runtime_model_has_no_sparsity() {
+    let machine =
+        chain::core::load_file(&root().join(FILES[0].0)).unwrap_or_else(|d| panic!("{d}"));
+    let runtime = chain::core::compile(&machine);
+    assert_eq!(runtime.sparsity(), None);
+    let mut out = [5.0; 32];
+    assert!(!runtime.sensitivity_nonzeros(&[1.0, 2.0, 3.0], &[], &mut out));
+    assert_eq!(out, [5.0; 32]);
+}
+
 /// The whole comparison for one machine: new type `$new`, v1 type `$old`.
 macro_rules! compare {
     ($new:ty, $old:ty, $file:expr) => {{
@@ -163,8 +175,18 @@ macro_rules! compare {
                     assert!(same(o, via_trait[c * N + j]), "ErrorModel [{c}][{j}]");
                 }
             }
+            let mut nz_trait = vec![f64::NAN; K];
+            let model = <$new>::default();
+            assert!(ErrorModel::sensitivity_nonzeros(
+                &model,
+                &q,
+                &p,
+                &mut nz_trait
+            ));
+            assert_eq!(ErrorModel::sparsity(&model), Some(&<$new>::NONZEROS[..]));
             for (k, &(c, j)) in <$new>::NONZEROS.iter().enumerate() {
                 assert!(same(old[c][j], nz[k]), "nonzeros[{k}] = ({c}, {j})");
+                assert!(same(old[c][j], nz_trait[k]), "ErrorModel nonzeros[{k}]");
             }
             // Every entry outside NONZEROS is exactly zero at this point.
             for c in 0..6 {
@@ -204,6 +226,13 @@ macro_rules! compare {
         let mut out = vec![0.0; 6 * N];
         ErrorModel::sensitivity(&<$new>::default(), &[0.0; 0], &[1.0; P], &mut out);
         assert!(out.iter().all(|x| x.is_nan()));
+        // The sparse path refuses wrong lengths and leaves `out` alone.
+        let mut wrong = vec![3.0; K + 1];
+        let model = <$new>::default();
+        assert!(!ErrorModel::sensitivity_nonzeros(
+            &model, &[0.0; V], &[1.0; P], &mut wrong
+        ));
+        assert!(wrong.iter().all(|x| *x == 3.0));
         K
     }};
 }

@@ -4276,6 +4276,22 @@ impl crate::shim::core::ErrorModel for Legendre5 {
             _ => out.iter_mut().for_each(|slot| *slot = f64::NAN),
         }
     }
+    fn sparsity(&self) -> ::core::option::Option<&[(usize, usize)]> {
+        ::core::option::Option::Some(&Self::NONZEROS)
+    }
+    fn sensitivity_nonzeros(&self, q: &[f64], p: &[f64], out: &mut [f64]) -> bool {
+        match (
+            <&[f64; 5]>::try_from(q),
+            <&[f64; 2]>::try_from(p),
+            <&mut [f64; 433]>::try_from(out),
+        ) {
+            (Ok(q), Ok(p), Ok(out)) => {
+                Self::sensitivity_nonzeros(q, p, out);
+                true
+            }
+            _ => false,
+        }
+    }
     fn nominal(&self, q: &[f64], p: &[f64]) -> crate::shim::core::Pose {
         match (<&[f64; 5]>::try_from(q), <&[f64; 2]>::try_from(p)) {
             (Ok(q), Ok(p)) => {

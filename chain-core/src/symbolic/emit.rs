@@ -316,6 +316,22 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
                     _ => out.iter_mut().for_each(|slot| *slot = f64::NAN),
                 }
             }
+            fn sparsity(&self) -> ::core::option::Option<&[(usize, usize)]> {
+                ::core::option::Option::Some(&Self::NONZEROS)
+            }
+            fn sensitivity_nonzeros(&self, q: &[f64], p: &[f64], out: &mut [f64]) -> bool {
+                match (
+                    <&[f64; #v]>::try_from(q),
+                    <&[f64; #p]>::try_from(p),
+                    <&mut [f64; #k]>::try_from(out),
+                ) {
+                    (Ok(q), Ok(p), Ok(out)) => {
+                        Self::sensitivity_nonzeros(q, p, out);
+                        true
+                    }
+                    _ => false,
+                }
+            }
         };
         (error_fns, sensitivity_fns, model_fns)
     } else {
