@@ -36,6 +36,22 @@ pub trait ErrorModel {
     /// (`out[c * N + j] = ∂E_c/∂e_j`). `out.len()` must be `6 * N`.
     fn sensitivity(&self, q: &[f64], p: &[f64], out: &mut [f64]);
 
+    /// The entries of the sensitivity matrix that are not identically zero,
+    /// `(row, error index)`, row-major, when the model knows them (a
+    /// `machine!` type: its `NONZEROS`); `None` otherwise (the default).
+    fn sparsity(&self) -> Option<&[(usize, usize)]> {
+        None
+    }
+
+    /// The entries [`ErrorModel::sparsity`] names, in that order, into `out`
+    /// (`out.len()` = their number). Returns `false`, leaving `out` as it
+    /// was, when the model has no sparsity (the default) or a slice has
+    /// another length; the caller then uses [`ErrorModel::sensitivity`].
+    fn sensitivity_nonzeros(&self, q: &[f64], p: &[f64], out: &mut [f64]) -> bool {
+        let _ = (q, p, out);
+        false
+    }
+
     /// The nominal pose of the tool relative to the workpiece:
     /// `R_wt(q, 0)` and `T_wt(q, 0) · tool_point`.
     fn nominal(&self, q: &[f64], p: &[f64]) -> Pose;

@@ -5,11 +5,25 @@
 use std::hint::black_box;
 
 use chain::core::ErrorModel;
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::{criterion_group, Criterion};
 
 chain::machine!(GantryGrinder = "../examples/machines/gantry_grinder.yaml");
 chain::machine!(Cnc5Bevel = "../examples/machines/cnc5_bevel.yaml");
 chain::machine!(AcTrunnion = "../examples/machines/ac_trunnion.yaml");
+chain::machine!(BcHeadTable = "benches/machines/bc_head_table.yaml");
+
+/// The v1 emission of the same machine (`chain derive --format rust`, the
+/// bodies before issue 17), committed for `tests/generated_into.rs`.
+#[allow(dead_code)]
+mod v1 {
+    include!("../../tests/generated_v1/bc_head_table.rs");
+}
+
+/// SymPy's `cse` + `rust_code` of the same 6×33 Jacobian
+/// (`benches/sympy/generate.py`).
+mod sympy {
+    include!("sympy/bc_head_table_sympy.rs");
+}
 
 /// Seed 000's corrected Eq. 18 sensitivity written by hand, in the generated
 /// type's error order (docs/errata.md for the two corrections).
@@ -112,5 +126,99 @@ fn two_rotary_axes(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, gantry, five_axis, two_rotary_axes);
-criterion_main!(benches);
+/// Issue 17: the B-head/C-table machine with 33 errors
+/// (`benches/machines/bc_head_table.yaml`): the v1 body, the new functions
+/// and SymPy's output of the same Jacobian, in one binary.
+fn bc_head_table(c: &mut Criterion) {
+    let p = [150.0];
+    let q = [120.0, 0.7, -40.0, 250.0, -0.4];
+    let reference = BcHeadTable::sensitivity(&q, &p);
+    let mut sym = [[0.0; 33]; 6];
+    sympy::sensitivity_sympy(&q, &p, &mut sym);
+    for (a, b) in reference.iter().flatten().zip(sym.iter().flatten()) {
+        assert!(
+            (a - b).abs() <= 1e-12 * a.abs().max(1.0),
+            "SymPy {b} vs {a}"
+        );
+    }
+    assert_eq!(v1::BcHeadTable::sensitivity(&q, &p), reference);
+    let mut g = c.benchmark_group("bc_head_table");
+    g.bench_function("v1_sensitivity", |b| {
+        b.iter(|| black_box(v1::BcHeadTable::sensitivity(black_box(&q), black_box(&p))))
+    });
+    g.bench_function("sensitivity", |b| {
+        b.iter(|| black_box(BcHeadTable::sensitivity(black_box(&q), black_box(&p))))
+    });
+    let mut out = [[0.0; 33]; 6];
+    g.bench_function("sensitivity_into", |b| {
+        b.iter(|| {
+            BcHeadTable::sensitivity_into(black_box(&q), black_box(&p), &mut out);
+            black_box(&mut out);
+        })
+    });
+    let mut nz = [0.0; BcHeadTable::NONZEROS.len()];
+    g.bench_function("sensitivity_nonzeros", |b| {
+        b.iter(|| {
+            BcHeadTable::sensitivity_nonzeros(black_box(&q), black_box(&p), &mut nz);
+            black_box(&mut nz);
+        })
+    });
+    g.bench_function("sympy_cse_rust_code", |b| {
+        b.iter(|| {
+            sympy::sensitivity_sympy(black_box(&q), black_box(&p), &mut out);
+            black_box(&mut out);
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, gantry, five_axis, two_rotary_axes, bc_head_table);
+/// `CHAIN_CALLGRIND=NAME:COUNT` runs one function of the `bc_head_table`
+/// group COUNT times and exits (no criterion): instruction counts under
+/// `valgrind --tool=callgrind` that do not depend on the machine's load
+/// (docs/performance.md, "Generated code at the limit").
+fn callgrind(spec: &str) {
+    let (name, count) = spec.split_once(':').unwrap_or((spec, "100000"));
+    let count: usize = count.parse().expect("CHAIN_CALLGRIND=NAME:COUNT");
+    let p = [150.0];
+    let q = [120.0, 0.7, -40.0, 250.0, -0.4];
+    let mut out = [[0.0; 33]; 6];
+    let mut nz = [0.0; BcHeadTable::NONZEROS.len()];
+    for _ in 0..count {
+        match name {
+            "v1_sensitivity" => {
+                black_box(v1::BcHeadTable::sensitivity(black_box(&q), black_box(&p)));
+            }
+            "sensitivity" => {
+                black_box(BcHeadTable::sensitivity(black_box(&q), black_box(&p)));
+            }
+            "sensitivity_into" => {
+                BcHeadTable::sensitivity_into(black_box(&q), black_box(&p), &mut out);
+                black_box(&mut out);
+            }
+            "sensitivity_nonzeros" => {
+                BcHeadTable::sensitivity_nonzeros(black_box(&q), black_box(&p), &mut nz);
+                black_box(&mut nz);
+            }
+            "sympy" => {
+                sympy::sensitivity_sympy(black_box(&q), black_box(&p), &mut out);
+                black_box(&mut out);
+            }
+            "sin_cos" => {
+                let (s, c) = black_box(q[1]).sin_cos();
+                let (t, d) = black_box(q[4]).sin_cos();
+                black_box((s, c, t, d));
+            }
+            other => panic!("unknown function {other}"),
+        }
+    }
+}
+
+fn main() {
+    if let Ok(spec) = std::env::var("CHAIN_CALLGRIND") {
+        callgrind(&spec);
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -27,6 +27,26 @@ pub struct EmitOptions {
     pub visibility: TokenStream,
     /// Path of the `chain` facade crate in the generated code (default `::chain`).
     pub crate_path: TokenStream,
+    /// Which functions and bodies to emit.
+    pub emission: Emission,
+}
+
+/// Which generation of the generated API to emit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Emission {
+    /// The original functions (`error`, `sensitivity`, `nominal`) with their
+    /// original bodies, text for text: what `chain derive --format rust`
+    /// prints (its output is pinned byte for byte by `tests/golden/`).
+    V1,
+    /// What `machine!` emits (issue 17): the v1 functions, the same values,
+    /// plus the functions that write into the caller's storage —
+    /// `sensitivity_into`, `sensitivity_flat_into`, `NONZEROS` and
+    /// `sensitivity_nonzeros`, `error_into` — with bodies in which a sum and
+    /// its negation, and every inner sum of the factored coefficients, are
+    /// computed once. The v1 functions and the `ErrorModel` impl write
+    /// through them (`docs/macro.md`).
+    #[default]
+    Direct,
 }
 
 impl EmitOptions {
@@ -37,7 +57,15 @@ impl EmitOptions {
             type_name: type_name_for(&model.machine),
             visibility: quote!(pub),
             crate_path: quote!(::chain),
+            emission: Emission::V1,
         }
+    }
+
+    /// The same options with another [`Emission`].
+    #[must_use]
+    pub fn with_emission(mut self, emission: Emission) -> EmitOptions {
+        self.emission = emission;
+        self
     }
 }
 
@@ -96,6 +124,7 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
         .collect();
 
     let index_consts = index_constants(model);
+    let direct = options.emission == Emission::Direct;
 
     // Sensitivity: every non-zero coefficient.
     let sens_polys: Vec<(usize, usize, &Poly)> = model
@@ -104,22 +133,33 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
         .enumerate()
         .flat_map(|(c, entries)| entries.iter().map(move |(j, poly)| (c, *j, poly)))
         .collect();
-    let mut sens = Body::new(model);
-    let sens_assign: Vec<TokenStream> = sens_polys
+    let mut sens = Body::new(model, direct);
+    let sens_entries: Vec<(usize, usize, bool, TokenStream)> = sens_polys
         .iter()
+        .filter(|(_, _, poly)| !(direct && poly.is_zero()))
         .map(|(c, j, poly)| {
             let (negative, e) = sens.signed(poly);
+            (*c, *j, negative, e)
+        })
+        .collect();
+    let signed_value = |negative: bool, e: &TokenStream| {
+        if negative {
+            quote!(-#e)
+        } else {
+            quote!(#e)
+        }
+    };
+    let sens_assign: Vec<TokenStream> = sens_entries
+        .iter()
+        .map(|(c, j, negative, e)| {
+            let value = signed_value(*negative, e);
             let (c, j) = (lit(*c), lit(*j));
-            if negative {
-                quote!(s[#c][#j] = -#e;)
-            } else {
-                quote!(s[#c][#j] = #e;)
-            }
+            quote!(s[#c][#j] = #value;)
         })
         .collect();
     let sens_prelude = sens.prelude();
 
-    let mut err = Body::new(model);
+    let mut err = Body::new(model, direct);
     let err_rows: Vec<TokenStream> = Component::ALL
         .iter()
         .map(|c| {
@@ -148,7 +188,7 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
         .collect();
     let err_prelude = err.prelude();
 
-    let mut nom = Body::new(model);
+    let mut nom = Body::new(model, false);
     let rot: Vec<TokenStream> = model
         .nominal_rotation
         .iter()
@@ -159,6 +199,185 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
         .collect();
     let pos: Vec<TokenStream> = model.nominal_position.iter().map(|x| nom.expr(x)).collect();
     let nom_prelude = nom.prelude();
+
+    let (error_fns, sensitivity_fns, model_fns) = if direct {
+        let total = 6 * model.errors.len();
+        let mut flat: Vec<TokenStream> = vec![quote!(0.0); total];
+        for (c, j, negative, e) in &sens_entries {
+            flat[c * model.errors.len() + j] = signed_value(*negative, e);
+        }
+        let flat_stores = flat.iter().enumerate().map(|(k, value)| {
+            let k = lit(k);
+            quote!(out[#k] = #value;)
+        });
+        let nonzero_stores = sens_entries
+            .iter()
+            .enumerate()
+            .map(|(k, (_, _, negative, e))| {
+                let value = signed_value(*negative, e);
+                let k = lit(k);
+                quote!(out[#k] = #value;)
+            });
+        let nonzeros = sens_entries.iter().map(|(c, j, _, _)| {
+            let (c, j) = (lit(*c), lit(*j));
+            quote!((#c, #j))
+        });
+        let k = lit(sens_entries.len());
+        let total = lit(total);
+        let error_stores = err_rows.iter().enumerate().map(|(c, row)| {
+            let c = lit(c);
+            quote!(out[#c] = #row;)
+        });
+        let error_fns = quote! {
+            #[inline]
+            #[must_use]
+            pub fn error(q: &[f64; #v], p: &[f64; #p], e: &[f64; #n]) -> [f64; 6] {
+                let mut out = [0.0f64; 6];
+                Self::error_into(q, p, e, &mut out);
+                out
+            }
+
+            /// [`Self::error`] written into `out` (every component).
+            #[inline]
+            pub fn error_into(q: &[f64; #v], p: &[f64; #p], e: &[f64; #n], out: &mut [f64; 6]) {
+                #err_prelude
+                #(#error_stores)*
+            }
+        };
+        let sensitivity_fns = quote! {
+            #[inline]
+            #[must_use]
+            pub fn sensitivity(q: &[f64; #v], p: &[f64; #p]) -> [[f64; #n]; 6] {
+                // Its own body: zero-filling a returned array and then calling
+                // `sensitivity_into` over it measured 1.5× slower (issue 17).
+                #sens_prelude
+                let mut s = [[0.0f64; #n]; 6];
+                #(#sens_assign)*
+                s
+            }
+
+            /// [`Self::sensitivity`] written into `out`: every entry, the
+            /// structural zeros included (no zero-filling needed, no copy).
+            #[inline]
+            pub fn sensitivity_into(q: &[f64; #v], p: &[f64; #p], out: &mut [[f64; #n]; 6]) {
+                // `6 × N` elements: the conversion cannot fail.
+                if let ::core::result::Result::Ok(flat) =
+                    <&mut [f64; #total]>::try_from(out.as_flattened_mut())
+                {
+                    Self::sensitivity_flat_into(q, p, flat);
+                }
+            }
+
+            /// [`Self::sensitivity`] written row-major into `out`
+            /// (`out[c * N + j] = ∂E_c/∂e_j`), every entry in index order.
+            #[inline]
+            pub fn sensitivity_flat_into(q: &[f64; #v], p: &[f64; #p], out: &mut [f64; #total]) {
+                #sens_prelude
+                #(#flat_stores)*
+            }
+
+            /// The entries of the sensitivity matrix that are not identically
+            /// zero, `(row, error index)`, row-major: the order of
+            /// [`Self::sensitivity_nonzeros`]. Every other entry is exactly 0.
+            pub const NONZEROS: [(usize, usize); #k] = [#(#nonzeros),*];
+
+            /// The entries [`Self::NONZEROS`] of the sensitivity matrix, in
+            /// that order: `out[k] = s[NONZEROS[k].0][NONZEROS[k].1]`.
+            #[inline]
+            pub fn sensitivity_nonzeros(q: &[f64; #v], p: &[f64; #p], out: &mut [f64; #k]) {
+                #sens_prelude
+                #(#nonzero_stores)*
+            }
+        };
+        let model_fns = quote! {
+            fn error(&self, q: &[f64], p: &[f64], e: &[f64], out: &mut [f64; 6]) {
+                match (
+                    <&[f64; #v]>::try_from(q),
+                    <&[f64; #p]>::try_from(p),
+                    <&[f64; #n]>::try_from(e),
+                ) {
+                    (Ok(q), Ok(p), Ok(e)) => Self::error_into(q, p, e, out),
+                    _ => *out = [f64::NAN; 6],
+                }
+            }
+            fn sensitivity(&self, q: &[f64], p: &[f64], out: &mut [f64]) {
+                match (<&[f64; #v]>::try_from(q), <&[f64; #p]>::try_from(p)) {
+                    (Ok(q), Ok(p)) => match <&mut [f64; #total]>::try_from(&mut *out) {
+                        Ok(flat) => Self::sensitivity_flat_into(q, p, flat),
+                        // A slice of another length (the trait asks for 6 × N):
+                        // the entries that fit.
+                        Err(_) => {
+                            let s = Self::sensitivity(q, p);
+                            for (slot, value) in out.iter_mut().zip(s.iter().flatten()) {
+                                *slot = *value;
+                            }
+                        }
+                    },
+                    _ => out.iter_mut().for_each(|slot| *slot = f64::NAN),
+                }
+            }
+            fn sparsity(&self) -> ::core::option::Option<&[(usize, usize)]> {
+                ::core::option::Option::Some(&Self::NONZEROS)
+            }
+            fn sensitivity_nonzeros(&self, q: &[f64], p: &[f64], out: &mut [f64]) -> bool {
+                match (
+                    <&[f64; #v]>::try_from(q),
+                    <&[f64; #p]>::try_from(p),
+                    <&mut [f64; #k]>::try_from(out),
+                ) {
+                    (Ok(q), Ok(p), Ok(out)) => {
+                        Self::sensitivity_nonzeros(q, p, out);
+                        true
+                    }
+                    _ => false,
+                }
+            }
+        };
+        (error_fns, sensitivity_fns, model_fns)
+    } else {
+        let error_fns = quote! {
+            #[inline]
+            #[must_use]
+            pub fn error(q: &[f64; #v], p: &[f64; #p], e: &[f64; #n]) -> [f64; 6] {
+                #err_prelude
+                [#(#err_rows),*]
+            }
+        };
+        let sensitivity_fns = quote! {
+            #[inline]
+            #[must_use]
+            pub fn sensitivity(q: &[f64; #v], p: &[f64; #p]) -> [[f64; #n]; 6] {
+                #sens_prelude
+                let mut s = [[0.0f64; #n]; 6];
+                #(#sens_assign)*
+                s
+            }
+        };
+        let model_fns = quote! {
+            fn error(&self, q: &[f64], p: &[f64], e: &[f64], out: &mut [f64; 6]) {
+                *out = match (
+                    <&[f64; #v]>::try_from(q),
+                    <&[f64; #p]>::try_from(p),
+                    <&[f64; #n]>::try_from(e),
+                ) {
+                    (Ok(q), Ok(p), Ok(e)) => Self::error(q, p, e),
+                    _ => [f64::NAN; 6],
+                };
+            }
+            fn sensitivity(&self, q: &[f64], p: &[f64], out: &mut [f64]) {
+                match (<&[f64; #v]>::try_from(q), <&[f64; #p]>::try_from(p)) {
+                    (Ok(q), Ok(p)) => {
+                        let s = Self::sensitivity(q, p);
+                        for (slot, value) in out.iter_mut().zip(s.iter().flatten()) {
+                            *slot = *value;
+                        }
+                    }
+                    _ => out.iter_mut().for_each(|slot| *slot = f64::NAN),
+                }
+            }
+        };
+        (error_fns, sensitivity_fns, model_fns)
+    };
 
     let text = |poly: &Poly| poly.to_text(&|s| model.symbol_name(s));
     let component_docs: Vec<String> = Component::ALL
@@ -262,26 +481,14 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
             /// The error vector `[px, py, pz, ox, oy, oz]`:
             ///
             #(#[doc = #component_docs])*
-            #[inline]
-            #[must_use]
-            pub fn error(q: &[f64; #v], p: &[f64; #p], e: &[f64; #n]) -> [f64; 6] {
-                #err_prelude
-                [#(#err_rows),*]
-            }
+            #error_fns
 
             #error_at
 
             /// The sensitivity matrix `s[c][j] = ∂E_c/∂e_j` (rows `px, py, pz, ox, oy, oz`):
             ///
             #(#[doc = #component_docs])*
-            #[inline]
-            #[must_use]
-            pub fn sensitivity(q: &[f64; #v], p: &[f64; #p]) -> [[f64; #n]; 6] {
-                #sens_prelude
-                let mut s = [[0.0f64; #n]; 6];
-                #(#sens_assign)*
-                s
-            }
+            #sensitivity_fns
 
             /// The nominal pose `R_wt(q, 0)` and `T_wt(q, 0)·tool_point`:
             ///
@@ -304,27 +511,7 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
             fn errors(&self) -> &[&str] {
                 &Self::ERRORS
             }
-            fn error(&self, q: &[f64], p: &[f64], e: &[f64], out: &mut [f64; 6]) {
-                *out = match (
-                    <&[f64; #v]>::try_from(q),
-                    <&[f64; #p]>::try_from(p),
-                    <&[f64; #n]>::try_from(e),
-                ) {
-                    (Ok(q), Ok(p), Ok(e)) => Self::error(q, p, e),
-                    _ => [f64::NAN; 6],
-                };
-            }
-            fn sensitivity(&self, q: &[f64], p: &[f64], out: &mut [f64]) {
-                match (<&[f64; #v]>::try_from(q), <&[f64; #p]>::try_from(p)) {
-                    (Ok(q), Ok(p)) => {
-                        let s = Self::sensitivity(q, p);
-                        for (slot, value) in out.iter_mut().zip(s.iter().flatten()) {
-                            *slot = *value;
-                        }
-                    }
-                    _ => out.iter_mut().for_each(|slot| *slot = f64::NAN),
-                }
-            }
+            #model_fns
             fn nominal(&self, q: &[f64], p: &[f64]) -> #krate::core::Pose {
                 match (<&[f64; #v]>::try_from(q), <&[f64; #p]>::try_from(p)) {
                     (Ok(q), Ok(p)) => {
@@ -399,11 +586,15 @@ struct Body<'a> {
     monomial_index: HashMap<Monomial, Ident>,
     shared: HashMap<String, (Ident, TokenStream, usize)>,
     shared_order: Vec<String>,
+    /// [`Emission::Direct`]: a sum and its negation share one local, and the
+    /// inner sums of the factored form are shared too.
+    direct: bool,
 }
 
 impl<'a> Body<'a> {
-    fn new(model: &'a SymbolicModel) -> Body<'a> {
+    fn new(model: &'a SymbolicModel, direct: bool) -> Body<'a> {
         Body {
+            direct,
             model,
             symbols: Vec::new(),
             monomials: Vec::new(),
@@ -487,7 +678,18 @@ impl<'a> Body<'a> {
             })
             .collect();
         let id = self.symbol(sym);
-        let inner = self.horner(reduced);
+        let inner = if self.direct && reduced.len() > 1 {
+            // The inner sum is parenthesised, so a shared local computes
+            // exactly the same value (a negated one: the same magnitude).
+            let (negative, local) = self.shared_signed(reduced);
+            if negative {
+                quote!(-#local)
+            } else {
+                local
+            }
+        } else {
+            self.horner(reduced)
+        };
         if without.is_empty() {
             quote!(#id * (#inner))
         } else {
@@ -536,7 +738,37 @@ impl<'a> Body<'a> {
             let single = Poly::from_terms(vec![(m.clone(), c.abs())]);
             return (*c < 0.0, self.poly_tokens(&single));
         }
+        if self.direct {
+            return self.shared_signed(poly.terms().to_vec());
+        }
         (false, self.expr(poly))
+    }
+
+    /// A multi-term polynomial as a shared local up to its sign: `P` and `−P`
+    /// are one local (the one whose first term is positive), returned with
+    /// `true` when `poly` is its negation. Negation is exact in IEEE 754
+    /// (round to nearest is symmetric), so `−k` has the bits of `−P` computed
+    /// directly, but for the sign of a zero result.
+    fn shared_signed(&mut self, terms: Vec<(Monomial, f64)>) -> (bool, TokenStream) {
+        // The terms as they are (no re-sorting, no `sin²` folding): the local
+        // must evaluate exactly what the inline form did.
+        let negative = terms.first().is_some_and(|(_, c)| *c < 0.0);
+        let canonical: Vec<(Monomial, f64)> = if negative {
+            terms.into_iter().map(|(m, c)| (m, -c)).collect()
+        } else {
+            terms
+        };
+        let key = format!("{canonical:?}");
+        if let Some((id, _, uses)) = self.shared.get_mut(&key) {
+            *uses += 1;
+            let id = id.clone();
+            return (negative, quote!(#id));
+        }
+        let body = self.horner(canonical);
+        let id = format_ident!("k{}", self.shared_order.len());
+        self.shared.insert(key.clone(), (id.clone(), body, 1));
+        self.shared_order.push(key);
+        (negative, quote!(#id))
     }
 
     /// The expression of a polynomial; repeated multi-term polynomials are
@@ -674,6 +906,7 @@ mod tests {
             type_name: "Legendre5".into(),
             visibility: quote!(pub),
             crate_path: quote!(crate::shim),
+            emission: Emission::Direct,
         };
         let code = format!(
             "// Generated by `chain_core::emit` from examples/machines/legendre5.yaml\n\
