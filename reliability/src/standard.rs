@@ -27,6 +27,10 @@ pub(crate) struct AffineU {
     pub(crate) tolerances: Vec<f64>,
     /// Criterion.
     pub(crate) criterion: Criterion,
+    /// One component under a per-component criterion (the common case of
+    /// one tolerance): `(m, tolerance, two-sided)`, evaluated without the
+    /// general loop over components.
+    pub(crate) single: Option<(f64, f64, bool)>,
 }
 
 /// `G(u) = g(T(u))` on the active standard coordinates.
@@ -57,12 +61,21 @@ impl<'e, 'a, L: LimitState> Standard<'e, 'a, L> {
             for c in 0..k {
                 a.extend(active.iter().map(|&j| aff.row(c)[j]));
             }
+            let tolerances = aff.view.tolerances().to_vec();
+            let criterion = aff.view.criterion();
+            let single = match criterion {
+                Criterion::Each(sided) if k == 1 => {
+                    Some((aff.mean[0], tolerances[0], sided == Sided::Two))
+                }
+                _ => None,
+            };
             AffineU {
                 k,
                 m: aff.mean.clone(),
                 a,
-                tolerances: aff.view.tolerances().to_vec(),
-                criterion: aff.view.criterion(),
+                tolerances,
+                criterion,
+                single,
             }
         });
         Standard {
@@ -87,8 +100,26 @@ impl<'e, 'a, L: LimitState> Standard<'e, 'a, L> {
     }
 
     /// `G(u)` at the active coordinates `u` (the others at 0).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn value(&self, u: &[f64], s: &mut Scratch) -> f64 {
+        if let Some(AffineU {
+            single: Some((m, t, two)),
+            a,
+            ..
+        }) = &self.affine
+        {
+            // The same operations, in the same order, as the general loop
+            // of `value_general` with k = 1 (so the values are bit-identical).
+            let e = m + dot(a, u);
+            let margin = if *two { t - e.abs() } else { t - e };
+            return f64::INFINITY.min(margin);
+        }
+        self.value_general(u, s)
+    }
+
+    /// [`Standard::value`] outside the one-component fast path.
+    #[inline(never)]
+    fn value_general(&self, u: &[f64], s: &mut Scratch) -> f64 {
         if let Some(aff) = &self.affine {
             let na = self.active.len();
             let e = |c: usize| aff.m[c] + dot(&aff.a[c * na..(c + 1) * na], u);

@@ -338,8 +338,6 @@ impl SubsetSimulation {
         let mut order: Vec<usize> = (0..n_level).collect();
         let mut next_u = vec![0.0; n_level * na];
         let mut next_g = vec![0.0; n_level];
-        let mut cand = vec![0.0; na];
-        let mut z = vec![0.0; na];
         for level in 0..self.max_levels {
             let failing = g.iter().filter(|&&v| v <= 0.0).count();
             let last = failing >= nc;
@@ -410,52 +408,28 @@ impl SubsetSimulation {
                     *s = var.sqrt();
                 }
             }
-            let group = ((ADAPT_FRACTION * nc as f64).floor() as usize).max(1);
-            let spreads = |lambda: f64| -> (Vec<f64>, Vec<f64>) {
-                let s: Vec<f64> = sigma_hat.iter().map(|h| (lambda * h).min(1.0)).collect();
-                let r = s.iter().map(|s| (1.0 - s * s).max(0.0).sqrt()).collect();
-                (s, r)
+            let level_data = Level {
+                seeds,
+                u: &u,
+                g: &g,
+                sigma_hat: &sigma_hat,
+                threshold,
+                ns,
             };
-            let (mut sig, mut rho) = spreads(lambda);
-            let mut adapt_step = 1.0f64;
-            let (mut accepted_group, mut proposed_group) = (0u64, 0u64);
-            let (mut accepted, mut proposed) = (0u64, 0u64);
-            for (c, &seed) in seeds.iter().enumerate() {
-                let start = c * ns;
-                next_u[start * na..(start + 1) * na]
-                    .copy_from_slice(&u[seed * na..(seed + 1) * na]);
-                next_g[start] = g[seed];
-                for t in 1..ns {
-                    let prev = (start + t - 1) * na;
-                    rng.fill_normal(&mut z);
-                    for k in 0..na {
-                        cand[k] = rho[k] * next_u[prev + k] + sig[k] * z[k];
-                    }
-                    let gc = std.value(&cand, &mut scratch);
-                    let here = (start + t) * na;
-                    if gc <= threshold {
-                        next_u[here..here + na].copy_from_slice(&cand);
-                        next_g[start + t] = gc;
-                        accepted_group += 1;
-                    } else {
-                        next_u.copy_within(prev..prev + na, here);
-                        next_g[start + t] = next_g[start + t - 1];
-                    }
-                    proposed_group += 1;
-                }
-                if (c + 1) % group == 0 && proposed_group > 0 {
-                    let rate = accepted_group as f64 / proposed_group as f64;
-                    lambda = (lambda.ln() + (rate - TARGET_ACCEPTANCE) / adapt_step.sqrt()).exp();
-                    adapt_step += 1.0;
-                    (sig, rho) = spreads(lambda);
-                    accepted += accepted_group;
-                    proposed += proposed_group;
-                    accepted_group = 0;
-                    proposed_group = 0;
-                }
-            }
-            accepted += accepted_group;
-            proposed += proposed_group;
+            let out = (&mut next_u[..], &mut next_g[..]);
+            // The dimension as a constant for the common small cases, so
+            // the per-state loops are unrolled.
+            let (accepted, proposed) = match na {
+                1 => level_data.populate::<1, L>(std, &mut rng, &mut lambda, out),
+                2 => level_data.populate::<2, L>(std, &mut rng, &mut lambda, out),
+                3 => level_data.populate::<3, L>(std, &mut rng, &mut lambda, out),
+                4 => level_data.populate::<4, L>(std, &mut rng, &mut lambda, out),
+                5 => level_data.populate::<5, L>(std, &mut rng, &mut lambda, out),
+                6 => level_data.populate::<6, L>(std, &mut rng, &mut lambda, out),
+                7 => level_data.populate::<7, L>(std, &mut rng, &mut lambda, out),
+                8 => level_data.populate::<8, L>(std, &mut rng, &mut lambda, out),
+                _ => level_data.populate::<0, L>(std, &mut rng, &mut lambda, out),
+            };
             let new = (nc * (ns - 1)) as u64;
             calls += new;
             samples += n_level as u64;
@@ -482,6 +456,99 @@ impl SubsetSimulation {
     }
 }
 
+/// What the Markov chains of one level start from.
+struct Level<'a> {
+    /// The seeds (indices into `u` and `g`), in the order the chains run.
+    seeds: &'a [usize],
+    /// The states of the previous level, `na` coordinates each.
+    u: &'a [f64],
+    /// Their values of `G`.
+    g: &'a [f64],
+    /// The seeds' standard deviation per coordinate.
+    sigma_hat: &'a [f64],
+    /// The level's threshold `b_j`.
+    threshold: f64,
+    /// States per chain `N_s` (the seed is the first).
+    ns: usize,
+}
+
+impl Level<'_> {
+    /// Runs the aCS chains of one level (Papaioannou et al. 2015,
+    /// Algorithm 5), writing chain `c` to states `c·N_s..(c+1)·N_s` of
+    /// `next` (coordinates and values); adapts `λ` after every group of
+    /// chains. Returns the accepted and the proposed moves. `N` is the
+    /// dimension when known at compile time (0: `sigma_hat.len()`).
+    fn populate<const N: usize, L: LimitState>(
+        &self,
+        std: &Standard<'_, '_, L>,
+        rng: &mut CaseRng,
+        lambda: &mut f64,
+        (next_u, next_g): (&mut [f64], &mut [f64]),
+    ) -> (u64, u64) {
+        let na = if N > 0 { N } else { self.sigma_hat.len() };
+        let ns = self.ns;
+        let nc = self.seeds.len();
+        let mut scratch = std.scratch();
+        let mut cand = vec![0.0; na];
+        let mut z = vec![0.0; na];
+        let group = ((ADAPT_FRACTION * nc as f64).floor() as usize).max(1);
+        let spreads = |lambda: f64| -> (Vec<f64>, Vec<f64>) {
+            let s: Vec<f64> = self
+                .sigma_hat
+                .iter()
+                .map(|h| (lambda * h).min(1.0))
+                .collect();
+            let r = s.iter().map(|s| (1.0 - s * s).max(0.0).sqrt()).collect();
+            (s, r)
+        };
+        let (mut sig, mut rho) = spreads(*lambda);
+        let mut adapt_step = 1.0f64;
+        let (mut accepted_group, mut proposed_group) = (0u64, 0u64);
+        let (mut accepted, mut proposed) = (0u64, 0u64);
+        for (c, &seed) in self.seeds.iter().enumerate() {
+            let start = c * ns;
+            let chain_u = &mut next_u[start * na..(start + ns) * na];
+            let chain_g = &mut next_g[start..start + ns];
+            chain_u[..na].copy_from_slice(&self.u[seed * na..(seed + 1) * na]);
+            chain_g[0] = self.g[seed];
+            let (r, s) = (&rho[..na], &sig[..na]);
+            for t in 1..ns {
+                let z = &mut z[..na];
+                rng.fill_normal(z);
+                let (done, rest) = chain_u.split_at_mut(t * na);
+                let prev = &done[(t - 1) * na..t * na];
+                let next = &mut rest[..na];
+                let cand = &mut cand[..na];
+                for k in 0..na {
+                    cand[k] = r[k] * prev[k] + s[k] * z[k];
+                }
+                let gc = std.value(cand, &mut scratch);
+                // Accept or stay, without a data-dependent branch (the
+                // acceptance rate is near 0.44, the worst case for a
+                // branch predictor).
+                let accept = gc <= self.threshold;
+                for k in 0..na {
+                    next[k] = if accept { cand[k] } else { prev[k] };
+                }
+                chain_g[t] = if accept { gc } else { chain_g[t - 1] };
+                accepted_group += u64::from(accept);
+                proposed_group += 1;
+            }
+            if (c + 1) % group == 0 && proposed_group > 0 {
+                let rate = accepted_group as f64 / proposed_group as f64;
+                *lambda = (lambda.ln() + (rate - TARGET_ACCEPTANCE) / adapt_step.sqrt()).exp();
+                adapt_step += 1.0;
+                (sig, rho) = spreads(*lambda);
+                accepted += accepted_group;
+                proposed += proposed_group;
+                accepted_group = 0;
+                proposed_group = 0;
+            }
+        }
+        (accepted + accepted_group, proposed + proposed_group)
+    }
+}
+
 /// Au & Beck (2001) Eq. 28-29: `γ = 2·Σ_{k=1}^{N_s−1}(1 − k/N_s)·ρ(k)`
 /// from the indicator `G ≤ b` along `nc` chains of `ns` states (chain-major).
 fn gamma_factor(g: &[f64], b: f64, nc: usize, ns: usize, p: f64) -> f64 {
@@ -490,18 +557,55 @@ fn gamma_factor(g: &[f64], b: f64, nc: usize, ns: usize, p: f64) -> f64 {
         return 0.0;
     }
     let n = (nc * ns) as f64;
+    let sums: Vec<u64> = if ns <= 64 {
+        lag_pairs_bits(g, b, ns)
+    } else {
+        lag_pairs_scan(g, b, ns)
+    };
+    sums.iter()
+        .enumerate()
+        .map(|(i, &sum)| {
+            let k = i + 1;
+            let rk = sum as f64 / (n - (k * nc) as f64) - p * p;
+            2.0 * (1.0 - k as f64 / ns as f64) * rk / r0
+        })
+        .fold(0.0, |gamma, term| gamma + term)
+}
+
+/// For each lag `k = 1..ns`, the number of pairs `(l, l + k)` of states of
+/// one chain both with `G ≤ b`, over all chains (`ns ≤ 64`): each chain's
+/// indicators are the bits of one word, and the pairs at lag `k` are the
+/// set bits of `m & (m >> k)`.
+fn lag_pairs_bits(g: &[f64], b: f64, ns: usize) -> Vec<u64> {
+    let masks: Vec<u64> = g
+        .chunks_exact(ns)
+        .map(|chain| {
+            chain
+                .iter()
+                .enumerate()
+                .fold(0u64, |m, (l, &v)| m | (u64::from(v <= b) << l))
+        })
+        .collect();
+    (1..ns)
+        .map(|k| {
+            masks
+                .iter()
+                .map(|&m| u64::from((m & (m >> k)).count_ones()))
+                .sum()
+        })
+        .collect()
+}
+
+/// [`lag_pairs_bits`] for any chain length, by a scan of the indicators.
+fn lag_pairs_scan(g: &[f64], b: f64, ns: usize) -> Vec<u64> {
     let ind: Vec<bool> = g.iter().map(|&v| v <= b).collect();
-    let mut gamma = 0.0;
-    for k in 1..ns {
-        let mut sum = 0u64;
-        for c in 0..nc {
-            let chain = &ind[c * ns..(c + 1) * ns];
-            sum += (0..ns - k).filter(|&l| chain[l] && chain[l + k]).count() as u64;
-        }
-        let rk = sum as f64 / (n - (k * nc) as f64) - p * p;
-        gamma += 2.0 * (1.0 - k as f64 / ns as f64) * rk / r0;
-    }
-    gamma
+    (1..ns)
+        .map(|k| {
+            ind.chunks_exact(ns)
+                .map(|chain| (0..ns - k).filter(|&l| chain[l] && chain[l + k]).count() as u64)
+                .sum()
+        })
+        .collect()
 }
 
 /// The mean of the runs' estimates and its standard error
@@ -551,6 +655,23 @@ mod tests {
             .collect();
         let gamma = gamma_factor(&g, 0.0, nc, ns, 0.5);
         assert!((gamma - (ns as f64 - 1.0)).abs() < 1e-12, "{gamma}");
+    }
+
+    #[test]
+    fn lag_pairs_by_bits_equal_the_scan() {
+        // Pseudo-random indicators (a fixed LCG), chains of 10 and of 64.
+        let mut state = 12345u64;
+        for ns in [2, 10, 64] {
+            let g: Vec<f64> = (0..50 * ns)
+                .map(|_| {
+                    state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
+                    (state >> 11) as f64 / (1u64 << 53) as f64 - 0.3
+                })
+                .collect();
+            let bits = lag_pairs_bits(&g, 0.0, ns);
+            assert_eq!(bits, lag_pairs_scan(&g, 0.0, ns), "ns = {ns}");
+            assert!(bits.iter().any(|&s| s > 0), "ns = {ns}");
+        }
     }
 
     #[test]
