@@ -14,7 +14,7 @@ Every result's ``to_dict()`` is the document the ``chain`` CLI prints with
 
 from ._chain import MachineError
 from ._machine import Machine, Nominal
-from ._results import Derivation, ReliabilityResult, Result
+from ._results import Derivation, ReliabilityResult, Result, SobolResult
 
 __all__ = [
     "Derivation",
@@ -23,6 +23,7 @@ __all__ = [
     "Nominal",
     "ReliabilityResult",
     "Result",
+    "SobolResult",
 ]
 
 __version__ = "0.1.0"

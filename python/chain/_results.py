@@ -107,3 +107,35 @@ class ReliabilityResult(Result):
                     row[key] = value
             rows.append(row)
         return rows
+
+
+class SobolResult(Result):
+    """``chain sobol --format json``: first-order and total Sobol indices.
+
+    Attributes: ``machine``, ``method`` (``saltelli-jansen``), ``at`` (the
+    point, or ``None`` when pooled over the grid), ``grid`` (when pooled),
+    ``points``, ``samples``, ``seed``, ``bootstrap``, ``confidence``,
+    ``blocks``, ``evaluations_per_point``, ``outputs`` (per output: variance,
+    sum_first, sum_total, errors). Rows of ``to_dataframe()``: one per
+    output and error, as the CLI's CSV (first, first_low, first_high, total,
+    total_low, total_high, exact).
+    """
+
+    command = "sobol"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        rows = []
+        for output, doc in self._document["outputs"].items():
+            for e in doc["errors"]:
+                rows.append({
+                    "output": output,
+                    "error": e["error"],
+                    "first": e["first"]["value"],
+                    "first_low": e["first"]["low"],
+                    "first_high": e["first"]["high"],
+                    "total": e["total"]["value"],
+                    "total_low": e["total"]["low"],
+                    "total_high": e["total"]["high"],
+                    "exact": e["first"].get("exact"),
+                })
+        return rows
