@@ -20,7 +20,7 @@ use std::mem::MaybeUninit;
 
 use chain_core::model::{Machine, Origin};
 use chain_core::{CompiledModel, Diagnostics, ErrorModel};
-use numpy::{PyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
