@@ -120,7 +120,7 @@ def test_a_bad_posterior_is_located_in_the_values_file(tmp_path, cli_error):
     with pytest.raises(chain.MachineError) as info:
         chain.Machine.load(GANTRY).reliability(values=values)
     e = info.value
-    assert e.file.endswith("posterior.yaml") and (e.line, e.column) == (11, 11)
+    assert e.file.endswith("posterior.yaml") and (e.line, e.column) == (10, 11)
     assert "unknown name `dxq` (did you mean `dxx`?)" in str(e)
     assert "unknown name `dxq` (did you mean `dxx`?)" in cli_error("reliability", GANTRY, "--values", values)
 
