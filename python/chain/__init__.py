@@ -16,6 +16,7 @@ from ._chain import MachineError
 from ._machine import Machine, Nominal
 from ._results import Derivation, ReliabilityResult, Result
 from ._results import IdentifyResult, MapResult, PlanResult
+from ._results import Derivation, ReliabilityResult, Result, SobolResult
 
 __all__ = [
     "Derivation",
@@ -27,6 +28,7 @@ __all__ = [
     "Nominal",
     "ReliabilityResult",
     "Result",
+    "SobolResult",
 ]
 
 __version__ = "0.1.0"

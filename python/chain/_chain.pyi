@@ -46,15 +46,33 @@ class Model:
     def tape_per_point(
         self, q: npt.NDArray[np.float64], params: Sequence[Tuple[str, float]]
     ) -> Tuple[float, float]: ...
-    def reliability_json(
-        self,
-        method: str,
-        samples: Optional[int],
-        seed: int,
-        grid: Sequence[Tuple[str, Sequence[float]]],
-        params: Sequence[Tuple[str, float]],
-        sided: Optional[str],
-    ) -> str: ...
+
+def reliability_json(
+    model: Model,
+    method: str,
+    samples: Optional[int],
+    seed: int,
+    cov: Optional[float],
+    grid: Sequence[Tuple[str, Sequence[float]]],
+    params: Sequence[Tuple[str, float]],
+    sided: Optional[str],
+    system: Optional[str],
+    system_tolerance: Optional[float],
+    values: Optional[str],
+    acceptance: bool,
+    acceptance_tolerance: float,
+) -> str: ...
+def sobol_json(
+    model: Model,
+    at: Optional[Sequence[Tuple[str, float]]],
+    samples: int,
+    seed: int,
+    bootstrap: int,
+    confidence: float,
+    grid: Sequence[Tuple[str, Sequence[float]]],
+    params: Sequence[Tuple[str, float]],
+) -> str: ...
+
 
 # -- group B: the measured machine (python/src/group_b.rs) --------------------
 

@@ -8,7 +8,7 @@ from typing import Any, Dict, List, Mapping, NamedTuple, Optional, Sequence, Tup
 import numpy as np
 
 from . import _chain
-from ._results import Derivation, ReliabilityResult
+from ._results import Derivation, ReliabilityResult, SobolResult
 
 ArrayLike = Any
 Params = Optional[Mapping[str, float]]
@@ -185,23 +185,57 @@ class Machine:
         grid: Optional[Mapping[str, Sequence[float]]] = None,
         params: Params = None,
         sided: Optional[str] = None,
+        cov: Optional[float] = None,
+        system: Optional[str] = None,
+        system_tolerance: Optional[float] = None,
+        values: Optional[Union[str, "os.PathLike[str]"]] = None,
+        acceptance: bool = False,
+        acceptance_tolerance: float = 1e-3,
     ) -> ReliabilityResult:
         """Machining-accuracy reliability over the file's grid, ``chain reliability --format json``.
 
-        ``method``: ``"form"``, ``"is"`` (importance sampling, 10,000 samples
-        per case by default) or ``"mc"`` (Monte Carlo, 100,000); ``grid``:
-        axes replacing (or adding to) the file's, ``{"x": [0, 500, 1000]}``;
-        ``sided``: ``"upper"`` or ``"two"`` to override the file's.
+        Every option of the command line, by the same name:
+
+        - ``method``: ``"form"``, ``"is"`` (importance sampling, 10,000
+          samples per case by default), ``"mc"`` (Monte Carlo, 100,000),
+          ``"subset"`` (subset simulation, 1,000 per level),
+          ``"directional"`` (10,000) or ``"sorm"``;
+        - ``samples`` per case, ``seed`` of the random streams;
+        - ``cov``: a target coefficient of variation in (0, 1] of each
+          case's p_f (sampling methods only): ``samples`` is then the budget
+          (mc 10^7, is and directional 10^6 by default);
+        - ``grid``: axes replacing (or adding to) the file's,
+          ``{"x": [0, 500, 1000]}``; ``params``; ``sided``: ``"upper"`` or
+          ``"two"`` to override the file's;
+        - ``system``: ``"series"`` or ``"volumetric"`` (``system_tolerance``:
+          the allowable volumetric error, default the smallest position
+          tolerance);
+        - ``values``: a values file with a calibration's posterior (means,
+          ``std``, ``correlation``), as ``--values``;
+        - ``acceptance=True``: also the whole-machine acceptance probability
+          (the document's ``acceptance``; also computed when the file sets
+          ``reliability.acceptance: true``), to ``acceptance_tolerance``.
         """
         if samples is not None and (not isinstance(samples, int) or isinstance(samples, bool) or samples < 1):
             raise ValueError(f"samples must be a positive integer, not {samples!r}")
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
             raise ValueError(f"seed must be a non-negative integer, not {seed!r}")
+        if not isinstance(method, str):
+            raise ValueError(f"method must be a str, not {type(method).__name__}")
+        if not isinstance(acceptance, bool):
+            raise ValueError(f"acceptance must be True or False, not {acceptance!r}")
+        cov = _optional_float(cov, "cov")
+        system_tolerance = _optional_float(system_tolerance, "system_tolerance")
+        acceptance_tolerance = _optional_float(acceptance_tolerance, "acceptance_tolerance")
         axes = []
-        for name, values in (grid or {}).items():
-            a = _float_array(values, f"grid[{name!r}]").ravel()
+        for name, values_ in (grid or {}).items():
+            a = _float_array(values_, f"grid[{name!r}]").ravel()
             axes.append((str(name), [float(v) for v in a]))
-        text = self._model.reliability_json(method, samples, seed, axes, _params(params), sided)
+        path = None if values is None else os.fspath(values)
+        text = _chain.reliability_json(
+            self._model, method, samples, seed, cov, axes, _params(params), sided, system,
+            system_tolerance, path, acceptance, acceptance_tolerance,
+        )
         return ReliabilityResult._from_json(text)
 
     # -- the measured machine (group B: map, identify, plan) -----------------
@@ -346,3 +380,55 @@ def _csv_input(data: Any, what: str) -> Tuple[Optional[str], Optional[str]]:
     for i in range(n or 0):
         lines.append(",".join(repr(float(c[i])) for c in columns))
     return None, "\n".join(lines) + "\n"
+    def sobol(
+        self,
+        at: Optional[Mapping[str, float]] = None,
+        samples: int = 10_000,
+        seed: int = 0,
+        bootstrap: int = 1000,
+        confidence: float = 0.95,
+        grid: Optional[Mapping[str, Sequence[float]]] = None,
+        params: Params = None,
+    ) -> SobolResult:
+        """First-order and total Sobol indices, ``chain sobol --format json``.
+
+        Saltelli et al. 2010's first-order and Jansen's total estimator of
+        every toleranced component and of ``|p|`` with respect to every error
+        parameter, with bootstrap percentile intervals (docs/sobol.md):
+        at one point ``at`` (every axis variable, ``{"x": 0, "y": 1500, ...}``),
+        otherwise pooled over the reliability grid (``grid`` replacing axes,
+        not with ``at``). ``samples``: base samples N (N·(k+2) evaluations
+        per point); ``bootstrap`` replicates at ``confidence``.
+        """
+        for name, v in (("samples", samples), ("seed", seed), ("bootstrap", bootstrap)):
+            if not isinstance(v, int) or isinstance(v, bool) or v < 0:
+                raise ValueError(f"{name} must be a non-negative integer, not {v!r}")
+        confidence = _optional_float(confidence, "confidence")
+        point = None
+        if at is not None:
+            if not isinstance(at, Mapping):
+                raise ValueError(f"at must be a mapping of axis variable to value, not {type(at).__name__}")
+            point = []
+            for name, value in at.items():
+                try:
+                    point.append((str(name), float(value)))
+                except (TypeError, ValueError):
+                    raise ValueError(f"at: `{name}` = {value!r} is not a number") from None
+        axes = []
+        for name, values_ in (grid or {}).items():
+            a = _float_array(values_, f"grid[{name!r}]").ravel()
+            axes.append((str(name), [float(v) for v in a]))
+        text = _chain.sobol_json(self._model, point, samples, seed, bootstrap, confidence, axes, _params(params))
+        return SobolResult._from_json(text)
+
+
+def _optional_float(x: Any, name: str) -> Optional[float]:
+    """``x`` as a float (``None`` stays ``None``); a non-number raises ValueError naming ``name``."""
+    if x is None:
+        return None
+    if isinstance(x, bool):
+        raise ValueError(f"{name} must be a number, not {x!r}")
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, not {x!r}") from None

@@ -170,3 +170,33 @@ class PlanResult(Result):
             {"error": e, "aliased": d["aliased"][j], "optimal_std": d["optimal"]["std"][j], "even_std": d["even"]["std"][j]}
             for j, e in enumerate(d["errors"])
         ]
+class SobolResult(Result):
+    """``chain sobol --format json``: first-order and total Sobol indices.
+
+    Attributes: ``machine``, ``method`` (``saltelli-jansen``), ``at`` (the
+    point, or ``None`` when pooled over the grid), ``grid`` (when pooled),
+    ``points``, ``samples``, ``seed``, ``bootstrap``, ``confidence``,
+    ``blocks``, ``evaluations_per_point``, ``outputs`` (per output: variance,
+    sum_first, sum_total, errors). Rows of ``to_dataframe()``: one per
+    output and error, as the CLI's CSV (first, first_low, first_high, total,
+    total_low, total_high, exact).
+    """
+
+    command = "sobol"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        rows = []
+        for output, doc in self._document["outputs"].items():
+            for e in doc["errors"]:
+                rows.append({
+                    "output": output,
+                    "error": e["error"],
+                    "first": e["first"]["value"],
+                    "first_low": e["first"]["low"],
+                    "first_high": e["first"]["high"],
+                    "total": e["total"]["value"],
+                    "total_low": e["total"]["low"],
+                    "total_high": e["total"]["high"],
+                    "exact": e["first"].get("exact"),
+                })
+        return rows

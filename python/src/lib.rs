@@ -17,16 +17,19 @@
 //! `column` and `key`.
 
 mod group_b;
+use std::mem::MaybeUninit;
 
 use chain_core::model::{Machine, Origin};
 use chain_core::{CompiledModel, Diagnostics, ErrorModel};
-use numpy::{PyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
-use reliability::document::{describe, ReliabilityDocument};
-use reliability::{Algorithm, Form, ImportanceSampling, MonteCarlo, ReliabilityError, Study};
+use reliability::document::describe;
+use reliability::{ReliabilityError, Study};
+
+mod reliability_v2;
 
 create_exception!(
     _chain,
@@ -37,6 +40,49 @@ create_exception!(
 
 /// Points per parallel block of the batch evaluations.
 const BLOCK: usize = 1024;
+
+/// A new uninitialised float64 numpy array of `len` values and its data as
+/// a slice of `MaybeUninit` for the workers to initialise (numpy's allocator
+/// obtains it, so the pages are first touched by the workers that write
+/// them, and large arrays get numpy's transparent-huge-page advice).
+fn uninit_array(py: Python<'_>, len: usize) -> (Bound<'_, PyArray1<f64>>, &mut [MaybeUninit<f64>]) {
+    // SAFETY: `PyArray1::new` returns an array of `len` float64 values whose
+    // memory numpy owns and nobody else references yet; it is viewed as
+    // `MaybeUninit` (no value is read before it is written, `par_rows`
+    // writes every one) for as long as the caller holds the array.
+    unsafe {
+        let array = PyArray1::<f64>::new(py, len, false);
+        let data = array.data() as *mut MaybeUninit<f64>;
+        let slice = if len == 0 {
+            &mut []
+        } else {
+            std::slice::from_raw_parts_mut(data, len)
+        };
+        (array, slice)
+    }
+}
+
+/// Writes every row of `out` (rows of `width` values) as `row(i, values)`
+/// does, point `i` after point, in parallel blocks of [`BLOCK`] rows; each
+/// row is zeroed first (in cache), so `row` sees initialised values and
+/// `out` is wholly initialised on return. The one loop of the batch
+/// evaluations (sensitivity, error, nominal).
+fn par_rows(out: &mut [MaybeUninit<f64>], width: usize, row: impl Fn(usize, &mut [f64]) + Sync) {
+    if width == 0 {
+        return;
+    }
+    out.par_chunks_mut(width * BLOCK)
+        .enumerate()
+        .for_each(|(b, chunk)| {
+            for (k, values) in chunk.chunks_mut(width).enumerate() {
+                values.fill(MaybeUninit::new(0.0));
+                // SAFETY: every value of `values` was just initialised, and
+                // `MaybeUninit<f64>` has the layout of `f64`.
+                let values = unsafe { &mut *(values as *mut [MaybeUninit<f64>] as *mut [f64]) };
+                row(b * BLOCK + k, values);
+            }
+        });
+}
 
 /// A `MachineError` with its location attributes set.
 pub(crate) fn machine_error(
@@ -261,21 +307,13 @@ impl Model {
         let (v, ne) = (self.model.variables().len(), self.model.errors().len());
         let width = 6 * ne;
         let model = &self.model;
-        let out = py.allow_threads(|| {
-            let mut out = vec![0.0; n * width];
-            if width > 0 {
-                out.par_chunks_mut(width * BLOCK)
-                    .enumerate()
-                    .for_each(|(b, chunk)| {
-                        for (k, row) in chunk.chunks_mut(width).enumerate() {
-                            let i = b * BLOCK + k;
-                            model.sensitivity(&q[i * v..(i + 1) * v], &p, row);
-                        }
-                    });
-            }
-            out
+        let (array, out) = uninit_array(py, n * width);
+        py.allow_threads(|| {
+            par_rows(out, width, |i, row| {
+                model.sensitivity(&q[i * v..(i + 1) * v], &p, row)
+            })
         });
-        Ok(PyArray1::from_vec(py, out))
+        Ok(array)
     }
 
     /// The error `E = S·e` at each row of `q` (`(N, V)`) with the errors of
@@ -311,22 +349,17 @@ impl Model {
             .map_err(|_| value_error("e must be a C-contiguous float64 array"))?;
         check_finite(e, ne, "e")?;
         let model = &self.model;
-        let out = py.allow_threads(|| {
-            let mut out = vec![0.0; n * 6];
-            out.par_chunks_mut(6 * BLOCK)
-                .enumerate()
-                .for_each(|(b, chunk)| {
-                    let mut r = [0.0; 6];
-                    for (k, row) in chunk.chunks_mut(6).enumerate() {
-                        let i = b * BLOCK + k;
-                        let j = if e_rows == 1 { 0 } else { i };
-                        model.error(&q[i * v..(i + 1) * v], &p, &e[j * ne..(j + 1) * ne], &mut r);
-                        row.copy_from_slice(&r);
-                    }
-                });
-            out
+        let (array, out) = uninit_array(py, n * 6);
+        py.allow_threads(|| {
+            par_rows(out, 6, |i, row| {
+                let j = if e_rows == 1 { 0 } else { i };
+                // Every row has 6 values (`par_rows` cuts them so).
+                if let Ok(row) = <&mut [f64; 6]>::try_from(row) {
+                    model.error(&q[i * v..(i + 1) * v], &p, &e[j * ne..(j + 1) * ne], row);
+                }
+            })
         });
-        Ok(PyArray1::from_vec(py, out))
+        Ok(array)
     }
 
     /// The nominal pose at each row of `q`: a flat `N·12` array, per point
@@ -342,23 +375,17 @@ impl Model {
         let (q, n) = self.points(&q)?;
         let v = self.model.variables().len();
         let model = &self.model;
-        let out = py.allow_threads(|| {
-            let mut out = vec![0.0; n * 12];
-            out.par_chunks_mut(12 * BLOCK)
-                .enumerate()
-                .for_each(|(b, chunk)| {
-                    for (k, row) in chunk.chunks_mut(12).enumerate() {
-                        let i = b * BLOCK + k;
-                        let pose = model.nominal(&q[i * v..(i + 1) * v], &p);
-                        for r in 0..3 {
-                            row[3 * r..3 * r + 3].copy_from_slice(&pose.rotation[r]);
-                        }
-                        row[9..12].copy_from_slice(&pose.position);
-                    }
-                });
-            out
+        let (array, out) = uninit_array(py, n * 12);
+        py.allow_threads(|| {
+            par_rows(out, 12, |i, row| {
+                let pose = model.nominal(&q[i * v..(i + 1) * v], &p);
+                for r in 0..3 {
+                    row[3 * r..3 * r + 3].copy_from_slice(&pose.rotation[r]);
+                }
+                row[9..12].copy_from_slice(&pose.position);
+            })
         });
-        Ok(PyArray1::from_vec(py, out))
+        Ok(array)
     }
 
     /// The benchmark's reference (python/benches/sensitivity.py): the runtime
@@ -387,53 +414,6 @@ impl Model {
             (start.elapsed().as_secs_f64(), sum)
         }))
     }
-
-    /// `chain reliability --format json`: the study of the file's
-    /// reliability section (`method`: `"form"`, `"is"`, `"mc"`; `samples`
-    /// per case, `None` for the method's default; `grid`: axes replacing the
-    /// file's; `sided`: `None`, `"upper"` or `"two"`).
-    #[pyo3(signature = (method, samples, seed, grid, params, sided))]
-    #[allow(clippy::too_many_arguments)]
-    fn reliability_json(
-        &self,
-        py: Python<'_>,
-        method: &str,
-        samples: Option<u64>,
-        seed: u64,
-        grid: Vec<(String, Vec<f64>)>,
-        params: Vec<(String, f64)>,
-        sided: Option<&str>,
-    ) -> PyResult<String> {
-        let algorithm = match method {
-            "form" => Algorithm::Form(Form::default()),
-            "is" => Algorithm::ImportanceSampling(ImportanceSampling {
-                samples: samples.unwrap_or(10_000),
-                seed,
-                form: Form::default(),
-            }),
-            "mc" => Algorithm::MonteCarlo(MonteCarlo {
-                samples: samples.unwrap_or(100_000),
-                seed,
-            }),
-            other => {
-                return Err(value_error(format!(
-                    "method must be \"form\", \"is\" or \"mc\", not {other:?}"
-                )))
-            }
-        };
-        if samples == Some(0) && method != "form" {
-            return Err(value_error("samples must be at least 1"));
-        }
-        let study = self.study(py, &grid, &params, sided)?;
-        let result = py
-            .allow_threads(|| study.run(&algorithm, &|_| {}))
-            .map_err(|e| study_error(py, &e, &self.file))?;
-        to_json(&ReliabilityDocument::new(
-            &self.machine.name,
-            &study,
-            &result,
-        ))
-    }
 }
 
 impl Model {
@@ -445,10 +425,24 @@ impl Model {
         params: &[(String, f64)],
         sided: Option<&str>,
     ) -> PyResult<Study> {
+        self.study_with(py, grid, params, sided, None, None)
+    }
+
+    /// [`Model::study`] with a system target (`--system`) and the inputs of
+    /// a posterior (`--values`; `None`: the `statistics` section).
+    pub(crate) fn study_with(
+        &self,
+        py: Python<'_>,
+        grid: &[(String, Vec<f64>)],
+        params: &[(String, f64)],
+        sided: Option<&str>,
+        system: Option<reliability::System>,
+        posterior: Option<&reliability::Posterior>,
+    ) -> PyResult<Study> {
         use chain_core::model::Sided;
         let m = &self.machine;
         let err = |e: ReliabilityError| study_error(py, &e, &self.file);
-        let mut spec = reliability::machine::spec(m, None).map_err(err)?;
+        let mut spec = reliability::machine::spec(m, system).map_err(err)?;
         match sided {
             None => {}
             Some("upper") => spec.sided = Sided::Upper,
@@ -480,7 +474,14 @@ impl Model {
                 None => spec.grid.axes.push((name.clone(), values.clone())),
             }
         }
-        let inputs = reliability::machine::inputs(m).map_err(err)?;
+        let inputs = match posterior {
+            None => reliability::machine::inputs(m).map_err(err)?,
+            Some(p) => p.inputs(m).map_err(|e| match e {
+                reliability::PosteriorError::Reliability(e) => err(e),
+                reliability::PosteriorError::Values(v) => load_error(py, v.diagnostics()),
+                reliability::PosteriorError::File(d) => load_error(py, &d),
+            })?,
+        };
         let values = self.parameter_vector(py, params)?;
         Study::new(&self.model, &values, inputs, spec).map_err(err)
     }
@@ -494,5 +495,7 @@ fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(group_b::identify_json, m)?)?;
     m.add_function(wrap_pyfunction!(group_b::plan_json, m)?)?;
     m.add_function(wrap_pyfunction!(group_b::map_json, m)?)?;
+    m.add_function(wrap_pyfunction!(reliability_v2::reliability_json, m)?)?;
+    m.add_function(wrap_pyfunction!(reliability_v2::sobol_json, m)?)?;
     Ok(())
 }

@@ -6,6 +6,12 @@
 //! declaration order, are the JSON keys); the binary adds its table and CSV
 //! forms on top, the Python bindings serialise them as they are.
 //!
+//! The same holds for the whole-machine acceptance object
+//! ([`AcceptanceDocument`], `chain reliability --acceptance`) and the Sobol
+//! indices ([`SobolDocument`], `chain sobol`); [`algorithm`] turns a method
+//! name's options into the [`Algorithm`] both run (the defaults in one
+//! place), [`volumetric`] the `--system volumetric` target.
+//!
 //! [`describe`] is the one wording of a [`ReliabilityError`] against the
 //! machine file it concerns (message, location, label, help), shared by the
 //! binary's diagnostics and the Python exceptions.
@@ -14,9 +20,14 @@ use chain_core::model::{Origin, Sided};
 use chain_core::named::NameMap;
 use serde::Serialize;
 
+use chain_core::model::Machine;
+
+use crate::acceptance::{Acceptance, AcceptanceResult, Rectangles};
+use crate::sobol::{Estimate, OutputIndices, SobolResult};
 use crate::{
-    Calls, FormCase, Method, Posterior, ReliabilityError, SormCase, Stopping, Study, StudyResult,
-    SubsetLevel, Target,
+    Algorithm, Calls, DirectionalSimulation, Form, FormCase, ImportanceSampling, Method,
+    MonteCarlo, Posterior, ReliabilityError, SormCase, Stopping, Study, StudyResult, SubsetLevel,
+    SubsetSimulation, System, Target,
 };
 
 /// The document of a grid study (the spec's `reliability` JSON contract).
@@ -38,6 +49,9 @@ pub struct ReliabilityDocument<'a> {
     /// The posterior the inputs came from (a calibration's values file), when given.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub posterior: Option<&'a Posterior>,
+    /// The whole-machine acceptance probability (`--acceptance`), when run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub acceptance: Option<AcceptanceDocument<'a>>,
 }
 
 /// One case (target at a grid point) of a [`ReliabilityDocument`].
@@ -177,6 +191,295 @@ impl<'a> ReliabilityDocument<'a> {
             summary,
             requirement: RequirementDocument::of(r),
             posterior: None,
+            acceptance: None,
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// The algorithm of a method name's options.
+
+/// The samples per case of `method` when `given` is `None` (spec
+/// reliability-v2 §2): is 10⁴, mc 10⁵; with a target coefficient of
+/// variation (`to_cov`) the budget, mc 10⁷, is and directional 10⁶;
+/// subset 10³ per level, directional 10⁴; 0 for FORM and SORM, which draw none.
+pub fn samples(method: Method, given: Option<u64>, to_cov: bool) -> u64 {
+    match (method, to_cov) {
+        (Method::Form | Method::Sorm, _) => 0,
+        (Method::ImportanceSampling, false) => given.unwrap_or(10_000),
+        (Method::MonteCarlo, false) => given.unwrap_or(100_000),
+        (Method::ImportanceSampling, true) => given.unwrap_or(1_000_000),
+        (Method::MonteCarlo, true) => given.unwrap_or(10_000_000),
+        (Method::Subset, _) => given.unwrap_or(1_000),
+        (Method::Directional, false) => given.unwrap_or(10_000),
+        (Method::Directional, true) => given.unwrap_or(1_000_000),
+    }
+}
+
+/// Subset simulation's sample budget with a target coefficient of
+/// variation, in levels of its samples per level.
+pub const SUBSET_BUDGET_LEVELS: u64 = 1000;
+
+/// The algorithm of `method` with `samples` per case (see [`samples`] for
+/// the defaults; FORM and SORM ignore it and `seed`) and an optional target
+/// coefficient of variation `cov` (`samples` is then the budget; for subset
+/// simulation the samples per level, [`SUBSET_BUDGET_LEVELS`] levels' worth
+/// at most). FORM and SORM take no target: callers refuse one before.
+pub fn algorithm(method: Method, samples: u64, seed: u64, cov: Option<f64>) -> Algorithm {
+    let is = ImportanceSampling {
+        samples,
+        seed,
+        form: Form::default(),
+    };
+    match (method, cov) {
+        (Method::MonteCarlo, Some(c)) => {
+            Algorithm::MonteCarloToCov(MonteCarlo { samples, seed }, c)
+        }
+        (Method::MonteCarlo, None) => Algorithm::MonteCarlo(MonteCarlo { samples, seed }),
+        (Method::ImportanceSampling, Some(c)) => Algorithm::ImportanceSamplingToCov(is, c),
+        (Method::ImportanceSampling, None) => Algorithm::ImportanceSampling(is),
+        (Method::Subset, _) => {
+            let mut s = SubsetSimulation::new(samples, seed);
+            s.cov = cov;
+            s.budget = samples.saturating_mul(SUBSET_BUDGET_LEVELS);
+            Algorithm::Subset(s)
+        }
+        (Method::Directional, _) => {
+            Algorithm::Directional(DirectionalSimulation { samples, seed, cov })
+        }
+        (Method::Form, _) => Algorithm::Form(Form::default()),
+        (Method::Sorm, _) => Algorithm::Sorm(crate::sorm::Sorm::default()),
+    }
+}
+
+/// The `--system volumetric` target: `√(px² + py² + pz²) ≤ tolerance`,
+/// by default the smallest position tolerance of the reliability section.
+pub fn volumetric(machine: &Machine, tolerance: Option<f64>) -> Result<System, ReliabilityError> {
+    let tolerance = match tolerance {
+        Some(t) => t,
+        None => machine
+            .reliability
+            .as_ref()
+            .ok_or(ReliabilityError::NoReliabilitySection)?
+            .tolerance
+            .iter()
+            .filter(|(c, _)| c.index() < 3)
+            .map(|(_, t)| *t)
+            .fold(f64::INFINITY, f64::min),
+    };
+    Ok(System::Volumetric { tolerance })
+}
+
+// ---------------------------------------------------------------------------
+// The whole-machine acceptance probability (spec reliability-v2 §4).
+
+/// The acceptance probability of every point × toleranced component of
+/// `study` at once, to an absolute error `tolerance` (three standard
+/// errors), with its sensitivities, as `chain reliability --acceptance`
+/// runs it ([`Acceptance`] over [`Rectangles::from_study`]).
+pub fn acceptance(
+    study: &Study,
+    tolerance: f64,
+    seed: u64,
+) -> Result<AcceptanceResult, ReliabilityError> {
+    let system = Rectangles::from_study(study)?;
+    Acceptance {
+        tolerance,
+        seed,
+        ..Acceptance::default()
+    }
+    .run(&system)
+}
+
+/// The `acceptance` object of a [`ReliabilityDocument`] (spec §4:
+/// probability, std_error, method, sensitivity; then samples, converged,
+/// tolerance, constraints, rank).
+#[derive(Debug, Serialize)]
+pub struct AcceptanceDocument<'a> {
+    /// P(every toleranced component within tolerance at every point).
+    pub probability: f64,
+    /// Its standard error.
+    pub std_error: f64,
+    /// `genz-bretz-qmc` or `monte-carlo`.
+    pub method: &'static str,
+    /// ∂P/∂σ and ∂P/∂μ of every error parameter.
+    pub sensitivity: Vec<AcceptanceSensitivityDocument<'a>>,
+    /// Integrand evaluations.
+    pub samples: u64,
+    /// Whether three standard errors are below the tolerance.
+    pub converged: bool,
+    /// The absolute error asked for.
+    pub tolerance: Option<f64>,
+    /// Constraints (points × toleranced components).
+    pub constraints: usize,
+    /// The rank of the constraints' rows.
+    pub rank: usize,
+    /// Levels, CoV and pilot of subset simulation (method `subset` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subset: Option<&'a crate::acceptance::AcceptanceSubset>,
+}
+
+/// One error parameter of [`AcceptanceDocument::sensitivity`].
+#[derive(Debug, Serialize)]
+pub struct AcceptanceSensitivityDocument<'a> {
+    /// The error parameter.
+    pub error: &'a str,
+    /// ∂P/∂σ.
+    pub dr_dstd: f64,
+    /// ∂P/∂μ.
+    pub dr_dmean: f64,
+    /// The standard error of ∂P/∂σ.
+    pub dr_dstd_std_error: f64,
+    /// The standard error of ∂P/∂μ.
+    pub dr_dmean_std_error: f64,
+}
+
+impl<'a> AcceptanceDocument<'a> {
+    /// The document of an acceptance result.
+    pub fn of(a: &'a AcceptanceResult) -> AcceptanceDocument<'a> {
+        AcceptanceDocument {
+            probability: a.probability,
+            std_error: a.std_error,
+            method: a.method.name(),
+            sensitivity: a
+                .sensitivity
+                .iter()
+                .map(|s| AcceptanceSensitivityDocument {
+                    error: &s.error,
+                    dr_dstd: s.dr_dstd,
+                    dr_dmean: s.dr_dmean,
+                    dr_dstd_std_error: s.dr_dstd_std_error,
+                    dr_dmean_std_error: s.dr_dmean_std_error,
+                })
+                .collect(),
+            samples: a.samples,
+            converged: a.converged,
+            tolerance: a.tolerance,
+            constraints: a.constraints,
+            rank: a.rank,
+            subset: a.subset.as_ref(),
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Sobol indices (`chain sobol`, docs/sobol.md).
+
+/// The document of `chain sobol` (docs/sobol.md): the settings, then per
+/// output its variance, the sums of the indices and every error's first
+/// and total index with its interval.
+#[derive(Debug, Serialize)]
+pub struct SobolDocument<'a> {
+    /// The machine's name.
+    pub machine: &'a str,
+    /// `saltelli-jansen`: Saltelli 2010 Table 2 (b) and (f).
+    pub method: &'static str,
+    /// The point, or `null` when the indices pool the grid.
+    pub at: Option<NameMap<String, f64>>,
+    /// The grid pooled (absent at a point).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grid: Option<NameMap<String, Vec<f64>>>,
+    /// Points evaluated.
+    pub points: usize,
+    /// Base samples `N`.
+    pub samples: usize,
+    /// The seed.
+    pub seed: u64,
+    /// Bootstrap replicates.
+    pub bootstrap: usize,
+    /// Confidence level of the intervals.
+    pub confidence: f64,
+    /// Bootstrap blocks.
+    pub blocks: usize,
+    /// Model evaluations per point, `N·(k + 2)`.
+    pub evaluations_per_point: u64,
+    /// Each output's indices, by name.
+    pub outputs: NameMap<&'static str, SobolOutputDocument<'a>>,
+    /// The result the document shows (for the table and CSV forms).
+    #[serde(skip)]
+    pub result: &'a SobolResult,
+}
+
+/// One output of a [`SobolDocument`].
+#[derive(Debug, Serialize)]
+pub struct SobolOutputDocument<'a> {
+    /// The output's variance (summed over the grid when pooled).
+    pub variance: f64,
+    /// Σ of the first-order indices.
+    pub sum_first: &'a Estimate,
+    /// Σ of the total indices.
+    pub sum_total: &'a Estimate,
+    /// Every error's indices.
+    pub errors: Vec<SobolErrorDocument<'a>>,
+}
+
+/// One error of a [`SobolOutputDocument`].
+#[derive(Debug, Serialize)]
+pub struct SobolErrorDocument<'a> {
+    /// The error parameter.
+    pub error: &'a str,
+    /// Its first-order index.
+    pub first: &'a Estimate,
+    /// Its total index.
+    pub total: &'a Estimate,
+}
+
+impl<'a> SobolOutputDocument<'a> {
+    fn of(o: &'a OutputIndices) -> SobolOutputDocument<'a> {
+        SobolOutputDocument {
+            variance: o.variance,
+            sum_first: &o.sum_first,
+            sum_total: &o.sum_total,
+            errors: o
+                .errors
+                .iter()
+                .map(|e| SobolErrorDocument {
+                    error: &e.error,
+                    first: &e.first,
+                    total: &e.total,
+                })
+                .collect(),
+        }
+    }
+}
+
+impl<'a> SobolDocument<'a> {
+    /// The document of `result`, the indices of `study`: at its one point
+    /// when `at_point` (a [`Study::at_points`] study), otherwise pooled
+    /// over its grid.
+    pub fn new(
+        machine: &'a str,
+        study: &Study,
+        at_point: bool,
+        result: &'a SobolResult,
+    ) -> SobolDocument<'a> {
+        let at = at_point.then(|| {
+            NameMap::zip(
+                study.variables().iter().cloned(),
+                study.points().first().into_iter().flatten().copied(),
+            )
+        });
+        let grid = (!at_point).then(|| NameMap(study.spec().grid.axes.clone()));
+        SobolDocument {
+            machine,
+            method: "saltelli-jansen",
+            at,
+            grid,
+            points: result.points,
+            samples: result.settings.samples,
+            seed: result.settings.seed,
+            bootstrap: result.settings.bootstrap,
+            confidence: result.settings.confidence,
+            blocks: result.blocks,
+            evaluations_per_point: result.evaluations_per_point,
+            outputs: NameMap(
+                result
+                    .outputs
+                    .iter()
+                    .map(|o| (o.output.name(), SobolOutputDocument::of(o)))
+                    .collect(),
+            ),
+            result,
         }
     }
 }

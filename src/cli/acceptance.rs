@@ -1,12 +1,12 @@
 //! The whole-machine acceptance probability in `chain reliability`
 //! (`--acceptance` or `reliability.acceptance: true`, spec reliability-v2
-//! §4): running it over a study and its JSON object, table section and CSV
-//! row (docs/acceptance.md).
+//! §4): running it over a study (the run and its JSON object are the
+//! library's, `reliability::document`), its table section and CSV row
+//! (docs/acceptance.md).
 
 use miette::MietteDiagnostic;
-use reliability::acceptance::{Acceptance, AcceptanceResult, Rectangles};
+use reliability::acceptance::AcceptanceResult;
 use reliability::{normal, Study};
-use serde::{Serialize, Serializer};
 
 use super::reliability::Loaded;
 
@@ -26,14 +26,8 @@ pub(crate) fn run(
             .with_code("chain::reliability::invalid_option"),
         ));
     }
-    let system = Rectangles::from_study(study).map_err(|e| loaded.report(e))?;
-    let r = Acceptance {
-        tolerance,
-        seed,
-        ..Acceptance::default()
-    }
-    .run(&system)
-    .map_err(|e| loaded.report(e))?;
+    let r =
+        reliability::document::acceptance(study, tolerance, seed).map_err(|e| loaded.report(e))?;
     if !r.converged {
         eprintln!(
             "warning: the acceptance probability did not converge: 3 standard errors = {:.2e} > {tolerance:.2e} after {} samples",
@@ -42,69 +36,6 @@ pub(crate) fn run(
         );
     }
     Ok(r)
-}
-
-/// The JSON object (spec §4: probability, std_error, method, sensitivity;
-/// then samples, converged, tolerance, constraints, rank).
-#[derive(Serialize)]
-struct Doc<'a> {
-    probability: f64,
-    std_error: f64,
-    method: &'static str,
-    sensitivity: Vec<SensitivityDoc<'a>>,
-    samples: u64,
-    converged: bool,
-    tolerance: Option<f64>,
-    constraints: usize,
-    rank: usize,
-    /// Levels, CoV and pilot of subset simulation (method `subset` only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    subset: Option<&'a reliability::acceptance::AcceptanceSubset>,
-}
-
-#[derive(Serialize)]
-struct SensitivityDoc<'a> {
-    error: &'a str,
-    dr_dstd: f64,
-    dr_dmean: f64,
-    dr_dstd_std_error: f64,
-    dr_dmean_std_error: f64,
-}
-
-fn doc(a: &AcceptanceResult) -> Doc<'_> {
-    Doc {
-        probability: a.probability,
-        std_error: a.std_error,
-        method: a.method.name(),
-        sensitivity: a
-            .sensitivity
-            .iter()
-            .map(|s| SensitivityDoc {
-                error: &s.error,
-                dr_dstd: s.dr_dstd,
-                dr_dmean: s.dr_dmean,
-                dr_dstd_std_error: s.dr_dstd_std_error,
-                dr_dmean_std_error: s.dr_dmean_std_error,
-            })
-            .collect(),
-        samples: a.samples,
-        converged: a.converged,
-        tolerance: a.tolerance,
-        constraints: a.constraints,
-        rank: a.rank,
-        subset: a.subset.as_ref(),
-    }
-}
-
-/// `serialize_with` of the report's `acceptance` field.
-pub(crate) fn serialize<S: Serializer>(
-    a: &Option<&AcceptanceResult>,
-    serializer: S,
-) -> Result<S::Ok, S::Error> {
-    match a {
-        Some(a) => doc(a).serialize(serializer),
-        None => serializer.serialize_none(),
-    }
 }
 
 /// The table section: the probability with its error and method, and the
@@ -144,19 +75,6 @@ pub(crate) fn table(study: &Study, a: &AcceptanceResult) -> String {
         a.method.title(),
         a.samples
     );
-    if let Some(r) = &a.subset {
-        let _ = writeln!(
-            out,
-            "  {} side by subset simulation: {:.4e}, CoV {:.1} %, {} levels, {} runs (pilot: {} of {} samples on it)",
-            r.side.name(),
-            r.probability,
-            r.cov * 100.0,
-            r.levels.len(),
-            r.runs,
-            r.pilot_events,
-            r.pilot_samples
-        );
-    }
     let stds = study.inputs().stds();
     let mut order: Vec<usize> = (0..a.sensitivity.len()).collect();
     order.sort_by(|&i, &j| {

@@ -19,11 +19,10 @@ use std::path::{Path, PathBuf};
 
 use chain_core::model::{Machine, Sided};
 use miette::{LabeledSpan, MietteDiagnostic, NamedSource};
-use reliability::document::ReliabilityDocument;
+use reliability::document::{AcceptanceDocument, ReliabilityDocument};
 use reliability::{
-    machine, Algorithm, DirectionalSimulation, Form, FormCase, ImportanceSampling, Method,
-    MonteCarlo, Posterior, PosteriorError, ReliabilityError, Stopping, Study, StudyResult,
-    SubsetLevel, SubsetSimulation, System, Termination,
+    machine, Algorithm, Form, FormCase, Method, Posterior, PosteriorError, ReliabilityError,
+    Stopping, Study, StudyResult, SubsetLevel, System, Termination,
 };
 use serde::Serialize;
 
@@ -55,62 +54,27 @@ impl MethodArg {
     /// ignores both) and an optional target coefficient of variation
     /// (`samples` is then the budget; for subset the samples per level).
     pub(crate) fn algorithm_with(self, samples: u64, seed: u64, cov: Option<f64>) -> Algorithm {
-        match (self, cov) {
-            (MethodArg::Mc, Some(c)) => {
-                return Algorithm::MonteCarloToCov(MonteCarlo { samples, seed }, c)
-            }
-            (MethodArg::Is, Some(c)) => {
-                return Algorithm::ImportanceSamplingToCov(
-                    ImportanceSampling {
-                        samples,
-                        seed,
-                        form: Form::default(),
-                    },
-                    c,
-                )
-            }
-            (MethodArg::Subset, _) => {
-                let mut s = SubsetSimulation::new(samples, seed);
-                s.cov = cov;
-                s.budget = samples.saturating_mul(SUBSET_BUDGET_LEVELS);
-                return Algorithm::Subset(s);
-            }
-            (MethodArg::Directional, _) => {
-                return Algorithm::Directional(DirectionalSimulation { samples, seed, cov })
-            }
-            _ => {}
-        }
+        reliability::document::algorithm(self.method(), samples, seed, cov)
+    }
+
+    /// The library's method.
+    pub(crate) fn method(self) -> Method {
         match self {
-            MethodArg::Form => Algorithm::Form(Form::default()),
-            MethodArg::Sorm => Algorithm::Sorm(reliability::sorm::Sorm::default()),
-            MethodArg::Is => Algorithm::ImportanceSampling(ImportanceSampling {
-                samples,
-                seed,
-                form: Form::default(),
-            }),
-            MethodArg::Mc => Algorithm::MonteCarlo(MonteCarlo { samples, seed }),
-            MethodArg::Subset | MethodArg::Directional => unreachable!("handled above"),
+            MethodArg::Form => Method::Form,
+            MethodArg::Is => Method::ImportanceSampling,
+            MethodArg::Mc => Method::MonteCarlo,
+            MethodArg::Subset => Method::Subset,
+            MethodArg::Directional => Method::Directional,
+            MethodArg::Sorm => Method::Sorm,
         }
     }
 
-    /// The samples per case: `--samples` or the method's default (is:
-    /// 10,000, mc: 100,000; 0 for FORM, which draws none).
+    /// The samples per case: `--samples` or the method's default
+    /// ([`reliability::document::samples`]; 0 for FORM, which draws none).
     pub(crate) fn samples(self, given: Option<u64>, to_cov: bool) -> u64 {
-        match (self, to_cov) {
-            (MethodArg::Form | MethodArg::Sorm, _) => 0,
-            (MethodArg::Is, false) => given.unwrap_or(10_000),
-            (MethodArg::Mc, false) => given.unwrap_or(100_000),
-            (MethodArg::Is, true) => given.unwrap_or(1_000_000),
-            (MethodArg::Mc, true) => given.unwrap_or(10_000_000),
-            (MethodArg::Subset, _) => given.unwrap_or(1_000),
-            (MethodArg::Directional, false) => given.unwrap_or(10_000),
-            (MethodArg::Directional, true) => given.unwrap_or(1_000_000),
-        }
+        reliability::document::samples(self.method(), given, to_cov)
     }
 }
-
-/// Subset simulation's sample budget with `--cov`, in levels of `--samples`.
-const SUBSET_BUDGET_LEVELS: u64 = 1000;
 
 /// Parses `--cov`: a finite number in (0, 1].
 pub(crate) fn parse_cov(s: &str) -> Result<f64, String> {
@@ -264,6 +228,7 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     };
     let mut doc = ReliabilityDoc::new(&loaded.machine.name, &study, &result);
     doc.doc.posterior = posterior.as_ref();
+    doc.doc.acceptance = acceptance.as_ref().map(AcceptanceDocument::of);
     doc.acceptance = acceptance.as_ref();
     report::emit(&doc, args.format.into())
 }
@@ -449,21 +414,7 @@ pub(crate) fn system_of(
     Ok(match system {
         None => None,
         Some(SystemArg::Series) => Some(System::Series),
-        Some(SystemArg::Volumetric) => {
-            let t = match tolerance {
-                Some(t) => t,
-                None => machine
-                    .reliability
-                    .as_ref()
-                    .ok_or(ReliabilityError::NoReliabilitySection)?
-                    .tolerance
-                    .iter()
-                    .filter(|(c, _)| c.index() < 3)
-                    .map(|(_, t)| *t)
-                    .fold(f64::INFINITY, f64::min),
-            };
-            Some(System::Volumetric { tolerance: t })
-        }
+        Some(SystemArg::Volumetric) => Some(reliability::document::volumetric(machine, tolerance)?),
     })
 }
 
@@ -545,11 +496,9 @@ pub(crate) fn axes(study: &Study) -> Vec<(String, usize)> {
 pub(crate) struct ReliabilityDoc<'a> {
     #[serde(flatten)]
     pub(crate) doc: ReliabilityDocument<'a>,
-    /// The whole-machine acceptance probability (`--acceptance`).
-    #[serde(
-        skip_serializing_if = "Option::is_none",
-        serialize_with = "super::acceptance::serialize"
-    )]
+    /// The whole-machine acceptance probability (`--acceptance`) for the
+    /// table and CSV (the JSON has the document's `acceptance`).
+    #[serde(skip)]
     pub(crate) acceptance: Option<&'a reliability::AcceptanceResult>,
     #[serde(skip)]
     study: &'a Study,

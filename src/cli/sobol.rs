@@ -9,12 +9,12 @@
 
 use std::path::PathBuf;
 
-use reliability::sobol::{Estimate, OutputIndices, Sobol, SobolError, SobolResult};
+use reliability::document::SobolDocument;
+use reliability::sobol::{Estimate, Sobol, SobolError};
 use reliability::{machine, Study};
-use serde::Serialize;
 
 use super::args::ParamArgs;
-use super::reliability::{parse_axis, Loaded, Pairs};
+use super::reliability::{parse_axis, Loaded};
 use super::report::{self, Csv, Report};
 use super::sensitivity::{parse_point, resolve_at, AtPoint};
 
@@ -70,7 +70,7 @@ pub fn exec(args: SobolArgs) -> miette::Result<()> {
     let (study, at) = match &args.at {
         None => {
             let (study, _) = loaded.study_with(&args.param.params, &args.grid, None, None, None)?;
-            (study, None)
+            (study, false)
         }
         Some(AtPoint(coords)) => {
             if !args.grid.is_empty() {
@@ -87,42 +87,15 @@ pub fn exec(args: SobolArgs) -> miette::Result<()> {
             let values =
                 machine::parameters(m, &args.param.params).map_err(|e| loaded.report(e))?;
             let model = chain_core::compile(m);
-            let study = Study::at_points(&model, &values, inputs, spec, vec![point.clone()])
+            let study = Study::at_points(&model, &values, inputs, spec, vec![point])
                 .map_err(|e| loaded.report(e))?;
-            let at: Vec<(String, f64)> = study
-                .variables()
-                .iter()
-                .cloned()
-                .zip(point.iter().copied())
-                .collect();
-            (study, Some(at))
+            (study, true)
         }
     };
     let result = settings
         .run_study(&study)
         .map_err(|e| sobol_error(&args.file, e))?;
-    let grid = at.is_none().then(|| Pairs(study.spec().grid.axes.clone()));
-    let doc = SobolDoc {
-        machine: &loaded.machine.name,
-        method: "saltelli-jansen",
-        at: at.map(Pairs),
-        grid,
-        points: result.points,
-        samples: result.settings.samples,
-        seed: result.settings.seed,
-        bootstrap: result.settings.bootstrap,
-        confidence: result.settings.confidence,
-        blocks: result.blocks,
-        evaluations_per_point: result.evaluations_per_point,
-        outputs: Pairs(
-            result
-                .outputs
-                .iter()
-                .map(|o| (o.output.name(), OutputDoc::of(o)))
-                .collect(),
-        ),
-        result: &result,
-    };
+    let doc = SobolDocument::new(&loaded.machine.name, &study, at, &result);
     report::emit(&doc, args.format.into())
 }
 
@@ -150,65 +123,6 @@ fn sobol_error(file: &std::path::Path, e: SobolError) -> miette::Report {
     miette::Report::new(e).wrap_err(format!("{file}: chain sobol"))
 }
 
-/// The document of `chain sobol`.
-#[derive(Serialize)]
-struct SobolDoc<'a> {
-    machine: &'a str,
-    /// `saltelli-jansen`: Saltelli 2010 Table 2 (b) and (f).
-    method: &'static str,
-    /// The point, or `null` when the indices pool the grid.
-    at: Option<Pairs<String, f64>>,
-    /// The grid pooled (absent at a point).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    grid: Option<Pairs<String, Vec<f64>>>,
-    points: usize,
-    samples: usize,
-    seed: u64,
-    bootstrap: usize,
-    confidence: f64,
-    blocks: usize,
-    evaluations_per_point: u64,
-    outputs: Pairs<&'static str, OutputDoc<'a>>,
-    #[serde(skip)]
-    result: &'a SobolResult,
-}
-
-/// One output of [`SobolDoc`].
-#[derive(Serialize)]
-struct OutputDoc<'a> {
-    variance: f64,
-    sum_first: &'a Estimate,
-    sum_total: &'a Estimate,
-    errors: Vec<ErrorDoc<'a>>,
-}
-
-/// One error of [`OutputDoc`].
-#[derive(Serialize)]
-struct ErrorDoc<'a> {
-    error: &'a str,
-    first: &'a Estimate,
-    total: &'a Estimate,
-}
-
-impl<'a> OutputDoc<'a> {
-    fn of(o: &'a OutputIndices) -> OutputDoc<'a> {
-        OutputDoc {
-            variance: o.variance,
-            sum_first: &o.sum_first,
-            sum_total: &o.sum_total,
-            errors: o
-                .errors
-                .iter()
-                .map(|e| ErrorDoc {
-                    error: &e.error,
-                    first: &e.first,
-                    total: &e.total,
-                })
-                .collect(),
-        }
-    }
-}
-
 fn cell(v: f64) -> String {
     format!("{v:.6}")
 }
@@ -217,7 +131,7 @@ fn exact_cell(e: &Estimate) -> String {
     e.exact.map_or_else(|| "-".to_string(), cell)
 }
 
-impl Report for SobolDoc<'_> {
+impl Report for SobolDocument<'_> {
     fn table(&self) -> String {
         use std::fmt::Write as _;
         let mut out = String::new();

@@ -1,0 +1,268 @@
+//! The reliability bindings (issue 16): `chain reliability` with every
+//! option of the command line (methods form, is, mc, sorm, subset,
+//! directional; `cov`; `system`; `values`; `acceptance`) and `chain sobol`.
+//!
+//! Each returns the library's document as JSON text, the document the CLI
+//! prints with `--format json` for the same input: [`ReliabilityDocument`]
+//! (with its [`AcceptanceDocument`]) and [`SobolDocument`], built by the same
+//! library functions the CLI calls ([`document::algorithm`],
+//! [`document::acceptance`], [`document::volumetric`]). Every option is
+//! checked before any work and refused with the CLI's wording, the option
+//! named as the Python keyword.
+
+use std::path::Path;
+
+use pyo3::prelude::*;
+use reliability::document::{self, AcceptanceDocument, ReliabilityDocument, SobolDocument};
+use reliability::sobol::{Sobol, SobolError};
+use reliability::{Method, Posterior, PosteriorError, ReliabilityError, Study, System};
+
+use crate::{load_error, study_error, to_json, value_error, Model};
+
+/// The methods of `method`, in the CLI's order of `--method`.
+const METHODS: [Method; 6] = [
+    Method::Form,
+    Method::ImportanceSampling,
+    Method::MonteCarlo,
+    Method::Subset,
+    Method::Directional,
+    Method::Sorm,
+];
+
+/// The method named `name` (`--method`'s spelling), or the CLI's refusal.
+fn method_named(name: &str) -> PyResult<Method> {
+    METHODS
+        .into_iter()
+        .find(|m| m.name() == name)
+        .ok_or_else(|| {
+            let all: Vec<&str> = METHODS.iter().map(|m| m.name()).collect();
+            value_error(format!(
+                "invalid value {name:?} for `method` [possible values: {}]",
+                all.join(", ")
+            ))
+        })
+}
+
+/// A posterior's refusal: located in the values file (`MachineError`), or
+/// a reliability error worded against the machine file.
+fn posterior_error(py: Python<'_>, model: &Model, e: PosteriorError) -> PyErr {
+    match e {
+        PosteriorError::Values(v) => load_error(py, v.diagnostics()),
+        PosteriorError::File(d) => load_error(py, &d),
+        PosteriorError::Reliability(e) => study_error(py, &e, &model.file),
+    }
+}
+
+/// `chain reliability --format json` with every option (`None`: the
+/// option not given; the defaults are the CLI's).
+///
+/// `method`: `form`, `is`, `mc`, `subset`, `directional` or `sorm`;
+/// `samples` per case (for subset per level); `cov` the target coefficient
+/// of variation in (0, 1] (samples then the budget); `system`: `series` or
+/// `volumetric` (`system_tolerance`: its allowable error); `values`: a
+/// values file with a calibration's posterior; `acceptance`: also the
+/// whole-machine acceptance probability (also when the file asks for it),
+/// to `acceptance_tolerance`.
+#[pyfunction]
+#[pyo3(signature = (model, method, samples, seed, cov, grid, params, sided, system, system_tolerance, values, acceptance, acceptance_tolerance))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn reliability_json(
+    py: Python<'_>,
+    model: &Model,
+    method: &str,
+    samples: Option<u64>,
+    seed: u64,
+    cov: Option<f64>,
+    grid: Vec<(String, Vec<f64>)>,
+    params: Vec<(String, f64)>,
+    sided: Option<&str>,
+    system: Option<&str>,
+    system_tolerance: Option<f64>,
+    values: Option<&str>,
+    acceptance: bool,
+    acceptance_tolerance: f64,
+) -> PyResult<String> {
+    let method = method_named(method)?;
+    let draws = !matches!(method, Method::Form | Method::Sorm);
+    if let Some(c) = cov {
+        if !c.is_finite() || c <= 0.0 || c > 1.0 {
+            return Err(value_error(format!(
+                "invalid value for `cov`: the target coefficient of variation must be in (0, 1] (found `{c}`)"
+            )));
+        }
+        if !draws {
+            let what = if method == Method::Form {
+                "FORM"
+            } else {
+                "SORM"
+            };
+            return Err(value_error(format!(
+                "cov: {what} draws no samples; a target coefficient of variation needs method \"mc\", \"is\", \"subset\" or \"directional\""
+            )));
+        }
+    }
+    if samples == Some(0) && draws {
+        return Err(value_error("samples must be at least 1"));
+    }
+    if !(acceptance_tolerance.is_finite()
+        && acceptance_tolerance > 0.0
+        && acceptance_tolerance < 1.0)
+    {
+        return Err(value_error(format!(
+            "invalid value for `acceptance_tolerance`: {acceptance_tolerance} (an absolute error in (0, 1))"
+        )));
+    }
+    let system = match (system, system_tolerance) {
+        (None, None) => None,
+        (None, Some(_)) => {
+            return Err(value_error(
+                "system_tolerance is the allowable error of system=\"volumetric\": give system too",
+            ))
+        }
+        (Some("series"), None) => Some(System::Series),
+        (Some("series"), Some(_)) => {
+            return Err(value_error(
+                "system_tolerance applies to system=\"volumetric\", not \"series\"",
+            ))
+        }
+        (Some("volumetric"), t) => {
+            if let Some(t) = t.filter(|t| !(t.is_finite() && *t > 0.0)) {
+                return Err(value_error(format!(
+                    "invalid value for `system_tolerance`: {t} (a positive allowable volumetric error)"
+                )));
+            }
+            Some(
+                document::volumetric(&model.machine, t)
+                    .map_err(|e| study_error(py, &e, &model.file))?,
+            )
+        }
+        (Some(other), _) => {
+            return Err(value_error(format!(
+                "invalid value {other:?} for `system` [possible values: series, volumetric]"
+            )))
+        }
+    };
+    let posterior = match values {
+        None => None,
+        Some(path) => Some(
+            Posterior::read(Path::new(path), &model.machine)
+                .map_err(|e| posterior_error(py, model, e))?,
+        ),
+    };
+    let study = model.study_with(py, &grid, &params, sided, system, posterior.as_ref())?;
+    let algorithm = document::algorithm(
+        method,
+        document::samples(method, samples, cov.is_some()),
+        seed,
+        cov,
+    );
+    let wanted = acceptance
+        || model
+            .machine
+            .reliability
+            .as_ref()
+            .is_some_and(|r| r.acceptance);
+    let (result, accepted) = py
+        .allow_threads(|| {
+            let result = study.run(&algorithm, &|_| {})?;
+            let accepted = match wanted {
+                true => Some(document::acceptance(&study, acceptance_tolerance, seed)?),
+                false => None,
+            };
+            Ok::<_, ReliabilityError>((result, accepted))
+        })
+        .map_err(|e| study_error(py, &e, &model.file))?;
+    let mut doc = ReliabilityDocument::new(&model.machine.name, &study, &result);
+    doc.posterior = posterior.as_ref();
+    doc.acceptance = accepted.as_ref().map(AcceptanceDocument::of);
+    to_json(&doc)
+}
+
+/// `chain sobol --format json`: first-order and total Sobol indices
+/// (Saltelli 2010 Table 2 (b), (f)) at the point `at` (every axis
+/// variable), or pooled over the reliability grid (`grid` replacing axes;
+/// not with `at`).
+#[pyfunction]
+#[pyo3(signature = (model, at, samples, seed, bootstrap, confidence, grid, params))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn sobol_json(
+    py: Python<'_>,
+    model: &Model,
+    at: Option<Vec<(String, f64)>>,
+    samples: u64,
+    seed: u64,
+    bootstrap: u64,
+    confidence: f64,
+    grid: Vec<(String, Vec<f64>)>,
+    params: Vec<(String, f64)>,
+) -> PyResult<String> {
+    let settings = Sobol {
+        samples: usize::try_from(samples).unwrap_or(usize::MAX),
+        seed,
+        bootstrap: usize::try_from(bootstrap).unwrap_or(usize::MAX),
+        confidence,
+    };
+    match settings.validate() {
+        Err(SobolError::InvalidSetting { what, rule, found }) => {
+            return Err(value_error(format!("{what} {found}: must be {rule}")))
+        }
+        Err(e) => return Err(value_error(e.to_string())),
+        Ok(()) => {}
+    }
+    let study = match &at {
+        None => model.study(py, &grid, &params, None)?,
+        Some(coords) => {
+            if !grid.is_empty() {
+                return Err(value_error(
+                    "grid cannot be combined with at (at evaluates at one point, grid sets the grid to pool over; give one)",
+                ));
+            }
+            let point = resolve_at(py, model, coords)?;
+            let m = &model.machine;
+            let err = |e: ReliabilityError| study_error(py, &e, &model.file);
+            let spec = reliability::machine::spec(m, None).map_err(err)?;
+            let inputs = reliability::machine::inputs(m).map_err(err)?;
+            let values = model.parameter_vector(py, &params)?;
+            Study::at_points(&model.model, &values, inputs, spec, vec![point]).map_err(err)?
+        }
+    };
+    let result = py
+        .allow_threads(|| settings.run_study(&study))
+        .map_err(|e| value_error(format!("{}: chain sobol: {e}", model.file)))?;
+    to_json(&SobolDocument::new(
+        &model.machine.name,
+        &study,
+        at.is_some(),
+        &result,
+    ))
+}
+
+/// The values of `at` in the machine's variable order: every axis variable
+/// once, no unknown name, all finite (as `chain sobol --at`).
+fn resolve_at(py: Python<'_>, model: &Model, coords: &[(String, f64)]) -> PyResult<Vec<f64>> {
+    let m = &model.machine;
+    let vars: Vec<&str> = m.variables.iter().map(|v| v.name.as_str()).collect();
+    if let Some((name, _)) = coords.iter().find(|(n, _)| !vars.contains(&n.as_str())) {
+        let e = ReliabilityError::unknown("axis variable", name, vars.iter().copied());
+        return Err(study_error(py, &e, &model.file));
+    }
+    if let Some((name, x)) = coords.iter().find(|(_, x)| !x.is_finite()) {
+        return Err(value_error(format!("at: `{name}` = {x} is not finite")));
+    }
+    vars.iter()
+        .map(|v| {
+            coords
+                .iter()
+                .rev()
+                .find(|(n, _)| n == v)
+                .map(|(_, x)| *x)
+                .ok_or_else(|| {
+                    let every: Vec<String> = vars.iter().map(|v| format!("{v:?}: …")).collect();
+                    value_error(format!(
+                        "at has no value for axis variable `{v}` (give every axis variable: at={{{}}})",
+                        every.join(", ")
+                    ))
+                })
+        })
+        .collect()
+}
