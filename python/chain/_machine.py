@@ -316,6 +316,48 @@ class Machine:
         return PlanResult._from_json(_chain.plan_json(self._model, path, text, name, k, kind, _params(params)))
 
 
+    def sobol(
+        self,
+        at: Optional[Mapping[str, float]] = None,
+        samples: int = 10_000,
+        seed: int = 0,
+        bootstrap: int = 1000,
+        confidence: float = 0.95,
+        grid: Optional[Mapping[str, Sequence[float]]] = None,
+        params: Params = None,
+    ) -> SobolResult:
+        """First-order and total Sobol indices, ``chain sobol --format json``.
+
+        Saltelli et al. 2010's first-order and Jansen's total estimator of
+        every toleranced component and of ``|p|`` with respect to every error
+        parameter, with bootstrap percentile intervals (docs/sobol.md):
+        at one point ``at`` (every axis variable, ``{"x": 0, "y": 1500, ...}``),
+        otherwise pooled over the reliability grid (``grid`` replacing axes,
+        not with ``at``). ``samples``: base samples N (N·(k+2) evaluations
+        per point); ``bootstrap`` replicates at ``confidence``.
+        """
+        for name, v in (("samples", samples), ("seed", seed), ("bootstrap", bootstrap)):
+            if not isinstance(v, int) or isinstance(v, bool) or v < 0:
+                raise ValueError(f"{name} must be a non-negative integer, not {v!r}")
+        confidence = _optional_float(confidence, "confidence")
+        point = None
+        if at is not None:
+            if not isinstance(at, Mapping):
+                raise ValueError(f"at must be a mapping of axis variable to value, not {type(at).__name__}")
+            point = []
+            for name, value in at.items():
+                try:
+                    point.append((str(name), float(value)))
+                except (TypeError, ValueError):
+                    raise ValueError(f"at: `{name}` = {value!r} is not a number") from None
+        axes = []
+        for name, values_ in (grid or {}).items():
+            a = _float_array(values_, f"grid[{name!r}]").ravel()
+            axes.append((str(name), [float(v) for v in a]))
+        text = _chain.sobol_json(self._model, point, samples, seed, bootstrap, confidence, axes, _params(params))
+        return SobolResult._from_json(text)
+
+
 # -- group B helpers ----------------------------------------------------------
 
 
@@ -380,46 +422,6 @@ def _csv_input(data: Any, what: str) -> Tuple[Optional[str], Optional[str]]:
     for i in range(n or 0):
         lines.append(",".join(repr(float(c[i])) for c in columns))
     return None, "\n".join(lines) + "\n"
-    def sobol(
-        self,
-        at: Optional[Mapping[str, float]] = None,
-        samples: int = 10_000,
-        seed: int = 0,
-        bootstrap: int = 1000,
-        confidence: float = 0.95,
-        grid: Optional[Mapping[str, Sequence[float]]] = None,
-        params: Params = None,
-    ) -> SobolResult:
-        """First-order and total Sobol indices, ``chain sobol --format json``.
-
-        Saltelli et al. 2010's first-order and Jansen's total estimator of
-        every toleranced component and of ``|p|`` with respect to every error
-        parameter, with bootstrap percentile intervals (docs/sobol.md):
-        at one point ``at`` (every axis variable, ``{"x": 0, "y": 1500, ...}``),
-        otherwise pooled over the reliability grid (``grid`` replacing axes,
-        not with ``at``). ``samples``: base samples N (N·(k+2) evaluations
-        per point); ``bootstrap`` replicates at ``confidence``.
-        """
-        for name, v in (("samples", samples), ("seed", seed), ("bootstrap", bootstrap)):
-            if not isinstance(v, int) or isinstance(v, bool) or v < 0:
-                raise ValueError(f"{name} must be a non-negative integer, not {v!r}")
-        confidence = _optional_float(confidence, "confidence")
-        point = None
-        if at is not None:
-            if not isinstance(at, Mapping):
-                raise ValueError(f"at must be a mapping of axis variable to value, not {type(at).__name__}")
-            point = []
-            for name, value in at.items():
-                try:
-                    point.append((str(name), float(value)))
-                except (TypeError, ValueError):
-                    raise ValueError(f"at: `{name}` = {value!r} is not a number") from None
-        axes = []
-        for name, values_ in (grid or {}).items():
-            a = _float_array(values_, f"grid[{name!r}]").ravel()
-            axes.append((str(name), [float(v) for v in a]))
-        text = _chain.sobol_json(self._model, point, samples, seed, bootstrap, confidence, axes, _params(params))
-        return SobolResult._from_json(text)
 
 
 def _optional_float(x: Any, name: str) -> Optional[float]:

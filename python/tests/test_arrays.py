@@ -158,7 +158,7 @@ def test_missing_statistic_is_located(tmp_path):
 
 def test_bad_options(ac):
     g = chain.Machine.load(ROOT / "examples/machines/gantry_grinder.yaml")
-    with pytest.raises(ValueError, match="method must be"):
+    with pytest.raises(ValueError, match=r"invalid value \"sorm\?\" for `method`"):
         g.reliability(method="sorm?")
     with pytest.raises(ValueError, match="samples must be"):
         g.reliability(method="mc", samples=0)
