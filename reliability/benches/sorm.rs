@@ -5,6 +5,11 @@
 //!
 //! Run with `cargo bench -p reliability --bench sorm`; the figure is recorded
 //! in `docs/performance.md` (part A of issue 15).
+//!
+//! With `CHAIN_SORM_CASES=path.json` set, the benchmark first writes the 375
+//! cases (inputs, each case's sensitivity row, tolerance and chain's FORM and
+//! SORM indices) to that file for `openturns_sorm375.py`, the side-by-side
+//! run through OpenTURNS.
 
 use std::hint::black_box;
 use std::path::Path;
@@ -38,6 +43,9 @@ fn benches(c: &mut Criterion) {
     let events = study.events().expect("events");
     assert_eq!(events.len(), 375);
     let sorm = Sorm::default();
+    if let Ok(path) = std::env::var("CHAIN_SORM_CASES") {
+        write_cases(&path, study.inputs(), &events, &sorm);
+    }
     let mut g = c.benchmark_group("sorm");
     g.throughput(Throughput::Elements(375));
     g.bench_function("375_cases_nonnormal", |b| {
@@ -50,6 +58,31 @@ fn benches(c: &mut Criterion) {
         })
     });
     g.finish();
+}
+
+/// The cases and chain's answers as JSON, for the OpenTURNS script.
+fn write_cases(
+    path: &str,
+    inputs: &reliability::Inputs,
+    events: &[reliability::Event<'_>],
+    sorm: &Sorm,
+) {
+    let cases: Vec<serde_json::Value> = events
+        .iter()
+        .map(|e| {
+            let r = sorm.run(e).expect("sorm");
+            serde_json::json!({
+                "row": e.limit_state.row(0),
+                "tolerance": e.limit_state.tolerances()[0],
+                "beta_form": r.form.beta,
+                "beta_breitung": r.beta_breitung,
+                "beta_hohenbichler_rackwitz": r.beta_hohenbichler_rackwitz,
+                "beta_tvedt": r.beta_tvedt,
+            })
+        })
+        .collect();
+    let doc = serde_json::json!({"inputs": inputs, "cases": cases});
+    std::fs::write(path, serde_json::to_string(&doc).expect("json")).expect("write the cases");
 }
 
 criterion_group! {
