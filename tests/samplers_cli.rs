@@ -160,3 +160,34 @@ fn bad_cov_is_refused_with_the_option_named() {
     let err = fails(&["reliability", &g, "--method", "subset", "--samples", "1005"]);
     assert!(err.contains("multiple of 1/p0"), "{err}");
 }
+
+/// The sampler options that need no model are refused before the load,
+/// with the option named: SORM draws no samples (so `--cov` with it is an
+/// error, not ignored), subset's samples per level are a multiple of
+/// 1/p0 = 10.
+#[test]
+fn sampler_options_are_checked_with_their_name() {
+    let g = gantry();
+    let err = fails(&["reliability", &g, "--method", "sorm", "--cov", "0.1"]);
+    assert!(
+        err.contains("'--cov'") && err.contains("SORM draws no samples"),
+        "{err}"
+    );
+    for n in ["5", "1005"] {
+        let err = fails(&["reliability", &g, "--method", "subset", "--samples", n]);
+        assert!(
+            err.contains("'--samples'") && err.contains(&format!("(found {n})")),
+            "{n}: {err}"
+        );
+    }
+    // Checked before the machine file is read: a missing file is not reached.
+    let err = fails(&[
+        "reliability",
+        "no/such.yaml",
+        "--method",
+        "sorm",
+        "--cov",
+        "0.1",
+    ]);
+    assert!(err.contains("'--cov'"), "{err}");
+}

@@ -83,25 +83,17 @@ pub(crate) fn reliability_json(
     acceptance_tolerance: f64,
 ) -> PyResult<String> {
     let method = method_named(method)?;
-    let draws = !matches!(method, Method::Form | Method::Sorm);
     if let Some(c) = cov {
         if !c.is_finite() || c <= 0.0 || c > 1.0 {
             return Err(value_error(format!(
                 "invalid value for `cov`: the target coefficient of variation must be in (0, 1] (found `{c}`)"
             )));
         }
-        if !draws {
-            let what = if method == Method::Form {
-                "FORM"
-            } else {
-                "SORM"
-            };
-            return Err(value_error(format!(
-                "cov: {what} draws no samples; a target coefficient of variation needs method \"mc\", \"is\", \"subset\" or \"directional\""
-            )));
-        }
     }
-    if samples == Some(0) && draws {
+    if let Err(p) = document::check_options(method, samples, cov) {
+        return Err(value_error(format!("{}: {}", p.option, p.message)));
+    }
+    if samples == Some(0) && !matches!(method, Method::Form | Method::Sorm) {
         return Err(value_error("samples must be at least 1"));
     }
     if !(acceptance_tolerance.is_finite()

@@ -216,6 +216,52 @@ pub fn samples(method: Method, given: Option<u64>, to_cov: bool) -> u64 {
     }
 }
 
+/// A sampler option that cannot hold for its method, found before any
+/// work is done: `option` is the option's name (`"cov"`, `"samples"`); the
+/// binary spells it `--cov`, the Python package `cov=`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OptionProblem {
+    /// The option at fault.
+    pub option: &'static str,
+    /// What is wrong with it.
+    pub message: String,
+}
+
+/// The checks of `method`'s sampler options that need no model, shared by
+/// `chain reliability` and the Python package: a target coefficient of
+/// variation with FORM or SORM (which draw no samples) and subset
+/// simulation's samples per level (a positive multiple of `1/p0`). Zero
+/// samples are the library's own `invalid_samples` error.
+pub fn check_options(
+    method: Method,
+    samples: Option<u64>,
+    cov: Option<f64>,
+) -> Result<(), OptionProblem> {
+    let problem = |option, message: String| Err(OptionProblem { option, message });
+    let draws = !matches!(method, Method::Form | Method::Sorm);
+    if cov.is_some() && !draws {
+        let what = if method == Method::Form {
+            "FORM"
+        } else {
+            "SORM"
+        };
+        return problem(
+            "cov",
+            format!(
+                "{what} draws no samples; a target coefficient of variation needs method mc, is, subset or directional"
+            ),
+        );
+    }
+    if method == Method::Subset {
+        if let Some(n) = samples {
+            if let Err(ReliabilityError::InvalidSampler(m)) = SubsetSimulation::new(n, 0).check() {
+                return problem("samples", m);
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Subset simulation's sample budget with a target coefficient of
 /// variation, in levels of its samples per level.
 pub const SUBSET_BUDGET_LEVELS: u64 = 1000;

@@ -169,7 +169,7 @@ struct Run {
 }
 
 impl SubsetSimulation {
-    fn check(&self) -> Result<(usize, usize), ReliabilityError> {
+    pub(crate) fn check(&self) -> Result<(usize, usize), ReliabilityError> {
         if !(self.p0 > 0.0 && self.p0 < 1.0) {
             return Err(ReliabilityError::InvalidSampler(format!(
                 "the level probability p0 must be in (0, 1) (found {})",

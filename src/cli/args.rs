@@ -67,14 +67,18 @@ pub struct AlgorithmArgs {
 }
 
 impl AlgorithmArgs {
-    /// Refuses `--cov` with FORM (it draws no samples).
+    /// The sampler options that need no model (`reliability::document::check_options`):
+    /// `--cov` with FORM or SORM, subset samples per level.
     pub fn check(&self) -> miette::Result<()> {
-        if self.cov.is_some() && self.method == MethodArg::Form {
-            miette::bail!(
-                "--cov: FORM draws no samples; a target coefficient of variation needs --method mc, is, subset or directional"
-            );
-        }
-        Ok(())
+        let method = self.method.method();
+        reliability::document::check_options(method, self.samples, self.cov).map_err(|p| {
+            miette::miette!(
+                code = "chain::cli::invalid_option",
+                "invalid value for '--{}': {}",
+                p.option,
+                p.message
+            )
+        })
     }
 
     /// The library's algorithm for these options.
