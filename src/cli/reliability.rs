@@ -192,7 +192,9 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     let bar = if !args.algorithm.method.samples_anything() {
         ProgressBar(None)
     } else {
-        ProgressBar::new(samples, study_cases(&study), args.format)
+        let known = args.algorithm.cov.is_none() && args.algorithm.method != MethodArg::Subset;
+        let total = known.then(|| samples.saturating_mul(study_cases(&study)));
+        ProgressBar::new(total, args.format)
     };
     let result = study.run(&args.algorithm.algorithm(), &|n| bar.inc(n));
     bar.finish();
@@ -260,17 +262,24 @@ pub(crate) fn note_form_limits(study: &Study) {
 struct ProgressBar(Option<indicatif::ProgressBar>);
 
 impl ProgressBar {
-    fn new(samples: u64, cases: u64, format: ReliabilityFormat) -> ProgressBar {
+    /// A bar over `total` samples when the count is known in advance (the
+    /// fixed-count samplers); otherwise (subset simulation, whose levels are
+    /// found as it runs, and every sampler stopped by `--cov`) a counter of
+    /// the samples drawn, since any total would be a guess.
+    fn new(total: Option<u64>, format: ReliabilityFormat) -> ProgressBar {
         if format == ReliabilityFormat::Json || !std::io::stderr().is_terminal() {
             return ProgressBar(None);
         }
         let bar = indicatif::ProgressBar::with_draw_target(
-            Some(samples.saturating_mul(cases)),
+            total,
             indicatif::ProgressDrawTarget::stderr(),
         );
-        if let Ok(style) = indicatif::ProgressStyle::with_template(
-            "{spinner} sampling [{bar:40}] {percent:>3}% {human_pos}/{human_len} samples, eta {eta}",
-        ) {
+        let template = if total.is_some() {
+            "{spinner} sampling [{bar:40}] {percent:>3}% {human_pos}/{human_len} samples, eta {eta}"
+        } else {
+            "{spinner} sampling: {human_pos} samples drawn, {elapsed}"
+        };
+        if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
             bar.set_style(style.progress_chars("=> "));
         }
         ProgressBar(Some(bar))
