@@ -17,9 +17,11 @@ from ._machine import Machine, Nominal
 from ._results import Derivation, ReliabilityResult, Result
 from ._results import IdentifyResult, MapResult, PlanResult
 from ._results import Derivation, ReliabilityResult, Result, SobolResult
+from ._results import GeometricSensitivityResult, SensitivityResult
 
 __all__ = [
     "Derivation",
+    "GeometricSensitivityResult",
     "IdentifyResult",
     "MapResult",
     "PlanResult",
@@ -28,6 +30,7 @@ __all__ = [
     "Nominal",
     "ReliabilityResult",
     "Result",
+    "SensitivityResult",
     "SobolResult",
 ]
 

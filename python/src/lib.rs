@@ -30,6 +30,7 @@ use reliability::document::describe;
 use reliability::{ReliabilityError, Study};
 
 mod reliability_v2;
+mod sensitivity;
 
 create_exception!(
     _chain,
@@ -497,5 +498,7 @@ fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(group_b::map_json, m)?)?;
     m.add_function(wrap_pyfunction!(reliability_v2::reliability_json, m)?)?;
     m.add_function(wrap_pyfunction!(reliability_v2::sobol_json, m)?)?;
+    m.add_function(wrap_pyfunction!(sensitivity::sensitivity_reliability_json, m)?)?;
+    m.add_function(wrap_pyfunction!(sensitivity::geometric_json, m)?)?;
     Ok(())
 }

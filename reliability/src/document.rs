@@ -12,6 +12,9 @@
 //! name's options into the [`Algorithm`] both run (the defaults in one
 //! place), [`volumetric`] the `--system volumetric` target.
 //!
+//! [`sensitivity`] runs `chain sensitivity --kind reliability` (at a point
+//! or the grid mean) and [`SensitivityDocument`] is its JSON.
+//!
 //! [`describe`] is the one wording of a [`ReliabilityError`] against the
 //! machine file it concerns (message, location, label, help), shared by the
 //! binary's diagnostics and the Python exceptions.
@@ -25,9 +28,9 @@ use chain_core::model::Machine;
 use crate::acceptance::{Acceptance, AcceptanceResult, Rectangles};
 use crate::sobol::{Estimate, OutputIndices, SobolResult};
 use crate::{
-    Algorithm, Calls, DirectionalSimulation, Form, FormCase, ImportanceSampling, Method,
-    MonteCarlo, Posterior, ReliabilityError, SormCase, Stopping, Study, StudyResult, SubsetLevel,
-    SubsetSimulation, System, Target,
+    Algorithm, Calls, DirectionalSimulation, ErrorModel, Form, FormCase, ImportanceSampling,
+    Method, MonteCarlo, Posterior, ReliabilityError, SensitivityMethod, SormCase, Stopping, Study,
+    StudyResult, SubsetLevel, SubsetSimulation, System, Target, TargetSensitivity,
 };
 
 /// The document of a grid study (the spec's `reliability` JSON contract).
@@ -548,5 +551,109 @@ fn at(origin: &Origin) -> String {
         format!(":{}:{}", origin.line, origin.column)
     } else {
         String::new()
+    }
+}
+
+/// The reliability sensitivities of `chain sensitivity --kind reliability`:
+/// at `point` (axis values in the model's variable order) or, with `None`,
+/// the mean over the study's grid (FORM settings `form`). With a point, the
+/// point is also returned as `(variable, value)` pairs in the grid's axis
+/// order, then any other variable (the order the document lists it in).
+#[allow(clippy::type_complexity)]
+pub fn sensitivity<M: ErrorModel + ?Sized>(
+    study: &Study,
+    model: &M,
+    parameters: &[f64],
+    point: Option<&[f64]>,
+    form: &Form,
+) -> Result<(Option<Vec<(String, f64)>>, Vec<TargetSensitivity>), ReliabilityError> {
+    let Some(point) = point else {
+        return Ok((None, study.sensitivity_mean(form)?));
+    };
+    let result = study.sensitivity_point(model, parameters, point, form)?;
+    let vars = study.variables();
+    let mut order: Vec<usize> = study
+        .spec()
+        .grid
+        .axes
+        .iter()
+        .filter_map(|(n, _)| vars.iter().position(|v| v == n))
+        .collect();
+    order.extend((0..vars.len()).filter(|i| !order.contains(i)).collect::<Vec<_>>());
+    let at = order.iter().map(|&i| (vars[i].clone(), point[i])).collect();
+    Ok((Some(at), result))
+}
+
+/// The document of `chain sensitivity --kind reliability`.
+#[derive(Debug, Serialize)]
+pub struct SensitivityDocument<'a> {
+    /// The machine's name.
+    pub machine: &'a str,
+    /// The point, or `null` for the grid mean.
+    pub at: Option<NameMap<String, f64>>,
+    /// Each target's route (exact or FORM).
+    pub methods: NameMap<Target, SensitivityMethod>,
+    /// Each target's errors, sorted by `|∂R/∂σ|`, largest first.
+    pub components: NameMap<Target, Vec<SensitivityErrorDocument<'a>>>,
+    /// The posterior the inputs came from (`--values`), when given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub posterior: Option<&'a Posterior>,
+    /// The sensitivities the document was built from (for tables).
+    #[serde(skip)]
+    pub result: &'a [TargetSensitivity],
+}
+
+/// One error of a [`SensitivityDocument`]; the grid mean also has the mean
+/// absolute values.
+#[derive(Debug, Serialize)]
+pub struct SensitivityErrorDocument<'a> {
+    /// The error parameter.
+    pub error: &'a str,
+    /// `∂R/∂σ` (Eq. 33).
+    pub dr_dstd: f64,
+    /// `∂R/∂μ` (Eq. 32).
+    pub dr_dmean: f64,
+    /// The FORM importance factor.
+    pub importance: f64,
+    /// The grid mean of `|∂R/∂σ|` (grid mean only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean_abs_dr_dstd: Option<f64>,
+    /// The grid mean of `|∂R/∂μ|` (grid mean only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean_abs_dr_dmean: Option<f64>,
+}
+
+impl<'a> SensitivityDocument<'a> {
+    /// The document of the sensitivities `result`, at the point `at` (or
+    /// the grid mean, which adds the mean absolute values), with the
+    /// posterior `posterior` when the inputs came from one.
+    pub fn new(
+        machine: &'a str,
+        at: Option<Vec<(String, f64)>>,
+        result: &'a [TargetSensitivity],
+        posterior: Option<&'a Posterior>,
+    ) -> SensitivityDocument<'a> {
+        let mean = at.is_none();
+        let errors = |t: &'a TargetSensitivity| -> Vec<SensitivityErrorDocument<'a>> {
+            t.errors
+                .iter()
+                .map(|e| SensitivityErrorDocument {
+                    error: &e.error,
+                    dr_dstd: e.dr_dstd,
+                    dr_dmean: e.dr_dmean,
+                    importance: e.importance,
+                    mean_abs_dr_dstd: mean.then_some(e.mean_abs_dr_dstd),
+                    mean_abs_dr_dmean: mean.then_some(e.mean_abs_dr_dmean),
+                })
+                .collect()
+        };
+        SensitivityDocument {
+            machine,
+            at: at.map(NameMap),
+            methods: result.iter().map(|t| (t.target, t.method)).collect(),
+            components: result.iter().map(|t| (t.target, errors(t))).collect(),
+            posterior,
+            result,
+        }
     }
 }
