@@ -17,9 +17,10 @@ from ._machine import Machine, Nominal
 from ._results import Derivation, ReliabilityResult, Result
 from ._results import IdentifyResult, MapResult, PlanResult
 from ._results import Derivation, ReliabilityResult, Result, SobolResult
-from ._results import GeometricSensitivityResult, SensitivityResult
+from ._results import AllocationResult, GeometricSensitivityResult, SensitivityResult
 
 __all__ = [
+    "AllocationResult",
     "Derivation",
     "GeometricSensitivityResult",
     "IdentifyResult",

@@ -93,6 +93,20 @@ def geometric_json(
 ) -> str: ...
 
 
+# -- allocation (python/src/allocate.rs) --------------------------------------
+
+def allocate_json(
+    model: Model,
+    strategy: str,
+    step: float,
+    threshold: float,
+    rank: str,
+    level: Optional[float],
+    params: Sequence[Tuple[str, float]],
+    sided: Optional[str],
+) -> str: ...
+
+
 # -- group B: the measured machine (python/src/group_b.rs) --------------------
 
 def identify_json(

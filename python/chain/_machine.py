@@ -8,7 +8,7 @@ from typing import Any, Dict, List, Mapping, NamedTuple, Optional, Sequence, Tup
 import numpy as np
 
 from . import _chain
-from ._results import Derivation, GeometricSensitivityResult, ReliabilityResult, SensitivityResult, SobolResult
+from ._results import AllocationResult, Derivation, GeometricSensitivityResult, ReliabilityResult, SensitivityResult, SobolResult
 
 ArrayLike = Any
 Params = Optional[Mapping[str, float]]
@@ -406,6 +406,42 @@ class Machine:
             raise ValueError(f"sizes must be a str or a mapping of error kind to size, not {type(sizes).__name__}")
         text = _chain.geometric_json(self._model, point, _grid_axes(grid), _params(params), text_sizes)
         return GeometricSensitivityResult._from_json(text)
+
+    def allocate(
+        self,
+        strategy: str = "optimal",
+        step: float = 0.005,
+        threshold: float = 0.1,
+        rank: str = "component",
+        target: str = "requirement",
+        level: Optional[float] = None,
+        params: Params = None,
+        sided: Optional[str] = None,
+    ) -> AllocationResult:
+        """Precision allocation, ``chain allocate --format json`` (docs/allocation.md).
+
+        ``strategy="optimal"``: the least-cost standard deviations meeting the
+        requirement, with the KKT check; ``"paper"``: Wang & Yuan 2021's
+        rounds (``step`` in Table 1's tolerance units, ``threshold`` a fraction
+        of the largest sensitivity, ``rank`` ``"component"`` or ``"pooled"``).
+        ``target="requirement"`` (the reliability section's) or
+        ``"acceptance"`` with ``level`` in (0, 1): the whole-machine
+        acceptance probability. An allocation that misses its target is
+        returned with ``final["met"]`` false (the CLI exits non-zero).
+        """
+        step = _optional_float(step, "step")
+        threshold = _optional_float(threshold, "threshold")
+        level = _optional_float(level, "level")
+        if target == "acceptance":
+            if level is None:
+                raise ValueError('target="acceptance" needs level (e.g. level=0.9)')
+        elif target == "requirement":
+            if level is not None:
+                raise ValueError('level applies to target="acceptance" only')
+        else:
+            raise ValueError(f"invalid value {target!r} for `target` [possible values: requirement, acceptance]")
+        text = _chain.allocate_json(self._model, strategy, step, threshold, rank, level, _params(params), sided)
+        return AllocationResult._from_json(text)
 
 
 # -- group B helpers ----------------------------------------------------------

@@ -243,3 +243,24 @@ class GeometricSensitivityResult(Result):
             for component, errors in self._document["components"].items()
             for e in errors
         ]
+
+
+class AllocationResult(Result):
+    """``chain allocate --format json`` (docs/allocation.md).
+
+    Attributes: ``machine``, ``strategy`` (``optimal`` or ``paper``),
+    ``requirement``, ``initial`` (``std`` per error, ``summary`` per
+    component), ``steps`` (the paper's rounds), ``final`` (``std``, ``cost``,
+    ``met``, ``summary``), ``kkt`` (optimal), ``acceptance`` (target
+    acceptance). Rows of ``to_dataframe()``: one per error, its initial and
+    allocated standard deviation.
+    """
+
+    command = "allocate"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        d = self._document
+        return [
+            {"error": e, "std0": s0, "std": d["final"]["std"][e], "ratio": s0 / d["final"]["std"][e]}
+            for e, s0 in d["initial"]["std"].items()
+        ]

@@ -29,6 +29,7 @@ use rayon::prelude::*;
 use reliability::document::describe;
 use reliability::{ReliabilityError, Study};
 
+mod allocate;
 mod reliability_v2;
 mod sensitivity;
 
@@ -500,5 +501,6 @@ fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reliability_v2::sobol_json, m)?)?;
     m.add_function(wrap_pyfunction!(sensitivity::sensitivity_reliability_json, m)?)?;
     m.add_function(wrap_pyfunction!(sensitivity::geometric_json, m)?)?;
+    m.add_function(wrap_pyfunction!(allocate::allocate_json, m)?)?;
     Ok(())
 }
