@@ -239,7 +239,11 @@ pub(crate) fn sobol_json(
 
 /// The values of `at` in the machine's variable order: every axis variable
 /// once, no unknown name, all finite (as `chain sobol --at`).
-pub(crate) fn resolve_at(py: Python<'_>, model: &Model, coords: &[(String, f64)]) -> PyResult<Vec<f64>> {
+pub(crate) fn resolve_at(
+    py: Python<'_>,
+    model: &Model,
+    coords: &[(String, f64)],
+) -> PyResult<Vec<f64>> {
     let m = &model.machine;
     let vars: Vec<&str> = m.variables.iter().map(|v| v.name.as_str()).collect();
     if let Some((name, _)) = coords.iter().find(|(n, _)| !vars.contains(&n.as_str())) {

@@ -584,7 +584,11 @@ pub fn sensitivity<M: ErrorModel + ?Sized>(
         .iter()
         .filter_map(|(n, _)| vars.iter().position(|v| v == n))
         .collect();
-    order.extend((0..vars.len()).filter(|i| !order.contains(i)).collect::<Vec<_>>());
+    order.extend(
+        (0..vars.len())
+            .filter(|i| !order.contains(i))
+            .collect::<Vec<_>>(),
+    );
     let at = order.iter().map(|&i| (vars[i].clone(), point[i])).collect();
     Ok((Some(at), result))
 }

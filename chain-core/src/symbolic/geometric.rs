@@ -535,7 +535,11 @@ impl<'a> GeometricDocument<'a> {
             points: grid.then_some(r.points),
             normalisation: "c = s*e / sum(s*e)",
             values: nominal,
-            totals: r.components.iter().map(|c| (c.component, c.total)).collect(),
+            totals: r
+                .components
+                .iter()
+                .map(|c| (c.component, c.total))
+                .collect(),
             components: r
                 .components
                 .iter()
