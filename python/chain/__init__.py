@@ -17,9 +17,12 @@ from ._machine import Machine, Nominal
 from ._results import Derivation, ReliabilityResult, Result
 from ._results import IdentifyResult, MapResult, PlanResult
 from ._results import Derivation, ReliabilityResult, Result, SobolResult
+from ._results import AllocationResult, GeometricSensitivityResult, SensitivityResult
 
 __all__ = [
+    "AllocationResult",
     "Derivation",
+    "GeometricSensitivityResult",
     "IdentifyResult",
     "MapResult",
     "PlanResult",
@@ -28,6 +31,7 @@ __all__ = [
     "Nominal",
     "ReliabilityResult",
     "Result",
+    "SensitivityResult",
     "SobolResult",
 ]
 

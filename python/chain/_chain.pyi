@@ -74,6 +74,39 @@ def sobol_json(
 ) -> str: ...
 
 
+# -- sensitivity (python/src/sensitivity.rs) ----------------------------------
+
+def sensitivity_reliability_json(
+    model: Model,
+    at: Optional[Sequence[Tuple[str, float]]],
+    grid: Sequence[Tuple[str, Sequence[float]]],
+    params: Sequence[Tuple[str, float]],
+    sided: Optional[str],
+    values: Optional[str],
+) -> str: ...
+def geometric_json(
+    model: Model,
+    at: Optional[Sequence[Tuple[str, float]]],
+    grid: Sequence[Tuple[str, Sequence[float]]],
+    params: Sequence[Tuple[str, float]],
+    sizes: Optional[str],
+) -> str: ...
+
+
+# -- allocation (python/src/allocate.rs) --------------------------------------
+
+def allocate_json(
+    model: Model,
+    strategy: str,
+    step: float,
+    threshold: float,
+    rank: str,
+    level: Optional[float],
+    params: Sequence[Tuple[str, float]],
+    sided: Optional[str],
+) -> str: ...
+
+
 # -- group B: the measured machine (python/src/group_b.rs) --------------------
 
 def identify_json(

@@ -8,7 +8,7 @@ from typing import Any, Dict, List, Mapping, NamedTuple, Optional, Sequence, Tup
 import numpy as np
 
 from . import _chain
-from ._results import Derivation, ReliabilityResult, SobolResult
+from ._results import AllocationResult, Derivation, GeometricSensitivityResult, ReliabilityResult, SensitivityResult, SobolResult
 
 ArrayLike = Any
 Params = Optional[Mapping[str, float]]
@@ -357,6 +357,92 @@ class Machine:
         text = _chain.sobol_json(self._model, point, samples, seed, bootstrap, confidence, axes, _params(params))
         return SobolResult._from_json(text)
 
+    def sensitivity_reliability(
+        self,
+        at: Optional[Mapping[str, float]] = None,
+        grid: Optional[Mapping[str, Sequence[float]]] = None,
+        params: Params = None,
+        sided: Optional[str] = None,
+        values: Optional[Union[str, "os.PathLike[str]"]] = None,
+    ) -> SensitivityResult:
+        """Reliability sensitivity, ``chain sensitivity --kind reliability --format json``.
+
+        The sensitivity of each toleranced component's reliability to the
+        mean and standard deviation of every error parameter (Wang & Yuan
+        2021 Eq. 32-33) and its FORM importance factor, sorted by
+        ``|dR/dstd|``: at one point ``at`` (every axis variable), otherwise
+        the mean over the reliability grid (``grid`` replacing axes).
+        ``values``: a values file with a calibration's posterior (``--values``).
+        """
+        point = _at_point(at)
+        path = None if values is None else os.fspath(values)
+        text = _chain.sensitivity_reliability_json(self._model, point, _grid_axes(grid), _params(params), sided, path)
+        return SensitivityResult._from_json(text)
+
+    def geometric_sensitivity(
+        self,
+        at: Optional[Mapping[str, float]] = None,
+        grid: Optional[Mapping[str, Sequence[float]]] = None,
+        sizes: Optional[Union[str, Mapping[str, Union[float, str]]]] = None,
+        params: Params = None,
+    ) -> GeometricSensitivityResult:
+        """Geometric error sensitivity, ``chain sensitivity --kind geometric --format json``.
+
+        Fan et al. 2020's coefficients ``S = |dE/de|`` and ``C = S*e / sum(S*e)``
+        per direction (Eq. 5-6): at one point ``at`` (every axis variable),
+        otherwise the mean over the reliability grid (``grid`` replacing or
+        adding axes; not with ``at``). ``sizes``: the nominal error sizes
+        ``e``, as ``--values`` spells them (``"linear=0.001,angular=0.001deg"``)
+        or a mapping ``{"linear": 0.001, "angular": "0.001deg"}`` (angles in
+        radians, or strings with a ``deg`` suffix; ``squareness`` follows
+        ``angular`` unless given); default 0.001 mm and 0.001 degrees.
+        """
+        point = _at_point(at)
+        if sizes is None or isinstance(sizes, str):
+            text_sizes = sizes
+        elif isinstance(sizes, Mapping):
+            text_sizes = ",".join(f"{k}={v if isinstance(v, str) else repr(float(v))}" for k, v in sizes.items())
+        else:
+            raise ValueError(f"sizes must be a str or a mapping of error kind to size, not {type(sizes).__name__}")
+        text = _chain.geometric_json(self._model, point, _grid_axes(grid), _params(params), text_sizes)
+        return GeometricSensitivityResult._from_json(text)
+
+    def allocate(
+        self,
+        strategy: str = "optimal",
+        step: float = 0.005,
+        threshold: float = 0.1,
+        rank: str = "component",
+        target: str = "requirement",
+        level: Optional[float] = None,
+        params: Params = None,
+        sided: Optional[str] = None,
+    ) -> AllocationResult:
+        """Precision allocation, ``chain allocate --format json`` (docs/allocation.md).
+
+        ``strategy="optimal"``: the least-cost standard deviations meeting the
+        requirement, with the KKT check; ``"paper"``: Wang & Yuan 2021's
+        rounds (``step`` in Table 1's tolerance units, ``threshold`` a fraction
+        of the largest sensitivity, ``rank`` ``"component"`` or ``"pooled"``).
+        ``target="requirement"`` (the reliability section's) or
+        ``"acceptance"`` with ``level`` in (0, 1): the whole-machine
+        acceptance probability. An allocation that misses its target is
+        returned with ``final["met"]`` false (the CLI exits non-zero).
+        """
+        step = _optional_float(step, "step")
+        threshold = _optional_float(threshold, "threshold")
+        level = _optional_float(level, "level")
+        if target == "acceptance":
+            if level is None:
+                raise ValueError('target="acceptance" needs level (e.g. level=0.9)')
+        elif target == "requirement":
+            if level is not None:
+                raise ValueError('level applies to target="acceptance" only')
+        else:
+            raise ValueError(f"invalid value {target!r} for `target` [possible values: requirement, acceptance]")
+        text = _chain.allocate_json(self._model, strategy, step, threshold, rank, level, _params(params), sided)
+        return AllocationResult._from_json(text)
+
 
 # -- group B helpers ----------------------------------------------------------
 
@@ -434,3 +520,18 @@ def _optional_float(x: Any, name: str) -> Optional[float]:
         return float(x)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a number, not {x!r}") from None
+
+
+def _at_point(at: Optional[Mapping[str, float]]) -> Optional[List[Tuple[str, float]]]:
+    """``at`` as ``(variable, value)`` pairs (``None`` stays ``None``)."""
+    if at is None:
+        return None
+    if not isinstance(at, Mapping):
+        raise ValueError(f"at must be a mapping of axis variable to value, not {type(at).__name__}")
+    point = []
+    for name, value in at.items():
+        try:
+            point.append((str(name), float(value)))
+        except (TypeError, ValueError):
+            raise ValueError(f"at: `{name}` = {value!r} is not a number") from None
+    return point

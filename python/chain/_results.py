@@ -200,3 +200,67 @@ class SobolResult(Result):
                     "exact": e["first"].get("exact"),
                 })
         return rows
+
+
+class SensitivityResult(Result):
+    """``chain sensitivity --kind reliability --format json``.
+
+    Attributes: ``machine``, ``at`` (the point, or ``None`` for the grid
+    mean), ``methods`` (per target: ``exact`` or ``form``), ``components``
+    (per target: the errors sorted by ``|dr_dstd|``, each with ``dr_dstd``,
+    ``dr_dmean``, ``importance`` and, for the grid mean,
+    ``mean_abs_dr_dstd``, ``mean_abs_dr_dmean``), ``posterior`` (when
+    ``values`` was given). Rows of ``to_dataframe()``: one per target and
+    error.
+    """
+
+    command = "sensitivity"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        return [
+            {"target": target, "method": self._document["methods"][target], **e}
+            for target, errors in self._document["components"].items()
+            for e in errors
+        ]
+
+
+class GeometricSensitivityResult(Result):
+    """``chain sensitivity --kind geometric --format json``.
+
+    Attributes: ``machine``, ``kind`` (``geometric``), ``at`` (the point, or
+    ``None`` for the grid mean), ``grid`` and ``points`` (grid mean),
+    ``normalisation``, ``values`` (the nominal sizes), ``totals`` (``sum(S*e)``
+    per direction), ``components`` (per direction: every error ranked by
+    ``c``, with ``s``, ``c``, ``e`` and, for the grid mean, ``c_min``,
+    ``c_max``). Rows of ``to_dataframe()``: one per direction and error.
+    """
+
+    command = "sensitivity --kind geometric"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        return [
+            {"component": component, **e}
+            for component, errors in self._document["components"].items()
+            for e in errors
+        ]
+
+
+class AllocationResult(Result):
+    """``chain allocate --format json`` (docs/allocation.md).
+
+    Attributes: ``machine``, ``strategy`` (``optimal`` or ``paper``),
+    ``requirement``, ``initial`` (``std`` per error, ``summary`` per
+    component), ``steps`` (the paper's rounds), ``final`` (``std``, ``cost``,
+    ``met``, ``summary``), ``kkt`` (optimal), ``acceptance`` (target
+    acceptance). Rows of ``to_dataframe()``: one per error, its initial and
+    allocated standard deviation.
+    """
+
+    command = "allocate"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        d = self._document
+        return [
+            {"error": e, "std0": s0, "std": d["final"]["std"][e], "ratio": s0 / d["final"]["std"][e]}
+            for e, s0 in d["initial"]["std"].items()
+        ]

@@ -29,7 +29,9 @@ use rayon::prelude::*;
 use reliability::document::describe;
 use reliability::{ReliabilityError, Study};
 
+mod allocate;
 mod reliability_v2;
+mod sensitivity;
 
 create_exception!(
     _chain,
@@ -497,5 +499,11 @@ fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(group_b::map_json, m)?)?;
     m.add_function(wrap_pyfunction!(reliability_v2::reliability_json, m)?)?;
     m.add_function(wrap_pyfunction!(reliability_v2::sobol_json, m)?)?;
+    m.add_function(wrap_pyfunction!(
+        sensitivity::sensitivity_reliability_json,
+        m
+    )?)?;
+    m.add_function(wrap_pyfunction!(sensitivity::geometric_json, m)?)?;
+    m.add_function(wrap_pyfunction!(allocate::allocate_json, m)?)?;
     Ok(())
 }

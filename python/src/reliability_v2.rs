@@ -45,7 +45,7 @@ fn method_named(name: &str) -> PyResult<Method> {
 
 /// A posterior's refusal: located in the values file (`MachineError`), or
 /// a reliability error worded against the machine file.
-fn posterior_error(py: Python<'_>, model: &Model, e: PosteriorError) -> PyErr {
+pub(crate) fn posterior_error(py: Python<'_>, model: &Model, e: PosteriorError) -> PyErr {
     match e {
         PosteriorError::Values(v) => load_error(py, v.diagnostics()),
         PosteriorError::File(d) => load_error(py, &d),
@@ -231,7 +231,11 @@ pub(crate) fn sobol_json(
 
 /// The values of `at` in the machine's variable order: every axis variable
 /// once, no unknown name, all finite (as `chain sobol --at`).
-fn resolve_at(py: Python<'_>, model: &Model, coords: &[(String, f64)]) -> PyResult<Vec<f64>> {
+pub(crate) fn resolve_at(
+    py: Python<'_>,
+    model: &Model,
+    coords: &[(String, f64)],
+) -> PyResult<Vec<f64>> {
     let m = &model.machine;
     let vars: Vec<&str> = m.variables.iter().map(|v| v.name.as_str()).collect();
     if let Some((name, _)) = coords.iter().find(|(n, _)| !vars.contains(&n.as_str())) {

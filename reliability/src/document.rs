@@ -12,22 +12,30 @@
 //! name's options into the [`Algorithm`] both run (the defaults in one
 //! place), [`volumetric`] the `--system volumetric` target.
 //!
+//! [`sensitivity`] runs `chain sensitivity --kind reliability` (at a point
+//! or the grid mean) and [`SensitivityDocument`] is its JSON.
+//!
+//! [`allocation`] runs `chain allocate` and [`AllocationDocument`] is its JSON.
+//!
 //! [`describe`] is the one wording of a [`ReliabilityError`] against the
 //! machine file it concerns (message, location, label, help), shared by the
 //! binary's diagnostics and the Python exceptions.
 
-use chain_core::model::{Origin, Sided};
+use chain_core::model::{Origin, Requirement, Sided};
 use chain_core::named::NameMap;
 use serde::Serialize;
 
 use chain_core::model::Machine;
 
 use crate::acceptance::{Acceptance, AcceptanceResult, Rectangles};
+use crate::allocate::{
+    self, AcceptanceAllocation, AcceptanceStrategy, AllocateError, Allocation, ErrorBounds, Optimal,
+};
 use crate::sobol::{Estimate, OutputIndices, SobolResult};
 use crate::{
-    Algorithm, Calls, DirectionalSimulation, Form, FormCase, ImportanceSampling, Method,
-    MonteCarlo, Posterior, ReliabilityError, SormCase, Stopping, Study, StudyResult, SubsetLevel,
-    SubsetSimulation, System, Target,
+    Algorithm, Calls, DirectionalSimulation, ErrorModel, Form, FormCase, ImportanceSampling,
+    Method, MonteCarlo, Posterior, ReliabilityError, SensitivityMethod, SormCase, Stopping, Study,
+    StudyResult, SubsetLevel, SubsetSimulation, Summary, System, Target, TargetSensitivity,
 };
 
 /// The document of a grid study (the spec's `reliability` JSON contract).
@@ -594,5 +602,341 @@ fn at(origin: &Origin) -> String {
         format!(":{}:{}", origin.line, origin.column)
     } else {
         String::new()
+    }
+}
+
+/// The reliability sensitivities of `chain sensitivity --kind reliability`:
+/// at `point` (axis values in the model's variable order) or, with `None`,
+/// the mean over the study's grid (FORM settings `form`). With a point, the
+/// point is also returned as `(variable, value)` pairs in the grid's axis
+/// order, then any other variable (the order the document lists it in).
+#[allow(clippy::type_complexity)]
+pub fn sensitivity<M: ErrorModel + ?Sized>(
+    study: &Study,
+    model: &M,
+    parameters: &[f64],
+    point: Option<&[f64]>,
+    form: &Form,
+) -> Result<(Option<Vec<(String, f64)>>, Vec<TargetSensitivity>), ReliabilityError> {
+    let Some(point) = point else {
+        return Ok((None, study.sensitivity_mean(form)?));
+    };
+    let result = study.sensitivity_point(model, parameters, point, form)?;
+    let vars = study.variables();
+    let mut order: Vec<usize> = study
+        .spec()
+        .grid
+        .axes
+        .iter()
+        .filter_map(|(n, _)| vars.iter().position(|v| v == n))
+        .collect();
+    order.extend(
+        (0..vars.len())
+            .filter(|i| !order.contains(i))
+            .collect::<Vec<_>>(),
+    );
+    let at = order.iter().map(|&i| (vars[i].clone(), point[i])).collect();
+    Ok((Some(at), result))
+}
+
+/// The document of `chain sensitivity --kind reliability`.
+#[derive(Debug, Serialize)]
+pub struct SensitivityDocument<'a> {
+    /// The machine's name.
+    pub machine: &'a str,
+    /// The point, or `null` for the grid mean.
+    pub at: Option<NameMap<String, f64>>,
+    /// Each target's route (exact or FORM).
+    pub methods: NameMap<Target, SensitivityMethod>,
+    /// Each target's errors, sorted by `|∂R/∂σ|`, largest first.
+    pub components: NameMap<Target, Vec<SensitivityErrorDocument<'a>>>,
+    /// The posterior the inputs came from (`--values`), when given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub posterior: Option<&'a Posterior>,
+    /// The sensitivities the document was built from (for tables).
+    #[serde(skip)]
+    pub result: &'a [TargetSensitivity],
+}
+
+/// One error of a [`SensitivityDocument`]; the grid mean also has the mean
+/// absolute values.
+#[derive(Debug, Serialize)]
+pub struct SensitivityErrorDocument<'a> {
+    /// The error parameter.
+    pub error: &'a str,
+    /// `∂R/∂σ` (Eq. 33).
+    pub dr_dstd: f64,
+    /// `∂R/∂μ` (Eq. 32).
+    pub dr_dmean: f64,
+    /// The FORM importance factor.
+    pub importance: f64,
+    /// The grid mean of `|∂R/∂σ|` (grid mean only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean_abs_dr_dstd: Option<f64>,
+    /// The grid mean of `|∂R/∂μ|` (grid mean only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean_abs_dr_dmean: Option<f64>,
+}
+
+impl<'a> SensitivityDocument<'a> {
+    /// The document of the sensitivities `result`, at the point `at` (or
+    /// the grid mean, which adds the mean absolute values), with the
+    /// posterior `posterior` when the inputs came from one.
+    pub fn new(
+        machine: &'a str,
+        at: Option<Vec<(String, f64)>>,
+        result: &'a [TargetSensitivity],
+        posterior: Option<&'a Posterior>,
+    ) -> SensitivityDocument<'a> {
+        let mean = at.is_none();
+        let errors = |t: &'a TargetSensitivity| -> Vec<SensitivityErrorDocument<'a>> {
+            t.errors
+                .iter()
+                .map(|e| SensitivityErrorDocument {
+                    error: &e.error,
+                    dr_dstd: e.dr_dstd,
+                    dr_dmean: e.dr_dmean,
+                    importance: e.importance,
+                    mean_abs_dr_dstd: mean.then_some(e.mean_abs_dr_dstd),
+                    mean_abs_dr_dmean: mean.then_some(e.mean_abs_dr_dmean),
+                })
+                .collect()
+        };
+        SensitivityDocument {
+            machine,
+            at: at.map(NameMap),
+            methods: result.iter().map(|t| (t.target, t.method)).collect(),
+            components: result.iter().map(|t| (t.target, errors(t))).collect(),
+            posterior,
+            result,
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// `chain allocate`.
+
+/// Runs `chain allocate`: the `strategy` (least cost, or the paper's rounds
+/// with their options) for the reliability section's requirement, or, with
+/// `level`, for the whole-machine acceptance probability to reach `level`.
+pub fn allocation<M: ErrorModel + ?Sized>(
+    model: &M,
+    parameters: &[f64],
+    study: &Study,
+    bounds: &[ErrorBounds],
+    strategy: AcceptanceStrategy,
+    level: Option<f64>,
+) -> Result<Allocation, AllocateError> {
+    match (level, strategy) {
+        (Some(level), strategy) => {
+            allocate::acceptance(model, parameters, study, bounds, level, strategy)
+        }
+        (None, AcceptanceStrategy::Optimal) => {
+            allocate::optimal(model, parameters, study, bounds, &Optimal::default())
+        }
+        (None, AcceptanceStrategy::Paper(paper)) => {
+            allocate::paper(model, parameters, study, bounds, &paper)
+        }
+    }
+}
+
+/// The document of `chain allocate` (docs/allocation.md; field order = key order).
+#[derive(Debug, Serialize)]
+pub struct AllocationDocument<'a> {
+    /// The machine's name.
+    pub machine: &'a str,
+    /// `optimal` or `paper`.
+    pub strategy: &'a str,
+    /// The reliability section's requirement.
+    pub requirement: Option<Requirement>,
+    /// The standard deviations and summaries before allocation.
+    pub initial: InitialDocument<'a>,
+    /// The paper's rounds (empty for the optimal strategy).
+    pub steps: Vec<StepDocument<'a>>,
+    /// The allocated standard deviations, cost and summaries.
+    #[serde(rename = "final")]
+    pub last: FinalDocument<'a>,
+    /// The KKT check (optimal strategy).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kkt: Option<KktDocument<'a>>,
+    /// `--target acceptance`: level, initial and allocated probability.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub acceptance: Option<&'a AcceptanceAllocation>,
+}
+
+/// One component's reliability over the grid in an [`AllocationDocument`].
+#[derive(Debug, Serialize)]
+pub struct AllocationSummaryDocument {
+    /// Mean reliability over the grid.
+    pub mean: f64,
+    /// Smallest reliability.
+    pub min: f64,
+    /// Largest reliability.
+    pub max: f64,
+    /// Whether the requirement is met (`null` without one).
+    pub met: Option<bool>,
+}
+
+/// The starting point of an [`AllocationDocument`].
+#[derive(Debug, Serialize)]
+pub struct InitialDocument<'a> {
+    /// The initial standard deviation of every error.
+    pub std: NameMap<&'a str, f64>,
+    /// Each component's reliability over the grid.
+    pub summary: NameMap<String, AllocationSummaryDocument>,
+}
+
+/// One round of the paper's procedure in an [`AllocationDocument`].
+#[derive(Debug, Serialize)]
+pub struct StepDocument<'a> {
+    /// 1, 2, …
+    pub round: usize,
+    /// The errors tightened this round.
+    pub tightened: &'a [String],
+    /// Their new standard deviations.
+    pub std: NameMap<&'a str, f64>,
+    /// Each component's reliability after the round.
+    pub summary: NameMap<String, AllocationSummaryDocument>,
+}
+
+/// The outcome of an [`AllocationDocument`].
+#[derive(Debug, Serialize)]
+pub struct FinalDocument<'a> {
+    /// The allocated standard deviations.
+    pub std: NameMap<&'a str, f64>,
+    /// `Σ w (σ0/σ − 1)`.
+    pub cost: f64,
+    /// Whether the requirement (or the acceptance level) is met.
+    pub met: bool,
+    /// Each component's reliability (FORM re-evaluation).
+    pub summary: NameMap<String, AllocationSummaryDocument>,
+}
+
+/// The KKT check of an [`AllocationDocument`].
+#[derive(Debug, Serialize)]
+pub struct KktDocument<'a> {
+    /// `‖∇f − Σ λₖ∇gₖ − z‖∞`.
+    pub stationarity: f64,
+    /// `max |λₖ gₖ|` and the bounds'.
+    pub complementarity: f64,
+    /// Constraint and bound violations.
+    pub feasibility: f64,
+    /// Wrong-signed multipliers.
+    pub dual_feasibility: f64,
+    /// The largest of the four.
+    pub residual: f64,
+    /// Whether the active-set Newton polish converged.
+    pub polished: bool,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// The active constraints.
+    pub active: Vec<ActiveDocument<'a>>,
+    /// The errors at a bound.
+    pub at_bound: Vec<AtBoundDocument<'a>>,
+}
+
+/// An active constraint of a [`KktDocument`].
+#[derive(Debug, Serialize)]
+pub struct ActiveDocument<'a> {
+    /// The constraint.
+    pub constraint: &'a str,
+    /// Its multiplier.
+    pub multiplier: f64,
+}
+
+/// An error at a bound in a [`KktDocument`].
+#[derive(Debug, Serialize)]
+pub struct AtBoundDocument<'a> {
+    /// The error.
+    pub error: &'a str,
+    /// `unchanged` or `min_std`.
+    pub bound: &'a str,
+    /// The bound's multiplier.
+    pub multiplier: f64,
+}
+
+/// `{target: {mean, min, max, met}}` of a list of summaries.
+fn allocation_summaries(s: &[Summary]) -> NameMap<String, AllocationSummaryDocument> {
+    s.iter()
+        .map(|s| {
+            (
+                s.target.to_string(),
+                AllocationSummaryDocument {
+                    mean: s.mean,
+                    min: s.min,
+                    max: s.max,
+                    met: s.met,
+                },
+            )
+        })
+        .collect()
+}
+
+/// `{error: std}` of a list of named standard deviations.
+fn named_stds(s: &[(String, f64)]) -> NameMap<&str, f64> {
+    s.iter().map(|(n, v)| (n.as_str(), *v)).collect()
+}
+
+impl<'a> AllocationDocument<'a> {
+    /// The document of the allocation `r` of the machine `machine`, started
+    /// from `bounds`, for the requirement `requirement`.
+    pub fn new(
+        machine: &'a str,
+        requirement: Option<Requirement>,
+        bounds: &'a [ErrorBounds],
+        r: &'a Allocation,
+    ) -> AllocationDocument<'a> {
+        AllocationDocument {
+            machine,
+            strategy: r.strategy,
+            requirement,
+            initial: InitialDocument {
+                std: bounds.iter().map(|b| (b.error.as_str(), b.std0)).collect(),
+                summary: allocation_summaries(&r.initial),
+            },
+            steps: r
+                .steps
+                .iter()
+                .map(|s| StepDocument {
+                    round: s.round,
+                    tightened: &s.tightened,
+                    std: named_stds(&s.std),
+                    summary: allocation_summaries(&s.summaries),
+                })
+                .collect(),
+            last: FinalDocument {
+                std: named_stds(&r.std),
+                cost: r.cost,
+                met: r.met,
+                summary: allocation_summaries(&r.summaries),
+            },
+            kkt: r.kkt.as_ref().map(|k| KktDocument {
+                stationarity: k.stationarity,
+                complementarity: k.complementarity,
+                feasibility: k.feasibility,
+                dual_feasibility: k.dual_feasibility,
+                residual: k.residual(),
+                polished: k.polished,
+                iterations: k.iterations,
+                active: k
+                    .active
+                    .iter()
+                    .map(|(n, l)| ActiveDocument {
+                        constraint: n,
+                        multiplier: *l,
+                    })
+                    .collect(),
+                at_bound: k
+                    .at_bound
+                    .iter()
+                    .map(|(n, b, z)| AtBoundDocument {
+                        error: n,
+                        bound: b,
+                        multiplier: *z,
+                    })
+                    .collect(),
+            }),
+            acceptance: r.acceptance.as_ref(),
+        }
     }
 }

@@ -9,11 +9,11 @@
 use std::path::PathBuf;
 
 use chain_core::model::Requirement;
-use chain_core::named::NameMap;
 use miette::MietteDiagnostic;
-use reliability::allocate::{self, AllocateError, Allocation, ErrorBounds, Optimal, Paper};
+use reliability::allocate::{self, AllocateError, Allocation, ErrorBounds, Paper};
+use reliability::document::{self, AllocationDocument};
 use reliability::Summary;
-use serde::{Serialize, Serializer};
+use serde::Serialize;
 
 use super::args::ModelArgs;
 use super::reliability::Loaded;
@@ -128,25 +128,11 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
         }
         (TargetArg::Requirement, None) => None,
     };
-    let result = match (level, args.strategy) {
-        (Some(level), strategy) => allocate::acceptance(
-            &model,
-            &values,
-            &study,
-            &bounds,
-            level,
-            match strategy {
-                StrategyArg::Optimal => allocate::AcceptanceStrategy::Optimal,
-                StrategyArg::Paper => allocate::AcceptanceStrategy::Paper(paper_options),
-            },
-        ),
-        (None, StrategyArg::Optimal) => {
-            allocate::optimal(&model, &values, &study, &bounds, &Optimal::default())
-        }
-        (None, StrategyArg::Paper) => {
-            allocate::paper(&model, &values, &study, &bounds, &paper_options)
-        }
+    let strategy = match args.strategy {
+        StrategyArg::Optimal => allocate::AcceptanceStrategy::Optimal,
+        StrategyArg::Paper => allocate::AcceptanceStrategy::Paper(paper_options),
     };
+    let result = document::allocation(&model, &values, &study, &bounds, strategy, level);
     let result = result.map_err(|e| failure(&loaded, e))?;
     if let Some(dir) = &args.plot {
         let stds: Vec<f64> = result.std.iter().map(|(_, s)| *s).collect();
@@ -169,8 +155,12 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
         }
     }
     let doc = AllocationReport {
-        machine: &loaded.machine.name,
-        requirement: study.spec().requirement,
+        document: AllocationDocument::new(
+            &loaded.machine.name,
+            study.spec().requirement,
+            &bounds,
+            &result,
+        ),
         bounds: &bounds,
         result: &result,
     };
@@ -301,183 +291,27 @@ fn failure(loaded: &Loaded, error: AllocateError) -> miette::Report {
     }
 }
 
-/// The result document of `chain allocate`: the allocation of one machine
-/// with the bounds it started from (JSON: docs/allocation.md).
+/// The result document of `chain allocate` (the library's
+/// [`AllocationDocument`], JSON: docs/allocation.md) with its table.
+#[derive(Serialize)]
+#[serde(transparent)]
 struct AllocationReport<'a> {
-    machine: &'a str,
-    requirement: Option<Requirement>,
+    document: AllocationDocument<'a>,
+    #[serde(skip)]
     bounds: &'a [ErrorBounds],
+    #[serde(skip)]
     result: &'a Allocation,
-}
-
-/// `{target: {mean, min, max, met}}` of a list of summaries.
-fn summaries(s: &[Summary]) -> NameMap<String, SummaryDoc> {
-    s.iter()
-        .map(|s| {
-            (
-                s.target.to_string(),
-                SummaryDoc {
-                    mean: s.mean,
-                    min: s.min,
-                    max: s.max,
-                    met: s.met,
-                },
-            )
-        })
-        .collect()
-}
-
-/// `{error: std}` of a list of named standard deviations.
-fn stds(s: &[(String, f64)]) -> NameMap<&str, f64> {
-    s.iter().map(|(n, v)| (n.as_str(), *v)).collect()
-}
-
-/// One component's reliability over the grid.
-#[derive(Serialize)]
-struct SummaryDoc {
-    mean: f64,
-    min: f64,
-    max: f64,
-    met: Option<bool>,
-}
-
-/// The JSON document (field order = key order).
-#[derive(Serialize)]
-struct AllocationDoc<'a> {
-    machine: &'a str,
-    strategy: &'a str,
-    requirement: Option<Requirement>,
-    initial: InitialDoc<'a>,
-    steps: Vec<StepDoc<'a>>,
-    #[serde(rename = "final")]
-    last: FinalDoc<'a>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    kkt: Option<KktDoc<'a>>,
-    /// `--target acceptance`: level, initial and allocated probability.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    acceptance: Option<&'a allocate::AcceptanceAllocation>,
-}
-
-#[derive(Serialize)]
-struct InitialDoc<'a> {
-    std: NameMap<&'a str, f64>,
-    summary: NameMap<String, SummaryDoc>,
-}
-
-#[derive(Serialize)]
-struct StepDoc<'a> {
-    round: usize,
-    tightened: &'a [String],
-    std: NameMap<&'a str, f64>,
-    summary: NameMap<String, SummaryDoc>,
-}
-
-#[derive(Serialize)]
-struct FinalDoc<'a> {
-    std: NameMap<&'a str, f64>,
-    cost: f64,
-    met: bool,
-    summary: NameMap<String, SummaryDoc>,
-}
-
-#[derive(Serialize)]
-struct KktDoc<'a> {
-    stationarity: f64,
-    complementarity: f64,
-    feasibility: f64,
-    dual_feasibility: f64,
-    residual: f64,
-    polished: bool,
-    iterations: usize,
-    active: Vec<ActiveDoc<'a>>,
-    at_bound: Vec<AtBoundDoc<'a>>,
-}
-
-#[derive(Serialize)]
-struct ActiveDoc<'a> {
-    constraint: &'a str,
-    multiplier: f64,
-}
-
-#[derive(Serialize)]
-struct AtBoundDoc<'a> {
-    error: &'a str,
-    bound: &'a str,
-    multiplier: f64,
-}
-
-impl AllocationReport<'_> {
-    fn document(&self) -> AllocationDoc<'_> {
-        let r = self.result;
-        AllocationDoc {
-            machine: self.machine,
-            strategy: r.strategy,
-            requirement: self.requirement,
-            initial: InitialDoc {
-                std: self
-                    .bounds
-                    .iter()
-                    .map(|b| (b.error.as_str(), b.std0))
-                    .collect(),
-                summary: summaries(&r.initial),
-            },
-            steps: r
-                .steps
-                .iter()
-                .map(|s| StepDoc {
-                    round: s.round,
-                    tightened: &s.tightened,
-                    std: stds(&s.std),
-                    summary: summaries(&s.summaries),
-                })
-                .collect(),
-            last: FinalDoc {
-                std: stds(&r.std),
-                cost: r.cost,
-                met: r.met,
-                summary: summaries(&r.summaries),
-            },
-            kkt: r.kkt.as_ref().map(|k| KktDoc {
-                stationarity: k.stationarity,
-                complementarity: k.complementarity,
-                feasibility: k.feasibility,
-                dual_feasibility: k.dual_feasibility,
-                residual: k.residual(),
-                polished: k.polished,
-                iterations: k.iterations,
-                active: k
-                    .active
-                    .iter()
-                    .map(|(n, l)| ActiveDoc {
-                        constraint: n,
-                        multiplier: *l,
-                    })
-                    .collect(),
-                at_bound: k
-                    .at_bound
-                    .iter()
-                    .map(|(n, b, z)| AtBoundDoc {
-                        error: n,
-                        bound: b,
-                        multiplier: *z,
-                    })
-                    .collect(),
-            }),
-            acceptance: r.acceptance.as_ref(),
-        }
-    }
-}
-
-impl Serialize for AllocationReport<'_> {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        self.document().serialize(serializer)
-    }
 }
 
 impl Report for AllocationReport<'_> {
     /// Rounds like Tables 5-7, the changed tolerances, the cost and the KKT check.
     fn table(&self) -> String {
-        to_table(self.machine, self.requirement, self.bounds, self.result)
+        to_table(
+            self.document.machine,
+            self.document.requirement,
+            self.bounds,
+            self.result,
+        )
     }
 }
 

@@ -19,16 +19,16 @@ mod geometric_plot;
 
 use std::path::PathBuf;
 
-use chain_core::geometric::{self, Coefficient, GeometricSensitivity, NominalSizes};
-use chain_core::model::Component;
-use reliability::{
-    machine, Form, Posterior, ReliabilityError, SensitivityMethod, Target, TargetSensitivity,
+use chain_core::geometric::{
+    self, GeometricDocument, GeometricSensitivity, GridAxisError, NominalSizes, Where,
 };
+use reliability::document::{self, SensitivityDocument};
+use reliability::{machine, Form, ReliabilityError};
 use serde::Serialize;
 
 use super::args::ModelArgs;
 use super::reliability::reliability_plot;
-use super::reliability::{parse_assignment, parse_axis, Loaded, Pairs};
+use super::reliability::{parse_assignment, parse_axis, Loaded};
 use super::report::{self, Report};
 
 /// What `chain sensitivity` computes.
@@ -140,33 +140,14 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
         posterior.as_ref(),
     )?;
     let form = Form::default();
-    let (at, result) = match &args.at {
-        None => (
-            None,
-            study
-                .sensitivity_mean(&form)
-                .map_err(|e| loaded.report(e))?,
-        ),
-        Some(AtPoint(coords)) => {
-            let vars = study.variables();
-            let point = resolve_at(coords, &loaded)?;
-            let values = machine::parameters(&loaded.machine, &args.model.param.params)
-                .map_err(|e| loaded.report(e))?;
-            let r = study
-                .sensitivity_point(&model, &values, &point, &form)
-                .map_err(|e| loaded.report(e))?;
-            // Report the point in the grid's axis order (x, y, z), then any other.
-            let mut order: Vec<usize> = super::reliability::axes(&study)
-                .iter()
-                .map(|(_, i)| *i)
-                .collect();
-            let rest: Vec<usize> = (0..vars.len()).filter(|i| !order.contains(i)).collect();
-            order.extend(rest);
-            let at: Vec<(String, f64)> =
-                order.iter().map(|&i| (vars[i].clone(), point[i])).collect();
-            (Some(at), r)
-        }
+    let point = match &args.at {
+        None => None,
+        Some(AtPoint(coords)) => Some(resolve_at(coords, &loaded)?),
     };
+    let values = machine::parameters(&loaded.machine, &args.model.param.params)
+        .map_err(|e| loaded.report(e))?;
+    let (at, result) = document::sensitivity(&study, &model, &values, point.as_deref(), &form)
+        .map_err(|e| loaded.report(e))?;
     if let Some(dir) = &args.plot {
         let where_ = match &at {
             Some(a) => at_text(a),
@@ -183,9 +164,8 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
             eprintln!("wrote {}", f.display());
         }
     }
-    let mut doc = SensitivityDoc::new(&loaded.machine.name, at, &result);
-    doc.posterior = posterior.as_ref();
-    report::emit(&doc, args.format.into())
+    let doc = SensitivityDocument::new(&loaded.machine.name, at, &result, posterior.as_ref());
+    report::emit(&SensitivityDoc(doc), args.format.into())
 }
 
 report::formats!(SensitivityFormat: Table, Json);
@@ -201,82 +181,27 @@ fn at_text(a: &[(String, f64)]) -> String {
     )
 }
 
-/// The document of `chain sensitivity --kind reliability`.
+/// The document of `chain sensitivity --kind reliability` (the library's
+/// [`SensitivityDocument`]) with its table.
 #[derive(Serialize)]
-struct SensitivityDoc<'a> {
-    machine: &'a str,
-    /// The point, or `null` for the grid mean.
-    at: Option<Pairs<String, f64>>,
-    methods: Pairs<Target, SensitivityMethod>,
-    components: Pairs<Target, Vec<ErrorDoc<'a>>>,
-    /// The posterior of `--values`, when given.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    posterior: Option<&'a Posterior>,
-    #[serde(skip)]
-    result: &'a [TargetSensitivity],
-}
-
-/// One error of [`SensitivityDoc`]; the grid mean also has the mean
-/// absolute values.
-#[derive(Serialize)]
-struct ErrorDoc<'a> {
-    error: &'a str,
-    dr_dstd: f64,
-    dr_dmean: f64,
-    importance: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    mean_abs_dr_dstd: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    mean_abs_dr_dmean: Option<f64>,
-}
-
-impl<'a> SensitivityDoc<'a> {
-    /// The document of the sensitivities `result`, at the point `at` (or the
-    /// grid mean, which adds the mean absolute values).
-    fn new(
-        machine: &'a str,
-        at: Option<Vec<(String, f64)>>,
-        result: &'a [TargetSensitivity],
-    ) -> SensitivityDoc<'a> {
-        let mean = at.is_none();
-        let errors = |t: &'a TargetSensitivity| -> Vec<ErrorDoc<'a>> {
-            t.errors
-                .iter()
-                .map(|e| ErrorDoc {
-                    error: &e.error,
-                    dr_dstd: e.dr_dstd,
-                    dr_dmean: e.dr_dmean,
-                    importance: e.importance,
-                    mean_abs_dr_dstd: mean.then_some(e.mean_abs_dr_dstd),
-                    mean_abs_dr_dmean: mean.then_some(e.mean_abs_dr_dmean),
-                })
-                .collect()
-        };
-        SensitivityDoc {
-            machine,
-            at: at.map(Pairs),
-            methods: Pairs(result.iter().map(|t| (t.target, t.method)).collect()),
-            components: Pairs(result.iter().map(|t| (t.target, errors(t))).collect()),
-            posterior: None,
-            result,
-        }
-    }
-}
+#[serde(transparent)]
+struct SensitivityDoc<'a>(SensitivityDocument<'a>);
 
 impl Report for SensitivityDoc<'_> {
     fn table(&self) -> String {
         use std::fmt::Write as _;
+        let d = &self.0;
         let mut out = String::new();
-        let where_ = match &self.at {
+        let where_ = match &d.at {
             Some(a) => at_text(&a.0),
             None => "mean over the reliability grid".to_string(),
         };
         let _ = writeln!(
             out,
             "{}: reliability sensitivity (Eq. 32-33), {where_}",
-            self.machine
+            d.machine
         );
-        if let Some(p) = self.posterior {
+        if let Some(p) = d.posterior {
             let _ = write!(out, "{}", super::reliability::posterior_lines(p));
             if !p.correlations.is_empty() {
                 let _ = writeln!(
@@ -285,7 +210,7 @@ impl Report for SensitivityDoc<'_> {
                 );
             }
         }
-        for t in self.result {
+        for t in d.result {
             let _ = writeln!(
                 out,
                 "\n{} ({}), sorted by |dR/dstd|:",
@@ -311,14 +236,6 @@ impl Report for SensitivityDoc<'_> {
 
 // ---------------------------------------------------------------------------
 // `--kind geometric` (seed 004, Eq. 4-6).
-
-/// Where the geometric coefficients were evaluated.
-enum Where {
-    /// One point, `(variable, value)` in the model's variable order.
-    At(Vec<(String, f64)>),
-    /// The mean over a grid, `(variable, values)` in the model's variable order.
-    Grid(Vec<(String, Vec<f64>)>),
-}
 
 fn unknown_variable(loaded: &Loaded, name: &str) -> miette::Report {
     let m = &loaded.machine;
@@ -377,7 +294,7 @@ fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {
     };
     let sizes = nominal.of(m);
     let vars: Vec<&str> = m.variables.iter().map(|v| v.name.as_str()).collect();
-    let (where_, result) = match &args.at {
+    let where_ = match &args.at {
         Some(AtPoint(coords)) => {
             if !args.grid.is_empty() {
                 return Err(miette::miette!(
@@ -387,64 +304,33 @@ fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {
                 ));
             }
             let point = resolve_at(coords, &loaded)?;
-            let r = geometric::at_point(&model, &point, &params, &sizes);
-            let at = vars
-                .iter()
-                .zip(&point)
-                .map(|(n, x)| (n.to_string(), *x))
-                .collect();
-            (Where::At(at), r)
+            Where::At(
+                vars.iter()
+                    .zip(&point)
+                    .map(|(n, x)| (n.to_string(), *x))
+                    .collect(),
+            )
         }
-        None => {
-            let mut axes: Vec<(String, Vec<f64>)> = m
-                .reliability
-                .as_ref()
-                .map(|r| {
-                    r.grid
-                        .iter()
-                        .map(|(i, v)| (vars[*i].to_string(), v.clone()))
-                        .collect()
-                })
-                .unwrap_or_default();
-            for (name, values) in &args.grid {
-                if !vars.contains(&name.as_str()) {
-                    return Err(unknown_variable(&loaded, name));
-                }
-                match axes.iter_mut().find(|(n, _)| n == name) {
-                    Some(axis) => axis.1 = values.clone(),
-                    None => axes.push((name.clone(), values.clone())),
-                }
-            }
-            let ordered = vars
-                .iter()
-                .map(|v| {
-                    let values = axes.iter().find(|(n, _)| n == v).map(|(_, x)| x.clone());
-                    match values {
-                        Some(x) if !x.is_empty() => Ok((v.to_string(), x)),
-                        _ => Err(miette::miette!(
-                            help = format!(
-                                "evaluate at one point with --at {}, or give the grid with --grid {v}=V1,V2,...",
-                                vars.iter().map(|v| format!("{v}=…")).collect::<Vec<_>>().join(",")
-                            ),
-                            "{}: no grid values for axis variable `{v}` (key `reliability.grid.{v}`)",
-                            loaded.machine.file.as_deref().unwrap_or("machine")
-                        )),
-                    }
-                })
-                .collect::<miette::Result<Vec<_>>>()?;
-            let values: Vec<Vec<f64>> = ordered.iter().map(|(_, x)| x.clone()).collect();
-            let points = geometric::grid_points(&values);
-            let r = geometric::mean_over(&model, points, &params, &sizes);
-            (Where::Grid(ordered), r)
-        }
+        None => Where::Grid(geometric::grid_axes(m, &args.grid).map_err(|e| match e {
+            GridAxisError::UnknownVariable(name) => unknown_variable(&loaded, &name),
+            GridAxisError::NoValues(v) => miette::miette!(
+                help = format!(
+                    "evaluate at one point with --at {}, or give the grid with --grid {v}=V1,V2,...",
+                    vars.iter().map(|v| format!("{v}=…")).collect::<Vec<_>>().join(",")
+                ),
+                "{}: no grid values for axis variable `{v}` (key `reliability.grid.{v}`)",
+                loaded.machine.file.as_deref().unwrap_or("machine")
+            ),
+        })?),
     };
+    let result = geometric::evaluate(&model, &where_, &params, &sizes);
     if let Some(dir) = &args.plot {
         let files = geometric_plot::write_all(dir, &m.name, &where_text(&where_), &result)?;
         for f in files {
             eprintln!("wrote {}", f.display());
         }
     }
-    let doc = GeometricDoc::new(&m.name, &where_, &nominal, &result);
+    let doc = GeometricDoc(GeometricDocument::new(&m.name, &where_, &nominal, &result));
     report::emit(&doc, args.format.into())
 }
 
@@ -464,93 +350,15 @@ fn where_text(w: &Where) -> String {
     }
 }
 
-/// The document of `chain sensitivity --kind geometric`.
+/// The document of `chain sensitivity --kind geometric` (the library's
+/// [`GeometricDocument`]) with its table.
 #[derive(Serialize)]
-struct GeometricDoc<'a> {
-    machine: &'a str,
-    kind: &'static str,
-    /// The point, or `null` for the grid mean.
-    at: Option<Pairs<&'a str, f64>>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    grid: Option<Pairs<&'a str, &'a [f64]>>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    points: Option<usize>,
-    normalisation: &'static str,
-    values: &'a NominalSizes,
-    totals: Pairs<Component, f64>,
-    components: Pairs<Component, Vec<CoefficientDoc<'a>>>,
-    #[serde(skip)]
-    where_: &'a Where,
-    #[serde(skip)]
-    result: &'a GeometricSensitivity,
-}
-
-/// One coefficient of [`GeometricDoc`]; the grid mean also has the range.
-#[derive(Serialize)]
-struct CoefficientDoc<'a> {
-    error: &'a str,
-    s: f64,
-    c: f64,
-    e: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    c_min: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    c_max: Option<f64>,
-}
-
-impl<'a> GeometricDoc<'a> {
-    fn new(
-        machine: &'a str,
-        where_: &'a Where,
-        nominal: &'a NominalSizes,
-        r: &'a GeometricSensitivity,
-    ) -> GeometricDoc<'a> {
-        let grid = matches!(where_, Where::Grid(_));
-        let coefficient = |e: &'a Coefficient| CoefficientDoc {
-            error: &e.error,
-            s: e.s,
-            c: e.c,
-            e: e.e,
-            c_min: grid.then_some(e.c_min),
-            c_max: grid.then_some(e.c_max),
-        };
-        GeometricDoc {
-            machine,
-            kind: "geometric",
-            at: match where_ {
-                Where::At(a) => Some(Pairs(a.iter().map(|(n, v)| (n.as_str(), *v)).collect())),
-                Where::Grid(_) => None,
-            },
-            grid: match where_ {
-                Where::Grid(g) => Some(Pairs(
-                    g.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect(),
-                )),
-                Where::At(_) => None,
-            },
-            points: grid.then_some(r.points),
-            normalisation: "c = s*e / sum(s*e)",
-            values: nominal,
-            totals: Pairs(
-                r.components
-                    .iter()
-                    .map(|c| (c.component, c.total))
-                    .collect(),
-            ),
-            components: Pairs(
-                r.components
-                    .iter()
-                    .map(|c| (c.component, c.ranked.iter().map(coefficient).collect()))
-                    .collect(),
-            ),
-            where_,
-            result: r,
-        }
-    }
-}
+#[serde(transparent)]
+struct GeometricDoc<'a>(GeometricDocument<'a>);
 
 impl Report for GeometricDoc<'_> {
     fn table(&self) -> String {
-        geometric_table(self.machine, self.where_, self.values, self.result)
+        geometric_table(self.0.machine, self.0.where_, self.0.values, self.0.result)
     }
 }
 

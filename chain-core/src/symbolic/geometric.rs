@@ -36,6 +36,7 @@
 use serde::Serialize;
 
 use crate::model::{BasisFn, Component, ErrorKind, Machine};
+use crate::named::NameMap;
 use crate::ErrorModel;
 
 /// One degree in radians.
@@ -372,4 +373,180 @@ pub fn grid_points(axes: &[Vec<f64>]) -> Vec<Vec<f64>> {
             .collect();
     }
     out
+}
+
+// ---------------------------------------------------------------------------
+// The document of `chain sensitivity --kind geometric`, shared by the CLI and
+// the Python package.
+
+/// Where geometric coefficients were evaluated.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Where {
+    /// One point, `(variable, value)` in the model's variable order.
+    At(Vec<(String, f64)>),
+    /// The mean over a grid, `(variable, values)` in the model's variable order.
+    Grid(Vec<(String, Vec<f64>)>),
+}
+
+/// Why [`grid_axes`] has no grid.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GridAxisError {
+    /// An override names no axis variable of the machine.
+    #[error("unknown axis variable `{0}`")]
+    UnknownVariable(String),
+    /// An axis variable has no grid values (neither the reliability grid nor an override).
+    #[error("no grid values for axis variable `{0}` (key `reliability.grid.{0}`)")]
+    NoValues(String),
+}
+
+/// The grid of the geometric mean: the machine's reliability grid with the
+/// axes of `overrides` replaced (or added), every axis variable in the
+/// model's variable order; each needs at least one value.
+pub fn grid_axes(
+    machine: &Machine,
+    overrides: &[(String, Vec<f64>)],
+) -> Result<Vec<(String, Vec<f64>)>, GridAxisError> {
+    let vars: Vec<&str> = machine.variables.iter().map(|v| v.name.as_str()).collect();
+    let mut axes: Vec<(String, Vec<f64>)> = machine
+        .reliability
+        .as_ref()
+        .map(|r| {
+            r.grid
+                .iter()
+                .map(|(i, v)| (vars[*i].to_string(), v.clone()))
+                .collect()
+        })
+        .unwrap_or_default();
+    for (name, values) in overrides {
+        if !vars.contains(&name.as_str()) {
+            return Err(GridAxisError::UnknownVariable(name.clone()));
+        }
+        match axes.iter_mut().find(|(n, _)| n == name) {
+            Some(axis) => axis.1 = values.clone(),
+            None => axes.push((name.clone(), values.clone())),
+        }
+    }
+    vars.iter()
+        .map(|v| match axes.iter().find(|(n, _)| n == v) {
+            Some((_, x)) if !x.is_empty() => Ok((v.to_string(), x.clone())),
+            _ => Err(GridAxisError::NoValues(v.to_string())),
+        })
+        .collect()
+}
+
+/// The coefficients at `where_`: at its point, or the mean over its grid.
+pub fn evaluate<M: ErrorModel + ?Sized>(
+    model: &M,
+    where_: &Where,
+    parameters: &[f64],
+    sizes: &[f64],
+) -> GeometricSensitivity {
+    match where_ {
+        Where::At(at) => {
+            let point: Vec<f64> = at.iter().map(|(_, x)| *x).collect();
+            at_point(model, &point, parameters, sizes)
+        }
+        Where::Grid(axes) => {
+            let values: Vec<Vec<f64>> = axes.iter().map(|(_, x)| x.clone()).collect();
+            mean_over(model, grid_points(&values), parameters, sizes)
+        }
+    }
+}
+
+/// The document of `chain sensitivity --kind geometric` (its JSON).
+#[derive(Debug, Serialize)]
+pub struct GeometricDocument<'a> {
+    /// The machine's name.
+    pub machine: &'a str,
+    /// Always `"geometric"`.
+    pub kind: &'static str,
+    /// The point, or `null` for the grid mean.
+    pub at: Option<NameMap<&'a str, f64>>,
+    /// The grid of the mean (grid mean only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grid: Option<NameMap<&'a str, &'a [f64]>>,
+    /// The number of grid points (grid mean only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub points: Option<usize>,
+    /// How `c` is normalised.
+    pub normalisation: &'static str,
+    /// The nominal error sizes.
+    pub values: &'a NominalSizes,
+    /// `Σ S·e` per direction.
+    pub totals: NameMap<Component, f64>,
+    /// Each direction's coefficients, ranked.
+    pub components: NameMap<Component, Vec<CoefficientDocument<'a>>>,
+    /// Where the coefficients were evaluated (for tables).
+    #[serde(skip)]
+    pub where_: &'a Where,
+    /// The coefficients the document was built from (for tables).
+    #[serde(skip)]
+    pub result: &'a GeometricSensitivity,
+}
+
+/// One coefficient of a [`GeometricDocument`]; the grid mean also has the range.
+#[derive(Debug, Serialize)]
+pub struct CoefficientDocument<'a> {
+    /// The error parameter.
+    pub error: &'a str,
+    /// `S = |∂E/∂e|` (or its mean).
+    pub s: f64,
+    /// `C = S·e / Σ S·e` (or its mean).
+    pub c: f64,
+    /// The nominal size `e`.
+    pub e: f64,
+    /// Smallest `C` over the grid (grid mean only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub c_min: Option<f64>,
+    /// Largest `C` over the grid (grid mean only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub c_max: Option<f64>,
+}
+
+impl<'a> GeometricDocument<'a> {
+    /// The document of the coefficients `r` evaluated at `where_` with the
+    /// nominal sizes `nominal`.
+    pub fn new(
+        machine: &'a str,
+        where_: &'a Where,
+        nominal: &'a NominalSizes,
+        r: &'a GeometricSensitivity,
+    ) -> GeometricDocument<'a> {
+        let grid = matches!(where_, Where::Grid(_));
+        let coefficient = |e: &'a Coefficient| CoefficientDocument {
+            error: &e.error,
+            s: e.s,
+            c: e.c,
+            e: e.e,
+            c_min: grid.then_some(e.c_min),
+            c_max: grid.then_some(e.c_max),
+        };
+        GeometricDocument {
+            machine,
+            kind: "geometric",
+            at: match where_ {
+                Where::At(a) => Some(a.iter().map(|(n, v)| (n.as_str(), *v)).collect()),
+                Where::Grid(_) => None,
+            },
+            grid: match where_ {
+                Where::Grid(g) => Some(g.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect()),
+                Where::At(_) => None,
+            },
+            points: grid.then_some(r.points),
+            normalisation: "c = s*e / sum(s*e)",
+            values: nominal,
+            totals: r
+                .components
+                .iter()
+                .map(|c| (c.component, c.total))
+                .collect(),
+            components: r
+                .components
+                .iter()
+                .map(|c| (c.component, c.ranked.iter().map(coefficient).collect()))
+                .collect(),
+            where_,
+            result: r,
+        }
+    }
 }
