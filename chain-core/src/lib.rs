@@ -30,7 +30,7 @@ pub use symbolic::{algebra, derive, dmm, emit, eval, expand, export, geometric};
 pub use built::{BuiltMachine, MapResult};
 pub use derive::{derive, derive_in, SymbolicModel};
 pub use diagnostic::Diagnostics;
-pub use eval::{compile, CompiledModel};
+pub use eval::{compile, BatchError, CompiledModel, BATCH_LANES};
 pub use load::{load_bytes, load_file, load_str};
 pub use measured::{identify, measurements};
 pub use model::Machine;

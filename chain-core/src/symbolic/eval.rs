@@ -25,6 +25,30 @@ use crate::model_trait::{ErrorModel, Pose};
 /// Registers kept on the stack; larger tapes use a heap buffer per call.
 const STACK_REGISTERS: usize = 256;
 
+/// Points per block of [`CompiledModel::sensitivity_batch`].
+pub const BATCH_LANES: usize = 8;
+
+/// A refused [`CompiledModel::sensitivity_batch`] call.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum BatchError {
+    /// `qs` is not a whole number of points.
+    #[error("qs holds {values} values, not a whole number of points of {variables} variables")]
+    Points {
+        /// Length of `qs`.
+        values: usize,
+        /// Variables per point.
+        variables: usize,
+    },
+    /// `out` does not hold one sensitivity matrix per point.
+    #[error("out holds {len} values, expected {expected} (one 6 x errors matrix per point)")]
+    Output {
+        /// Length of `out`.
+        len: usize,
+        /// Points times `6 * errors`.
+        expected: usize,
+    },
+}
+
 /// A machine's error model compiled to a flat tape. Implements [`ErrorModel`].
 #[derive(Debug, Clone)]
 pub struct CompiledModel {
@@ -137,6 +161,95 @@ impl CompiledModel {
             regs[dst as usize] = regs[a as usize] * regs[b as usize];
         }
         f(regs)
+    }
+
+    /// The sensitivity matrix at many points: `qs` holds the points one after
+    /// another (`variables().len()` values each), `out` receives each point's
+    /// row-major `6 × errors().len()` matrix in the same order. The tape runs
+    /// over blocks of [`BATCH_LANES`] points per instruction (structure of
+    /// arrays); the last block is padded with copies of its last point and only
+    /// its real points are written. Blocks run in parallel under the
+    /// `parallel` feature. Every value equals [`ErrorModel::sensitivity`] at
+    /// that point (the same products and sums in the same order).
+    ///
+    /// # Errors
+    /// [`BatchError`] when `qs` is not a whole number of points or `out` does
+    /// not hold exactly one matrix per point.
+    pub fn sensitivity_batch(
+        &self,
+        qs: &[f64],
+        p: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), BatchError> {
+        let nv = self.variables.len();
+        let width = 6 * self.errors.len();
+        let points = if nv == 0 { 0 } else { qs.len() / nv };
+        if nv == 0 || qs.len() % nv != 0 {
+            return Err(BatchError::Points {
+                values: qs.len(),
+                variables: nv,
+            });
+        }
+        if out.len() != points * width {
+            return Err(BatchError::Output {
+                len: out.len(),
+                expected: points * width,
+            });
+        }
+        if points == 0 {
+            return Ok(());
+        }
+        let run = |(qb, ob): (&[f64], &mut [f64])| self.sensitivity_block(qb, p, ob);
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            qs.par_chunks(nv * BATCH_LANES)
+                .zip(out.par_chunks_mut(width * BATCH_LANES))
+                .for_each(run);
+        }
+        #[cfg(not(feature = "parallel"))]
+        qs.chunks(nv * BATCH_LANES)
+            .zip(out.chunks_mut(width * BATCH_LANES))
+            .for_each(run);
+        Ok(())
+    }
+
+    /// One block of at most [`BATCH_LANES`] points.
+    fn sensitivity_block(&self, qs: &[f64], p: &[f64], out: &mut [f64]) {
+        const W: usize = BATCH_LANES;
+        let nv = self.variables.len();
+        let width = 6 * self.errors.len();
+        let real = qs.len() / nv;
+        let mut regs = vec![[0.0f64; W]; self.register_count];
+        regs[0] = [1.0; W];
+        for lane in 0..W {
+            let k = lane.min(real - 1);
+            let q = &qs[k * nv..(k + 1) * nv];
+            for &(r, s) in &self.loads {
+                regs[r][lane] = SymbolicModel::symbol_value(s, q, p);
+            }
+        }
+        for &(dst, a, b) in &self.products {
+            let (x, y) = (regs[a as usize], regs[b as usize]);
+            let mut z = [0.0; W];
+            for l in 0..W {
+                z[l] = x[l] * y[l];
+            }
+            regs[dst as usize] = z;
+        }
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for &(idx, start, end) in &self.sensitivity {
+            let mut acc = [-0.0f64; W];
+            for &(c, r) in &self.terms[start as usize..end as usize] {
+                let x = &regs[r as usize];
+                for l in 0..W {
+                    acc[l] += c * x[l];
+                }
+            }
+            for (l, v) in acc.iter().enumerate().take(real) {
+                out[l * width + idx as usize] = *v;
+            }
+        }
     }
 
     #[inline]
