@@ -18,7 +18,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use chain_core::model::{Machine, Sided};
-use miette::{LabeledSpan, MietteDiagnostic, NamedSource};
+use miette::{LabeledSpan, MietteDiagnostic};
 use reliability::document::{AcceptanceDocument, ReliabilityDocument};
 use reliability::{
     machine, Algorithm, Form, FormCase, Method, Posterior, PosteriorError, ReliabilityError,
@@ -408,7 +408,7 @@ impl Loaded {
             let len = o.len.min(self.source.len() - o.offset);
             diag = diag.with_label(LabeledSpan::at(o.offset..o.offset + len, d.label));
             return miette::Report::new(diag).with_source_code(
-                NamedSource::new(self.file.clone(), self.source.clone()).with_language("yaml"),
+                chain_core::diagnostic::Snippet::new(self.file.clone(), self.source.clone()),
             );
         }
         miette::Report::new(diag)

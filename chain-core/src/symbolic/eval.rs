@@ -183,7 +183,7 @@ impl CompiledModel {
     ) -> Result<(), BatchError> {
         let nv = self.variables.len();
         let width = 6 * self.errors.len();
-        let points = if nv == 0 { 0 } else { qs.len() / nv };
+        let points = qs.len().checked_div(nv).unwrap_or(0);
         if nv == 0 || qs.len() % nv != 0 {
             return Err(BatchError::Points {
                 values: qs.len(),
@@ -222,28 +222,25 @@ impl CompiledModel {
         let real = qs.len() / nv;
         let mut regs = vec![[0.0f64; W]; self.register_count];
         regs[0] = [1.0; W];
-        for lane in 0..W {
+        for (lane, q) in (0..W).map(|lane| {
             let k = lane.min(real - 1);
-            let q = &qs[k * nv..(k + 1) * nv];
+            (lane, &qs[k * nv..(k + 1) * nv])
+        }) {
             for &(r, s) in &self.loads {
                 regs[r][lane] = SymbolicModel::symbol_value(s, q, p);
             }
         }
         for &(dst, a, b) in &self.products {
             let (x, y) = (regs[a as usize], regs[b as usize]);
-            let mut z = [0.0; W];
-            for l in 0..W {
-                z[l] = x[l] * y[l];
-            }
-            regs[dst as usize] = z;
+            regs[dst as usize] = std::array::from_fn(|l| x[l] * y[l]);
         }
         out.iter_mut().for_each(|v| *v = 0.0);
         for &(idx, start, end) in &self.sensitivity {
             let mut acc = [-0.0f64; W];
             for &(c, r) in &self.terms[start as usize..end as usize] {
                 let x = &regs[r as usize];
-                for l in 0..W {
-                    acc[l] += c * x[l];
+                for (a, x) in acc.iter_mut().zip(x) {
+                    *a += c * x;
                 }
             }
             for (l, v) in acc.iter().enumerate().take(real) {
