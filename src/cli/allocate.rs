@@ -57,6 +57,21 @@ pub enum AllocateFormat {
 
 report::formats!(AllocateFormat: Table, Json);
 
+/// Parses `--threshold`: a fraction of the largest sensitivity in [0, 1]
+/// (above 1 no error is ever tightened, and NaN compares false with all).
+fn parse_threshold(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    if !(0.0..=1.0).contains(&v) {
+        return Err(format!(
+            "the threshold is a fraction of the largest sensitivity, in [0, 1] (found `{s}`)"
+        ));
+    }
+    Ok(v)
+}
+
 /// Arguments of `chain allocate`.
 #[derive(Debug, clap::Args)]
 pub struct AllocateArgs {
@@ -69,8 +84,8 @@ pub struct AllocateArgs {
     /// step/6 mm, step/6000 rad for angular and step/3000 rad for squareness errors).
     #[arg(long, value_name = "TOL", default_value_t = 0.005)]
     pub step: f64,
-    /// Sensitivity threshold of `--strategy paper`, as a fraction of the largest.
-    #[arg(long, default_value_t = 0.1)]
+    /// Sensitivity threshold of `--strategy paper`, as a fraction of the largest, in [0, 1].
+    #[arg(long, default_value_t = 0.1, value_parser = parse_threshold, allow_negative_numbers = true)]
     pub threshold: f64,
     /// Ranking of `--strategy paper`.
     #[arg(long, value_enum, default_value = "component")]

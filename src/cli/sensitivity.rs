@@ -107,12 +107,19 @@ fn parse_values(s: &str) -> Result<ValuesArg, String> {
 pub struct AtPoint(pub Vec<(String, f64)>);
 
 /// Parses `x=0,y=1500,z=600`.
+/// A coordinate given twice is refused (the last one would silently win).
 pub(crate) fn parse_point(s: &str) -> Result<AtPoint, String> {
-    s.split(',')
+    let point = s
+        .split(',')
         .filter(|p| !p.trim().is_empty())
         .map(parse_assignment)
-        .collect::<Result<Vec<_>, _>>()
-        .map(AtPoint)
+        .collect::<Result<Vec<_>, _>>()?;
+    for (i, (name, _)) in point.iter().enumerate() {
+        if point[..i].iter().any(|(n, _)| n == name) {
+            return Err(format!("`{name}` is given twice"));
+        }
+    }
+    Ok(AtPoint(point))
 }
 
 /// Runs `chain sensitivity`.
