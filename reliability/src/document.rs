@@ -623,19 +623,11 @@ pub fn sensitivity<M: ErrorModel + ?Sized>(
     };
     let result = study.sensitivity_point(model, parameters, point, form)?;
     let vars = study.variables();
-    let mut order: Vec<usize> = study
-        .spec()
-        .grid
-        .axes
+    let at = study
+        .display_order()
         .iter()
-        .filter_map(|(n, _)| vars.iter().position(|v| v == n))
+        .map(|&i| (vars[i].clone(), point[i]))
         .collect();
-    order.extend(
-        (0..vars.len())
-            .filter(|i| !order.contains(i))
-            .collect::<Vec<_>>(),
-    );
-    let at = order.iter().map(|&i| (vars[i].clone(), point[i])).collect();
     Ok((Some(at), result))
 }
 

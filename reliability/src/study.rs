@@ -725,6 +725,25 @@ impl Study {
         &self.variables
     }
 
+    /// The variables' indices in the order a point is shown: the grid's
+    /// axes first (x, y, z as the file lists them), then any other variable.
+    pub fn display_order(&self) -> Vec<usize> {
+        let vars = &self.variables;
+        let mut order: Vec<usize> = self
+            .spec
+            .grid
+            .axes
+            .iter()
+            .filter_map(|(name, _)| vars.iter().position(|v| v == name))
+            .collect();
+        order.extend(
+            (0..vars.len())
+                .filter(|i| !order.contains(i))
+                .collect::<Vec<_>>(),
+        );
+        order
+    }
+
     /// The specification.
     pub fn spec(&self) -> &StudySpec {
         &self.spec

@@ -129,21 +129,9 @@ pub fn optimal<M: ErrorModel + ?Sized>(
 
 /// The grid point `p` as `x=…, y=…` (grid axes first).
 pub(super) fn point_name(study: &Study, p: usize) -> String {
-    // In the grid's axis order (x, y, z), then any other variable.
     let vars = study.variables();
-    let mut order: Vec<usize> = study
-        .spec()
-        .grid
-        .axes
-        .iter()
-        .filter_map(|(name, _)| vars.iter().position(|v| v == name))
-        .collect();
-    order.extend(
-        (0..vars.len())
-            .filter(|i| !order.contains(i))
-            .collect::<Vec<_>>(),
-    );
-    order
+    study
+        .display_order()
         .iter()
         .map(|&i| format!("{}={}", vars[i], study.points()[p][i]))
         .collect::<Vec<_>>()
