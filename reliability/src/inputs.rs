@@ -806,6 +806,30 @@ impl Inputs {
         Ok(out)
     }
 
+    /// A copy with every standard deviation replaced by `stds` (one per
+    /// input), the means, families and correlations held: for non-normal
+    /// members of the correlated block the Gaussian-copula matrix `R₀` is
+    /// held, as in [`Inputs::with_moments`], so that derivatives at fixed `u`
+    /// are those of [`Marginal::dx_dstd`].
+    pub fn with_stds(&self, stds: &[f64]) -> Result<Inputs, ReliabilityError> {
+        if stds.len() != self.len() {
+            return Err(ReliabilityError::Dimension {
+                what: "standard deviations",
+                expected: self.len(),
+                found: stds.len(),
+            });
+        }
+        let marginals = self
+            .marginals
+            .iter()
+            .zip(stds)
+            .map(|(m, &s)| m.with_moments(m.mean(), s))
+            .collect::<Result<Vec<Marginal>, _>>()?;
+        let mut out = Inputs::new(self.names.clone(), marginals)?;
+        out.correlation = self.correlation.clone();
+        Ok(out)
+    }
+
     /// The inputs `order[0], order[1], …` of these, in that order (the
     /// marginal of a subset: the correlations among the kept inputs are
     /// kept, those with dropped inputs dropped).

@@ -25,14 +25,11 @@
 use chain_core::ErrorModel;
 use serde::Serialize;
 
-use super::{component_summaries, step_std};
+use super::{component_summaries, evaluate, step_std};
 use super::{AllocateError, Allocation, ErrorBounds, Paper, Step};
 use crate::acceptance::{Acceptance, AcceptanceResult, Rectangles, Sampler};
 use crate::error::ReliabilityError;
-use crate::form::Form;
-use crate::inputs::Inputs;
 use crate::study::Study;
-use crate::study::StudyResult;
 
 /// How to allocate against the acceptance probability.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,35 +60,6 @@ pub struct AcceptanceAllocation {
 
 /// Samples per evaluation of `P` for non-normal inputs (2¹⁹).
 const MC_SAMPLES: u64 = 1 << 19;
-
-/// The study's inputs with other standard deviations, the means, families
-/// and correlations (the Gaussian-copula matrix) held.
-fn inputs_with_stds(study: &Study, stds: &[f64]) -> Result<Inputs, ReliabilityError> {
-    let mut inputs = study.inputs().clone();
-    for (j, &s) in stds.iter().enumerate() {
-        let mean = inputs.means()[j];
-        inputs = inputs.with_moments(j, mean, s)?;
-    }
-    Ok(inputs)
-}
-
-/// FORM over the study's grid with other standard deviations, the
-/// correlations held (the per-component summaries beside `P`).
-fn evaluate<M: ErrorModel + ?Sized>(
-    model: &M,
-    parameters: &[f64],
-    study: &Study,
-    stds: &[f64],
-) -> Result<(Study, StudyResult), ReliabilityError> {
-    let s = Study::new(
-        model,
-        parameters,
-        inputs_with_stds(study, stds)?,
-        study.spec().clone(),
-    )?;
-    let r = s.form(&Form::default())?;
-    Ok((s, r))
-}
 
 fn evaluate_p(
     system: &Rectangles,

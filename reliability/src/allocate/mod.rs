@@ -40,7 +40,7 @@ use serde::Serialize;
 
 use crate::error::ReliabilityError;
 use crate::form::Form;
-use crate::inputs::{Inputs, Marginal};
+use crate::inputs::Inputs;
 use crate::study::{Study, StudyResult, Summary, Target};
 
 mod acceptance;
@@ -318,16 +318,10 @@ pub enum AllocateError {
     NotConverged(String),
 }
 
-/// The study's inputs with other standard deviations (same families and means).
+/// The study's inputs with other standard deviations: families, means and
+/// correlations held ([`Inputs::with_stds`]).
 pub fn with_stds(study: &Study, stds: &[f64]) -> Result<Inputs, ReliabilityError> {
-    let inputs = study.inputs();
-    let marginals = inputs
-        .marginals()
-        .iter()
-        .zip(stds)
-        .map(|(m, &s)| m.with_moments(m.mean(), s))
-        .collect::<Result<Vec<Marginal>, _>>()?;
-    Inputs::new(inputs.names().to_vec(), marginals)
+    study.inputs().with_stds(stds)
 }
 
 /// FORM over the study's grid with other standard deviations.
@@ -376,4 +370,42 @@ pub fn components(study: &Study) -> Vec<Target> {
         .copied()
         .filter(|t| matches!(t, Target::Component(_)))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::inputs::{Correlation, Inputs};
+    use crate::util::fixtures::gantry;
+    use crate::{machine, Study};
+
+    /// Re-evaluating a study at its own standard deviations reproduces its
+    /// FORM results: the correlations are held, not dropped (with them
+    /// dropped the correlated pair's cases move).
+    #[test]
+    fn evaluate_holds_the_correlations() {
+        let (m, model) = gantry();
+        let independent = machine::study(&m, &model, &[], None).unwrap();
+        let inputs = independent.inputs();
+        let names = inputs.names();
+        let at = |n: &str| names.iter().position(|x| x == n).unwrap();
+        let pair = [Correlation {
+            a: at("dxx"),
+            b: at("ezx"),
+            rho: 0.8,
+        }];
+        let correlated =
+            Inputs::correlated(names.to_vec(), inputs.marginals().to_vec(), &pair).unwrap();
+        let study = Study::new(&model, &[], correlated, independent.spec().clone()).unwrap();
+        let own = study.form(&crate::Form::default()).unwrap();
+        let (_, again) = super::evaluate(&model, &[], &study, study.inputs().stds()).unwrap();
+        let plain = independent.form(&crate::Form::default()).unwrap();
+        let mut moved = 0.0f64;
+        for ((a, b), c) in own.cases.iter().zip(&again.cases).zip(&plain.cases) {
+            assert!((a.beta - b.beta).abs() <= 1e-12 * a.beta.abs().max(1.0));
+            moved = moved.max((a.beta - c.beta).abs());
+        }
+        assert!(moved > 1e-3, "the correlation changes some case: {moved}");
+        let held = super::with_stds(&study, study.inputs().stds()).unwrap();
+        assert_eq!(held.correlations(), &pair[..]);
+    }
 }
