@@ -165,7 +165,7 @@ fn the_pilot_selects_subset_simulation_below_one_hundred_events() {
 }
 
 /// The test's own generator: splitmix64 + Box–Muller, independent of the
-/// library's ChaCha8 streams.
+/// library's xoshiro256++ streams.
 struct SplitMix(u64);
 
 impl SplitMix {

@@ -9,7 +9,8 @@
 //! tolerance in normal inputs). N = 10,000 samples per level, p0 = 0.1:
 //! six levels, CoV ≈ 0.10 (printed once before timing).
 //!
-//! Run: `cargo bench -p reliability --bench subset`; with `PRINT_CASE=1` in the
+//! Run: `cargo bench -p reliability --bench subset` (`SUBSET_RUNS=n` in the
+//! environment: n untimed runs, for callgrind); with `PRINT_CASE=1` in the
 //! environment it prints the standard-space coefficients for the script.
 
 use std::hint::black_box;
@@ -67,6 +68,17 @@ fn benches(c: &mut Criterion) {
         r.levels.len(),
         r.calls
     );
+    // `SUBSET_RUNS=n`: n runs and no timing, for instruction counts
+    // (`valgrind --tool=callgrind`, docs/performance.md).
+    if let Some(n) = std::env::var("SUBSET_RUNS")
+        .ok()
+        .and_then(|v| v.parse::<u32>().ok())
+    {
+        for _ in 0..n {
+            black_box(ss.run(&event).expect("subset"));
+        }
+        return;
+    }
     let mut g = c.benchmark_group("subset");
     g.sample_size(20);
     g.bench_function("px_pf_1e-6_N10000", |b| {

@@ -61,6 +61,18 @@ pub(crate) mod prelude {
     }
 
     impl<I: Iterator> MapInit for I {}
+
+    /// `par_chunks_mut()` on slices: the ordinary `chunks_mut()`.
+    pub(crate) trait ParallelSliceMut<T> {
+        /// Iterates over chunks of `size` in order.
+        fn par_chunks_mut(&mut self, size: usize) -> std::slice::ChunksMut<'_, T>;
+    }
+
+    impl<T> ParallelSliceMut<T> for [T] {
+        fn par_chunks_mut(&mut self, size: usize) -> std::slice::ChunksMut<'_, T> {
+            self.chunks_mut(size)
+        }
+    }
 }
 
 /// The number of worker threads (1 without the `parallel` feature): the

@@ -2,7 +2,7 @@
 //! crude Monte Carlo, on one driver.
 //!
 //! Both split every case into blocks of [`BLOCK`] samples; block `b` of case
-//! `c` draws from its own ChaCha8 stream (`c << 32 | b`, see [`crate::rng`]),
+//! `c` draws from its own xoshiro256++ stream (`c << 32 | b`, see [`crate::rng`]),
 //! rayon runs the blocks of all cases in parallel, and the per-block sums are
 //! added in block order. Results are therefore bit-identical for a given seed
 //! whatever the number of threads. Nothing is allocated inside the sampling
@@ -281,26 +281,19 @@ impl MonteCarlo {
             };
             (pf, (var / n).sqrt())
         };
-        let runs = match target {
-            None => drive(events.len(), self.samples, width, progress, block)
-                .into_iter()
-                .map(|s| (s, self.samples, None))
-                .collect::<Vec<_>>(),
-            Some(t) => drive_to_cov(
-                events.len(),
-                self.samples,
-                width,
-                progress,
-                block,
-                |_, s, n| {
+        let runs = drive(
+            events.len(),
+            self.samples,
+            width,
+            progress,
+            block,
+            target.map(|t| {
+                (t, move |_: usize, s: &Sums, n: u64| {
                     let (pf, se) = estimate(s, n);
                     s.s1 > 0.0 && se <= t * pf
-                },
-            )
-            .into_iter()
-            .map(|(s, n, stop)| (s, n, Some(Stopping::new(stop, Some(t)))))
-            .collect(),
-        };
+                })
+            }),
+        );
         Ok(runs
             .into_iter()
             .map(|(s, samples, stopping)| {
@@ -398,28 +391,22 @@ impl ImportanceSampling {
             };
             (pf.clamp(0.0, 1.0), (var / n).sqrt())
         };
-        let runs = match target {
-            None => drive(events.len(), self.samples, width, progress, block)
-                .into_iter()
-                .map(|s| (s, self.samples, None))
-                .collect::<Vec<_>>(),
-            Some(t) => drive_to_cov(
-                events.len(),
-                self.samples,
-                width,
-                progress,
-                block,
-                |case, s, n| {
+        let runs = drive(
+            events.len(),
+            self.samples,
+            width,
+            progress,
+            block,
+            target.map(|t| {
+                let kernels = &kernels;
+                (t, move |case: usize, s: &Sums, n: u64| {
                     let (pf, se) = estimate(&kernels[case], s, n);
                     // A zero-variance estimate (a linear limit state in
                     // normal inputs, or p_f = 0 or 1 exactly) is exact.
                     se == 0.0 || se <= t * pf
-                },
-            )
-            .into_iter()
-            .map(|(s, n, stop)| (s, n, Some(Stopping::new(stop, Some(t)))))
-            .collect(),
-        };
+                })
+            }),
+        );
         Ok(runs
             .into_iter()
             .zip(&kernels)
@@ -467,61 +454,36 @@ fn case_id(case: usize) -> u32 {
     u32::try_from(case).unwrap_or(u32::MAX)
 }
 
-/// Runs `samples` per case in blocks of [`BLOCK`], in parallel, and adds the
-/// block sums of each case in block order.
-fn drive<F>(cases: usize, samples: u64, width: usize, progress: &dyn Progress, run: F) -> Vec<Sums>
-where
-    F: Fn(usize, u32, u64, &mut [f64]) -> Sums + Sync,
-{
-    let blocks = samples.div_ceil(BLOCK);
-    (0..cases)
-        .into_par_iter()
-        .map(|case| {
-            let sums: Vec<Sums> = (0..blocks)
-                .into_par_iter()
-                .map_init(
-                    // Padded by a cache line on each side: the scratch of two
-                    // workers must not share a line (false sharing).
-                    || vec![0.0; width + 16],
-                    |scratch, block| {
-                        let count = BLOCK.min(samples - block * BLOCK);
-                        let block_id = u32::try_from(block).unwrap_or(u32::MAX);
-                        let s = run(case, block_id, count, &mut scratch[8..8 + width]);
-                        progress.advance(count);
-                        s
-                    },
-                )
-                .collect();
-            // Block order, whatever thread ran which block.
-            sums.iter().fold(Sums::default(), |a, b| Sums {
-                s1: a.s1 + b.s1,
-                s2: a.s2 + b.s2,
-                calls: a.calls + b.calls,
-            })
-        })
-        .collect()
-}
-
-/// [`drive`] with a stopping rule: per case, blocks run in parallel batches
-/// (as wide as the thread pool) and are added in block order; `done(case,
-/// sums, samples)` is asked after each block, and the first block after
-/// which it holds ends the case ([`Stop::TargetCov`]; blocks of its batch
-/// beyond it are dropped, so the result does not depend on the thread
-/// count). Running out of `samples` first is [`Stop::Budget`].
-fn drive_to_cov<F, D>(
+/// Runs up to `samples` per case in blocks of [`BLOCK`], in parallel, and
+/// adds the block sums of each case in block order. Returns per case the
+/// sums, the samples used and, under a stopping rule, how it stopped.
+///
+/// Without a rule every block runs (all in parallel). With `rule = (target,
+/// done)` blocks run in parallel batches as wide as the thread pool;
+/// `done(case, sums, samples)` is asked after each block in block order,
+/// and the first block after which it holds ends the case
+/// ([`Stop::TargetCov`]; blocks of its batch beyond it are dropped, so the
+/// result does not depend on the thread count); running out of `samples`
+/// first is [`Stop::Budget`]. Either way the estimate is bit-identical to a
+/// fixed-count run of the samples used.
+fn drive<F, D>(
     cases: usize,
     samples: u64,
     width: usize,
     progress: &dyn Progress,
     run: F,
-    done: D,
-) -> Vec<(Sums, u64, Stop)>
+    rule: Option<(f64, D)>,
+) -> Vec<(Sums, u64, Option<Stopping>)>
 where
     F: Fn(usize, u32, u64, &mut [f64]) -> Sums + Sync,
     D: Fn(usize, &Sums, u64) -> bool + Sync,
 {
     let blocks = samples.div_ceil(BLOCK);
-    let batch = crate::par::threads().max(1) as u64;
+    let batch = match rule {
+        Some(_) => crate::par::threads().max(1) as u64,
+        None => blocks.max(1),
+    };
+    let stopping = |stop| rule.as_ref().map(|(t, _)| Stopping::new(stop, Some(*t)));
     (0..cases)
         .into_par_iter()
         .map(|case| {
@@ -533,6 +495,9 @@ where
                 let parts: Vec<(Sums, u64)> = (next..end)
                     .into_par_iter()
                     .map_init(
+                        // Padded by a cache line on each side: the scratch
+                        // of two workers must not share a line (false
+                        // sharing).
                         || vec![0.0; width + 16],
                         |scratch, block| {
                             let count = BLOCK.min(samples - block * BLOCK);
@@ -544,6 +509,7 @@ where
                     )
                     .collect();
                 next = end;
+                // Block order, whatever thread ran which block.
                 for (b, count) in parts {
                     total = Sums {
                         s1: total.s1 + b.s1,
@@ -551,12 +517,14 @@ where
                         calls: total.calls + b.calls,
                     };
                     used += count;
-                    if done(case, &total, used) {
-                        return (total, used, Stop::TargetCov);
+                    if let Some((_, done)) = &rule {
+                        if done(case, &total, used) {
+                            return (total, used, stopping(Stop::TargetCov));
+                        }
                     }
                 }
             }
-            (total, used, Stop::Budget)
+            (total, used, stopping(Stop::Budget))
         })
         .collect()
 }

@@ -76,6 +76,8 @@ const INITIAL_SCALE: f64 = 0.6;
 const ADAPT_FRACTION: f64 = 0.1;
 /// Random streams per run (levels) in the block index of [`CaseRng`].
 const LEVEL_STREAMS: u32 = 64;
+/// Samples per parallel block of level 0 (each its own sub-stream).
+const LEVEL0_BLOCK: usize = 1024;
 
 /// Subset simulation with adaptive conditional sampling.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -317,14 +319,25 @@ impl SubsetSimulation {
             };
         }
         let block = |level: usize| run * LEVEL_STREAMS + level as u32;
-        let mut rng = CaseRng::new(self.seed, case_id, block(0));
-        // Level 0: independent draws.
+        // Level 0: independent draws, in blocks of `LEVEL0_BLOCK` samples
+        // in parallel, block `k` from sub-stream `k + 1` of the level's
+        // stream.
         let mut u = vec![0.0; n_level * na];
-        rng.fill_normal(&mut u);
-        let mut g: Vec<f64> = u
-            .chunks_exact(na)
-            .map(|ui| std.value(ui, &mut scratch))
-            .collect();
+        let mut g = vec![0.0; n_level];
+        u.par_chunks_mut(LEVEL0_BLOCK * na)
+            .zip(g.par_chunks_mut(LEVEL0_BLOCK))
+            .enumerate()
+            .map_init(
+                || std.scratch(),
+                |scratch, (k, (u, g))| {
+                    let mut rng = CaseRng::substream(self.seed, case_id, block(0), k as u32 + 1);
+                    rng.fill_normal(u);
+                    for (ui, gi) in u.chunks_exact(na).zip(g.iter_mut()) {
+                        *gi = std.value(ui, scratch);
+                    }
+                },
+            )
+            .for_each(drop);
         progress.advance(n_level as u64);
         let mut calls = n_level as u64;
         let mut samples = n_level as u64;
@@ -417,18 +430,19 @@ impl SubsetSimulation {
                 ns,
             };
             let out = (&mut next_u[..], &mut next_g[..]);
+            let streams = (self.seed, case_id, block(level + 1));
             // The dimension as a constant for the common small cases, so
             // the per-state loops are unrolled.
             let (accepted, proposed) = match na {
-                1 => level_data.populate::<1, L>(std, &mut rng, &mut lambda, out),
-                2 => level_data.populate::<2, L>(std, &mut rng, &mut lambda, out),
-                3 => level_data.populate::<3, L>(std, &mut rng, &mut lambda, out),
-                4 => level_data.populate::<4, L>(std, &mut rng, &mut lambda, out),
-                5 => level_data.populate::<5, L>(std, &mut rng, &mut lambda, out),
-                6 => level_data.populate::<6, L>(std, &mut rng, &mut lambda, out),
-                7 => level_data.populate::<7, L>(std, &mut rng, &mut lambda, out),
-                8 => level_data.populate::<8, L>(std, &mut rng, &mut lambda, out),
-                _ => level_data.populate::<0, L>(std, &mut rng, &mut lambda, out),
+                1 => level_data.populate::<1, L>(std, streams, &mut lambda, out),
+                2 => level_data.populate::<2, L>(std, streams, &mut lambda, out),
+                3 => level_data.populate::<3, L>(std, streams, &mut lambda, out),
+                4 => level_data.populate::<4, L>(std, streams, &mut lambda, out),
+                5 => level_data.populate::<5, L>(std, streams, &mut lambda, out),
+                6 => level_data.populate::<6, L>(std, streams, &mut lambda, out),
+                7 => level_data.populate::<7, L>(std, streams, &mut lambda, out),
+                8 => level_data.populate::<8, L>(std, streams, &mut lambda, out),
+                _ => level_data.populate::<0, L>(std, streams, &mut lambda, out),
             };
             let new = (nc * (ns - 1)) as u64;
             calls += new;
@@ -481,16 +495,13 @@ impl Level<'_> {
     fn populate<const N: usize, L: LimitState>(
         &self,
         std: &Standard<'_, '_, L>,
-        rng: &mut CaseRng,
+        streams: (u64, u32, u32),
         lambda: &mut f64,
         (next_u, next_g): (&mut [f64], &mut [f64]),
     ) -> (u64, u64) {
         let na = if N > 0 { N } else { self.sigma_hat.len() };
         let ns = self.ns;
         let nc = self.seeds.len();
-        let mut scratch = std.scratch();
-        let mut cand = vec![0.0; na];
-        let mut z = vec![0.0; na];
         let group = ((ADAPT_FRACTION * nc as f64).floor() as usize).max(1);
         let spreads = |lambda: f64| -> (Vec<f64>, Vec<f64>) {
             let s: Vec<f64> = self
@@ -501,51 +512,92 @@ impl Level<'_> {
             let r = s.iter().map(|s| (1.0 - s * s).max(0.0).sqrt()).collect();
             (s, r)
         };
-        let (mut sig, mut rho) = spreads(*lambda);
         let mut adapt_step = 1.0f64;
-        let (mut accepted_group, mut proposed_group) = (0u64, 0u64);
         let (mut accepted, mut proposed) = (0u64, 0u64);
-        for (c, &seed) in self.seeds.iter().enumerate() {
-            let start = c * ns;
-            let chain_u = &mut next_u[start * na..(start + ns) * na];
-            let chain_g = &mut next_g[start..start + ns];
-            chain_u[..na].copy_from_slice(&self.u[seed * na..(seed + 1) * na]);
-            chain_g[0] = self.g[seed];
+        let (seed, case_id, block) = streams;
+        for first in (0..nc).step_by(group) {
+            let last = (first + group).min(nc);
+            let (sig, rho) = spreads(*lambda);
             let (r, s) = (&rho[..na], &sig[..na]);
-            for t in 1..ns {
-                let z = &mut z[..na];
-                rng.fill_normal(z);
-                let (done, rest) = chain_u.split_at_mut(t * na);
-                let prev = &done[(t - 1) * na..t * na];
-                let next = &mut rest[..na];
-                let cand = &mut cand[..na];
-                for k in 0..na {
-                    cand[k] = r[k] * prev[k] + s[k] * z[k];
-                }
-                let gc = std.value(cand, &mut scratch);
-                // Accept or stay, without a data-dependent branch (the
-                // acceptance rate is near 0.44, the worst case for a
-                // branch predictor).
-                let accept = gc <= self.threshold;
-                for k in 0..na {
-                    next[k] = if accept { cand[k] } else { prev[k] };
-                }
-                chain_g[t] = if accept { gc } else { chain_g[t - 1] };
-                accepted_group += u64::from(accept);
-                proposed_group += 1;
-            }
-            if (c + 1) % group == 0 && proposed_group > 0 {
+            // The chains of one group share the spreads and run in
+            // parallel; chain `c` draws from sub-stream `c + 1` of the
+            // level's block.
+            let chain_u = &mut next_u[first * ns * na..last * ns * na];
+            let chain_g = &mut next_g[first * ns..last * ns];
+            let accepted_group: u64 = chain_u
+                .par_chunks_mut(ns * na)
+                .zip(chain_g.par_chunks_mut(ns))
+                .enumerate()
+                .map_init(
+                    || (std.scratch(), vec![0.0; na], vec![0.0; na]),
+                    |(scratch, cand, z), (k, (chain_u, chain_g))| {
+                        let c = first + k;
+                        let mut rng = CaseRng::substream(seed, case_id, block, c as u32 + 1);
+                        self.chain::<N, L>(
+                            std,
+                            (r, s),
+                            &mut rng,
+                            (scratch, cand, z),
+                            c,
+                            (chain_u, chain_g),
+                        )
+                    },
+                )
+                .sum();
+            let proposed_group = ((last - first) * (ns - 1)) as u64;
+            accepted += accepted_group;
+            proposed += proposed_group;
+            if last - first == group && proposed_group > 0 {
                 let rate = accepted_group as f64 / proposed_group as f64;
                 *lambda = (lambda.ln() + (rate - TARGET_ACCEPTANCE) / adapt_step.sqrt()).exp();
                 adapt_step += 1.0;
-                (sig, rho) = spreads(*lambda);
-                accepted += accepted_group;
-                proposed += proposed_group;
-                accepted_group = 0;
-                proposed_group = 0;
             }
         }
-        (accepted + accepted_group, proposed + proposed_group)
+        (accepted, proposed)
+    }
+
+    /// One aCS chain from seed `c` (Papaioannou et al. 2015, Algorithm 5:
+    /// `v_k = ρ_k·u_k + σ_k·z_k`, kept when `G(v) ≤ b_j`), its `N_s` states
+    /// written to `chain_u` and `chain_g`; returns the accepted moves.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn chain<const N: usize, L: LimitState>(
+        &self,
+        std: &Standard<'_, '_, L>,
+        (r, s): (&[f64], &[f64]),
+        rng: &mut CaseRng,
+        (scratch, cand, z): (&mut crate::standard::Scratch, &mut [f64], &mut [f64]),
+        c: usize,
+        (chain_u, chain_g): (&mut [f64], &mut [f64]),
+    ) -> u64 {
+        let na = if N > 0 { N } else { self.sigma_hat.len() };
+        let seed = self.seeds[c];
+        chain_u[..na].copy_from_slice(&self.u[seed * na..(seed + 1) * na]);
+        chain_g[0] = self.g[seed];
+        let (r, s) = (&r[..na], &s[..na]);
+        let mut accepted = 0u64;
+        for t in 1..self.ns {
+            let z = &mut z[..na];
+            rng.fill_normal(z);
+            let (done, rest) = chain_u.split_at_mut(t * na);
+            let prev = &done[(t - 1) * na..t * na];
+            let next = &mut rest[..na];
+            let cand = &mut cand[..na];
+            for k in 0..na {
+                cand[k] = r[k] * prev[k] + s[k] * z[k];
+            }
+            let gc = std.value(cand, scratch);
+            // Accept or stay, without a data-dependent branch (the
+            // acceptance rate is near 0.44, the worst case for a branch
+            // predictor).
+            let accept = gc <= self.threshold;
+            for k in 0..na {
+                next[k] = if accept { cand[k] } else { prev[k] };
+            }
+            chain_g[t] = if accept { gc } else { chain_g[t - 1] };
+            accepted += u64::from(accept);
+        }
+        accepted
     }
 }
 

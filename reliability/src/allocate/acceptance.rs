@@ -9,9 +9,16 @@
 //!   by sequential linearisation of the one constraint: at `t`, with
 //!   `gᵢ = ∂P/∂tᵢ = −σᵢ·∂P/∂σᵢ`, the subproblem `min Σ wᵢ(e^{tᵢ'} − 1)`
 //!   s.t. `P + g·(t' − t) ≥ L + margin` has the KKT solution
-//!   `tᵢ'(λ) = clamp(ln(λ·gᵢ/wᵢ), 0, t_maxᵢ)`, `λ` by bisection; steps are
-//!   limited to 1 in `t` (a trust region), and it stops when the
-//!   re-evaluated `P` is within `[L + margin, L + margin + slack]`. A fixed
+//!   `tᵢ'(λ) = clamp(ln(λ·gᵢ/wᵢ), 0, t_maxᵢ)`, `λ` by bisection; half of
+//!   that step is taken within a trust region (radius 1 in `t`, halved when
+//!   the linear model mispredicts the change of `P` beyond the noise,
+//!   doubled back when it predicts well), and it stops when the
+//!   re-evaluated `P` is within `[L + margin, L + margin + slack]`; when the
+//!   region shrinks below 1e-3 or the linearisations run out, the cheapest
+//!   point found that meets the level is the answer, or, if none did, the
+//!   last point tightened along the errors that raise `P` until it does
+//!   (`restore`: near the level the estimated gradient's noise makes the
+//!   linearisations trade errors without gaining `P`). A fixed
 //!   point satisfies the KKT conditions of the original problem with the
 //!   gradient at the solution. The margin is three standard errors of the
 //!   estimate, so that an independent re-evaluation finds the level met.
@@ -60,17 +67,16 @@ pub struct AcceptanceAllocation {
 
 /// Samples per evaluation of `P` for non-normal inputs (2¹⁹).
 const MC_SAMPLES: u64 = 1 << 19;
+/// Linearisations of the optimal strategy before it gives up (or returns
+/// the best point found that meets the level).
+const MAX_LINEARISATIONS: usize = 25;
 
 fn evaluate_p(
     system: &Rectangles,
     stds: &[f64],
     acc: &Acceptance,
 ) -> Result<AcceptanceResult, ReliabilityError> {
-    let mut inputs = system.inputs().clone();
-    for (j, &s) in stds.iter().enumerate() {
-        let mean = inputs.means()[j];
-        inputs = inputs.with_moments(j, mean, s)?;
-    }
+    let inputs = system.inputs().with_stds(stds)?;
     acc.run(&system.with_inputs(inputs)?)
 }
 
@@ -132,14 +138,38 @@ pub fn acceptance<M: ErrorModel + ?Sized>(
                 .collect();
             let mut t = vec![0.0; n];
             let mut done = current.probability >= level + margin(&current);
+            // The cost `Σ wᵢ (e^{tᵢ} − 1)`, the best point meeting the level
+            // so far (cost, stds, P) and the trust region's radius in t.
+            let cost = |t: &[f64]| -> f64 {
+                t.iter()
+                    .zip(bounds)
+                    .map(|(t, b)| b.cost_weight * (t.exp() - 1.0))
+                    .sum()
+            };
+            let mut best: Option<(f64, Vec<f64>, AcceptanceResult)> = None;
+            let mut radius = 1.0f64;
             let mut iter = 0;
             while !done {
                 iter += 1;
-                if iter > 40 {
-                    return Err(AllocateError::NotConverged(format!(
-                        "the acceptance allocation did not reach {level} within 40 linearisations (P = {})",
-                        current.probability
-                    )));
+                if iter > MAX_LINEARISATIONS {
+                    // The best point that meets the level, else the
+                    // current one tightened until it does.
+                    if let Some((_, s, _)) = best.take() {
+                        stds = s;
+                    } else {
+                        let g: Vec<f64> = current.sensitivity.iter().map(|s| s.dr_dstd).collect();
+                        (stds, _) = restore(
+                            &system,
+                            bounds,
+                            &tmax,
+                            &t,
+                            &g,
+                            level,
+                            &acc,
+                            &mut evaluations,
+                        )?;
+                    }
+                    break;
                 }
                 let g: Vec<f64> = (0..n)
                     .map(|i| (-stds[i] * current.sensitivity[i].dr_dstd).max(0.0))
@@ -173,15 +203,21 @@ pub fn acceptance<M: ErrorModel + ?Sized>(
                     }
                 }
                 let mut next = at(hi.exp());
-                // Damped (half the step) within a trust region of 1 in t:
-                // P saturates in each tᵢ, so the full linearised step
+                // Damped (half the step) within a trust region of `radius`
+                // in t: P saturates in each tᵢ, so the full linearised step
                 // over-rewards the steepest errors and oscillates.
                 let mut moved = 0.0f64;
                 for i in 0..n {
-                    let step = (0.5 * (next[i] - t[i])).clamp(-1.0, 1.0);
+                    let step = (0.5 * (next[i] - t[i])).clamp(-radius, radius);
                     moved = moved.max(step.abs());
                     next[i] = t[i] + step;
                 }
+                let predicted: f64 = g
+                    .iter()
+                    .zip(next.iter().zip(&t))
+                    .map(|(g, (a, b))| g * (a - b))
+                    .sum();
+                let before = current.probability;
                 t = next;
                 for i in 0..n {
                     stds[i] = bounds[i].std0 * (-t[i]).exp();
@@ -189,12 +225,58 @@ pub fn acceptance<M: ErrorModel + ?Sized>(
                 current = evaluate_p(&system, &stds, &acc)?;
                 evaluations += 1;
                 let target = level + margin(&current);
+                if current.probability >= target {
+                    let c = cost(&t);
+                    if best.as_ref().is_none_or(|(bc, _, _)| c < *bc) {
+                        best = Some((c, stds.clone(), current.clone()));
+                    }
+                }
+                // The trust region: halved when the linear model mispredicts
+                // the change of P (wrong sign or less than a quarter of it,
+                // beyond the noise of the two estimates), so that the
+                // iteration cannot cycle around the level; doubled back (up
+                // to 1) when it predicts well.
+                let actual = current.probability - before;
+                let noise = 2.0 * current.std_error;
+                let agrees = predicted.abs() <= noise
+                    || (actual * predicted > 0.0 && actual.abs() >= 0.25 * predicted.abs());
+                radius = if agrees {
+                    (2.0 * radius).min(1.0)
+                } else {
+                    0.5 * radius
+                };
                 if current.probability >= target
                     && (current.probability <= target + slack || moved < 1e-3)
                 {
                     done = true;
                 } else if t.iter().zip(&tmax).all(|(a, b)| a >= b) && current.probability < target {
                     return Err(infeasible(bounds, level, current.probability));
+                } else if radius < 1e-3 {
+                    // The region has shrunk to nothing: the best point that
+                    // meets the level (there is one unless the level is out
+                    // of reach of these steps).
+                    match best.take() {
+                        Some((_, s, r)) => {
+                            stds = s;
+                            current = r;
+                            done = true;
+                        }
+                        None => {
+                            let g: Vec<f64> =
+                                current.sensitivity.iter().map(|s| s.dr_dstd).collect();
+                            (stds, current) = restore(
+                                &system,
+                                bounds,
+                                &tmax,
+                                &t,
+                                &g,
+                                level,
+                                &acc,
+                                &mut evaluations,
+                            )?;
+                            done = true;
+                        }
+                    }
                 }
             }
         }
@@ -290,6 +372,70 @@ pub fn acceptance<M: ErrorModel + ?Sized>(
         evaluations,
     });
     Ok(out)
+}
+
+/// Feasibility restoration of the optimal strategy, when the linearisations
+/// end below the level (near it the noise of the estimated gradient makes
+/// them trade errors against each other without gaining `P`): every error
+/// whose tightening raises `P` (`∂P/∂σᵢ < 0`) is tightened by the same `δ`
+/// in `tᵢ = ln(σ0ᵢ/σᵢ)` (within its bound), `δ` doubled from 0.01 until `P`
+/// meets `L` + 3 standard errors and then bisected five times. `P` grows
+/// with `δ`, so this ends, or the bounds are reached and the level is
+/// infeasible.
+#[allow(clippy::too_many_arguments)]
+fn restore(
+    system: &Rectangles,
+    bounds: &[ErrorBounds],
+    tmax: &[f64],
+    t: &[f64],
+    dp_dstd: &[f64],
+    level: f64,
+    acc: &Acceptance,
+    evaluations: &mut usize,
+) -> Result<(Vec<f64>, AcceptanceResult), AllocateError> {
+    let stds_at = |delta: f64| -> Vec<f64> {
+        (0..t.len())
+            .map(|i| {
+                let ti = if dp_dstd[i] < 0.0 {
+                    (t[i] + delta).min(tmax[i]).max(t[i])
+                } else {
+                    t[i]
+                };
+                bounds[i].std0 * (-ti).exp()
+            })
+            .collect()
+    };
+    let meets = |r: &AcceptanceResult| r.probability >= level + 3.0 * r.std_error;
+    let mut lo = 0.0f64;
+    let mut hi = 0.01f64;
+    let found = loop {
+        let stds = stds_at(hi);
+        let r = evaluate_p(system, &stds, acc)?;
+        *evaluations += 1;
+        if meets(&r) {
+            break (stds, r);
+        }
+        let saturated = (0..t.len()).all(|i| dp_dstd[i] >= 0.0 || t[i] + hi >= tmax[i]);
+        if saturated || hi > 64.0 {
+            return Err(infeasible(bounds, level, r.probability));
+        }
+        lo = hi;
+        hi *= 2.0;
+    };
+    let mut best = found;
+    for _ in 0..5 {
+        let mid = 0.5 * (lo + hi);
+        let stds = stds_at(mid);
+        let r = evaluate_p(system, &stds, acc)?;
+        *evaluations += 1;
+        if meets(&r) {
+            hi = mid;
+            best = (stds, r);
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(best)
 }
 
 fn infeasible(bounds: &[ErrorBounds], level: f64, best: f64) -> AllocateError {
