@@ -17,9 +17,11 @@
 //! `|(px, py, pz)|`, and the ISO 230-1-style summary (per component minimum,
 //! maximum and RMS; the largest volumetric error and where; its RMS).
 //!
-//! The map evaluates the values and the model once per point into one
-//! scratch vector per block of [`MAP_BLOCK`] points, so nothing is allocated
-//! per point, and re-evaluates only the tables whose axis value changed from
+//! The map evaluates the values once per point into one scratch vector per
+//! block of [`MAP_BLOCK`] points, so nothing is allocated per point, and the
+//! model over runs of up to 256 points at a time through
+//! [`ErrorModel::error_points`] (a [`CompiledModel`]'s batched tape, equal
+//! bit for bit to [`ErrorModel::error`] point by point); it re-evaluates only the tables whose axis value changed from
 //! the previous point ([`Values::update`]: along a grid, mostly one axis);
 //! with the `parallel` feature the blocks run on rayon's threads.
 //! Each block's summary is computed inside the block and the blocks' are
@@ -38,6 +40,10 @@ use crate::values::{OrderError, Values};
 /// Points per block of [`BuiltMachine::map`]: the unit of parallel work and
 /// of progress reports.
 pub const MAP_BLOCK: usize = 4096;
+
+/// Points of a map block evaluated together by
+/// [`ErrorModel::error_points`] (the batched tape of a [`CompiledModel`]).
+const MAP_CHUNK: usize = 256;
 
 /// The component names, in `E`'s order.
 const COMPONENTS: [&str; 6] = ["px", "py", "pz", "ox", "oy", "oz"];
@@ -471,36 +477,57 @@ impl<M: ErrorModel + Sync> BuiltMachine<M> {
         mut errors: Option<&mut [[f64; 6]]>,
     ) -> Result<Partial, MapError> {
         let nv = self.variables.len();
+        let n = self.model.errors().len();
         let mut scratch = self.scratch();
         let mut cursor = points.cursor(start);
         // The previous point: the values of its tables are in `scratch`.
         let mut previous = vec![f64::NAN; nv];
         let mut q = vec![0.0; nv];
         let mut part = Partial::new();
-        let mut e = [0.0; 6];
-        for k in 0..len {
-            let i = start + k;
-            cursor.next_into(&mut q);
-            let values = if k == 0 {
-                crate::ErrorValues::values_at(&self.values, &q, &mut scratch)
-            } else {
-                self.values.update(&previous, &q, &mut scratch)
-            };
-            if let Err(source) = values {
-                return Err(MapError::OutOfRange {
-                    point: i,
-                    at: (self.variables.iter().zip(&q))
-                        .map(|(n, x)| format!("{n} = {x}"))
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                    source: Box::new(source),
-                });
+        // Up to `MAP_CHUNK` points' coordinates and error values, evaluated
+        // together by the model's batch entry point.
+        let chunk = MAP_CHUNK.min(len);
+        let mut qs = vec![0.0; chunk * nv];
+        let mut es = vec![0.0; chunk * n];
+        let mut flat = vec![0.0; chunk * 6];
+        for c0 in (0..len).step_by(MAP_CHUNK) {
+            let m = MAP_CHUNK.min(len - c0);
+            for k in c0..c0 + m {
+                let i = start + k;
+                cursor.next_into(&mut q);
+                let values = if k == 0 {
+                    crate::ErrorValues::values_at(&self.values, &q, &mut scratch)
+                } else {
+                    self.values.update(&previous, &q, &mut scratch)
+                };
+                if let Err(source) = values {
+                    return Err(MapError::OutOfRange {
+                        point: i,
+                        at: (self.variables.iter().zip(&q))
+                            .map(|(n, x)| format!("{n} = {x}"))
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                        source: Box::new(source),
+                    });
+                }
+                let r = k - c0;
+                qs[r * nv..(r + 1) * nv].copy_from_slice(&q);
+                es[r * n..(r + 1) * n].copy_from_slice(&scratch);
+                std::mem::swap(&mut previous, &mut q);
             }
-            self.model.error(&q, &self.parameters, &scratch, &mut e);
-            std::mem::swap(&mut previous, &mut q);
-            part.add(i, &e);
-            if let Some(out) = errors.as_deref_mut() {
-                out[k] = e;
+            // The slices hold `m` whole points, so the sizes fit.
+            let _ = self.model.error_points(
+                &qs[..m * nv],
+                &self.parameters,
+                &es[..m * n],
+                &mut flat[..m * 6],
+            );
+            for (r, e) in flat[..m * 6].chunks_exact(6).enumerate() {
+                let e: [f64; 6] = std::array::from_fn(|c| e[c]);
+                part.add(start + c0 + r, &e);
+                if let Some(out) = errors.as_deref_mut() {
+                    out[c0 + r] = e;
+                }
             }
         }
         Ok(part)

@@ -52,6 +52,81 @@ pub trait ErrorModel {
         false
     }
 
+    /// The sensitivity matrices at many points: `qs` holds `k` points one
+    /// after another (`variables().len()` values each), `out` receives each
+    /// point's row-major `6 × N` matrix in the same order (`k · 6N` values).
+    /// Each matrix equals [`ErrorModel::sensitivity`] at its point. The
+    /// default evaluates point after point; [`crate::CompiledModel`] runs its
+    /// tape over blocks of [`crate::BATCH_LANES`] points on the calling
+    /// thread (its parallel entry point is
+    /// [`crate::CompiledModel::sensitivity_batch`]).
+    ///
+    /// # Errors
+    /// [`BatchError`] when `qs` is not a whole number of points or `out`
+    /// does not hold one matrix per point; nothing is written then.
+    fn sensitivity_points(&self, qs: &[f64], p: &[f64], out: &mut [f64]) -> Result<(), BatchError> {
+        let nv = self.variables().len();
+        let width = 6 * self.errors().len();
+        let points = batch_points(nv, qs.len())?;
+        check_len(
+            out.len(),
+            points * width,
+            BatchError::Output {
+                len: 0,
+                expected: 0,
+            },
+        )?;
+        if width > 0 {
+            for (q, s) in qs.chunks_exact(nv).zip(out.chunks_exact_mut(width)) {
+                self.sensitivity(q, p, s);
+            }
+        }
+        Ok(())
+    }
+
+    /// The errors `E = S · e` at many points: `qs` as in
+    /// [`ErrorModel::sensitivity_points`], `es` the error values of each
+    /// point one after another (`k · N` values) or one row of `N` values for
+    /// every point, `out` each point's `[px, py, pz, ox, oy, oz]` (`k · 6`
+    /// values). Each equals [`ErrorModel::error`] at its point. The default
+    /// evaluates point after point; [`crate::CompiledModel`] runs its tape
+    /// over blocks of [`crate::BATCH_LANES`] points on the calling thread.
+    ///
+    /// # Errors
+    /// [`BatchError`] when a slice does not fit the number of points;
+    /// nothing is written then.
+    fn error_points(
+        &self,
+        qs: &[f64],
+        p: &[f64],
+        es: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), BatchError> {
+        let nv = self.variables().len();
+        let n = self.errors().len();
+        let points = batch_points(nv, qs.len())?;
+        let broadcast = check_error_rows(es.len(), n, points)?;
+        check_len(
+            out.len(),
+            6 * points,
+            BatchError::Rows {
+                len: 0,
+                expected: 0,
+            },
+        )?;
+        for (k, (q, o)) in qs.chunks_exact(nv).zip(out.chunks_exact_mut(6)).enumerate() {
+            let e = if broadcast {
+                es
+            } else {
+                &es[k * n..(k + 1) * n]
+            };
+            let mut row = [0.0; 6];
+            self.error(q, p, e, &mut row);
+            o.copy_from_slice(&row);
+        }
+        Ok(())
+    }
+
     /// The nominal pose of the tool relative to the workpiece:
     /// `R_wt(q, 0)` and `T_wt(q, 0) · tool_point`.
     fn nominal(&self, q: &[f64], p: &[f64]) -> Pose;
@@ -71,6 +146,85 @@ pub trait ErrorModel {
         values.values_at(q, e)?;
         self.error(q, p, e, out);
         Ok(())
+    }
+}
+
+/// A refused batch evaluation ([`ErrorModel::sensitivity_points`],
+/// [`ErrorModel::error_points`], [`crate::CompiledModel::sensitivity_batch`],
+/// [`crate::CompiledModel::error_batch`]): a slice that does not fit.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum BatchError {
+    /// `qs` is not a whole number of points.
+    #[error("qs holds {values} values, not a whole number of points of {variables} variables")]
+    Points {
+        /// Length of `qs`.
+        values: usize,
+        /// Variables per point.
+        variables: usize,
+    },
+    /// `out` does not hold one sensitivity matrix per point.
+    #[error("out holds {len} values, expected {expected} (one 6 x errors matrix per point)")]
+    Output {
+        /// Length of `out`.
+        len: usize,
+        /// Points times `6 * errors`.
+        expected: usize,
+    },
+    /// `out` does not hold one error vector per point.
+    #[error("out holds {len} values, expected {expected} (6 per point)")]
+    Rows {
+        /// Length of `out`.
+        len: usize,
+        /// Points times 6.
+        expected: usize,
+    },
+    /// `es` is neither one row of error values nor one row per point.
+    #[error("es holds {len} values; expected {errors} (one row for every point) or {expected} (one row of {errors} per point)")]
+    ErrorValues {
+        /// Length of `es`.
+        len: usize,
+        /// Errors of the model (one row).
+        errors: usize,
+        /// Points times errors.
+        expected: usize,
+    },
+}
+
+/// The number of points in `len` values of `nv` variables each.
+pub(crate) fn batch_points(nv: usize, len: usize) -> Result<usize, BatchError> {
+    match len.checked_div(nv) {
+        Some(points) if len % nv == 0 => Ok(points),
+        _ => Err(BatchError::Points {
+            values: len,
+            variables: nv,
+        }),
+    }
+}
+
+/// `Ok` when `len == expected`, else `err` (an `Output` or `Rows`) with them.
+pub(crate) fn check_len(len: usize, expected: usize, err: BatchError) -> Result<(), BatchError> {
+    if len == expected {
+        return Ok(());
+    }
+    Err(match err {
+        BatchError::Rows { .. } => BatchError::Rows { len, expected },
+        _ => BatchError::Output { len, expected },
+    })
+}
+
+/// Whether `es` (`len` values) is one row for every point (`true`) or one
+/// row per point (`false`).
+pub(crate) fn check_error_rows(len: usize, n: usize, points: usize) -> Result<bool, BatchError> {
+    if len == n * points {
+        Ok(false)
+    } else if len == n {
+        Ok(true)
+    } else {
+        Err(BatchError::ErrorValues {
+            len,
+            errors: n,
+            expected: n * points,
+        })
     }
 }
 

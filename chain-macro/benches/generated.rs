@@ -11,6 +11,12 @@ chain::machine!(GantryGrinder = "../examples/machines/gantry_grinder.yaml");
 chain::machine!(Cnc5Bevel = "../examples/machines/cnc5_bevel.yaml");
 chain::machine!(AcTrunnion = "../examples/machines/ac_trunnion.yaml");
 chain::machine!(BcHeadTable = "benches/machines/bc_head_table.yaml");
+chain::machine!(CradleGenerator = "../examples/machines/cradle_generator.yaml");
+chain::machine!(HeadHeadBc = "../examples/machines/head_head_bc.yaml");
+chain::machine!(InternalGrinder = "../examples/machines/internal_grinder.yaml");
+chain::machine!(Legendre5 = "../examples/machines/legendre5.yaml");
+chain::machine!(SpreadAlongAxis = "../examples/machines/spread_along_axis.yaml");
+chain::machine!(Vmc3 = "../examples/machines/vmc3.yaml");
 
 /// The v1 emission of the same machine (`chain derive --format rust`, the
 /// bodies before issue 17), committed for `tests/generated_into.rs`.
@@ -172,7 +178,258 @@ fn bc_head_table(c: &mut Criterion) {
     g.finish();
 }
 
+/// Points per iteration of the `every_machine` group (criterion's
+/// throughput is per point).
+const POINTS: usize = 1024;
+
+/// Points per call of the batched routes in the `every_machine` group.
+const CHUNK: usize = 64;
+
+/// Deterministic points of `nv` coordinates: ±500 on even coordinates,
+/// a few radians on odd ones (every value is valid for both kinds).
+fn bench_points(nv: usize) -> Vec<f64> {
+    (0..POINTS * nv)
+        .map(|i| {
+            let x = (i as f64 * 0.618_033_988_749_895).fract() - 0.5;
+            if i % 2 == 0 {
+                1000.0 * x
+            } else {
+                6.0 * x
+            }
+        })
+        .collect()
+}
+
+/// Issue 17 §4: one group for every example machine and the B-head/C-table
+/// five-axis machine, `POINTS` points per iteration: generated
+/// `sensitivity_into`, the runtime tape point by point, the batched tape on
+/// the calling thread (`sensitivity_points`) and `sensitivity_batch` in a
+/// rayon pool of 1 and of 2 threads.
+macro_rules! every_machine {
+    ($g:expr, $pools:expr, $ty:ident, $name:literal, $path:literal) => {{
+        const NV: usize = $ty::VARIABLES.len();
+        const NP: usize = $ty::PARAMETERS.len();
+        const NE: usize = $ty::ERRORS.len();
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/", $path);
+        let machine = chain::core::load_file(std::path::Path::new(path)).expect("valid machine");
+        let runtime = chain::core::compile(&machine);
+        let qs = bench_points(NV);
+        let p: [f64; NP] = std::array::from_fn(|k| $ty::PARAMETER_VALUES[k].unwrap_or(100.0));
+        // The runtime model's orders, by name.
+        let var_of: Vec<usize> = (runtime.variables().iter())
+            .map(|v| {
+                $ty::VARIABLES
+                    .iter()
+                    .position(|w| w == v)
+                    .expect("same variables")
+            })
+            .collect();
+        let err_of: Vec<usize> = (runtime.errors().iter())
+            .map(|e| {
+                $ty::ERRORS
+                    .iter()
+                    .position(|f| f == e)
+                    .expect("same errors")
+            })
+            .collect();
+        let rp: Vec<f64> = (runtime.parameters().iter())
+            .map(|n| {
+                p[$ty::PARAMETERS
+                    .iter()
+                    .position(|m| m == n)
+                    .expect("same parameters")]
+            })
+            .collect();
+        let rqs: Vec<f64> = (0..POINTS)
+            .flat_map(|k| var_of.iter().map(move |&v| (k, v)))
+            .map(|(k, v)| qs[k * NV + v])
+            .collect();
+        // The four routes agree before they are timed.
+        let mut batch = vec![0.0; POINTS * 6 * NE];
+        runtime
+            .sensitivity_batch(&rqs, &rp, &mut batch)
+            .expect("sizes fit");
+        for k in 0..POINTS {
+            let q: [f64; NV] = std::array::from_fn(|v| qs[k * NV + v]);
+            let mut out = [[0.0; NE]; 6];
+            $ty::sensitivity_into(&q, &p, &mut out);
+            for c in 0..6 {
+                for (j, &g) in err_of.iter().enumerate() {
+                    let (a, b) = (out[c][g], batch[k * 6 * NE + c * NE + j]);
+                    assert!(
+                        (a - b).abs() <= 1e-10 * a.abs().max(1.0),
+                        "{}: point {k}, ({c}, {j}): generated {a} vs batch {b}",
+                        $name
+                    );
+                }
+            }
+        }
+        let mut out = [[0.0; NE]; 6];
+        $g.bench_function(concat!($name, "/generated_into"), |b| {
+            b.iter(|| {
+                for q in qs.chunks_exact(NV) {
+                    let q: &[f64; NV] = q.try_into().expect("NV values");
+                    $ty::sensitivity_into(black_box(q), black_box(&p), &mut out);
+                    black_box(&mut out);
+                }
+            })
+        });
+        let mut one = vec![0.0; 6 * NE];
+        $g.bench_function(concat!($name, "/runtime_per_point"), |b| {
+            b.iter(|| {
+                for q in rqs.chunks_exact(NV) {
+                    runtime.sensitivity(black_box(q), black_box(&rp), &mut one);
+                    black_box(&mut one);
+                }
+            })
+        });
+        // The batched routes write `CHUNK` points' matrices into one reused
+        // buffer at a time (as `BuiltMachine::map` consumes its runs), so
+        // the output stays in cache as the generated code's one matrix does.
+        let (cv, cw) = (CHUNK * NV, CHUNK * 6 * NE);
+        let mut chunk = vec![0.0; cw];
+        $g.bench_function(concat!($name, "/batch_calling_thread"), |b| {
+            b.iter(|| {
+                for qc in rqs.chunks_exact(cv) {
+                    runtime
+                        .sensitivity_points(black_box(qc), black_box(&rp), &mut chunk)
+                        .expect("sizes fit");
+                    black_box(&mut chunk);
+                }
+            })
+        });
+        $g.bench_function(concat!($name, "/batch_1_thread"), |b| {
+            b.iter(|| {
+                $pools[0].1.install(|| {
+                    for qc in rqs.chunks_exact(cv) {
+                        runtime
+                            .sensitivity_batch(black_box(qc), black_box(&rp), &mut chunk)
+                            .expect("sizes fit");
+                        black_box(&mut chunk);
+                    }
+                })
+            })
+        });
+        // Two threads: each takes half the points, its own reused buffer.
+        let mut halves = vec![vec![0.0; cw]; 2];
+        $g.bench_function(concat!($name, "/batch_2_thread"), |b| {
+            b.iter(|| {
+                $pools[1].1.install(|| {
+                    use rayon::prelude::*;
+                    (rqs.par_chunks(rqs.len() / 2))
+                        .zip(halves.par_iter_mut())
+                        .for_each(|(half, buf)| {
+                            for qc in half.chunks_exact(cv) {
+                                runtime
+                                    .sensitivity_points(black_box(qc), black_box(&rp), buf)
+                                    .expect("sizes fit");
+                                black_box(&mut *buf);
+                            }
+                        })
+                })
+            })
+        });
+        // The whole `POINTS` matrices in one parallel call (2 threads).
+        $g.bench_function(concat!($name, "/batch_all_points_2_thread"), |b| {
+            b.iter(|| {
+                $pools[1]
+                    .1
+                    .install(|| {
+                        runtime.sensitivity_batch(black_box(&rqs), black_box(&rp), &mut batch)
+                    })
+                    .expect("sizes fit");
+                black_box(&mut batch);
+            })
+        });
+    }};
+}
+
+/// The `every_machine` group (see [`every_machine!`]).
+fn every_machine(c: &mut Criterion) {
+    let pools: Vec<(usize, rayon::ThreadPool)> = [1, 2]
+        .into_iter()
+        .map(|t| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .expect("a pool");
+            (t, pool)
+        })
+        .collect();
+    let mut g = c.benchmark_group("every_machine");
+    g.throughput(criterion::Throughput::Elements(POINTS as u64));
+    g.sample_size(20)
+        .warm_up_time(std::time::Duration::from_millis(700))
+        .measurement_time(std::time::Duration::from_millis(2000));
+    every_machine!(
+        g,
+        &pools,
+        AcTrunnion,
+        "ac_trunnion",
+        "../examples/machines/ac_trunnion.yaml"
+    );
+    every_machine!(
+        g,
+        &pools,
+        Cnc5Bevel,
+        "cnc5_bevel",
+        "../examples/machines/cnc5_bevel.yaml"
+    );
+    every_machine!(
+        g,
+        &pools,
+        CradleGenerator,
+        "cradle_generator",
+        "../examples/machines/cradle_generator.yaml"
+    );
+    every_machine!(
+        g,
+        &pools,
+        GantryGrinder,
+        "gantry_grinder",
+        "../examples/machines/gantry_grinder.yaml"
+    );
+    every_machine!(
+        g,
+        &pools,
+        HeadHeadBc,
+        "head_head_bc",
+        "../examples/machines/head_head_bc.yaml"
+    );
+    every_machine!(
+        g,
+        &pools,
+        InternalGrinder,
+        "internal_grinder",
+        "../examples/machines/internal_grinder.yaml"
+    );
+    every_machine!(
+        g,
+        &pools,
+        Legendre5,
+        "legendre5",
+        "../examples/machines/legendre5.yaml"
+    );
+    every_machine!(
+        g,
+        &pools,
+        SpreadAlongAxis,
+        "spread_along_axis",
+        "../examples/machines/spread_along_axis.yaml"
+    );
+    every_machine!(g, &pools, Vmc3, "vmc3", "../examples/machines/vmc3.yaml");
+    every_machine!(
+        g,
+        &pools,
+        BcHeadTable,
+        "bc_head_table",
+        "benches/machines/bc_head_table.yaml"
+    );
+    g.finish();
+}
+
 criterion_group!(benches, gantry, five_axis, two_rotary_axes, bc_head_table);
+criterion_group!(machines, every_machine);
 /// `CHAIN_CALLGRIND=NAME:COUNT` runs one function of the `bc_head_table`
 /// group COUNT times and exits (no criterion): instruction counts under
 /// `valgrind --tool=callgrind` that do not depend on the machine's load
@@ -220,5 +477,6 @@ fn main() {
         return;
     }
     benches();
+    machines();
     Criterion::default().configure_from_args().final_summary();
 }

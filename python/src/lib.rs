@@ -64,6 +64,14 @@ fn uninit_array(py: Python<'_>, len: usize) -> (Bound<'_, PyArray1<f64>>, &mut [
     }
 }
 
+/// `out` with every value set to zero, as the `f64`s it then holds.
+fn zeroed(out: &mut [MaybeUninit<f64>]) -> &mut [f64] {
+    out.fill(MaybeUninit::new(0.0));
+    // SAFETY: every value was just initialised, and `MaybeUninit<f64>` has
+    // the layout of `f64`.
+    unsafe { &mut *(out as *mut [MaybeUninit<f64>] as *mut [f64]) }
+}
+
 /// Writes every row of `out` (rows of `width` values) as `row(i, values)`
 /// does, point `i` after point, in parallel blocks of [`BLOCK`] rows; each
 /// row is zeroed first (in cache), so `row` sees initialised values and
@@ -306,15 +314,21 @@ impl Model {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let p = self.parameter_vector(py, &params)?;
         let (q, n) = self.points(&q)?;
-        let (v, ne) = (self.model.variables().len(), self.model.errors().len());
-        let width = 6 * ne;
+        let width = 6 * self.model.errors().len();
         let model = &self.model;
         let (array, out) = uninit_array(py, n * width);
+        let v = model.variables().len();
         py.allow_threads(|| {
-            par_rows(out, width, |i, row| {
-                model.sensitivity(&q[i * v..(i + 1) * v], &p, row)
-            })
-        });
+            if v == 0 {
+                // No coordinates to count the points by: one after another.
+                par_rows(out, width, |_, row| model.sensitivity(&[], &p, row));
+                return Ok(());
+            }
+            let out = zeroed(out);
+            // The batched tape, in parallel blocks (`points` gave whole rows).
+            model.sensitivity_batch(q, &p, out)
+        })
+        .map_err(|e| value_error(e.to_string()))?;
         Ok(array)
     }
 
@@ -352,15 +366,24 @@ impl Model {
         check_finite(e, ne, "e")?;
         let model = &self.model;
         let (array, out) = uninit_array(py, n * 6);
+        // One row of `e` for every point, or one per point.
+        let e = if e_rows == 1 { &e[..ne] } else { e };
         py.allow_threads(|| {
-            par_rows(out, 6, |i, row| {
-                let j = if e_rows == 1 { 0 } else { i };
-                // Every row has 6 values (`par_rows` cuts them so).
-                if let Ok(row) = <&mut [f64; 6]>::try_from(row) {
-                    model.error(&q[i * v..(i + 1) * v], &p, &e[j * ne..(j + 1) * ne], row);
-                }
-            })
-        });
+            if v == 0 {
+                // No coordinates to count the points by: one after another.
+                par_rows(out, 6, |i, row| {
+                    let j = if e_rows == 1 { 0 } else { i };
+                    if let Ok(row) = <&mut [f64; 6]>::try_from(row) {
+                        model.error(&[], &p, &e[j * ne..(j + 1) * ne], row);
+                    }
+                });
+                return Ok(());
+            }
+            let out = zeroed(out);
+            // The batched tape, in parallel blocks.
+            model.error_batch(q, &p, e, out)
+        })
+        .map_err(|e| value_error(e.to_string()))?;
         Ok(array)
     }
 

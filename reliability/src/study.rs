@@ -667,15 +667,29 @@ impl Study {
                 });
             }
         }
-        let mut sensitivities = Vec::with_capacity(points.len());
-        for q in &points {
-            let mut s = vec![0.0; 6 * n];
-            model.sensitivity(q, parameters, &mut s);
-            if s.iter().any(|v| !v.is_finite()) {
-                return Err(ReliabilityError::NonFinite("the model's sensitivities"));
+        // Every point at once through the model's batch entry point (a
+        // compiled model's tape over blocks of points; the same values as
+        // `sensitivity` point by point).
+        let qs: Vec<f64> = points.iter().flatten().copied().collect();
+        let mut flat = vec![0.0; points.len() * 6 * n];
+        if model
+            .sensitivity_points(&qs, parameters, &mut flat)
+            .is_err()
+        {
+            // The points were checked against the model's variables; a model
+            // whose lengths still disagree is evaluated point by point.
+            for (q, s) in points.iter().zip(flat.chunks_exact_mut(6 * n.max(1))) {
+                model.sensitivity(q, parameters, s);
             }
-            sensitivities.push(s);
         }
+        if flat.iter().any(|v| !v.is_finite()) {
+            return Err(ReliabilityError::NonFinite("the model's sensitivities"));
+        }
+        let sensitivities: Vec<Vec<f64>> = if n == 0 {
+            vec![Vec::new(); points.len()]
+        } else {
+            flat.chunks_exact(6 * n).map(<[f64]>::to_vec).collect()
+        };
         let mut targets: Vec<Target> = spec
             .tolerances
             .iter()

@@ -28,25 +28,25 @@ const STACK_REGISTERS: usize = 256;
 /// Points per block of [`CompiledModel::sensitivity_batch`].
 pub const BATCH_LANES: usize = 8;
 
-/// A refused [`CompiledModel::sensitivity_batch`] call.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum BatchError {
-    /// `qs` is not a whole number of points.
-    #[error("qs holds {values} values, not a whole number of points of {variables} variables")]
-    Points {
-        /// Length of `qs`.
-        values: usize,
-        /// Variables per point.
-        variables: usize,
-    },
-    /// `out` does not hold one sensitivity matrix per point.
-    #[error("out holds {len} values, expected {expected} (one 6 x errors matrix per point)")]
-    Output {
-        /// Length of `out`.
-        len: usize,
-        /// Points times `6 * errors`.
-        expected: usize,
-    },
+pub use crate::model_trait::BatchError;
+use crate::model_trait::{batch_points, check_error_rows, check_len};
+
+/// The registers of one block: one lane per point.
+type Lanes = [f64; BATCH_LANES];
+
+thread_local! {
+    /// Each thread's block registers, reused by every batch call on it (no
+    /// allocation per call once they have grown to the largest tape).
+    static BLOCK_REGISTERS: std::cell::RefCell<Vec<Lanes>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Runs `f` with this thread's block registers (a fresh buffer if they are
+/// in use further up the stack).
+fn with_block_registers<R>(f: impl FnOnce(&mut Vec<Lanes>) -> R) -> R {
+    BLOCK_REGISTERS.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut regs) => f(&mut regs),
+        Err(_) => f(&mut Vec::new()),
+    })
 }
 
 /// A machine's error model compiled to a flat tape. Implements [`ErrorModel`].
@@ -169,7 +169,8 @@ impl CompiledModel {
     /// over blocks of [`BATCH_LANES`] points per instruction (structure of
     /// arrays); the last block is padded with copies of its last point and only
     /// its real points are written. Blocks run in parallel under the
-    /// `parallel` feature. Every value equals [`ErrorModel::sensitivity`] at
+    /// `parallel` feature ([`ErrorModel::sensitivity_points`] runs them on the
+    /// calling thread). Every value equals [`ErrorModel::sensitivity`] at
     /// that point (the same products and sums in the same order).
     ///
     /// # Errors
@@ -181,25 +182,13 @@ impl CompiledModel {
         p: &[f64],
         out: &mut [f64],
     ) -> Result<(), BatchError> {
-        let nv = self.variables.len();
-        let width = 6 * self.errors.len();
-        let points = qs.len().checked_div(nv).unwrap_or(0);
-        if nv == 0 || qs.len() % nv != 0 {
-            return Err(BatchError::Points {
-                values: qs.len(),
-                variables: nv,
-            });
-        }
-        if out.len() != points * width {
-            return Err(BatchError::Output {
-                len: out.len(),
-                expected: points * width,
-            });
-        }
-        if points == 0 {
+        let (nv, width) = self.check_sensitivity(qs, out)?;
+        if width == 0 {
             return Ok(());
         }
-        let run = |(qb, ob): (&[f64], &mut [f64])| self.sensitivity_block(qb, p, ob);
+        let run = |(qb, ob): (&[f64], &mut [f64])| {
+            with_block_registers(|regs| self.sensitivity_block(qb, p, ob, regs))
+        };
         #[cfg(feature = "parallel")]
         {
             use rayon::prelude::*;
@@ -214,13 +203,95 @@ impl CompiledModel {
         Ok(())
     }
 
-    /// One block of at most [`BATCH_LANES`] points.
-    fn sensitivity_block(&self, qs: &[f64], p: &[f64], out: &mut [f64]) {
-        const W: usize = BATCH_LANES;
+    /// The errors `E = S · e` at many points through the batched tape:
+    /// `qs` as in [`CompiledModel::sensitivity_batch`], `es` one row of
+    /// `errors().len()` values per point or one row for every point, `out`
+    /// six values per point. Blocks run in parallel under the `parallel`
+    /// feature ([`ErrorModel::error_points`] runs them on the calling
+    /// thread). Every value equals [`ErrorModel::error`] at that point, bit
+    /// for bit (the same products and sums in the same order).
+    ///
+    /// # Errors
+    /// [`BatchError`] when a slice does not fit the number of points.
+    pub fn error_batch(
+        &self,
+        qs: &[f64],
+        p: &[f64],
+        es: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), BatchError> {
+        let (nv, broadcast) = self.check_error(qs, es, out)?;
+        let n = self.errors.len();
+        let run = |(b, (qb, ob)): (usize, (&[f64], &mut [f64]))| {
+            let eb = if broadcast {
+                es
+            } else {
+                let start = b * BATCH_LANES * n;
+                &es[start..start + ob.len() / 6 * n]
+            };
+            with_block_registers(|regs| self.error_block(qb, p, eb, broadcast, ob, regs))
+        };
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            qs.par_chunks(nv * BATCH_LANES)
+                .zip(out.par_chunks_mut(6 * BATCH_LANES))
+                .enumerate()
+                .for_each(run);
+        }
+        #[cfg(not(feature = "parallel"))]
+        qs.chunks(nv * BATCH_LANES)
+            .zip(out.chunks_mut(6 * BATCH_LANES))
+            .enumerate()
+            .for_each(run);
+        Ok(())
+    }
+
+    /// `(variables, 6 · errors)` when `qs` and `out` fit each other.
+    fn check_sensitivity(&self, qs: &[f64], out: &[f64]) -> Result<(usize, usize), BatchError> {
         let nv = self.variables.len();
         let width = 6 * self.errors.len();
+        let points = batch_points(nv, qs.len())?;
+        check_len(
+            out.len(),
+            points * width,
+            BatchError::Output {
+                len: 0,
+                expected: 0,
+            },
+        )?;
+        Ok((nv, width))
+    }
+
+    /// `(variables, es is one row for all points)` when the slices fit.
+    fn check_error(
+        &self,
+        qs: &[f64],
+        es: &[f64],
+        out: &[f64],
+    ) -> Result<(usize, bool), BatchError> {
+        let nv = self.variables.len();
+        let points = batch_points(nv, qs.len())?;
+        let broadcast = check_error_rows(es.len(), self.errors.len(), points)?;
+        check_len(
+            out.len(),
+            6 * points,
+            BatchError::Rows {
+                len: 0,
+                expected: 0,
+            },
+        )?;
+        Ok((nv, broadcast))
+    }
+
+    /// Loads and runs the tape over one block of at most [`BATCH_LANES`]
+    /// points (`qs`, padded with its last point) into `regs`; returns the
+    /// number of real points.
+    fn run_block(&self, qs: &[f64], p: &[f64], regs: &mut Vec<Lanes>) -> usize {
+        const W: usize = BATCH_LANES;
+        let nv = self.variables.len();
         let real = qs.len() / nv;
-        let mut regs = vec![[0.0f64; W]; self.register_count];
+        regs.resize(self.register_count, [0.0; W]);
         regs[0] = [1.0; W];
         for (lane, q) in (0..W).map(|lane| {
             let k = lane.min(real - 1);
@@ -234,17 +305,55 @@ impl CompiledModel {
             let (x, y) = (regs[a as usize], regs[b as usize]);
             regs[dst as usize] = std::array::from_fn(|l| x[l] * y[l]);
         }
+        real
+    }
+
+    /// One output's dot product in every lane.
+    #[inline]
+    fn dot_lanes(&self, regs: &[Lanes], start: u32, end: u32) -> Lanes {
+        let mut acc = [-0.0f64; BATCH_LANES];
+        for &(c, r) in &self.terms[start as usize..end as usize] {
+            let x = &regs[r as usize];
+            for (a, x) in acc.iter_mut().zip(x) {
+                *a += c * x;
+            }
+        }
+        acc
+    }
+
+    /// One block's sensitivity matrices.
+    fn sensitivity_block(&self, qs: &[f64], p: &[f64], out: &mut [f64], regs: &mut Vec<Lanes>) {
+        let width = 6 * self.errors.len();
+        let real = self.run_block(qs, p, regs);
         out.iter_mut().for_each(|v| *v = 0.0);
         for &(idx, start, end) in &self.sensitivity {
-            let mut acc = [-0.0f64; W];
-            for &(c, r) in &self.terms[start as usize..end as usize] {
-                let x = &regs[r as usize];
-                for (a, x) in acc.iter_mut().zip(x) {
-                    *a += c * x;
-                }
-            }
+            let acc = self.dot_lanes(regs, start, end);
             for (l, v) in acc.iter().enumerate().take(real) {
                 out[l * width + idx as usize] = *v;
+            }
+        }
+    }
+
+    /// One block's errors: `es` one row per real point, or one row for all
+    /// (`broadcast`); `out` six values per real point.
+    fn error_block(
+        &self,
+        qs: &[f64],
+        p: &[f64],
+        es: &[f64],
+        broadcast: bool,
+        out: &mut [f64],
+        regs: &mut Vec<Lanes>,
+    ) {
+        let n = self.errors.len();
+        self.run_block(qs, p, regs);
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for &(idx, start, end) in &self.sensitivity {
+            let acc = self.dot_lanes(regs, start, end);
+            let (c, j) = (idx as usize / n, idx as usize % n);
+            for (l, (o, a)) in out.chunks_exact_mut(6).zip(acc).enumerate() {
+                let e = if broadcast { j } else { l * n + j };
+                o[c] += a * es.get(e).copied().unwrap_or(0.0);
             }
         }
     }
@@ -292,6 +401,49 @@ impl ErrorModel for CompiledModel {
                 }
             }
         });
+    }
+
+    fn sensitivity_points(&self, qs: &[f64], p: &[f64], out: &mut [f64]) -> Result<(), BatchError> {
+        let (nv, width) = self.check_sensitivity(qs, out)?;
+        if width == 0 {
+            return Ok(());
+        }
+        with_block_registers(|regs| {
+            for (qb, ob) in qs
+                .chunks(nv * BATCH_LANES)
+                .zip(out.chunks_mut(width * BATCH_LANES))
+            {
+                self.sensitivity_block(qb, p, ob, regs);
+            }
+        });
+        Ok(())
+    }
+
+    fn error_points(
+        &self,
+        qs: &[f64],
+        p: &[f64],
+        es: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), BatchError> {
+        let (nv, broadcast) = self.check_error(qs, es, out)?;
+        let n = self.errors.len();
+        with_block_registers(|regs| {
+            for (b, (qb, ob)) in qs
+                .chunks(nv * BATCH_LANES)
+                .zip(out.chunks_mut(6 * BATCH_LANES))
+                .enumerate()
+            {
+                let eb = if broadcast {
+                    es
+                } else {
+                    let start = b * BATCH_LANES * n;
+                    &es[start..start + ob.len() / 6 * n]
+                };
+                self.error_block(qb, p, eb, broadcast, ob, regs);
+            }
+        });
+        Ok(())
     }
 
     fn nominal(&self, q: &[f64], p: &[f64]) -> Pose {
