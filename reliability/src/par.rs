@@ -89,6 +89,22 @@ pub(crate) fn threads() -> usize {
     }
 }
 
+/// Runs `f` on a worker of the thread pool while the calling thread waits
+/// (`rayon::scope`), so that the parallel loops inside `f` fork and join
+/// within the pool: from a thread outside it every loop would be injected
+/// and waited for anew (a wake-up per loop; subset simulation has about 70
+/// per run). Without the `parallel` feature, `f()`.
+pub(crate) fn in_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    #[cfg(feature = "parallel")]
+    {
+        rayon::scope(|_| f())
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        f()
+    }
+}
+
 #[cfg(all(test, not(feature = "parallel")))]
 mod tests {
     use super::prelude::*;

@@ -243,10 +243,13 @@ impl SubsetSimulation {
                 Some(target) => self.until_cov(&std, case_id, nc, ns, target, progress),
             }
         };
-        if events.len() == 1 {
-            return Ok(vec![case(0)]);
-        }
-        Ok((0..events.len()).into_par_iter().map(case).collect())
+        Ok(crate::par::in_pool(|| {
+            if events.len() == 1 {
+                vec![case(0)]
+            } else {
+                (0..events.len()).into_par_iter().map(case).collect()
+            }
+        }))
     }
 
     /// Independent runs until the target CoV or the budget; runs go in
