@@ -152,6 +152,7 @@ pub(crate) fn read_measurements(path: &Path) -> Result<Measurements, CompensateE
 fn records_error(e: RecordsError) -> CompensateError {
     match e {
         RecordsError::Io { name, source } => CompensateError::Io { file: name, source },
+        RecordsError::TooLarge { name, limit } => CompensateError::TooLarge { file: name, limit },
         RecordsError::Malformed {
             name,
             line,

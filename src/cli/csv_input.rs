@@ -7,6 +7,31 @@ use std::io::Read;
 use std::path::Path;
 
 use chain::compensate::RawRecord;
+use chain_core::bounded;
+
+/// The bytes of an input file (`-`: stdin) and its display name, at most
+/// `limit` of them (`chain_core::bounded`): a larger input is refused with
+/// its name and the limit.
+pub(crate) fn read_input(path: &Path, limit: usize) -> miette::Result<(String, Vec<u8>)> {
+    let (name, read) = if path.as_os_str() == "-" {
+        (
+            "<stdin>".to_string(),
+            bounded::read_from(std::io::stdin().lock(), limit),
+        )
+    } else {
+        (path.display().to_string(), bounded::read_path(path, limit))
+    };
+    match read {
+        Ok(bytes) => Ok((name, bytes)),
+        Err(e @ bounded::ReadError::TooLarge { .. }) => {
+            Err(miette::miette!(code = "chain::too_large", "{name}: {e}"))
+        }
+        Err(e) => Err(miette::miette!(
+            code = "chain::io",
+            "cannot read {name}: {e}"
+        )),
+    }
+}
 
 /// An open CSV: display name, reader and trimmed header.
 pub(crate) struct CsvInput {
@@ -17,13 +42,8 @@ pub(crate) struct CsvInput {
 
 /// Opens a CSV file (`-`: stdin) and reads its header.
 pub(crate) fn open_csv(path: &Path) -> miette::Result<CsvInput> {
-    let (name, source): (String, Box<dyn Read>) = if path.as_os_str() == "-" {
-        ("<stdin>".into(), Box::new(std::io::stdin()))
-    } else {
-        let file = std::fs::File::open(path)
-            .map_err(|e| miette::miette!("cannot read {}: {e}", path.display()))?;
-        (path.display().to_string(), Box::new(file))
-    };
+    let (name, bytes) = read_input(path, bounded::PATH_BYTES)?;
+    let source: Box<dyn Read> = Box::new(std::io::Cursor::new(bytes));
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_reader(source);
@@ -191,6 +211,13 @@ pub(crate) enum RecordsError {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// The file is larger than its bound (`chain_core::bounded`).
+    TooLarge {
+        /// The file as named.
+        name: String,
+        /// The bound in bytes.
+        limit: usize,
+    },
     /// A line is not well-formed CSV (bad UTF-8).
     Malformed {
         /// The file as named.
@@ -210,9 +237,15 @@ pub(crate) enum RecordsError {
 /// measurements with it.
 pub(crate) fn read_records(path: &Path) -> Result<Vec<RawRecord>, RecordsError> {
     let name = path.display().to_string();
-    let data = std::fs::read(path).map_err(|source| RecordsError::Io {
-        name: name.clone(),
-        source,
+    let data = bounded::read_path(path, bounded::COMPENSATE_BYTES).map_err(|e| match e {
+        bounded::ReadError::Io(source) => RecordsError::Io {
+            name: name.clone(),
+            source,
+        },
+        bounded::ReadError::TooLarge { limit } => RecordsError::TooLarge {
+            name: name.clone(),
+            limit,
+        },
     })?;
     parse_records(&name, &data)
 }

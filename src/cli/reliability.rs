@@ -312,7 +312,11 @@ impl Loaded {
     /// Loads and validates a machine file.
     pub(crate) fn new(path: &Path) -> miette::Result<Loaded> {
         let machine = chain_core::load_file(path)?;
-        let source = std::fs::read_to_string(path).unwrap_or_default();
+        // Read again for the messages' snippets, within the loader's bound.
+        let source = chain_core::bounded::read_path(path, chain_core::bounded::MACHINE_BYTES)
+            .ok()
+            .and_then(|b| String::from_utf8(b).ok())
+            .unwrap_or_default();
         let file = machine
             .file
             .clone()

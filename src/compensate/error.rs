@@ -24,6 +24,16 @@ pub enum CompensateError {
         #[source]
         source: std::io::Error,
     },
+    /// The file is larger than the bound of its kind
+    /// (`chain_core::bounded::COMPENSATE_BYTES`).
+    #[error("{file}: the file is too large (more than {})", chain_core::bounded::describe(*limit))]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::too_large)))]
+    TooLarge {
+        /// The file.
+        file: String,
+        /// The bound in bytes.
+        limit: usize,
+    },
     /// The file has no header line.
     #[error("{file}, line 1: the file is empty; expected a header `theta_deg,z1,z3` (optionally with `z2`)")]
     #[cfg_attr(feature = "cli", diagnostic(code(chain::compensate::empty)))]

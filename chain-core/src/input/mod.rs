@@ -5,6 +5,7 @@
 //! files of `chain motion` ([`settings`]) and the values files of a built
 //! machine ([`values`]).
 
+pub mod bounded;
 pub mod diagnostic;
 pub mod expr;
 pub mod inline;

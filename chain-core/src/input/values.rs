@@ -74,7 +74,7 @@ pub const INTERPOLATIONS: &[&str] = &["linear", "cubic"];
 pub const EXTRAPOLATIONS: &[&str] = &["error", "hold"];
 
 /// Values files larger than this are refused.
-pub const MAX_VALUES_BYTES: usize = 16 * 1024 * 1024;
+pub const MAX_VALUES_BYTES: usize = crate::bounded::VALUES_BYTES;
 
 // ---------------------------------------------------------------------------
 // Units

@@ -44,7 +44,7 @@ pub const STD_COLUMN: &str = "std";
 /// written with five or more digits pass.
 pub const UNIT_TOLERANCE: f64 = 1e-4;
 /// Measurement CSV files larger than this are refused.
-pub const MAX_MEASUREMENT_BYTES: usize = 256 * 1024 * 1024;
+pub const MAX_MEASUREMENT_BYTES: usize = crate::bounded::MEASUREMENT_BYTES;
 
 /// What a CSV must hold besides the poses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

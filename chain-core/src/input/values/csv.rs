@@ -14,7 +14,7 @@ use crate::diagnostic::{Diagnostics, Message, Problem};
 use crate::model::Origin;
 
 /// CSV tables larger than this are refused.
-pub const MAX_TABLE_BYTES: usize = 64 * 1024 * 1024;
+pub const MAX_TABLE_BYTES: usize = crate::bounded::TABLE_BYTES;
 
 /// One CSV file, read once however many entries use it.
 #[derive(Debug, Clone)]
