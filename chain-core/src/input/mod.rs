@@ -12,5 +12,6 @@ pub mod inline;
 pub mod load;
 pub mod model;
 pub mod settings;
+pub mod tabular;
 pub mod values;
 pub mod yaml;
