@@ -556,7 +556,7 @@ fn bad_input_is_refused_with_its_location() {
         &["bad.csv:2:", "standard deviation must be positive"],
     );
     refused("", &["bad.csv:1:", "empty"]);
-    refused("x,y,z,dpx,dpy,dpz\n", &["bad.csv:1:", "no measurement row"]);
+    refused("x,y,z,dpx,dpy,dpz\n", &["bad.csv:1:", "no data row"]);
     refused(
         "x,y,z,dpx,dpy,dpz\n0,0,600,0,0,0\n1,2,3\n",
         &["bad.csv:3:", "has 3 fields but the header has 6 columns"],

@@ -570,7 +570,7 @@ fn cli_bad_input_is_located() {
         "header.csv",
         "x,y,z\n",
         "1",
-        &["header.csv:1:", "no candidate pose row"],
+        &["header.csv:1:", "no data row"],
     );
     bad(
         "wide.csv",
