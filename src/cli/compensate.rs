@@ -118,8 +118,10 @@ pub fn exec(args: CompensateArgs) -> miette::Result<()> {
             file: out.display().to_string(),
             source,
         };
-        let file = std::fs::File::create(out).map_err(write_error)?;
-        compensate::write_table_csv(&rows, std::io::BufWriter::new(file)).map_err(write_error)?;
+        super::atomic::write_with(out, |file| {
+            compensate::write_table_csv(&rows, std::io::BufWriter::new(file))
+        })
+        .map_err(write_error)?;
         files.push(out.clone());
         table_rows = Some(rows.len());
     } else if args.grid.is_some() {
