@@ -192,8 +192,11 @@ pub enum CompensateError {
         /// Distinct angles present.
         got: usize,
     },
-    /// `--length` is not a positive finite number.
-    #[error("--length must be a positive finite number of millimetres, got {length}")]
+    /// `--length` is not a positive number of at most
+    /// [`MAX_LENGTH_MM`](super::analysis::MAX_LENGTH_MM).
+    #[error(
+        "--length must be a positive number of millimetres of at most 1e6 (1 km), got {length}"
+    )]
     #[cfg_attr(feature = "cli", diagnostic(code(chain::compensate::invalid_length)))]
     InvalidLength {
         /// The value given.
