@@ -493,7 +493,7 @@ fn cli_errors() {
     // An unknown variable in --at, with a hint.
     run(
         &["--at", "x1=-100,x3=0,z=40"],
-        &["unknown axis variable `x3`", "x1"],
+        &["--at: `x3` is not an axis variable", "x1"],
     );
     // A missing one.
     run(

@@ -541,11 +541,11 @@ fn bad_input_is_refused_with_its_location() {
     );
     refused(
         "x,y,z,dpx,dpy,dpz\n0,0,600,0,0,0\n10,0,600,NaN,0,0\n",
-        &["bad.csv:3:", "`NaN` (column `dpx`) is not finite"],
+        &["bad.csv:3:", "column `dpx`: `NaN` is not finite"],
     );
     refused(
         "x,y,z,dpx,dpy,dpz\n0,0,600,0,0,0\n10,0,inf,0,0,0\n",
-        &["bad.csv:3:", "(column `z`) is not finite"],
+        &["bad.csv:3:", "is not finite"],
     );
     refused(
         "x,y,z,dpx,dpy,dpz,std\n0,0,600,0,0,0,0.001\n1,0,600,0,0,0,0\n",
@@ -556,7 +556,7 @@ fn bad_input_is_refused_with_its_location() {
         &["bad.csv:2:", "standard deviation must be positive"],
     );
     refused("", &["bad.csv:1:", "empty"]);
-    refused("x,y,z,dpx,dpy,dpz\n", &["bad.csv:1:", "no measurement row"]);
+    refused("x,y,z,dpx,dpy,dpz\n", &["bad.csv:1:", "no data row"]);
     refused(
         "x,y,z,dpx,dpy,dpz\n0,0,600,0,0,0\n1,2,3\n",
         &["bad.csv:3:", "has 3 fields but the header has 6 columns"],
@@ -571,7 +571,7 @@ fn bad_input_is_refused_with_its_location() {
     );
     refused(
         "x,y,z,dpx,dpy,dpz\n0,0,600,abc,0,0\n",
-        &["bad.csv:2:", "`abc` (column `dpx`) is not a number"],
+        &["bad.csv:2:", "column `dpx`: `abc` is not a number"],
     );
     let err = fails(&[
         "identify",

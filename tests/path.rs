@@ -613,7 +613,7 @@ fn bad_input_is_a_clear_error_naming_file_and_line() {
         &on_axes,
         "header_only.csv",
         "x,y,z\n",
-        &["header_only.csv", "no data row"],
+        &["header_only.csv:1:", "chain::csv::no_data"],
     );
     rejects(&on_axes, "empty.csv", "", &["empty.csv:1:"]);
 

@@ -557,20 +557,20 @@ fn cli_bad_input_is_located() {
         "nan.csv",
         "x,y,z\n0,0,600\n1,NaN,600\n",
         "1",
-        &["nan.csv:3:", "`NaN` (column `y`) is not finite"],
+        &["nan.csv:3:", "column `y`: `NaN` is not finite"],
     );
     bad(
         "inf.csv",
         "x,y,z\n0,0,inf\n",
         "1",
-        &["inf.csv:2:", "`inf` (column `z`) is not finite"],
+        &["inf.csv:2:", "column `z`: `inf` is not finite"],
     );
     bad("empty.csv", "", "1", &["empty.csv:1:", "empty"]);
     bad(
         "header.csv",
         "x,y,z\n",
         "1",
-        &["header.csv:1:", "no candidate pose row"],
+        &["header.csv:1:", "no data row"],
     );
     bad(
         "wide.csv",
@@ -589,7 +589,7 @@ fn cli_bad_input_is_located() {
         "word.csv",
         "x,y,z\n0,zero,600\n",
         "1",
-        &["word.csv:2:", "`zero` (column `y`) is not a number"],
+        &["word.csv:2:", "column `y`: `zero` is not a number"],
     );
     bad(
         "measured.csv",

@@ -389,7 +389,10 @@ fn bad_input_is_refused_with_its_location() {
     let file = gantry_file();
     let f = file.to_str().unwrap();
     let cases: [(&[&str], &str); 7] = [
-        (&["--at", "x=0,y=0,w=1"], "unknown axis variable `w`"),
+        (
+            &["--at", "x=0,y=0,w=1"],
+            "--at: `w` is not an axis variable",
+        ),
         (
             &["--at", "x=0,y=0"],
             "--at has no value for axis variable `z`",

@@ -769,31 +769,10 @@ fn csv_tables_are_located_by_file_and_line() {
     // A cell that is not a number, one that is not finite, an empty one.
     let csv = "# measured\nx,Ex\n0,0\n1,abc\n2,inf\n3,\n";
     let (err, dir) = refused("csv_number", &values("{table: t.csv}"), &[("t.csv", csv)]);
-    located(
-        &err,
-        &dir,
-        "t.csv",
-        "4:3",
-        "Ex",
-        "chain::values::csv_number",
-    );
-    located(
-        &err,
-        &dir,
-        "t.csv",
-        "5:3",
-        "Ex",
-        "chain::values::not_finite",
-    );
-    located(
-        &err,
-        &dir,
-        "t.csv",
-        "6:3",
-        "Ex",
-        "chain::values::csv_number",
-    );
-    assert!(err.contains("`abc` (column `Ex`) is not a number"), "{err}");
+    located(&err, &dir, "t.csv", "4:3", "Ex", "chain::csv::not_a_number");
+    located(&err, &dir, "t.csv", "5:3", "Ex", "chain::csv::not_finite");
+    located(&err, &dir, "t.csv", "6:3", "Ex", "chain::csv::empty_cell");
+    assert!(err.contains("column `Ex`: `abc` is not a number"), "{err}");
     // Unsorted and repeated positions: at the CSV line.
     let (err, dir) = refused(
         "csv_sorted",
@@ -841,7 +820,7 @@ fn csv_tables_are_located_by_file_and_line() {
         &values("{table: t.csv}"),
         &[("t.csv", "x,Ex\n0,0\n1\n")],
     );
-    located(&err, &dir, "t.csv", "3:1", "", "chain::values::csv_row");
+    located(&err, &dir, "t.csv", "3:1", "", "chain::csv::ragged");
     let (err, dir) = refused(
         "csv_header",
         &values("{table: t.csv}"),

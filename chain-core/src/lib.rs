@@ -23,7 +23,7 @@ pub mod symbolic;
 
 // The stages' modules under their historical flat paths (`chain_core::load`,
 // `chain_core::inverse`, ...), which downstream code and the docs use.
-pub use input::{diagnostic, expr, inline, load, model, settings, values, yaml};
+pub use input::{bounded, diagnostic, expr, inline, load, model, settings, tabular, values, yaml};
 pub use kinematics::{conversion, geometry, inverse, jet, motion};
 pub use symbolic::{algebra, derive, dmm, emit, eval, expand, export, geometric};
 

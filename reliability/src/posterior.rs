@@ -121,19 +121,22 @@ impl Posterior {
         let values = Values::read(path, machine).map_err(PosteriorError::Values)?;
         let file = path.display().to_string();
         // `Values::read` has read and decoded it: it exists and is UTF-8.
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            let m = Message::new(
-                format!("cannot read `{file}`: {e}"),
-                "unreadable",
-                "chain::posterior::read",
-            );
-            PosteriorError::File(Diagnostics::single(
-                file.clone(),
-                "",
-                origin_at(0, ""),
-                m.into(),
-            ))
-        })?;
+        let text = chain_core::bounded::read_path(path, chain_core::bounded::VALUES_BYTES)
+            .map_err(|e| e.to_string())
+            .and_then(|b| String::from_utf8(b).map_err(|e| e.to_string()))
+            .map_err(|e| {
+                let m = Message::new(
+                    format!("cannot read `{file}`: {e}"),
+                    "unreadable",
+                    "chain::posterior::read",
+                );
+                PosteriorError::File(Diagnostics::single(
+                    file.clone(),
+                    "",
+                    origin_at(0, ""),
+                    m.into(),
+                ))
+            })?;
         Posterior::from_values(&values, &text, &file, machine)
     }
 

@@ -118,8 +118,10 @@ pub fn exec(args: CompensateArgs) -> miette::Result<()> {
             file: out.display().to_string(),
             source,
         };
-        let file = std::fs::File::create(out).map_err(write_error)?;
-        compensate::write_table_csv(&rows, std::io::BufWriter::new(file)).map_err(write_error)?;
+        super::atomic::write_with(out, |file| {
+            compensate::write_table_csv(&rows, std::io::BufWriter::new(file))
+        })
+        .map_err(write_error)?;
         files.push(out.clone());
         table_rows = Some(rows.len());
     } else if args.grid.is_some() {
@@ -152,6 +154,7 @@ pub(crate) fn read_measurements(path: &Path) -> Result<Measurements, CompensateE
 fn records_error(e: RecordsError) -> CompensateError {
     match e {
         RecordsError::Io { name, source } => CompensateError::Io { file: name, source },
+        RecordsError::TooLarge { name, limit } => CompensateError::TooLarge { file: name, limit },
         RecordsError::Malformed {
             name,
             line,
@@ -339,18 +342,18 @@ mod tests {
         );
         assert!(
             e.to_string()
-                .starts_with("bad.csv, line 2: the line is not valid UTF-8"),
+                .starts_with("bad.csv:2: the line is not valid UTF-8"),
             "{e}"
         );
         let e = parse("empty.csv", b"# only a comment\n\n").unwrap_err();
         assert_eq!(
             e.to_string(),
-            "empty.csv, line 1: the file is empty; expected a header `theta_deg,z1,z3` (optionally with `z2`)"
+            "empty.csv:1: the file is empty; expected a header line `theta_deg,z1,z3` (optionally with `z2`)"
         );
         let e = parse("short.csv", b"theta_deg,z1,z3\n1,0,-0.1\n2,0\n").unwrap_err();
         assert_eq!(
             e.to_string(),
-            "short.csv, line 3: expected 3 fields as in the header (line 1), found 2"
+            "short.csv:3: this row has 2 fields but the header has 3 columns"
         );
         let e = read_measurements(Path::new("/nonexistent/swing.csv")).unwrap_err();
         assert!(matches!(e, CompensateError::Io { .. }), "{e}");

@@ -3,87 +3,105 @@
 //! numbers; `chain compensate`: every record with its line, for the library
 //! to check); every error names the file, the line and the column.
 
-use std::io::Read;
 use std::path::Path;
 
 use chain::compensate::RawRecord;
+use chain_core::bounded;
+use chain_core::tabular::{self, CsvProblem};
+use chain_core::values::csv::CsvFile;
 
-/// An open CSV: display name, reader and trimmed header.
+/// The bytes of an input file (`-`: stdin) and its display name, at most
+/// `limit` of them (`chain_core::bounded`): a larger input is refused with
+/// its name and the limit.
+pub(crate) fn read_input(path: &Path, limit: usize) -> miette::Result<(String, Vec<u8>)> {
+    let (name, read) = if path.as_os_str() == "-" {
+        (
+            "<stdin>".to_string(),
+            bounded::read_from(std::io::stdin().lock(), limit),
+        )
+    } else {
+        (path.display().to_string(), bounded::read_path(path, limit))
+    };
+    match read {
+        Ok(bytes) => Ok((name, bytes)),
+        Err(e @ bounded::ReadError::TooLarge { .. }) => {
+            Err(miette::miette!(code = "chain::too_large", "{name}: {e}"))
+        }
+        Err(e) => Err(miette::miette!(
+            code = "chain::io",
+            "cannot read {name}: {e}"
+        )),
+    }
+}
+
+/// An open CSV: display name, its located cells and trimmed header.
 pub(crate) struct CsvInput {
     pub(crate) name: String,
-    pub(crate) reader: csv::Reader<Box<dyn Read>>,
+    pub(crate) table: CsvFile,
     pub(crate) header: Vec<String>,
 }
 
-/// Opens a CSV file (`-`: stdin) and reads its header.
+/// A refusal located at `name:line` in the shared wording, with its code.
+fn refusal(name: &str, line: usize, problem: &CsvProblem) -> miette::Report {
+    miette::MietteDiagnostic::new(problem.at(name, line as u64))
+        .with_code(problem.code())
+        .into()
+}
+
+/// Opens a CSV file (`-`: stdin; at most [`bounded::PATH_BYTES`]) and reads
+/// its header and rows through the one CSV reader
+/// (`chain_core::values::csv::CsvFile`): a leading byte-order mark is
+/// dropped, `#` lines and blank lines skipped, a header-only file and a
+/// ragged row refused as `file:line: …`.
 pub(crate) fn open_csv(path: &Path) -> miette::Result<CsvInput> {
-    let (name, source): (String, Box<dyn Read>) = if path.as_os_str() == "-" {
-        ("<stdin>".into(), Box::new(std::io::stdin()))
-    } else {
-        let file = std::fs::File::open(path)
-            .map_err(|e| miette::miette!("cannot read {}: {e}", path.display()))?;
-        (path.display().to_string(), Box::new(file))
-    };
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(source);
-    let header: Vec<String> = reader
-        .headers()
-        .map_err(|e| miette::miette!("{name}:1: {e}"))?
-        .iter()
-        .map(str::to_string)
-        .collect();
-    if header.iter().all(String::is_empty) {
-        miette::bail!("{name}:1: the file is empty; expected a header line");
-    }
-    if let Some(dup) = header
-        .iter()
-        .enumerate()
-        .find(|(k, h)| header[..*k].contains(h))
-        .map(|(_, h)| h)
-    {
-        miette::bail!("{name}:1: column `{dup}` appears twice in the header");
-    }
+    let (name, bytes) = read_input(path, bounded::PATH_BYTES)?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let line = 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count();
+        miette::MietteDiagnostic::new(format!("{name}:{line}: the line is not valid UTF-8"))
+            .with_code("chain::csv::malformed")
+    })?;
+    let table = CsvFile::parse_with(&text, &name, "the header names the columns, e.g. `t,x,y,z`")
+        .map_err(|d| {
+        let first = d.first();
+        miette::Report::from(
+            miette::MietteDiagnostic::new(format!(
+                "{name}:{}: {}",
+                first.origin.line,
+                first.problem.headline()
+            ))
+            .with_code(first.problem.code()),
+        )
+    })?;
+    let header = table.header.iter().map(|(h, _)| h.clone()).collect();
     Ok(CsvInput {
         name,
-        reader,
+        table,
         header,
     })
 }
 
-/// Reads every data row as finite numbers: `(line, values)`. Errors name the
-/// file, the line and the column.
+/// Reads every data row as finite numbers: `(line, values)`. Errors are
+/// `file:line: column `name`: …` ([`CsvProblem`]).
 pub(crate) fn numeric_rows(input: &mut CsvInput) -> miette::Result<Vec<(usize, Vec<f64>)>> {
     let name = &input.name;
-    let mut out = Vec::new();
-    for rec in input.reader.records() {
-        let rec = rec.map_err(|e| {
-            let line = e.position().map_or(0, |p| p.line());
-            miette::miette!("{name}:{line}: {e}")
-        })?;
-        let line = rec.position().map_or(0, |p| p.line() as usize);
-        let values = rec
-            .iter()
-            .zip(&input.header)
-            .map(|(field, column)| {
-                let x: f64 = field.parse().map_err(|_| {
-                    miette::miette!("{name}:{line}: `{field}` (column `{column}`) is not a number")
-                })?;
-                if x.is_finite() {
-                    Ok(x)
-                } else {
-                    Err(miette::miette!(
-                        "{name}:{line}: `{field}` (column `{column}`) is not finite"
-                    ))
-                }
-            })
-            .collect::<miette::Result<Vec<f64>>>()?;
-        out.push((line, values));
-    }
-    if out.is_empty() {
-        miette::bail!("{name}: no data row (only a header)");
-    }
-    Ok(out)
+    input
+        .table
+        .rows
+        .iter()
+        .map(|row| {
+            let line = row.first().map_or(0, |(_, o)| o.line);
+            let values = row
+                .iter()
+                .map(|(text, origin)| {
+                    tabular::number(text, &origin.key).map_err(|p| refusal(name, line, &p))
+                })
+                .collect::<miette::Result<Vec<f64>>>()?;
+            Ok((line, values))
+        })
+        .collect()
 }
 
 /// The orientation part of a pose row.
@@ -191,6 +209,13 @@ pub(crate) enum RecordsError {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// The file is larger than its bound (`chain_core::bounded`).
+    TooLarge {
+        /// The file as named.
+        name: String,
+        /// The bound in bytes.
+        limit: usize,
+    },
     /// A line is not well-formed CSV (bad UTF-8).
     Malformed {
         /// The file as named.
@@ -210,9 +235,15 @@ pub(crate) enum RecordsError {
 /// measurements with it.
 pub(crate) fn read_records(path: &Path) -> Result<Vec<RawRecord>, RecordsError> {
     let name = path.display().to_string();
-    let data = std::fs::read(path).map_err(|source| RecordsError::Io {
-        name: name.clone(),
-        source,
+    let data = bounded::read_path(path, bounded::COMPENSATE_BYTES).map_err(|e| match e {
+        bounded::ReadError::Io(source) => RecordsError::Io {
+            name: name.clone(),
+            source,
+        },
+        bounded::ReadError::TooLarge { limit } => RecordsError::TooLarge {
+            name: name.clone(),
+            limit,
+        },
     })?;
     parse_records(&name, &data)
 }

@@ -357,7 +357,7 @@ fn write_files(dir: &std::path::Path, files: &[ExportedFile]) -> miette::Result<
         .map_err(|e| miette::miette!("cannot create {}: {e}", dir.display()))?;
     for f in files {
         let path = dir.join(&f.name);
-        std::fs::write(&path, &f.text)
+        super::atomic::write(&path, f.text.as_bytes())
             .map_err(|e| miette::miette!("cannot write {}: {e}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }

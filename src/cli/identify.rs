@@ -75,7 +75,7 @@ pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
     if let Some(path) = &args.values_out {
         let source = args.measurements.display().to_string();
         let text = values_file(m, &source, &result);
-        std::fs::write(path, text)
+        super::atomic::write(path, text.as_bytes())
             .map_err(|e| miette::miette!("cannot write {}: {e}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }

@@ -443,11 +443,25 @@ fn write_both(
     let png = dir.join(format!("{stem}.png"));
     let svg = dir.join(format!("{stem}.svg"));
     let fail = |p: &Path, e: String| miette::miette!("{}: cannot draw the chart: {e}", p.display());
-    draw(Area::Bitmap(
-        BitMapBackend::new(&png, size).into_drawing_area(),
-    ))
-    .map_err(|e| fail(&png, e))?;
-    draw(Area::Svg(SVGBackend::new(&svg, size).into_drawing_area())).map_err(|e| fail(&svg, e))?;
+    let io = |p: String| move |e: std::io::Error| miette::miette!("cannot write {p}: {e}");
+    crate::cli::atomic::write_via(
+        &png,
+        |tmp| {
+            draw(Area::Bitmap(
+                BitMapBackend::new(tmp, size).into_drawing_area(),
+            ))
+            .map_err(|e| fail(&png, e))
+        },
+        io(png.display().to_string()),
+    )?;
+    crate::cli::atomic::write_via(
+        &svg,
+        |tmp| {
+            draw(Area::Svg(SVGBackend::new(tmp, size).into_drawing_area()))
+                .map_err(|e| fail(&svg, e))
+        },
+        io(svg.display().to_string()),
+    )?;
     Ok(vec![png, svg])
 }
 

@@ -4,6 +4,7 @@
 mod acceptance;
 pub mod allocate;
 mod args;
+mod atomic;
 pub mod compensate;
 mod csv_input;
 pub mod derive;

@@ -73,9 +73,10 @@ pub fn exec(args: PlanArgs) -> miette::Result<()> {
     args.param.check_names(m)?;
     let name = display(&args.candidates);
     let candidates = if args.candidates.as_os_str() == "-" {
-        let mut text = String::new();
-        std::io::Read::read_to_string(&mut std::io::stdin(), &mut text)
-            .map_err(|e| miette::miette!("cannot read {name}: {e}"))?;
+        let (_, bytes) =
+            super::csv_input::read_input(&args.candidates, chain_core::bounded::MEASUREMENT_BYTES)?;
+        let text = String::from_utf8(bytes)
+            .map_err(|e| miette::miette!(code = "chain::utf8", "{name}: not UTF-8 text ({e})"))?;
         Measurements::parse(&text, &name, m, &args.param.params, Layout::Candidates)?
     } else {
         Measurements::read(&args.candidates, m, &args.param.params, Layout::Candidates)?

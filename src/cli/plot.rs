@@ -255,30 +255,46 @@ impl XyChart {
         Ok(vec![png, svg])
     }
 
-    /// Draws the chart into a PNG file.
+    /// Draws the chart into a PNG file (written atomically).
     pub fn write_png(&self, path: &Path) -> Result<(), PlotError> {
-        self.write_file(path, BitMapBackend::new)
-    }
-
-    /// Draws the chart into an SVG file.
-    pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
-        self.write_file(path, SVGBackend::new)
-    }
-
-    /// Draws the chart into `path` through the backend `backend` opens there
-    /// (once the ranges are known).
-    fn write_file<'a, DB: DrawingBackend>(
-        &self,
-        path: &'a Path,
-        backend: impl FnOnce(&'a Path, (u32, u32)) -> DB,
-    ) -> Result<(), PlotError> {
         let ranges = self.ranges()?;
-        ensure_fonts();
-        let root = backend(path, self.size).into_drawing_area();
-        self.draw(root, ranges).map_err(|message| PlotError::Draw {
-            path: path.display().to_string(),
-            message,
+        self.write_file(path, |tmp| {
+            self.draw(
+                BitMapBackend::new(tmp, self.size).into_drawing_area(),
+                ranges,
+            )
         })
+    }
+
+    /// Draws the chart into an SVG file (written atomically).
+    pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
+        let ranges = self.ranges()?;
+        self.write_file(path, |tmp| {
+            self.draw(SVGBackend::new(tmp, self.size).into_drawing_area(), ranges)
+        })
+    }
+
+    /// Draws the chart through `draw` into a temporary file beside `path`,
+    /// then renames it into place (`cli/atomic.rs`).
+    fn write_file(
+        &self,
+        path: &Path,
+        draw: impl FnOnce(&Path) -> Result<(), String>,
+    ) -> Result<(), PlotError> {
+        ensure_fonts();
+        super::atomic::write_via(
+            path,
+            |tmp| {
+                draw(tmp).map_err(|message| PlotError::Draw {
+                    path: path.display().to_string(),
+                    message,
+                })
+            },
+            |source| PlotError::Io {
+                path: path.display().to_string(),
+                source,
+            },
+        )
     }
 
     /// Axis ranges: the explicit ones, or the finite data padded by 3 % (x)
@@ -518,10 +534,28 @@ impl BarChart {
             path: path.display().to_string(),
             message,
         };
-        self.draw(BitMapBackend::new(&png, self.size).into_drawing_area())
-            .map_err(|m| fail(&png, m))?;
-        self.draw(SVGBackend::new(&svg, self.size).into_drawing_area())
-            .map_err(|m| fail(&svg, m))?;
+        let io = |path: String| {
+            move |source| PlotError::Io {
+                path: path.clone(),
+                source,
+            }
+        };
+        super::atomic::write_via(
+            &png,
+            |tmp| {
+                self.draw(BitMapBackend::new(tmp, self.size).into_drawing_area())
+                    .map_err(|m| fail(&png, m))
+            },
+            io(png.display().to_string()),
+        )?;
+        super::atomic::write_via(
+            &svg,
+            |tmp| {
+                self.draw(SVGBackend::new(tmp, self.size).into_drawing_area())
+                    .map_err(|m| fail(&svg, m))
+            },
+            io(svg.display().to_string()),
+        )?;
         Ok(vec![png, svg])
     }
 

@@ -312,7 +312,11 @@ impl Loaded {
     /// Loads and validates a machine file.
     pub(crate) fn new(path: &Path) -> miette::Result<Loaded> {
         let machine = chain_core::load_file(path)?;
-        let source = std::fs::read_to_string(path).unwrap_or_default();
+        // Read again for the messages' snippets, within the loader's bound.
+        let source = chain_core::bounded::read_path(path, chain_core::bounded::MACHINE_BYTES)
+            .ok()
+            .and_then(|b| String::from_utf8(b).ok())
+            .unwrap_or_default();
         let file = machine
             .file
             .clone()
@@ -392,6 +396,11 @@ impl Loaded {
 
     /// A located, rendered diagnostic for a reliability error (worded by
     /// [`reliability::document::describe`]).
+    /// The machine file's name as messages give it.
+    pub(crate) fn file_name(&self) -> &str {
+        &self.file
+    }
+
     pub(crate) fn report(&self, err: ReliabilityError) -> miette::Report {
         let d = reliability::document::describe(&err, &self.file);
         let mut diag = MietteDiagnostic::new(d.message);
@@ -590,10 +599,10 @@ impl Report for ReliabilityDoc<'_> {
         for c in &r.cases {
             let mut row = vec![c.target.to_string()];
             row.extend(ax.iter().map(|(_, i)| fmt_num(c.point[*i])));
-            row.extend([c.reliability, c.pf, c.beta].map(|v| format!("{v:?}")));
+            row.extend([c.reliability, c.pf, c.beta].map(csv_number));
             if sampled && self.acceptance.is_some() {
-                row.push(c.std_error.map_or(String::new(), |v| format!("{v:?}")));
-                row.push(c.cov.map_or(String::new(), |v| format!("{v:?}")));
+                row.push(c.std_error.map_or(String::new(), csv_number));
+                row.push(c.cov.map_or(String::new(), csv_number));
                 row.push(c.samples.map_or(String::new(), |v| v.to_string()));
             } else if sampled {
                 row.push(format!("{:?}", c.std_error.unwrap_or(0.0)));
@@ -633,7 +642,7 @@ impl Report for ReliabilityDoc<'_> {
                                 so.beta_hohenbichler_rackwitz,
                                 so.beta_tvedt,
                             ]
-                            .map(|v| format!("{v:?}")),
+                            .map(csv_number),
                         );
                         row.push(so.converged.to_string());
                     }
@@ -1081,4 +1090,15 @@ pub(crate) fn resolve_fixed(
         }
     }
     Ok(out)
+}
+
+/// A CSV cell of a number: shortest round-trip form when finite, an empty
+/// cell otherwise, as the JSON writes `null` (a sampled `pf` of exactly 1
+/// has `beta = −∞`; `docs/robustness.md`).
+fn csv_number(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:?}")
+    } else {
+        String::new()
+    }
 }

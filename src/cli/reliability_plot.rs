@@ -132,14 +132,23 @@ fn write_both(
     let png = dir.join(format!("{stem}.png"));
     let svg = dir.join(format!("{stem}.svg"));
     let fail = |p: &Path, e: String| miette::miette!("{}: cannot draw the chart: {e}", p.display());
-    {
-        let root = BitMapBackend::new(&png, size).into_drawing_area();
-        draw(Area::Bitmap(root)).map_err(|e| fail(&png, e))?;
-    }
-    {
-        let root = SVGBackend::new(&svg, size).into_drawing_area();
-        draw(Area::Svg(root)).map_err(|e| fail(&svg, e))?;
-    }
+    let io = |p: String| move |e: std::io::Error| miette::miette!("cannot write {p}: {e}");
+    crate::cli::atomic::write_via(
+        &png,
+        |tmp| {
+            let root = BitMapBackend::new(tmp, size).into_drawing_area();
+            draw(Area::Bitmap(root)).map_err(|e| fail(&png, e))
+        },
+        io(png.display().to_string()),
+    )?;
+    crate::cli::atomic::write_via(
+        &svg,
+        |tmp| {
+            let root = SVGBackend::new(tmp, size).into_drawing_area();
+            draw(Area::Svg(root)).map_err(|e| fail(&svg, e))
+        },
+        io(svg.display().to_string()),
+    )?;
     Ok(vec![png, svg])
 }
 

@@ -263,7 +263,19 @@ pub(crate) fn resolve_at(coords: &[(String, f64)], loaded: &Loaded) -> miette::R
         .map(|v| v.name.as_str())
         .collect();
     if let Some((name, _)) = coords.iter().find(|(n, _)| !vars.contains(&n.as_str())) {
-        return Err(unknown_variable(loaded, name));
+        // The option is wrong, not the machine file: name `--at`.
+        let guess = chain_core::diagnostic::closest(name, vars.iter().copied())
+            .map(|g| format!(" (did you mean `{g}`?)"))
+            .unwrap_or_default();
+        return Err(miette::miette!(
+            code = "chain::cli::at_unknown_variable",
+            help = format!(
+                "the axis variables of {} are {}",
+                loaded.file_name(),
+                vars.join(", ")
+            ),
+            "--at: `{name}` is not an axis variable{guess}"
+        ));
     }
     vars.iter()
         .map(|v| {

@@ -164,12 +164,16 @@ impl Analysis {
     }
 }
 
+/// The longest swing arm `L` (mm) accepted: 1 km, far beyond any machine,
+/// and small enough that `L·(1 − cos θ)` and its derivatives stay finite.
+pub const MAX_LENGTH_MM: f64 = 1e6;
+
 /// Processes measurements: `Δθ` per point (Eq. 5), least-squares fits of
 /// orders `min_order..=max_order`, the selected order and the law.
 pub fn analyze(m: &Measurements, options: &Options) -> Result<Analysis, CompensateError> {
     let file = m.source.clone();
     let length = options.length;
-    if !(length > 0.0 && length.is_finite()) {
+    if !(length > 0.0 && length <= MAX_LENGTH_MM) {
         return Err(CompensateError::InvalidLength { length });
     }
     if options.min_order > options.max_order {

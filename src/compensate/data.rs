@@ -123,34 +123,35 @@ impl Measurements {
         for row in records {
             let line = row.line;
             if row.fields.len() != header.fields.len() {
-                return Err(CompensateError::Malformed {
+                return Err(CompensateError::Ragged {
                     file: file.to_string(),
                     line,
-                    message: format!(
-                        "expected {} fields as in the header (line {header_line}), found {}",
-                        header.fields.len(),
-                        row.fields.len()
-                    ),
+                    fields: row.fields.len(),
+                    columns: header.fields.len(),
                 });
             }
             let cell = |index: usize, column: &'static str| -> Result<f64, CompensateError> {
                 let text = row.fields.get(index).map_or("", String::as_str);
-                let value: f64 = text.parse().map_err(|_| CompensateError::NotNumeric {
-                    file: file.to_string(),
-                    line,
-                    column,
-                    value: text.to_string(),
-                })?;
-                if value.is_finite() {
-                    Ok(value)
-                } else {
-                    Err(CompensateError::NotFinite {
+                use chain_core::tabular::{number, CsvProblem};
+                number(text, column).map_err(|problem| match problem {
+                    CsvProblem::EmptyCell { .. } => CompensateError::EmptyCell {
+                        file: file.to_string(),
+                        line,
+                        column,
+                    },
+                    CsvProblem::NotFinite { .. } => CompensateError::NotFinite {
                         file: file.to_string(),
                         line,
                         column,
                         value: text.to_string(),
-                    })
-                }
+                    },
+                    _ => CompensateError::NotNumeric {
+                        file: file.to_string(),
+                        line,
+                        column,
+                        value: text.to_string(),
+                    },
+                })
             };
             let theta_deg = cell(i_theta, "theta_deg")?;
             let z1 = cell(i_z1, "z1")?;

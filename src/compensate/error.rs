@@ -24,17 +24,26 @@ pub enum CompensateError {
         #[source]
         source: std::io::Error,
     },
+    /// The file is larger than the bound of its kind
+    /// (`chain_core::bounded::COMPENSATE_BYTES`).
+    #[error("{file}: the file is too large (more than {})", chain_core::bounded::describe(*limit))]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::too_large)))]
+    TooLarge {
+        /// The file.
+        file: String,
+        /// The bound in bytes.
+        limit: usize,
+    },
     /// The file has no header line.
-    #[error("{file}, line 1: the file is empty; expected a header `theta_deg,z1,z3` (optionally with `z2`)")]
-    #[cfg_attr(feature = "cli", diagnostic(code(chain::compensate::empty)))]
+    #[error("{file}:1: the file is empty; expected a header line `theta_deg,z1,z3` (optionally with `z2`)")]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::csv::empty)))]
     Empty {
         /// The file.
         file: String,
     },
-    /// A line is not well-formed CSV (bad UTF-8, reported by the reader) or
-    /// has another number of fields than the header.
-    #[error("{file}, line {line}: {message}")]
-    #[cfg_attr(feature = "cli", diagnostic(code(chain::compensate::malformed)))]
+    /// A line is not well-formed CSV (bad UTF-8, reported by the reader).
+    #[error("{file}:{line}: {message}")]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::csv::malformed)))]
     Malformed {
         /// The file.
         file: String,
@@ -43,8 +52,32 @@ pub enum CompensateError {
         /// What is wrong.
         message: String,
     },
+    /// A row has another number of fields than the header.
+    #[error("{file}:{line}: {}", chain_core::tabular::CsvProblem::Ragged { fields: *fields, columns: *columns })]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::csv::ragged)))]
+    Ragged {
+        /// The file.
+        file: String,
+        /// The line.
+        line: u64,
+        /// The row's fields.
+        fields: usize,
+        /// The header's columns.
+        columns: usize,
+    },
+    /// A cell is empty.
+    #[error("{file}:{line}: column `{column}`: the cell is empty")]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::csv::empty_cell)))]
+    EmptyCell {
+        /// The file.
+        file: String,
+        /// The line.
+        line: u64,
+        /// The column.
+        column: &'static str,
+    },
     /// A required column is missing from the header.
-    #[error("{file}, line {line}: the header has no column `{column}` (found: {found}); expected `theta_deg,z1,z3` with an optional `z2`")]
+    #[error("{file}:{line}: the header has no column `{column}` (found: {found}); expected `theta_deg,z1,z3` with an optional `z2`")]
     #[cfg_attr(feature = "cli", diagnostic(code(chain::compensate::missing_column)))]
     MissingColumn {
         /// The file.
@@ -57,7 +90,7 @@ pub enum CompensateError {
         found: String,
     },
     /// A known column appears twice in the header.
-    #[error("{file}, line {line}: column `{column}` appears twice in the header")]
+    #[error("{file}:{line}: column `{column}` appears twice in the header")]
     #[cfg_attr(feature = "cli", diagnostic(code(chain::compensate::duplicate_column)))]
     DuplicateColumn {
         /// The file.
@@ -68,8 +101,8 @@ pub enum CompensateError {
         column: String,
     },
     /// A cell is not a number.
-    #[error("{file}, line {line}, column `{column}`: `{value}` is not a number")]
-    #[cfg_attr(feature = "cli", diagnostic(code(chain::compensate::not_numeric)))]
+    #[error("{file}:{line}: column `{column}`: `{value}` is not a number")]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::csv::not_a_number)))]
     NotNumeric {
         /// The file.
         file: String,
@@ -81,8 +114,8 @@ pub enum CompensateError {
         value: String,
     },
     /// A cell is NaN or infinite.
-    #[error("{file}, line {line}, column `{column}`: `{value}` is not a finite number")]
-    #[cfg_attr(feature = "cli", diagnostic(code(chain::compensate::not_finite)))]
+    #[error("{file}:{line}: column `{column}`: `{value}` is not finite")]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::csv::not_finite)))]
     NotFinite {
         /// The file.
         file: String,
@@ -94,9 +127,7 @@ pub enum CompensateError {
         value: String,
     },
     /// A commanded angle is not in the open interval (0°, 90°).
-    #[error(
-        "{file}, line {line}, column `theta_deg`: swing angle {theta_deg}° is outside (0°, 90°)"
-    )]
+    #[error("{file}:{line}: column `theta_deg`: swing angle {theta_deg}° is outside (0°, 90°)")]
     #[cfg_attr(feature = "cli", diagnostic(
         code(chain::compensate::angle_out_of_range),
         help("Eq. 5 divides by sin θ in effect: at θ = 0 a height change says nothing about the angle")
@@ -110,7 +141,7 @@ pub enum CompensateError {
         theta_deg: f64,
     },
     /// `cos θ − ΔZ/L` is outside `[-1, 1]`, so Eq. 5 has no solution.
-    #[error("{file}, line {line}: cos θ − ΔZ/L = {argument:.9} is outside [−1, 1] (θ = {theta_deg}°, z1 − z3 = {drop:.6} mm, L = {length} mm); the measured drop z1 − z3 must lie in [0, 2L]")]
+    #[error("{file}:{line}: cos θ − ΔZ/L = {argument:.9} is outside [−1, 1] (θ = {theta_deg}°, z1 − z3 = {drop:.6} mm, L = {length} mm); the measured drop z1 − z3 must lie in [0, 2L]")]
     #[cfg_attr(feature = "cli", diagnostic(
         code(chain::compensate::acos_domain),
         help("check the sign convention (z3 is the measured tip height, below z1 for θ > 0) and --length")
@@ -130,8 +161,8 @@ pub enum CompensateError {
         argument: f64,
     },
     /// The header is followed by no data row.
-    #[error("{file}, line {header_line}: the header is followed by no data row")]
-    #[cfg_attr(feature = "cli", diagnostic(code(chain::compensate::no_data)))]
+    #[error("{file}:{header_line}: the header is followed by no data row")]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::csv::no_data)))]
     NoData {
         /// The file.
         file: String,
@@ -139,7 +170,7 @@ pub enum CompensateError {
         header_line: u64,
     },
     /// Too few points (at distinct angles) for the highest order asked for.
-    #[error("{file}, lines {first_line}-{last_line}: a polynomial of order {order} needs points at {needed} distinct angles or more (one more than its coefficients, so that it has a residual and a cross-validation error), but these lines give {got}")]
+    #[error("{file}:{first_line}-{last_line}: a polynomial of order {order} needs points at {needed} distinct angles or more (one more than its coefficients, so that it has a residual and a cross-validation error), but these lines give {got}")]
     #[cfg_attr(
         feature = "cli",
         diagnostic(
@@ -161,8 +192,11 @@ pub enum CompensateError {
         /// Distinct angles present.
         got: usize,
     },
-    /// `--length` is not a positive finite number.
-    #[error("--length must be a positive finite number of millimetres, got {length}")]
+    /// `--length` is not a positive number of at most
+    /// [`MAX_LENGTH_MM`](super::analysis::MAX_LENGTH_MM).
+    #[error(
+        "--length must be a positive number of millimetres of at most 1e6 (1 km), got {length}"
+    )]
     #[cfg_attr(feature = "cli", diagnostic(code(chain::compensate::invalid_length)))]
     InvalidLength {
         /// The value given.

@@ -547,7 +547,10 @@ impl Problem {
             Problem::TooLarge { limit } => D::new(
                 "chain::too_large",
                 "file",
-                format!("the file is too large (more than {limit} bytes)"),
+                format!(
+                    "the file is too large (more than {})",
+                    crate::bounded::describe(*limit)
+                ),
             ),
             Problem::Binary { offset } => D::new(
                 "chain::binary",

@@ -5,11 +5,13 @@
 //! files of `chain motion` ([`settings`]) and the values files of a built
 //! machine ([`values`]).
 
+pub mod bounded;
 pub mod diagnostic;
 pub mod expr;
 pub mod inline;
 pub mod load;
 pub mod model;
 pub mod settings;
+pub mod tabular;
 pub mod values;
 pub mod yaml;

@@ -69,7 +69,7 @@ pub const BUILTIN_GENERATOR: &str = include_str!("cradle_generator.yaml");
 pub const BUILTIN_GENERATOR_NAME: &str = "cradle_generator.yaml (built-in)";
 
 /// Settings files larger than this are refused.
-pub const MAX_SETTINGS_BYTES: usize = 1024 * 1024;
+pub const MAX_SETTINGS_BYTES: usize = crate::bounded::SETTINGS_BYTES;
 
 /// How to write an angle, for an angle that cannot be read.
 const DMS_HELP: &str =

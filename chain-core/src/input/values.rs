@@ -74,7 +74,7 @@ pub const INTERPOLATIONS: &[&str] = &["linear", "cubic"];
 pub const EXTRAPOLATIONS: &[&str] = &["error", "hold"];
 
 /// Values files larger than this are refused.
-pub const MAX_VALUES_BYTES: usize = 16 * 1024 * 1024;
+pub const MAX_VALUES_BYTES: usize = crate::bounded::VALUES_BYTES;
 
 // ---------------------------------------------------------------------------
 // Units
@@ -1460,27 +1460,14 @@ fn is_table(node: &Node) -> bool {
 /// A CSV cell as a finite number; a problem located at the cell otherwise.
 #[cfg(feature = "csv")]
 fn cell_number(text: &str, origin: &Origin, bad: &mut Vec<(Origin, Problem)>) -> Option<f64> {
-    let column = &origin.key;
-    let (message, code) = match text.parse::<f64>() {
-        Ok(v) if v.is_finite() => return Some(v),
-        Ok(_) => (
-            format!("`{text}` (column `{column}`) is not finite"),
-            "chain::values::not_finite",
-        ),
-        Err(_) if text.is_empty() => (
-            format!("the cell of column `{column}` is empty"),
-            "chain::values::csv_number",
-        ),
-        Err(_) => (
-            format!("`{text}` (column `{column}`) is not a number"),
-            "chain::values::csv_number",
-        ),
-    };
-    bad.push((
-        origin.clone(),
-        Message::new(message, "not a number", code).into(),
-    ));
-    None
+    match crate::tabular::number(text, &origin.key) {
+        Ok(v) => Some(v),
+        Err(problem) => {
+            let message = Message::new(problem.to_string(), problem.label(), problem.code());
+            bad.push((origin.clone(), message.into()));
+            None
+        }
+    }
 }
 
 #[cfg(all(test, not(feature = "csv")))]

@@ -44,7 +44,7 @@ pub const STD_COLUMN: &str = "std";
 /// written with five or more digits pass.
 pub const UNIT_TOLERANCE: f64 = 1e-4;
 /// Measurement CSV files larger than this are refused.
-pub const MAX_MEASUREMENT_BYTES: usize = 256 * 1024 * 1024;
+pub const MAX_MEASUREMENT_BYTES: usize = crate::bounded::MEASUREMENT_BYTES;
 
 /// What a CSV must hold besides the poses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -430,28 +430,9 @@ impl Columns {
     fn record(&self, cells: &[(String, Origin)]) -> Result<Measurement, Located> {
         let number = |c: usize| -> Result<f64, Located> {
             let (text, origin) = &cells[c];
-            let column = &origin.key;
-            match text.parse::<f64>() {
-                Ok(x) if x.is_finite() => Ok(x),
-                Ok(_) => Err(located(
-                    origin,
-                    format!("`{text}` (column `{column}`) is not finite"),
-                    "not finite",
-                    "chain::measurements::not_finite",
-                )),
-                Err(_) if text.is_empty() => Err(located(
-                    origin,
-                    format!("the cell of column `{column}` is empty"),
-                    "empty",
-                    "chain::measurements::empty_cell",
-                )),
-                Err(_) => Err(located(
-                    origin,
-                    format!("`{text}` (column `{column}`) is not a number"),
-                    "not a number",
-                    "chain::measurements::not_a_number",
-                )),
-            }
+            crate::tabular::number(text, &origin.key).map_err(|problem| {
+                located(origin, problem.to_string(), problem.label(), problem.code())
+            })
         };
         let line = cells.first().map_or(0, |(_, o)| o.line);
         let q = self

@@ -64,6 +64,11 @@ impl Default for NominalSizes {
     }
 }
 
+/// The largest nominal angular (or squareness) error size: π rad.
+pub const MAX_NOMINAL_ANGLE: f64 = std::f64::consts::PI;
+/// The largest nominal linear error size: 1e6 in the model's length unit.
+pub const MAX_NOMINAL_LENGTH: f64 = 1e6;
+
 impl NominalSizes {
     /// The size of one kind of error.
     pub fn of_kind(&self, kind: ErrorKind) -> f64 {
@@ -125,6 +130,18 @@ impl NominalSizes {
                 if !x.is_finite() || x <= 0.0 {
                     return Err(format!(
                         "`{key}={v}`: the nominal error size must be positive and finite"
+                    ));
+                }
+                // A size is a small error: bounded so that `S·e` and its sum
+                // stay finite (issue 18).
+                let (max, unit) = if angle {
+                    (MAX_NOMINAL_ANGLE, "π rad (180°)")
+                } else {
+                    (MAX_NOMINAL_LENGTH, "1e6 (model units)")
+                };
+                if x > max {
+                    return Err(format!(
+                        "`{key}={v}`: the nominal error size must be at most {unit}"
                     ));
                 }
                 Ok(x)

@@ -29,7 +29,6 @@ pub(crate) mod reader;
 mod sections;
 
 use std::collections::{HashMap, HashSet};
-use std::io::Read;
 use std::path::Path;
 
 use crate::diagnostic::{closest, Diagnostics, LoadError, Problem};
@@ -39,7 +38,7 @@ use crate::yaml::{self, Node};
 use reader::{index, join, start_origin, Fields, TreeReader};
 
 /// Files larger than this many bytes are refused by [`load_file`].
-pub const MAX_FILE_BYTES: usize = 16 * 1024 * 1024;
+pub const MAX_FILE_BYTES: usize = crate::bounded::MACHINE_BYTES;
 
 /// Keys allowed at the top level of a machine file.
 pub const TOP_KEYS: &[&str] = &[
@@ -124,22 +123,15 @@ pub fn load_file(path: &Path) -> Result<Machine, Diagnostics> {
 /// The bytes of the file at `path` (named `file` in diagnostics), at most
 /// `limit` of them: a file that cannot be read or is larger is a diagnostic.
 pub(crate) fn read_file(path: &Path, file: &str, limit: usize) -> Result<Vec<u8>, Diagnostics> {
-    let error = |problem: Problem| Diagnostics::single(file, "", Origin::default(), problem);
-    let io_error = |e: std::io::Error| {
-        error(Problem::Io {
-            message: e.to_string(),
-        })
-    };
-    let handle = std::fs::File::open(path).map_err(io_error)?;
-    let mut bytes = Vec::new();
-    handle
-        .take(limit as u64 + 1)
-        .read_to_end(&mut bytes)
-        .map_err(io_error)?;
-    if bytes.len() > limit {
-        return Err(error(Problem::TooLarge { limit }));
-    }
-    Ok(bytes)
+    crate::bounded::read_path(path, limit).map_err(|e| {
+        let problem = match e {
+            crate::bounded::ReadError::TooLarge { limit } => Problem::TooLarge { limit },
+            crate::bounded::ReadError::Io(e) => Problem::Io {
+                message: e.to_string(),
+            },
+        };
+        Diagnostics::single(file, "", Origin::default(), problem)
+    })
 }
 
 /// The text of a file's bytes: a NUL byte (binary file) or invalid UTF-8 is

@@ -57,6 +57,11 @@ const FAMILY_KEYS: &[(&str, &[&str])] = &[
 const V2_KEYS: &[&str] = &["shift", "scale", "shape", "mode"];
 /// Keys of the reliability section.
 pub const RELIABILITY_KEYS: &[&str] = &["tolerance", "sided", "grid", "requirement", "acceptance"];
+/// The largest magnitude of a statistics number (`mean`, `std`, `min`, ...):
+/// squared and summed over the errors in the moments, larger ones would
+/// overflow to `inf`.
+pub const MAX_STATISTIC: f64 = 1e100;
+
 /// Keys of a reliability requirement.
 pub const REQUIREMENT_KEYS: &[&str] = &["min", "mean"];
 /// Component names.
@@ -191,10 +196,27 @@ impl Loader {
     ) -> Option<Option<f64>> {
         let node = f.get(key)?;
         let path = f.path(key);
-        Some(if positive {
+        let v = if positive {
             self.positive(node, &path, key)
         } else {
             self.finite(node, &path, key)
+        };
+        // Moments square these numbers and sum them over the errors: a
+        // magnitude above `MAX_STATISTIC` would overflow to `inf` (issue 18).
+        Some(match v {
+            Some(x) if x.abs() > MAX_STATISTIC => {
+                self.report(
+                    node.span,
+                    &path,
+                    Problem::OutOfRange {
+                        what: key,
+                        value: x,
+                        range: "[-1e100, 1e100] (its square enters the moments)",
+                    },
+                );
+                None
+            }
+            v => v,
         })
     }
 

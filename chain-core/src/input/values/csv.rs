@@ -12,19 +12,22 @@ use std::path::Path;
 
 use crate::diagnostic::{Diagnostics, Message, Problem};
 use crate::model::Origin;
+use crate::tabular::CsvProblem;
 
 /// CSV tables larger than this are refused.
-pub const MAX_TABLE_BYTES: usize = 64 * 1024 * 1024;
+pub const MAX_TABLE_BYTES: usize = crate::bounded::TABLE_BYTES;
 
-/// One CSV file, read once however many entries use it.
+/// One CSV file as located cells: the one place the `csv` crate's records
+/// become cells with their origins (values tables, measurement and
+/// candidate files, and the command line's pose and axes CSVs).
 #[derive(Debug, Clone)]
-pub(crate) struct CsvFile {
+pub struct CsvFile {
     /// Its text (for the diagnostics' snippets).
-    pub(crate) text: String,
+    pub text: String,
     /// Header names with their origins.
-    pub(crate) header: Vec<(String, Origin)>,
+    pub header: Vec<(String, Origin)>,
     /// Data rows: each cell's text and origin (key: its column's name).
-    pub(crate) rows: Vec<Vec<(String, Origin)>>,
+    pub rows: Vec<Vec<(String, Origin)>>,
 }
 
 /// Why a CSV file could not be used at all.
@@ -55,9 +58,11 @@ impl CsvFile {
         CsvFile::parse_with(text, name, TABLE_HEADER)
     }
 
-    /// Parses CSV text; `header_help` says what the header of this kind of
+    /// Parses CSV text (header, then at least one data row, every row as
+    /// wide as the header; refusals worded by [`CsvProblem`]);
+    /// `header_help` says what the header of this kind of
     /// file names (the help of an empty file or an unnamed column).
-    pub(crate) fn parse_with(
+    pub fn parse_with(
         text: &str,
         name: &str,
         header_help: &'static str,
@@ -142,15 +147,11 @@ impl CsvFile {
                 continue;
             }
             if record.len() != header.len() {
-                let width = Message::new(
-                    format!(
-                        "this row has {} but the header has {} columns",
-                        plural(record.len(), "field"),
-                        header.len()
-                    ),
-                    "row",
-                    "chain::values::csv_row",
-                );
+                let problem = CsvProblem::Ragged {
+                    fields: record.len(),
+                    columns: header.len(),
+                };
+                let width = Message::new(problem.to_string(), problem.label(), problem.code());
                 return Err(located(cell(0, ""), width));
             }
             rows.push(
@@ -163,13 +164,18 @@ impl CsvFile {
             );
         }
         if header.is_empty() {
-            let empty = Message::new(
-                "the CSV file is empty; expected a header line",
-                "empty",
-                "chain::values::csv_empty",
-            )
-            .help(header_help);
+            let problem = CsvProblem::Empty;
+            let empty = Message::new(problem.to_string(), problem.label(), problem.code())
+                .help(header_help);
             return Err(located(line_origin(text, 1), empty));
+        }
+        if rows.is_empty() {
+            let problem = CsvProblem::NoData;
+            let none = Message::new(problem.to_string(), problem.label(), problem.code())
+                .help("each row after the header is one record");
+            let first = &header[0].1;
+            let origin = line_origin(text, first.line as u64);
+            return Err(located(origin, none));
         }
         Ok(CsvFile {
             text: text.to_string(),
@@ -199,15 +205,6 @@ impl CsvFile {
             column: first.column,
             key: String::new(),
         }
-    }
-}
-
-/// `1 field`, `3 fields`.
-fn plural(n: usize, what: &str) -> String {
-    if n == 1 {
-        format!("1 {what}")
-    } else {
-        format!("{n} {what}s")
     }
 }
 

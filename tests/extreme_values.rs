@@ -1,0 +1,161 @@
+//! Numbers that stay numbers (issue 18, point 4): extreme values are refused
+//! with their key or option, or written in a finite form, never as `inf` or
+//! `NaN` in a successful output.
+
+use std::process::Command;
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+fn run(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_chain"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn flat(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes)
+        .split_whitespace()
+        .filter(|w| *w != "│")
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+fn gantry() -> String {
+    std::fs::read_to_string(format!("{ROOT}/examples/machines/gantry_grinder.yaml")).unwrap()
+}
+
+fn scratch(name: &str, text: &str) -> String {
+    let dir = std::env::temp_dir().join(format!("chain-extreme-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn a_std_whose_square_overflows_is_refused_at_load_with_its_key_and_line() {
+    let text = gantry().replacen(
+        "dxx: {dist: normal, mean: 0, std: 0.05/6}",
+        "dxx: {dist: normal, mean: 0, std: 1e155}",
+        1,
+    );
+    let line = text.lines().position(|l| l.contains("std: 1e155")).unwrap() + 1;
+    let file = scratch("big_std.yaml", &text);
+    let out = run(&[
+        "path",
+        &file,
+        "--axes",
+        &format!("{ROOT}/examples/paths/gantry_path.csv"),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let err = flat(&out.stderr);
+    assert!(err.contains(&format!("big_std.yaml:{line}:")), "{err}");
+    assert!(
+        err.contains("statistics.dxx.std") && err.contains("[-1e100, 1e100]"),
+        "{err}"
+    );
+    assert!(err.contains("chain::out_of_range"), "{err}");
+}
+
+#[test]
+fn compensate_length_1e308_is_refused_naming_the_option() {
+    let out = run(&[
+        "compensate",
+        &format!("{ROOT}/examples/data/swing_htm50200.csv"),
+        "--length",
+        "1e308",
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    assert!(out.stdout.is_empty());
+    let err = flat(&out.stderr);
+    assert!(
+        err.contains("--length") && err.contains("at most 1e6"),
+        "{err}"
+    );
+    // The largest accepted length still gives finite numbers.
+    let out = run(&[
+        "compensate",
+        &format!("{ROOT}/examples/data/swing_htm50200.csv"),
+        "--length",
+        "1e6",
+        "--format",
+        "json",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(!text.contains("inf") && !text.contains("NaN"), "{text}");
+}
+
+#[test]
+fn reliability_csv_writes_an_infinite_beta_as_the_json_does() {
+    // Every sample fails (mean far beyond the tolerance): pf = 1, beta = −∞.
+    let text = gantry().replacen(
+        "dxx: {dist: normal, mean: 0, std: 0.05/6}",
+        "dxx: {dist: normal, mean: -100, std: 0.05/6}",
+        1,
+    );
+    let file = scratch("pf_one.yaml", &text);
+    let args = [
+        "reliability",
+        &file,
+        "--method",
+        "mc",
+        "--samples",
+        "200",
+        "--seed",
+        "1",
+    ];
+    let csv = run(&[&args[..], &["--format", "csv"]].concat());
+    assert!(csv.status.success(), "{csv:?}");
+    let csv = String::from_utf8_lossy(&csv.stdout).into_owned();
+    assert!(!csv.contains("inf") && !csv.contains("NaN"), "{csv}");
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let (pf, beta) = (
+        header.iter().position(|h| *h == "pf").unwrap(),
+        header.iter().position(|h| *h == "beta").unwrap(),
+    );
+    let first: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(first[pf], "1.0");
+    assert_eq!(first[beta], "", "an empty cell, the JSON's null");
+    let json = run(&[&args[..], &["--format", "json"]].concat());
+    let doc: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let case = &doc["results"][0];
+    assert_eq!(case["pf"], 1.0);
+    assert!(case["beta"].is_null(), "{case}");
+}
+
+#[test]
+fn nominal_angular_1e308_is_refused_naming_values() {
+    let gantry = format!("{ROOT}/examples/machines/gantry_grinder.yaml");
+    let out = run(&[
+        "sensitivity",
+        &gantry,
+        "--kind",
+        "geometric",
+        "--values",
+        "angular=1e308",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    let err = flat(&out.stderr);
+    assert!(
+        err.contains("--values") && err.contains("at most π rad"),
+        "{err}"
+    );
+}
+
+#[test]
+fn an_unknown_at_name_blames_at_not_the_machine_file() {
+    let gantry = format!("{ROOT}/examples/machines/gantry_grinder.yaml");
+    let out = run(&["sensitivity", &gantry, "--at", "q=1"]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let err = flat(&out.stderr);
+    assert!(
+        err.contains("--at: `q` is not an axis variable (did you mean `x`?)"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("gantry_grinder.yaml:"),
+        "no location in the machine file: {err}"
+    );
+}
