@@ -514,16 +514,7 @@ fn the_machine_key_adds_the_acceptance_object() {
 /// 3 standard errors, and the allocation's own check agrees with it.
 #[test]
 fn allocate_reaches_the_acceptance_level_with_non_normal_inputs() {
-    let text = std::fs::read_to_string(example_path("gantry_grinder.yaml"))
-        .unwrap()
-        .replace(
-            "  dxx: {dist: normal, mean: 0, std: 0.05/6}",
-            "  dxx: {dist: lognormal, mean: 0.002, std: 0.05/6, shift: -0.03}",
-        )
-        .replace(
-            "  dyy: {dist: normal, mean: 0, std: 0.05/6}",
-            "  dyy: {dist: truncated_normal, mean: 0, std: 0.05/6, min: -0.01, max: 0.012}",
-        )
+    let text = common::gantry_nonnormal_text()
         .replace("x: [0, 250, 500, 750, 1000]", "x: [0, 1000]")
         .replace("y: [-1500, -750, 0, 750, 1500]", "y: [-1500, 1500]")
         .replace("z: [600, 800, 1000, 1200, 1400]", "z: [600, 1400]");

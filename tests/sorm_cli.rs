@@ -18,17 +18,7 @@ const GANTRY: &str = "examples/machines/gantry_grinder.yaml";
 /// The gantry with `dxx` lognormal, `dyy` truncated normal and `dxx`, `dyx`
 /// correlated (0.5): the case of `reliability/benches/sorm.rs`.
 fn nonnormal() -> String {
-    let text = std::fs::read_to_string(GANTRY)
-        .unwrap()
-        .replace(
-            "  dxx: {dist: normal, mean: 0, std: 0.05/6}",
-            "  dxx: {dist: lognormal, mean: 0.002, std: 0.05/6, shift: -0.03}",
-        )
-        .replace(
-            "  dyy: {dist: normal, mean: 0, std: 0.05/6}",
-            "  dyy: {dist: truncated_normal, mean: 0, std: 0.05/6, min: -0.01, max: 0.012}",
-        );
-    assert!(text.contains("lognormal") && text.contains("truncated_normal"));
+    let text = common::gantry_nonnormal_text();
     let dir = scratch("sorm-cli");
     let path = write(
         &dir,

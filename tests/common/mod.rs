@@ -640,6 +640,25 @@ pub fn example_path(file: &str) -> std::path::PathBuf {
     example_file("machines").join(file)
 }
 
+/// The gantry grinder's text with `dxx` lognormal (mean 0.002, shift
+/// −0.03), `dyy` truncated normal on [−0.01, 0.012], the other inputs as in
+/// Table 1 and no correlation section (callers append one): the non-normal
+/// case of `reliability/benches/sorm.rs`.
+pub fn gantry_nonnormal_text() -> String {
+    let text = std::fs::read_to_string(example_path("gantry_grinder.yaml"))
+        .unwrap()
+        .replace(
+            "  dxx: {dist: normal, mean: 0, std: 0.05/6}",
+            "  dxx: {dist: lognormal, mean: 0.002, std: 0.05/6, shift: -0.03}",
+        )
+        .replace(
+            "  dyy: {dist: normal, mean: 0, std: 0.05/6}",
+            "  dyy: {dist: truncated_normal, mean: 0, std: 0.05/6, min: -0.01, max: 0.012}",
+        );
+    assert!(text.contains("lognormal") && text.contains("truncated_normal"));
+    text
+}
+
 /// Loads an example machine file, panicking with the rendered diagnostics.
 pub fn load_example(file: &str) -> Machine {
     match chain_core::load_file(&example_path(file)) {

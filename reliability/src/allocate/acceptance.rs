@@ -146,6 +146,11 @@ pub fn acceptance<M: ErrorModel + ?Sized>(
                     .map(|(t, b)| b.cost_weight * (t.exp() - 1.0))
                     .sum()
             };
+            let restore_from = |t: &[f64], at: &AcceptanceResult, evaluations: &mut usize| {
+                let dp_dstd: Vec<f64> = at.sensitivity.iter().map(|s| s.dr_dstd).collect();
+                let context = (&system, bounds, &tmax[..], &acc);
+                restore(context, t, &dp_dstd, level, evaluations)
+            };
             let mut best: Option<(f64, Vec<f64>, AcceptanceResult)> = None;
             let mut radius = 1.0f64;
             let mut iter = 0;
@@ -157,17 +162,7 @@ pub fn acceptance<M: ErrorModel + ?Sized>(
                     if let Some((_, s, _)) = best.take() {
                         stds = s;
                     } else {
-                        let g: Vec<f64> = current.sensitivity.iter().map(|s| s.dr_dstd).collect();
-                        (stds, _) = restore(
-                            &system,
-                            bounds,
-                            &tmax,
-                            &t,
-                            &g,
-                            level,
-                            &acc,
-                            &mut evaluations,
-                        )?;
+                        (stds, _) = restore_from(&t, &current, &mut evaluations)?;
                     }
                     break;
                 }
@@ -262,18 +257,7 @@ pub fn acceptance<M: ErrorModel + ?Sized>(
                             done = true;
                         }
                         None => {
-                            let g: Vec<f64> =
-                                current.sensitivity.iter().map(|s| s.dr_dstd).collect();
-                            (stds, current) = restore(
-                                &system,
-                                bounds,
-                                &tmax,
-                                &t,
-                                &g,
-                                level,
-                                &acc,
-                                &mut evaluations,
-                            )?;
+                            (stds, current) = restore_from(&t, &current, &mut evaluations)?;
                             done = true;
                         }
                     }
@@ -382,15 +366,11 @@ pub fn acceptance<M: ErrorModel + ?Sized>(
 /// meets `L` + 3 standard errors and then bisected five times. `P` grows
 /// with `δ`, so this ends, or the bounds are reached and the level is
 /// infeasible.
-#[allow(clippy::too_many_arguments)]
 fn restore(
-    system: &Rectangles,
-    bounds: &[ErrorBounds],
-    tmax: &[f64],
+    (system, bounds, tmax, acc): (&Rectangles, &[ErrorBounds], &[f64], &Acceptance),
     t: &[f64],
     dp_dstd: &[f64],
     level: f64,
-    acc: &Acceptance,
     evaluations: &mut usize,
 ) -> Result<(Vec<f64>, AcceptanceResult), AllocateError> {
     let stds_at = |delta: f64| -> Vec<f64> {
