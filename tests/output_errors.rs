@@ -1,7 +1,8 @@
 //! Output errors (issue 18, point 1): a closed pipe ends every command
 //! quietly (no panic, no message), a full device is a clear message and
-//! exit 1. Commands covered here: derive, reliability, sensitivity, path,
-//! compensate, identify, plan (the others are listed in docs/robustness.md).
+//! exit 1. Every subcommand that writes a result to stdout: derive,
+//! reliability, sensitivity, allocate, inverse, path, map, compensate,
+//! export, identify, plan, sobol, motion.
 
 use std::io::Read;
 use std::process::{Command, Stdio};
@@ -39,6 +40,43 @@ fn commands() -> Vec<Vec<String>> {
             "577.11",
             "--format",
             "json",
+        ]),
+        s(&["allocate", &m("machines/gantry_grinder.yaml")]),
+        s(&[
+            "inverse",
+            &m("machines/cnc5_bevel.yaml"),
+            "--pose",
+            &m("paths/cnc5_bevel_pose.csv"),
+        ]),
+        s(&[
+            "map",
+            &m("machines/vmc3.yaml"),
+            "--values",
+            &m("values/vmc3.yaml"),
+        ]),
+        s(&[
+            "export",
+            &m("machines/vmc3.yaml"),
+            "--values",
+            &m("values/vmc3.yaml"),
+            "--controller",
+            "grid",
+        ]),
+        s(&[
+            "sobol",
+            &m("machines/gantry_grinder.yaml"),
+            "--at",
+            "x=500,y=1500,z=600",
+            "--samples",
+            "2000",
+        ]),
+        s(&[
+            "motion",
+            &m("machines/cnc5_bevel.yaml"),
+            "--settings",
+            &m("settings/seed002_concave.yaml"),
+            "--samples",
+            "5",
         ]),
         s(&[
             "identify",
