@@ -66,16 +66,7 @@ pub trait ErrorModel {
     /// does not hold one matrix per point; nothing is written then.
     fn sensitivity_points(&self, qs: &[f64], p: &[f64], out: &mut [f64]) -> Result<(), BatchError> {
         let nv = self.variables().len();
-        let width = 6 * self.errors().len();
-        let points = batch_points(nv, qs.len())?;
-        check_len(
-            out.len(),
-            points * width,
-            BatchError::Output {
-                len: 0,
-                expected: 0,
-            },
-        )?;
+        let (_, width) = sensitivity_shape(nv, self.errors().len(), qs.len(), out.len())?;
         if width > 0 {
             for (q, s) in qs.chunks_exact(nv).zip(out.chunks_exact_mut(width)) {
                 self.sensitivity(q, p, s);
@@ -104,22 +95,9 @@ pub trait ErrorModel {
     ) -> Result<(), BatchError> {
         let nv = self.variables().len();
         let n = self.errors().len();
-        let points = batch_points(nv, qs.len())?;
-        let broadcast = check_error_rows(es.len(), n, points)?;
-        check_len(
-            out.len(),
-            6 * points,
-            BatchError::Rows {
-                len: 0,
-                expected: 0,
-            },
-        )?;
+        let broadcast = error_shape(nv, n, qs.len(), es.len(), out.len())?;
         for (k, (q, o)) in qs.chunks_exact(nv).zip(out.chunks_exact_mut(6)).enumerate() {
-            let e = if broadcast {
-                es
-            } else {
-                &es[k * n..(k + 1) * n]
-            };
+            let e = error_rows(es, broadcast, n, k, 1);
             let mut row = [0.0; 6];
             self.error(q, p, e, &mut row);
             o.copy_from_slice(&row);
@@ -190,41 +168,85 @@ pub enum BatchError {
     },
 }
 
+/// The shape of a batch of sensitivity matrices: `(points, 6 · errors)`
+/// when `qs` (`qs_len` values) is a whole number of points of `nv`
+/// variables and `out` (`out_len` values) holds exactly one matrix per
+/// point. The one check of [`ErrorModel::sensitivity_points`] and
+/// [`crate::CompiledModel::sensitivity_batch`].
+pub(crate) fn sensitivity_shape(
+    nv: usize,
+    errors: usize,
+    qs_len: usize,
+    out_len: usize,
+) -> Result<(usize, usize), BatchError> {
+    let points = batch_points(nv, qs_len)?;
+    let width = 6 * errors;
+    if out_len != points * width {
+        return Err(BatchError::Output {
+            len: out_len,
+            expected: points * width,
+        });
+    }
+    Ok((points, width))
+}
+
+/// The shape of a batch of errors `E = S · e`: whether `es` (`es_len`
+/// values) is one row of `errors` values for every point (`true`) or one
+/// row per point (`false`), when `qs` is a whole number of points and
+/// `out` holds six values per point. The one check of
+/// [`ErrorModel::error_points`] and [`crate::CompiledModel::error_batch`].
+pub(crate) fn error_shape(
+    nv: usize,
+    errors: usize,
+    qs_len: usize,
+    es_len: usize,
+    out_len: usize,
+) -> Result<bool, BatchError> {
+    let points = batch_points(nv, qs_len)?;
+    let broadcast = if es_len == errors * points {
+        false
+    } else if es_len == errors {
+        true
+    } else {
+        return Err(BatchError::ErrorValues {
+            len: es_len,
+            errors,
+            expected: errors * points,
+        });
+    };
+    if out_len != 6 * points {
+        return Err(BatchError::Rows {
+            len: out_len,
+            expected: 6 * points,
+        });
+    }
+    Ok(broadcast)
+}
+
+/// The error values of `count` points starting at point `first`: all of
+/// `es` when it is one row for every point, else their rows.
+pub(crate) fn error_rows(
+    es: &[f64],
+    broadcast: bool,
+    errors: usize,
+    first: usize,
+    count: usize,
+) -> &[f64] {
+    if broadcast {
+        es
+    } else {
+        &es[first * errors..(first + count) * errors]
+    }
+}
+
 /// The number of points in `len` values of `nv` variables each.
-pub(crate) fn batch_points(nv: usize, len: usize) -> Result<usize, BatchError> {
+fn batch_points(nv: usize, len: usize) -> Result<usize, BatchError> {
     match len.checked_div(nv) {
         Some(points) if len % nv == 0 => Ok(points),
         _ => Err(BatchError::Points {
             values: len,
             variables: nv,
         }),
-    }
-}
-
-/// `Ok` when `len == expected`, else `err` (an `Output` or `Rows`) with them.
-pub(crate) fn check_len(len: usize, expected: usize, err: BatchError) -> Result<(), BatchError> {
-    if len == expected {
-        return Ok(());
-    }
-    Err(match err {
-        BatchError::Rows { .. } => BatchError::Rows { len, expected },
-        _ => BatchError::Output { len, expected },
-    })
-}
-
-/// Whether `es` (`len` values) is one row for every point (`true`) or one
-/// row per point (`false`).
-pub(crate) fn check_error_rows(len: usize, n: usize, points: usize) -> Result<bool, BatchError> {
-    if len == n * points {
-        Ok(false)
-    } else if len == n {
-        Ok(true)
-    } else {
-        Err(BatchError::ErrorValues {
-            len,
-            errors: n,
-            expected: n * points,
-        })
     }
 }
 

@@ -29,7 +29,7 @@ const STACK_REGISTERS: usize = 256;
 pub const BATCH_LANES: usize = 8;
 
 pub use crate::model_trait::BatchError;
-use crate::model_trait::{batch_points, check_error_rows, check_len};
+use crate::model_trait::{error_rows, error_shape, sensitivity_shape};
 
 /// The registers of one block: one lane per point.
 type Lanes = [f64; BATCH_LANES];
@@ -182,7 +182,8 @@ impl CompiledModel {
         p: &[f64],
         out: &mut [f64],
     ) -> Result<(), BatchError> {
-        let (nv, width) = self.check_sensitivity(qs, out)?;
+        let nv = self.variables.len();
+        let (_, width) = sensitivity_shape(nv, self.errors.len(), qs.len(), out.len())?;
         if width == 0 {
             return Ok(());
         }
@@ -220,15 +221,11 @@ impl CompiledModel {
         es: &[f64],
         out: &mut [f64],
     ) -> Result<(), BatchError> {
-        let (nv, broadcast) = self.check_error(qs, es, out)?;
+        let nv = self.variables.len();
+        let broadcast = error_shape(nv, self.errors.len(), qs.len(), es.len(), out.len())?;
         let n = self.errors.len();
         let run = |(b, (qb, ob)): (usize, (&[f64], &mut [f64]))| {
-            let eb = if broadcast {
-                es
-            } else {
-                let start = b * BATCH_LANES * n;
-                &es[start..start + ob.len() / 6 * n]
-            };
+            let eb = error_rows(es, broadcast, n, b * BATCH_LANES, ob.len() / 6);
             with_block_registers(|regs| self.error_block(qb, p, eb, broadcast, ob, regs))
         };
         #[cfg(feature = "parallel")]
@@ -245,43 +242,6 @@ impl CompiledModel {
             .enumerate()
             .for_each(run);
         Ok(())
-    }
-
-    /// `(variables, 6 · errors)` when `qs` and `out` fit each other.
-    fn check_sensitivity(&self, qs: &[f64], out: &[f64]) -> Result<(usize, usize), BatchError> {
-        let nv = self.variables.len();
-        let width = 6 * self.errors.len();
-        let points = batch_points(nv, qs.len())?;
-        check_len(
-            out.len(),
-            points * width,
-            BatchError::Output {
-                len: 0,
-                expected: 0,
-            },
-        )?;
-        Ok((nv, width))
-    }
-
-    /// `(variables, es is one row for all points)` when the slices fit.
-    fn check_error(
-        &self,
-        qs: &[f64],
-        es: &[f64],
-        out: &[f64],
-    ) -> Result<(usize, bool), BatchError> {
-        let nv = self.variables.len();
-        let points = batch_points(nv, qs.len())?;
-        let broadcast = check_error_rows(es.len(), self.errors.len(), points)?;
-        check_len(
-            out.len(),
-            6 * points,
-            BatchError::Rows {
-                len: 0,
-                expected: 0,
-            },
-        )?;
-        Ok((nv, broadcast))
     }
 
     /// Loads and runs the tape over one block of at most [`BATCH_LANES`]
@@ -404,7 +364,8 @@ impl ErrorModel for CompiledModel {
     }
 
     fn sensitivity_points(&self, qs: &[f64], p: &[f64], out: &mut [f64]) -> Result<(), BatchError> {
-        let (nv, width) = self.check_sensitivity(qs, out)?;
+        let nv = self.variables.len();
+        let (_, width) = sensitivity_shape(nv, self.errors.len(), qs.len(), out.len())?;
         if width == 0 {
             return Ok(());
         }
@@ -426,7 +387,8 @@ impl ErrorModel for CompiledModel {
         es: &[f64],
         out: &mut [f64],
     ) -> Result<(), BatchError> {
-        let (nv, broadcast) = self.check_error(qs, es, out)?;
+        let nv = self.variables.len();
+        let broadcast = error_shape(nv, self.errors.len(), qs.len(), es.len(), out.len())?;
         let n = self.errors.len();
         with_block_registers(|regs| {
             for (b, (qb, ob)) in qs
@@ -434,12 +396,7 @@ impl ErrorModel for CompiledModel {
                 .zip(out.chunks_mut(6 * BATCH_LANES))
                 .enumerate()
             {
-                let eb = if broadcast {
-                    es
-                } else {
-                    let start = b * BATCH_LANES * n;
-                    &es[start..start + ob.len() / 6 * n]
-                };
+                let eb = error_rows(es, broadcast, n, b * BATCH_LANES, ob.len() / 6);
                 self.error_block(qb, p, eb, broadcast, ob, regs);
             }
         });
