@@ -18,7 +18,10 @@ if [ ! -x "$VENV/bin/python" ]; then
 fi
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
 "$VENV/bin/python" -m pip install --quiet "maturin>=1.5,<2" numpy pytest sympy pandas
-# The wheel is built in python/target (reused between runs).
-"$VENV/bin/python" -m pip install --quiet --force-reinstall --no-deps ./python
+# The wheel is built in the workspace's target/ (reused between runs): the
+# dependencies it shares with the Rust tests (same versions, features and
+# release profile) are compiled once for both.
+CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}" \
+  "$VENV/bin/python" -m pip install --quiet --force-reinstall --no-deps ./python
 # From the repository root, so the installed package (not python/chain/) is imported.
 "$VENV/bin/python" -m pytest -p no:cacheprovider python/tests

@@ -19,7 +19,7 @@ this script has its own model of the machine, the exact 4x4 product
   E(d, eps) = [exp([eps x]) (Rodrigues), d]  (to first order the spec's small-angle matrix)
   T_wt = inv(P(x_table)) . P(tool),   p = T_wt(q, e) . tp - T_wt(q, 0) . tp
 
-(machine-format spec section 1, the conventions of tests/common/mod.rs), so
+(machine-format spec section 1, the conventions of tests/it/common/mod.rs), so
 that chain identify recovering truth.yaml from these files checks chain's own
 derivation. Noise: Gaussian, random.Random(SEED).gauss, in the order the rows
 are written; the std of each row is its `std` column.

@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
-"""OpenTURNS' SORM on the three non-normal cases of reliability/tests/sorm.rs.
+"""OpenTURNS' SORM on the three non-normal cases of reliability/tests/it/sorm.rs.
 
 Run by hand (CI has no OpenTURNS):
     python3 -m venv /tmp/ot && /tmp/ot/bin/pip install openturns
     /tmp/ot/bin/python reliability/benches/openturns_sorm.py
 It prints, per case, FORM's beta and the generalised reliability indices of
 Breitung, Hohenbichler-Rackwitz and Tvedt, recorded as constants in
-reliability/tests/sorm.rs. OpenTURNS 1.27.
+reliability/tests/it/sorm.rs. OpenTURNS 1.27.
 """
 import openturns as ot
 

@@ -1,5 +1,5 @@
 // A crate outside the workspace that depends on `chain` alone: the generated
-// code must name only paths reachable through `chain`. tests/downstream.rs
+// code must name only paths reachable through `chain`. tests/it/downstream.rs
 // builds this same file as a crate of its own on `chain` without default
 // features (the library without the CLI).
 use chain::core::ErrorModel;
@@ -24,7 +24,7 @@ chain::machine! {
 
 chain::machine!(pub(crate) Gantry = "examples/machines/gantry_grinder.yaml");
 
-fn main() {
+pub fn main() {
     let s = Slide::sensitivity(&[10.0], &[250.0]);
     // px = dxx - L*eyx (the tool sits L below the slide)
     assert_eq!(s[0][Slide::ERR_DXX], 1.0);
@@ -47,6 +47,8 @@ fn main() {
         chain::core::model::Sided::Upper,
     )
     .unwrap();
-    let form = Form::default().run(&Event::new(&inputs, g).unwrap()).unwrap();
+    let form = Form::default()
+        .run(&Event::new(&inputs, g).unwrap())
+        .unwrap();
     assert!(form.reliability > 0.99);
 }

@@ -24,7 +24,7 @@ chain::machine! {
 
 chain::machine!(pub FromFile = "tests/ui/pass_function_slots.yaml");
 
-fn main() {
+pub fn main() {
     assert_eq!(
         Slide::ERRORS,
         [
