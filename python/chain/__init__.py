@@ -18,6 +18,8 @@ from ._results import Derivation, ReliabilityResult, Result
 from ._results import IdentifyResult, MapResult, PlanResult
 from ._results import Derivation, ReliabilityResult, Result, SobolResult
 from ._results import AllocationResult, GeometricSensitivityResult, SensitivityResult
+from ._results import PositioningResult
+from ._positioning import positioning
 
 __all__ = [
     "AllocationResult",
@@ -26,6 +28,7 @@ __all__ = [
     "IdentifyResult",
     "MapResult",
     "PlanResult",
+    "PositioningResult",
     "Machine",
     "MachineError",
     "Nominal",
@@ -33,6 +36,7 @@ __all__ = [
     "Result",
     "SensitivityResult",
     "SobolResult",
+    "positioning",
 ]
 
 __version__ = "0.1.0"

@@ -135,3 +135,13 @@ def map_json(
     points: Optional[npt.NDArray[np.float64]],
     params: Sequence[Tuple[str, float]],
 ) -> str: ...
+
+# -- positioning runs (python/src/positioning.rs) ------------------------------
+
+def positioning_json(
+    path: Optional[str],
+    text: Optional[str],
+    file: str,
+    k: float,
+    rotary: bool,
+) -> str: ...

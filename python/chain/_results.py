@@ -264,3 +264,19 @@ class AllocationResult(Result):
             {"error": e, "std0": s0, "std": d["final"]["std"][e], "ratio": s0 / d["final"]["std"][e]}
             for e, s0 in d["initial"]["std"].items()
         ]
+
+
+class PositioningResult(Result):
+    """``chain positioning --format json``: the ISO 230-2 evaluation of positioning runs.
+
+    Attributes: ``k``, ``runs``, ``unit``, ``targets`` (per target: means,
+    reversal, s, repeatabilities), ``axis`` (``A``, ``E``, ``M``, ``R``,
+    ``B``, ``B_mean`` and the per-direction values), ``axis_kind``,
+    ``target_unit``, ``file``, ``points``. Rows of ``to_dataframe()``: one
+    per target.
+    """
+
+    command = "positioning"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        return [dict(t) for t in self._document["targets"]]

@@ -3,6 +3,7 @@
 import json
 import os
 import pathlib
+import re
 import subprocess
 
 import pytest
@@ -44,3 +45,14 @@ def cli_error():
         return out.stderr
 
     return run
+
+
+def flat(text):
+    """Text without the CLI renderer's frame, runs of white space made one space: miette wraps long
+    lines (where, depends on the length of the paths in them), so a message is compared flattened."""
+    return " ".join(re.sub(r"[│×╭╰─┬·▶]", " ", text).split())
+
+
+def squeezed(text):
+    """``flat`` without any space: for messages whose wrap falls inside a path."""
+    return flat(text).replace(" ", "")

@@ -6,7 +6,7 @@ refused naming the keyword."""
 import pytest
 
 import chain
-from conftest import MACHINES, ROOT
+from conftest import MACHINES, ROOT, flat
 
 WITH_REQUIREMENT = [p for p in MACHINES if "requirement:" in p.read_text() and "\nstatistics:" in p.read_text()]
 IDS = [p.stem for p in WITH_REQUIREMENT]
@@ -77,7 +77,7 @@ def test_bad_options_are_refused_naming_the_keyword(cli_error):
         m.allocate(level=0.5)
     with pytest.raises(ValueError, match="the step must be positive"):
         m.allocate(strategy="paper", step=0)
-    assert "the step must be positive" in _flat(cli_error("allocate", GANTRY, "--strategy", "paper", "--step", 0))
+    assert "the step must be positive" in flat(cli_error("allocate", GANTRY, "--strategy", "paper", "--step", 0))
     text = GANTRY.read_text()
     assert "  requirement: {min: 0.95, mean: 0.97}\n" in text
     no_req = chain.Machine.from_yaml(text.replace("  requirement: {min: 0.95, mean: 0.97}\n", ""), "no_req.yaml")
@@ -85,6 +85,3 @@ def test_bad_options_are_refused_naming_the_keyword(cli_error):
         no_req.allocate()
 
 
-def _flat(t):
-    """The CLI's message without miette's wrapping (it depends on the path's length)."""
-    return " ".join(t.replace("│", " ").replace("×", " ").replace("╰─▶", " ").split())

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import chain
-from conftest import ROOT
+from conftest import ROOT, squeezed
 
 AC = ROOT / "examples/machines/ac_trunnion.yaml"
 
@@ -118,10 +118,6 @@ tool: x
 """
 
 
-def _flat(text):
-    """The text without the renderer's frame and line breaks (miette wraps long lines)."""
-    return "".join(re.sub(r"[│×╭╰─┬·]", " ", text).split())
-
 
 def test_malformed_machine_raises_machine_error(tmp_path, cli_error):
     with pytest.raises(chain.MachineError) as info:
@@ -136,7 +132,7 @@ def test_malformed_machine_raises_machine_error(tmp_path, cli_error):
         chain.Machine.load(path)
     assert info.value.line == 4 and info.value.key == "bodies.x.bogus"
     # the same message as the CLI's
-    assert _flat(str(info.value)) in _flat(cli_error("derive", path))
+    assert squeezed(str(info.value)) in squeezed(cli_error("derive", path))
 
 
 def test_missing_file_and_reliability_section(tmp_path, cli_error):
@@ -145,7 +141,7 @@ def test_missing_file_and_reliability_section(tmp_path, cli_error):
     m = chain.Machine.load(AC)
     with pytest.raises(chain.MachineError, match="missing key `reliability`") as info:
         m.reliability()
-    assert _flat(str(info.value).splitlines()[0]) in _flat(cli_error("reliability", AC))
+    assert squeezed(str(info.value).splitlines()[0]) in squeezed(cli_error("reliability", AC))
 
 
 def test_missing_statistic_is_located(tmp_path):

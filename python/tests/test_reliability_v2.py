@@ -7,7 +7,7 @@ import math
 import pytest
 
 import chain
-from conftest import MACHINES, ROOT
+from conftest import MACHINES, ROOT, flat
 
 WITH_RELIABILITY = [p for p in MACHINES if "\nreliability:" in p.read_text() and "\nstatistics:" in p.read_text()]
 IDS = [p.stem for p in WITH_RELIABILITY]
@@ -159,9 +159,6 @@ def test_sobol_with_a_grid_is_the_cli_json(cli):
     assert doc["grid"]["x"] == [0.0, 1000.0]
 
 
-def _flat(t):
-    return " ".join(t.replace("│", " ").replace("×", " ").replace("╰─▶", " ").split())
-
 
 @pytest.mark.parametrize("kw,opts,wording", [
     ({"method": "bogus"}, ["--method", "bogus"], "possible values: form, is, mc, subset, directional, sorm"),
@@ -181,7 +178,7 @@ def test_bad_options_are_refused_with_the_cli_wording(kw, opts, wording, cli_err
     with pytest.raises(ValueError) as info:
         chain.Machine.load(GANTRY).reliability(**kw)
     assert wording in str(info.value)
-    assert _flat(wording) in _flat(cli_error("reliability", GANTRY, *opts))
+    assert flat(wording) in flat(cli_error("reliability", GANTRY, *opts))
 
 
 def test_other_bad_options_raise_value_error():

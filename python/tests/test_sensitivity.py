@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import chain
-from conftest import MACHINES, ROOT
+from conftest import MACHINES, ROOT, flat
 from test_reliability_v2 import POSTERIOR
 
 WITH_RELIABILITY = [p for p in MACHINES if "\nreliability:" in p.read_text() and "\nstatistics:" in p.read_text()]
@@ -134,7 +134,7 @@ def test_bad_options_are_refused_naming_the_keyword(cli_error):
         m.sensitivity_reliability(at={"x": 0})
     with pytest.raises(chain.MachineError, match="unknown axis variable `q`"):
         m.geometric_sensitivity(grid={"q": [0]})
-    assert "unknown axis variable" in _flat(cli_error("sensitivity", GANTRY, "--kind", "geometric", "--grid", "q=0"))
+    assert "unknown axis variable" in flat(cli_error("sensitivity", GANTRY, "--kind", "geometric", "--grid", "q=0"))
     with pytest.raises(ValueError, match="sided must be"):
         m.sensitivity_reliability(sided="three")
     with pytest.raises(ValueError, match="non-finite"):
@@ -143,6 +143,3 @@ def test_bad_options_are_refused_naming_the_keyword(cli_error):
         m.sensitivity_reliability(values="no-such.yaml")
 
 
-def _flat(t):
-    """The CLI's message without miette's wrapping (it depends on the path's length)."""
-    return " ".join(t.replace("│", " ").replace("×", " ").replace("╰─▶", " ").split())

@@ -16,6 +16,7 @@ pub mod motion;
 pub mod path;
 pub mod plan;
 pub mod plot;
+pub mod positioning;
 pub mod reliability;
 pub mod report;
 pub mod sensitivity;
@@ -58,6 +59,8 @@ enum Command {
     Plan(plan::PlanArgs),
     /// Compensation for a controller: the axis corrections that cancel a built machine's error (the universal grid CSV; controller formats), with the residual they leave.
     Export(export::ExportArgs),
+    /// ISO 230-2 positioning: the statistics of an axis's bidirectional positioning runs (mean deviation per direction, reversal, repeatability, accuracy).
+    Positioning(positioning::PositioningArgs),
     /// Motion conversion ("Precision Machining Technology of Jewelry on CNC Machine Tool", 2022): CNC axis motions reproducing a cradle-type generator's roll, and their Maclaurin series.
     Motion(motion::MotionArgs),
 }
@@ -78,5 +81,6 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Identify(args) => identify::exec(args),
         Command::Plan(args) => plan::exec(args),
         Command::Export(args) => export::exec(args),
+        Command::Positioning(args) => positioning::exec(args),
     }
 }

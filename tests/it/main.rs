@@ -44,6 +44,7 @@ mod option_ranges;
 mod output_errors;
 mod path;
 mod plan;
+mod positioning;
 mod posterior_reliability;
 mod reliability_cli;
 mod reliability_gantry;

@@ -5,11 +5,13 @@
 //! [`measurements`] reads a measurement (or `chain plan` candidate) CSV
 //! against a [`crate::Machine`] and gives each record's design rows from a
 //! model's exact sensitivity; [`identify`] solves the weighted least-squares
-//! problem (or its Gaussian-prior posterior) through an SVD.
+//! problem (or its Gaussian-prior posterior) through an SVD; [`positioning`]
+//! reads an axis's ISO 230-2 positioning runs and evaluates them.
 
 pub mod document;
 pub mod identify;
 pub mod measurements;
+pub mod positioning;
 
 pub use identify::{identify, Identification, IdentifyError, IdentifyOptions};
 pub use measurements::{

@@ -1,0 +1,67 @@
+"""``chain.positioning``: the ISO 230-2 evaluation of an axis's positioning runs."""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Mapping, Optional, Tuple, Union
+
+import numpy as np
+
+from . import _chain
+from ._results import PositioningResult
+
+
+def _cell(v: Any) -> str:
+    """One CSV cell: strings as written, whole numbers as integers, other numbers in full precision."""
+    if isinstance(v, (str, np.str_)):
+        return str(v)
+    if isinstance(v, (bool, np.bool_)):
+        raise ValueError(f"{v!r} is not a number or a direction")
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    return repr(float(v))
+
+
+def _runs_input(runs: Any) -> Tuple[Optional[str], Optional[str]]:
+    """A run file's path, or its columns (a dict of 1-D sequences or a DataFrame) as the CSV's text."""
+    if isinstance(runs, (str, os.PathLike)):
+        return os.fspath(runs), None
+    if hasattr(runs, "columns") and hasattr(runs, "__getitem__") and not isinstance(runs, Mapping):
+        runs = {str(c): runs[c].to_numpy() for c in runs.columns}
+    if not isinstance(runs, Mapping):
+        raise ValueError(f"runs must be a CSV path or a dict of columns, not {type(runs).__name__}")
+    if not runs:
+        raise ValueError("runs has no column")
+    names = [str(n) for n in runs]
+    columns = [list(np.asarray(v).ravel()) if np.ndim(v) == 1 else None for v in runs.values()]
+    for name, column in zip(names, columns):
+        if column is None:
+            raise ValueError(f"runs[{name!r}]: expected a 1-D column")
+        if len(column) != len(columns[0]):
+            raise ValueError(f"runs[{name!r}] has {len(column)} values, {names[0]!r} has {len(columns[0])}")
+    lines = [",".join(names)]
+    for i in range(len(columns[0])):
+        lines.append(",".join(_cell(c[i]) for c in columns))
+    return None, "\n".join(lines) + "\n"
+
+
+def positioning(
+    runs: Union[str, "os.PathLike[str]", Mapping[str, Any]],
+    k: float = 2,
+    rotary: bool = False,
+    name: str = "<runs>",
+) -> PositioningResult:
+    """The ISO 230-2 evaluation of positioning runs, ``chain positioning RUNS --format json``.
+
+    ``runs``: the run file's path, or its columns as a dict (a pandas
+    DataFrame works too) named as the file's header: ``target``,
+    ``direction`` (``"up"``/``"down"``, ``"+"``/``"-"``), ``run`` (1..n), and
+    ``measured`` or ``deviation`` (mm; degrees with ``rotary``); ``name``
+    names them in messages. ``k``: the coverage factor (``--k``; 2, or 3 for
+    the 1988 edition); ``rotary``: statistics in arcseconds (``--rotary``).
+    A refused file raises ``MachineError`` with the CLI's message, located.
+    """
+    path, text = _runs_input(runs)
+    if isinstance(k, bool):
+        raise ValueError(f"k must be a number, not {k!r}")
+    return PositioningResult._from_json(_chain.positioning_json(path, text, name, float(k), bool(rotary)))

@@ -1,0 +1,69 @@
+"""chain.positioning returns `chain positioning --format json` for the same runs."""
+
+import csv
+
+import numpy as np
+import pytest
+
+import chain
+from conftest import ROOT, squeezed
+
+RUNS = ROOT / "examples/positioning"
+
+
+def _columns(path):
+    with open(path) as f:
+        rows = list(csv.reader(line for line in f if not line.startswith("#")))
+    header, data = rows[0], rows[1:]
+    out = {}
+    for j, name in enumerate(header):
+        column = [r[j] for r in data]
+        if name == "direction":
+            out[name] = np.array(column, dtype=object)
+        elif name == "run":
+            out[name] = np.array(column, dtype=int)
+        else:
+            out[name] = np.array(column, dtype=float)
+    return out
+
+
+@pytest.mark.parametrize("name,rotary", [("x_axis_runs.csv", False), ("c_axis_runs.csv", True)])
+def test_positioning_is_the_cli_json(name, rotary, cli):
+    path = RUNS / name
+    flags = ["--rotary"] if rotary else []
+    r = chain.positioning(path, rotary=rotary)
+    assert r.to_dict() == cli("positioning", path, *flags)
+    assert chain.positioning(path, rotary=rotary, k=3).to_dict() == cli("positioning", path, *flags, "--k", "3")
+    df = r.to_dataframe()
+    assert len(df) == len(r.targets) and list(df["mean_up"]) == [t["mean_up"] for t in r.targets]
+
+
+def test_columns_are_read_as_the_file():
+    path = RUNS / "x_axis_runs.csv"
+    cols = _columns(path)
+    by_columns = chain.positioning(cols, name=str(path)).to_dict()
+    assert by_columns == chain.positioning(path).to_dict()
+    import pandas
+
+    assert chain.positioning(pandas.DataFrame(cols), name=str(path)).to_dict() == by_columns
+
+
+def test_refusals_are_the_cli_messages(cli_error, tmp_path):
+    bad = tmp_path / "twice.csv"
+    bad.write_text("target,direction,run,deviation\n0,up,1,0\n0,up,2,0\n0,down,1,0\n0,down,2,0\n"
+                   "5,up,1,0\n5,up,2,0\n5,down,1,0\n5,down,1,0\n")
+    with pytest.raises(chain.MachineError) as info:
+        chain.positioning(bad)
+    e = info.value
+    assert (e.file, e.line, e.column) == (str(bad), 9, 8)
+    assert "target 5, direction down, run 1 is given twice (first on line 8)" in str(e)
+    assert squeezed(e.message) in squeezed(cli_error("positioning", bad))
+    cols = _columns(RUNS / "x_axis_runs.csv")
+    cols["direction"][3] = "sideways"
+    with pytest.raises(chain.MachineError, match="`sideways` is not a direction") as info:
+        chain.positioning(cols)
+    assert info.value.file == "<runs>" and info.value.line == 5
+    with pytest.raises(ValueError, match=r"the coverage factor k must be a finite number > 0, not 0"):
+        chain.positioning(RUNS / "x_axis_runs.csv", k=0)
+    with pytest.raises(ValueError, match="not both|dict of columns"):
+        chain.positioning(42)

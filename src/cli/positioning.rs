@@ -1,0 +1,232 @@
+//! `chain positioning RUNS.csv [--k 2] [--rotary] [--format table|json|csv]
+//! [--plot DIR]`: the ISO 230-2 evaluation of an axis's bidirectional
+//! positioning runs (`../shared/spec/positioning.md`, `docs/positioning.md`),
+//! through [`chain_core::measured::positioning`].
+
+use std::path::PathBuf;
+
+use chain_core::measured::positioning::{
+    self, AxisKind, Coverage, Direction, PositioningDocument, Runs,
+};
+
+use super::report::{self, Csv, Report};
+
+#[path = "positioning_plot.rs"]
+mod positioning_plot;
+
+/// Output formats of `chain positioning`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PositioningFormat {
+    /// The per-target statistics and the axis values.
+    Table,
+    /// The document of the positioning spec.
+    Json,
+    /// One row per target.
+    Csv,
+}
+
+report::formats!(PositioningFormat: Table, Json, Csv);
+
+/// Arguments of `chain positioning`.
+#[derive(Debug, clap::Args)]
+pub struct PositioningArgs {
+    /// The run file (CSV): `target`, `direction` (`up`/`down`, `+`/`-`),
+    /// `run` (1..n), and `measured` (the reached position) or `deviation`
+    /// (reached minus target); mm, or degrees with `--rotary`.
+    pub runs: PathBuf,
+    /// The coverage factor k: 2 (ISO 230-2:1997-2014) or 3 (the 1988
+    /// edition, VDI/DGQ 3441); any number > 0.
+    #[arg(long, default_value = "2", value_parser = coverage)]
+    pub k: Coverage,
+    /// A rotary axis: targets and deviations in degrees, statistics in
+    /// arcseconds.
+    #[arg(long)]
+    pub rotary: bool,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "table")]
+    pub format: PositioningFormat,
+    /// Write the standard's chart (mean deviation per direction with the
+    /// ±k·s band, each run's points, the reversal) into DIR as PNG and SVG.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+}
+
+/// `--k`: a number the library takes as a coverage factor.
+fn coverage(text: &str) -> Result<Coverage, String> {
+    let k: f64 = text
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number"))?;
+    Coverage::new(k).map_err(|e| e.to_string())
+}
+
+/// Runs `chain positioning`.
+pub fn exec(args: PositioningArgs) -> miette::Result<()> {
+    let kind = if args.rotary {
+        AxisKind::Rotary
+    } else {
+        AxisKind::Linear
+    };
+    let runs = Runs::read(&args.runs, kind)?;
+    let doc = positioning::evaluate(&runs, args.k);
+    if let Some(dir) = &args.plot {
+        for f in positioning_plot::write(dir, &doc)? {
+            eprintln!("wrote {}", f.display());
+        }
+    }
+    report::emit(&doc, args.format.into())
+}
+
+/// A statistic in the table: 6 decimals in mm (0.001 µm), 3 in arcseconds.
+fn cell(doc: &PositioningDocument, v: f64) -> String {
+    match doc.unit {
+        positioning::Unit::Mm => format!("{v:.6}"),
+        positioning::Unit::Arcsec => format!("{v:.3}"),
+    }
+}
+
+impl Report for PositioningDocument {
+    fn table(&self) -> String {
+        use std::fmt::Write;
+        let u = self.unit.name();
+        let mut out = String::new();
+        let _ = writeln!(
+            out,
+            "ISO 230-2 positioning of {} ({} axis, {} targets, {} runs per direction, k = {}; deviations in {u})",
+            if self.file.is_empty() { "the runs" } else { &self.file },
+            self.axis_kind,
+            self.targets.len(),
+            self.runs,
+            serde_json::to_string(&self.k).unwrap_or_default(),
+        );
+        let _ = writeln!(out);
+        let header = [
+            format!("target ({})", self.target_unit),
+            "mean ↑".into(),
+            "mean ↓".into(),
+            "mean".into(),
+            "reversal B".into(),
+            "s ↑".into(),
+            "s ↓".into(),
+            "R ↑".into(),
+            "R ↓".into(),
+            "R".into(),
+        ];
+        let rows: Vec<[String; 10]> = self
+            .targets
+            .iter()
+            .map(|t| {
+                [
+                    format!("{}", t.target),
+                    cell(self, t.mean_up),
+                    cell(self, t.mean_down),
+                    cell(self, t.mean),
+                    cell(self, t.reversal),
+                    cell(self, t.s_up),
+                    cell(self, t.s_down),
+                    cell(self, t.repeatability_up),
+                    cell(self, t.repeatability_down),
+                    cell(self, t.repeatability),
+                ]
+            })
+            .collect();
+        let widths: Vec<usize> = (0..header.len())
+            .map(|c| {
+                rows.iter()
+                    .map(|r| r[c].chars().count())
+                    .chain([header[c].chars().count()])
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect();
+        let line = |cells: &[String]| -> String {
+            let parts: Vec<String> = cells
+                .iter()
+                .zip(&widths)
+                .map(|(c, w)| format!("{c:>w$}", w = *w))
+                .collect();
+            parts.join("  ").trim_end().to_string()
+        };
+        let _ = writeln!(out, "{}", line(&header));
+        for r in &rows {
+            let _ = writeln!(out, "{}", line(r));
+        }
+        let a = &self.axis;
+        let _ = writeln!(out);
+        let _ = writeln!(out, "axis ({u}):");
+        let pairs = [
+            ("A  accuracy", a.A, a.A_up, a.A_down),
+            ("E  systematic deviation", a.E, a.E_up, a.E_down),
+            ("R  repeatability", a.R, a.R_up, a.R_down),
+        ];
+        for (name, both, up, down) in pairs {
+            let _ = writeln!(
+                out,
+                "  {name:<26} {:>12}   ↑ {:>12}   ↓ {:>12}",
+                cell(self, both),
+                cell(self, up),
+                cell(self, down)
+            );
+        }
+        let _ = writeln!(
+            out,
+            "  {:<26} {:>12}",
+            "M  mean deviation range",
+            cell(self, a.M)
+        );
+        let _ = writeln!(
+            out,
+            "  {:<26} {:>12}   mean B̄ {:>12}",
+            "B  reversal",
+            cell(self, a.B),
+            cell(self, a.B_mean)
+        );
+        out
+    }
+
+    fn csv(&self) -> Option<Csv> {
+        let mut c = Csv::new([
+            "target",
+            "mean_up",
+            "mean_down",
+            "mean",
+            "reversal",
+            "s_up",
+            "s_down",
+            "repeatability_up",
+            "repeatability_down",
+            "repeatability",
+        ]);
+        for t in &self.targets {
+            c.row(
+                [
+                    t.target,
+                    t.mean_up,
+                    t.mean_down,
+                    t.mean,
+                    t.reversal,
+                    t.s_up,
+                    t.s_down,
+                    t.repeatability_up,
+                    t.repeatability_down,
+                    t.repeatability,
+                ]
+                .map(|v| format!("{v:?}")),
+            );
+        }
+        Some(c)
+    }
+}
+
+/// The points of each direction's runs, for the chart.
+fn run_points(doc: &PositioningDocument, direction: Direction) -> Vec<(f64, f64)> {
+    doc.points
+        .iter()
+        .filter(|r| r.direction == direction)
+        .flat_map(|r| {
+            doc.targets
+                .iter()
+                .zip(&r.deviations)
+                .map(|(t, &x)| (t.target, x))
+        })
+        .collect()
+}
