@@ -479,8 +479,8 @@ def _values_input(machine: "Machine", values: Any) -> Tuple[Optional[str], Optio
     return None, text, "<values>"
 
 
-def _csv_input(data: Any, what: str) -> Tuple[Optional[str], Optional[str]]:
-    """A CSV path, or columns (a dict of 1-D arrays, or a DataFrame) as the CSV's text."""
+def _table_source(data: Any, what: str) -> Tuple[Optional[str], Optional[Mapping[str, Any]]]:
+    """A CSV given as its path (``(path, None)``) or as columns: a dict, or a DataFrame's (``(None, columns)``)."""
     if isinstance(data, (str, os.PathLike)):
         return os.fspath(data), None
     if hasattr(data, "columns") and hasattr(data, "__getitem__") and not isinstance(data, Mapping):
@@ -489,6 +489,14 @@ def _csv_input(data: Any, what: str) -> Tuple[Optional[str], Optional[str]]:
         raise ValueError(f"{what} must be a CSV path or a dict of columns, not {type(data).__name__}")
     if not data:
         raise ValueError(f"{what} has no column")
+    return None, data
+
+
+def _csv_input(data: Any, what: str) -> Tuple[Optional[str], Optional[str]]:
+    """A CSV path, or columns (a dict of 1-D arrays, or a DataFrame) as the CSV's text."""
+    path, data = _table_source(data, what)
+    if data is None:
+        return path, None
     names = [str(n) for n in data]
     columns = []
     n = None

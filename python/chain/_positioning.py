@@ -8,6 +8,7 @@ from typing import Any, Mapping, Optional, Tuple, Union
 import numpy as np
 
 from . import _chain
+from ._machine import _table_source
 from ._results import PositioningResult
 
 
@@ -24,14 +25,9 @@ def _cell(v: Any) -> str:
 
 def _runs_input(runs: Any) -> Tuple[Optional[str], Optional[str]]:
     """A run file's path, or its columns (a dict of 1-D sequences or a DataFrame) as the CSV's text."""
-    if isinstance(runs, (str, os.PathLike)):
-        return os.fspath(runs), None
-    if hasattr(runs, "columns") and hasattr(runs, "__getitem__") and not isinstance(runs, Mapping):
-        runs = {str(c): runs[c].to_numpy() for c in runs.columns}
-    if not isinstance(runs, Mapping):
-        raise ValueError(f"runs must be a CSV path or a dict of columns, not {type(runs).__name__}")
-    if not runs:
-        raise ValueError("runs has no column")
+    path, runs = _table_source(runs, "runs")
+    if runs is None:
+        return path, None
     names = [str(n) for n in runs]
     columns = [list(np.asarray(v).ravel()) if np.ndim(v) == 1 else None for v in runs.values()]
     for name, column in zip(names, columns):

@@ -13,7 +13,8 @@ MACHINES = sorted((ROOT / "examples" / "machines").glob("*.yaml"))
 
 
 def cli_binary() -> pathlib.Path:
-    """The release `chain` binary (built by test.sh's cargo test; built here if absent)."""
+    """The `chain` binary: `CHAIN_CLI` (test.sh sets it to the one its Rust tests built,
+    target/ci/chain), else the release binary, built here if absent."""
     exe = pathlib.Path(os.environ.get("CHAIN_CLI", ROOT / "target" / "release" / "chain"))
     if not exe.exists():
         subprocess.run(["cargo", "build", "--release", "--quiet"], cwd=ROOT, check=True)
