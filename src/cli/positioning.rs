@@ -5,9 +5,7 @@
 
 use std::path::PathBuf;
 
-use chain_core::measured::positioning::{
-    self, AxisKind, Coverage, Direction, PositioningDocument, Runs,
-};
+use chain_core::measured::positioning::{self, AxisKind, Coverage, PositioningDocument, Runs};
 
 use super::report::{self, Csv, Report};
 
@@ -96,7 +94,7 @@ impl Report for PositioningDocument {
             self.axis_kind,
             self.targets.len(),
             self.runs,
-            serde_json::to_string(&self.k).unwrap_or_default(),
+            self.k,
         );
         let _ = writeln!(out);
         let header = [
@@ -215,18 +213,4 @@ impl Report for PositioningDocument {
         }
         Some(c)
     }
-}
-
-/// The points of each direction's runs, for the chart.
-fn run_points(doc: &PositioningDocument, direction: Direction) -> Vec<(f64, f64)> {
-    doc.points
-        .iter()
-        .filter(|r| r.direction == direction)
-        .flat_map(|r| {
-            doc.targets
-                .iter()
-                .zip(&r.deviations)
-                .map(|(t, &x)| (t.target, x))
-        })
-        .collect()
 }

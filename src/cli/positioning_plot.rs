@@ -9,7 +9,6 @@ use std::path::{Path, PathBuf};
 
 use chain_core::measured::positioning::{Direction, PositioningDocument};
 
-use super::run_points;
 use crate::cli::plot::{self, Legend, PlotError, Series, XyChart};
 
 /// A statistic in a title: four significant digits.
@@ -26,7 +25,7 @@ fn short(v: f64) -> String {
 /// `dir` (created if missing) and returns the paths written.
 pub fn write(dir: &Path, doc: &PositioningDocument) -> Result<Vec<PathBuf>, PlotError> {
     let u = doc.unit.name();
-    let k = serde_json::to_string(&doc.k).unwrap_or_default();
+    let k = doc.k;
     let x_label = format!("target ({})", doc.target_unit);
     let a = &doc.axis;
     let up = plot::color(0);
@@ -114,4 +113,18 @@ pub fn write(dir: &Path, doc: &PositioningDocument) -> Result<Vec<PathBuf>, Plot
     .hline(0.0);
     written.extend(reversal.write(dir, "positioning_reversal")?);
     Ok(written)
+}
+
+/// The points of each direction's runs, for the chart.
+fn run_points(doc: &PositioningDocument, direction: Direction) -> Vec<(f64, f64)> {
+    doc.points
+        .iter()
+        .filter(|r| r.direction == direction)
+        .flat_map(|r| {
+            doc.targets
+                .iter()
+                .zip(&r.deviations)
+                .map(|(t, &x)| (t.target, x))
+        })
+        .collect()
 }

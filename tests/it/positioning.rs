@@ -63,8 +63,13 @@ fn independent(table: &Table, k: f64) -> Value {
         rd.push(rid);
         r.push(ri);
     }
-    let max = |v: &[f64]| spread(v.to_vec()) + v.iter().copied().fold(f64::MAX, f64::min);
-    let min = |v: &[f64]| v.iter().copied().fold(f64::MAX, f64::min);
+    let sorted = |v: &[f64]| {
+        let mut v = v.to_vec();
+        v.sort_by(f64::total_cmp);
+        v
+    };
+    let max = |v: &[f64]| sorted(v)[v.len() - 1];
+    let min = |v: &[f64]| sorted(v)[0];
     let both_hi: Vec<f64> = hi_u.iter().chain(&hi_d).copied().collect();
     let both_lo: Vec<f64> = lo_u.iter().chain(&lo_d).copied().collect();
     let axis = serde_json::json!({

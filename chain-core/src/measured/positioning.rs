@@ -139,9 +139,6 @@ pub struct TargetRuns {
     pub up: Vec<f64>,
     /// `x_ij↓`, run `j` at index `j − 1`.
     pub down: Vec<f64>,
-    /// The run file's line of each value (`[up, down]`, per run; 0 when built
-    /// from Rust).
-    pub lines: [Vec<usize>; 2],
 }
 
 /// The positioning runs of one axis: every target approached `n` times from
@@ -210,12 +207,7 @@ impl Runs {
             if !target.is_finite() || up.iter().chain(&down).any(|x| !x.is_finite()) {
                 return Err(RunsError::NotFinite { target });
             }
-            out.push(TargetRuns {
-                target,
-                lines: [vec![0; up.len()], vec![0; down.len()]],
-                up,
-                down,
-            });
+            out.push(TargetRuns { target, up, down });
         }
         out.sort_by(|a, b| a.target.total_cmp(&b.target));
         if let Some(w) = out.windows(2).find(|w| w[0].target == w[1].target) {
@@ -502,29 +494,17 @@ fn group(mut cells: Vec<Cell>, kind: AxisKind, file: &str) -> Result<Runs, Locat
             ));
         }
     }
-    let mut targets: Vec<(Vec<&Cell>, Vec<&Cell>)> = Vec::new();
-    for c in &cells {
-        if targets
-            .last()
-            .is_none_or(|(u, d)| u.first().or(d.first()).map(|f| f.target) != Some(c.target))
-        {
-            targets.push((Vec::new(), Vec::new()));
-        }
-        let (up, down) = targets.last_mut().expect("pushed");
-        match c.direction {
-            Direction::Up => up.push(c),
-            Direction::Down => down.push(c),
-        }
-    }
-    // The first line of each target: where its problems are reported.
-    let first_of = |t: &(Vec<&Cell>, Vec<&Cell>)| -> Cell {
-        (*t.0
-            .iter()
-            .chain(&t.1)
+    // One chunk per target, its up rows first (sorted above).
+    let targets: Vec<(&[Cell], &[Cell])> = cells
+        .chunk_by(|a, b| a.target == b.target)
+        .map(|rows| rows.split_at(rows.partition_point(|c| c.direction == Direction::Up)))
+        .collect();
+    // A target's first row in the file: where its problems are reported.
+    fn first_of<'a>(t: &(&'a [Cell], &'a [Cell])) -> &'a Cell {
+        (t.0.iter().chain(t.1))
             .min_by_key(|c| c.target_origin.line)
-            .expect("a row"))
-        .clone()
-    };
+            .expect("a chunk has a row")
+    }
     if targets.len() < 2 {
         let only = first_of(&targets[0]);
         return Err(located(
@@ -545,7 +525,7 @@ fn group(mut cells: Vec<Cell>, kind: AxisKind, file: &str) -> Result<Runs, Locat
         .max()
         .unwrap_or(0);
     for t in &targets {
-        for (dir, list) in Direction::BOTH.iter().zip([&t.0, &t.1]) {
+        for (dir, list) in Direction::BOTH.iter().zip([t.0, t.1]) {
             let missing = (1..=runs).find(|j| !list.iter().any(|c| c.run == *j));
             if let Some(j) = missing {
                 let first = first_of(t);
@@ -576,15 +556,11 @@ fn group(mut cells: Vec<Cell>, kind: AxisKind, file: &str) -> Result<Runs, Locat
         ));
     }
     let targets = targets
-        .into_iter()
-        .map(|(up, down)| TargetRuns {
-            target: up[0].target,
-            lines: [
-                up.iter().map(|c| c.target_origin.line).collect(),
-                down.iter().map(|c| c.target_origin.line).collect(),
-            ],
-            up: up.iter().map(|c| c.deviation).collect(),
-            down: down.iter().map(|c| c.deviation).collect(),
+        .iter()
+        .map(|t| TargetRuns {
+            target: first_of(t).target,
+            up: t.0.iter().map(|c| c.deviation).collect(),
+            down: t.1.iter().map(|c| c.deviation).collect(),
         })
         .collect();
     Ok(Runs {
@@ -620,6 +596,14 @@ impl Coverage {
     /// The value.
     pub fn get(self) -> f64 {
         self.0
+    }
+}
+
+/// `2`, `3`, `2.5`: as the user wrote it (Rust prints a whole `f64` without
+/// a fraction).
+impl std::fmt::Display for Coverage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
     }
 }
 
@@ -873,7 +857,6 @@ mod tests {
         assert_eq!(r.targets[0].down, [0.3, 0.5]);
         assert_eq!(r.targets[1].up, [0.7, 0.6]);
         assert_eq!(r.targets[1].down, [0.8, 0.4]);
-        assert_eq!(r.targets[1].lines, [vec![8, 7], vec![9, 2]]);
     }
 
     #[test]
@@ -972,6 +955,10 @@ mod tests {
         assert_eq!(
             serde_json::to_string(&Coverage::new(2.5).unwrap()).unwrap(),
             "2.5"
+        );
+        assert_eq!(
+            format!("{} {}", Coverage::ISO, Coverage::new(2.5).unwrap()),
+            "2 2.5"
         );
         assert_eq!(
             Coverage::new(0.0).unwrap_err().to_string(),
