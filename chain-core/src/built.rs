@@ -406,6 +406,7 @@ impl<M: ErrorModel + Sync> BuiltMachine<M> {
             points,
             errors,
             summary,
+            reversals: self.values.reversals(),
         })
     }
 
@@ -829,6 +830,10 @@ pub struct MapResult {
     pub errors: Vec<[f64; 6]>,
     /// The summary.
     pub summary: MapSummary,
+    /// Per bidirectional table of the values, the reversal that the
+    /// approach read leaves out (docs/values.md, "Direction"); serialised
+    /// as `reversals` after the spec's keys, only when there are any.
+    pub reversals: Vec<crate::values::Reversal>,
 }
 
 impl MapResult {
@@ -855,11 +860,16 @@ impl MapResult {
 
 impl Serialize for MapResult {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let mut s = serializer.serialize_struct("MapResult", 4)?;
+        let mut s = serializer.serialize_struct("MapResult", 5)?;
         s.serialize_field("machine", &self.machine)?;
         s.serialize_field("frame", &self.frame)?;
         s.serialize_field("points", &PointList(self))?;
         s.serialize_field("summary", &self.summary)?;
+        if self.reversals.is_empty() {
+            s.skip_field("reversals")?;
+        } else {
+            s.serialize_field("reversals", &self.reversals)?;
+        }
         s.end()
     }
 }

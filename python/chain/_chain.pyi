@@ -134,6 +134,7 @@ def map_json(
     grid: Sequence[Tuple[str, Sequence[float]]],
     points: Optional[npt.NDArray[np.float64]],
     params: Sequence[Tuple[str, float]],
+    approach: Optional[str],
 ) -> str: ...
 
 # -- positioning runs (python/src/positioning.rs) ------------------------------

@@ -246,6 +246,7 @@ class Machine:
         grid: Optional[Mapping[str, Sequence[float]]] = None,
         points: Optional[ArrayLike] = None,
         params: Params = None,
+        approach: Union[None, str, Mapping[str, str]] = None,
     ) -> "MapResult":
         """The error map of the built machine, ``chain map --values VALUES --format json``.
 
@@ -254,6 +255,9 @@ class Machine:
         dict (mm and rad). ``grid``: axes replacing the file's
         ``reliability.grid`` (``--grid``); ``points``: an ``(N, V)`` array of
         axis values in ``variables`` order instead (``--axes``).
+        ``approach``: which direction of the bidirectional tables to map
+        (``--approach``): ``"up"``, ``"down"``, ``"mean"`` (the default),
+        ``"x=up,y=down"`` or ``{"x": "up"}``.
         """
         from ._results import MapResult
 
@@ -261,7 +265,11 @@ class Machine:
         q = None
         if points is not None:
             q, _ = _rows(points, "points", len(self.variables), "the variables " + ", ".join(self.variables))
-        text_json = _chain.map_json(self._model, path, text, name, _grid_axes(grid), q, _params(params))
+        if isinstance(approach, Mapping):
+            approach = ",".join(f"{k}={v}" for k, v in approach.items())
+        text_json = _chain.map_json(
+            self._model, path, text, name, _grid_axes(grid), q, _params(params), approach
+        )
         return MapResult._from_json(text_json)
 
     def identify(

@@ -117,7 +117,8 @@ class MapResult(Result):
 
     Attributes: ``machine``, ``frame``, ``points`` (one dict per point:
     ``point``, ``error`` px..oz, ``volumetric``), ``summary`` (the ISO
-    230-1-style summary). Rows of ``to_dataframe()``: one per point, the
+    230-1-style summary), and with bidirectional tables ``reversals`` (per
+    table the reversal the chosen approach leaves out). Rows of ``to_dataframe()``: one per point, the
     axis variables, px..oz and ``volumetric`` as columns.
     """
 

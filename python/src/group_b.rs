@@ -204,7 +204,7 @@ fn grid_axes(
 /// from `values_path` or `values_text` named `values_file`) over the grid
 /// (`grid` overriding the file's) or at the rows of `points` (`(N, V)`).
 #[pyfunction]
-#[pyo3(signature = (model, values_path, values_text, values_file, grid, points, params))]
+#[pyo3(signature = (model, values_path, values_text, values_file, grid, points, params, approach))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn map_json(
     py: Python<'_>,
@@ -215,9 +215,17 @@ pub(crate) fn map_json(
     grid: Vec<(String, Vec<f64>)>,
     points: Option<PyReadonlyArray2<'_, f64>>,
     params: Vec<(String, f64)>,
+    approach: Option<&str>,
 ) -> PyResult<String> {
     let m = &model.machine;
-    let (values, name) = read_values(py, m, values_path, values_text, values_file)?;
+    let (mut values, name) = read_values(py, m, values_path, values_text, values_file)?;
+    if let Some(text) = approach {
+        let choices = chain_core::values::parse_approaches(text)
+            .map_err(|e| value_error(format!("approach: {e}")))?;
+        values
+            .choose_approach(&choices)
+            .map_err(|e| value_error(format!("approach: {e} (values {name})")))?;
+    }
     let p = model.parameter_vector(py, &params)?;
     let points = match &points {
         Some(q) => {

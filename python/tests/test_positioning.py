@@ -67,3 +67,23 @@ def test_refusals_are_the_cli_messages(cli_error, tmp_path):
         chain.positioning(RUNS / "x_axis_runs.csv", k=0)
     with pytest.raises(ValueError, match="not both|dict of columns"):
         chain.positioning(42)
+
+
+def test_map_with_an_approach_is_the_cli_json(cli, tmp_path):
+    """A run written by `chain positioning --values-out`, mapped per approach, equals the CLI's JSON."""
+    vmc3 = ROOT / "examples/machines/vmc3.yaml"
+    values = tmp_path / "x.yaml"
+    cli("positioning", RUNS / "x_axis_runs.csv", "--values-out", values, "--machine", vmc3, "--slot", "EXX")
+    m = chain.Machine.load(vmc3)
+    grid = {"x": [0.0, 102.8, 1000.0], "y": [0.0], "z": [0.0]}
+    args = ["map", vmc3, "--values", values, "--grid", "x=0,102.8,1000", "--grid", "y=0", "--grid", "z=0"]
+    for approach, flag in [(None, []), ("up", ["--approach", "up"]), ({"x": "down"}, ["--approach", "x=down"])]:
+        got = m.map(values, grid=grid, approach=approach)
+        assert got.to_dict() == cli(*args, *flag)
+    up = m.map(values, grid=grid, approach="up")
+    assert up.reversals[0]["name"] == "EXX" and up.reversals[0]["approach"] == "up"
+    assert up.points[0]["error"]["px"] == pytest.approx(0.0026352, abs=1e-12)  # x̄↑ at 0 mm (chain positioning)
+    with pytest.raises(ValueError, match="no table along `y` has a reverse direction"):
+        m.map(values, grid=grid, approach={"y": "up"})
+    with pytest.raises(ValueError, match="`sideways` is not an approach direction"):
+        m.map(values, grid=grid, approach="sideways")

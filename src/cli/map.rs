@@ -24,7 +24,7 @@ use std::path::PathBuf;
 use chain_core::built::{BuiltMachine, MapError, MapSummary, Points};
 use chain_core::compensation::controllers::{Controller, ExportOptions, DEFAULT_STEP};
 use chain_core::model::Frame;
-use chain_core::values::{Entry, EntryKind, Given, Values};
+use chain_core::values::{parse_approaches, Approach, Entry, EntryKind, Given, Reversal, Values};
 use chain_core::MapResult;
 use miette::MietteDiagnostic;
 use reliability::machine;
@@ -69,6 +69,11 @@ pub struct MapArgs {
     /// `VAR=LO:HI:N` for N evenly spaced values from LO to HI (repeatable).
     #[arg(long = "grid", value_name = "VAR=V1,V2,...|VAR=LO:HI:N", value_parser = parse_grid_axis)]
     pub grid: Vec<(String, Vec<f64>)>,
+    /// Which approach direction of the bidirectional tables to map:
+    /// `up`, `down` or `mean` (the default) for every axis, or per axis
+    /// `x=up,y=down` (repeatable; docs/values.md, "Direction").
+    #[arg(long, value_name = "DIR|VAR=DIR,...", value_parser = parse_approaches)]
+    pub approach: Vec<Vec<(Option<String>, Approach)>>,
     /// Points from a CSV instead of the grid: a header naming every axis
     /// variable (any order; rotary ones in radians), an optional leading
     /// column `t`; `-` reads stdin.
@@ -147,7 +152,13 @@ pub(crate) fn parse_grid_axis(s: &str) -> Result<(String, Vec<f64>), String> {
 pub fn exec(args: MapArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
-    let values = Values::read(&args.values, m)?;
+    let mut values = Values::read(&args.values, m)?;
+    let choices: Vec<_> = args.approach.iter().flatten().cloned().collect();
+    if !choices.is_empty() {
+        values
+            .choose_approach(&choices)
+            .map_err(|e| miette::miette!("--approach: {e} (values {})", args.values.display()))?;
+    }
     let params = machine::parameters(m, &args.param.params).map_err(|e| loaded.report(e))?;
     let (points, input) = match &args.axes {
         Some(path) => {
@@ -212,6 +223,7 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
         input,
         result,
         compensated,
+        reversals: built.values().reversals(),
     };
     if let Some(dir) = &args.plot {
         for f in map_plot::write_all(dir, &doc, &built)? {
@@ -231,6 +243,7 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
                 input: doc.input.clone(),
                 result: Mapped::Full(r),
                 compensated: None,
+                reversals: doc.reversals.clone(),
             };
             for f in map_plot::write_all(&dir.join("compensated"), &after, &built)? {
                 eprintln!("wrote {}", f.display());
@@ -551,6 +564,8 @@ pub(crate) struct MapDoc {
     pub(crate) result: Mapped,
     /// The map after compensation (`--compensated`).
     compensated: Option<Compensated>,
+    /// Per bidirectional table, the reversal the approach read leaves out.
+    reversals: Vec<Reversal>,
 }
 
 /// The error left after a controller's compensation, at the map's points.
@@ -575,12 +590,13 @@ struct CompensatedDoc<'a> {
     map: &'a MapResult,
 }
 
-/// The spec's JSON document with `compensated` added.
+/// The spec's JSON document, with `compensated` (`--compensated`) added.
 #[derive(Serialize)]
-struct WithCompensated<'a> {
+struct MapJson<'a> {
     #[serde(flatten)]
     map: &'a MapResult,
-    compensated: CompensatedDoc<'a>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    compensated: Option<CompensatedDoc<'a>>,
 }
 
 impl MapDoc {
@@ -595,19 +611,18 @@ impl MapDoc {
 
 impl Serialize for MapDoc {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        match (self.full(), &self.compensated) {
-            (Some(r), None) => r.serialize(s),
-            (Some(r), Some(c)) => WithCompensated {
-                map: r,
-                compensated: CompensatedDoc {
-                    controller: c.controller,
-                    correction_nodes: c.nodes,
-                    map: &c.result,
-                },
-            }
-            .serialize(s),
-            (None, _) => Err(serde::ser::Error::custom("the map kept no point")),
+        let Some(map) = self.full() else {
+            return Err(serde::ser::Error::custom("the map kept no point"));
+        };
+        MapJson {
+            map,
+            compensated: self.compensated.as_ref().map(|c| CompensatedDoc {
+                controller: c.controller,
+                correction_nodes: c.nodes,
+                map: &c.result,
+            }),
         }
+        .serialize(s)
     }
 }
 
@@ -665,6 +680,32 @@ impl Report for MapDoc {
             constants,
             if constants == 1 { "" } else { "s" },
         );
+        for r in &self.reversals {
+            let (f, unit) = if r.unit == "mm" {
+                (1e3, "µm")
+            } else {
+                (1e6, "µrad")
+            };
+            let read = match r.approach {
+                Approach::Mean => format!(
+                    "the map reads their mean, leaving out ±{:.3} {unit}",
+                    r.left_out * f
+                ),
+                a => format!(
+                    "the map reads `{a}`, leaving out up to {:.3} {unit} when approached the other way",
+                    r.left_out * f
+                ),
+            };
+            let _ = writeln!(
+                out,
+                "reversal of {} along {}: up to {:.3} {unit} between the approach directions ({} = {}); {read}",
+                r.name,
+                r.variable,
+                r.largest * f,
+                r.variable,
+                number(r.at)
+            );
+        }
         match &self.input {
             Input::Grid(axes) => {
                 let desc: Vec<String> = axes

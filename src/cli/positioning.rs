@@ -6,6 +6,7 @@
 use std::path::PathBuf;
 
 use chain_core::measured::positioning::{self, AxisKind, Coverage, PositioningDocument, Runs};
+use chain_core::measured::positioning_values;
 
 use super::report::{self, Csv, Report};
 
@@ -47,6 +48,18 @@ pub struct PositioningArgs {
     /// ±k·s band, each run's points, the reversal) into DIR as PNG and SVG.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    /// Write the run into a values file: the mean deviation per approach
+    /// direction and its standard deviation per target, in the error motion
+    /// `--slot` of the machine `--machine` (docs/positioning.md).
+    #[arg(long, value_name = "VALUES.yaml", requires_all = ["machine", "slot"])]
+    pub values_out: Option<PathBuf>,
+    /// The machine file the values are for (with `--values-out`).
+    #[arg(long, value_name = "FILE", requires = "values_out")]
+    pub machine: Option<PathBuf>,
+    /// The machine's name for the axis's positioning error, e.g. `EXX`
+    /// (with `--values-out`).
+    #[arg(long, value_name = "NAME", requires = "values_out")]
+    pub slot: Option<String>,
 }
 
 /// `--k`: a number the library takes as a coverage factor.
@@ -66,6 +79,26 @@ pub fn exec(args: PositioningArgs) -> miette::Result<()> {
     };
     let runs = Runs::read(&args.runs, kind)?;
     let doc = positioning::evaluate(&runs, args.k);
+    if let (Some(out), Some(file), Some(name)) = (&args.values_out, &args.machine, &args.slot) {
+        let machine = chain_core::load_file(file)?;
+        let slot = positioning_values::slot(&machine, name, kind).map_err(|e| {
+            miette::Report::new(*e).wrap_err(format!("--slot {name} (machine {})", file.display()))
+        })?;
+        let text = positioning_values::values_file(
+            &doc,
+            &machine,
+            &slot,
+            &args.runs.display().to_string(),
+        );
+        super::atomic::write(out, text.as_bytes())
+            .map_err(|e| miette::miette!("cannot write {}: {e}", out.display()))?;
+        eprintln!(
+            "wrote {} ({} of {})",
+            out.display(),
+            slot.name,
+            slot.variable
+        );
+    }
     if let Some(dir) = &args.plot {
         for f in positioning_plot::write(dir, &doc)? {
             eprintln!("wrote {}", f.display());

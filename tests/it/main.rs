@@ -45,6 +45,7 @@ mod output_errors;
 mod path;
 mod plan;
 mod positioning;
+mod positioning_values;
 mod posterior_reliability;
 mod reliability_cli;
 mod reliability_gantry;

@@ -11,11 +11,11 @@ use serde_json::Value;
 use crate::common::cli::{fails, ok, ok_json, ok_stdout, scratch, scratch_file, unwrapped};
 
 /// Per target: `(P_i, x↑ per run, x↓ per run)`.
-type Table = Vec<(f64, Vec<f64>, Vec<f64>)>;
+pub(crate) type Table = Vec<(f64, Vec<f64>, Vec<f64>)>;
 
 /// Mean and `n − 1` standard deviation by Welford's one-pass update (chain
 /// uses a sum, then a second pass about the mean).
-fn welford(x: &[f64]) -> (f64, f64) {
+pub(crate) fn welford(x: &[f64]) -> (f64, f64) {
     let (mut mean, mut m2) = (0.0, 0.0);
     for (i, &v) in x.iter().enumerate() {
         let d = v - mean;
@@ -188,7 +188,7 @@ fn known_answers_in_closed_form() {
 }
 
 /// The test's own reading of a run file: split lines and commas.
-fn read_runs(path: &str, scale: f64) -> Table {
+pub(crate) fn read_runs(path: &str, scale: f64) -> Table {
     let text = std::fs::read_to_string(crate::common::root().join(path)).unwrap();
     let mut lines = text
         .lines()

@@ -321,6 +321,7 @@ impl<M: ErrorModel + Sync> BuiltMachine<M> {
             points,
             errors,
             summary,
+            reversals: self.values().reversals(),
         })
     }
 }

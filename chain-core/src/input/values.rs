@@ -63,7 +63,14 @@ pub const ENTRY_KEYS: &[&str] = &[
     "column",
     "interpolation",
     "extrapolate",
+    "reverse",
+    "reverse_std",
+    "reverse_points",
+    "std_points",
+    "reverse_std_points",
 ];
+/// Values of `chain map --approach` and [`Approach`].
+pub const APPROACHES: &[&str] = &["up", "down", "mean"];
 /// Linear units.
 pub const LINEAR_UNITS: &[&str] = &["mm", "um"];
 /// Angular units.
@@ -238,6 +245,25 @@ pub enum BindError {
         /// The function.
         function: String,
     },
+    /// A standard deviation of the reverse direction without a reverse
+    /// direction.
+    #[error("`{name}` has a reverse standard deviation but no reverse direction")]
+    ReverseStdWithoutReverse {
+        /// The name.
+        name: String,
+    },
+    /// A negative standard deviation in a table.
+    #[error("the standard deviations of `{name}` ({table}) must be ≥ 0: point {index} is {value}")]
+    NegativeStd {
+        /// The name.
+        name: String,
+        /// Where the table came from.
+        table: String,
+        /// The point (0-based).
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
     /// A constant that is infinite or NaN.
     #[error("the value of `{name}` must be finite, got {value}")]
     NotFinite {
@@ -287,7 +313,147 @@ pub enum Given {
         interpolation: Interpolation,
         /// What it gives outside its range.
         extrapolation: Extrapolation,
+        /// Where the other approach direction's points came from
+        /// (`reverse_points` or `FILE.csv, column NAME`), if given.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        reverse: Option<String>,
+        /// Where the per-position standard deviations came from, if given.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        std: Option<String>,
+        /// Where the other direction's standard deviations came from.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        reverse_std: Option<String>,
     },
+}
+
+/// Which approach direction of a bidirectional error motion is read
+/// (docs/values.md, "Direction"). A table without a reverse direction reads
+/// the same for all three.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Approach {
+    /// The position approached moving in the positive direction (ISO 230-2
+    /// ↑): the table's main values.
+    Up,
+    /// Approached moving in the negative direction (↓): its `reverse` values.
+    Down,
+    /// The mean of the two, `(up + down)/2` (ISO 230-2:2014 2.14, the mean
+    /// bidirectional positional deviation `x̄_i`): the default.
+    #[default]
+    Mean,
+}
+
+impl Approach {
+    /// `up`, `down` or `mean`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Approach::Up => "up",
+            Approach::Down => "down",
+            Approach::Mean => "mean",
+        }
+    }
+}
+
+impl std::fmt::Display for Approach {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Approach {
+    type Err = String;
+    fn from_str(text: &str) -> Result<Approach, String> {
+        match text {
+            "up" | "+" => Ok(Approach::Up),
+            "down" | "-" => Ok(Approach::Down),
+            "mean" => Ok(Approach::Mean),
+            _ => Err(format!(
+                "`{text}` is not an approach direction: expected up, down or mean"
+            )),
+        }
+    }
+}
+
+/// A table with where its points came from (for messages and reports).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sourced {
+    /// The table.
+    pub table: Table,
+    /// `points`, or `FILE.csv, column NAME`.
+    pub source: String,
+}
+
+/// A measured error motion with what a bidirectional positioning run gives
+/// (docs/values.md, "Direction"): the deviation approached moving up, the
+/// one approached moving down, and each one's standard deviation per
+/// position (the run-to-run scatter, ISO 230-2:2014 2.17). Only `up` is
+/// required; without `down` the motion is the same from either side.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Motion {
+    /// `v↑(q)`, or the only table.
+    pub up: Sourced,
+    /// `v↓(q)`.
+    pub down: Option<Sourced>,
+    /// `s↑(q)` (every value ≥ 0); without `std_down` it holds for both
+    /// directions.
+    pub std_up: Option<Sourced>,
+    /// `s↓(q)` (needs `down`).
+    pub std_down: Option<Sourced>,
+}
+
+impl Motion {
+    /// One table, the same from either side, without a scatter.
+    pub fn single(table: Table, source: &str) -> Motion {
+        Motion {
+            up: Sourced {
+                table,
+                source: source.to_string(),
+            },
+            down: None,
+            std_up: None,
+            std_down: None,
+        }
+    }
+}
+
+/// The largest difference between the two approach directions of one
+/// bidirectional error motion: what a choice of [`Approach`] leaves out.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Reversal {
+    /// The entry (error motion or function slot).
+    pub name: String,
+    /// Its axis variable.
+    pub variable: String,
+    /// The approach read.
+    pub approach: Approach,
+    /// `max |v↑(q) − v↓(q)|` over the positions of both tables inside
+    /// their common range, in the machine's units (mm or rad).
+    pub largest: f64,
+    /// The position where it is largest.
+    pub at: f64,
+    /// What the choice leaves out at worst: the whole reversal for `up` or
+    /// `down`, half of it for `mean`.
+    pub left_out: f64,
+    /// The unit of `largest` and `left_out`: `mm` or `rad`.
+    pub unit: &'static str,
+}
+
+/// Parses a choice of approach directions: `DIR` for every axis, or
+/// `VAR=DIR`, comma-separated (`x=up,y=down`); `DIR` is `up`, `down` or
+/// `mean` (`chain map --approach`).
+pub fn parse_approaches(text: &str) -> Result<Vec<(Option<String>, Approach)>, String> {
+    text.split(',')
+        .map(|item| {
+            let item = item.trim();
+            match item.split_once('=') {
+                Some((var, dir)) if !var.trim().is_empty() => {
+                    Ok((Some(var.trim().to_string()), dir.trim().parse()?))
+                }
+                Some(_) => Err(format!("`{item}` has no variable before `=`")),
+                None => Ok((None, item.parse()?)),
+            }
+        })
+        .collect()
 }
 
 /// One name of the machine and what the values gave it (for reports).
@@ -317,7 +483,100 @@ struct Tabulated {
     error: usize,
     /// The axis it reads, in [`Values::variables`] order.
     variable: usize,
+    /// `v↑`, or the only table.
     table: Table,
+    /// `v↓`.
+    reverse: Option<Table>,
+    /// `s↑` (or `s` for both directions).
+    std: Option<Table>,
+    /// `s↓`.
+    reverse_std: Option<Table>,
+    /// The direction read (its axis's).
+    approach: Approach,
+    /// `mm` or `rad`: the unit of the value it writes.
+    unit: &'static str,
+}
+
+impl Tabulated {
+    /// `v(q)` for the chosen approach: `None` outside a table in use.
+    #[inline]
+    fn eval(&self, x: f64) -> Option<f64> {
+        match (&self.reverse, self.approach) {
+            (None, _) | (Some(_), Approach::Up) => self.table.eval(x),
+            (Some(r), Approach::Down) => r.eval(x),
+            (Some(r), Approach::Mean) => Some(0.5 * (self.table.eval(x)? + r.eval(x)?)),
+        }
+    }
+
+    /// `s(q)` for the chosen approach (0 without a scatter): `s↑` or `s↓`,
+    /// and for `mean` the root mean square `√((s↑² + s↓²)/2)`, the scatter of
+    /// a position approached from either side with equal probability once
+    /// the reversal is left out (docs/values.md).
+    fn std_eval(&self, x: f64) -> Option<f64> {
+        let Some(up) = &self.std else {
+            return Some(0.0);
+        };
+        match (&self.reverse_std, self.approach) {
+            (None, _) | (Some(_), Approach::Up) => up.eval(x),
+            (Some(d), Approach::Down) => d.eval(x),
+            (Some(d), Approach::Mean) => {
+                let (a, b) = (up.eval(x)?, d.eval(x)?);
+                Some((0.5 * (a * a + b * b)).sqrt())
+            }
+        }
+    }
+
+    /// The range in which every table in use is read (their common range
+    /// where they do not hold their ends).
+    fn range(&self) -> (f64, f64) {
+        let mut tables = vec![&self.table];
+        tables.extend(
+            self.reverse
+                .iter()
+                .chain(&self.std)
+                .chain(&self.reverse_std),
+        );
+        tables
+            .iter()
+            .map(|t| t.range())
+            .fold((f64::NEG_INFINITY, f64::INFINITY), |(lo, hi), (a, b)| {
+                (lo.max(a), hi.min(b))
+            })
+    }
+
+    /// The reversal `max |v↑ − v↓|` over both tables' positions in their
+    /// common range, if the motion has two directions.
+    fn reversal(&self, variable: &str) -> Option<Reversal> {
+        let r = self.reverse.as_ref()?;
+        let (lo, hi) = {
+            let (a, b) = self.table.range();
+            let (c, d) = r.range();
+            (a.max(c), b.min(d))
+        };
+        let mut best = (0.0_f64, lo);
+        for &q in self.table.positions().iter().chain(r.positions()) {
+            if !(lo..=hi).contains(&q) {
+                continue;
+            }
+            if let (Some(u), Some(d)) = (self.table.eval(q), r.eval(q)) {
+                if (u - d).abs() > best.0 {
+                    best = ((u - d).abs(), q);
+                }
+            }
+        }
+        Some(Reversal {
+            name: self.name.clone(),
+            variable: variable.to_string(),
+            approach: self.approach,
+            largest: best.0,
+            at: best.1,
+            left_out: match self.approach {
+                Approach::Mean => 0.5 * best.0,
+                Approach::Up | Approach::Down => best.0,
+            },
+            unit: self.unit,
+        })
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -363,6 +622,35 @@ pub struct Values {
     constants: Vec<f64>,
     tables: Vec<Tabulated>,
     entries: Vec<Entry>,
+    /// Per variable, the approach direction read.
+    approaches: Vec<Approach>,
+}
+
+/// A choice of approach direction that names what these values do not have
+/// (`chain map --approach`).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ApproachError {
+    /// Not an axis variable of the machine.
+    #[error("`{name}` is not an axis variable of machine `{machine}` (its variables: {})", variables.join(", "))]
+    UnknownVariable {
+        /// The name given.
+        name: String,
+        /// The machine.
+        machine: String,
+        /// Its variables.
+        variables: Vec<String>,
+        /// The closest variable, if one is close.
+        suggestion: Option<String>,
+    },
+    /// An axis without a table that has a reverse direction.
+    #[error("no table along `{variable}` has a reverse direction, so there is no approach to choose for it")]
+    NotDirectional {
+        /// The variable.
+        variable: String,
+    },
+    /// No table at all has a reverse direction.
+    #[error("no table of these values has a reverse direction (`reverse` or `reverse_points`), so there is no approach to choose")]
+    NoDirection,
 }
 
 /// A model's variable or error names are not the machine's (by name).
@@ -503,6 +791,9 @@ impl Values {
         for (j, &c) in self.constants.iter().enumerate() {
             out.constants[err[j]] = c;
         }
+        for (v, &a) in self.approaches.iter().enumerate() {
+            out.approaches[var[v]] = a;
+        }
         for t in &mut out.tables {
             t.error = err[t.error];
             t.variable = var[t.variable];
@@ -521,18 +812,7 @@ impl ErrorValues for Values {
         for (o, c) in out.iter_mut().zip(&self.constants) {
             *o = *c;
         }
-        for t in &self.tables {
-            let x = q.get(t.variable).copied().unwrap_or(f64::NAN);
-            match t.table.eval(x) {
-                Some(v) => {
-                    if let Some(o) = out.get_mut(t.error) {
-                        *o = v;
-                    }
-                }
-                None => return Err(self.out_of_range(t, x)),
-            }
-        }
-        Ok(())
+        self.write(self.tables.iter(), q, out, Tabulated::eval)
     }
 }
 
@@ -544,13 +824,115 @@ impl Values {
     /// result is the same as [`ErrorValues::values_at`]'s, bit for bit.
     #[inline]
     pub fn update(&self, previous: &[f64], q: &[f64], out: &mut [f64]) -> Result<(), OutOfRange> {
-        for t in &self.tables {
-            let x = q.get(t.variable).copied().unwrap_or(f64::NAN);
-            // NaN is never equal: it is evaluated, and refused.
-            if previous.get(t.variable) == Some(&x) {
-                continue;
+        // NaN is never equal: it is evaluated, and refused.
+        let moved = (self.tables.iter()).filter(|t| {
+            previous.get(t.variable) != Some(&q.get(t.variable).copied().unwrap_or(f64::NAN))
+        });
+        self.write(moved, q, out, Tabulated::eval)
+    }
+
+    /// The approach direction read along each variable, in
+    /// [`Values::variables`] order (all [`Approach::Mean`] unless chosen).
+    pub fn approaches(&self) -> &[Approach] {
+        &self.approaches
+    }
+
+    /// Reads every bidirectional table along `variable` (an index into
+    /// [`Values::variables`]) for `approach`.
+    pub fn set_approach(&mut self, variable: usize, approach: Approach) {
+        if let Some(a) = self.approaches.get_mut(variable) {
+            *a = approach;
+        }
+        for t in self.tables.iter_mut().filter(|t| t.variable == variable) {
+            t.approach = approach;
+        }
+    }
+
+    /// Applies a choice of approach: `(None, a)` for every variable with a
+    /// bidirectional table, `(Some(x), a)` for variable `x` (later choices
+    /// win). Naming a variable without a bidirectional table, or choosing
+    /// when no table has two directions, is an error: the choice would
+    /// change nothing.
+    pub fn choose_approach(
+        &mut self,
+        choices: &[(Option<String>, Approach)],
+    ) -> Result<(), ApproachError> {
+        let directional = |v: usize| {
+            self.tables
+                .iter()
+                .any(|t| t.variable == v && t.reverse.is_some())
+        };
+        let mut set = Vec::new();
+        for (name, approach) in choices {
+            match name {
+                None => {
+                    let all: Vec<usize> = (0..self.variables.len())
+                        .filter(|&v| directional(v))
+                        .collect();
+                    if all.is_empty() {
+                        return Err(ApproachError::NoDirection);
+                    }
+                    set.extend(all.into_iter().map(|v| (v, *approach)));
+                }
+                Some(name) => {
+                    let Some(v) = self.variables.iter().position(|x| x == name) else {
+                        return Err(ApproachError::UnknownVariable {
+                            name: name.clone(),
+                            machine: self.machine.clone(),
+                            variables: self.variables.clone(),
+                            suggestion: closest(name, self.variables.iter().map(String::as_str))
+                                .map(str::to_string),
+                        });
+                    };
+                    if !directional(v) {
+                        return Err(ApproachError::NotDirectional {
+                            variable: name.clone(),
+                        });
+                    }
+                    set.push((v, *approach));
+                }
             }
-            match t.table.eval(x) {
+        }
+        for (v, a) in set {
+            self.set_approach(v, a);
+        }
+        Ok(())
+    }
+
+    /// Per bidirectional table, the reversal the chosen approach leaves out.
+    pub fn reversals(&self) -> Vec<Reversal> {
+        (self.tables.iter())
+            .filter_map(|t| t.reversal(&self.variables[t.variable]))
+            .collect()
+    }
+
+    /// True if some table gives a standard deviation per position.
+    pub fn has_repeatability(&self) -> bool {
+        self.tables.iter().any(|t| t.std.is_some())
+    }
+
+    /// The standard deviation of each error at `q` for the chosen approach:
+    /// 0 for constants and tables without one (docs/values.md,
+    /// "Direction"). Orders as [`ErrorValues::values_at`].
+    pub fn repeatability_at(&self, q: &[f64], out: &mut [f64]) -> Result<(), OutOfRange> {
+        out.iter_mut().for_each(|o| *o = 0.0);
+        let scattered = self.tables.iter().filter(|t| t.std.is_some());
+        self.write(scattered, q, out, Tabulated::std_eval)
+    }
+
+    /// Writes `eval` of each of `tables` at its axis value into its error's
+    /// place in `out`; the first table `q` is outside of is the error.
+    #[inline]
+    fn write<'t>(
+        &self,
+        tables: impl Iterator<Item = &'t Tabulated>,
+        q: &[f64],
+        out: &mut [f64],
+        eval: impl Fn(&Tabulated, f64) -> Option<f64>,
+    ) -> Result<(), OutOfRange> {
+        for t in tables {
+            let x = q.get(t.variable).copied().unwrap_or(f64::NAN);
+            match eval(t, x) {
                 Some(v) => {
                     if let Some(o) = out.get_mut(t.error) {
                         *o = v;
@@ -564,7 +946,7 @@ impl Values {
 
     #[cold]
     fn out_of_range(&self, t: &Tabulated, value: f64) -> OutOfRange {
-        let (lo, hi) = t.table.range();
+        let (lo, hi) = t.range();
         OutOfRange {
             name: t.name.clone(),
             table: t.source.clone(),
@@ -676,16 +1058,39 @@ impl<'m> ValuesBuilder<'m> {
     /// messages). Values in mm or rad; positions in the axis variable's
     /// units.
     pub fn table(&mut self, name: &str, table: Table, source: &str) -> Result<(), BindError> {
-        self.table_with(name, table, source, None)
+        self.motion_with(name, Motion::single(table, source), None)
     }
 
-    fn table_with(
+    /// A bidirectional error motion (docs/values.md, "Direction"): where
+    /// [`ValuesBuilder::table`] takes one table, this takes the two approach
+    /// directions and their scatter.
+    pub fn motion(&mut self, name: &str, motion: Motion) -> Result<(), BindError> {
+        self.motion_with(name, motion, None)
+    }
+
+    fn motion_with(
         &mut self,
         name: &str,
-        table: Table,
-        source: &str,
+        motion: Motion,
         origin: Option<Origin>,
     ) -> Result<(), BindError> {
+        if motion.std_down.is_some() && motion.down.is_none() {
+            return Err(BindError::ReverseStdWithoutReverse {
+                name: name.to_string(),
+            });
+        }
+        for s in motion.std_up.iter().chain(&motion.std_down) {
+            if let Some((index, &value)) =
+                (s.table.values().iter().enumerate()).find(|(_, v)| **v < 0.0)
+            {
+                return Err(BindError::NegativeStd {
+                    name: name.to_string(),
+                    table: s.source.clone(),
+                    index,
+                    value,
+                });
+            }
+        }
         let (error, variable, kind, function) = self.table_target(name)?;
         if let Some(fi) = function {
             self.function_tables[fi] = true;
@@ -694,26 +1099,39 @@ impl<'m> ValuesBuilder<'m> {
         self.tables.retain(|t| t.error != error);
         self.constants[error] = 0.0;
         self.given[error] = true;
+        let table = &motion.up.table;
         let (lo, hi) = table.range();
+        let source = |s: &Option<Sourced>| s.as_ref().map(|s| s.source.clone());
         self.record(Entry {
             name: name.to_string(),
             kind,
             given: Given::Table {
                 variable: m.variables[variable].name.clone(),
-                source: source.to_string(),
+                source: motion.up.source.clone(),
                 points: table.positions().len(),
                 range: [lo, hi],
                 interpolation: table.interpolation(),
                 extrapolation: table.extrapolation(),
+                reverse: source(&motion.down),
+                std: source(&motion.std_up),
+                reverse_std: source(&motion.std_down),
             },
             origin,
         });
         self.tables.push(Tabulated {
             name: name.to_string(),
-            source: source.to_string(),
+            source: motion.up.source,
             error,
             variable,
-            table,
+            table: motion.up.table,
+            reverse: motion.down.map(|s| s.table),
+            std: motion.std_up.map(|s| s.table),
+            reverse_std: motion.std_down.map(|s| s.table),
+            approach: Approach::default(),
+            unit: match m.errors[error].kind {
+                ErrorKind::Linear => "mm",
+                ErrorKind::Angular | ErrorKind::Squareness => "rad",
+            },
         });
         Ok(())
     }
@@ -781,6 +1199,7 @@ impl<'m> ValuesBuilder<'m> {
             constants: self.constants,
             tables: self.tables,
             entries: self.entries,
+            approaches: vec![Approach::default(); m.variables.len()],
         }
     }
 }
@@ -915,6 +1334,15 @@ fn bind_problem(e: &BindError) -> Problem {
         BindError::NotFinite { .. } => {
             Message::new(text, "not finite", "chain::values::not_finite")
         }
+        BindError::ReverseStdWithoutReverse { .. } => Message::new(
+            text,
+            "no reverse direction",
+            "chain::values::reverse_std_without_reverse",
+        )
+        .help("give the reverse direction too (`reverse` or `reverse_points`), or one `std` for both directions"),
+        BindError::NegativeStd { .. } => {
+            Message::new(text, "negative std", "chain::values::negative_std")
+        }
     };
     message.into()
 }
@@ -952,7 +1380,43 @@ impl TreeReader for Reader {
     }
 }
 
-/// The table part of one entry, as read.
+/// The tables of one table entry, in [`Motion`]'s order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Part {
+    /// `points` / `column`: `v↑`, or the only table.
+    Main,
+    /// `reverse_points` / `reverse`: `v↓`.
+    Reverse,
+    /// `std_points` / `std`: `s↑` (or both directions').
+    Std,
+    /// `reverse_std_points` / `reverse_std`: `s↓`.
+    ReverseStd,
+}
+
+impl Part {
+    const ALL: [Part; 4] = [Part::Main, Part::Reverse, Part::Std, Part::ReverseStd];
+
+    /// Its key in a `points` entry, or (`false`) in a CSV `table` entry.
+    fn key(self, points: bool) -> &'static str {
+        let (p, c) = match self {
+            Part::Main => ("points", "column"),
+            Part::Reverse => ("reverse_points", "reverse"),
+            Part::Std => ("std_points", "std"),
+            Part::ReverseStd => ("reverse_std_points", "reverse_std"),
+        };
+        if points {
+            p
+        } else {
+            c
+        }
+    }
+
+    fn is_std(self) -> bool {
+        matches!(self, Part::Std | Part::ReverseStd)
+    }
+}
+
+/// One table of one entry, as read.
 struct TableSpec {
     points: Vec<((f64, f64), Origin)>,
     source: String,
@@ -1077,7 +1541,16 @@ impl Reader {
             return;
         }
         if let Some((_, vn)) = value {
-            for extra in ["column", "interpolation", "extrapolate"] {
+            for extra in [
+                "column",
+                "interpolation",
+                "extrapolate",
+                "reverse",
+                "reverse_std",
+                "reverse_points",
+                "std_points",
+                "reverse_std_points",
+            ] {
                 if let Some((kn, _)) = fields.entry(extra) {
                     let text = format!("`{extra}` belongs to a table; `{name}` is given a `value`");
                     let not =
@@ -1121,9 +1594,23 @@ impl Reader {
             }
             return;
         }
-        if let Some((kn, _)) = fields.entry("std") {
-            let text = format!("`std` belongs to a constant `value`; `{name}` is given a table");
-            let not = Message::new(text, "not a constant", "chain::values::key_not_for_table");
+        if fields.get("points").is_none() {
+            let number = |n: &Node| n.as_str().is_none_or(|t| t.trim().parse::<f64>().is_ok());
+            if let Some((_, sn)) = fields.entry("std").filter(|(_, n)| number(n)) {
+                let text = format!("`std` of a CSV table names the column of standard deviations; `{name}` is given a table, not a constant `value`");
+                let not = Message::new(text, "not a column name", "chain::values::key_not_for_table")
+                    .help("write `std: COLUMN` (a column of per-position standard deviations), or give a constant as `{value: V, std: S}`");
+                self.report(sn.span, fields.path("std"), not.into());
+                return;
+            }
+        } else if let Some((kn, _)) = fields.entry("std") {
+            let text = format!(
+                "`std` belongs to a constant `value` or a CSV `table`; `{name}` is given `points`"
+            );
+            let not = Message::new(text, "not a constant", "chain::values::key_not_for_table")
+                .help(
+                    "per-position standard deviations of `points` are `std_points: [[q, s], ...]`",
+                );
             self.report(kn.span, fields.path("std"), not.into());
         }
         let variable = match b.table_target(name) {
@@ -1134,21 +1621,81 @@ impl Reader {
             }
         };
         let var_name = m.variables[variable].name.as_str();
-        let Some(spec) = self.table_spec(name, &fields, key, factor, var_name) else {
+        let Some(specs) = self.table_spec(name, &fields, key, factor, var_name) else {
             return;
         };
-        let points: Vec<(f64, f64)> = spec.points.iter().map(|(p, _)| *p).collect();
-        match Table::new(points, spec.interpolation, spec.extrapolation) {
-            Ok(table) => {
-                if let Err(e) = b.table_with(name, table, &spec.source, Some(key_origin.clone())) {
-                    self.problems.push((key_origin, bind_problem(&e)));
+        let mut parts: [Option<Sourced>; 4] = Default::default();
+        let mut ok = true;
+        for (part, spec) in &specs {
+            if part.is_std() {
+                if let Some((_, origin)) = spec.points.iter().find(|((_, v), _)| *v < 0.0) {
+                    let text = format!(
+                        "a standard deviation must be ≥ 0, got {}",
+                        spec.points
+                            .iter()
+                            .find(|((_, v), _)| *v < 0.0)
+                            .map_or(0.0, |p| p.0 .1 / factor)
+                    );
+                    let neg = Message::new(text, "negative", "chain::values::negative_std");
+                    self.locate(&spec.csv, origin.clone(), neg.into());
+                    ok = false;
+                    continue;
                 }
             }
-            Err(e) => self.table_problem(&e, &spec, &fields, key),
+            let points: Vec<(f64, f64)> = spec.points.iter().map(|(p, _)| *p).collect();
+            match Table::new(points, spec.interpolation, spec.extrapolation) {
+                Ok(table) => {
+                    parts[*part as usize] = Some(Sourced {
+                        table,
+                        source: spec.source.clone(),
+                    });
+                }
+                Err(e) => {
+                    self.table_problem(&e, spec, *part, &fields, key);
+                    ok = false;
+                }
+            }
+        }
+        if !ok {
+            return;
+        }
+        let [Some(up), down, std_up, std_down] = parts else {
+            return;
+        };
+        let motion = Motion {
+            up,
+            down,
+            std_up,
+            std_down,
+        };
+        if let Err(e) = b.motion_with(name, motion, Some(key_origin.clone())) {
+            let at = match e {
+                BindError::ReverseStdWithoutReverse { .. } => {
+                    let k = Part::ReverseStd.key(fields.get("points").is_some());
+                    fields
+                        .entry(k)
+                        .map(|(kn, _)| kn.span.origin(fields.path(k)))
+                }
+                _ => None,
+            };
+            self.problems
+                .push((at.unwrap_or(key_origin), bind_problem(&e)));
         }
     }
 
-    /// The points, source and reading of a table entry.
+    /// A problem at `origin` in the values file, or in the CSV file `csv`.
+    fn locate(&mut self, csv: &Option<(String, String)>, origin: Origin, problem: Problem) {
+        match csv {
+            Some((file, text)) => {
+                self.tables
+                    .push(Diagnostics::single(file, text.clone(), origin, problem));
+            }
+            None => self.problems.push((origin, problem)),
+        }
+    }
+
+    /// The points, sources and reading of a table entry: its main table and
+    /// whichever of `reverse`, `std` and `reverse_std` it gives.
     fn table_spec(
         &mut self,
         name: &str,
@@ -1156,7 +1703,7 @@ impl Reader {
         key: &Node,
         factor: f64,
         variable: &str,
-    ) -> Option<TableSpec> {
+    ) -> Option<Vec<(Part, TableSpec)>> {
         let interpolation = match fields.get("interpolation") {
             Some(n) => match self.keyword(
                 n,
@@ -1181,21 +1728,75 @@ impl Reader {
             },
             None => Extrapolation::Error,
         };
-        if let Some(pn) = fields.get("points") {
-            if let Some((kn, _)) = fields.entry("column") {
-                let text = format!("`column` belongs to a CSV `table`; `{name}` is given `points`");
-                let not =
-                    Message::new(text, "not a CSV table", "chain::values::key_not_for_points");
-                self.report(kn.span, fields.path("column"), not.into());
+        let spec = |points, source, csv| TableSpec {
+            points,
+            source,
+            interpolation,
+            extrapolation,
+            csv,
+        };
+        let in_points = fields.get("points").is_some();
+        if let (true, Some((kn, _))) = (in_points, fields.entry("table")) {
+            let both = Problem::Conflict {
+                first: "points",
+                second: "table",
+            };
+            self.report(kn.span, fields.path("table"), both);
+            return None;
+        }
+        // The keys of the other form.
+        let mut wrong = false;
+        for part in Part::ALL {
+            let other = part.key(!in_points);
+            if other == "std" || other == "points" {
+                continue; // `std` is checked with the constant; `points` is this form
             }
-            let points = self.points(pn, &fields.path("points"), factor)?;
-            return Some(TableSpec {
-                points,
-                source: "points".to_string(),
-                interpolation,
-                extrapolation,
-                csv: None,
-            });
+            if let Some((kn, _)) = fields.entry(other) {
+                let (text, label, code) = if in_points {
+                    (
+                        format!("`{other}` belongs to a CSV `table`; `{name}` is given `points`"),
+                        "not a CSV table",
+                        "chain::values::key_not_for_points",
+                    )
+                } else {
+                    (
+                        format!("`{other}` belongs to `points`; `{name}` is given a CSV `table`"),
+                        "not points",
+                        "chain::values::key_not_for_csv",
+                    )
+                };
+                let help = format!(
+                    "with `{}`, write `{}`",
+                    if in_points { "points" } else { "table" },
+                    part.key(in_points)
+                );
+                self.report(
+                    kn.span,
+                    fields.path(other),
+                    Message::new(text, label, code).help(help).into(),
+                );
+                wrong = true;
+            }
+        }
+        if wrong {
+            return None;
+        }
+        let mut out = Vec::new();
+        if in_points {
+            for part in Part::ALL {
+                let k = part.key(true);
+                let Some(pn) = fields.get(k) else {
+                    continue;
+                };
+                let points = self.points(pn, &fields.path(k), factor)?;
+                let source = if part == Part::Main {
+                    "points".to_string()
+                } else {
+                    k.to_string()
+                };
+                out.push((part, spec(points, source, None)));
+            }
+            return Some(out);
         }
         let Some(tn) = fields.get("table") else {
             let text = format!("`{name}` needs a `value`, `points` or a `table`");
@@ -1206,21 +1807,30 @@ impl Reader {
             return None;
         };
         let file = self.name(tn, &fields.path("table"), "a CSV file path")?;
-        let column = match fields.get("column") {
-            Some(cn) => (
-                self.name(cn, &fields.path("column"), "a column name")?,
-                Some(cn),
-            ),
-            None => (name.to_string(), None),
-        };
-        self.csv_points(name, &file, tn, column, fields, factor, variable)
-            .map(|(points, source, csv)| TableSpec {
-                points,
-                source,
-                interpolation,
-                extrapolation,
-                csv: Some(csv),
-            })
+        for part in Part::ALL {
+            let k = part.key(false);
+            let column = match fields.get(k) {
+                Some(cn) => (
+                    self.name(cn, &fields.path(k), "a column name")?,
+                    Some((cn, k)),
+                ),
+                None if part == Part::Main => (name.to_string(), None),
+                None => continue,
+            };
+            // A standard deviation's problem is its own cell's; a
+            // position's is the position's.
+            let (points, source, csv) = self.csv_points(
+                name,
+                &file,
+                tn,
+                column,
+                fields,
+                (factor, part.is_std()),
+                variable,
+            )?;
+            out.push((part, spec(points, source, Some(csv))));
+        }
+        Some(out)
     }
 
     /// `[[q, v], ...]`, with each point's origin.
@@ -1265,7 +1875,14 @@ impl Reader {
     }
 
     /// Reports why the points are not a table, at the offending point.
-    fn table_problem(&mut self, e: &TableError, spec: &TableSpec, fields: &Fields<'_>, key: &Node) {
+    fn table_problem(
+        &mut self,
+        e: &TableError,
+        spec: &TableSpec,
+        part: Part,
+        fields: &Fields<'_>,
+        key: &Node,
+    ) {
         let (index, text, code, help) = match *e {
             TableError::TooFewPoints { found } => (
                 None,
@@ -1298,17 +1915,14 @@ impl Reader {
         let at = index
             .and_then(|i| spec.points.get(i))
             .map(|(_, o)| o.clone());
-        match (&spec.csv, at) {
-            (Some((file, text)), Some(origin)) => {
-                let d = Diagnostics::single(file, text.clone(), origin, message.into());
-                self.tables.push(d);
-            }
-            (None, Some(origin)) => self.problems.push((origin, message.into())),
-            (_, None) => {
-                let key_path = if spec.csv.is_some() {
-                    "table"
-                } else {
-                    "points"
+        match at {
+            Some(origin) => self.locate(&spec.csv, origin, message.into()),
+            None => {
+                let in_points = spec.csv.is_none();
+                let key_path = match fields.entry(part.key(in_points)) {
+                    Some(_) => part.key(in_points),
+                    None if in_points => "points",
+                    None => "table",
                 };
                 let (kn, _) = fields.entry(key_path).map_or((key, key), |e| e);
                 self.report(kn.span, fields.path(key_path), message.into());
@@ -1324,9 +1938,9 @@ impl Reader {
         name: &str,
         file: &str,
         table_node: &Node,
-        (column, column_node): (String, Option<&Node>),
+        (column, column_node): (String, Option<(&Node, &str)>),
         fields: &Fields<'_>,
-        factor: f64,
+        (factor, at_value): (f64, bool),
         var_name: &str,
     ) -> Option<CsvPoints> {
         use csv::{CsvFile, CsvOpenError};
@@ -1394,7 +2008,7 @@ impl Reader {
                     }
                 ));
             let (span, key) = match column_node {
-                Some(n) => (n.span, fields.path("column")),
+                Some((n, k)) => (n.span, fields.path(k)),
                 None => (table_node.span, fields.path("table")),
             };
             self.report(span, key, missing.into());
@@ -1408,7 +2022,7 @@ impl Reader {
             let q = cell_number(qt, qo, &mut bad);
             let v = cell_number(vt, vo, &mut bad);
             if let (Some(q), Some(v)) = (q, v) {
-                points.push(((q, v * factor), qo.clone()));
+                points.push(((q, v * factor), if at_value { vo } else { qo }.clone()));
             }
         }
         if let Some(d) = Diagnostics::located(&shown, csv.text.clone(), bad) {
@@ -1430,9 +2044,9 @@ impl Reader {
         _name: &str,
         _file: &str,
         table_node: &Node,
-        _column: (String, Option<&Node>),
+        _column: (String, Option<(&Node, &str)>),
         fields: &Fields<'_>,
-        _factor: f64,
+        _factor: (f64, bool),
         _variable: &str,
     ) -> Option<CsvPoints> {
         let text =

@@ -6,12 +6,14 @@
 //! against a [`crate::Machine`] and gives each record's design rows from a
 //! model's exact sensitivity; [`identify`] solves the weighted least-squares
 //! problem (or its Gaussian-prior posterior) through an SVD; [`positioning`]
-//! reads an axis's ISO 230-2 positioning runs and evaluates them.
+//! reads an axis's ISO 230-2 positioning runs and evaluates them, and
+//! [`positioning_values`] writes them into a values file.
 
 pub mod document;
 pub mod identify;
 pub mod measurements;
 pub mod positioning;
+pub mod positioning_values;
 
 pub use identify::{identify, Identification, IdentifyError, IdentifyOptions};
 pub use measurements::{

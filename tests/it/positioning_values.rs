@@ -1,0 +1,529 @@
+//! Direction in values files (docs/values.md, "Direction") and
+//! `chain positioning --values-out` (docs/positioning.md): a run written into
+//! the axis's positioning error and read back, the approach choice of
+//! `chain map`, the repeatability, and every refusal with its location.
+//!
+//! The expected values are the test's own: the run file read by splitting
+//! lines, per-target means and standard deviations by Welford's update
+//! (`positioning::welford`), interpolation written out here.
+
+use std::path::{Path, PathBuf};
+
+use chain::core::values::{
+    parse_approaches, Approach, Extrapolation, Interpolation, Motion, Sourced, Table, Values,
+    ValuesBuilder,
+};
+use chain::core::ErrorValues;
+
+use crate::common::cli::{fails, ok, ok_json, scratch, unwrapped, write};
+use crate::common::example_file;
+use crate::positioning::{read_runs, welford};
+
+/// A one-axis machine: the tool on an x slide along `axis`, the positioning
+/// error `EXX` in `dx`, a straightness `EYX`, a squareness `S`, and a rotary
+/// table `C` with `ECC` in `ez`.
+fn machine(axis: &str) -> String {
+    format!(
+        "machine: m
+bodies:
+  bed: {{}}
+  table: {{parent: bed, joint: {{type: rotary, axis: +z, variable: C}}, errors: {{ez: ECC, dx: EXC}}}}
+  x_slide: {{parent: bed, joint: {{type: prismatic, axis: {axis}, variable: x}}, errors: {{dx: EXX, dy: EYX}}, squareness: {{ez: S}}}}
+  tool: {{parent: x_slide, offset: [0, 0, -50]}}
+workpiece: table
+tool: tool
+"
+    )
+}
+
+/// The arguments of `chain positioning RUNS --values-out OUT --machine
+/// MACHINE --slot SLOT [--rotary]`.
+fn positioning_args(
+    runs: &Path,
+    out: &Path,
+    machine: &Path,
+    slot: &str,
+    rotary: bool,
+) -> Vec<String> {
+    let mut args: Vec<String> = ["positioning", "--values-out", "--machine", "--slot"]
+        .iter()
+        .zip([runs, out, machine, Path::new(slot)])
+        .flat_map(|(flag, v)| [flag.to_string(), v.display().to_string()])
+        .collect();
+    if rotary {
+        args.push("--rotary".into());
+    }
+    args
+}
+
+/// `chain positioning RUNS --values-out` into `dir`; the values file.
+fn values_out(dir: &Path, runs: &str, machine: &Path, slot: &str, rotary: bool) -> PathBuf {
+    let out = dir.join(format!("{slot}.yaml"));
+    let args = positioning_args(&example_file(runs), &out, machine, slot, rotary);
+    ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    out
+}
+
+#[test]
+fn values_out_reads_back_as_the_per_target_means_and_stds() {
+    let dir = scratch("read_back");
+    let table = read_runs("examples/positioning/x_axis_runs.csv", 1.0);
+    for (axis, sign) in [("+x", 1.0), ("-x", -1.0)] {
+        let m_path = write(&dir, &format!("m{sign}.yaml"), &machine(axis));
+        let m = chain::core::load_file(&m_path).unwrap();
+        let path = values_out(&dir, "positioning/x_axis_runs.csv", &m_path, "EXX", false);
+        let mut v = Values::read(&path, &m).unwrap_or_else(|e| panic!("{e:?}"));
+        let x = m.variables.iter().position(|v| v.name == "x").unwrap();
+        let j = m.error_index("EXX").unwrap();
+        let mut q = vec![0.0; m.variables.len()];
+        let (mut e, mut s) = (vec![0.0; m.errors.len()], vec![0.0; m.errors.len()]);
+        for (approach, pick) in [(Approach::Up, 0), (Approach::Down, 1), (Approach::Mean, 2)] {
+            v.set_approach(x, approach);
+            for (p, up, down) in &table {
+                let ((mu, su), (md, sd)) = (welford(up), welford(down));
+                let (want, want_s) = match pick {
+                    0 => (mu, su),
+                    1 => (md, sd),
+                    _ => (0.5 * (mu + md), (0.5 * (su * su + sd * sd)).sqrt()),
+                };
+                q[x] = *p;
+                v.values_at(&q, &mut e).unwrap();
+                v.repeatability_at(&q, &mut s).unwrap();
+                // The slot's value is the deviation times the axis's sign.
+                assert!(
+                    (e[j] - sign * want).abs() < 1e-12,
+                    "{axis} {approach} at {p}: {} vs {}",
+                    e[j],
+                    sign * want
+                );
+                assert!(
+                    (s[j] - want_s).abs() < 1e-12,
+                    "{axis} {approach} std at {p}"
+                );
+            }
+            // Between targets: linear in both directions.
+            let (a, b) = (&table[3], &table[4]);
+            let t = 0.3;
+            q[x] = a.0 + t * (b.0 - a.0);
+            v.values_at(&q, &mut e).unwrap();
+            let at = |i: usize| {
+                let (pa, pb) = (
+                    (welford(&a.1).0, welford(&a.2).0),
+                    (welford(&b.1).0, welford(&b.2).0),
+                );
+                let (va, vb) = match i {
+                    0 => (pa.0, pb.0),
+                    1 => (pa.1, pb.1),
+                    _ => (0.5 * (pa.0 + pa.1), 0.5 * (pb.0 + pb.1)),
+                };
+                va + t * (vb - va)
+            };
+            assert!((e[j] - sign * at(pick)).abs() < 1e-12);
+        }
+        // Beyond the run's travel: an error naming the table.
+        q[x] = 1000.5;
+        let err = v.values_at(&q, &mut e).unwrap_err();
+        assert!(err.to_string().contains("EXX"), "{err}");
+        // The reversal: the largest |x̄↑ − x̄↓| at a target.
+        let r = &v.reversals()[0];
+        let (bmax, at) = (table.iter())
+            .map(|(p, u, d)| ((welford(u).0 - welford(d).0).abs(), *p))
+            .fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
+        assert!((r.largest - bmax).abs() < 1e-12 && r.at == at, "{r:?}");
+        assert_eq!(r.left_out, r.largest * 0.5); // mean (the last set)
+    }
+}
+
+#[test]
+fn map_with_each_approach_gives_the_per_target_means() {
+    // vmc3's x table moves along −x: the map's px is the deviation itself
+    // (the tool relative to the table), whatever the slot's sign.
+    let dir = scratch("map_approach");
+    let vmc3 = example_file("machines/vmc3.yaml");
+    let path = values_out(&dir, "positioning/x_axis_runs.csv", &vmc3, "EXX", false);
+    let table = read_runs("examples/positioning/x_axis_runs.csv", 1.0);
+    let grid = format!(
+        "x={}",
+        table
+            .iter()
+            .map(|t| t.0.to_string())
+            .collect::<Vec<_>>()
+            .join(",")
+    );
+    for (flag, pick) in [
+        (Some("x=up"), 0),
+        (Some("down"), 1),
+        (None, 2),
+        (Some("mean"), 2),
+    ] {
+        let mut args = vec![
+            "map",
+            vmc3.to_str().unwrap(),
+            "--values",
+            path.to_str().unwrap(),
+            "--grid",
+            &grid,
+            "--grid",
+            "y=0",
+            "--grid",
+            "z=0",
+            "--format",
+            "json",
+        ];
+        if let Some(f) = flag {
+            args.extend(["--approach", f]);
+        }
+        let doc = ok_json(&args);
+        let points = doc["points"].as_array().unwrap();
+        assert_eq!(points.len(), table.len());
+        for (pt, (p, up, down)) in points.iter().zip(&table) {
+            assert_eq!(pt["point"]["x"].as_f64().unwrap(), *p);
+            let (mu, md) = (welford(up).0, welford(down).0);
+            let want = [mu, md, 0.5 * (mu + md)][pick];
+            let px = pt["error"]["px"].as_f64().unwrap();
+            assert!((px - want).abs() < 1e-12, "{flag:?} at {p}: {px} vs {want}");
+        }
+        let r = &doc["reversals"][0];
+        assert_eq!(r["name"], "EXX");
+        assert_eq!(
+            r["approach"],
+            ["up", "down", "mean", "mean"][pick + (flag == Some("mean")) as usize]
+        );
+    }
+    // The summary says what the choice leaves out.
+    let out = ok(&[
+        "map",
+        vmc3.to_str().unwrap(),
+        "--values",
+        path.to_str().unwrap(),
+        "--grid",
+        "x=0,500",
+        "--grid",
+        "y=0",
+        "--grid",
+        "z=0",
+        "--approach",
+        "up",
+    ]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("reversal of EXX along x: up to 4.987 µm between the approach directions (x = 599.9); the map reads `up`, leaving out up to 4.987 µm"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_rotary_run_goes_in_radians_and_arcseconds() {
+    let dir = scratch("rotary");
+    let m_path = write(&dir, "m.yaml", &machine("+x"));
+    let m = chain::core::load_file(&m_path).unwrap();
+    let path = values_out(&dir, "positioning/c_axis_runs.csv", &m_path, "ECC", true);
+    let table = read_runs("examples/positioning/c_axis_runs.csv", 1.0);
+    let v = Values::read(&path, &m).unwrap();
+    let c = m.variables.iter().position(|v| v.name == "C").unwrap();
+    let j = m.error_index("ECC").unwrap();
+    let (mut q, mut e) = (vec![0.0; 2], vec![0.0; m.errors.len()]);
+    for (deg, up, down) in &table {
+        q[c] = deg.to_radians();
+        v.values_at(&q, &mut e).unwrap();
+        // Degrees in the run file, radians in the machine.
+        let want = (0.5 * (welford(up).0 + welford(down).0)).to_radians();
+        assert!((e[j] - want).abs() < 1e-15, "{deg}: {} vs {want}", e[j]);
+    }
+}
+
+#[test]
+fn the_slot_must_be_the_axis_positioning_error() {
+    let dir = scratch("slots");
+    let m_path = write(&dir, "m.yaml", &machine("+x"));
+    let runs = example_file("positioning/x_axis_runs.csv");
+    let out = dir.join("v.yaml");
+    let run = |slot: &str, rotary: bool| {
+        let args = positioning_args(&runs, &out, &m_path, slot, rotary);
+        unwrapped(&fails(&args.iter().map(String::as_str).collect::<Vec<_>>()))
+    };
+    let e = run("EYX", false);
+    assert!(e.contains("`EYX` is in the `dy` slot of body `x_slide`, whose joint moves along +x: the positioning error of that axis is its `dx` slot (`EXX` is there)"), "{e}");
+    assert!(
+        e.contains("chain::positioning::not_along_axis") && e.contains("--slot EYX"),
+        "{e}"
+    );
+    let e = run("EXXX", false);
+    assert!(
+        e.contains("did you mean `EXX`?") && e.contains("chain::positioning::unknown_slot"),
+        "{e}"
+    );
+    let e = run("S", false);
+    assert!(e.contains("chain::positioning::not_a_motion"), "{e}");
+    let e = run("ECC", false);
+    assert!(
+        e.contains("`ECC` is an error of the rotary axis `C`, but the runs are of a linear axis"),
+        "{e}"
+    );
+    let e = run("EXC", false);
+    assert!(e.contains("chain::positioning::axis_kind"), "{e}");
+    let e = run("EXX", true);
+    assert!(
+        e.contains("the prismatic axis `x`, but the runs are of a rotary axis"),
+        "{e}"
+    );
+    assert!(!out.exists(), "nothing written on a refusal");
+    // --values-out needs --machine and --slot.
+    let e = fails(&[
+        "positioning",
+        runs.to_str().unwrap(),
+        "--values-out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(e.contains("--machine") && e.contains("--slot"), "{e}");
+}
+
+/// `v` read from `values` for [`machine`]`("+x")` in a fresh directory.
+fn read(name: &str, values: &str, csvs: &[(&str, &str)]) -> Result<Values, String> {
+    let dir = scratch(name);
+    let m = chain::core::load_file(&write(&dir, "m.yaml", &machine("+x"))).unwrap();
+    for (f, t) in csvs {
+        write(&dir, f, t);
+    }
+    Values::read(&write(&dir, "v.yaml", values), &m).map_err(|e| {
+        let d = e.diagnostics();
+        format!(
+            "{}:{}:{} {} {}",
+            Path::new(d.file()).file_name().unwrap().to_string_lossy(),
+            d.first().origin.line,
+            d.first().origin.column,
+            d.first().origin.key,
+            d.first().problem.code()
+        ) + &format!(" | {e}")
+    })
+}
+
+#[test]
+fn csv_columns_per_direction() {
+    let csv = "x,up,down,s_up,s_down,note\n0,1,3,0.5,0.1,a\n100,2,-2,0.3,0.2,b\n";
+    let v = read(
+        "csv_dir",
+        "machine: m\nunits: {linear: um}\nvalues:\n  EXX: {table: x.csv, column: up, reverse: down, std: s_up, reverse_std: s_down}\n",
+        &[("x.csv", csv)],
+    )
+    .unwrap();
+    let mut v = v;
+    let mut q = [0.0, 25.0];
+    let j = 2; // ECC, EXC, EXX, ...
+    assert_eq!(v.errors()[j], "EXX");
+    let (mut e, mut s) = ([0.0; 5], [0.0; 5]);
+    let x = 1;
+    for (a, want, want_s) in [
+        (Approach::Up, 1.25, 0.45),
+        (Approach::Down, 1.75, 0.125),
+        (
+            Approach::Mean,
+            1.5,
+            (0.5f64 * (0.45 * 0.45 + 0.125 * 0.125)).sqrt(),
+        ),
+    ] {
+        v.set_approach(x, a);
+        v.values_at(&q, &mut e).unwrap();
+        v.repeatability_at(&q, &mut s).unwrap();
+        assert!((e[j] - want * 1e-3).abs() < 1e-15, "{a}: {}", e[j]);
+        assert!((s[j] - want_s * 1e-3).abs() < 1e-15, "{a}: {}", s[j]);
+        assert_eq!(v.approaches()[x], a);
+    }
+    q[1] = 100.0;
+    v.set_approach(x, Approach::Mean);
+    v.values_at(&q, &mut e).unwrap();
+    assert_eq!(e[j], 0.0);
+    let entry = &v.entries()[0];
+    let json = serde_json::to_value(entry).unwrap();
+    assert_eq!(json["reverse"], "x.csv, column down");
+    assert_eq!(json["std"], "x.csv, column s_up");
+    assert_eq!(json["reverse_std"], "x.csv, column s_down");
+    // One `std` column serves both directions.
+    let v = read(
+        "csv_one_std",
+        "machine: m\nvalues:\n  EXX: {table: x.csv, column: up, reverse: down, std: s_up}\n",
+        &[("x.csv", csv)],
+    )
+    .unwrap();
+    v.repeatability_at(&[0.0, 0.0], &mut s).unwrap();
+    assert_eq!(s[j], 0.5);
+    assert!(v.has_repeatability());
+}
+
+#[test]
+fn the_builder_takes_a_motion() {
+    let dir = scratch("builder");
+    let m = chain::core::load_file(&write(&dir, "m.yaml", &machine("+x"))).unwrap();
+    let t =
+        |p: Vec<(f64, f64)>| Table::new(p, Interpolation::Linear, Extrapolation::Error).unwrap();
+    let src = |table, s: &str| Sourced {
+        table,
+        source: s.into(),
+    };
+    let mut b = ValuesBuilder::new(&m);
+    let motion = Motion {
+        up: src(t(vec![(0.0, 1e-3), (10.0, 2e-3)]), "up"),
+        down: Some(src(t(vec![(0.0, -1e-3), (20.0, 0.0)]), "down")),
+        std_up: None,
+        std_down: Some(src(t(vec![(0.0, 1e-4), (10.0, 1e-4)]), "s")),
+    };
+    b.motion("EXX", motion.clone()).unwrap();
+    let mut v = b.build();
+    let mut e = [0.0; 5];
+    v.values_at(&[0.0, 5.0], &mut e).unwrap();
+    assert!((e[2] - 0.5 * (1.5e-3 - 0.75e-3)).abs() < 1e-18);
+    // The mean reads both tables: outside the shorter one is an error.
+    let err = v.values_at(&[0.0, 15.0], &mut e).unwrap_err();
+    assert_eq!((err.lo, err.hi), (0.0, 10.0));
+    v.set_approach(1, Approach::Down);
+    v.values_at(&[0.0, 15.0], &mut e).unwrap();
+    assert!((e[2] + 0.25e-3).abs() < 1e-18);
+    // A reverse std without a reverse direction; a negative std.
+    let mut b = ValuesBuilder::new(&m);
+    let bad = Motion {
+        down: None,
+        ..motion.clone()
+    };
+    assert!(b
+        .motion("EXX", bad)
+        .unwrap_err()
+        .to_string()
+        .contains("no reverse direction"));
+    let neg = Motion {
+        std_up: Some(src(t(vec![(0.0, 1e-4), (10.0, -1e-4)]), "s")),
+        ..motion
+    };
+    let e = b.motion("EXX", neg).unwrap_err().to_string();
+    assert!(e.contains("must be ≥ 0: point 1 is -0.0001"), "{e}");
+}
+
+#[test]
+fn approach_choices() {
+    assert_eq!(
+        parse_approaches("x=up, y=down").unwrap(),
+        vec![
+            (Some("x".into()), Approach::Up),
+            (Some("y".into()), Approach::Down)
+        ]
+    );
+    assert_eq!(
+        parse_approaches("mean").unwrap(),
+        vec![(None, Approach::Mean)]
+    );
+    assert!(parse_approaches("x=sideways")
+        .unwrap_err()
+        .contains("`sideways` is not an approach direction"));
+    assert!(parse_approaches("=up").is_err());
+    let mut v = read(
+        "choices",
+        "machine: m\nvalues:\n  EXX: {points: [[0, 0], [1, 1]], reverse_points: [[0, 1], [1, 2]]}\n  EXC: {points: [[0, 0], [1, 1]]}\n",
+        &[],
+    )
+    .unwrap();
+    v.choose_approach(&parse_approaches("x=down").unwrap())
+        .unwrap();
+    assert_eq!(v.approaches(), &[Approach::Mean, Approach::Down]);
+    let e = v
+        .choose_approach(&parse_approaches("C=up").unwrap())
+        .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("no table along `C` has a reverse direction"),
+        "{e}"
+    );
+    let e = v
+        .choose_approach(&parse_approaches("xx=up").unwrap())
+        .unwrap_err();
+    assert!(
+        e.to_string().contains("`xx` is not an axis variable"),
+        "{e}"
+    );
+    let mut plain = read(
+        "plain",
+        "machine: m\nvalues:\n  EXC: {points: [[0, 0], [1, 1]]}\n",
+        &[],
+    )
+    .unwrap();
+    let e = plain.choose_approach(&[(None, Approach::Up)]).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("no table of these values has a reverse direction"),
+        "{e}"
+    );
+    assert!(plain.reversals().is_empty() && !plain.has_repeatability());
+}
+
+/// `(scratch name, values file, CSV files, the expected location and code)`.
+type Case<'a> = (&'a str, &'a str, &'a [(&'a str, &'a str)], &'a str);
+
+#[test]
+fn direction_refusals_are_located() {
+    let cases: &[Case] = &[
+        (
+            "rev_std_alone",
+            "machine: m\nvalues:\n  EXX: {points: [[0, 0], [1, 1]], reverse_std_points: [[0, 0], [1, 1]]}\n",
+            &[],
+            "v.yaml:3:35 values.EXX.reverse_std_points chain::values::reverse_std_without_reverse",
+        ),
+        (
+            "neg_std_points",
+            "machine: m\nvalues:\n  EXX: {points: [[0, 0], [1, 1]], std_points: [[0, 0], [1, -1]]}\n",
+            &[],
+            "v.yaml:3:56 values.EXX.std_points[1] chain::values::negative_std",
+        ),
+        (
+            "neg_std_csv",
+            "machine: m\nvalues:\n  EXX: {table: x.csv, column: up, std: s}\n",
+            &[("x.csv", "x,up,s\n0,0,0.1\n1,1,-0.1\n")],
+            "x.csv:3:5 s chain::values::negative_std",
+        ),
+        (
+            "reverse_in_points",
+            "machine: m\nvalues:\n  EXX: {points: [[0, 0], [1, 1]], reverse: down}\n",
+            &[],
+            "v.yaml:3:35 values.EXX.reverse chain::values::key_not_for_points",
+        ),
+        (
+            "reverse_points_in_table",
+            "machine: m\nvalues:\n  EXX: {table: x.csv, reverse_points: [[0, 0], [1, 1]]}\n",
+            &[("x.csv", "x,EXX\n0,0\n1,1\n")],
+            "v.yaml:3:23 values.EXX.reverse_points chain::values::key_not_for_csv",
+        ),
+        (
+            "std_number_on_table",
+            "machine: m\nvalues:\n  EXX: {table: x.csv, std: 0.1}\n",
+            &[("x.csv", "x,EXX\n0,0\n1,1\n")],
+            "v.yaml:3:28 values.EXX.std chain::values::key_not_for_table",
+        ),
+        (
+            "points_and_table",
+            "machine: m\nvalues:\n  EXX: {points: [[0, 0], [1, 1]], table: x.csv}\n",
+            &[],
+            "v.yaml:3:35 values.EXX.table chain::conflicting_keys",
+        ),
+        (
+            "reverse_column_missing",
+            "machine: m\nvalues:\n  EXX: {table: x.csv, reverse: dwon}\n",
+            &[("x.csv", "x,EXX,down\n0,0,0\n1,1,1\n")],
+            "v.yaml:3:32 values.EXX.reverse chain::values::csv_no_column",
+        ),
+        (
+            "reverse_too_few",
+            "machine: m\nvalues:\n  EXX: {points: [[0, 0], [1, 1]], reverse_points: [[0, 0]]}\n",
+            &[],
+            "v.yaml:3:35 values.EXX.reverse_points chain::values::too_few_points",
+        ),
+        (
+            "reverse_on_constant",
+            "machine: m\nvalues:\n  EXX: {value: 1, reverse_points: [[0, 0], [1, 1]]}\n",
+            &[],
+            "v.yaml:3:19 values.EXX.reverse_points chain::values::key_not_for_constant",
+        ),
+    ];
+    for (name, values, csvs, want) in cases {
+        let got = read(name, values, csvs)
+            .err()
+            .unwrap_or_else(|| panic!("{name}: accepted"));
+        assert!(got.starts_with(want), "{name}: {got}");
+    }
+}
