@@ -330,9 +330,17 @@ impl<M: ErrorModel> BuiltMachine<M> {
     /// machine's order (plain errors, then functions); their errors add up
     /// to [`BuiltMachine::error`].
     pub fn parts(&self, q: &[f64]) -> Result<Vec<Part>, OutOfRange> {
+        self.parts_with(q, &self.values)
+    }
+
+    /// [`BuiltMachine::parts`] with other values for the same model: a
+    /// clone of [`BuiltMachine::values`] read for another approach
+    /// direction ([`Values::set_approach`]; the export of a controller's
+    /// forward and reverse columns).
+    pub fn parts_with(&self, q: &[f64], values: &Values) -> Result<Vec<Part>, OutOfRange> {
         let n = self.model.errors().len();
         let mut v = vec![0.0; n];
-        crate::ErrorValues::values_at(&self.values, q, &mut v)?;
+        crate::ErrorValues::values_at(values, q, &mut v)?;
         let mut s = vec![0.0; 6 * n];
         self.model.sensitivity(q, &self.parameters, &mut s);
         Ok(self

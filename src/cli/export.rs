@@ -588,6 +588,24 @@ impl Report for TablesDoc {
                 r.resampling
             );
         }
+        for d in &r.directions {
+            let _ = if d.bidirectional {
+                writeln!(
+                    out,
+                    "{} ({}): forward and reverse columns from the two approach directions; mean reversal {:.4} µm (BACKLASH {:.6} mm without the COMP_FILE)",
+                    d.variable,
+                    d.error,
+                    d.mean_reversal * 1e3,
+                    d.backlash
+                )
+            } else {
+                writeln!(
+                    out,
+                    "{} ({}): the same trim in both columns (no reverse direction in the values)",
+                    d.variable, d.error
+                )
+            };
+        }
         let grid: Vec<String> = (r.check_grid.iter())
             .map(|(n, v)| format!("{n} {} nodes", v.len()))
             .collect();

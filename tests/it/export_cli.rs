@@ -116,13 +116,17 @@ fn the_command_writes_the_library_files_with_its_travel_and_step() {
             linuxcnc = Some(dir);
         }
     }
-    // Field by field: x's comp file runs 100 to 700 every 25 mm (25 lines);
-    // y's keeps the machine file's travel 0..500, at 25 mm (21 lines).
+    // Field by field: x's comp file runs 100 to 700 every 25 mm, with the
+    // measured table's positions (every 40 mm) between (37 lines); y's keeps
+    // the machine file's travel 0..500, at 25 mm, where its table's
+    // positions are too (21 lines).
     let dir = linuxcnc.unwrap();
     let x = comp_lines(&std::fs::read_to_string(dir.join("x.comp")).unwrap());
-    assert_eq!(x.len(), 25);
-    for (k, row) in x.iter().enumerate() {
-        assert_eq!(row[0], 100.0 + 25.0 * k as f64);
+    let mut nominals: Vec<f64> = (0..25).map(|k| 100.0 + 25.0 * k as f64).collect();
+    nominals.extend((3..18).map(|m| 40.0 * m as f64).filter(|q| q % 25.0 != 0.0));
+    nominals.sort_by(f64::total_cmp);
+    assert_eq!(x.iter().map(|r| r[0]).collect::<Vec<_>>(), nominals);
+    for row in &x {
         assert_eq!(row[1], row[2]);
     }
     let y = comp_lines(&std::fs::read_to_string(dir.join("y.comp")).unwrap());

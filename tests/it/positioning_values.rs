@@ -527,3 +527,147 @@ fn direction_refusals_are_located() {
         assert!(got.starts_with(want), "{name}: {got}");
     }
 }
+
+/// The triplets LinuxCNC reads from a `COMP_FILE`: lines of three numbers
+/// until the first line that is not (`usrmotLoadComp`).
+fn comp_triplets(text: &str) -> Vec<[f64; 3]> {
+    text.lines()
+        .map_while(|line| {
+            let f: Vec<f64> = line
+                .split_whitespace()
+                .map_while(|t| t.parse().ok())
+                .collect();
+            <[f64; 3]>::try_from(f).ok()
+        })
+        .collect()
+}
+
+/// LinuxCNC's reading of one column at `x`: linear between entries, the end
+/// values held (`compute_screw_comp`).
+fn comp_at(rows: &[[f64; 3]], column: usize, x: f64) -> f64 {
+    if x <= rows[0][0] {
+        return rows[0][column];
+    }
+    let k = rows
+        .iter()
+        .position(|r| r[0] >= x)
+        .unwrap_or(rows.len() - 1);
+    let (a, b) = (rows[k - 1], rows[k]);
+    a[column] + (b[column] - a[column]) * (x - a[0]) / (b[0] - a[0])
+}
+
+#[test]
+fn linuxcnc_forward_and_reverse_leave_only_the_scatter() {
+    let dir = scratch("linuxcnc");
+    let vmc3 = example_file("machines/vmc3.yaml");
+    let values = values_out(&dir, "positioning/x_axis_runs.csv", &vmc3, "EXX", false);
+    let out = dir.join("comp");
+    let doc = ok_json(&[
+        "export",
+        vmc3.to_str().unwrap(),
+        "--values",
+        values.to_str().unwrap(),
+        "--controller",
+        "linuxcnc",
+        "--out",
+        out.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    let text = std::fs::read_to_string(out.join("x.comp")).unwrap();
+    let rows = comp_triplets(&text);
+    assert!(text.contains(
+        "# directions: forward = -u approached moving up, reverse = -u approached moving down"
+    ));
+    // The run file read by this test, every run's deviation at every target
+    // inside the travel (vmc3's x: 0 to 800 mm).
+    let table = read_runs("examples/positioning/x_axis_runs.csv", 1.0);
+    let mut scatter = [Vec::new(), Vec::new()];
+    for (p, up, down) in table.iter().filter(|t| t.0 <= 800.0) {
+        // The targets are entries of the table (written exactly).
+        assert!(rows.iter().any(|r| r[0] == *p), "no entry at {p}");
+        for (d, runs, column) in [(0, up, 1), (1, down, 2)] {
+            let mean = welford(runs).0;
+            for x in runs {
+                // LinuxCNC adds the trim of the direction it moves in: the
+                // position reached is off by the run's deviation plus it.
+                let left = x + comp_at(&rows, column, *p);
+                assert!(
+                    (left - (x - mean)).abs() < 1e-12,
+                    "{p} {d}: {left} vs {}",
+                    x - mean
+                );
+                scatter[d].push(left);
+            }
+        }
+    }
+    // What is left has zero mean per direction: the run-to-run scatter.
+    for s in &scatter {
+        assert!(s.iter().sum::<f64>().abs() / (s.len() as f64) < 1e-12);
+    }
+    // The report says which it did and the BACKLASH of the mean reversal:
+    // the mean of (x̄↑ − x̄↓) over the table's entries, negated.
+    let d = doc["directions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|d| d["variable"] == "x")
+        .unwrap();
+    assert_eq!(d["bidirectional"], true);
+    let mean_reversal = rows.iter().map(|r| r[2] - r[1]).sum::<f64>() / rows.len() as f64;
+    assert!((d["mean_reversal"].as_f64().unwrap() - mean_reversal).abs() < 1e-15);
+    assert_eq!(
+        d["backlash"].as_f64().unwrap(),
+        -d["mean_reversal"].as_f64().unwrap()
+    );
+    let y = doc["directions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|d| d["variable"] == "y")
+        .unwrap();
+    assert_eq!(y["bidirectional"], false);
+    let readme = std::fs::read_to_string(out.join("linuxcnc-README.txt")).unwrap();
+    assert!(readme.contains("BACKLASH = "), "{readme}");
+    // `map --compensated linuxcnc --approach up`: the forward column removes
+    // the up direction at the targets, to the second order of the errors
+    // (the trim is looked up at the commanded position: the table's slope,
+    // ≤ 4e-5, times the error, ≤ 9 µm).
+    let grid = format!(
+        "x={}",
+        table
+            .iter()
+            .filter(|t| t.0 <= 800.0)
+            .map(|t| t.0.to_string())
+            .collect::<Vec<_>>()
+            .join(",")
+    );
+    for approach in ["up", "down", "mean"] {
+        let map = ok_json(&[
+            "map",
+            vmc3.to_str().unwrap(),
+            "--values",
+            values.to_str().unwrap(),
+            "--grid",
+            &grid,
+            "--grid",
+            "y=0",
+            "--grid",
+            "z=0",
+            "--approach",
+            approach,
+            "--compensated",
+            "linuxcnc",
+            "--format",
+            "json",
+        ]);
+        let before = map["summary"]["volumetric"]["max"].as_f64().unwrap();
+        let after = map["compensated"]["summary"]["volumetric"]["max"]
+            .as_f64()
+            .unwrap();
+        assert!(
+            before > 3e-3 && after < 4e-7,
+            "{approach}: {before} -> {after}"
+        );
+    }
+}

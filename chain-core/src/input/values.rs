@@ -906,6 +906,18 @@ impl Values {
             .collect()
     }
 
+    /// The positions of the tables of entry `name` (both approach
+    /// directions), increasing, each once; `None` if `name` is not given as
+    /// a table.
+    pub fn table_positions(&self, name: &str) -> Option<Vec<f64>> {
+        let t = self.tables.iter().find(|t| t.name == name)?;
+        let mut q: Vec<f64> = t.table.positions().to_vec();
+        q.extend(t.reverse.iter().flat_map(|r| r.positions().iter().copied()));
+        q.sort_by(f64::total_cmp);
+        q.dedup();
+        Some(q)
+    }
+
     /// True if some table gives a standard deviation per position.
     pub fn has_repeatability(&self) -> bool {
         self.tables.iter().any(|t| t.std.is_some())

@@ -5,7 +5,7 @@
 //! | [`Controller`] | files | what the format expresses |
 //! |---|---|---|
 //! | [`Controller::Beckhoff`] | `vol_comp_0.lis`, `chain_volcomp.csv` (`ISG_CSV`) | the ISO 230-1 error parameters of the three linear axes: the tool-point position error (not the orientation) |
-//! | [`Controller::Linuxcnc`] | `<variable>.comp` per joint (`COMP_FILE_TYPE = 1`), `linuxcnc-README.txt` | each joint's positioning error along its own axis |
+//! | [`Controller::Linuxcnc`] | `<variable>.comp` per joint (`COMP_FILE_TYPE = 1`), `linuxcnc-README.txt` | each joint's positioning error along its own axis, forward and reverse columns from the values' two approach directions where its table has them |
 //! | [`Controller::SiemensCec`] | `NC_CEC.INI` (`%_N_NC_CEC_INI`) | each straightness error, as a cross-axis table (base axis → compensation axis) |
 //! | [`Controller::Klipper`] | `skew_correction.cfg` | the squareness errors, as Klipper's shear factors `xy`, `xz`, `yz` |
 //!
@@ -59,10 +59,11 @@ use crate::compensation::{Correction, ExportedFile};
 use crate::kinematics::forward::Kinematics;
 use crate::model::{ErrorKind, JointKind, Machine};
 use crate::model_trait::{ErrorModel, OutOfRange};
+use crate::values::Values;
 
 pub use beckhoff::BeckhoffCorrection;
 pub use klipper::{KlipperCorrection, SkewFactors};
-pub use linuxcnc::LinuxcncCorrection;
+pub use linuxcnc::{LinuxcncCorrection, LinuxcncTable};
 pub use siemens_cec::CecCorrection;
 
 /// The default table step (mm): [`ExportOptions::step`].
@@ -355,6 +356,33 @@ pub struct FormatReport {
     /// the table nodes, at most 11 per axis, where the sizes above are
     /// taken.
     pub check_grid: Vec<(String, Vec<f64>)>,
+    /// Per table of a format with a column per approach direction
+    /// (LinuxCNC), what its directions hold (serialised only when there
+    /// are any).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub directions: Vec<DirectionReport>,
+}
+
+/// What one table's approach-direction columns hold (LinuxCNC's forward and
+/// reverse trims; docs/export-controllers.md).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DirectionReport {
+    /// The axis variable.
+    pub variable: String,
+    /// The positioning error the table is made from.
+    pub error: String,
+    /// True when the two columns come from the values' two approach
+    /// directions (a table with a reverse direction); false when both hold
+    /// the same values.
+    pub bidirectional: bool,
+    /// The mean reversal at the tool point along the axis over the table's
+    /// nodes, `B̄ = mean(u↑ − u↓)` (mm; ISO 230-2:2014 2.16 with `u` the
+    /// positioning error at the tool point): 0 without a reverse direction.
+    pub mean_reversal: f64,
+    /// LinuxCNC's `[JOINT_n]BACKLASH` that gives the same mean reversal
+    /// correction, `−B̄` (LinuxCNC adds `±BACKLASH/2` moving up/down,
+    /// `control.c`); LinuxCNC ignores it when a `COMP_FILE` is given.
+    pub backlash: f64,
 }
 
 /// The result of [`export`]: files, report and the correction the
@@ -679,14 +707,17 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
         &self,
         axis: &LinearAxis,
     ) -> Result<Vec<Vec<crate::built::Part>>, ControllerError> {
-        let mut q = self.reference.clone();
-        axis.nodes
-            .iter()
-            .map(|&x| {
-                q[axis.variable] = x;
-                self.parts(&q).map_err(|e| self.out_of_table(axis, e))
-            })
-            .collect()
+        self.along_with(axis, self.built.values())
+    }
+
+    /// [`Context::along`] with other values for the built machine's model
+    /// (another approach direction).
+    pub fn along_with(
+        &self,
+        axis: &LinearAxis,
+        values: &Values,
+    ) -> Result<Vec<Vec<crate::built::Part>>, ControllerError> {
+        self.sample(axis, values, axis.nodes.clone())
     }
 
     /// The parts at the midpoints between the nodes of `axis`.
@@ -694,14 +725,39 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
         &self,
         axis: &LinearAxis,
     ) -> Result<Vec<Vec<crate::built::Part>>, ControllerError> {
+        self.midpoints_with(axis, self.built.values())
+    }
+
+    /// [`Context::midpoints`] with other values.
+    pub fn midpoints_with(
+        &self,
+        axis: &LinearAxis,
+        values: &Values,
+    ) -> Result<Vec<Vec<crate::built::Part>>, ControllerError> {
+        let mids = axis.nodes.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();
+        self.sample(axis, values, mids)
+    }
+
+    /// The parts at each of `xs` along `axis` (the others at the reference).
+    fn sample(
+        &self,
+        axis: &LinearAxis,
+        values: &Values,
+        xs: Vec<f64>,
+    ) -> Result<Vec<Vec<crate::built::Part>>, ControllerError> {
         let mut q = self.reference.clone();
-        axis.nodes
-            .windows(2)
-            .map(|w| {
-                q[axis.variable] = 0.5 * (w[0] + w[1]);
-                self.parts(&q).map_err(|e| self.out_of_table(axis, e))
+        xs.into_iter()
+            .map(|x| {
+                q[axis.variable] = x;
+                (self.built.parts_with(&self.built_q(&q), values))
+                    .map_err(|e| self.out_of_table(axis, e))
             })
             .collect()
+    }
+
+    /// The built model's index of machine variable `v`.
+    pub fn built_variable(&self, v: usize) -> usize {
+        self.to_built[v]
     }
 
     fn out_of_table(&self, axis: &LinearAxis, e: OutOfRange) -> ControllerError {
@@ -858,6 +914,7 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
                 residual: accounting.residual,
                 resampling,
                 check_grid: accounting.check_grid,
+                directions: Vec::new(),
             },
             files,
             correction,
