@@ -500,16 +500,22 @@ impl Model {
                 None => spec.grid.axes.push((name.clone(), values.clone())),
             }
         }
+        let posterior_error = |e| match e {
+            reliability::PosteriorError::Reliability(e) => err(e),
+            reliability::PosteriorError::Values(v) => load_error(py, v.diagnostics()),
+            reliability::PosteriorError::File(d) => load_error(py, &d),
+            e @ reliability::PosteriorError::Point { .. } => value_error(e.to_string()),
+        };
         let inputs = match posterior {
             None => reliability::machine::inputs(m).map_err(err)?,
-            Some(p) => p.inputs(m).map_err(|e| match e {
-                reliability::PosteriorError::Reliability(e) => err(e),
-                reliability::PosteriorError::Values(v) => load_error(py, v.diagnostics()),
-                reliability::PosteriorError::File(d) => load_error(py, &d),
-            })?,
+            Some(p) => p.inputs(m).map_err(posterior_error)?,
         };
         let values = self.parameter_vector(py, params)?;
-        Study::new(&self.model, &values, inputs, spec).map_err(err)
+        let study = Study::new(&self.model, &values, inputs, spec).map_err(err)?;
+        match posterior {
+            Some(p) => p.apply(m, study).map_err(posterior_error),
+            None => Ok(study),
+        }
     }
 }
 

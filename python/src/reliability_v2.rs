@@ -50,6 +50,7 @@ pub(crate) fn posterior_error(py: Python<'_>, model: &Model, e: PosteriorError) 
         PosteriorError::Values(v) => load_error(py, v.diagnostics()),
         PosteriorError::File(d) => load_error(py, &d),
         PosteriorError::Reliability(e) => study_error(py, &e, &model.file),
+        e @ PosteriorError::Point { .. } => value_error(e.to_string()),
     }
 }
 

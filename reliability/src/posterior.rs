@@ -49,6 +49,7 @@ use serde::Serialize;
 
 use crate::error::ReliabilityError;
 use crate::inputs::{Correlation, Inputs, Marginal};
+use crate::study::Study;
 
 /// Why a posterior could not be read or used.
 #[derive(Debug, thiserror::Error)]
@@ -66,6 +67,22 @@ pub enum PosteriorError {
     #[error(transparent)]
     #[cfg_attr(feature = "miette", diagnostic(transparent))]
     Reliability(ReliabilityError),
+    /// A point where the tables give no input: outside a table, or a
+    /// repeatability of 0 there.
+    #[error("{file}: {message}")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(
+            code(chain::posterior::table_point),
+            help("study the points inside the tables (--grid), extend them, or add `extrapolate: hold` to the entry")
+        )
+    )]
+    Point {
+        /// The values file.
+        file: String,
+        /// What is wrong, naming the table and the point.
+        message: String,
+    },
 }
 
 /// One error parameter the posterior gives.
@@ -78,6 +95,24 @@ pub struct PosteriorValue {
     /// Its standard deviation, if the file gives one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub std: Option<f64>,
+}
+
+/// A tabulated error's input at one point: `(error index, mean, std)`
+/// (without `std`: the `statistics` spread about the mean).
+type AtPoint = (usize, f64, Option<f64>);
+
+/// One error motion the posterior gives as a table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PosteriorTable {
+    /// The entry (error motion or function slot).
+    pub name: String,
+    /// Its axis variable.
+    pub variable: String,
+    /// True when it gives a standard deviation per position (a normal input
+    /// with that repeatability); false: its `statistics` spread.
+    pub repeatability: bool,
+    /// The approach direction read along its axis.
+    pub approach: chain_core::values::Approach,
 }
 
 /// One correlation coefficient of the posterior.
@@ -102,10 +137,16 @@ pub struct Posterior {
     pub values: Vec<PosteriorValue>,
     /// The correlations, in the file's order.
     pub correlations: Vec<PosteriorCorrelation>,
+    /// The error motions given as tables (their input varies along the
+    /// axis: [`Posterior::inputs_at`]), in the file's order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub tables: Vec<String>,
+    /// The values, kept when some error is a table.
+    #[serde(skip)]
+    built: Option<Values>,
 }
 
 /// Codes of the posterior's refusals.
-const CODE_TABLE: &str = "chain::posterior::table";
 const CODE_STD: &str = "chain::posterior::zero_std";
 const CODE_SHAPE: &str = "chain::posterior::correlation_entry";
 const CODE_UNKNOWN: &str = "chain::posterior::unknown_name";
@@ -162,6 +203,7 @@ impl Posterior {
     ) -> Result<Posterior, PosteriorError> {
         let mut problems: Vec<(Origin, Problem)> = Vec::new();
         let mut given = Vec::new();
+        let mut tables = Vec::new();
         for e in values.entries() {
             let origin = e.origin.clone().unwrap_or_else(|| origin_at(0, "values"));
             match (&e.given, e.kind) {
@@ -181,18 +223,8 @@ impl Posterior {
                         std: *std,
                     });
                 }
-                _ => {
-                    let m = Message::new(
-                        format!(
-                            "`{}` is a table: reliability takes a posterior of constants (a mean per error parameter or coefficient)",
-                            e.name
-                        ),
-                        "a table",
-                        CODE_TABLE,
-                    )
-                    .help("give the identified constants or function-slot coefficients (`chain identify --values-out` writes them)");
-                    problems.push((origin, m.into()));
-                }
+                (Given::Table { .. }, _) => tables.push(e.name.clone()),
+                (Given::Constant { .. }, EntryKind::Function) => {}
             }
         }
         let parsed = yaml::parse(text);
@@ -213,10 +245,13 @@ impl Posterior {
         if let Some(d) = Diagnostics::located(file, text, problems) {
             return Err(PosteriorError::File(d));
         }
+        let built = (!tables.is_empty()).then(|| values.clone());
         Ok(Posterior {
             file: Some(file.to_string()),
             values: given,
             correlations,
+            tables,
+            built,
         })
     }
 
@@ -230,13 +265,147 @@ impl Posterior {
     /// section elsewhere. An error the posterior gives without `std`, or
     /// does not give, needs a `statistics` entry
     /// ([`ReliabilityError::MissingStatistic`]).
+    ///
+    /// An error given as a table varies along its axis: its input is the
+    /// point's ([`Posterior::inputs_at`]), and a standard normal stands in
+    /// for it here (a study built from these inputs takes each point's with
+    /// `Study::with_point_inputs`).
     pub fn inputs(&self, machine: &Machine) -> Result<Inputs, PosteriorError> {
+        let tabulated: Vec<AtPoint> = match &self.built {
+            Some(v) => (v.tabulated().into_iter())
+                .map(|(j, _)| (j, 0.0, Some(1.0)))
+                .collect(),
+            None => Vec::new(),
+        };
+        self.inputs_with(machine, &tabulated)
+    }
+
+    /// The tables, with what each gives and the approach read.
+    pub fn table_inputs(&self) -> Vec<PosteriorTable> {
+        let Some(v) = &self.built else {
+            return Vec::new();
+        };
+        (v.entries().iter())
+            .filter_map(|e| match &e.given {
+                Given::Table { variable, std, .. } => Some(PosteriorTable {
+                    name: e.name.clone(),
+                    variable: variable.clone(),
+                    repeatability: std.is_some(),
+                    approach: (v.variables().iter())
+                        .position(|x| x == variable)
+                        .map(|k| v.approaches()[k])
+                        .unwrap_or_default(),
+                }),
+                Given::Constant { .. } => None,
+            })
+            .collect()
+    }
+
+    /// True when some error is a table: its input differs from point to
+    /// point.
+    pub fn varies(&self) -> bool {
+        !self.tables.is_empty()
+    }
+
+    /// Reads every bidirectional table for these approach directions
+    /// (`chain reliability --approach`; [`Values::choose_approach`]).
+    pub fn choose_approach(
+        &mut self,
+        choices: &[(Option<String>, chain_core::values::Approach)],
+    ) -> Result<(), chain_core::values::ApproachError> {
+        match &mut self.built {
+            Some(v) => v.choose_approach(choices),
+            None => Err(chain_core::values::ApproachError::NoDirection),
+        }
+    }
+
+    /// The inputs at axis values `q` (the machine's variable order;
+    /// docs/posterior.md, "Tables"): a table with a standard deviation per
+    /// position gives a normal input with the table's value (for the chosen
+    /// approach) as mean and its interpolated standard deviation, the run's
+    /// repeatability; a table without one gives its `statistics` marginal
+    /// with the mean moved to the table's value; everything else as
+    /// [`Posterior::inputs`]. A `q` outside a table is an error naming it.
+    pub fn inputs_at(&self, machine: &Machine, q: &[f64]) -> Result<Inputs, PosteriorError> {
+        let Some(values) = &self.built else {
+            return self.inputs(machine);
+        };
+        let n = machine.errors.len();
+        let (mut v, mut s) = (vec![0.0; n], vec![0.0; n]);
+        let file = self.file.clone().unwrap_or_else(|| "values".into());
+        let outside = |e: chain_core::OutOfRange| PosteriorError::Point {
+            file: file.clone(),
+            message: e.to_string(),
+        };
+        chain_core::ErrorValues::values_at(values, q, &mut v).map_err(outside)?;
+        values.repeatability_at(q, &mut s).map_err(outside)?;
+        let mut tabulated = Vec::new();
+        for (j, has_std) in values.tabulated() {
+            if has_std && (s[j] <= 0.0 || s[j].is_nan()) {
+                let at: Vec<String> = (machine.variables.iter().zip(q))
+                    .map(|(var, x)| format!("{} = {x}", var.name))
+                    .collect();
+                return Err(PosteriorError::Point {
+                    file,
+                    message: format!(
+                        "`{}`: its table's standard deviation is {} at {}; a repeatability must be positive where the study evaluates it",
+                        machine.errors[j].name,
+                        s[j],
+                        at.join(", ")
+                    ),
+                });
+            }
+            tabulated.push((j, v[j], has_std.then_some(s[j])));
+        }
+        self.inputs_with(machine, &tabulated)
+    }
+
+    /// `study` (built from [`Posterior::inputs`]) with each point's inputs
+    /// ([`Posterior::inputs_at`]) when some error is a table; unchanged
+    /// otherwise. The one place a study meets a varying posterior: the
+    /// command line and Python both call it.
+    pub fn apply(&self, machine: &Machine, study: Study) -> Result<Study, PosteriorError> {
+        if !self.varies() {
+            return Ok(study);
+        }
+        // A point in the model's variable order; the values' in the
+        // machine's.
+        let order: Vec<usize> = (machine.variables.iter())
+            .map(|v| {
+                (study.variables().iter())
+                    .position(|n| *n == v.name)
+                    .ok_or_else(|| ReliabilityError::MissingCoordinate(v.name.clone()))
+            })
+            .collect::<Result<_, _>>()
+            .map_err(PosteriorError::Reliability)?;
+        let each = (study.points().iter())
+            .map(|q| self.inputs_at(machine, &order.iter().map(|&k| q[k]).collect::<Vec<_>>()))
+            .collect::<Result<Vec<_>, _>>()?;
+        study
+            .with_point_inputs(each)
+            .map_err(PosteriorError::Reliability)
+    }
+
+    /// The inputs with the errors of `tabulated` given `(mean, std)` there.
+    fn inputs_with(
+        &self,
+        machine: &Machine,
+        tabulated: &[AtPoint],
+    ) -> Result<Inputs, PosteriorError> {
         let err = PosteriorError::Reliability;
         let mut names = Vec::with_capacity(machine.errors.len());
         let mut marginals = Vec::with_capacity(machine.errors.len());
         for (j, e) in machine.errors.iter().enumerate() {
-            let given = self.value(&e.name);
-            let marginal = match given {
+            let table = tabulated.iter().find(|(k, _, _)| *k == j);
+            let given = match table {
+                Some(&(_, mean, std)) => Some(PosteriorValue {
+                    name: e.name.clone(),
+                    mean,
+                    std,
+                }),
+                None => self.value(&e.name).cloned(),
+            };
+            let marginal = match &given {
                 Some(PosteriorValue {
                     mean,
                     std: Some(std),
@@ -252,7 +421,7 @@ impl Posterior {
                             });
                     let stat = stat.map_err(err)?;
                     let prior = crate::machine::marginal(&stat.distribution);
-                    match (prior, given) {
+                    match (prior, &given) {
                         (Ok(p), Some(v)) => p.with_moments(v.mean, p.std()),
                         (p, _) => p,
                     }

@@ -297,6 +297,9 @@ impl FormCase {
 #[derive(Debug, Clone)]
 pub struct Study {
     inputs: Inputs,
+    /// Per point, its own inputs, when they differ from point to point
+    /// ([`Study::with_point_inputs`]).
+    point_inputs: Option<Vec<Inputs>>,
     variables: Vec<String>,
     spec: StudySpec,
     points: Vec<Vec<f64>>,
@@ -726,12 +729,53 @@ impl Study {
             points,
             sensitivities,
             targets,
+            point_inputs: None,
         })
     }
 
-    /// The inputs, in the model's error order.
+    /// The inputs, in the model's error order. With inputs per point
+    /// ([`Study::with_point_inputs`]) these are the common ones (names,
+    /// families), and [`Study::inputs_at`] gives a point's.
     pub fn inputs(&self) -> &Inputs {
         &self.inputs
+    }
+
+    /// The inputs at point `p`: its own, or the common ones.
+    pub fn inputs_at(&self, p: usize) -> &Inputs {
+        match &self.point_inputs {
+            Some(each) => &each[p],
+            None => &self.inputs,
+        }
+    }
+
+    /// True when the inputs differ from point to point.
+    pub fn varies(&self) -> bool {
+        self.point_inputs.is_some()
+    }
+
+    /// The study with inputs of its own at every point (in
+    /// [`Study::points`] order, the same errors in the same order): a built
+    /// machine whose measured error motions have a mean and a repeatability
+    /// that vary along the axes (`chain reliability --values` with
+    /// tables, docs/posterior.md). Every case's event and moments use its
+    /// point's inputs.
+    pub fn with_point_inputs(mut self, each: Vec<Inputs>) -> Result<Study, ReliabilityError> {
+        if each.len() != self.points.len() {
+            return Err(ReliabilityError::Dimension {
+                what: "inputs per point",
+                expected: self.points.len(),
+                found: each.len(),
+            });
+        }
+        if let Some(bad) = each.iter().find(|i| i.names() != self.inputs.names()) {
+            return Err(ReliabilityError::Dimension {
+                what: "inputs of a point (the study's errors)",
+                expected: self.inputs.len(),
+                found: bad.len(),
+            });
+        }
+        self.point_inputs = Some(each);
+        Ok(self)
     }
 
     /// The model's axis variables.
@@ -784,7 +828,8 @@ impl Study {
         if self.spec.system.is_some() {
             out.push(FormLimit::System);
         }
-        if !self.inputs.is_affine() {
+        let each = self.point_inputs.iter().flatten();
+        if !self.inputs.is_affine() || each.clone().any(|i| !i.is_affine()) {
             out.push(FormLimit::NonNormal);
         }
         out
@@ -819,14 +864,15 @@ impl Study {
     /// `Cov(E_a, E_b) = S_aᵀΣS_b`, [`Inputs::covariance`], the diagonal sum
     /// alone for independent inputs).
     pub fn moments(&self, p: usize) -> ErrorMoments {
-        let means = self.inputs.means();
+        let inputs = self.inputs_at(p);
+        let means = inputs.means();
         let mut mean = [0.0; 6];
         let mut covariance = [[0.0; 6]; 6];
         for a in Component::ALL {
             let ra = self.row(p, a);
             mean[a.index()] = ra.iter().zip(means).map(|(s, m)| s * m).sum();
             for b in Component::ALL {
-                covariance[a.index()][b.index()] = self.inputs.covariance(ra, self.row(p, b));
+                covariance[a.index()][b.index()] = inputs.covariance(ra, self.row(p, b));
             }
         }
         ErrorMoments { mean, covariance }
@@ -876,7 +922,7 @@ impl Study {
 
     /// The event of `target` at point `p`.
     pub fn event(&self, target: Target, p: usize) -> Result<Event<'_>, ReliabilityError> {
-        Event::new(&self.inputs, self.limit_state(target, p)?)
+        Event::new(self.inputs_at(p), self.limit_state(target, p)?)
     }
 
     /// Every case's event, target-major.
@@ -1135,6 +1181,12 @@ impl Study {
                 what: "point coordinates",
                 expected: self.variables.len(),
                 found: point.len(),
+            });
+        }
+        if self.varies() {
+            return Err(ReliabilityError::InvalidOption {
+                option: "--at",
+                message: "the inputs differ from point to point (tables in the values); give the point as a one-point grid (--grid VAR=VALUE for every axis) instead".into(),
             });
         }
         let single = Study::at_points(

@@ -157,10 +157,17 @@ pub struct ReliabilityArgs {
     #[command(flatten)]
     pub system: SystemArgs,
     /// A values file with the posterior of a calibration (means, `std` per
-    /// constant, `correlation: [[NAME, NAME, rho], ...]`); errors it does not
-    /// give keep their `statistics` (docs/posterior.md).
+    /// constant, `correlation: [[NAME, NAME, rho], ...]`) or a built
+    /// machine's measured tables (a positioning run's means and
+    /// repeatability); errors it does not give keep their `statistics`
+    /// (docs/posterior.md).
     #[arg(long, value_name = "VALUES.yaml")]
     pub values: Option<PathBuf>,
+    /// Which approach direction of the values' bidirectional tables to
+    /// read: `up`, `down` or `mean` (the default), or per axis
+    /// `x=up,y=down` (docs/values.md, "Direction").
+    #[arg(long, value_name = "DIR|VAR=DIR,...", value_parser = chain_core::values::parse_approaches, requires = "values")]
+    pub approach: Vec<Vec<(Option<String>, chain_core::values::Approach)>>,
     /// Also the whole-machine acceptance probability: every toleranced
     /// component within tolerance at every grid point at once, with its
     /// sensitivities (as `reliability.acceptance: true`; docs/acceptance.md).
@@ -177,7 +184,7 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let system = system_of(&loaded.machine, args.system.system, args.system.tolerance)
         .map_err(|e| loaded.report(e))?;
-    let posterior = loaded.posterior(args.values.as_deref())?;
+    let posterior = loaded.posterior(args.values.as_deref(), &args.approach)?;
     let (study, _model) = loaded.study_with(
         &args.model.param.params,
         &args.grid,
@@ -341,16 +348,27 @@ impl Loaded {
     }
 
     /// The posterior of `--values`, if given (its refusals located in the
-    /// values file).
-    pub(crate) fn posterior(&self, values: Option<&Path>) -> miette::Result<Option<Posterior>> {
+    /// values file), its tables read for the `--approach` choices.
+    pub(crate) fn posterior(
+        &self,
+        values: Option<&Path>,
+        approach: &[Vec<(Option<String>, chain_core::values::Approach)>],
+    ) -> miette::Result<Option<Posterior>> {
         let Some(path) = values else {
             return Ok(None);
         };
-        match Posterior::read(path, &self.machine) {
-            Ok(p) => Ok(Some(p)),
-            Err(PosteriorError::Reliability(e)) => Err(self.report(e)),
-            Err(e) => Err(e.into()),
+        let mut posterior = match Posterior::read(path, &self.machine) {
+            Ok(p) => p,
+            Err(PosteriorError::Reliability(e)) => return Err(self.report(e)),
+            Err(e) => return Err(e.into()),
+        };
+        let choices: Vec<_> = approach.iter().flatten().cloned().collect();
+        if !choices.is_empty() {
+            posterior
+                .choose_approach(&choices)
+                .map_err(|e| miette::miette!("--approach: {e} (values {})", path.display()))?;
         }
+        Ok(Some(posterior))
     }
 
     /// [`Loaded::study`] with the inputs of a posterior (`None`: the
@@ -390,7 +408,13 @@ impl Loaded {
         };
         let values = machine::parameters(m, params).map_err(|e| self.report(e))?;
         let model = chain_core::compile(m);
-        let study = Study::new(&model, &values, inputs, spec).map_err(|e| self.report(e))?;
+        let mut study = Study::new(&model, &values, inputs, spec).map_err(|e| self.report(e))?;
+        if let Some(p) = posterior {
+            study = p.apply(m, study).map_err(|e| match e {
+                PosteriorError::Reliability(e) => self.report(e),
+                other => other.into(),
+            })?;
+        }
         Ok((study, model))
     }
 
@@ -664,10 +688,14 @@ impl Report for ReliabilityDoc<'_> {
 pub(crate) fn posterior_lines(p: &Posterior) -> String {
     let with_std = p.values.iter().filter(|v| v.std.is_some()).count();
     let mut out = format!(
-        "posterior: {} ({} errors given, {with_std} with std, {} correlations; the others from `statistics`)\n",
+        "posterior: {} ({} errors given, {with_std} with std, {} correlations{}; the others from `statistics`)\n",
         p.file.as_deref().unwrap_or("values"),
         p.values.len(),
-        p.correlations.len()
+        p.correlations.len(),
+        match p.tables.len() {
+            0 => String::new(),
+            n => format!(", {n} table{}", if n == 1 { "" } else { "s" }),
+        }
     );
     for v in &p.values {
         match v.std {
@@ -686,6 +714,19 @@ pub(crate) fn posterior_lines(p: &Posterior) -> String {
     }
     for c in &p.correlations {
         out.push_str(&format!("  rho({}, {}) = {}\n", c.a, c.b, fmt_num(c.rho)));
+    }
+    for t in p.table_inputs() {
+        out.push_str(&format!(
+            "  {:<12} table along {} (approach {}): {}\n",
+            t.name,
+            t.variable,
+            t.approach,
+            if t.repeatability {
+                "normal, the table's mean and repeatability at each point"
+            } else {
+                "its statistics spread about the table's value at each point"
+            }
+        ));
     }
     out.push('\n');
     out

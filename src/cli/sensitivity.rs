@@ -74,6 +74,11 @@ pub struct SensitivityArgs {
     /// An argument with `=` is nominal sizes, any other a values file.
     #[arg(long, value_name = "VALUES.yaml | KIND=VALUE,...", value_parser = parse_values)]
     pub values: Option<ValuesArg>,
+    /// `--kind reliability` with a values file: which approach direction of
+    /// its bidirectional tables to read, `up`, `down`, `mean` (the default)
+    /// or per axis `x=up,y=down` (docs/values.md, "Direction").
+    #[arg(long, value_name = "DIR|VAR=DIR,...", value_parser = chain_core::values::parse_approaches, requires = "values")]
+    pub approach: Vec<Vec<(Option<String>, chain_core::values::Approach)>>,
     /// Replace the grid values of one axis for the grid mean, `VAR=v1,v2,...` (repeatable).
     #[arg(long = "grid", value_name = "VAR=V1,V2,...", value_parser = parse_axis)]
     pub grid: Vec<(String, Vec<f64>)>,
@@ -138,7 +143,7 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
         None => None,
     };
     let loaded = Loaded::new(&args.file)?;
-    let posterior = loaded.posterior(file)?;
+    let posterior = loaded.posterior(file, &args.approach)?;
     let (study, model) = loaded.study_with(
         &args.model.param.params,
         &args.grid,

@@ -134,6 +134,28 @@ fn values_out_reads_back_as_the_per_target_means_and_stds() {
     }
 }
 
+/// `chain map vmc3 --values VALUES --grid GRID --grid y=0 --grid z=0
+/// EXTRA... --format json`.
+fn vmc3_map_json(values: &Path, grid: &str, extra: &[&str]) -> serde_json::Value {
+    let vmc3 = example_file("machines/vmc3.yaml");
+    let mut args = vec![
+        "map",
+        vmc3.to_str().unwrap(),
+        "--values",
+        values.to_str().unwrap(),
+        "--grid",
+        grid,
+        "--grid",
+        "y=0",
+        "--grid",
+        "z=0",
+        "--format",
+        "json",
+    ];
+    args.extend(extra);
+    ok_json(&args)
+}
+
 #[test]
 fn map_with_each_approach_gives_the_per_target_means() {
     // vmc3's x table moves along −x: the map's px is the deviation itself
@@ -156,24 +178,8 @@ fn map_with_each_approach_gives_the_per_target_means() {
         (None, 2),
         (Some("mean"), 2),
     ] {
-        let mut args = vec![
-            "map",
-            vmc3.to_str().unwrap(),
-            "--values",
-            path.to_str().unwrap(),
-            "--grid",
-            &grid,
-            "--grid",
-            "y=0",
-            "--grid",
-            "z=0",
-            "--format",
-            "json",
-        ];
-        if let Some(f) = flag {
-            args.extend(["--approach", f]);
-        }
-        let doc = ok_json(&args);
+        let extra: Vec<&str> = flag.into_iter().flat_map(|f| ["--approach", f]).collect();
+        let doc = vmc3_map_json(&path, &grid, &extra);
         let points = doc["points"].as_array().unwrap();
         assert_eq!(points.len(), table.len());
         for (pt, (p, up, down)) in points.iter().zip(&table) {
@@ -643,24 +649,11 @@ fn linuxcnc_forward_and_reverse_leave_only_the_scatter() {
             .join(",")
     );
     for approach in ["up", "down", "mean"] {
-        let map = ok_json(&[
-            "map",
-            vmc3.to_str().unwrap(),
-            "--values",
-            values.to_str().unwrap(),
-            "--grid",
+        let map = vmc3_map_json(
+            &values,
             &grid,
-            "--grid",
-            "y=0",
-            "--grid",
-            "z=0",
-            "--approach",
-            approach,
-            "--compensated",
-            "linuxcnc",
-            "--format",
-            "json",
-        ]);
+            &["--approach", approach, "--compensated", "linuxcnc"],
+        );
         let before = map["summary"]["volumetric"]["max"].as_f64().unwrap();
         let after = map["compensated"]["summary"]["volumetric"]["max"]
             .as_f64()
@@ -670,4 +663,161 @@ fn linuxcnc_forward_and_reverse_leave_only_the_scatter() {
             "{approach}: {before} -> {after}"
         );
     }
+}
+
+/// A one-axis machine with a reliability section: `px` within `tol` (upper)
+/// at the targets.
+fn one_axis(tol: f64, targets: &[f64]) -> String {
+    let grid: Vec<String> = targets.iter().map(|t| t.to_string()).collect();
+    format!(
+        "machine: m
+bodies:
+  bed: {{}}
+  x_slide: {{parent: bed, joint: {{type: prismatic, axis: +x, variable: x}}, errors: {{dx: EXX}}}}
+workpiece: bed
+tool: x_slide
+reliability:
+  tolerance: {{px: {tol}}}
+  sided: upper
+  grid:
+    x: [{}]
+",
+        grid.join(", ")
+    )
+}
+
+#[test]
+fn reliability_with_the_repeatability_matches_resampling_the_runs() {
+    // Runs of our own making: 400 per direction at three targets, normal
+    // about a mean per direction with a spread per target (Box-Muller from
+    // the tests' generator).
+    let targets = [0.0, 250.0, 500.0];
+    let (mean_up, mean_down) = ([0.0020, 0.0026, 0.0012], [-0.0004, 0.0003, -0.0010]);
+    let (s_up, s_down) = ([0.0008, 0.0005, 0.0011], [0.0006, 0.0009, 0.0004]);
+    let n = 400;
+    let mut rng = crate::common::Rng::new(2302);
+    let mut normal = move || {
+        let (u, v) = (1.0 - rng.unit(), rng.unit());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    };
+    let mut csv = String::from("target,direction,run,deviation\n");
+    let mut runs = vec![(Vec::new(), Vec::new()); 3];
+    for j in 1..=n {
+        for (i, p) in targets.iter().enumerate() {
+            let (u, d) = (
+                mean_up[i] + s_up[i] * normal(),
+                mean_down[i] + s_down[i] * normal(),
+            );
+            csv.push_str(&format!("{p},up,{j},{u:?}\n{p},down,{j},{d:?}\n"));
+            runs[i].0.push(u);
+            runs[i].1.push(d);
+        }
+    }
+    let dir = scratch("repeatability");
+    let tol = 0.003;
+    let machine = write(&dir, "m.yaml", &one_axis(tol, &targets));
+    let runs_file = write(&dir, "runs.csv", &csv);
+    let values = dir.join("v.yaml");
+    let args = positioning_args(&runs_file, &values, &machine, "EXX", false);
+    ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let mut rng = crate::common::Rng::new(7);
+    for (approach, pick) in [("up", 0), ("down", 1)] {
+        let doc = ok_json(&[
+            "reliability",
+            machine.to_str().unwrap(),
+            "--values",
+            values.to_str().unwrap(),
+            "--approach",
+            approach,
+            "--format",
+            "json",
+        ]);
+        for (i, r) in doc["results"].as_array().unwrap().iter().enumerate() {
+            let got = r["reliability"].as_f64().unwrap();
+            let x = if pick == 0 { &runs[i].0 } else { &runs[i].1 };
+            // FORM is exact here: Φ((tol − x̄)/s) with the runs' own mean
+            // and n − 1 standard deviation.
+            let (m, s) = welford(x);
+            let closed = crate::common::normal_cdf((tol - m) / s);
+            assert!(
+                (got - closed).abs() < 1e-12,
+                "{approach} {i}: {got} vs {closed}"
+            );
+            // A Monte Carlo that resamples the runs: 200,000 draws with
+            // replacement, the fraction within the tolerance. Its spread
+            // about chain's normal model: the runs' own binomial error
+            // (400 runs) and the draws'.
+            let draws = 200_000;
+            let inside = (0..draws)
+                .filter(|_| x[(rng.unit() * x.len() as f64) as usize] <= tol)
+                .count() as f64
+                / draws as f64;
+            let se = (got * (1.0 - got) / x.len() as f64).sqrt()
+                + (got * (1.0 - got) / draws as f64).sqrt();
+            assert!(
+                (inside - got).abs() <= 4.0 * se,
+                "{approach} at {}: resampled {inside} vs {got} (se {se})",
+                targets[i]
+            );
+        }
+    }
+    // The mean approach: the mean of the two means, the pooled spread.
+    let doc = ok_json(&[
+        "reliability",
+        machine.to_str().unwrap(),
+        "--values",
+        values.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    for (i, r) in doc["results"].as_array().unwrap().iter().enumerate() {
+        let ((mu, su), (md, sd)) = (welford(&runs[i].0), welford(&runs[i].1));
+        let closed =
+            crate::common::normal_cdf((tol - 0.5 * (mu + md)) / (0.5 * (su * su + sd * sd)).sqrt());
+        let got = r["reliability"].as_f64().unwrap();
+        assert!((got - closed).abs() < 1e-12, "mean {i}: {got} vs {closed}");
+    }
+    assert_eq!(doc["posterior"]["tables"][0], "EXX");
+    // Between the targets the mean and the spread are interpolated.
+    let doc = ok_json(&[
+        "reliability",
+        machine.to_str().unwrap(),
+        "--values",
+        values.to_str().unwrap(),
+        "--approach",
+        "up",
+        "--grid",
+        "x=100",
+        "--format",
+        "json",
+    ]);
+    let t = 100.0 / 250.0;
+    let ((m0, s0), (m1, s1)) = (welford(&runs[0].0), welford(&runs[1].0));
+    let closed = crate::common::normal_cdf((tol - (m0 + t * (m1 - m0))) / (s0 + t * (s1 - s0)));
+    let got = doc["results"][0]["reliability"].as_f64().unwrap();
+    assert!((got - closed).abs() < 1e-12, "between: {got} vs {closed}");
+    // Outside the run's travel: refused, naming the values file and table.
+    let e = unwrapped(&fails(&[
+        "reliability",
+        machine.to_str().unwrap(),
+        "--values",
+        values.to_str().unwrap(),
+        "--grid",
+        "x=600",
+    ]));
+    assert!(
+        e.contains("chain::posterior::table_point")
+            && e.contains("x = 600 is outside the table of `EXX`"),
+        "{e}"
+    );
+    // --at cannot take inputs that vary by point; a one-point grid can.
+    let e = unwrapped(&fails(&[
+        "sensitivity",
+        machine.to_str().unwrap(),
+        "--values",
+        values.to_str().unwrap(),
+        "--at",
+        "x=100",
+    ]));
+    assert!(e.contains("one-point grid"), "{e}");
 }

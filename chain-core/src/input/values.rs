@@ -918,6 +918,14 @@ impl Values {
         Some(q)
     }
 
+    /// The errors written by tables (in [`Values::errors`] order), each with
+    /// whether its table gives a standard deviation per position.
+    pub fn tabulated(&self) -> Vec<(usize, bool)> {
+        (self.tables.iter())
+            .map(|t| (t.error, t.std.is_some()))
+            .collect()
+    }
+
     /// True if some table gives a standard deviation per position.
     pub fn has_repeatability(&self) -> bool {
         self.tables.iter().any(|t| t.std.is_some())
