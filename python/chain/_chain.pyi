@@ -61,6 +61,7 @@ def reliability_json(
     values: Optional[str],
     acceptance: bool,
     acceptance_tolerance: float,
+    approach: Optional[str],
 ) -> str: ...
 def sobol_json(
     model: Model,
@@ -83,6 +84,7 @@ def sensitivity_reliability_json(
     params: Sequence[Tuple[str, float]],
     sided: Optional[str],
     values: Optional[str],
+    approach: Optional[str],
 ) -> str: ...
 def geometric_json(
     model: Model,
@@ -145,4 +147,6 @@ def positioning_json(
     file: str,
     k: float,
     rotary: bool,
-) -> str: ...
+    model: Optional[Model],
+    slot: Optional[str],
+) -> Tuple[str, Optional[str]]: ...

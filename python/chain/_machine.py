@@ -21,6 +21,15 @@ class Nominal(NamedTuple):
     position: np.ndarray
 
 
+def _approach(approach: Union[None, str, Mapping[str, str]]) -> Optional[str]:
+    """``--approach``'s text: ``"up"`` as given, ``{"x": "up"}`` as ``"x=up"``."""
+    if approach is None or isinstance(approach, str):
+        return approach
+    if isinstance(approach, Mapping):
+        return ",".join(f"{k}={v}" for k, v in approach.items())
+    raise ValueError(f"approach must be a str or a mapping, not {type(approach).__name__}")
+
+
 def _params(params: Params) -> List[Tuple[str, float]]:
     if params is None:
         return []
@@ -191,6 +200,7 @@ class Machine:
         values: Optional[Union[str, "os.PathLike[str]"]] = None,
         acceptance: bool = False,
         acceptance_tolerance: float = 1e-3,
+        approach: Union[None, str, Mapping[str, str]] = None,
     ) -> ReliabilityResult:
         """Machining-accuracy reliability over the file's grid, ``chain reliability --format json``.
 
@@ -211,7 +221,11 @@ class Machine:
           the allowable volumetric error, default the smallest position
           tolerance);
         - ``values``: a values file with a calibration's posterior (means,
-          ``std``, ``correlation``), as ``--values``;
+          ``std``, ``correlation``) or a built machine's measured tables (a
+          positioning run's means and repeatability), as ``--values``;
+          ``approach``: the direction of its bidirectional tables
+          (``--approach``: ``"up"``, ``"down"``, ``"mean"``, ``"x=up"`` or
+          ``{"x": "up"}``);
         - ``acceptance=True``: also the whole-machine acceptance probability
           (the document's ``acceptance``; also computed when the file sets
           ``reliability.acceptance: true``), to ``acceptance_tolerance``.
@@ -234,7 +248,7 @@ class Machine:
         path = None if values is None else os.fspath(values)
         text = _chain.reliability_json(
             self._model, method, samples, seed, cov, axes, _params(params), sided, system,
-            system_tolerance, path, acceptance, acceptance_tolerance,
+            system_tolerance, path, acceptance, acceptance_tolerance, _approach(approach),
         )
         return ReliabilityResult._from_json(text)
 
@@ -265,10 +279,8 @@ class Machine:
         q = None
         if points is not None:
             q, _ = _rows(points, "points", len(self.variables), "the variables " + ", ".join(self.variables))
-        if isinstance(approach, Mapping):
-            approach = ",".join(f"{k}={v}" for k, v in approach.items())
         text_json = _chain.map_json(
-            self._model, path, text, name, _grid_axes(grid), q, _params(params), approach
+            self._model, path, text, name, _grid_axes(grid), q, _params(params), _approach(approach)
         )
         return MapResult._from_json(text_json)
 
@@ -372,6 +384,7 @@ class Machine:
         params: Params = None,
         sided: Optional[str] = None,
         values: Optional[Union[str, "os.PathLike[str]"]] = None,
+        approach: Union[None, str, Mapping[str, str]] = None,
     ) -> SensitivityResult:
         """Reliability sensitivity, ``chain sensitivity --kind reliability --format json``.
 
@@ -380,11 +393,14 @@ class Machine:
         2021 Eq. 32-33) and its FORM importance factor, sorted by
         ``|dR/dstd|``: at one point ``at`` (every axis variable), otherwise
         the mean over the reliability grid (``grid`` replacing axes).
-        ``values``: a values file with a calibration's posterior (``--values``).
+        ``values``: a values file with a calibration's posterior (``--values``);
+        ``approach``: the direction of its bidirectional tables (``--approach``).
         """
         point = _at_point(at)
         path = None if values is None else os.fspath(values)
-        text = _chain.sensitivity_reliability_json(self._model, point, _grid_axes(grid), _params(params), sided, path)
+        text = _chain.sensitivity_reliability_json(
+            self._model, point, _grid_axes(grid), _params(params), sided, path, _approach(approach)
+        )
         return SensitivityResult._from_json(text)
 
     def geometric_sensitivity(

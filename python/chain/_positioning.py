@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import os
-from typing import Any, Mapping, Optional, Tuple, Union
+from typing import TYPE_CHECKING, Any, Mapping, Optional, Tuple, Union
 
 import numpy as np
 
 from . import _chain
 from ._machine import _table_source
 from ._results import PositioningResult
+
+if TYPE_CHECKING:
+    from ._machine import Machine
 
 
 def _cell(v: Any) -> str:
@@ -46,6 +49,9 @@ def positioning(
     k: float = 2,
     rotary: bool = False,
     name: str = "<runs>",
+    machine: Optional["Machine"] = None,
+    slot: Optional[str] = None,
+    values_out: Optional[Union[str, "os.PathLike[str]"]] = None,
 ) -> PositioningResult:
     """The ISO 230-2 evaluation of positioning runs, ``chain positioning RUNS --format json``.
 
@@ -56,8 +62,23 @@ def positioning(
     names them in messages. ``k``: the coverage factor (``--k``; 2, or 3 for
     the 1988 edition); ``rotary``: statistics in arcseconds (``--rotary``).
     A refused file raises ``MachineError`` with the CLI's message, located.
+
+    ``machine`` and ``slot`` (``--machine``, ``--slot``): the run as the
+    axis's positioning error in a values file (means and standard
+    deviations per approach direction, docs/positioning.md), kept as the
+    result's ``values_text`` and written to ``values_out`` when given
+    (``--values-out``).
     """
     path, text = _runs_input(runs)
     if isinstance(k, bool):
         raise ValueError(f"k must be a number, not {k!r}")
-    return PositioningResult._from_json(_chain.positioning_json(path, text, name, float(k), bool(rotary)))
+    if values_out is not None and (machine is None or slot is None):
+        raise ValueError("values_out needs machine and slot")
+    model = machine._model if machine is not None else None
+    doc, values_text = _chain.positioning_json(path, text, name, float(k), bool(rotary), model, slot)
+    result = PositioningResult._from_json(doc)
+    result.values_text = values_text
+    if values_out is not None:
+        with open(os.fspath(values_out), "w", encoding="utf-8") as f:
+            f.write(values_text)
+    return result

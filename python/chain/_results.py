@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import copy
 import json
-from typing import Any, Dict, Iterator, List
+from typing import Any, Dict, Iterator, List, Optional
 
 
 class Result:
@@ -273,11 +273,13 @@ class PositioningResult(Result):
     Attributes: ``k``, ``runs``, ``unit``, ``targets`` (per target: means,
     reversal, s, repeatabilities), ``axis`` (``A``, ``E``, ``M``, ``R``,
     ``B``, ``B_mean`` and the per-direction values), ``axis_kind``,
-    ``target_unit``, ``file``, ``points``. Rows of ``to_dataframe()``: one
-    per target.
+    ``target_unit``, ``file``, ``points``; ``values_text``: the values file
+    of ``machine`` and ``slot`` (``--values-out``), or None. Rows of
+    ``to_dataframe()``: one per target.
     """
 
     command = "positioning"
+    values_text: Optional[str] = None
 
     def _rows(self) -> List[Dict[str, Any]]:
         return [dict(t) for t in self._document["targets"]]

@@ -5,14 +5,18 @@
 use std::path::Path;
 
 use chain_core::measured::positioning::{self, AxisKind, Coverage, Runs};
+use chain_core::measured::positioning_values;
 use pyo3::prelude::*;
 
-use crate::{load_error, to_json, value_error};
+use crate::{load_error, to_json, value_error, Model};
 
 /// The positioning document of the runs at `path`, or of `text` named
-/// `file`; `k` the coverage factor, `rotary` as `--rotary`.
+/// `file`; `k` the coverage factor, `rotary` as `--rotary`. With `model`
+/// and `slot` (`--machine`, `--slot`), also the values file `--values-out`
+/// writes.
 #[pyfunction]
-#[pyo3(signature = (path, text, file, k, rotary))]
+#[pyo3(signature = (path, text, file, k, rotary, model, slot))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn positioning_json(
     py: Python<'_>,
     path: Option<&str>,
@@ -20,7 +24,9 @@ pub(crate) fn positioning_json(
     file: &str,
     k: f64,
     rotary: bool,
-) -> PyResult<String> {
+    model: Option<&Model>,
+    slot: Option<&str>,
+) -> PyResult<(String, Option<String>)> {
     let k = Coverage::new(k).map_err(|e| value_error(e.to_string()))?;
     let kind = if rotary {
         AxisKind::Rotary
@@ -37,5 +43,21 @@ pub(crate) fn positioning_json(
         }
     }
     .map_err(|e| load_error(py, e.diagnostics()))?;
-    to_json(&positioning::evaluate(&runs, k))
+    let doc = positioning::evaluate(&runs, k);
+    let values = match (model, slot) {
+        (Some(model), Some(name)) => {
+            let m = &model.machine;
+            let slot = positioning_values::slot(m, name, kind)
+                .map_err(|e| value_error(format!("slot `{name}` (machine {}): {e}", model.file)))?;
+            Some(positioning_values::values_file(
+                &doc,
+                m,
+                &slot,
+                path.unwrap_or(file),
+            ))
+        }
+        (None, None) => None,
+        _ => return Err(value_error("give machine and slot together")),
+    };
+    Ok((to_json(&doc)?, values))
 }

@@ -43,6 +43,32 @@ fn method_named(name: &str) -> PyResult<Method> {
         })
 }
 
+/// The posterior of the values file at `path` (`--values`), its tables read
+/// for `approach` (`--approach`: `up`, `down`, `mean` or `x=up,...`).
+pub(crate) fn read_posterior(
+    py: Python<'_>,
+    model: &Model,
+    path: Option<&str>,
+    approach: Option<&str>,
+) -> PyResult<Option<Posterior>> {
+    let Some(path) = path else {
+        if approach.is_some() {
+            return Err(value_error("approach needs values"));
+        }
+        return Ok(None);
+    };
+    let mut posterior = Posterior::read(Path::new(path), &model.machine)
+        .map_err(|e| posterior_error(py, model, e))?;
+    if let Some(text) = approach {
+        let choices = chain_core::values::parse_approaches(text)
+            .map_err(|e| value_error(format!("approach: {e}")))?;
+        posterior
+            .choose_approach(&choices)
+            .map_err(|e| value_error(format!("approach: {e} (values {path})")))?;
+    }
+    Ok(Some(posterior))
+}
+
 /// A posterior's refusal: located in the values file (`MachineError`), or
 /// a reliability error worded against the machine file.
 pub(crate) fn posterior_error(py: Python<'_>, model: &Model, e: PosteriorError) -> PyErr {
@@ -65,7 +91,7 @@ pub(crate) fn posterior_error(py: Python<'_>, model: &Model, e: PosteriorError) 
 /// whole-machine acceptance probability (also when the file asks for it),
 /// to `acceptance_tolerance`.
 #[pyfunction]
-#[pyo3(signature = (model, method, samples, seed, cov, grid, params, sided, system, system_tolerance, values, acceptance, acceptance_tolerance))]
+#[pyo3(signature = (model, method, samples, seed, cov, grid, params, sided, system, system_tolerance, values, acceptance, acceptance_tolerance, approach))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn reliability_json(
     py: Python<'_>,
@@ -82,6 +108,7 @@ pub(crate) fn reliability_json(
     values: Option<&str>,
     acceptance: bool,
     acceptance_tolerance: f64,
+    approach: Option<&str>,
 ) -> PyResult<String> {
     let method = method_named(method)?;
     if let Some(c) = cov {
@@ -135,13 +162,7 @@ pub(crate) fn reliability_json(
             )))
         }
     };
-    let posterior = match values {
-        None => None,
-        Some(path) => Some(
-            Posterior::read(Path::new(path), &model.machine)
-                .map_err(|e| posterior_error(py, model, e))?,
-        ),
-    };
+    let posterior = read_posterior(py, model, values, approach)?;
     let study = model.study_with(py, &grid, &params, sided, system, posterior.as_ref())?;
     let algorithm = document::algorithm(
         method,

@@ -7,14 +7,12 @@
 //! [`geometric::grid_axes`], [`geometric::evaluate`] and
 //! [`GeometricDocument`].
 
-use std::path::Path;
-
 use chain_core::geometric::{self, GeometricDocument, GridAxisError, NominalSizes, Where};
 use pyo3::prelude::*;
 use reliability::document::{self, SensitivityDocument};
-use reliability::{Form, Posterior, ReliabilityError};
+use reliability::{Form, ReliabilityError};
 
-use crate::reliability_v2::{posterior_error, resolve_at};
+use crate::reliability_v2::{read_posterior, resolve_at};
 use crate::{study_error, to_json, value_error, Model};
 
 /// `chain sensitivity --kind reliability --format json`: the reliability
@@ -24,7 +22,8 @@ use crate::{study_error, to_json, value_error, Model};
 /// reliability grid (`grid` replacing axes). `values`: a values file with
 /// a calibration's posterior (`--values`).
 #[pyfunction]
-#[pyo3(signature = (model, at, grid, params, sided, values))]
+#[pyo3(signature = (model, at, grid, params, sided, values, approach))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn sensitivity_reliability_json(
     py: Python<'_>,
     model: &Model,
@@ -33,14 +32,9 @@ pub(crate) fn sensitivity_reliability_json(
     params: Vec<(String, f64)>,
     sided: Option<&str>,
     values: Option<&str>,
+    approach: Option<&str>,
 ) -> PyResult<String> {
-    let posterior = match values {
-        None => None,
-        Some(path) => Some(
-            Posterior::read(Path::new(path), &model.machine)
-                .map_err(|e| posterior_error(py, model, e))?,
-        ),
-    };
+    let posterior = read_posterior(py, model, values, approach)?;
     let study = model.study_with(py, &grid, &params, sided, None, posterior.as_ref())?;
     let point = match &at {
         None => None,

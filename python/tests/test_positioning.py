@@ -87,3 +87,40 @@ def test_map_with_an_approach_is_the_cli_json(cli, tmp_path):
         m.map(values, grid=grid, approach={"y": "up"})
     with pytest.raises(ValueError, match="`sideways` is not an approach direction"):
         m.map(values, grid=grid, approach="sideways")
+
+
+def test_values_out_and_reliability_with_the_repeatability(cli, tmp_path):
+    """positioning(machine=, slot=) writes what --values-out writes; reliability(values=, approach=) is the CLI's."""
+    vmc3 = ROOT / "examples/machines/vmc3.yaml"
+    m = chain.Machine.load(vmc3)
+    ours = tmp_path / "ours.yaml"
+    r = chain.positioning(RUNS / "x_axis_runs.csv", machine=m, slot="EXX", values_out=ours)
+    theirs = tmp_path / "theirs.yaml"
+    cli("positioning", RUNS / "x_axis_runs.csv", "--values-out", theirs, "--machine", vmc3, "--slot", "EXX")
+    # The same file but for the run file's name in its comments.
+    strip = lambda text: [l for l in text.splitlines() if not l.startswith("#") and not l.startswith("description")]
+    assert strip(ours.read_text()) == strip(theirs.read_text())
+    assert r.values_text == ours.read_text()
+    assert chain.positioning(RUNS / "x_axis_runs.csv").values_text is None
+    with pytest.raises(ValueError, match="is in the `dy` slot"):
+        chain.positioning(RUNS / "x_axis_runs.csv", machine=m, slot="EYX")
+    with pytest.raises(ValueError, match="values_out needs machine and slot"):
+        chain.positioning(RUNS / "x_axis_runs.csv", values_out=tmp_path / "x.yaml")
+    # Reliability of a one-axis machine with the run's mean and repeatability.
+    one = tmp_path / "one.yaml"
+    one.write_text(
+        "machine: one\nbodies:\n  bed: {}\n"
+        "  x_slide: {parent: bed, joint: {type: prismatic, axis: +x, variable: x}, errors: {dx: EXX}}\n"
+        "workpiece: bed\ntool: x_slide\n"
+        "reliability:\n  tolerance: {px: 0.004}\n  sided: upper\n  grid:\n    x: [0, 102.8, 401.4]\n"
+    )
+    m1 = chain.Machine.load(one)
+    values = tmp_path / "one_values.yaml"
+    chain.positioning(RUNS / "x_axis_runs.csv", machine=m1, slot="EXX", values_out=values)
+    for approach, flag in [(None, []), ("up", ["--approach", "up"]), ({"x": "down"}, ["--approach", "x=down"])]:
+        got = m1.reliability(values=values, approach=approach).to_dict()
+        assert got == cli("reliability", one, "--values", values, *flag)
+    s = m1.sensitivity_reliability(values=values, approach="up").to_dict()
+    assert s == cli("sensitivity", one, "--values", values, "--approach", "up")
+    with pytest.raises(ValueError, match="approach needs values"):
+        m1.reliability(approach="up")
