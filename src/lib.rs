@@ -22,3 +22,4 @@ pub use reliability;
 pub use chain_macro::machine;
 
 pub mod compensate;
+pub mod ops;

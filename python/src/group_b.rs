@@ -20,30 +20,7 @@ use chain_core::values::{Values, ValuesError};
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
-use crate::{check_finite, load_error, study_error, to_json, value_error, Model};
-
-/// `--param NAME=VALUE` names checked against the machine (the CLI's
-/// `ParamArgs::check_names` wording).
-fn check_param_names(m: &Machine, params: &[(String, f64)]) -> PyResult<()> {
-    for (name, v) in params {
-        if m.parameter_index(name).is_none() {
-            let suggestion =
-                chain_core::diagnostic::closest(name, m.parameters.iter().map(|p| p.name.as_str()))
-                    .map(|s| format!(" (did you mean `{s}`?)"))
-                    .unwrap_or_default();
-            return Err(value_error(format!(
-                "--param {name}: machine `{}` has no parameter `{name}`{suggestion}",
-                m.name
-            )));
-        }
-        if !v.is_finite() {
-            return Err(value_error(format!(
-                "parameter `{name}` = {v} is not finite"
-            )));
-        }
-    }
-    Ok(())
-}
+use crate::{load_error, resolve_error, to_json, value_error, Model};
 
 /// A measurement or candidate CSV: read from `path`, or parsed from `text`
 /// named `file`.
@@ -105,7 +82,7 @@ pub(crate) fn identify_json(
     prior: bool,
 ) -> PyResult<(String, String)> {
     let m = &model.machine;
-    check_param_names(m, &params)?;
+    chain::ops::resolve::check_parameters(m, &params).map_err(|e| resolve_error(py, model, e))?;
     let measurements = read_measurements(py, m, path, text, file, &params, Layout::Measurements)?;
     let (doc, result) = py
         .allow_threads(|| identify_document(m, &measurements, prior))
@@ -143,7 +120,7 @@ pub(crate) fn plan_json(
             )))
         }
     };
-    check_param_names(m, &params)?;
+    chain::ops::resolve::check_parameters(m, &params).map_err(|e| resolve_error(py, model, e))?;
     let candidates = read_measurements(py, m, path, text, file, &params, Layout::Candidates)?;
     let kind = Kind::of(&candidates, asked)
         .map_err(|e| value_error(e.to_string()))?
@@ -152,52 +129,6 @@ pub(crate) fn plan_json(
         .allow_threads(|| plan::plan_document(m, &candidates, count, kind))
         .map_err(|e| value_error(format!("{}: {e}", candidates.file)))?;
     to_json(&doc)
-}
-
-/// The grid of `chain map` (`--grid` over the file's `reliability.grid`, in
-/// the machine's variable order), as the CLI resolves it.
-fn grid_axes(
-    py: Python<'_>,
-    model: &Model,
-    overrides: &[(String, Vec<f64>)],
-) -> PyResult<Vec<Vec<f64>>> {
-    let m = &model.machine;
-    for (name, values) in overrides {
-        if m.variable_index(name).is_none() {
-            return Err(study_error(
-                py,
-                &reliability::ReliabilityError::unknown(
-                    "axis variable",
-                    name,
-                    m.variables.iter().map(|v| v.name.as_str()),
-                ),
-                &model.file,
-            ));
-        }
-        if values.is_empty() {
-            return Err(value_error(format!("grid axis `{name}` has no value")));
-        }
-        check_finite(values, 0, &format!("grid axis `{name}`"))?;
-    }
-    let file_grid = m.reliability.as_ref().map(|r| &r.grid);
-    let mut axes = Vec::new();
-    for (k, v) in m.variables.iter().enumerate() {
-        let given = overrides.iter().rev().find(|(n, _)| *n == v.name);
-        let values = match given {
-            Some((_, values)) => values.clone(),
-            None => match file_grid.and_then(|g| g.iter().find(|(i, _)| *i == k)) {
-                Some((_, values)) => values.clone(),
-                None => {
-                    return Err(value_error(format!(
-                        "{}: no grid values for axis variable `{}`; add `{1}: [...]` to `reliability.grid`, or pass grid={{\"{1}\": [...]}}",
-                        model.file, v.name
-                    )))
-                }
-            },
-        };
-        axes.push(values);
-    }
-    Ok(axes)
 }
 
 /// `chain map --format json`: the error map of the built machine (values
@@ -236,7 +167,13 @@ pub(crate) fn map_json(
             let v = q.shape()[1];
             Points::list(v, flat.to_vec()).map_err(|e| value_error(format!("points: {e}")))?
         }
-        None => Points::Grid(grid_axes(py, model, &grid)?),
+        None => Points::Grid(
+            chain::ops::resolve::grid_axes(m, &model.file, &grid)
+                .map_err(|e| resolve_error(py, model, e))?
+                .into_iter()
+                .map(|(_, values)| values)
+                .collect(),
+        ),
     };
     let built =
         BuiltMachine::compile(m, values, p).map_err(|e| value_error(format!("{name}: {e}")))?;

@@ -141,6 +141,22 @@ pub(crate) fn study_error(py: Python<'_>, err: &ReliabilityError, file: &str) ->
     machine_error(py, message, file, origin, vec![d.message])
 }
 
+/// An option refused by `chain::ops::resolve`, with the CLI's message: an
+/// unknown name as `MachineError` naming the machine file, a bad value as
+/// `ValueError`.
+pub(crate) fn resolve_error(
+    py: Python<'_>,
+    model: &Model,
+    e: chain::ops::resolve::ResolveError,
+) -> PyErr {
+    let message = e.with_help();
+    if e.names_the_machine() {
+        machine_error(py, message, &model.file, None, vec![e.to_string()])
+    } else {
+        value_error(message)
+    }
+}
+
 pub(crate) fn value_error(message: impl Into<String>) -> PyErr {
     PyValueError::new_err(message.into())
 }

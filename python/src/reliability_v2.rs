@@ -251,36 +251,13 @@ pub(crate) fn sobol_json(
     ))
 }
 
-/// The values of `at` in the machine's variable order: every axis variable
-/// once, no unknown name, all finite (as `chain sobol --at`).
+/// The values of `at` in the machine's variable order, by the CLI's rule
+/// (`chain::ops::resolve::at_point`).
 pub(crate) fn resolve_at(
     py: Python<'_>,
     model: &Model,
     coords: &[(String, f64)],
 ) -> PyResult<Vec<f64>> {
-    let m = &model.machine;
-    let vars: Vec<&str> = m.variables.iter().map(|v| v.name.as_str()).collect();
-    if let Some((name, _)) = coords.iter().find(|(n, _)| !vars.contains(&n.as_str())) {
-        let e = ReliabilityError::unknown("axis variable", name, vars.iter().copied());
-        return Err(study_error(py, &e, &model.file));
-    }
-    if let Some((name, x)) = coords.iter().find(|(_, x)| !x.is_finite()) {
-        return Err(value_error(format!("at: `{name}` = {x} is not finite")));
-    }
-    vars.iter()
-        .map(|v| {
-            coords
-                .iter()
-                .rev()
-                .find(|(n, _)| n == v)
-                .map(|(_, x)| *x)
-                .ok_or_else(|| {
-                    let every: Vec<String> = vars.iter().map(|v| format!("{v:?}: …")).collect();
-                    value_error(format!(
-                        "at has no value for axis variable `{v}` (give every axis variable: at={{{}}})",
-                        every.join(", ")
-                    ))
-                })
-        })
-        .collect()
+    chain::ops::resolve::at_point(&model.machine, &model.file, coords)
+        .map_err(|e| crate::resolve_error(py, model, e))
 }

@@ -130,3 +130,33 @@ def test_plan_bad_input():
         m.plan(MEAS / "candidates.csv", 451)
     with pytest.raises(ValueError, match="positive integer"):
         m.plan(MEAS / "candidates.csv", 0)
+
+
+def test_options_are_refused_in_the_cli_s_words(cli_error, tmp_path):
+    """Grid axes, --at and --param go through chain::ops::resolve in both: the same message."""
+    from conftest import squeezed
+
+    no_grid = tmp_path / "m.yaml"
+    no_grid.write_text(
+        "machine: m\nparameters: {L: 100}\nbodies:\n  bed: {}\n"
+        "  x_slide: {parent: bed, joint: {type: prismatic, axis: +x, variable: x}, errors: {dx: EXX}}\n"
+        "workpiece: bed\ntool: x_slide\n"
+    )
+    values = tmp_path / "v.yaml"
+    values.write_text("machine: m\nvalues: {EXX: 0.001}\n")
+    m = chain.Machine.load(no_grid)
+    cases = [
+        (lambda: m.map(values), ["map", no_grid, "--values", values], chain.MachineError,
+         "no grid values for axis variable `x`"),
+        (lambda: m.map(values, grid={"xx": [0.0]}), ["map", no_grid, "--values", values, "--grid", "xx=0"],
+         chain.MachineError, "unknown axis variable `xx` (did you mean `x`?)"),
+        (lambda: m.identify({"x": [0.0, 1.0], "dpx": [0.0, 0.0], "dpy": [0.0, 0.0], "dpz": [0.0, 0.0]},
+                            params={"l": 1.0}),
+         None, ValueError, "--param l: machine `m` has no parameter `l` (did you mean `L`?)"),
+    ]
+    for call, args, kind, wording in cases:
+        with pytest.raises(kind) as info:
+            call()
+        assert wording in str(info.value)
+        if args is not None:
+            assert squeezed(wording) in squeezed(cli_error(*args))

@@ -227,7 +227,10 @@ def test_bad_sobol_options_are_refused_with_the_cli_wording(cli_error):
     assert "--at has no value for axis variable `z`" in cli_error("sobol", GANTRY, "--at", "x=0")
     with pytest.raises(chain.MachineError) as info:
         m.sobol(at={"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0})
-    assert "unknown axis variable `w`" in str(info.value)
+    # The CLI's message, word for word (chain::ops::resolve).
+    wording = "--at: `w` is not an axis variable"
+    assert wording in str(info.value)
+    assert wording in cli_error("sobol", GANTRY, "--at", "x=0,y=0,z=0,w=1")
     with pytest.raises(ValueError, match="grid cannot be combined with at"):
         m.sobol(at={"x": 0.0, "y": 0.0, "z": 0.0}, grid={"x": [0.0]})
     with pytest.raises(ValueError, match="not finite"):

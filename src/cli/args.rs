@@ -16,21 +16,7 @@ impl ParamArgs {
     /// name), for the commands whose parameters may also come per CSV row
     /// (`identify`, `plan`): their values are checked where they are used.
     pub fn check_names(&self, m: &chain_core::Machine) -> miette::Result<()> {
-        for (name, _) in &self.params {
-            if m.parameter_index(name).is_none() {
-                let suggestion = chain_core::diagnostic::closest(
-                    name,
-                    m.parameters.iter().map(|p| p.name.as_str()),
-                )
-                .map(|s| format!(" (did you mean `{s}`?)"))
-                .unwrap_or_default();
-                miette::bail!(
-                    "--param {name}: machine `{}` has no parameter `{name}`{suggestion}",
-                    m.name
-                );
-            }
-        }
-        Ok(())
+        Ok(chain::ops::resolve::check_parameters(m, &self.params)?)
     }
 }
 

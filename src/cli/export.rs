@@ -35,7 +35,7 @@ use reliability::machine;
 use serde::Serialize;
 
 use super::args::ParamArgs;
-use super::map::{axes_points, grid_axes, parse_grid_axis};
+use super::map::{axes_points, parse_grid_axis};
 use super::reliability::Loaded;
 use super::report::{self, Csv, Report};
 
@@ -214,7 +214,7 @@ fn exec_grid(
             .map_err(|e| miette::miette!("{}: {e}", path.display()))?,
         None => {
             let file = args.file.display().to_string();
-            let axes = grid_axes(m, loaded, &file, &args.grid)?;
+            let axes = chain::ops::resolve::grid_axes(m, &file, &args.grid)?;
             Points::Grid(axes.into_iter().map(|(_, v)| v).collect())
         }
     };

@@ -169,7 +169,7 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
         }
         None => {
             let file = args.file.display().to_string();
-            let axes = grid_axes(m, &loaded, &file, &args.grid)?;
+            let axes = chain::ops::resolve::grid_axes(m, &file, &args.grid)?;
             let values = axes.iter().map(|(_, v)| v.clone()).collect();
             (Points::Grid(values), Input::Grid(axes))
         }
@@ -321,7 +321,7 @@ fn compensate(
     let mut overrides = args.grid.clone();
     overrides.extend(args.compensation_grid.iter().cloned());
     let file = args.file.display().to_string();
-    let axes = grid_axes(m, loaded, &file, &overrides)?;
+    let axes = chain::ops::resolve::grid_axes(m, &file, &overrides)?;
     let nodes: usize = axes.iter().map(|(_, v)| v.len()).product();
     let source = format!("{nodes} correction nodes, docs/export.md");
     let kin = chain_core::kinematics::Kinematics::from_machine(m);
@@ -379,50 +379,6 @@ fn map_error(e: MapError, values: &std::path::Path) -> miette::Report {
         d = d.with_help(help);
     }
     miette::Report::new(d)
-}
-
-/// The grid axes, in the machine's variable order: `reliability.grid`, each
-/// axis replaced by `--grid`; every variable must have values.
-pub(crate) fn grid_axes(
-    m: &chain_core::Machine,
-    loaded: &Loaded,
-    file: &str,
-    overrides: &[(String, Vec<f64>)],
-) -> miette::Result<Vec<(String, Vec<f64>)>> {
-    for (name, _) in overrides {
-        if m.variable_index(name).is_none() {
-            return Err(loaded.report(reliability::ReliabilityError::unknown(
-                "axis variable",
-                name,
-                m.variables.iter().map(|v| v.name.as_str()),
-            )));
-        }
-    }
-    let file_grid = m.reliability.as_ref().map(|r| &r.grid);
-    let mut axes = Vec::new();
-    for (k, v) in m.variables.iter().enumerate() {
-        let given = overrides.iter().rev().find(|(n, _)| *n == v.name);
-        let values = match given {
-            Some((_, values)) => values.clone(),
-            None => match file_grid.and_then(|g| g.iter().find(|(i, _)| *i == k)) {
-                Some((_, values)) => values.clone(),
-                None => {
-                    let diag = MietteDiagnostic::new(format!(
-                        "{file}: no grid values for axis variable `{}`",
-                        v.name
-                    ))
-                    .with_code("chain::map::missing_grid")
-                    .with_help(format!(
-                        "add `{0}: [...]` to `reliability.grid`, or pass --grid {0}=V1,V2,... or --grid {0}=LO:HI:N",
-                        v.name
-                    ));
-                    return Err(miette::Report::new(diag));
-                }
-            },
-        };
-        axes.push((v.name.clone(), values));
-    }
-    Ok(axes)
 }
 
 /// The points of `--axes`: every row, in the machine's variable order.

@@ -258,46 +258,14 @@ fn unknown_variable(loaded: &Loaded, name: &str) -> miette::Report {
     ))
 }
 
-/// The values of `--at` in the machine's variable order: every axis
-/// variable once (a repeated name: the last value), no unknown name.
+/// The values of `--at` in the machine's variable order
+/// ([`chain::ops::resolve::at_point`]).
 pub(crate) fn resolve_at(coords: &[(String, f64)], loaded: &Loaded) -> miette::Result<Vec<f64>> {
-    let vars: Vec<&str> = loaded
-        .machine
-        .variables
-        .iter()
-        .map(|v| v.name.as_str())
-        .collect();
-    if let Some((name, _)) = coords.iter().find(|(n, _)| !vars.contains(&n.as_str())) {
-        // The option is wrong, not the machine file: name `--at`.
-        let guess = chain_core::diagnostic::closest(name, vars.iter().copied())
-            .map(|g| format!(" (did you mean `{g}`?)"))
-            .unwrap_or_default();
-        return Err(miette::miette!(
-            code = "chain::cli::at_unknown_variable",
-            help = format!(
-                "the axis variables of {} are {}",
-                loaded.file_name(),
-                vars.join(", ")
-            ),
-            "--at: `{name}` is not an axis variable{guess}"
-        ));
-    }
-    vars.iter()
-        .map(|v| {
-            coords
-                .iter()
-                .rev()
-                .find(|(n, _)| n == v)
-                .map(|(_, x)| *x)
-                .ok_or_else(|| {
-                    let every: Vec<String> = vars.iter().map(|v| format!("{v}=…")).collect();
-                    miette::miette!(
-                        help = format!("give every axis variable: --at {}", every.join(",")),
-                        "--at has no value for axis variable `{v}`"
-                    )
-                })
-        })
-        .collect()
+    Ok(chain::ops::resolve::at_point(
+        &loaded.machine,
+        loaded.file_name(),
+        coords,
+    )?)
 }
 
 fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {

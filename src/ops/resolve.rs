@@ -1,0 +1,367 @@
+//! Options resolved against a machine, one rule each (docs/python.md and
+//! the commands' docs name the options): `--param` names, the grid of a
+//! study or map (`--grid` over `reliability.grid`), and a point given by
+//! axis name (`--at`). [`ResolveError`] words every refusal once; the CLI
+//! prints it and Python raises it.
+
+use chain_core::diagnostic::closest;
+use chain_core::Machine;
+
+/// Why an option cannot be resolved against the machine.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[cfg_attr(feature = "cli", derive(miette::Diagnostic))]
+pub enum ResolveError {
+    /// `--param` names no parameter of the machine.
+    #[error(
+        "--param {name}: machine `{machine}` has no parameter `{name}`{}",
+        did_you_mean(suggestion)
+    )]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::cli::unknown_parameter)))]
+    UnknownParameter {
+        /// The name given.
+        name: String,
+        /// The machine.
+        machine: String,
+        /// The closest parameter, if one is close.
+        suggestion: Option<String>,
+    },
+    /// A parameter value that is infinite or NaN.
+    #[error("--param {name}: {value} is not finite")]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::cli::param_not_finite)))]
+    NonFiniteParameter {
+        /// The parameter.
+        name: String,
+        /// The value.
+        value: f64,
+    },
+    /// `--grid` names no axis variable of the machine.
+    #[error("{file}: unknown axis variable `{name}`{}", did_you_mean(suggestion))]
+    #[cfg_attr(
+        feature = "cli",
+        diagnostic(code(chain::reliability::unknown_name), help("the axis variables are {}", variables.join(", ")))
+    )]
+    UnknownGridAxis {
+        /// The machine file.
+        file: String,
+        /// The name given.
+        name: String,
+        /// The machine's axis variables.
+        variables: Vec<String>,
+        /// The closest variable, if one is close.
+        suggestion: Option<String>,
+    },
+    /// A `--grid` axis without values.
+    #[error("--grid {name}: the axis has no value")]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::cli::empty_grid_axis)))]
+    EmptyGridAxis {
+        /// The axis variable.
+        name: String,
+    },
+    /// A `--grid` value that is infinite or NaN.
+    #[error("--grid {name}: {value} is not finite")]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::cli::grid_not_finite)))]
+    NonFiniteGridValue {
+        /// The axis variable.
+        name: String,
+        /// The value.
+        value: f64,
+    },
+    /// An axis variable with neither `reliability.grid` values nor `--grid`.
+    #[error("{file}: no grid values for axis variable `{variable}`")]
+    #[cfg_attr(
+        feature = "cli",
+        diagnostic(
+            code(chain::map::missing_grid),
+            help("add `{variable}: [...]` to `reliability.grid`, or pass --grid {variable}=V1,V2,... or --grid {variable}=LO:HI:N")
+        )
+    )]
+    MissingGrid {
+        /// The machine file.
+        file: String,
+        /// The axis variable.
+        variable: String,
+    },
+    /// `--at` names no axis variable of the machine.
+    #[error("--at: `{name}` is not an axis variable{}", did_you_mean(suggestion))]
+    #[cfg_attr(
+        feature = "cli",
+        diagnostic(code(chain::cli::at_unknown_variable), help("the axis variables of {file} are {}", variables.join(", ")))
+    )]
+    UnknownAtVariable {
+        /// The machine file.
+        file: String,
+        /// The name given.
+        name: String,
+        /// The machine's axis variables.
+        variables: Vec<String>,
+        /// The closest variable, if one is close.
+        suggestion: Option<String>,
+    },
+    /// An `--at` value that is infinite or NaN.
+    #[error("--at: `{name}` = {value} is not finite")]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::cli::at_not_finite)))]
+    NonFiniteAt {
+        /// The axis variable.
+        name: String,
+        /// The value.
+        value: f64,
+    },
+    /// `--at` leaves an axis variable without a value.
+    #[error("--at has no value for axis variable `{variable}`")]
+    #[cfg_attr(
+        feature = "cli",
+        diagnostic(code(chain::cli::at_missing_variable), help("give every axis variable: --at {}", variables.iter().map(|v| format!("{v}=…")).collect::<Vec<_>>().join(",")))
+    )]
+    MissingAt {
+        /// The variable without a value.
+        variable: String,
+        /// Every axis variable.
+        variables: Vec<String>,
+    },
+}
+
+impl ResolveError {
+    /// True when the machine file is what the option does not match (an
+    /// unknown name): Python raises these as `MachineError` naming the file,
+    /// the others as `ValueError`.
+    pub fn names_the_machine(&self) -> bool {
+        matches!(
+            self,
+            ResolveError::UnknownGridAxis { .. }
+                | ResolveError::UnknownAtVariable { .. }
+                | ResolveError::MissingGrid { .. }
+        )
+    }
+
+    /// The message with its help, as one text (Python's exceptions, and
+    /// any renderer without miette).
+    pub fn with_help(&self) -> String {
+        let help = match self {
+            ResolveError::UnknownGridAxis { variables, .. } => {
+                format!("the axis variables are {}", variables.join(", "))
+            }
+            ResolveError::MissingGrid { variable, .. } => format!(
+                "add `{variable}: [...]` to `reliability.grid`, or pass --grid {variable}=V1,V2,... or --grid {variable}=LO:HI:N"
+            ),
+            ResolveError::UnknownAtVariable {
+                file, variables, ..
+            } => format!("the axis variables of {file} are {}", variables.join(", ")),
+            ResolveError::MissingAt { variables, .. } => format!(
+                "give every axis variable: --at {}",
+                variables
+                    .iter()
+                    .map(|v| format!("{v}=…"))
+                    .collect::<Vec<_>>()
+                    .join(",")
+            ),
+            _ => return self.to_string(),
+        };
+        format!("{self}\nhelp: {help}")
+    }
+}
+
+/// ` (did you mean `x`?)`, or nothing.
+fn did_you_mean(suggestion: &Option<String>) -> String {
+    suggestion
+        .as_ref()
+        .map(|s| format!(" (did you mean `{s}`?)"))
+        .unwrap_or_default()
+}
+
+fn variables(m: &Machine) -> Vec<String> {
+    m.variables.iter().map(|v| v.name.clone()).collect()
+}
+
+fn closest_variable(m: &Machine, name: &str) -> Option<String> {
+    closest(name, m.variables.iter().map(|v| v.name.as_str())).map(str::to_string)
+}
+
+/// Checks `--param NAME=VALUE` against the machine: every name one of its
+/// parameters, every value finite. (The values are placed by
+/// `reliability::machine::parameters`; the commands whose parameters may
+/// also come per CSV row check the names alone here.)
+pub fn check_parameters(m: &Machine, params: &[(String, f64)]) -> Result<(), ResolveError> {
+    for (name, value) in params {
+        if m.parameter_index(name).is_none() {
+            return Err(ResolveError::UnknownParameter {
+                name: name.clone(),
+                machine: m.name.clone(),
+                suggestion: closest(name, m.parameters.iter().map(|p| p.name.as_str()))
+                    .map(str::to_string),
+            });
+        }
+        if !value.is_finite() {
+            return Err(ResolveError::NonFiniteParameter {
+                name: name.clone(),
+                value: *value,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The grid axes in the machine's variable order: each axis of
+/// `reliability.grid`, replaced by the last override that names it; every
+/// axis variable must have at least one value (`chain map`, Python's
+/// `Machine.map`). `file` names the machine file in messages.
+pub fn grid_axes(
+    m: &Machine,
+    file: &str,
+    overrides: &[(String, Vec<f64>)],
+) -> Result<Vec<(String, Vec<f64>)>, ResolveError> {
+    for (name, values) in overrides {
+        if m.variable_index(name).is_none() {
+            return Err(ResolveError::UnknownGridAxis {
+                file: file.to_string(),
+                name: name.clone(),
+                variables: variables(m),
+                suggestion: closest_variable(m, name),
+            });
+        }
+        if values.is_empty() {
+            return Err(ResolveError::EmptyGridAxis { name: name.clone() });
+        }
+        if let Some(&value) = values.iter().find(|x| !x.is_finite()) {
+            return Err(ResolveError::NonFiniteGridValue {
+                name: name.clone(),
+                value,
+            });
+        }
+    }
+    let file_grid = m.reliability.as_ref().map(|r| &r.grid);
+    (m.variables.iter().enumerate())
+        .map(|(k, v)| {
+            let given = overrides.iter().rev().find(|(n, _)| *n == v.name);
+            let values = match given {
+                Some((_, values)) => values.clone(),
+                None => match file_grid.and_then(|g| g.iter().find(|(i, _)| *i == k)) {
+                    Some((_, values)) => values.clone(),
+                    None => {
+                        return Err(ResolveError::MissingGrid {
+                            file: file.to_string(),
+                            variable: v.name.clone(),
+                        })
+                    }
+                },
+            };
+            Ok((v.name.clone(), values))
+        })
+        .collect()
+}
+
+/// A point given by axis name (`--at x=0,y=100,...`) in the machine's
+/// variable order: every axis variable once (a repeated name: the last
+/// value), no unknown name, every value finite. `file` names the machine
+/// file in messages.
+pub fn at_point(
+    m: &Machine,
+    file: &str,
+    coords: &[(String, f64)],
+) -> Result<Vec<f64>, ResolveError> {
+    if let Some((name, _)) = coords.iter().find(|(n, _)| m.variable_index(n).is_none()) {
+        return Err(ResolveError::UnknownAtVariable {
+            file: file.to_string(),
+            name: name.clone(),
+            variables: variables(m),
+            suggestion: closest_variable(m, name),
+        });
+    }
+    if let Some((name, value)) = coords.iter().find(|(_, x)| !x.is_finite()) {
+        return Err(ResolveError::NonFiniteAt {
+            name: name.clone(),
+            value: *value,
+        });
+    }
+    (m.variables.iter())
+        .map(|v| {
+            (coords.iter().rev())
+                .find(|(n, _)| *n == v.name)
+                .map(|(_, x)| *x)
+                .ok_or_else(|| ResolveError::MissingAt {
+                    variable: v.name.clone(),
+                    variables: variables(m),
+                })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn machine() -> Machine {
+        let yaml = "machine: m\nparameters: {L: 100}\nbodies:\n  bed: {}\n  x_slide: {parent: bed, joint: {type: prismatic, axis: +x, variable: x}}\n  z_slide: {parent: x_slide, joint: {type: prismatic, axis: +z, variable: z}}\nworkpiece: bed\ntool: z_slide\nreliability:\n  tolerance: {px: 0.01}\n  grid: {x: [0, 10]}\n";
+        chain_core::load_str(yaml, "m.yaml").unwrap()
+    }
+
+    #[test]
+    fn grid_axes_are_the_file_s_with_overrides() {
+        let m = machine();
+        let e = grid_axes(&m, "m.yaml", &[]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "m.yaml: no grid values for axis variable `z`"
+        );
+        assert!(e
+            .with_help()
+            .ends_with("or pass --grid z=V1,V2,... or --grid z=LO:HI:N"));
+        let g = grid_axes(
+            &m,
+            "m.yaml",
+            &[("z".into(), vec![1.0]), ("z".into(), vec![2.0, 3.0])],
+        )
+        .unwrap();
+        assert_eq!(
+            g,
+            vec![("x".into(), vec![0.0, 10.0]), ("z".into(), vec![2.0, 3.0])]
+        );
+        let e = grid_axes(&m, "m.yaml", &[("xx".into(), vec![1.0])]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "m.yaml: unknown axis variable `xx` (did you mean `x`?)"
+        );
+        assert!(e.names_the_machine());
+        let e = grid_axes(&m, "m.yaml", &[("z".into(), vec![])]).unwrap_err();
+        assert_eq!(e.to_string(), "--grid z: the axis has no value");
+        let e = grid_axes(&m, "m.yaml", &[("z".into(), vec![f64::NAN])]).unwrap_err();
+        assert_eq!(e.to_string(), "--grid z: NaN is not finite");
+    }
+
+    #[test]
+    fn at_points_name_every_variable() {
+        let m = machine();
+        let p = at_point(
+            &m,
+            "m.yaml",
+            &[("z".into(), 1.0), ("x".into(), 2.0), ("z".into(), 3.0)],
+        )
+        .unwrap();
+        assert_eq!(p, vec![2.0, 3.0]);
+        let e = at_point(&m, "m.yaml", &[("x".into(), 2.0)]).unwrap_err();
+        assert_eq!(
+            e.with_help(),
+            "--at has no value for axis variable `z`\nhelp: give every axis variable: --at x=…,z=…"
+        );
+        let e = at_point(&m, "m.yaml", &[("w".into(), 2.0)]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "--at: `w` is not an axis variable (did you mean `x`?)"
+        );
+        let e = at_point(&m, "m.yaml", &[("x".into(), f64::INFINITY)]).unwrap_err();
+        assert_eq!(e.to_string(), "--at: `x` = inf is not finite");
+        assert!(!e.names_the_machine());
+    }
+
+    #[test]
+    fn parameters_are_the_machine_s() {
+        let m = machine();
+        assert!(check_parameters(&m, &[("L".into(), 5.0)]).is_ok());
+        let e = check_parameters(&m, &[("l".into(), 5.0)]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "--param l: machine `m` has no parameter `l` (did you mean `L`?)"
+        );
+        let e = check_parameters(&m, &[("L".into(), f64::NAN)]).unwrap_err();
+        assert_eq!(e.to_string(), "--param L: NaN is not finite");
+    }
+}
