@@ -471,7 +471,8 @@ impl Model {
     }
 
     /// [`Model::study`] with a system target (`--system`) and the inputs of
-    /// a posterior (`--values`; `None`: the `statistics` section).
+    /// a posterior (`--values`; `None`: the `statistics` section), through
+    /// [`chain::ops::study`] as the CLI builds it.
     pub(crate) fn study_with(
         &self,
         py: Python<'_>,
@@ -481,57 +482,37 @@ impl Model {
         system: Option<reliability::System>,
         posterior: Option<&reliability::Posterior>,
     ) -> PyResult<Study> {
+        use chain::ops::study::{StudyError, StudyOptions};
         use chain_core::model::Sided;
-        let m = &self.machine;
-        let err = |e: ReliabilityError| study_error(py, &e, &self.file);
-        let mut spec = reliability::machine::spec(m, system).map_err(err)?;
-        match sided {
-            None => {}
-            Some("upper") => spec.sided = Sided::Upper,
-            Some("two") => spec.sided = Sided::Two,
+        let sided = match sided {
+            None => None,
+            Some("upper") => Some(Sided::Upper),
+            Some("two") => Some(Sided::Two),
             Some(other) => {
                 return Err(value_error(format!(
                     "sided must be \"upper\" or \"two\", not {other:?}"
                 )))
             }
-        }
-        for (name, values) in grid {
-            if m.variable_index(name).is_none() {
-                return Err(err(ReliabilityError::unknown(
-                    "axis variable",
-                    name,
-                    m.variables.iter().map(|v| v.name.as_str()),
-                )));
-            }
-            if values.is_empty() {
-                return Err(value_error(format!("grid axis `{name}` has no value")));
-            }
-            if let Some(x) = values.iter().find(|x| !x.is_finite()) {
-                return Err(value_error(format!(
-                    "grid axis `{name}` has a non-finite value ({x})"
-                )));
-            }
-            match spec.grid.axes.iter_mut().find(|(n, _)| n == name) {
-                Some(axis) => axis.1 = values.clone(),
-                None => spec.grid.axes.push((name.clone(), values.clone())),
-            }
-        }
-        let posterior_error = |e| match e {
-            reliability::PosteriorError::Reliability(e) => err(e),
-            reliability::PosteriorError::Values(v) => load_error(py, v.diagnostics()),
-            reliability::PosteriorError::File(d) => load_error(py, &d),
-            e @ reliability::PosteriorError::Point { .. } => value_error(e.to_string()),
         };
-        let inputs = match posterior {
-            None => reliability::machine::inputs(m).map_err(err)?,
-            Some(p) => p.inputs(m).map_err(posterior_error)?,
+        self.parameter_vector(py, params)?;
+        let options = StudyOptions {
+            params,
+            grid,
+            sided,
+            system,
+            posterior,
         };
-        let values = self.parameter_vector(py, params)?;
-        let study = Study::new(&self.model, &values, inputs, spec).map_err(err)?;
-        match posterior {
-            Some(p) => p.apply(m, study).map_err(posterior_error),
-            None => Ok(study),
-        }
+        chain::ops::study::study(&self.machine, &self.file, &self.model, &options).map_err(|e| {
+            match e {
+                StudyError::Reliability(e) => study_error(py, &e, &self.file),
+                StudyError::Resolve(e) => resolve_error(py, self, e),
+                StudyError::Posterior(reliability::PosteriorError::Values(v)) => {
+                    load_error(py, v.diagnostics())
+                }
+                StudyError::Posterior(reliability::PosteriorError::File(d)) => load_error(py, &d),
+                StudyError::Posterior(e) => value_error(e.to_string()),
+            }
+        })
     }
 }
 

@@ -160,7 +160,7 @@ def test_bad_options(ac):
         g.reliability(method="mc", samples=0)
     with pytest.raises(chain.MachineError, match="axis variable"):
         g.reliability(grid={"w": [0.0]})
-    with pytest.raises(ValueError, match="non-finite"):
+    with pytest.raises(ValueError, match="--grid x: NaN is not finite"):
         g.reliability(grid={"x": [0.0, float("nan")]})
     with pytest.raises(ValueError, match="frame must be"):
         ac.derive("base")

@@ -17,12 +17,13 @@ pub(crate) mod reliability_plot;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
+use chain::ops::study::{StudyError, StudyOptions};
 use chain_core::model::{Machine, Sided};
 use miette::{LabeledSpan, MietteDiagnostic};
 use reliability::document::{AcceptanceDocument, ReliabilityDocument};
 use reliability::{
-    machine, Algorithm, Form, FormCase, Method, Posterior, PosteriorError, ReliabilityError,
-    Stopping, Study, StudyResult, SubsetLevel, System, Termination,
+    Algorithm, Form, FormCase, Method, Posterior, PosteriorError, ReliabilityError, Stopping,
+    Study, StudyResult, SubsetLevel, System, Termination,
 };
 use serde::Serialize;
 
@@ -372,7 +373,7 @@ impl Loaded {
     }
 
     /// [`Loaded::study`] with the inputs of a posterior (`None`: the
-    /// `statistics` section).
+    /// `statistics` section), through [`chain::ops::study`].
     pub(crate) fn study_with(
         &self,
         params: &[(String, f64)],
@@ -381,40 +382,22 @@ impl Loaded {
         system: Option<System>,
         posterior: Option<&Posterior>,
     ) -> miette::Result<(Study, chain_core::CompiledModel)> {
-        let m = &self.machine;
-        let mut spec = machine::spec(m, system).map_err(|e| self.report(e))?;
-        if let Some(s) = sided {
-            spec.sided = s.into();
-        }
-        for (name, values) in grid {
-            if m.variable_index(name).is_none() {
-                return Err(self.report(ReliabilityError::unknown(
-                    "axis variable",
-                    name,
-                    m.variables.iter().map(|v| v.name.as_str()),
-                )));
-            }
-            match spec.grid.axes.iter_mut().find(|(n, _)| n == name) {
-                Some(axis) => axis.1 = values.clone(),
-                None => spec.grid.axes.push((name.clone(), values.clone())),
-            }
-        }
-        let inputs = match posterior {
-            None => machine::inputs(m).map_err(|e| self.report(e))?,
-            Some(p) => p.inputs(m).map_err(|e| match e {
-                PosteriorError::Reliability(e) => self.report(e),
-                other => other.into(),
-            })?,
+        let model = chain_core::compile(&self.machine);
+        let options = StudyOptions {
+            params,
+            grid,
+            sided: sided.map(Into::into),
+            system,
+            posterior,
         };
-        let values = machine::parameters(m, params).map_err(|e| self.report(e))?;
-        let model = chain_core::compile(m);
-        let mut study = Study::new(&model, &values, inputs, spec).map_err(|e| self.report(e))?;
-        if let Some(p) = posterior {
-            study = p.apply(m, study).map_err(|e| match e {
-                PosteriorError::Reliability(e) => self.report(e),
-                other => other.into(),
+        let study =
+            chain::ops::study::study(&self.machine, &self.file, &model, &options).map_err(|e| {
+                match e {
+                    StudyError::Reliability(e) => self.report(e),
+                    StudyError::Resolve(e) => miette::Report::new(e),
+                    StudyError::Posterior(e) => e.into(),
+                }
             })?;
-        }
         Ok((study, model))
     }
 

@@ -7,4 +7,8 @@
 //! - [`resolve`]: parameter names, grid axes (the machine file's
 //!   `reliability.grid` with overrides), one point given by name (`--at`).
 
+//! - [`study`]: a reliability study from a machine and the options every
+//!   study command takes (parameters, grid, sided, system, a posterior).
+
 pub mod resolve;
+pub mod study;

@@ -209,25 +209,7 @@ pub fn grid_axes(
     file: &str,
     overrides: &[(String, Vec<f64>)],
 ) -> Result<Vec<(String, Vec<f64>)>, ResolveError> {
-    for (name, values) in overrides {
-        if m.variable_index(name).is_none() {
-            return Err(ResolveError::UnknownGridAxis {
-                file: file.to_string(),
-                name: name.clone(),
-                variables: variables(m),
-                suggestion: closest_variable(m, name),
-            });
-        }
-        if values.is_empty() {
-            return Err(ResolveError::EmptyGridAxis { name: name.clone() });
-        }
-        if let Some(&value) = values.iter().find(|x| !x.is_finite()) {
-            return Err(ResolveError::NonFiniteGridValue {
-                name: name.clone(),
-                value,
-            });
-        }
-    }
+    check_grid_overrides(m, file, overrides)?;
     let file_grid = m.reliability.as_ref().map(|r| &r.grid);
     (m.variables.iter().enumerate())
         .map(|(k, v)| {
@@ -247,6 +229,35 @@ pub fn grid_axes(
             Ok((v.name.clone(), values))
         })
         .collect()
+}
+
+/// Checks `--grid` overrides: each names an axis variable and has values,
+/// all finite.
+pub fn check_grid_overrides(
+    m: &Machine,
+    file: &str,
+    overrides: &[(String, Vec<f64>)],
+) -> Result<(), ResolveError> {
+    for (name, values) in overrides {
+        if m.variable_index(name).is_none() {
+            return Err(ResolveError::UnknownGridAxis {
+                file: file.to_string(),
+                name: name.clone(),
+                variables: variables(m),
+                suggestion: closest_variable(m, name),
+            });
+        }
+        if values.is_empty() {
+            return Err(ResolveError::EmptyGridAxis { name: name.clone() });
+        }
+        if let Some(&value) = values.iter().find(|x| !x.is_finite()) {
+            return Err(ResolveError::NonFiniteGridValue {
+                name: name.clone(),
+                value,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// A point given by axis name (`--at x=0,y=100,...`) in the machine's
