@@ -46,7 +46,7 @@ pub const MAP_BLOCK: usize = 4096;
 const MAP_CHUNK: usize = 256;
 
 /// The component names, in `E`'s order.
-const COMPONENTS: [&str; 6] = ["px", "py", "pz", "ox", "oy", "oz"];
+const COMPONENTS: [&str; 6] = crate::model::Component::NAMES;
 
 /// Why a model, values and parameters do not make one built machine.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

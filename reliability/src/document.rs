@@ -738,7 +738,7 @@ pub struct AllocationDocument<'a> {
     /// The machine's name.
     pub machine: &'a str,
     /// `optimal` or `paper`.
-    pub strategy: &'a str,
+    pub strategy: crate::allocate::StrategyName,
     /// The reliability section's requirement.
     pub requirement: Option<Requirement>,
     /// The standard deviations and summaries before allocation.

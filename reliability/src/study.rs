@@ -126,20 +126,6 @@ impl Serialize for Target {
     }
 }
 
-/// A target compares equal to its name (`Target::Series == "series"`).
-impl PartialEq<str> for Target {
-    fn eq(&self, other: &str) -> bool {
-        self.name() == other
-    }
-}
-
-/// A target compares equal to its name (`Target::Series == "series"`).
-impl PartialEq<&str> for Target {
-    fn eq(&self, other: &&str) -> bool {
-        self.name() == *other
-    }
-}
-
 /// The algorithm behind a [`StudyResult`].
 ///
 /// It serialises as the short name of `--method` (`form`, `is`, `mc`);

@@ -368,7 +368,7 @@ fn to_table(
         line(&mut out, &format!("round {}", s.round), &s.summaries);
         let _ = writeln!(out, "           tightened: {}", s.tightened.join(", "));
     }
-    if r.strategy == "optimal" {
+    if r.strategy == reliability::allocate::StrategyName::Optimal {
         line(&mut out, "optimal", &r.summaries);
     }
     let _ = writeln!(

@@ -23,7 +23,7 @@ use std::path::PathBuf;
 
 use chain_core::built::{BuiltMachine, MapError, MapSummary, Points};
 use chain_core::compensation::controllers::{Controller, ExportOptions, DEFAULT_STEP};
-use chain_core::model::Frame;
+use chain_core::model::{Component, Frame};
 use chain_core::values::{parse_approaches, Approach, Entry, EntryKind, Given, Reversal, Values};
 use chain_core::MapResult;
 use miette::MietteDiagnostic;
@@ -695,7 +695,7 @@ impl Report for MapDoc {
             let _ = writeln!(
                 out,
                 "{:<12} {:>12.3} {:>12.3} {:>12.3}",
-                format!("{} ({})", ["px", "py", "pz", "ox", "oy", "oz"][c], UNITS[c]),
+                format!("{} ({})", Component::NAMES[c], UNITS[c]),
                 cs.min * f,
                 cs.max * f,
                 cs.rms * f
@@ -724,7 +724,7 @@ impl Report for MapDoc {
                 let _ = writeln!(
                     out,
                     "{:<12} {:>12.3} {:>12.3} {:>12.3}   {:>12.4} {:>12.4} {:>12.4}",
-                    format!("{} ({})", ["px", "py", "pz", "ox", "oy", "oz"][k], UNITS[k]),
+                    format!("{} ({})", Component::NAMES[k], UNITS[k]),
                     b.min * f,
                     b.max * f,
                     b.rms * f,
@@ -746,10 +746,7 @@ impl Report for MapDoc {
         if let Some(r) = self.full().filter(|r| r.len() <= TABLE_POINTS) {
             let _ = writeln!(out);
             let mut header: Vec<String> = r.variables.clone();
-            header
-                .extend((0..6).map(|c| {
-                    format!("{} ({})", ["px", "py", "pz", "ox", "oy", "oz"][c], UNITS[c])
-                }));
+            header.extend((0..6).map(|c| format!("{} ({})", Component::NAMES[c], UNITS[c])));
             header.push("|p| (µm)".to_string());
             let widths: Vec<usize> = header.iter().map(|h| h.chars().count().max(10)).collect();
             let line = |cells: &[String]| {
@@ -774,12 +771,12 @@ impl Report for MapDoc {
     fn csv(&self) -> Option<Csv> {
         let r = self.full()?;
         let mut header: Vec<String> = r.variables.clone();
-        header.extend(["px", "py", "pz", "ox", "oy", "oz", "volumetric"].map(String::from));
+        header.extend(Component::NAMES.map(String::from));
+        header.push("volumetric".into());
         let after = self.compensated.as_ref().map(|c| &c.result);
         if after.is_some() {
-            header.extend(
-                ["px", "py", "pz", "ox", "oy", "oz", "volumetric"].map(|c| format!("{c}_after")),
-            );
+            let names = Component::NAMES.iter().chain(&["volumetric"]);
+            header.extend(names.map(|c| format!("{c}_after")));
         }
         let mut csv = Csv::new(header);
         for i in 0..r.len() {

@@ -32,7 +32,7 @@ use super::{Input, MapDoc};
 use crate::cli::plot::{ensure_fonts, ramp, Legend, Series, XyChart, GREY};
 
 const HEAT_SIZE: (u32, u32) = (1000, 760);
-const COMPONENTS: [&str; 6] = ["px", "py", "pz", "ox", "oy", "oz"];
+const COMPONENTS: [&str; 6] = chain_core::model::Component::NAMES;
 /// mm → µm, rad → µrad.
 const MICRO: [f64; 6] = [1e3, 1e3, 1e3, 1e6, 1e6, 1e6];
 const UNITS: [&str; 6] = ["µm", "µm", "µm", "µrad", "µrad", "µrad"];

@@ -31,7 +31,9 @@ fn gantry() -> (Machine, CompiledModel, Study) {
 }
 
 fn summary<'a>(s: &'a [Summary], target: &str) -> &'a Summary {
-    s.iter().find(|s| s.target == target).expect("component")
+    s.iter()
+        .find(|s| s.target.name() == target)
+        .expect("component")
 }
 
 fn std_of(b: &[ErrorBounds], stds: &[(String, f64)], name: &str) -> (f64, f64) {

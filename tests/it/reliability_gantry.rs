@@ -170,7 +170,7 @@ fn summaries_match_the_text_of_section_3_3() {
         let s = r
             .summaries
             .iter()
-            .find(|s| s.target == name)
+            .find(|s| s.target.name() == name)
             .expect("summary");
         eprintln!(
             "{name}: min {:.3} (paper {min}), mean {:.3} (paper {mean})",
@@ -434,7 +434,10 @@ fn sensitive_sets_of_figures_6_to_8() {
         ("pz", &["exx", "eyx", "exz", "Syz"]),
     ];
     for (name, expected) in paper {
-        let t = sens.iter().find(|t| t.target == name).expect("target");
+        let t = sens
+            .iter()
+            .find(|t| t.target.name() == name)
+            .expect("target");
         assert_eq!(t.method, SensitivityMethod::Exact);
         let top = t.errors[0].mean_abs_dr_dstd;
         let mut set: Vec<&str> = t

@@ -721,9 +721,12 @@ impl Component {
         self as usize
     }
 
+    /// The names of [`Component::ALL`], in order.
+    pub const NAMES: [&'static str; 6] = ["px", "py", "pz", "ox", "oy", "oz"];
+
     /// `px`, `py`, ...
     pub fn name(self) -> &'static str {
-        ["px", "py", "pz", "ox", "oy", "oz"][self.index()]
+        Component::NAMES[self.index()]
     }
 
     /// Parses `px`, `py`, ...

@@ -334,8 +334,8 @@ pub fn acceptance<M: ErrorModel + ?Sized>(
     )?;
     let (_, last) = evaluate(model, parameters, study, &stds)?;
     let strategy_name = match strategy {
-        Strategy::Optimal => "optimal",
-        Strategy::Paper(_) => "paper",
+        Strategy::Optimal => super::StrategyName::Optimal,
+        Strategy::Paper(_) => super::StrategyName::Paper,
     };
     let mut out = Allocation::new(
         strategy_name,

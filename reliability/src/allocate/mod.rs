@@ -188,11 +188,37 @@ impl Kkt {
     }
 }
 
+/// Which strategy allocated (serialised `optimal` or `paper`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StrategyName {
+    /// Least cost.
+    Optimal,
+    /// The paper's rounds.
+    Paper,
+}
+
+impl std::fmt::Display for StrategyName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl StrategyName {
+    /// `optimal` or `paper`.
+    pub fn name(self) -> &'static str {
+        match self {
+            StrategyName::Optimal => "optimal",
+            StrategyName::Paper => "paper",
+        }
+    }
+}
+
 /// The outcome of an allocation.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Allocation {
     /// `optimal` or `paper`.
-    pub strategy: &'static str,
+    pub strategy: StrategyName,
     /// The initial component summaries.
     pub initial: Vec<Summary>,
     /// The paper's rounds (empty for the optimal strategy).
@@ -217,7 +243,7 @@ impl Allocation {
     /// final summaries of its FORM re-evaluation: the cost and whether the
     /// requirement is met follow from them.
     pub(crate) fn new(
-        strategy: &'static str,
+        strategy: StrategyName,
         initial: Vec<Summary>,
         steps: Vec<Step>,
         bounds: &[ErrorBounds],

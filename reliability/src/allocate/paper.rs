@@ -120,6 +120,12 @@ pub fn paper<M: ErrorModel + ?Sized>(
         });
     }
     Ok(Allocation::new(
-        "paper", initial, steps, bounds, &stds, summaries, None,
+        super::StrategyName::Paper,
+        initial,
+        steps,
+        bounds,
+        &stds,
+        summaries,
+        None,
     ))
 }

@@ -65,7 +65,7 @@ pub const MAX_STATISTIC: f64 = 1e100;
 /// Keys of a reliability requirement.
 pub const REQUIREMENT_KEYS: &[&str] = &["min", "mean"];
 /// Component names.
-pub const COMPONENTS: &[&str] = &["px", "py", "pz", "ox", "oy", "oz"];
+pub const COMPONENTS: &[&str] = &crate::model::Component::NAMES;
 /// Values of `sided`.
 pub const SIDED: &[&str] = &["upper", "two"];
 

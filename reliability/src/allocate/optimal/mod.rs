@@ -161,7 +161,7 @@ fn finish<M: ErrorModel + ?Sized>(
     let (_, result) = evaluate(model, parameters, study, &stds)?;
     let summaries = component_summaries(&result);
     Ok(Allocation::new(
-        "optimal",
+        super::StrategyName::Optimal,
         initial,
         Vec::new(),
         bounds,
