@@ -8,7 +8,7 @@ use miette::MietteDiagnostic;
 use reliability::acceptance::AcceptanceResult;
 use reliability::{normal, Study};
 
-use super::reliability::Loaded;
+use super::loaded::Loaded;
 
 /// The acceptance probability of every point × toleranced component of
 /// `study`, to an absolute error `tolerance` (three standard errors).

@@ -16,7 +16,7 @@ use reliability::Summary;
 use serde::Serialize;
 
 use super::args::ModelArgs;
-use super::reliability::Loaded;
+use super::loaded::Loaded;
 use super::report::{self, Report};
 
 /// `--strategy`.

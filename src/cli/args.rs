@@ -1,7 +1,9 @@
 //! Command-line arguments shared by several subcommands, flattened into
 //! their argument structs with `#[command(flatten)]`.
 
-use super::reliability::{parse_assignment, MethodArg, SidedArg, SystemArg};
+use chain_core::compensation::controllers::Controller;
+use chain_core::model::{Machine, Sided};
+use reliability::{Algorithm, Method, ReliabilityError, System};
 
 /// `--param NAME=VALUE`: the values of the machine file's parameters.
 #[derive(Debug, clap::Args)]
@@ -48,7 +50,7 @@ pub struct AlgorithmArgs {
     /// 10^7, is and directional: 10^6 by default; subset: `--samples` per
     /// level, at most 1000 levels' worth); a case that runs out is marked
     /// not converged.
-    #[arg(long, value_name = "C", value_parser = super::reliability::parse_cov, allow_negative_numbers = true)]
+    #[arg(long, value_name = "C", value_parser = parse_cov, allow_negative_numbers = true)]
     pub cov: Option<f64>,
 }
 
@@ -84,4 +86,246 @@ pub struct SystemArgs {
     /// smallest position tolerance).
     #[arg(long = "system-tolerance", value_name = "I", requires = "system")]
     pub tolerance: Option<f64>,
+}
+
+/// Algorithms of `--method`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    /// FORM / improved first-order second-moment (Eq. 19-22, 31).
+    Form,
+    /// The advanced importance sampling (Eq. 23-28), centred by FORM.
+    Is,
+    /// Crude Monte Carlo.
+    Mc,
+    /// Subset simulation (Au & Beck 2001) with adaptive conditional
+    /// sampling, p0 = 0.1; `--samples` per level.
+    Subset,
+    /// Directional simulation (Bjerager 1988).
+    Directional,
+    /// SORM: FORM, then the exact curvatures at its design point;
+    /// Breitung, Hohenbichler–Rackwitz and Tvedt reported, Tvedt's the
+    /// answer.
+    Sorm,
+}
+
+impl MethodArg {
+    /// The library's algorithm with these samples per case and seed (FORM
+    /// ignores both) and an optional target coefficient of variation
+    /// (`samples` is then the budget; for subset the samples per level).
+    pub(crate) fn algorithm_with(self, samples: u64, seed: u64, cov: Option<f64>) -> Algorithm {
+        reliability::document::algorithm(self.method(), samples, seed, cov)
+    }
+
+    /// The library's method.
+    pub(crate) fn method(self) -> Method {
+        match self {
+            MethodArg::Form => Method::Form,
+            MethodArg::Is => Method::ImportanceSampling,
+            MethodArg::Mc => Method::MonteCarlo,
+            MethodArg::Subset => Method::Subset,
+            MethodArg::Directional => Method::Directional,
+            MethodArg::Sorm => Method::Sorm,
+        }
+    }
+
+    /// The samples per case: `--samples` or the method's default
+    /// ([`reliability::document::samples`]; 0 for FORM, which draws none).
+    pub(crate) fn samples(self, given: Option<u64>, to_cov: bool) -> u64 {
+        reliability::document::samples(self.method(), given, to_cov)
+    }
+}
+
+/// Parses `--cov`: a finite number in (0, 1].
+pub(crate) fn parse_cov(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    if !v.is_finite() || v <= 0.0 || v > 1.0 {
+        return Err(format!(
+            "the target coefficient of variation must be in (0, 1] (found `{s}`)"
+        ));
+    }
+    Ok(v)
+}
+
+impl MethodArg {
+    /// Whether the method samples (all but FORM).
+    pub(crate) fn samples_anything(self) -> bool {
+        !matches!(self, MethodArg::Form | MethodArg::Sorm)
+    }
+}
+
+/// `--sided` override.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SidedArg {
+    /// `g = I − E`.
+    Upper,
+    /// `|E| ≤ I`.
+    Two,
+}
+
+impl From<SidedArg> for Sided {
+    fn from(s: SidedArg) -> Sided {
+        match s {
+            SidedArg::Upper => Sided::Upper,
+            SidedArg::Two => Sided::Two,
+        }
+    }
+}
+
+/// `--system`: an extra system target.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SystemArg {
+    /// All listed components within tolerance at once.
+    Series,
+    /// `√(px² + py² + pz²) ≤ I` (`--system-tolerance`, default the smallest
+    /// position tolerance).
+    Volumetric,
+}
+
+pub(crate) fn system_of(
+    machine: &Machine,
+    system: Option<SystemArg>,
+    tolerance: Option<f64>,
+) -> Result<Option<System>, ReliabilityError> {
+    Ok(match system {
+        None => None,
+        Some(SystemArg::Series) => Some(System::Series),
+        Some(SystemArg::Volumetric) => Some(reliability::document::volumetric(machine, tolerance)?),
+    })
+}
+
+/// Parses `NAME=VALUE`.
+pub(crate) fn parse_assignment(s: &str) -> Result<(String, f64), String> {
+    let (name, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=VALUE, found `{s}`"))?;
+    let v: f64 = value
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{value}` is not a number"))?;
+    if !v.is_finite() {
+        return Err(format!("`{value}` is not finite"));
+    }
+    Ok((name.trim().to_string(), v))
+}
+
+/// Parses `VAR=v1,v2,...` (a grid axis on the command line).
+pub(crate) fn parse_axis(s: &str) -> Result<(String, Vec<f64>), String> {
+    let (name, values) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected VAR=V1,V2,..., found `{s}`"))?;
+    let values = values
+        .split(',')
+        .map(|v| {
+            v.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| format!("`{v}` is not a finite number"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    if values.is_empty() {
+        return Err(format!("axis `{name}` has no value"));
+    }
+    Ok((name.trim().to_string(), values))
+}
+
+/// Parses `VAR=V1,V2,...` or `VAR=LO:HI:N`.
+pub(crate) fn parse_grid_axis(s: &str) -> Result<(String, Vec<f64>), String> {
+    let Some((name, spec)) = s.split_once('=') else {
+        return Err(format!(
+            "expected VAR=V1,V2,... or VAR=LO:HI:N, found `{s}`"
+        ));
+    };
+    if !spec.contains(':') {
+        return parse_axis(s);
+    }
+    let parts: Vec<&str> = spec.split(':').map(str::trim).collect();
+    let [lo, hi, n] = parts[..] else {
+        return Err(format!("expected LO:HI:N after `{name}=`, found `{spec}`"));
+    };
+    let number = |t: &str| {
+        t.parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("`{t}` is not a finite number"))
+    };
+    let (lo, hi) = (number(lo)?, number(hi)?);
+    let n: usize = n
+        .parse()
+        .map_err(|_| format!("`{n}` is not a count of values (a whole number ≥ 2)"))?;
+    if n < 2 {
+        return Err(format!(
+            "LO:HI:N needs N ≥ 2 values, found {n} (one value is `{name}=V`)"
+        ));
+    }
+    if lo == hi {
+        return Err(format!("LO:HI:N needs LO ≠ HI, found {lo} twice"));
+    }
+    let step = (hi - lo) / (n - 1) as f64;
+    let values = (0..n)
+        .map(|k| if k == n - 1 { hi } else { lo + step * k as f64 })
+        .collect();
+    Ok((name.trim().to_string(), values))
+}
+
+/// The controllers `chain export` writes for (spec section 6's table).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ControllerName {
+    /// The universal grid CSV: `δq` at every node and the residual.
+    Grid,
+    /// Beckhoff TwinCAT / ISG volumetric compensation (`ISG_CSV`).
+    Beckhoff,
+    /// LinuxCNC `COMP_FILE` per joint.
+    Linuxcnc,
+    /// Sinumerik CEC sag / cross-axis tables.
+    SiemensCec,
+    /// Klipper `SET_SKEW`.
+    Klipper,
+}
+
+impl ControllerName {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            ControllerName::Grid => "grid",
+            ControllerName::Beckhoff => "beckhoff",
+            ControllerName::Linuxcnc => "linuxcnc",
+            ControllerName::SiemensCec => "siemens-cec",
+            ControllerName::Klipper => "klipper",
+        }
+    }
+
+    /// The per-axis table format, or `None` for `grid`.
+    pub fn tables(self) -> Option<Controller> {
+        match self {
+            ControllerName::Grid => None,
+            ControllerName::Beckhoff => Some(Controller::Beckhoff),
+            ControllerName::Linuxcnc => Some(Controller::Linuxcnc),
+            ControllerName::SiemensCec => Some(Controller::SiemensCec),
+            ControllerName::Klipper => Some(Controller::Klipper),
+        }
+    }
+}
+
+/// The coordinates of `--at`, `(variable, value)` in the order given.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AtPoint(pub Vec<(String, f64)>);
+
+/// Parses `x=0,y=1500,z=600`.
+/// A coordinate given twice is refused (the last one would silently win).
+pub(crate) fn parse_point(s: &str) -> Result<AtPoint, String> {
+    let point = s
+        .split(',')
+        .filter(|p| !p.trim().is_empty())
+        .map(parse_assignment)
+        .collect::<Result<Vec<_>, _>>()?;
+    for (i, (name, _)) in point.iter().enumerate() {
+        if point[..i].iter().any(|(n, _)| n == name) {
+            return Err(format!("`{name}` is given twice"));
+        }
+    }
+    Ok(AtPoint(point))
 }

@@ -289,3 +289,56 @@ fn csv_error_message(e: &csv::Error) -> String {
         _ => e.to_string(),
     }
 }
+
+/// The points of `--axes`: every row, in the machine's variable order.
+pub(crate) fn axes_points(
+    path: &std::path::Path,
+    m: &chain_core::Machine,
+) -> miette::Result<Vec<f64>> {
+    let mut input = open_csv(path)?;
+    let name = input.name.clone();
+    let has_t = input.header.first().is_some_and(|h| h == "t")
+        && (m.variable_index("t").is_none() || input.header[1..].iter().any(|h| h == "t"));
+    let skip = usize::from(has_t);
+    let mut column_of: Vec<Option<usize>> = vec![None; m.variables.len()];
+    for (k, h) in input.header.iter().enumerate().skip(skip) {
+        let Some(v) = m.variable_index(h) else {
+            let hint =
+                chain_core::diagnostic::closest(h, m.variables.iter().map(|v| v.name.as_str()))
+                    .map(|c| format!(" (did you mean `{c}`?)"))
+                    .unwrap_or_default();
+            miette::bail!(
+                "{name}:1: column `{h}` is not an axis variable of machine `{}`{hint}; expected `t` (optional, first) and {}",
+                m.name,
+                variable_list(m)
+            );
+        };
+        column_of[v] = Some(k);
+    }
+    let missing: Vec<String> = (m.variables.iter().zip(&column_of))
+        .filter(|(_, c)| c.is_none())
+        .map(|(v, _)| format!("`{}`", v.name))
+        .collect();
+    if !missing.is_empty() {
+        miette::bail!(
+            "{name}:1: no column for axis variable{} {}; the header names every axis variable ({})",
+            if missing.len() > 1 { "s" } else { "" },
+            missing.join(", "),
+            variable_list(m)
+        );
+    }
+    let rows = numeric_rows(&mut input)?;
+    let mut points = Vec::with_capacity(rows.len() * m.variables.len());
+    for (_, values) in rows {
+        points.extend(column_of.iter().map(|c| c.map_or(f64::NAN, |c| values[c])));
+    }
+    Ok(points)
+}
+
+pub(crate) fn variable_list(m: &chain_core::Machine) -> String {
+    m.variables
+        .iter()
+        .map(|v| format!("`{}`", v.name))
+        .collect::<Vec<_>>()
+        .join(", ")
+}

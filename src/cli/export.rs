@@ -27,7 +27,7 @@ use chain_core::compensation::controllers::{
     BECKHOFF_DEFAULT_MAX_RECORDS, CEC_DEFAULT_MAX_POINTS, DEFAULT_STEP,
 };
 use chain_core::compensation::grid::{self, GridCompensation};
-use chain_core::compensation::{CompensationError, ExportedFile};
+use chain_core::compensation::ExportedFile;
 use chain_core::kinematics::Kinematics;
 use chain_core::values::Values;
 use miette::MietteDiagnostic;
@@ -35,48 +35,11 @@ use reliability::machine;
 use serde::Serialize;
 
 use super::args::ParamArgs;
-use super::map::{axes_points, parse_grid_axis};
-use super::reliability::Loaded;
+use super::args::{parse_grid_axis, ControllerName};
+use super::csv_input::axes_points;
+use super::diagnostics::export_error;
+use super::loaded::Loaded;
 use super::report::{self, Csv, Report};
-
-/// The controllers `chain export` writes for (spec section 6's table).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum ControllerName {
-    /// The universal grid CSV: `δq` at every node and the residual.
-    Grid,
-    /// Beckhoff TwinCAT / ISG volumetric compensation (`ISG_CSV`).
-    Beckhoff,
-    /// LinuxCNC `COMP_FILE` per joint.
-    Linuxcnc,
-    /// Sinumerik CEC sag / cross-axis tables.
-    SiemensCec,
-    /// Klipper `SET_SKEW`.
-    Klipper,
-}
-
-impl ControllerName {
-    /// The name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            ControllerName::Grid => "grid",
-            ControllerName::Beckhoff => "beckhoff",
-            ControllerName::Linuxcnc => "linuxcnc",
-            ControllerName::SiemensCec => "siemens-cec",
-            ControllerName::Klipper => "klipper",
-        }
-    }
-
-    /// The per-axis table format, or `None` for `grid`.
-    pub fn tables(self) -> Option<Controller> {
-        match self {
-            ControllerName::Grid => None,
-            ControllerName::Beckhoff => Some(Controller::Beckhoff),
-            ControllerName::Linuxcnc => Some(Controller::Linuxcnc),
-            ControllerName::SiemensCec => Some(Controller::SiemensCec),
-            ControllerName::Klipper => Some(Controller::Klipper),
-        }
-    }
-}
 
 /// Output formats of `chain export`'s summary.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -381,35 +344,6 @@ pub(crate) fn controller_error(e: ControllerError, values: &std::path::Path) -> 
             .with_code("chain::export::out_of_table")
             .with_help(format!(
                 "the values file {} does not cover the travel: give a travel inside the table (--grid {}={},{}), measure the table over the whole travel, or add `extrapolate: hold` to its entry; nothing is extrapolated",
-                values.display(),
-                source.variable,
-                source.lo,
-                source.hi
-            ));
-            miette::Report::new(d)
-        }
-        _ => miette::Report::new(e),
-    }
-}
-
-/// A compensation error, rendered with its code and help.
-pub(crate) fn export_error(e: CompensationError, values: &std::path::Path) -> miette::Report {
-    match &e {
-        CompensationError::OutOfRange { point, at, source } => {
-            let d = MietteDiagnostic::new(format!(
-                "at node {} ({at}): {} = {} is outside the table of `{}` ({}, {} = {} to {})",
-                point + 1,
-                source.variable,
-                source.value,
-                source.name,
-                source.table,
-                source.variable,
-                source.lo,
-                source.hi
-            ))
-            .with_code("chain::export::out_of_range")
-            .with_help(format!(
-                "the values file {} does not cover the requested nodes: export inside {} = {} to {} (--grid), extend the table, or add `extrapolate: hold` to its entry",
                 values.display(),
                 source.variable,
                 source.lo,

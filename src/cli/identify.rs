@@ -17,7 +17,7 @@ use chain_core::measured::document::{
 use chain_core::measured::{Layout, Measurements};
 
 use super::args::ParamArgs;
-use super::reliability::Loaded;
+use super::loaded::Loaded;
 use super::report::{self, Report};
 
 /// Output formats of `chain identify`.

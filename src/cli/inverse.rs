@@ -10,9 +10,10 @@ use chain_core::inverse::{Inverse, InverseError, Solution, Status};
 use chain_core::named::NameMap;
 use serde::{Serialize, Serializer};
 
+use super::args::parse_assignment;
 use super::args::ParamArgs;
 use super::csv_input::{read_poses, Orientation, PoseRow};
-use super::reliability::{parse_assignment, resolve_fixed, Loaded};
+use super::loaded::{resolve_fixed, Loaded};
 use super::report::{self, Csv, Report};
 
 /// Arguments of `chain inverse`.

@@ -31,9 +31,10 @@ use reliability::machine;
 use serde::Serialize;
 
 use super::args::ParamArgs;
-use super::csv_input::{numeric_rows, open_csv};
-use super::export::{export_error, ControllerName};
-use super::reliability::{parse_axis, Loaded};
+use super::args::{parse_grid_axis, ControllerName};
+use super::csv_input::axes_points;
+use super::diagnostics::export_error;
+use super::loaded::Loaded;
 use super::report::{self, Csv, Report};
 
 /// Maps with at most this many points also list every point in the table
@@ -107,45 +108,6 @@ pub struct MapArgs {
         requires = "compensated"
     )]
     pub compensation_step: Option<f64>,
-}
-
-/// Parses `VAR=V1,V2,...` or `VAR=LO:HI:N`.
-pub(crate) fn parse_grid_axis(s: &str) -> Result<(String, Vec<f64>), String> {
-    let Some((name, spec)) = s.split_once('=') else {
-        return Err(format!(
-            "expected VAR=V1,V2,... or VAR=LO:HI:N, found `{s}`"
-        ));
-    };
-    if !spec.contains(':') {
-        return parse_axis(s);
-    }
-    let parts: Vec<&str> = spec.split(':').map(str::trim).collect();
-    let [lo, hi, n] = parts[..] else {
-        return Err(format!("expected LO:HI:N after `{name}=`, found `{spec}`"));
-    };
-    let number = |t: &str| {
-        t.parse::<f64>()
-            .ok()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| format!("`{t}` is not a finite number"))
-    };
-    let (lo, hi) = (number(lo)?, number(hi)?);
-    let n: usize = n
-        .parse()
-        .map_err(|_| format!("`{n}` is not a count of values (a whole number ≥ 2)"))?;
-    if n < 2 {
-        return Err(format!(
-            "LO:HI:N needs N ≥ 2 values, found {n} (one value is `{name}=V`)"
-        ));
-    }
-    if lo == hi {
-        return Err(format!("LO:HI:N needs LO ≠ HI, found {lo} twice"));
-    }
-    let step = (hi - lo) / (n - 1) as f64;
-    let values = (0..n)
-        .map(|k| if k == n - 1 { hi } else { lo + step * k as f64 })
-        .collect();
-    Ok((name.trim().to_string(), values))
 }
 
 /// Runs `chain map`.
@@ -379,59 +341,6 @@ fn map_error(e: MapError, values: &std::path::Path) -> miette::Report {
         d = d.with_help(help);
     }
     miette::Report::new(d)
-}
-
-/// The points of `--axes`: every row, in the machine's variable order.
-pub(crate) fn axes_points(
-    path: &std::path::Path,
-    m: &chain_core::Machine,
-) -> miette::Result<Vec<f64>> {
-    let mut input = open_csv(path)?;
-    let name = input.name.clone();
-    let has_t = input.header.first().is_some_and(|h| h == "t")
-        && (m.variable_index("t").is_none() || input.header[1..].iter().any(|h| h == "t"));
-    let skip = usize::from(has_t);
-    let mut column_of: Vec<Option<usize>> = vec![None; m.variables.len()];
-    for (k, h) in input.header.iter().enumerate().skip(skip) {
-        let Some(v) = m.variable_index(h) else {
-            let hint =
-                chain_core::diagnostic::closest(h, m.variables.iter().map(|v| v.name.as_str()))
-                    .map(|c| format!(" (did you mean `{c}`?)"))
-                    .unwrap_or_default();
-            miette::bail!(
-                "{name}:1: column `{h}` is not an axis variable of machine `{}`{hint}; expected `t` (optional, first) and {}",
-                m.name,
-                variable_list(m)
-            );
-        };
-        column_of[v] = Some(k);
-    }
-    let missing: Vec<String> = (m.variables.iter().zip(&column_of))
-        .filter(|(_, c)| c.is_none())
-        .map(|(v, _)| format!("`{}`", v.name))
-        .collect();
-    if !missing.is_empty() {
-        miette::bail!(
-            "{name}:1: no column for axis variable{} {}; the header names every axis variable ({})",
-            if missing.len() > 1 { "s" } else { "" },
-            missing.join(", "),
-            variable_list(m)
-        );
-    }
-    let rows = numeric_rows(&mut input)?;
-    let mut points = Vec::with_capacity(rows.len() * m.variables.len());
-    for (_, values) in rows {
-        points.extend(column_of.iter().map(|c| c.map_or(f64::NAN, |c| values[c])));
-    }
-    Ok(points)
-}
-
-fn variable_list(m: &chain_core::Machine) -> String {
-    m.variables
-        .iter()
-        .map(|v| format!("`{}`", v.name))
-        .collect::<Vec<_>>()
-        .join(", ")
 }
 
 /// A progress bar on stderr for large maps, only when stderr is a terminal

@@ -21,7 +21,8 @@ use chain_core::named::NameMap;
 use chain_core::settings;
 use serde::{Serialize, Serializer};
 
-use super::reliability::{parse_assignment, resolve_fixed};
+use super::args::parse_assignment;
+use super::loaded::resolve_fixed;
 use super::report::{self, Csv, Report};
 
 /// Highest order accepted for `--order` and `--max-order`: the JSON lists

@@ -26,12 +26,13 @@ use reliability::{
 };
 use serde::Serialize;
 
+use super::args::{parse_assignment, system_of, MethodArg};
 use super::args::{AlgorithmArgs, ModelArgs, SystemArgs};
-use super::csv_input::{numeric_rows, open_csv, read_poses};
+use super::csv_input::{numeric_rows, open_csv, read_poses, variable_list};
 use super::inverse::solve_rows;
+use super::loaded::{resolve_fixed, Loaded};
 use super::reliability::{
-    calls_text, note_form_limits, parse_assignment, requirement_text, resolve_fixed, sided_title,
-    system_of, warn_unconverged, Loaded, MethodArg, Pairs,
+    calls_text, note_form_limits, requirement_text, sided_title, warn_unconverged, Pairs,
 };
 use super::report::{self, Csv, Report};
 
@@ -237,14 +238,6 @@ fn axes_instants(
         })
         .collect();
     Ok((has_t, instants))
-}
-
-fn variable_list(m: &Machine) -> String {
-    m.variables
-        .iter()
-        .map(|v| format!("`{}`", v.name))
-        .collect::<Vec<_>>()
-        .join(", ")
 }
 
 /// The instants of `--pose`, each solved by the inverse kinematics of

@@ -15,7 +15,7 @@ use chain_core::plan::{self, Kind, PlanDocument, PlanError};
 use miette::MietteDiagnostic;
 
 use super::args::ParamArgs;
-use super::reliability::Loaded;
+use super::loaded::Loaded;
 use super::report::{self, Report};
 
 /// Output formats of `chain plan`.

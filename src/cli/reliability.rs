@@ -15,88 +15,18 @@
 pub(crate) mod reliability_plot;
 
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use chain::ops::study::{StudyError, StudyOptions};
-use chain_core::model::{Machine, Sided};
-use miette::{LabeledSpan, MietteDiagnostic};
+use chain_core::model::Sided;
 use reliability::document::{AcceptanceDocument, ReliabilityDocument};
 use reliability::{
-    Algorithm, Form, FormCase, Method, Posterior, PosteriorError, ReliabilityError, Stopping,
-    Study, StudyResult, SubsetLevel, System, Termination,
+    Form, FormCase, Method, Posterior, Stopping, Study, StudyResult, SubsetLevel, Termination,
 };
 use serde::Serialize;
 
-use super::args::{AlgorithmArgs, ModelArgs, SystemArgs};
+use super::args::{parse_axis, system_of, AlgorithmArgs, MethodArg, ModelArgs, SystemArgs};
+use super::loaded::Loaded;
 use super::report::{self, Csv, Report};
-
-/// Algorithms of `--method`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum MethodArg {
-    /// FORM / improved first-order second-moment (Eq. 19-22, 31).
-    Form,
-    /// The advanced importance sampling (Eq. 23-28), centred by FORM.
-    Is,
-    /// Crude Monte Carlo.
-    Mc,
-    /// Subset simulation (Au & Beck 2001) with adaptive conditional
-    /// sampling, p0 = 0.1; `--samples` per level.
-    Subset,
-    /// Directional simulation (Bjerager 1988).
-    Directional,
-    /// SORM: FORM, then the exact curvatures at its design point;
-    /// Breitung, Hohenbichler–Rackwitz and Tvedt reported, Tvedt's the
-    /// answer.
-    Sorm,
-}
-
-impl MethodArg {
-    /// The library's algorithm with these samples per case and seed (FORM
-    /// ignores both) and an optional target coefficient of variation
-    /// (`samples` is then the budget; for subset the samples per level).
-    pub(crate) fn algorithm_with(self, samples: u64, seed: u64, cov: Option<f64>) -> Algorithm {
-        reliability::document::algorithm(self.method(), samples, seed, cov)
-    }
-
-    /// The library's method.
-    pub(crate) fn method(self) -> Method {
-        match self {
-            MethodArg::Form => Method::Form,
-            MethodArg::Is => Method::ImportanceSampling,
-            MethodArg::Mc => Method::MonteCarlo,
-            MethodArg::Subset => Method::Subset,
-            MethodArg::Directional => Method::Directional,
-            MethodArg::Sorm => Method::Sorm,
-        }
-    }
-
-    /// The samples per case: `--samples` or the method's default
-    /// ([`reliability::document::samples`]; 0 for FORM, which draws none).
-    pub(crate) fn samples(self, given: Option<u64>, to_cov: bool) -> u64 {
-        reliability::document::samples(self.method(), given, to_cov)
-    }
-}
-
-/// Parses `--cov`: a finite number in (0, 1].
-pub(crate) fn parse_cov(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{s}` is not a number"))?;
-    if !v.is_finite() || v <= 0.0 || v > 1.0 {
-        return Err(format!(
-            "the target coefficient of variation must be in (0, 1] (found `{s}`)"
-        ));
-    }
-    Ok(v)
-}
-
-impl MethodArg {
-    /// Whether the method samples (all but FORM).
-    pub(crate) fn samples_anything(self) -> bool {
-        !matches!(self, MethodArg::Form | MethodArg::Sorm)
-    }
-}
 
 /// Output formats of `chain reliability`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -107,34 +37,6 @@ pub enum ReliabilityFormat {
     Json,
     /// One row per (target, point).
     Csv,
-}
-
-/// `--sided` override.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum SidedArg {
-    /// `g = I − E`.
-    Upper,
-    /// `|E| ≤ I`.
-    Two,
-}
-
-impl From<SidedArg> for Sided {
-    fn from(s: SidedArg) -> Sided {
-        match s {
-            SidedArg::Upper => Sided::Upper,
-            SidedArg::Two => Sided::Two,
-        }
-    }
-}
-
-/// `--system`: an extra system target.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum SystemArg {
-    /// All listed components within tolerance at once.
-    Series,
-    /// `√(px² + py² + pz²) ≤ I` (`--system-tolerance`, default the smallest
-    /// position tolerance).
-    Volumetric,
 }
 
 /// Arguments of `chain reliability`.
@@ -304,179 +206,6 @@ impl ProgressBar {
             b.finish_and_clear();
         }
     }
-}
-
-// ---------------------------------------------------------------------------
-// Shared with `chain sensitivity`.
-
-/// A loaded machine with its source text (for diagnostics).
-pub(crate) struct Loaded {
-    pub(crate) machine: Machine,
-    file: String,
-    source: String,
-}
-
-impl Loaded {
-    /// Loads and validates a machine file.
-    pub(crate) fn new(path: &Path) -> miette::Result<Loaded> {
-        let machine = chain_core::load_file(path)?;
-        // Read again for the messages' snippets, within the loader's bound.
-        let source = chain_core::bounded::read_path(path, chain_core::bounded::MACHINE_BYTES)
-            .ok()
-            .and_then(|b| String::from_utf8(b).ok())
-            .unwrap_or_default();
-        let file = machine
-            .file
-            .clone()
-            .unwrap_or_else(|| path.display().to_string());
-        Ok(Loaded {
-            machine,
-            file,
-            source,
-        })
-    }
-
-    /// The study of the machine's reliability section, with command-line
-    /// parameter values, grid axes and `sided`.
-    pub(crate) fn study(
-        &self,
-        params: &[(String, f64)],
-        grid: &[(String, Vec<f64>)],
-        sided: Option<SidedArg>,
-        system: Option<System>,
-    ) -> miette::Result<(Study, chain_core::CompiledModel)> {
-        self.study_with(params, grid, sided, system, None)
-    }
-
-    /// The posterior of `--values`, if given (its refusals located in the
-    /// values file), its tables read for the `--approach` choices.
-    pub(crate) fn posterior(
-        &self,
-        values: Option<&Path>,
-        approach: &[Vec<(Option<String>, chain_core::values::Approach)>],
-    ) -> miette::Result<Option<Posterior>> {
-        let Some(path) = values else {
-            return Ok(None);
-        };
-        let mut posterior = match Posterior::read(path, &self.machine) {
-            Ok(p) => p,
-            Err(PosteriorError::Reliability(e)) => return Err(self.report(e)),
-            Err(e) => return Err(e.into()),
-        };
-        let choices: Vec<_> = approach.iter().flatten().cloned().collect();
-        if !choices.is_empty() {
-            posterior
-                .choose_approach(&choices)
-                .map_err(|e| miette::miette!("--approach: {e} (values {})", path.display()))?;
-        }
-        Ok(Some(posterior))
-    }
-
-    /// [`Loaded::study`] with the inputs of a posterior (`None`: the
-    /// `statistics` section), through [`chain::ops::study`].
-    pub(crate) fn study_with(
-        &self,
-        params: &[(String, f64)],
-        grid: &[(String, Vec<f64>)],
-        sided: Option<SidedArg>,
-        system: Option<System>,
-        posterior: Option<&Posterior>,
-    ) -> miette::Result<(Study, chain_core::CompiledModel)> {
-        let model = chain_core::compile(&self.machine);
-        let options = StudyOptions {
-            params,
-            grid,
-            sided: sided.map(Into::into),
-            system,
-            posterior,
-        };
-        let study =
-            chain::ops::study::study(&self.machine, &self.file, &model, &options).map_err(|e| {
-                match e {
-                    StudyError::Reliability(e) => self.report(e),
-                    StudyError::Resolve(e) => miette::Report::new(e),
-                    StudyError::Posterior(e) => e.into(),
-                }
-            })?;
-        Ok((study, model))
-    }
-
-    /// A located, rendered diagnostic for a reliability error (worded by
-    /// [`reliability::document::describe`]).
-    /// The machine file's name as messages give it.
-    pub(crate) fn file_name(&self) -> &str {
-        &self.file
-    }
-
-    pub(crate) fn report(&self, err: ReliabilityError) -> miette::Report {
-        let d = reliability::document::describe(&err, &self.file);
-        let mut diag = MietteDiagnostic::new(d.message);
-        if let Some(code) = miette::Diagnostic::code(&err) {
-            diag = diag.with_code(code.to_string());
-        }
-        if !d.help.is_empty() {
-            diag = diag.with_help(d.help);
-        }
-        if let Some(o) = d
-            .origin
-            .filter(|o| o.line > 0 && o.offset <= self.source.len())
-        {
-            let len = o.len.min(self.source.len() - o.offset);
-            diag = diag.with_label(LabeledSpan::at(o.offset..o.offset + len, d.label));
-            return miette::Report::new(diag).with_source_code(
-                chain_core::diagnostic::Snippet::new(self.file.clone(), self.source.clone()),
-            );
-        }
-        miette::Report::new(diag)
-    }
-}
-
-pub(crate) fn system_of(
-    machine: &Machine,
-    system: Option<SystemArg>,
-    tolerance: Option<f64>,
-) -> Result<Option<System>, ReliabilityError> {
-    Ok(match system {
-        None => None,
-        Some(SystemArg::Series) => Some(System::Series),
-        Some(SystemArg::Volumetric) => Some(reliability::document::volumetric(machine, tolerance)?),
-    })
-}
-
-/// Parses `NAME=VALUE`.
-pub(crate) fn parse_assignment(s: &str) -> Result<(String, f64), String> {
-    let (name, value) = s
-        .split_once('=')
-        .ok_or_else(|| format!("expected NAME=VALUE, found `{s}`"))?;
-    let v: f64 = value
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{value}` is not a number"))?;
-    if !v.is_finite() {
-        return Err(format!("`{value}` is not finite"));
-    }
-    Ok((name.trim().to_string(), v))
-}
-
-/// Parses `VAR=v1,v2,...` (a grid axis on the command line).
-pub(crate) fn parse_axis(s: &str) -> Result<(String, Vec<f64>), String> {
-    let (name, values) = s
-        .split_once('=')
-        .ok_or_else(|| format!("expected VAR=V1,V2,..., found `{s}`"))?;
-    let values = values
-        .split(',')
-        .map(|v| {
-            v.trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| format!("`{v}` is not a finite number"))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    if values.is_empty() {
-        return Err(format!("axis `{name}` has no value"));
-    }
-    Ok((name.trim().to_string(), values))
 }
 
 // ---------------------------------------------------------------------------
@@ -1089,31 +818,6 @@ pub(crate) fn requirement_text(req: &chain_core::model::Requirement, met: bool) 
         100.0 * req.mean,
         if met { "met" } else { "NOT met" }
     )
-}
-
-/// `--fix` names resolved to variable indices.
-pub(crate) fn resolve_fixed(
-    m: &Machine,
-    fix: &[(String, f64)],
-) -> miette::Result<Vec<(usize, f64)>> {
-    let mut out: Vec<(usize, f64)> = Vec::new();
-    for (name, v) in fix {
-        let Some(i) = m.variable_index(name) else {
-            let hint =
-                chain_core::diagnostic::closest(name, m.variables.iter().map(|v| v.name.as_str()))
-                    .map(|h| format!(" (did you mean `{h}`?)"))
-                    .unwrap_or_default();
-            miette::bail!(
-                "--fix: `{name}` is not an axis variable of machine `{}`{hint}",
-                m.name
-            );
-        };
-        match out.iter_mut().find(|(j, _)| *j == i) {
-            Some(slot) => slot.1 = *v,
-            None => out.push((i, *v)),
-        }
-    }
-    Ok(out)
 }
 
 /// A CSV cell of a number: shortest round-trip form when finite, an empty

@@ -26,9 +26,9 @@ use reliability::document::{self, SensitivityDocument};
 use reliability::{machine, Form, ReliabilityError};
 use serde::Serialize;
 
-use super::args::ModelArgs;
+use super::args::{parse_axis, parse_point, AtPoint, ModelArgs};
+use super::loaded::{resolve_at, Loaded};
 use super::reliability::reliability_plot;
-use super::reliability::{parse_assignment, parse_axis, Loaded};
 use super::report::{self, Report};
 
 /// What `chain sensitivity` computes.
@@ -105,26 +105,6 @@ fn parse_values(s: &str) -> Result<ValuesArg, String> {
     } else {
         Ok(ValuesArg::File(PathBuf::from(s)))
     }
-}
-
-/// The coordinates of `--at`, `(variable, value)` in the order given.
-#[derive(Debug, Clone, PartialEq)]
-pub struct AtPoint(pub Vec<(String, f64)>);
-
-/// Parses `x=0,y=1500,z=600`.
-/// A coordinate given twice is refused (the last one would silently win).
-pub(crate) fn parse_point(s: &str) -> Result<AtPoint, String> {
-    let point = s
-        .split(',')
-        .filter(|p| !p.trim().is_empty())
-        .map(parse_assignment)
-        .collect::<Result<Vec<_>, _>>()?;
-    for (i, (name, _)) in point.iter().enumerate() {
-        if point[..i].iter().any(|(n, _)| n == name) {
-            return Err(format!("`{name}` is given twice"));
-        }
-    }
-    Ok(AtPoint(point))
 }
 
 /// Runs `chain sensitivity`.
@@ -256,16 +236,6 @@ fn unknown_variable(loaded: &Loaded, name: &str) -> miette::Report {
         name,
         m.variables.iter().map(|v| v.name.as_str()),
     ))
-}
-
-/// The values of `--at` in the machine's variable order
-/// ([`chain::ops::resolve::at_point`]).
-pub(crate) fn resolve_at(coords: &[(String, f64)], loaded: &Loaded) -> miette::Result<Vec<f64>> {
-    Ok(chain::ops::resolve::at_point(
-        &loaded.machine,
-        loaded.file_name(),
-        coords,
-    )?)
 }
 
 fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {

@@ -13,10 +13,12 @@ use reliability::document::SobolDocument;
 use reliability::sobol::{Estimate, Sobol, SobolError};
 use reliability::{machine, Study};
 
+use super::args::parse_axis;
 use super::args::ParamArgs;
-use super::reliability::{parse_axis, Loaded};
+use super::args::{parse_point, AtPoint};
+use super::loaded::resolve_at;
+use super::loaded::Loaded;
 use super::report::{self, Csv, Report};
-use super::sensitivity::{parse_point, resolve_at, AtPoint};
 
 /// Output formats of `chain sobol`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

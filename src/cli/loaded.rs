@@ -1,0 +1,170 @@
+//! The machine file a command works on, loaded once with its text (for
+//! messages' snippets), and what every study command builds from it: the
+//! study ([`chain::ops::study`]), the posterior of `--values`, located
+//! diagnostics of reliability errors; `--fix` names resolved.
+
+use std::path::Path;
+
+use chain::ops::study::{StudyError, StudyOptions};
+use chain_core::model::Machine;
+use miette::{LabeledSpan, MietteDiagnostic};
+use reliability::{Posterior, PosteriorError, ReliabilityError, Study, System};
+
+use super::args::SidedArg;
+
+/// A loaded machine with its source text (for diagnostics).
+pub(crate) struct Loaded {
+    pub(crate) machine: Machine,
+    file: String,
+    source: String,
+}
+
+impl Loaded {
+    /// Loads and validates a machine file.
+    pub(crate) fn new(path: &Path) -> miette::Result<Loaded> {
+        let machine = chain_core::load_file(path)?;
+        // Read again for the messages' snippets, within the loader's bound.
+        let source = chain_core::bounded::read_path(path, chain_core::bounded::MACHINE_BYTES)
+            .ok()
+            .and_then(|b| String::from_utf8(b).ok())
+            .unwrap_or_default();
+        let file = machine
+            .file
+            .clone()
+            .unwrap_or_else(|| path.display().to_string());
+        Ok(Loaded {
+            machine,
+            file,
+            source,
+        })
+    }
+
+    /// The study of the machine's reliability section, with command-line
+    /// parameter values, grid axes and `sided`.
+    pub(crate) fn study(
+        &self,
+        params: &[(String, f64)],
+        grid: &[(String, Vec<f64>)],
+        sided: Option<SidedArg>,
+        system: Option<System>,
+    ) -> miette::Result<(Study, chain_core::CompiledModel)> {
+        self.study_with(params, grid, sided, system, None)
+    }
+
+    /// The posterior of `--values`, if given (its refusals located in the
+    /// values file), its tables read for the `--approach` choices.
+    pub(crate) fn posterior(
+        &self,
+        values: Option<&Path>,
+        approach: &[Vec<(Option<String>, chain_core::values::Approach)>],
+    ) -> miette::Result<Option<Posterior>> {
+        let Some(path) = values else {
+            return Ok(None);
+        };
+        let mut posterior = match Posterior::read(path, &self.machine) {
+            Ok(p) => p,
+            Err(PosteriorError::Reliability(e)) => return Err(self.report(e)),
+            Err(e) => return Err(e.into()),
+        };
+        let choices: Vec<_> = approach.iter().flatten().cloned().collect();
+        if !choices.is_empty() {
+            posterior
+                .choose_approach(&choices)
+                .map_err(|e| miette::miette!("--approach: {e} (values {})", path.display()))?;
+        }
+        Ok(Some(posterior))
+    }
+
+    /// [`Loaded::study`] with the inputs of a posterior (`None`: the
+    /// `statistics` section), through [`chain::ops::study`].
+    pub(crate) fn study_with(
+        &self,
+        params: &[(String, f64)],
+        grid: &[(String, Vec<f64>)],
+        sided: Option<SidedArg>,
+        system: Option<System>,
+        posterior: Option<&Posterior>,
+    ) -> miette::Result<(Study, chain_core::CompiledModel)> {
+        let model = chain_core::compile(&self.machine);
+        let options = StudyOptions {
+            params,
+            grid,
+            sided: sided.map(Into::into),
+            system,
+            posterior,
+        };
+        let study =
+            chain::ops::study::study(&self.machine, &self.file, &model, &options).map_err(|e| {
+                match e {
+                    StudyError::Reliability(e) => self.report(e),
+                    StudyError::Resolve(e) => miette::Report::new(e),
+                    StudyError::Posterior(e) => e.into(),
+                }
+            })?;
+        Ok((study, model))
+    }
+
+    /// A located, rendered diagnostic for a reliability error (worded by
+    /// [`reliability::document::describe`]).
+    /// The machine file's name as messages give it.
+    pub(crate) fn file_name(&self) -> &str {
+        &self.file
+    }
+
+    pub(crate) fn report(&self, err: ReliabilityError) -> miette::Report {
+        let d = reliability::document::describe(&err, &self.file);
+        let mut diag = MietteDiagnostic::new(d.message);
+        if let Some(code) = miette::Diagnostic::code(&err) {
+            diag = diag.with_code(code.to_string());
+        }
+        if !d.help.is_empty() {
+            diag = diag.with_help(d.help);
+        }
+        if let Some(o) = d
+            .origin
+            .filter(|o| o.line > 0 && o.offset <= self.source.len())
+        {
+            let len = o.len.min(self.source.len() - o.offset);
+            diag = diag.with_label(LabeledSpan::at(o.offset..o.offset + len, d.label));
+            return miette::Report::new(diag).with_source_code(
+                chain_core::diagnostic::Snippet::new(self.file.clone(), self.source.clone()),
+            );
+        }
+        miette::Report::new(diag)
+    }
+}
+
+/// `--fix` names resolved to variable indices.
+pub(crate) fn resolve_fixed(
+    m: &Machine,
+    fix: &[(String, f64)],
+) -> miette::Result<Vec<(usize, f64)>> {
+    let mut out: Vec<(usize, f64)> = Vec::new();
+    for (name, v) in fix {
+        let Some(i) = m.variable_index(name) else {
+            let hint =
+                chain_core::diagnostic::closest(name, m.variables.iter().map(|v| v.name.as_str()))
+                    .map(|h| format!(" (did you mean `{h}`?)"))
+                    .unwrap_or_default();
+            miette::bail!(
+                "--fix: `{name}` is not an axis variable of machine `{}`{hint}",
+                m.name
+            );
+        };
+        match out.iter_mut().find(|(j, _)| *j == i) {
+            Some(slot) => slot.1 = *v,
+            None => out.push((i, *v)),
+        }
+    }
+    Ok(out)
+}
+
+/// The values of `--at` in the machine's variable order
+/// ([`chain::ops::resolve::at_point`]).
+pub(crate) fn resolve_at(coords: &[(String, f64)], loaded: &Loaded) -> miette::Result<Vec<f64>> {
+    Ok(chain::ops::resolve::at_point(
+        &loaded.machine,
+        loaded.file_name(),
+        coords,
+    )?)
+}
