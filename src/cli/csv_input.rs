@@ -342,3 +342,32 @@ pub(crate) fn variable_list(m: &chain_core::Machine) -> String {
         .collect::<Vec<_>>()
         .join(", ")
 }
+
+/// Solves the pose rows in order, each row's solutions sorted by their
+/// distance to the previous row's first solution (the first row: to the
+/// fixed values, 0 elsewhere), so a smooth path stays on one branch.
+pub(crate) fn solve_rows(
+    solver: &chain_core::inverse::Inverse,
+    rows: &[PoseRow],
+    variables: usize,
+    fixed: &[(usize, f64)],
+) -> Vec<chain_core::inverse::Solution> {
+    let mut prev = vec![0.0; variables];
+    for &(i, v) in fixed {
+        if let Some(p) = prev.get_mut(i) {
+            *p = v;
+        }
+    }
+    rows.iter()
+        .map(|row| {
+            let s = match row.orientation {
+                Orientation::Axis(axis) => solver.solve(row.point, axis, &prev),
+                Orientation::Rotation(r) => solver.solve_pose(row.point, &r, &prev),
+            };
+            if let Some(first) = s.solutions.first() {
+                prev.clone_from(first);
+            }
+            s
+        })
+        .collect()
+}

@@ -12,7 +12,7 @@ use serde::{Serialize, Serializer};
 
 use super::args::parse_assignment;
 use super::args::ParamArgs;
-use super::csv_input::{read_poses, Orientation, PoseRow};
+use super::csv_input::{read_poses, solve_rows};
 use super::loaded::{resolve_fixed, Loaded};
 use super::report::{self, Csv, Report};
 
@@ -166,33 +166,4 @@ impl Report for InverseReport<'_> {
         }
         Some(csv)
     }
-}
-
-/// Solves the pose rows in order, each row's solutions sorted by their
-/// distance to the previous row's first solution (the first row: to the
-/// fixed values, 0 elsewhere), so a smooth path stays on one branch.
-pub(crate) fn solve_rows(
-    solver: &Inverse,
-    rows: &[PoseRow],
-    variables: usize,
-    fixed: &[(usize, f64)],
-) -> Vec<Solution> {
-    let mut prev = vec![0.0; variables];
-    for &(i, v) in fixed {
-        if let Some(p) = prev.get_mut(i) {
-            *p = v;
-        }
-    }
-    rows.iter()
-        .map(|row| {
-            let s = match row.orientation {
-                Orientation::Axis(axis) => solver.solve(row.point, axis, &prev),
-                Orientation::Rotation(r) => solver.solve_pose(row.point, &r, &prev),
-            };
-            if let Some(first) = s.solutions.first() {
-                prev.clone_from(first);
-            }
-            s
-        })
-        .collect()
 }

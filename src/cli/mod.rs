@@ -20,9 +20,11 @@ pub mod plan;
 pub mod plot;
 pub mod positioning;
 pub mod reliability;
+mod reliability_plot;
 pub mod report;
 pub mod sensitivity;
 pub mod sobol;
+mod study_text;
 
 use clap::{Parser, Subcommand};
 

@@ -11,22 +11,21 @@
 //! seed 000. The helpers shared with `chain sensitivity` (loading, building
 //! the study, rendering errors against the file) live here too.
 
-#[path = "reliability_plot.rs"]
-pub(crate) mod reliability_plot;
-
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use chain_core::model::Sided;
 use reliability::document::{AcceptanceDocument, ReliabilityDocument};
-use reliability::{
-    Form, FormCase, Method, Posterior, Stopping, Study, StudyResult, SubsetLevel, Termination,
-};
+use reliability::{Form, Stopping, Study, StudyResult, SubsetLevel};
 use serde::Serialize;
 
 use super::args::{parse_axis, system_of, AlgorithmArgs, MethodArg, ModelArgs, SystemArgs};
 use super::loaded::Loaded;
+use super::reliability_plot;
 use super::report::{self, Csv, Report};
+use super::study_text::{
+    calls_text, fmt_num, note_form_limits, posterior_lines, requirement_text, sided_title,
+    target_map, warn_unconverged,
+};
 
 /// Output formats of `chain reliability`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -151,22 +150,6 @@ fn study_cases(study: &Study) -> u64 {
     (study.targets().len() * study.points().len()) as u64
 }
 
-/// FORM is exact only for one-sided components in normal inputs; say so on
-/// stderr when it is not.
-pub(crate) fn note_form_limits(study: &Study) {
-    let limits = study.form_limits();
-    if !limits.is_empty() {
-        let why = limits
-            .iter()
-            .map(|l| l.reason())
-            .collect::<Vec<_>>()
-            .join(", ");
-        eprintln!(
-            "note: FORM is a first-order approximation here ({why}); `--method is` corrects it"
-        );
-    }
-}
-
 /// A progress bar on stderr, only when stderr is a terminal and the output is
 /// not JSON.
 struct ProgressBar(Option<indicatif::ProgressBar>);
@@ -210,22 +193,6 @@ impl ProgressBar {
 
 // ---------------------------------------------------------------------------
 // Output.
-
-/// Pairs serialised as a JSON object, in their order (point coordinates,
-/// per-target values).
-#[derive(Debug, Clone)]
-pub(crate) struct Pairs<K, V>(pub(crate) Vec<(K, V)>);
-
-impl<K: Serialize, V: Serialize> Serialize for Pairs<K, V> {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::SerializeMap;
-        let mut map = serializer.serialize_map(Some(self.0.len()))?;
-        for (k, v) in &self.0 {
-            map.serialize_entry(k, v)?;
-        }
-        map.end()
-    }
-}
 
 /// The grid axes in file order, as (name, index in the model's variables).
 pub(crate) fn axes(study: &Study) -> Vec<(String, usize)> {
@@ -394,235 +361,6 @@ impl Report for ReliabilityDoc<'_> {
         }
         Some(csv)
     }
-}
-
-/// The lines saying which inputs come from a posterior (before the table).
-pub(crate) fn posterior_lines(p: &Posterior) -> String {
-    let with_std = p.values.iter().filter(|v| v.std.is_some()).count();
-    let mut out = format!(
-        "posterior: {} ({} errors given, {with_std} with std, {} correlations{}; the others from `statistics`)\n",
-        p.file.as_deref().unwrap_or("values"),
-        p.values.len(),
-        p.correlations.len(),
-        match p.tables.len() {
-            0 => String::new(),
-            n => format!(", {n} table{}", if n == 1 { "" } else { "s" }),
-        }
-    );
-    for v in &p.values {
-        match v.std {
-            Some(s) => out.push_str(&format!(
-                "  {:<12} mean {:>12} std {}\n",
-                v.name,
-                fmt_num(v.mean),
-                fmt_num(s)
-            )),
-            None => out.push_str(&format!(
-                "  {:<12} mean {:>12} (statistics spread)\n",
-                v.name,
-                fmt_num(v.mean)
-            )),
-        }
-    }
-    for c in &p.correlations {
-        out.push_str(&format!("  rho({}, {}) = {}\n", c.a, c.b, fmt_num(c.rho)));
-    }
-    for t in p.table_inputs() {
-        out.push_str(&format!(
-            "  {:<12} table along {} (approach {}): {}\n",
-            t.name,
-            t.variable,
-            t.approach,
-            if t.repeatability {
-                "normal, the table's mean and repeatability at each point"
-            } else {
-                "its statistics spread about the table's value at each point"
-            }
-        ));
-    }
-    out.push('\n');
-    out
-}
-
-/// Warns on stderr about the cases on which FORM did not converge (their
-/// reliability is the last iterate's, not a FORM result).
-pub(crate) fn warn_unconverged(r: &StudyResult, variables: &[String]) {
-    warn_sampler_unconverged(r, variables);
-    let bad: Vec<&reliability::CaseResult> = r
-        .cases
-        .iter()
-        .filter(|c| c.form.is_some_and(|f| !f.converged))
-        .collect();
-    if let Some(first) = bad.first() {
-        let at = variables
-            .iter()
-            .zip(&first.point)
-            .map(|(v, x)| format!("{v} = {x}"))
-            .collect::<Vec<_>>()
-            .join(", ");
-        eprintln!(
-            "warning: FORM did not converge on {} of {} cases (first: {} at {at}); their reliabilities are the last iterates' (listed under the table, `converged: false` in JSON and CSV)",
-            bad.len(),
-            r.cases.len(),
-            first.target
-        );
-    }
-}
-
-/// Warns on stderr about the cases whose sampler stopped without meeting
-/// its rule (the `--cov` target not reached within the budget, or subset
-/// simulation out of levels).
-fn warn_sampler_unconverged(r: &StudyResult, variables: &[String]) {
-    let bad: Vec<&reliability::CaseResult> =
-        r.cases.iter().filter(|c| !c.sampler_converged()).collect();
-    if let Some(first) = bad.first() {
-        let at = variables
-            .iter()
-            .zip(&first.point)
-            .map(|(v, x)| format!("{v} = {x}"))
-            .collect::<Vec<_>>()
-            .join(", ");
-        let why = first.stopping.map_or("", |s| match s.stopped_by {
-            reliability::Stop::Levels => "subset simulation ran out of levels",
-            _ => "the sample budget ran out before the target coefficient of variation",
-        });
-        eprintln!(
-            "warning: the {} did not converge on {} of {} cases (first: {} at {at}: {why}); their values are not converged estimates (listed under the table, `converged: false` in JSON and CSV)",
-            r.method.title(),
-            bad.len(),
-            r.cases.len(),
-            first.target
-        );
-    }
-}
-
-/// One target's reliabilities as maps over the two grid axes it varies along
-/// (further varying axes give one map per value), like Tables 2-4.
-pub(crate) struct TargetMap {
-    /// Row axis (name, values) and column axis, if the target varies along them.
-    pub(crate) rows: Option<(String, Vec<f64>)>,
-    pub(crate) cols: Option<(String, Vec<f64>)>,
-    /// One map per combination of the other varying axes: (label, values[row][col]).
-    pub(crate) maps: Vec<(String, Vec<Vec<f64>>)>,
-    /// Parallel to `maps`: true where FORM did not converge.
-    pub(crate) unconverged: Vec<Vec<Vec<bool>>>,
-}
-
-/// Builds the maps of target `t` from a study result.
-pub(crate) fn target_map(study: &Study, r: &StudyResult, t: usize) -> TargetMap {
-    let grid = &study.spec().grid;
-    let np = study.points().len();
-    let cases = r.target_cases(t);
-    let dims: Vec<usize> = grid.axes.iter().map(|(_, v)| v.len()).collect();
-    // Axes along which the limit state changes (decided on the model, not on
-    // sampled values, which are noisy).
-    let target = study.targets()[t];
-    let varying: Vec<usize> = (0..dims.len())
-        .filter(|&a| {
-            (0..np).any(|p| {
-                let mut idx = grid.index(p);
-                if idx[a] == 0 {
-                    return false;
-                }
-                idx[a] = 0;
-                let q = flat(&idx, &dims);
-                match (study.limit_state(target, p), study.limit_state(target, q)) {
-                    (Ok(g1), Ok(g2)) => g1 != g2,
-                    _ => true,
-                }
-            })
-        })
-        .collect();
-    let row_axis = varying.first().copied();
-    let col_axis = varying.get(1).copied();
-    let others: Vec<usize> = varying.iter().skip(2).copied().collect();
-    let len = |a: Option<usize>| a.map_or(1, |a| dims[a]);
-    let other_count: usize = others.iter().map(|&a| dims[a]).product();
-    let mut maps = Vec::new();
-    let mut unconverged = Vec::new();
-    for o in 0..other_count.max(1) {
-        let mut idx = vec![0; dims.len()];
-        let mut rest = o;
-        let mut label = Vec::new();
-        for &a in others.iter().rev() {
-            idx[a] = rest % dims[a];
-            rest /= dims[a];
-        }
-        for &a in &others {
-            label.push(format!("{} = {}", grid.axes[a].0, grid.axes[a].1[idx[a]]));
-        }
-        let mut m = vec![vec![0.0; len(col_axis)]; len(row_axis)];
-        let mut u = vec![vec![false; len(col_axis)]; len(row_axis)];
-        for (i, (row, urow)) in m.iter_mut().zip(&mut u).enumerate() {
-            for (j, (cell, ucell)) in row.iter_mut().zip(urow.iter_mut()).enumerate() {
-                if let Some(a) = row_axis {
-                    idx[a] = i;
-                }
-                if let Some(a) = col_axis {
-                    idx[a] = j;
-                }
-                let case = &cases[flat(&idx, &dims)];
-                *cell = case.reliability;
-                *ucell = !case.converged();
-            }
-        }
-        maps.push((label.join(", "), m));
-        unconverged.push(u);
-    }
-    TargetMap {
-        rows: row_axis.map(|a| grid.axes[a].clone()),
-        cols: col_axis.map(|a| grid.axes[a].clone()),
-        maps,
-        unconverged,
-    }
-}
-
-fn flat(idx: &[usize], dims: &[usize]) -> usize {
-    idx.iter().zip(dims).fold(0, |acc, (i, d)| acc * d + i)
-}
-
-/// `closed form 45, converged 3` (the terminations that occur).
-pub(crate) fn terminations_text<'a>(forms: impl Iterator<Item = &'a FormCase>) -> String {
-    let mut counts = [0usize; Termination::ALL.len()];
-    for f in forms {
-        if let Some(k) = Termination::ALL.iter().position(|t| *t == f.termination) {
-            counts[k] += 1;
-        }
-    }
-    Termination::ALL
-        .iter()
-        .zip(counts)
-        .filter(|(_, n)| *n > 0)
-        .map(|(t, n)| format!("{} {n}", t.name().replace('_', " ")))
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-/// The table line on how FORM ended and what the cases cost: `FORM: 25 of
-/// 25 cases converged (closed form 25); limit-state calls: 0 values, 0
-/// gradients`.
-pub(crate) fn calls_text<'a>(
-    cases: impl Iterator<Item = &'a reliability::CaseResult> + Clone,
-    method: Method,
-) -> String {
-    let values: u64 = cases.clone().map(|c| c.calls.values).sum();
-    let gradients: u64 = cases.clone().map(|c| c.calls.gradients).sum();
-    let calls = format!("limit-state calls: {values} values, {gradients} gradients");
-    let forms: Vec<&FormCase> = cases.filter_map(|c| c.form.as_ref()).collect();
-    if forms.is_empty() {
-        return calls;
-    }
-    let converged = forms.iter().filter(|f| f.converged).count();
-    let what = match method {
-        Method::Form => "FORM",
-        Method::Sorm => "FORM (SORM's design points)",
-        _ => "FORM (centring)",
-    };
-    format!(
-        "{what}: {converged} of {} cases converged ({}); {calls}",
-        forms.len(),
-        terminations_text(forms.iter().copied())
-    )
 }
 
 fn to_table(machine: &str, study: &Study, r: &StudyResult) -> String {
@@ -795,29 +533,6 @@ fn sampling_text(cases: &[reliability::CaseResult], rule: Stopping, se: f64) -> 
         }
     }
     text
-}
-
-/// `upper` or `two-sided`: how the tables name [`Sided`] (the JSON has
-/// [`Sided::name`]).
-pub(crate) fn sided_title(s: Sided) -> &'static str {
-    match s {
-        Sided::Upper => "upper",
-        Sided::Two => "two-sided",
-    }
-}
-
-fn fmt_num(v: f64) -> String {
-    report::whole(v).map_or_else(|| v.to_string(), |i| i.to_string())
-}
-
-/// `; requirement min … %, mean … %: met` for the table summaries.
-pub(crate) fn requirement_text(req: &chain_core::model::Requirement, met: bool) -> String {
-    format!(
-        "; requirement min {:.2} %, mean {:.2} %: {}",
-        100.0 * req.min,
-        100.0 * req.mean,
-        if met { "met" } else { "NOT met" }
-    )
 }
 
 /// A CSV cell of a number: shortest round-trip form when finite, an empty

@@ -11,7 +11,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use reliability::{Study, StudyResult, TargetSensitivity};
 
-use super::target_map;
+use super::study_text::target_map;
 
 const HEAT_SIZE: (u32, u32) = (900, 700);
 const BAR_SIZE: (u32, u32) = (1100, 600);

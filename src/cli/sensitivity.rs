@@ -28,7 +28,7 @@ use serde::Serialize;
 
 use super::args::{parse_axis, parse_point, AtPoint, ModelArgs};
 use super::loaded::{resolve_at, Loaded};
-use super::reliability::reliability_plot;
+use super::reliability_plot;
 use super::report::{self, Report};
 
 /// What `chain sensitivity` computes.
@@ -194,7 +194,7 @@ impl Report for SensitivityDoc<'_> {
             d.machine
         );
         if let Some(p) = d.posterior {
-            let _ = write!(out, "{}", super::reliability::posterior_lines(p));
+            let _ = write!(out, "{}", super::study_text::posterior_lines(p));
             if !p.correlations.is_empty() {
                 let _ = writeln!(
                     out,
