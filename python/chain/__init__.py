@@ -18,7 +18,7 @@ from ._results import Derivation, ReliabilityResult, Result
 from ._results import IdentifyResult, MapResult, PlanResult
 from ._results import Derivation, ReliabilityResult, Result, SobolResult
 from ._results import AllocationResult, GeometricSensitivityResult, SensitivityResult
-from ._results import PositioningResult
+from ._results import InverseResult, PositioningResult
 from ._positioning import positioning
 
 __all__ = [
@@ -26,6 +26,7 @@ __all__ = [
     "Derivation",
     "GeometricSensitivityResult",
     "IdentifyResult",
+    "InverseResult",
     "MapResult",
     "PlanResult",
     "PositioningResult",

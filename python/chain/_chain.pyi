@@ -150,3 +150,13 @@ def positioning_json(
     model: Optional[Model],
     slot: Optional[str],
 ) -> Tuple[str, Optional[str]]: ...
+
+
+# -- inverse kinematics (python/src/inverse.rs) ----------------------------------
+
+def inverse_json(
+    model: Model,
+    poses: npt.NDArray[np.float64],
+    fix: Sequence[Tuple[str, float]],
+    params: Sequence[Tuple[str, float]],
+) -> str: ...

@@ -252,6 +252,30 @@ class Machine:
         )
         return ReliabilityResult._from_json(text)
 
+    def inverse(
+        self,
+        poses: ArrayLike,
+        fix: Optional[Mapping[str, float]] = None,
+        params: Params = None,
+    ) -> "InverseResult":
+        """Inverse kinematics of tool poses, ``chain inverse --pose POSES --format json``.
+
+        ``poses``: an ``(N, 6)`` array of ``px, py, pz, i, j, k`` (tool point
+        and tool axis in the workpiece frame) or ``(N, 12)`` of ``px, py, pz,
+        r11 … r33`` (the whole tool frame, row-major); one pose may be a 1-D
+        row. ``fix``: values of the variables the pose does not determine
+        (``--fix``). Built and checked by ``chain::ops::inverse`` as the CLI's.
+        """
+        from ._results import InverseResult
+
+        a = _float_array(poses, "poses")
+        if a.ndim == 1:
+            a = a.reshape(1, -1)
+        if a.ndim != 2:
+            raise ValueError(f"poses of shape {a.shape}: expected (N, 6) or (N, 12)")
+        text = _chain.inverse_json(self._model, np.ascontiguousarray(a), _params(fix), _params(params))
+        return InverseResult._from_json(text)
+
     # -- the measured machine (group B: map, identify, plan) -----------------
 
     def map(

@@ -283,3 +283,27 @@ class PositioningResult(Result):
 
     def _rows(self) -> List[Dict[str, Any]]:
         return [dict(t) for t in self._document["targets"]]
+
+
+class InverseResult(Result):
+    """``chain inverse --format json``: the axis values that reach each tool pose.
+
+    Attributes: ``machine``, ``method``, ``variables``, ``rows`` (per pose:
+    ``row`` (1-based), ``status``, ``solutions`` as ``{variable: value}``).
+    Rows of ``to_dataframe()``: one per solution (``row``, ``status``,
+    ``solution`` and the variables), as ``--format csv``; an unreachable pose
+    has one row without values.
+    """
+
+    command = "inverse"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        out: List[Dict[str, Any]] = []
+        for r in self._document["rows"]:
+            if not r["solutions"]:
+                out.append({"row": r["row"], "status": r["status"], "solution": None})
+            for j, q in enumerate(r["solutions"]):
+                row = {"row": r["row"], "status": r["status"], "solution": j + 1}
+                row.update(q)
+                out.append(row)
+        return out

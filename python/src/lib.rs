@@ -17,6 +17,7 @@
 //! `column` and `key`.
 
 mod group_b;
+mod inverse;
 mod positioning;
 use std::mem::MaybeUninit;
 
@@ -533,5 +534,6 @@ fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sensitivity::geometric_json, m)?)?;
     m.add_function(wrap_pyfunction!(allocate::allocate_json, m)?)?;
     m.add_function(wrap_pyfunction!(positioning::positioning_json, m)?)?;
+    m.add_function(wrap_pyfunction!(inverse::inverse_json, m)?)?;
     Ok(())
 }

@@ -160,3 +160,31 @@ def test_options_are_refused_in_the_cli_s_words(cli_error, tmp_path):
         assert wording in str(info.value)
         if args is not None:
             assert squeezed(wording) in squeezed(cli_error(*args))
+
+
+def test_inverse_is_the_cli_json(cli, cli_error, tmp_path):
+    """Machine.inverse over an array equals `chain inverse --pose` on the same poses (chain::ops::inverse)."""
+    machine = ROOT / "examples/machines/cnc5_bevel.yaml"
+    pose_file = ROOT / "examples/paths/cnc5_bevel_pose.csv"
+    with open(pose_file) as f:
+        rows = [line for line in f if line.strip() and not line.startswith("#")]
+    poses = np.array([[float(v) for v in r.split(",")[1:]] for r in rows[1:]])
+    m = chain.Machine.load(machine)
+    got = m.inverse(poses)
+    assert got.to_dict() == cli("inverse", machine, "--pose", pose_file)
+    assert len(got.to_dataframe()) >= len(poses)
+    # One pose as a 1-D row; fix and params by name.
+    one = m.inverse(poses[0])
+    assert one.rows[0] == got.rows[0]
+    with pytest.raises(ValueError, match="poses must have 6 columns"):
+        m.inverse(np.zeros((2, 5)))
+    with pytest.raises(ValueError, match="poses row 1: the tool axis \\(i, j, k\\) is zero"):
+        m.inverse(np.array([poses[0], [0, 0, 0, 0, 0, 0]]))
+    bad = tmp_path / "bad.csv"
+    bad.write_text("px,py,pz,i,j,k\n0,0,0,0,0,0\n")
+    from conftest import flat
+
+    assert "the tool axis (i, j, k) is zero" in flat(cli_error("inverse", machine, "--pose", bad))
+    with pytest.raises(chain.MachineError) as info:
+        m.inverse(poses, fix={"muu": 0.0})
+    assert "--fix: `muu` is not an axis variable" in str(info.value)

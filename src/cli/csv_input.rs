@@ -6,6 +6,7 @@
 use std::path::Path;
 
 use chain::compensate::RawRecord;
+use chain::ops::inverse::{Orientation, PoseRow};
 use chain_core::bounded;
 use chain_core::tabular::{self, CsvProblem};
 use chain_core::values::csv::CsvFile;
@@ -104,26 +105,6 @@ pub(crate) fn numeric_rows(input: &mut CsvInput) -> miette::Result<Vec<(usize, V
         .collect()
 }
 
-/// The orientation part of a pose row.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Orientation {
-    /// The tool axis `i, j, k` (non-zero; not normalised here).
-    Axis([f64; 3]),
-    /// The full rotation `r11 … r33` (row-major, orthonormal, det +1).
-    Rotation([[f64; 3]; 3]),
-}
-
-/// One tool pose of a pose CSV.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct PoseRow {
-    /// The instant of an optional first column `t`.
-    pub(crate) t: Option<f64>,
-    /// The tool point `px, py, pz`.
-    pub(crate) point: [f64; 3],
-    /// The tool axis or the full rotation.
-    pub(crate) orientation: Orientation,
-}
-
 /// The header of a pose CSV with a tool axis (the spec's).
 const AXIS_HEADER: [&str; 6] = ["px", "py", "pz", "i", "j", "k"];
 /// The header of a pose CSV with a full rotation (an addition).
@@ -157,38 +138,13 @@ pub(crate) fn read_poses(path: &Path) -> miette::Result<(bool, Vec<PoseRow>)> {
         .map(|(line, all)| {
             let v = &all[skip..];
             let orientation = if full {
-                let r: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| v[3 + 3 * i + j]));
-                let mut worst = 0.0f64;
-                for i in 0..3 {
-                    for j in 0..3 {
-                        let dot: f64 = (0..3).map(|k| r[k][i] * r[k][j]).sum();
-                        worst = worst.max((dot - if i == j { 1.0 } else { 0.0 }).abs());
-                    }
-                }
-                let det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
-                    - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
-                    + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
-                if worst > 1e-6 || det <= 0.0 {
-                    miette::bail!(
-                        "{name}:{line}: r11..r33 is not a rotation (|RᵀR − I| = {worst:.1e}, det = {det:.6})"
-                    );
-                }
-                // The nearest rotation (polar factor U Vᵀ): rows written with
-                // a few digits are orthonormal only to their rounding.
-                let m = nalgebra::Matrix3::from_fn(|i, j| r[i][j]);
-                let svd = m.svd(true, true);
-                let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
-                    miette::bail!("{name}:{line}: r11..r33 is not a rotation");
-                };
-                let p = u * v_t;
-                Orientation::Rotation(std::array::from_fn(|i| std::array::from_fn(|j| p[(i, j)])))
+                let r: [[f64; 3]; 3] =
+                    std::array::from_fn(|i| std::array::from_fn(|j| v[3 + 3 * i + j]));
+                Orientation::rotation(r)
             } else {
-                let axis = [v[3], v[4], v[5]];
-                if (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt() < 1e-12 {
-                    miette::bail!("{name}:{line}: the tool axis (i, j, k) is zero");
-                }
-                Orientation::Axis(axis)
-            };
+                Orientation::axis([v[3], v[4], v[5]])
+            }
+            .map_err(|e| miette::miette!("{name}:{line}: {e}"))?;
             Ok(PoseRow {
                 t: has_t.then_some(all[0]),
                 point: [v[0], v[1], v[2]],
@@ -341,33 +297,4 @@ pub(crate) fn variable_list(m: &chain_core::Machine) -> String {
         .map(|v| format!("`{}`", v.name))
         .collect::<Vec<_>>()
         .join(", ")
-}
-
-/// Solves the pose rows in order, each row's solutions sorted by their
-/// distance to the previous row's first solution (the first row: to the
-/// fixed values, 0 elsewhere), so a smooth path stays on one branch.
-pub(crate) fn solve_rows(
-    solver: &chain_core::inverse::Inverse,
-    rows: &[PoseRow],
-    variables: usize,
-    fixed: &[(usize, f64)],
-) -> Vec<chain_core::inverse::Solution> {
-    let mut prev = vec![0.0; variables];
-    for &(i, v) in fixed {
-        if let Some(p) = prev.get_mut(i) {
-            *p = v;
-        }
-    }
-    rows.iter()
-        .map(|row| {
-            let s = match row.orientation {
-                Orientation::Axis(axis) => solver.solve(row.point, axis, &prev),
-                Orientation::Rotation(r) => solver.solve_pose(row.point, &r, &prev),
-            };
-            if let Some(first) = s.solutions.first() {
-                prev.clone_from(first);
-            }
-            s
-        })
-        .collect()
 }

@@ -6,14 +6,12 @@
 
 use std::path::PathBuf;
 
-use chain_core::inverse::{Inverse, InverseError, Solution, Status};
-use chain_core::named::NameMap;
-use serde::{Serialize, Serializer};
+use chain::ops::inverse::{self, InverseDocument, InverseOpsError, InverseRequest};
+use chain_core::inverse::InverseError;
 
-use super::args::parse_assignment;
-use super::args::ParamArgs;
-use super::csv_input::{read_poses, solve_rows};
-use super::loaded::{resolve_fixed, Loaded};
+use super::args::{parse_assignment, ParamArgs};
+use super::csv_input::read_poses;
+use super::loaded::Loaded;
 use super::report::{self, Csv, Report};
 
 /// Arguments of `chain inverse`.
@@ -47,24 +45,22 @@ pub enum InverseFormat {
     Csv,
 }
 
-/// Runs `chain inverse`.
+/// Runs `chain inverse` ([`chain::ops::inverse`]).
 pub fn exec(args: InverseArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
-    let m = &loaded.machine;
-    let params =
-        reliability::machine::parameters(m, &args.param.params).map_err(|e| loaded.report(e))?;
-    let fixed = resolve_fixed(m, &args.fix)?;
     let (_, poses) = read_poses(&args.pose)?;
-    let solver = Inverse::for_machine(m, &params, &fixed).map_err(|error| OnMachine {
-        machine: m.name.clone(),
-        error,
-    })?;
-    let doc = InverseReport {
-        machine: &m.name,
-        method: solver.method(),
-        variables: m.variables.iter().map(|v| v.name.as_str()).collect(),
-        rows: solve_rows(&solver, &poses, m.variables.len(), &fixed),
+    let request = InverseRequest {
+        params: &args.param.params,
+        fix: &args.fix,
+        poses: &poses,
     };
+    let doc = inverse::run(&loaded.machine, &request).map_err(|e| match e {
+        InverseOpsError::Reliability(e) => loaded.report(e),
+        InverseOpsError::Resolve(e) => miette::Report::new(e),
+        InverseOpsError::Machine { machine, error } => {
+            miette::Report::new(OnMachine { machine, error })
+        }
+    })?;
     report::emit(&doc, args.format.into())
 }
 
@@ -82,58 +78,7 @@ pub(crate) struct OnMachine {
     pub(crate) error: InverseError,
 }
 
-/// The result document of `chain inverse`: every pose row's status and
-/// solutions (JSON: docs/inverse.md; CSV: one line per solution).
-struct InverseReport<'a> {
-    machine: &'a str,
-    method: &'static str,
-    variables: Vec<&'a str>,
-    rows: Vec<Solution>,
-}
-
-/// The JSON document (field order = key order).
-#[derive(Serialize)]
-struct InverseDoc<'a> {
-    machine: &'a str,
-    method: &'static str,
-    variables: &'a [&'a str],
-    rows: Vec<RowDoc<'a>>,
-}
-
-/// One pose row: its 1-based number, status and solutions `{variable: value}`.
-#[derive(Serialize)]
-struct RowDoc<'a> {
-    row: usize,
-    status: Status,
-    solutions: Vec<NameMap<&'a str, f64>>,
-}
-
-impl Serialize for InverseReport<'_> {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        InverseDoc {
-            machine: self.machine,
-            method: self.method,
-            variables: &self.variables,
-            rows: self
-                .rows
-                .iter()
-                .enumerate()
-                .map(|(k, s)| RowDoc {
-                    row: k + 1,
-                    status: s.status,
-                    solutions: s
-                        .solutions
-                        .iter()
-                        .map(|q| NameMap::zip(self.variables.iter().copied(), q.iter().copied()))
-                        .collect(),
-                })
-                .collect(),
-        }
-        .serialize(serializer)
-    }
-}
-
-impl Report for InverseReport<'_> {
+impl Report for InverseDocument {
     /// `chain inverse` has no table: its text form is the JSON document.
     fn table(&self) -> String {
         report::json(self).unwrap_or_default()
@@ -145,7 +90,7 @@ impl Report for InverseReport<'_> {
         let mut csv = Csv::new(
             ["row", "status", "solution"]
                 .into_iter()
-                .chain(self.variables.iter().copied()),
+                .chain(self.variables.iter().map(String::as_str)),
         );
         for (k, s) in self.rows.iter().enumerate() {
             let (row, status) = ((k + 1).to_string(), s.status.name());

@@ -134,29 +134,12 @@ impl Loaded {
     }
 }
 
-/// `--fix` names resolved to variable indices.
+/// `--fix` names resolved to variable indices ([`chain::ops::resolve::fixed`]).
 pub(crate) fn resolve_fixed(
     m: &Machine,
     fix: &[(String, f64)],
 ) -> miette::Result<Vec<(usize, f64)>> {
-    let mut out: Vec<(usize, f64)> = Vec::new();
-    for (name, v) in fix {
-        let Some(i) = m.variable_index(name) else {
-            let hint =
-                chain_core::diagnostic::closest(name, m.variables.iter().map(|v| v.name.as_str()))
-                    .map(|h| format!(" (did you mean `{h}`?)"))
-                    .unwrap_or_default();
-            miette::bail!(
-                "--fix: `{name}` is not an axis variable of machine `{}`{hint}",
-                m.name
-            );
-        };
-        match out.iter_mut().find(|(j, _)| *j == i) {
-            Some(slot) => slot.1 = *v,
-            None => out.push((i, *v)),
-        }
-    }
-    Ok(out)
+    Ok(chain::ops::resolve::fixed(m, fix)?)
 }
 
 /// The values of `--at` in the machine's variable order

@@ -28,12 +28,13 @@ use serde::Serialize;
 
 use super::args::{parse_assignment, system_of, MethodArg};
 use super::args::{AlgorithmArgs, ModelArgs, SystemArgs};
-use super::csv_input::{numeric_rows, open_csv, read_poses, solve_rows, variable_list};
+use super::csv_input::{numeric_rows, open_csv, read_poses, variable_list};
 use super::loaded::{resolve_fixed, Loaded};
 use super::report::{self, Csv, Report};
 use super::study_text::{
     calls_text, note_form_limits, requirement_text, sided_title, warn_unconverged, Pairs,
 };
+use chain::ops::inverse::solve_rows;
 
 /// Output formats of `chain path`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

@@ -10,5 +10,8 @@
 //! - [`study`]: a reliability study from a machine and the options every
 //!   study command takes (parameters, grid, sided, system, a posterior).
 
+//! - [`inverse`]: `chain inverse`'s request, poses and document.
+
+pub mod inverse;
 pub mod resolve;
 pub mod study;

@@ -106,6 +106,20 @@ pub enum ResolveError {
         /// The value.
         value: f64,
     },
+    /// `--fix` names no axis variable of the machine.
+    #[error(
+        "--fix: `{name}` is not an axis variable of machine `{machine}`{}",
+        did_you_mean(suggestion)
+    )]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::cli::fix_unknown_variable)))]
+    UnknownFixed {
+        /// The name given.
+        name: String,
+        /// The machine.
+        machine: String,
+        /// The closest variable, if one is close.
+        suggestion: Option<String>,
+    },
     /// `--at` leaves an axis variable without a value.
     #[error("--at has no value for axis variable `{variable}`")]
     #[cfg_attr(
@@ -129,6 +143,7 @@ impl ResolveError {
             self,
             ResolveError::UnknownGridAxis { .. }
                 | ResolveError::UnknownAtVariable { .. }
+                | ResolveError::UnknownFixed { .. }
                 | ResolveError::MissingGrid { .. }
         )
     }
@@ -294,6 +309,26 @@ pub fn at_point(
                 })
         })
         .collect()
+}
+
+/// `--fix NAME=VALUE` as `(variable index, value)`, each variable once
+/// (given twice: the later value).
+pub fn fixed(m: &Machine, fix: &[(String, f64)]) -> Result<Vec<(usize, f64)>, ResolveError> {
+    let mut out: Vec<(usize, f64)> = Vec::new();
+    for (name, v) in fix {
+        let Some(i) = m.variable_index(name) else {
+            return Err(ResolveError::UnknownFixed {
+                name: name.clone(),
+                machine: m.name.clone(),
+                suggestion: closest_variable(m, name),
+            });
+        };
+        match out.iter_mut().find(|(j, _)| *j == i) {
+            Some(slot) => slot.1 = *v,
+            None => out.push((i, *v)),
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
