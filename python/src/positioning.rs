@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use chain_core::measured::positioning::{self, AxisKind, Coverage, Runs};
-use chain_core::measured::positioning_values;
+use chain::ops::positioning as ops;
+use chain_core::measured::positioning::{Coverage, Runs};
 use pyo3::prelude::*;
 
 use crate::{load_error, to_json, value_error, Model};
@@ -28,11 +28,7 @@ pub(crate) fn positioning_json(
     slot: Option<&str>,
 ) -> PyResult<(String, Option<String>)> {
     let k = Coverage::new(k).map_err(|e| value_error(e.to_string()))?;
-    let kind = if rotary {
-        AxisKind::Rotary
-    } else {
-        AxisKind::Linear
-    };
+    let kind = ops::axis_kind(rotary);
     let runs = match (path, text) {
         (Some(path), None) => Runs::read(Path::new(path), kind),
         (None, Some(text)) => Runs::parse(text, file, kind),
@@ -43,21 +39,23 @@ pub(crate) fn positioning_json(
         }
     }
     .map_err(|e| load_error(py, e.diagnostics()))?;
-    let doc = positioning::evaluate(&runs, k);
-    let values = match (model, slot) {
-        (Some(model), Some(name)) => {
-            let m = &model.machine;
-            let slot = positioning_values::slot(m, name, kind)
-                .map_err(|e| value_error(format!("slot `{name}` (machine {}): {e}", model.file)))?;
-            Some(positioning_values::values_file(
-                &doc,
-                m,
-                &slot,
-                path.unwrap_or(file),
-            ))
-        }
+    let runs_file = path.unwrap_or(file);
+    let values_out = match (model, slot) {
+        (Some(model), Some(slot)) => Some(ops::ValuesOut {
+            machine: &model.machine,
+            machine_file: &model.file,
+            slot,
+            runs_file,
+        }),
         (None, None) => None,
         _ => return Err(value_error("give machine and slot together")),
     };
+    let done = ops::run(&ops::PositioningRequest {
+        runs: &runs,
+        k,
+        values_out,
+    })
+    .map_err(|e| value_error(e.to_string()))?;
+    let (doc, values) = (done.document, done.values_text);
     Ok((to_json(&doc)?, values))
 }

@@ -5,8 +5,8 @@
 
 use std::path::PathBuf;
 
-use chain_core::measured::positioning::{self, AxisKind, Coverage, PositioningDocument, Runs};
-use chain_core::measured::positioning_values;
+use chain::ops::positioning as ops;
+use chain_core::measured::positioning::{self, Coverage, PositioningDocument, Runs};
 
 use super::report::{self, Csv, Report};
 
@@ -70,34 +70,35 @@ fn coverage(text: &str) -> Result<Coverage, String> {
     Coverage::new(k).map_err(|e| e.to_string())
 }
 
-/// Runs `chain positioning`.
+/// Runs `chain positioning` ([`chain::ops::positioning`]).
 pub fn exec(args: PositioningArgs) -> miette::Result<()> {
-    let kind = if args.rotary {
-        AxisKind::Rotary
-    } else {
-        AxisKind::Linear
+    let runs = Runs::read(&args.runs, ops::axis_kind(args.rotary))?;
+    let machine = match &args.machine {
+        Some(file) => Some(chain_core::load_file(file)?),
+        None => None,
     };
-    let runs = Runs::read(&args.runs, kind)?;
-    let doc = positioning::evaluate(&runs, args.k);
-    if let (Some(out), Some(file), Some(name)) = (&args.values_out, &args.machine, &args.slot) {
-        let machine = chain_core::load_file(file)?;
-        let slot = positioning_values::slot(&machine, name, kind).map_err(|e| {
-            miette::Report::new(*e).wrap_err(format!("--slot {name} (machine {})", file.display()))
-        })?;
-        let text = positioning_values::values_file(
-            &doc,
-            &machine,
-            &slot,
-            &args.runs.display().to_string(),
-        );
+    let machine_file = args.machine.as_ref().map(|f| f.display().to_string());
+    let runs_file = args.runs.display().to_string();
+    let values_out = match (&machine, &machine_file, &args.slot) {
+        (Some(machine), Some(machine_file), Some(slot)) => Some(ops::ValuesOut {
+            machine,
+            machine_file,
+            slot,
+            runs_file: &runs_file,
+        }),
+        _ => None,
+    };
+    let done = ops::run(&ops::PositioningRequest {
+        runs: &runs,
+        k: args.k,
+        values_out,
+    })?;
+    let doc = done.document;
+    if let (Some(out), Some(text)) = (&args.values_out, &done.values_text) {
         super::atomic::write(out, text.as_bytes())
             .map_err(|e| miette::miette!("cannot write {}: {e}", out.display()))?;
-        eprintln!(
-            "wrote {} ({} of {})",
-            out.display(),
-            slot.name,
-            slot.variable
-        );
+        let slot = args.slot.as_deref().unwrap_or_default();
+        eprintln!("wrote {} ({slot})", out.display());
     }
     if let Some(dir) = &args.plot {
         for f in positioning_plot::write(dir, &doc)? {

@@ -10,8 +10,10 @@
 //! - [`study`]: a reliability study from a machine and the options every
 //!   study command takes (parameters, grid, sided, system, a posterior).
 
-//! - [`inverse`]: `chain inverse`'s request, poses and document.
+//! - [`inverse`]: `chain inverse`'s request, poses and document;
+//! - [`positioning`]: `chain positioning`'s request, document and values file.
 
 pub mod inverse;
+pub mod positioning;
 pub mod resolve;
 pub mod study;
