@@ -11,16 +11,17 @@
 
 use std::path::Path;
 
-use chain_core::built::{BuiltMachine, Points};
 use chain_core::measured::document::{identify_document, values_file, DocumentError};
 use chain_core::measured::{Layout, Measurements, MeasurementsError};
 use chain_core::model::Machine;
 use chain_core::plan::{self, Kind};
 use chain_core::values::{Values, ValuesError};
-use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 
-use crate::{load_error, resolve_error, to_json, value_error, Model};
+use chain::ops::map::{MapOpsError, MapPoints, MapRequest, PreparedMap};
+
+use crate::{load_error, resolve_error, study_error, to_json, value_error, Model};
 
 /// A measurement or candidate CSV: read from `path`, or parsed from `text`
 /// named `file`.
@@ -149,34 +150,36 @@ pub(crate) fn map_json(
     approach: Option<&str>,
 ) -> PyResult<String> {
     let m = &model.machine;
-    let (mut values, name) = read_values(py, m, values_path, values_text, values_file)?;
-    if let Some(text) = approach {
-        let choices = chain_core::values::parse_approaches(text)
-            .map_err(|e| value_error(format!("approach: {e}")))?;
-        values
-            .choose_approach(&choices)
-            .map_err(|e| value_error(format!("approach: {e} (values {name})")))?;
-    }
-    let p = model.parameter_vector(py, &params)?;
+    let (values, name) = read_values(py, m, values_path, values_text, values_file)?;
+    let choices = match approach {
+        Some(text) => chain_core::values::parse_approaches(text)
+            .map_err(|e| value_error(format!("approach: {e}")))?,
+        None => Vec::new(),
+    };
+    model.parameter_vector(py, &params)?;
     let points = match &points {
         Some(q) => {
             if !grid.is_empty() {
                 return Err(value_error("give grid or points, not both"));
             }
             let (flat, _) = model.points(q)?;
-            let v = q.shape()[1];
-            Points::list(v, flat.to_vec()).map_err(|e| value_error(format!("points: {e}")))?
+            MapPoints::Rows(flat.to_vec())
         }
-        None => Points::Grid(
-            chain::ops::resolve::grid_axes(m, &model.file, &grid)
-                .map_err(|e| resolve_error(py, model, e))?
-                .into_iter()
-                .map(|(_, values)| values)
-                .collect(),
-        ),
+        None => MapPoints::Grid(&grid),
     };
-    let built =
-        BuiltMachine::compile(m, values, p).map_err(|e| value_error(format!("{name}: {e}")))?;
+    let request = MapRequest {
+        params: &params,
+        approach: &choices,
+        points,
+    };
+    let PreparedMap { built, points, .. } =
+        chain::ops::map::prepare(m, &model.file, values, &name, "points", &request).map_err(
+            |e| match e {
+                MapOpsError::Reliability(e) => study_error(py, &e, &model.file),
+                MapOpsError::Resolve(e) => resolve_error(py, model, e),
+                other => value_error(other.to_string()),
+            },
+        )?;
     let result = py
         .allow_threads(|| built.map(points))
         .map_err(|e| value_error(e.to_string()))?;

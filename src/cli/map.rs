@@ -21,13 +21,13 @@ mod map_plot;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
+use chain::ops::map::{MapOpsError, MapPoints, MapRequest, PreparedMap};
 use chain_core::built::{BuiltMachine, MapError, MapSummary, Points};
 use chain_core::compensation::controllers::{Controller, ExportOptions, DEFAULT_STEP};
 use chain_core::model::{Component, Frame};
 use chain_core::values::{parse_approaches, Approach, Entry, EntryKind, Given, Reversal, Values};
 use chain_core::MapResult;
 use miette::MietteDiagnostic;
-use reliability::machine;
 use serde::Serialize;
 
 use super::args::ParamArgs;
@@ -114,30 +114,37 @@ pub struct MapArgs {
 pub fn exec(args: MapArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
-    let mut values = Values::read(&args.values, m)?;
+    let values = Values::read(&args.values, m)?;
     let choices: Vec<_> = args.approach.iter().flatten().cloned().collect();
-    if !choices.is_empty() {
-        values
-            .choose_approach(&choices)
-            .map_err(|e| miette::miette!("--approach: {e} (values {})", args.values.display()))?;
-    }
-    let params = machine::parameters(m, &args.param.params).map_err(|e| loaded.report(e))?;
-    let (points, input) = match &args.axes {
-        Some(path) => {
-            let flat = axes_points(path, m)?;
-            let points = Points::list(m.variables.len(), flat)
-                .map_err(|e| miette::miette!("{}: {e}", path.display()))?;
-            (points, Input::Axes(path.display().to_string()))
-        }
-        None => {
-            let file = args.file.display().to_string();
-            let axes = chain::ops::resolve::grid_axes(m, &file, &args.grid)?;
-            let values = axes.iter().map(|(_, v)| v.clone()).collect();
-            (Points::Grid(values), Input::Grid(axes))
-        }
+    let (points, input_name) = match &args.axes {
+        Some(path) => (
+            MapPoints::Rows(axes_points(path, m)?),
+            path.display().to_string(),
+        ),
+        None => (MapPoints::Grid(&args.grid), String::new()),
     };
-    let built = BuiltMachine::compile(m, values, params)
-        .map_err(|e| miette::miette!("{}: {e}", args.values.display()))?;
+    let request = MapRequest {
+        params: &args.param.params,
+        approach: &choices,
+        points,
+    };
+    let file = args.file.display().to_string();
+    let values_file = args.values.display().to_string();
+    let prepared = chain::ops::map::prepare(m, &file, values, &values_file, &input_name, &request)
+        .map_err(|e| match e {
+            MapOpsError::Reliability(e) => loaded.report(e),
+            MapOpsError::Resolve(e) => miette::Report::new(e),
+            other => miette::miette!("{other}"),
+        })?;
+    let PreparedMap {
+        built,
+        points,
+        grid,
+    } = prepared;
+    let input = match grid {
+        Some(axes) => Input::Grid(axes),
+        None => Input::Axes(input_name),
+    };
     let compensated = match args.compensated {
         Some(controller) => Some(compensate(
             &args,

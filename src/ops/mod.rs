@@ -11,9 +11,11 @@
 //!   study command takes (parameters, grid, sided, system, a posterior).
 
 //! - [`inverse`]: `chain inverse`'s request, poses and document;
-//! - [`positioning`]: `chain positioning`'s request, document and values file.
+//! - [`positioning`]: `chain positioning`'s request, document and values file;
+//! - [`map`]: `chain map`'s preparation (values, approach, points, the built machine).
 
 pub mod inverse;
+pub mod map;
 pub mod positioning;
 pub mod resolve;
 pub mod study;
