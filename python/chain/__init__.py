@@ -18,11 +18,13 @@ from ._results import Derivation, ReliabilityResult, Result
 from ._results import IdentifyResult, MapResult, PlanResult
 from ._results import Derivation, ReliabilityResult, Result, SobolResult
 from ._results import AllocationResult, GeometricSensitivityResult, SensitivityResult
-from ._results import InverseResult, PositioningResult
+from ._results import CompensateResult, InverseResult, PositioningResult
 from ._positioning import positioning
+from ._compensate import compensate
 
 __all__ = [
     "AllocationResult",
+    "CompensateResult",
     "Derivation",
     "GeometricSensitivityResult",
     "IdentifyResult",
@@ -37,6 +39,7 @@ __all__ = [
     "Result",
     "SensitivityResult",
     "SobolResult",
+    "compensate",
     "positioning",
 ]
 

@@ -160,3 +160,17 @@ def inverse_json(
     fix: Sequence[Tuple[str, float]],
     params: Sequence[Tuple[str, float]],
 ) -> str: ...
+
+
+# -- swing-angle compensation (python/src/compensate.rs) -------------------------
+
+def compensate_json(
+    path: Optional[str],
+    text: Optional[str],
+    name: str,
+    length: float,
+    min_order: int,
+    max_order: int,
+    select: str,
+    order: Optional[int],
+) -> str: ...

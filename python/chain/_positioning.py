@@ -26,18 +26,18 @@ def _cell(v: Any) -> str:
     return repr(float(v))
 
 
-def _runs_input(runs: Any) -> Tuple[Optional[str], Optional[str]]:
-    """A run file's path, or its columns (a dict of 1-D sequences or a DataFrame) as the CSV's text."""
-    path, runs = _table_source(runs, "runs")
+def _runs_input(runs: Any, what: str = "runs") -> Tuple[Optional[str], Optional[str]]:
+    """A CSV file's path, or its columns (a dict of 1-D sequences or a DataFrame) as the CSV's text."""
+    path, runs = _table_source(runs, what)
     if runs is None:
         return path, None
     names = [str(n) for n in runs]
     columns = [list(np.asarray(v).ravel()) if np.ndim(v) == 1 else None for v in runs.values()]
     for name, column in zip(names, columns):
         if column is None:
-            raise ValueError(f"runs[{name!r}]: expected a 1-D column")
+            raise ValueError(f"{what}[{name!r}]: expected a 1-D column")
         if len(column) != len(columns[0]):
-            raise ValueError(f"runs[{name!r}] has {len(column)} values, {names[0]!r} has {len(columns[0])}")
+            raise ValueError(f"{what}[{name!r}] has {len(column)} values, {names[0]!r} has {len(columns[0])}")
     lines = [",".join(names)]
     for i in range(len(columns[0])):
         lines.append(",".join(_cell(c[i]) for c in columns))

@@ -307,3 +307,19 @@ class InverseResult(Result):
                 row.update(q)
                 out.append(row)
         return out
+
+
+class CompensateResult(Result):
+    """``chain compensate --format json``: a swing-angle error identified from tool-tip heights.
+
+    Attributes: ``file``, ``length``, ``points`` (per measured angle: the
+    heights, ΔZ, Δθ, the fit and its residual), ``fits`` (per order: R²,
+    adjusted R², RMSE, LOOCV, AICc, BIC, F-test p, coefficients),
+    ``selected_order``, ``selection``, ``law``, ... as the CLI's document.
+    Rows of ``to_dataframe()``: one per measured point.
+    """
+
+    command = "compensate"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        return [dict(p) for p in self._document["points"]]

@@ -16,6 +16,7 @@
 //! problems raise `MachineError` (a `ValueError`) with `file`, `line`,
 //! `column` and `key`.
 
+mod compensate;
 mod group_b;
 mod inverse;
 mod positioning;
@@ -535,5 +536,6 @@ fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(allocate::allocate_json, m)?)?;
     m.add_function(wrap_pyfunction!(positioning::positioning_json, m)?)?;
     m.add_function(wrap_pyfunction!(inverse::inverse_json, m)?)?;
+    m.add_function(wrap_pyfunction!(compensate::compensate_json, m)?)?;
     Ok(())
 }

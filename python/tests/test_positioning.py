@@ -124,3 +124,28 @@ def test_values_out_and_reliability_with_the_repeatability(cli, tmp_path):
     assert s == cli("sensitivity", one, "--values", values, "--approach", "up")
     with pytest.raises(ValueError, match="approach needs values"):
         m1.reliability(approach="up")
+
+
+def test_compensate_is_the_cli_json(cli, cli_error):
+    """chain.compensate over a path or columns equals `chain compensate ... --format json` (one reader, one analysis)."""
+    path = ROOT / "examples/data/swing_htm50200.csv"
+    expected = cli("compensate", path, "--length", "577.11")
+    assert chain.compensate(path, length=577.11).to_dict() == expected
+    cols = _columns(path)
+    got = chain.compensate(cols, length=577.11, name=str(path))
+    # The same analysis; the file is named as given, and its lines are the
+    # columns' (no comment lines before them).
+    def lineless(doc):
+        return {**doc, "points": [{k: v for k, v in p.items() if k != "line"} for p in doc["points"]]}
+
+    assert lineless(got.to_dict()) == lineless(expected)
+    assert [p["line"] for p in got.points] == list(range(2, 2 + len(got.points)))
+    r = chain.compensate(path, length=577.11, select="bic", max_order=5)
+    assert r.to_dict() == cli("compensate", path, "--length", "577.11", "--select", "bic", "--max-order", "5")
+    assert len(r.to_dataframe()) == len(r.points)
+    with pytest.raises(ValueError, match="invalid value \"best\" for `select`"):
+        chain.compensate(path, length=577.11, select="best")
+    bad = {k: v for k, v in cols.items() if k != "z3"}
+    with pytest.raises(ValueError) as info:
+        chain.compensate(bad, length=577.11, name="bad.csv")
+    assert "z3" in str(info.value)

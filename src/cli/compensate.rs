@@ -8,7 +8,6 @@ use chain::compensate::{
     self, Analysis, CompensateError, Grid, Measurements, Options, SelectionRule,
 };
 
-use super::csv_input::{self, RecordsError};
 use super::report::{self, Report};
 
 #[path = "compensate_plot.rs"]
@@ -141,30 +140,9 @@ pub fn exec(args: CompensateArgs) -> miette::Result<()> {
 
 report::formats!(Format: Table, Json);
 
-/// The measurements of a CSV file: the records from the shared CSV input
-/// module, checked and typed by the library.
+/// The measurements of a CSV file ([`chain::compensate::records`]).
 pub(crate) fn read_measurements(path: &Path) -> Result<Measurements, CompensateError> {
-    let name = path.display().to_string();
-    let records = csv_input::read_records(path).map_err(records_error)?;
-    Measurements::from_records(&name, records)
-}
-
-/// A reading failure in the library's words (same messages and codes as the
-/// analysis errors of the file).
-fn records_error(e: RecordsError) -> CompensateError {
-    match e {
-        RecordsError::Io { name, source } => CompensateError::Io { file: name, source },
-        RecordsError::TooLarge { name, limit } => CompensateError::TooLarge { file: name, limit },
-        RecordsError::Malformed {
-            name,
-            line,
-            message,
-        } => CompensateError::Malformed {
-            file: name,
-            line,
-            message,
-        },
-    }
+    compensate::records::read_measurements(path)
 }
 
 /// The result document of `chain compensate`: the analysis (the spec's fields
@@ -314,8 +292,7 @@ mod tests {
 
     /// What `chain compensate` makes of the bytes of a file named `name`.
     fn parse(name: &str, data: &[u8]) -> Result<Measurements, CompensateError> {
-        let records = csv_input::parse_records(name, data).map_err(records_error)?;
-        Measurements::from_records(name, records)
+        compensate::records::parse_measurements(name, data)
     }
 
     #[test]

@@ -44,6 +44,8 @@ pub mod error;
 pub mod fdist;
 pub mod fit;
 pub mod law;
+#[cfg(feature = "records")]
+pub mod records;
 pub mod select;
 pub mod table;
 
