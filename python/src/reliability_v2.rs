@@ -64,7 +64,7 @@ pub(crate) fn read_posterior(
             .map_err(|e| value_error(format!("approach: {e}")))?;
         posterior
             .choose_approach(&choices)
-            .map_err(|e| value_error(format!("approach: {e} (values {path})")))?;
+            .map_err(|e| value_error(format!("--approach: {e} (values {path})")))?;
     }
     Ok(Some(posterior))
 }

@@ -239,6 +239,12 @@ fn unknown_variable(loaded: &Loaded, name: &str) -> miette::Report {
 }
 
 fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {
+    if !args.approach.is_empty() {
+        return Err(miette::miette!(
+            help = "--approach chooses the direction of a values file's tables: use it with --kind reliability --values VALUES.yaml",
+            "--kind geometric does not take --approach"
+        ));
+    }
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
     let params = machine::parameters(m, &args.model.param.params).map_err(|e| loaded.report(e))?;

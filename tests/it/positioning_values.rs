@@ -370,7 +370,7 @@ fn the_builder_takes_a_motion() {
     let motion = Motion {
         up: src(t(vec![(0.0, 1e-3), (10.0, 2e-3)]), "up"),
         down: Some(src(t(vec![(0.0, -1e-3), (20.0, 0.0)]), "down")),
-        std_up: None,
+        std_up: Some(src(t(vec![(0.0, 2e-4), (10.0, 2e-4)]), "su")),
         std_down: Some(src(t(vec![(0.0, 1e-4), (10.0, 1e-4)]), "s")),
     };
     b.motion("EXX", motion.clone()).unwrap();
@@ -386,6 +386,15 @@ fn the_builder_takes_a_motion() {
     assert!((e[2] + 0.25e-3).abs() < 1e-18);
     // A reverse std without a reverse direction; a negative std.
     let mut b = ValuesBuilder::new(&m);
+    let no_std = Motion {
+        std_up: None,
+        ..motion.clone()
+    };
+    assert!(b
+        .motion("EXX", no_std)
+        .unwrap_err()
+        .to_string()
+        .contains("none for its main direction"));
     let bad = Motion {
         down: None,
         ..motion.clone()
@@ -470,6 +479,12 @@ fn direction_refusals_are_located() {
             "machine: m\nvalues:\n  EXX: {points: [[0, 0], [1, 1]], reverse_std_points: [[0, 0], [1, 1]]}\n",
             &[],
             "v.yaml:3:35 values.EXX.reverse_std_points chain::values::reverse_std_without_reverse",
+        ),
+        (
+            "rev_std_without_std",
+            "machine: m\nvalues:\n  EXX: {points: [[0, 0], [1, 1]], reverse_points: [[0, 0], [1, 1]], reverse_std_points: [[0, 0], [1, 1]]}\n",
+            &[],
+            "v.yaml:3:69 values.EXX.reverse_std_points chain::values::reverse_std_without_std",
         ),
         (
             "neg_std_points",
@@ -626,13 +641,9 @@ fn linuxcnc_forward_and_reverse_leave_only_the_scatter() {
         d["backlash"].as_f64().unwrap(),
         -d["mean_reversal"].as_f64().unwrap()
     );
-    let y = doc["directions"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|d| d["variable"] == "y")
-        .unwrap();
-    assert_eq!(y["bidirectional"], false);
+    // A table without a reverse direction has no entry (its file and
+    // report are as before).
+    assert_eq!(doc["directions"].as_array().unwrap().len(), 1);
     let readme = std::fs::read_to_string(out.join("linuxcnc-README.txt")).unwrap();
     assert!(readme.contains("BACKLASH = "), "{readme}");
     // `map --compensated linuxcnc --approach up`: the forward column removes
@@ -820,4 +831,31 @@ fn reliability_with_the_repeatability_matches_resampling_the_runs() {
         "x=100",
     ]));
     assert!(e.contains("one-point grid"), "{e}");
+    // The whole-machine acceptance needs one set of inputs.
+    let e = unwrapped(&fails(&[
+        "reliability",
+        machine.to_str().unwrap(),
+        "--values",
+        values.to_str().unwrap(),
+        "--acceptance",
+    ]));
+    assert!(
+        e.contains("acceptance: the inputs differ from point to point"),
+        "{e}"
+    );
+    // Geometric sensitivity has no tables to read.
+    let e = unwrapped(&fails(&[
+        "sensitivity",
+        machine.to_str().unwrap(),
+        "--kind",
+        "geometric",
+        "--values",
+        "linear=0.001",
+        "--approach",
+        "up",
+    ]));
+    assert!(
+        e.contains("--kind geometric does not take --approach"),
+        "{e}"
+    );
 }

@@ -252,6 +252,13 @@ pub enum BindError {
         /// The name.
         name: String,
     },
+    /// A standard deviation of the reverse direction without one of the
+    /// main direction.
+    #[error("`{name}` has a reverse standard deviation but none for its main direction")]
+    ReverseStdWithoutStd {
+        /// The name.
+        name: String,
+    },
     /// A negative standard deviation in a table.
     #[error("the standard deviations of `{name}` ({table}) must be ≥ 0: point {index} is {value}")]
     NegativeStd {
@@ -337,7 +344,7 @@ pub enum Approach {
     Up,
     /// Approached moving in the negative direction (↓): its `reverse` values.
     Down,
-    /// The mean of the two, `(up + down)/2` (ISO 230-2:2014 2.14, the mean
+    /// The mean of the two, `(up + down)/2` (ISO 230-2:2014 2.13, the mean
     /// bidirectional positional deviation `x̄_i`): the default.
     #[default]
     Mean,
@@ -631,7 +638,7 @@ pub struct Values {
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ApproachError {
     /// Not an axis variable of the machine.
-    #[error("`{name}` is not an axis variable of machine `{machine}` (its variables: {})", variables.join(", "))]
+    #[error("`{name}` is not an axis variable of machine `{machine}`{} (its variables: {})", suggestion.as_ref().map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default(), variables.join(", "))]
     UnknownVariable {
         /// The name given.
         name: String,
@@ -1099,6 +1106,11 @@ impl<'m> ValuesBuilder<'m> {
                 name: name.to_string(),
             });
         }
+        if motion.std_down.is_some() && motion.std_up.is_none() {
+            return Err(BindError::ReverseStdWithoutStd {
+                name: name.to_string(),
+            });
+        }
         for s in motion.std_up.iter().chain(&motion.std_down) {
             if let Some((index, &value)) =
                 (s.table.values().iter().enumerate()).find(|(_, v)| **v < 0.0)
@@ -1360,6 +1372,12 @@ fn bind_problem(e: &BindError) -> Problem {
             "chain::values::reverse_std_without_reverse",
         )
         .help("give the reverse direction too (`reverse` or `reverse_points`), or one `std` for both directions"),
+        BindError::ReverseStdWithoutStd { .. } => Message::new(
+            text,
+            "no main std",
+            "chain::values::reverse_std_without_std",
+        )
+        .help("give the main direction's standard deviations too (`std` or `std_points`)"),
         BindError::NegativeStd { .. } => {
             Message::new(text, "negative std", "chain::values::negative_std")
         }
@@ -1690,7 +1708,8 @@ impl Reader {
         };
         if let Err(e) = b.motion_with(name, motion, Some(key_origin.clone())) {
             let at = match e {
-                BindError::ReverseStdWithoutReverse { .. } => {
+                BindError::ReverseStdWithoutReverse { .. }
+                | BindError::ReverseStdWithoutStd { .. } => {
                     let k = Part::ReverseStd.key(fields.get("points").is_some());
                     fields
                         .entry(k)

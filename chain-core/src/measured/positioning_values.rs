@@ -299,7 +299,7 @@ pub fn values_file(
             Unit::Arcsec => "rad (the run's targets in degrees, converted)",
         }
     );
-    let _ = writeln!(out, "machine: {}", machine.name);
+    let _ = writeln!(out, "machine: '{}'", machine.name.replace('\'', "''"));
     let _ = writeln!(
         out,
         "description: 'ISO 230-2 positioning of {} from {}'",

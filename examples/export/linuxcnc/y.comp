@@ -62,6 +62,5 @@
 # chain export --controller linuxcnc: machine `vmc3`, joint 0 (axis variable `y`, the tool moves along +Y as it increases)
 # [JOINT_n] COMP_FILE_TYPE = 1: columns nominal (commanded joint position) | trim moving + | trim moving -
 # trim = -u, u = the positioning error `EYY` seen at the tool point along the joint's axis (actual - nominal); LinuxCNC adds the trim to the command
-# units: machine units, mm; step 10 mm; held at the end values outside 0 to 500
-# directions: the same trim both ways (the values give `EYY` without a reverse direction)
+# units: machine units, mm; step 10 mm; the same trim both directions (no reversal data); held at the end values outside 0 to 500
 # these comments must stay below the data: LinuxCNC stops reading at the first line that is not three numbers

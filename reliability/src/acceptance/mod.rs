@@ -183,6 +183,14 @@ impl Rectangles {
     /// Every toleranced component at every point of `study`:
     /// `E_c ≤ I_c` (one-sided) or `−I_c ≤ E_c ≤ I_c` (two-sided).
     pub fn from_study(study: &Study) -> Result<Rectangles, ReliabilityError> {
+        if study.varies() {
+            // One rectangle set over one set of inputs: a posterior whose
+            // inputs differ from point to point has no such set.
+            return Err(ReliabilityError::InvalidOption {
+                option: "acceptance",
+                message: "the inputs differ from point to point (tables in the values); the whole-machine acceptance needs one set of inputs for every point: give the values as constants, or leave acceptance out".into(),
+            });
+        }
         let spec = study.spec();
         let n = study.inputs().len();
         let np = study.points().len();

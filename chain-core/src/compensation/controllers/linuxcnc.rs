@@ -138,13 +138,15 @@ pub(super) fn export<M: ErrorModel + Sync>(
             .map(|(f, r)| r - f)
             .sum::<f64>()
             / forward.len() as f64;
-        directions.push(DirectionReport {
-            variable: axis.name.clone(),
-            error: motion.name.clone(),
-            bidirectional,
-            mean_reversal,
-            backlash: -mean_reversal,
-        });
+        if bidirectional {
+            directions.push(DirectionReport {
+                variable: axis.name.clone(),
+                error: motion.name.clone(),
+                bidirectional,
+                mean_reversal,
+                backlash: -mean_reversal,
+            });
+        }
         let joint = axis.variable;
         let mut text = String::new();
         for ((x, f), r) in axis.nodes.iter().zip(&forward).zip(&reverse) {
@@ -162,13 +164,13 @@ pub(super) fn export<M: ErrorModel + Sync>(
             "# trim = -u, u = the positioning error `{}` seen at the tool point along the joint's axis (actual - nominal); LinuxCNC adds the trim to the command\n",
             motion.name
         ));
-        text.push_str(&format!(
-            "# units: machine units, mm; step {} mm; held at the end values outside {} to {}\n",
-            num(axis.step),
-            num(axis.nodes[0]),
-            num(axis.nodes[axis.nodes.len() - 1])
-        ));
         if bidirectional {
+            text.push_str(&format!(
+                "# units: machine units, mm; step {} mm; held at the end values outside {} to {}\n",
+                num(axis.step),
+                num(axis.nodes[0]),
+                num(axis.nodes[axis.nodes.len() - 1])
+            ));
             text.push_str(&format!(
                 "# directions: forward = -u approached moving up, reverse = -u approached moving down (the values' `{}` and its reverse direction); mean reversal at the tool point {} mm\n",
                 motion.name,
@@ -176,8 +178,10 @@ pub(super) fn export<M: ErrorModel + Sync>(
             ));
         } else {
             text.push_str(&format!(
-                "# directions: the same trim both ways (the values give `{}` without a reverse direction)\n",
-                motion.name
+                "# units: machine units, mm; step {} mm; the same trim both directions (no reversal data); held at the end values outside {} to {}\n",
+                num(axis.step),
+                num(axis.nodes[0]),
+                num(axis.nodes[axis.nodes.len() - 1])
             ));
         }
         text.push_str("# these comments must stay below the data: LinuxCNC stops reading at the first line that is not three numbers\n");
@@ -218,12 +222,13 @@ pub(super) fn export<M: ErrorModel + Sync>(
         "chain export --controller linuxcnc: machine `{}`\n\nOne COMP_FILE per joint that has a positioning error. In the INI file:\n\n",
         ctx.machine.name
     );
-    for (t, d) in tables.iter().zip(&directions) {
+    for t in &tables {
+        let name = &ctx.machine.variables[t.joint].name;
         readme.push_str(&format!(
-            "[JOINT_{}]\nCOMP_FILE = {}.comp\nCOMP_FILE_TYPE = 1\n",
-            t.joint, ctx.machine.variables[t.joint].name
+            "[JOINT_{}]\nCOMP_FILE = {name}.comp\nCOMP_FILE_TYPE = 1\n",
+            t.joint
         ));
-        if d.bidirectional {
+        if let Some(d) = directions.iter().find(|d| d.variable == *name) {
             readme.push_str(&format!(
                 "# forward and reverse columns from the two approach directions of `{}`; without the COMP_FILE, BACKLASH = {} would correct the mean reversal alone\n",
                 d.error,
