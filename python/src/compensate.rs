@@ -26,14 +26,17 @@ pub(crate) fn compensate_json(
     select: &str,
     order: Option<usize>,
 ) -> PyResult<String> {
+    const SELECT: &str = "loocv, adjusted-r2, aicc, bic";
     let rule = match select {
         "loocv" => SelectionRule::Loocv,
         "adjusted-r2" => SelectionRule::AdjustedR2,
         "aicc" => SelectionRule::Aicc,
         "bic" => SelectionRule::Bic,
-        other => return Err(value_error(format!(
-            "invalid value {other:?} for `select` [possible values: loocv, adjusted-r2, aicc, bic]"
-        ))),
+        other => {
+            let message =
+                format!("invalid value {other:?} for `select` [possible values: {SELECT}]");
+            return Err(value_error(message));
+        }
     };
     let measurements = match (path, text) {
         (Some(path), None) => records::read_measurements(Path::new(path)),
