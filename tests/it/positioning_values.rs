@@ -384,6 +384,9 @@ fn the_builder_takes_a_motion() {
     v.set_approach(1, Approach::Down);
     v.values_at(&[0.0, 15.0], &mut e).unwrap();
     assert!((e[2] + 0.25e-3).abs() < 1e-18);
+    // Read downwards, the range is the reverse table's alone.
+    let err = v.values_at(&[0.0, 25.0], &mut e).unwrap_err();
+    assert_eq!((err.lo, err.hi), (0.0, 20.0));
     // A reverse std without a reverse direction; a negative std.
     let mut b = ValuesBuilder::new(&m);
     let no_std = Motion {

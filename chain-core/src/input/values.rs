@@ -533,18 +533,22 @@ impl Tabulated {
         }
     }
 
-    /// The range in which every table in use is read (their common range
-    /// where they do not hold their ends).
-    fn range(&self) -> (f64, f64) {
-        let mut tables = vec![&self.table];
-        tables.extend(
-            self.reverse
-                .iter()
-                .chain(&self.std)
-                .chain(&self.reverse_std),
-        );
-        tables
-            .iter()
+    /// The range in which the tables read for the chosen approach are
+    /// read (their common range): the values' tables, or (`std`) the
+    /// standard deviations'.
+    fn range(&self, std: bool) -> (f64, f64) {
+        let (main, reverse) = if std {
+            (self.std.as_ref(), self.reverse_std.as_ref())
+        } else {
+            (Some(&self.table), self.reverse.as_ref())
+        };
+        let read: Vec<&Table> = match (main, reverse, self.approach) {
+            (Some(m), None, _) | (Some(m), Some(_), Approach::Up) => vec![m],
+            (_, Some(r), Approach::Down) => vec![r],
+            (Some(m), Some(r), Approach::Mean) => vec![m, r],
+            (None, _, _) => vec![&self.table],
+        };
+        read.iter()
             .map(|t| t.range())
             .fold((f64::NEG_INFINITY, f64::INFINITY), |(lo, hi), (a, b)| {
                 (lo.max(a), hi.min(b))
@@ -819,7 +823,7 @@ impl ErrorValues for Values {
         for (o, c) in out.iter_mut().zip(&self.constants) {
             *o = *c;
         }
-        self.write(self.tables.iter(), q, out, Tabulated::eval)
+        self.write(self.tables.iter(), q, out, Tabulated::eval, false)
     }
 }
 
@@ -835,7 +839,7 @@ impl Values {
         let moved = (self.tables.iter()).filter(|t| {
             previous.get(t.variable) != Some(&q.get(t.variable).copied().unwrap_or(f64::NAN))
         });
-        self.write(moved, q, out, Tabulated::eval)
+        self.write(moved, q, out, Tabulated::eval, false)
     }
 
     /// The approach direction read along each variable, in
@@ -944,7 +948,7 @@ impl Values {
     pub fn repeatability_at(&self, q: &[f64], out: &mut [f64]) -> Result<(), OutOfRange> {
         out.iter_mut().for_each(|o| *o = 0.0);
         let scattered = self.tables.iter().filter(|t| t.std.is_some());
-        self.write(scattered, q, out, Tabulated::std_eval)
+        self.write(scattered, q, out, Tabulated::std_eval, true)
     }
 
     /// Writes `eval` of each of `tables` at its axis value into its error's
@@ -956,6 +960,7 @@ impl Values {
         q: &[f64],
         out: &mut [f64],
         eval: impl Fn(&Tabulated, f64) -> Option<f64>,
+        std: bool,
     ) -> Result<(), OutOfRange> {
         for t in tables {
             let x = q.get(t.variable).copied().unwrap_or(f64::NAN);
@@ -965,15 +970,15 @@ impl Values {
                         *o = v;
                     }
                 }
-                None => return Err(self.out_of_range(t, x)),
+                None => return Err(self.out_of_range(t, x, std)),
             }
         }
         Ok(())
     }
 
     #[cold]
-    fn out_of_range(&self, t: &Tabulated, value: f64) -> OutOfRange {
-        let (lo, hi) = t.range();
+    fn out_of_range(&self, t: &Tabulated, value: f64, std: bool) -> OutOfRange {
+        let (lo, hi) = t.range(std);
         OutOfRange {
             name: t.name.clone(),
             table: t.source.clone(),
