@@ -9,14 +9,12 @@ use chain_core::Machine;
 
 /// Why an option cannot be resolved against the machine.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[cfg_attr(feature = "cli", derive(miette::Diagnostic))]
 pub enum ResolveError {
     /// `--param` names no parameter of the machine.
     #[error(
         "--param {name}: machine `{machine}` has no parameter `{name}`{}",
         did_you_mean(suggestion)
     )]
-    #[cfg_attr(feature = "cli", diagnostic(code(chain::cli::unknown_parameter)))]
     UnknownParameter {
         /// The name given.
         name: String,
@@ -27,7 +25,6 @@ pub enum ResolveError {
     },
     /// A parameter value that is infinite or NaN.
     #[error("--param {name}: {value} is not finite")]
-    #[cfg_attr(feature = "cli", diagnostic(code(chain::cli::param_not_finite)))]
     NonFiniteParameter {
         /// The parameter.
         name: String,
@@ -36,10 +33,6 @@ pub enum ResolveError {
     },
     /// `--grid` names no axis variable of the machine.
     #[error("{file}: unknown axis variable `{name}`{}", did_you_mean(suggestion))]
-    #[cfg_attr(
-        feature = "cli",
-        diagnostic(code(chain::reliability::unknown_name), help("the axis variables are {}", variables.join(", ")))
-    )]
     UnknownGridAxis {
         /// The machine file.
         file: String,
@@ -52,14 +45,12 @@ pub enum ResolveError {
     },
     /// A `--grid` axis without values.
     #[error("--grid {name}: the axis has no value")]
-    #[cfg_attr(feature = "cli", diagnostic(code(chain::cli::empty_grid_axis)))]
     EmptyGridAxis {
         /// The axis variable.
         name: String,
     },
     /// A `--grid` value that is infinite or NaN.
     #[error("--grid {name}: {value} is not finite")]
-    #[cfg_attr(feature = "cli", diagnostic(code(chain::cli::grid_not_finite)))]
     NonFiniteGridValue {
         /// The axis variable.
         name: String,
@@ -68,13 +59,6 @@ pub enum ResolveError {
     },
     /// An axis variable with neither `reliability.grid` values nor `--grid`.
     #[error("{file}: no grid values for axis variable `{variable}`")]
-    #[cfg_attr(
-        feature = "cli",
-        diagnostic(
-            code(chain::map::missing_grid),
-            help("add `{variable}: [...]` to `reliability.grid`, or pass --grid {variable}=V1,V2,... or --grid {variable}=LO:HI:N")
-        )
-    )]
     MissingGrid {
         /// The machine file.
         file: String,
@@ -83,10 +67,6 @@ pub enum ResolveError {
     },
     /// `--at` names no axis variable of the machine.
     #[error("--at: `{name}` is not an axis variable{}", did_you_mean(suggestion))]
-    #[cfg_attr(
-        feature = "cli",
-        diagnostic(code(chain::cli::at_unknown_variable), help("the axis variables of {file} are {}", variables.join(", ")))
-    )]
     UnknownAtVariable {
         /// The machine file.
         file: String,
@@ -99,7 +79,6 @@ pub enum ResolveError {
     },
     /// An `--at` value that is infinite or NaN.
     #[error("--at: `{name}` = {value} is not finite")]
-    #[cfg_attr(feature = "cli", diagnostic(code(chain::cli::at_not_finite)))]
     NonFiniteAt {
         /// The axis variable.
         name: String,
@@ -111,7 +90,6 @@ pub enum ResolveError {
         "--fix: `{name}` is not an axis variable of machine `{machine}`{}",
         did_you_mean(suggestion)
     )]
-    #[cfg_attr(feature = "cli", diagnostic(code(chain::cli::fix_unknown_variable)))]
     UnknownFixed {
         /// The name given.
         name: String,
@@ -122,10 +100,6 @@ pub enum ResolveError {
     },
     /// `--at` leaves an axis variable without a value.
     #[error("--at has no value for axis variable `{variable}`")]
-    #[cfg_attr(
-        feature = "cli",
-        diagnostic(code(chain::cli::at_missing_variable), help("give every axis variable: --at {}", variables.iter().map(|v| format!("{v}=…")).collect::<Vec<_>>().join(",")))
-    )]
     MissingAt {
         /// The variable without a value.
         variable: String,
@@ -148,10 +122,25 @@ impl ResolveError {
         )
     }
 
-    /// The message with its help, as one text (Python's exceptions, and
-    /// any renderer without miette).
-    pub fn with_help(&self) -> String {
-        let help = match self {
+    /// The diagnostic code (`chain::…`).
+    pub fn code(&self) -> &'static str {
+        match self {
+            ResolveError::UnknownParameter { .. } => "chain::cli::unknown_parameter",
+            ResolveError::NonFiniteParameter { .. } => "chain::cli::param_not_finite",
+            ResolveError::UnknownGridAxis { .. } => "chain::reliability::unknown_name",
+            ResolveError::EmptyGridAxis { .. } => "chain::cli::empty_grid_axis",
+            ResolveError::NonFiniteGridValue { .. } => "chain::cli::grid_not_finite",
+            ResolveError::MissingGrid { .. } => "chain::map::missing_grid",
+            ResolveError::UnknownAtVariable { .. } => "chain::cli::at_unknown_variable",
+            ResolveError::NonFiniteAt { .. } => "chain::cli::at_not_finite",
+            ResolveError::UnknownFixed { .. } => "chain::cli::fix_unknown_variable",
+            ResolveError::MissingAt { .. } => "chain::cli::at_missing_variable",
+        }
+    }
+
+    /// What to do about it, if there is more to say than the message.
+    pub fn help(&self) -> Option<String> {
+        Some(match self {
             ResolveError::UnknownGridAxis { variables, .. } => {
                 format!("the axis variables are {}", variables.join(", "))
             }
@@ -163,15 +152,35 @@ impl ResolveError {
             } => format!("the axis variables of {file} are {}", variables.join(", ")),
             ResolveError::MissingAt { variables, .. } => format!(
                 "give every axis variable: --at {}",
-                variables
-                    .iter()
+                (variables.iter())
                     .map(|v| format!("{v}=…"))
                     .collect::<Vec<_>>()
                     .join(",")
             ),
-            _ => return self.to_string(),
-        };
-        format!("{self}\nhelp: {help}")
+            _ => return None,
+        })
+    }
+
+    /// The message with its help, as one text (Python's exceptions, and
+    /// any renderer without miette).
+    pub fn with_help(&self) -> String {
+        match self.help() {
+            Some(help) => format!("{self}\nhelp: {help}"),
+            None => self.to_string(),
+        }
+    }
+}
+
+/// The CLI's rendering: the code and help of [`ResolveError::code`] and
+/// [`ResolveError::help`], written once.
+#[cfg(feature = "cli")]
+impl miette::Diagnostic for ResolveError {
+    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        Some(Box::new(ResolveError::code(self)))
+    }
+
+    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        ResolveError::help(self).map(|h| Box::new(h) as Box<dyn std::fmt::Display>)
     }
 }
 

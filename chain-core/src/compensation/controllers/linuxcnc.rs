@@ -116,13 +116,18 @@ pub(super) fn export<M: ErrorModel + Sync>(
             v.set_approach(model_variable, approach);
             v
         };
-        let (up, down) = if bidirectional {
-            (read(Approach::Up), read(Approach::Down))
+        // One column per direction read; a one-direction table is read once
+        // and its trims written in both columns.
+        let reads: Vec<std::borrow::Cow<'_, Values>> = if bidirectional {
+            vec![
+                std::borrow::Cow::Owned(read(Approach::Up)),
+                std::borrow::Cow::Owned(read(Approach::Down)),
+            ]
         } else {
-            (values.clone(), values.clone())
+            vec![std::borrow::Cow::Borrowed(values)]
         };
         let mut columns = Vec::new();
-        for v in [&up, &down] {
+        for v in &reads {
             let u: Vec<f64> = ctx.along_with(axis, v)?.iter().map(|p| find(p)).collect();
             let trims: Vec<f64> = u.iter().map(|v| -v).collect();
             for (w, parts) in axis.nodes.windows(2).zip(ctx.midpoints_with(axis, v)?) {
@@ -132,7 +137,8 @@ pub(super) fn export<M: ErrorModel + Sync>(
             }
             columns.push(trims);
         }
-        let (forward, reverse) = (columns.remove(0), columns.remove(0));
+        let forward = columns.remove(0);
+        let reverse = columns.pop().unwrap_or_else(|| forward.clone());
         // B̄ = mean(u↑ − u↓) = mean(reverse − forward).
         let mean_reversal = (forward.iter().zip(&reverse))
             .map(|(f, r)| r - f)
