@@ -18,7 +18,7 @@ from ._results import Derivation, ReliabilityResult, Result
 from ._results import IdentifyResult, MapResult, PlanResult
 from ._results import Derivation, ReliabilityResult, Result, SobolResult
 from ._results import AllocationResult, GeometricSensitivityResult, SensitivityResult
-from ._results import CompensateResult, InverseResult, PositioningResult
+from ._results import CompensateResult, InverseResult, PathResult, PositioningResult
 from ._positioning import positioning
 from ._compensate import compensate
 
@@ -29,6 +29,7 @@ __all__ = [
     "GeometricSensitivityResult",
     "IdentifyResult",
     "InverseResult",
+    "PathResult",
     "MapResult",
     "PlanResult",
     "PositioningResult",

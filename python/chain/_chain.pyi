@@ -162,6 +162,26 @@ def inverse_json(
 ) -> str: ...
 
 
+# -- error and reliability along a path (python/src/path.rs) ---------------------
+
+def path_json(
+    model: Model,
+    header: Sequence[str],
+    axes: Optional[npt.NDArray[np.float64]],
+    poses: Optional[npt.NDArray[np.float64]],
+    t: Optional[npt.NDArray[np.float64]],
+    fix: Sequence[Tuple[str, float]],
+    params: Sequence[Tuple[str, float]],
+    method: str,
+    samples: Optional[int],
+    seed: int,
+    cov: Optional[float],
+    sided: Optional[str],
+    system: Optional[str],
+    system_tolerance: Optional[float],
+) -> str: ...
+
+
 # -- swing-angle compensation (python/src/compensate.rs) -------------------------
 
 def compensate_json(

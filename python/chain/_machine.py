@@ -276,6 +276,94 @@ class Machine:
         text = _chain.inverse_json(self._model, np.ascontiguousarray(a), _params(fix), _params(params))
         return InverseResult._from_json(text)
 
+    def path(
+        self,
+        axes: Optional[Union[ArrayLike, Mapping[str, ArrayLike]]] = None,
+        poses: Optional[ArrayLike] = None,
+        t: Optional[ArrayLike] = None,
+        fix: Optional[Mapping[str, float]] = None,
+        params: Params = None,
+        method: str = "form",
+        samples: Optional[int] = None,
+        seed: int = 0,
+        cov: Optional[float] = None,
+        sided: Optional[str] = None,
+        system: Optional[str] = None,
+        system_tolerance: Optional[float] = None,
+    ) -> "PathResult":
+        """Error and reliability along a path, ``chain path --axes AXES | --pose POSES --format json``.
+
+        Give exactly one of ``axes`` and ``poses``:
+
+        - ``axes``: an ``(N, V)`` array whose columns are :attr:`variables`
+          in order, or a mapping ``{name: column}`` (a pandas DataFrame
+          works) naming axis variables in any order, as the columns of
+          ``--axes`` (an optional first ``"t"`` is the instant);
+        - ``poses``: an ``(N, 6)`` or ``(N, 12)`` array of tool poses as for
+          :meth:`inverse`, solved by the inverse kinematics.
+
+        ``t``: the instants (``N`` values; the row numbers when omitted).
+        ``fix``: variables held at a value (``--fix``). ``method``,
+        ``samples``, ``seed``, ``cov``, ``sided``, ``system`` and
+        ``system_tolerance`` are :meth:`reliability`'s. Built, checked and
+        run by ``chain::ops::path`` as the CLI's.
+        """
+        from ._results import PathResult
+
+        if (axes is None) == (poses is None):
+            raise ValueError("give the path as axes=... or poses=... (one of them)")
+        header: List[str] = []
+        axes_array = poses_array = t_array = None
+        if t is not None:
+            t_array = np.ascontiguousarray(_float_array(t, "t"))
+            if t_array.ndim != 1:
+                raise ValueError(f"t of shape {t_array.shape}: expected (N,)")
+        if axes is not None:
+            if isinstance(axes, Mapping) or hasattr(axes, "columns"):
+                names = [str(k) for k in (axes.columns if hasattr(axes, "columns") else axes.keys())]
+                columns = [_float_array(axes[k], f"axes[{k!r}]") for k in (axes.columns if hasattr(axes, "columns") else axes.keys())]
+                for name, c in zip(names, columns):
+                    if c.ndim != 1:
+                        raise ValueError(f"axes[{name!r}] of shape {c.shape}: expected (N,)")
+                if len({c.shape[0] for c in columns}) > 1:
+                    raise ValueError("the columns of axes have different lengths")
+                n = columns[0].shape[0] if columns else 0
+                a = np.column_stack(columns) if columns else np.zeros((n, 0))
+                header = names
+            else:
+                a = _float_array(axes, "axes")
+                if a.ndim == 1:
+                    a = a.reshape(1, -1)
+                if a.ndim != 2 or a.shape[1] != len(self.variables):
+                    raise ValueError(
+                        f"axes of shape {a.shape}: expected (N, {len(self.variables)}), the columns {', '.join(self.variables)}"
+                        " (or a mapping naming them)"
+                    )
+                header = list(self.variables)
+            if t_array is not None:
+                if t_array.shape[0] != a.shape[0]:
+                    raise ValueError(f"t has {t_array.shape[0]} values for {a.shape[0]} rows of axes")
+                if header[:1] == ["t"]:
+                    raise ValueError("axes has a column \"t\" and t=... is given; give one of them")
+                a = np.column_stack([t_array, a])
+                header = ["t"] + header
+            axes_array = np.ascontiguousarray(a, dtype=np.float64)
+            t_array = None
+        else:
+            p = _float_array(poses, "poses")
+            if p.ndim == 1:
+                p = p.reshape(1, -1)
+            if p.ndim != 2:
+                raise ValueError(f"poses of shape {p.shape}: expected (N, 6) or (N, 12)")
+            poses_array = np.ascontiguousarray(p)
+        if not isinstance(method, str):
+            raise ValueError(f"method must be a str, not {type(method).__name__}")
+        text = _chain.path_json(
+            self._model, header, axes_array, poses_array, t_array, _params(fix), _params(params),
+            method, samples, seed, cov, sided, system, system_tolerance,
+        )
+        return PathResult._from_json(text)
+
     # -- the measured machine (group B: map, identify, plan) -----------------
 
     def map(

@@ -309,6 +309,31 @@ class InverseResult(Result):
         return out
 
 
+class PathResult(Result):
+    """``chain path --format json``: error and reliability at every instant of a path.
+
+    Attributes: ``machine``, ``method``, ``input`` (``axes`` or ``pose``),
+    ``frame``, ``sided``, ``tolerances``, ``variables``, ``instants`` (per
+    instant: ``row``, ``t``, ``axes``, ``status``, ``nominal``, ``mean``,
+    ``std``, ``reliability``, ...), ``summary``. Rows of ``to_dataframe()``:
+    one per instant (``row``, ``t``, ``status``, the axis values, then
+    ``mean_<q>``, ``std_<q>`` and ``reliability_<target>``).
+    """
+
+    command = "path"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        out: List[Dict[str, Any]] = []
+        for i in self._document["instants"]:
+            row: Dict[str, Any] = {"row": i["row"], "t": i["t"], "status": i["status"]}
+            row.update(i["axes"] or {v: None for v in self._document["variables"]})
+            for key in ("mean", "std", "reliability"):
+                for name, value in (i[key] or {}).items():
+                    row[f"{key}_{name}"] = value
+            out.append(row)
+        return out
+
+
 class CompensateResult(Result):
     """``chain compensate --format json``: a swing-angle error identified from tool-tip heights.
 

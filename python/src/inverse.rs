@@ -1,11 +1,21 @@
 //! `chain inverse --format json` over an array of poses, through
 //! `chain::ops::inverse` (the CLI's request, checks and document).
 
-use chain::ops::inverse::{self, InverseOpsError, InverseRequest, Orientation, PoseRow};
+use chain::ops::inverse::{self, InverseOpsError, InverseRequest, PoseRow};
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
 use crate::{check_finite, resolve_error, study_error, to_json, value_error, Model};
+
+/// The poses of a checked `(N, width)` array (`width` 6 or 12), each
+/// refused as `poses row K: ...` (0-based).
+pub(crate) fn pose_rows(flat: &[f64], width: usize) -> PyResult<Vec<PoseRow>> {
+    (flat.chunks_exact(width).enumerate())
+        .map(|(k, v)| {
+            PoseRow::from_values(None, v).map_err(|e| value_error(format!("poses row {k}: {e}")))
+        })
+        .collect()
+}
 
 /// The inverse kinematics of `poses` (`(N, 6)`: `px, py, pz, i, j, k`, or
 /// `(N, 12)`: `px, py, pz, r11 … r33`), `fix` and `params` as `--fix` and
@@ -27,26 +37,7 @@ pub(crate) fn inverse_json(
     }
     let flat = poses.as_slice()?;
     check_finite(flat, width, "poses")?;
-    let rows = flat
-        .chunks_exact(width)
-        .enumerate()
-        .map(|(k, v)| {
-            let orientation = if width == 12 {
-                Orientation::rotation(std::array::from_fn(|i| {
-                    std::array::from_fn(|j| v[3 + 3 * i + j])
-                }))
-            } else {
-                Orientation::axis([v[3], v[4], v[5]])
-            };
-            orientation
-                .map(|orientation| PoseRow {
-                    t: None,
-                    point: [v[0], v[1], v[2]],
-                    orientation,
-                })
-                .map_err(|e| value_error(format!("poses row {k}: {e}")))
-        })
-        .collect::<PyResult<Vec<_>>>()?;
+    let rows = pose_rows(flat, width)?;
     let request = InverseRequest {
         params: &params,
         fix: &fix,
@@ -57,7 +48,7 @@ pub(crate) fn inverse_json(
         .map_err(|e| match e {
             InverseOpsError::Reliability(e) => study_error(py, &e, &model.file),
             InverseOpsError::Resolve(e) => resolve_error(py, model, e),
-            e @ InverseOpsError::Machine { .. } => value_error(e.to_string()),
+            e @ InverseOpsError::Machine(_) => value_error(e.to_string()),
         })?;
     to_json(&doc)
 }

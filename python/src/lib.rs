@@ -19,6 +19,7 @@
 mod compensate;
 mod group_b;
 mod inverse;
+mod path;
 mod positioning;
 use std::mem::MaybeUninit;
 
@@ -485,17 +486,7 @@ impl Model {
         posterior: Option<&reliability::Posterior>,
     ) -> PyResult<Study> {
         use chain::ops::study::{StudyError, StudyOptions};
-        use chain_core::model::Sided;
-        let sided = match sided {
-            None => None,
-            Some("upper") => Some(Sided::Upper),
-            Some("two") => Some(Sided::Two),
-            Some(other) => {
-                return Err(value_error(format!(
-                    "sided must be \"upper\" or \"two\", not {other:?}"
-                )))
-            }
-        };
+        let sided = sided_named(sided)?;
         self.parameter_vector(py, params)?;
         let options = StudyOptions {
             params,
@@ -518,6 +509,19 @@ impl Model {
     }
 }
 
+/// `sided` as the CLI's `--sided` (`upper` or `two`).
+pub(crate) fn sided_named(sided: Option<&str>) -> PyResult<Option<chain_core::model::Sided>> {
+    use chain_core::model::Sided;
+    match sided {
+        None => Ok(None),
+        Some("upper") => Ok(Some(Sided::Upper)),
+        Some("two") => Ok(Some(Sided::Two)),
+        Some(other) => Err(value_error(format!(
+            "sided must be \"upper\" or \"two\", not {other:?}"
+        ))),
+    }
+}
+
 /// The compiled core of the `chain` package.
 #[pymodule]
 fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -536,6 +540,7 @@ fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(allocate::allocate_json, m)?)?;
     m.add_function(wrap_pyfunction!(positioning::positioning_json, m)?)?;
     m.add_function(wrap_pyfunction!(inverse::inverse_json, m)?)?;
+    m.add_function(wrap_pyfunction!(path::path_json, m)?)?;
     m.add_function(wrap_pyfunction!(compensate::compensate_json, m)?)?;
     Ok(())
 }

@@ -12,10 +12,11 @@
 
 use std::path::Path;
 
+use chain::ops::study::{self, AlgorithmOptions, SystemChoice};
 use pyo3::prelude::*;
 use reliability::document::{self, AcceptanceDocument, ReliabilityDocument, SobolDocument};
 use reliability::sobol::{Sobol, SobolError};
-use reliability::{Method, Posterior, PosteriorError, ReliabilityError, Study, System};
+use reliability::{Method, Posterior, PosteriorError, ReliabilityError, Study};
 
 use crate::{load_error, study_error, to_json, value_error, Model};
 
@@ -41,6 +42,58 @@ fn method_named(name: &str) -> PyResult<Method> {
                 all.join(", ")
             ))
         })
+}
+
+/// `method`, `samples`, `seed` and `cov` as the CLI's `--method`,
+/// `--samples`, `--seed` and `--cov`, checked by the same rule
+/// ([`AlgorithmOptions::check`]).
+pub(crate) fn algorithm_options(
+    method: &str,
+    samples: Option<u64>,
+    seed: u64,
+    cov: Option<f64>,
+) -> PyResult<AlgorithmOptions> {
+    let options = AlgorithmOptions {
+        method: method_named(method)?,
+        samples,
+        seed,
+        cov,
+    };
+    options.check().map_err(|e| value_error(e.to_string()))?;
+    if samples == Some(0) && !matches!(options.method, Method::Form | Method::Sorm) {
+        return Err(value_error("samples must be at least 1"));
+    }
+    Ok(options)
+}
+
+/// `system` (`series` or `volumetric`) and `system_tolerance` (the
+/// volumetric target's allowable error) as the CLI's `--system` and
+/// `--system-tolerance`.
+pub(crate) fn system_choice(
+    system: Option<&str>,
+    tolerance: Option<f64>,
+) -> PyResult<Option<SystemChoice>> {
+    match (system, tolerance) {
+        (None, None) => Ok(None),
+        (None, Some(_)) => Err(value_error(
+            "system_tolerance is the allowable error of system=\"volumetric\": give system too",
+        )),
+        (Some("series"), None) => Ok(Some(SystemChoice::Series)),
+        (Some("series"), Some(_)) => Err(value_error(
+            "system_tolerance applies to system=\"volumetric\", not \"series\"",
+        )),
+        (Some("volumetric"), t) => {
+            if let Some(t) = t.filter(|t| !(t.is_finite() && *t > 0.0)) {
+                return Err(value_error(format!(
+                    "invalid value for `system_tolerance`: {t} (a positive allowable volumetric error)"
+                )));
+            }
+            Ok(Some(SystemChoice::Volumetric(t)))
+        }
+        (Some(other), _) => Err(value_error(format!(
+            "invalid value {other:?} for `system` [possible values: series, volumetric]"
+        ))),
+    }
 }
 
 /// The posterior of the values file at `path` (`--values`), its tables read
@@ -110,20 +163,7 @@ pub(crate) fn reliability_json(
     acceptance_tolerance: f64,
     approach: Option<&str>,
 ) -> PyResult<String> {
-    let method = method_named(method)?;
-    if let Some(c) = cov {
-        if !c.is_finite() || c <= 0.0 || c > 1.0 {
-            return Err(value_error(format!(
-                "invalid value for `cov`: the target coefficient of variation must be in (0, 1] (found `{c}`)"
-            )));
-        }
-    }
-    if let Err(p) = document::check_options(method, samples, cov) {
-        return Err(value_error(format!("{}: {}", p.option, p.message)));
-    }
-    if samples == Some(0) && !matches!(method, Method::Form | Method::Sorm) {
-        return Err(value_error("samples must be at least 1"));
-    }
+    let options = algorithm_options(method, samples, seed, cov)?;
     if !(acceptance_tolerance.is_finite()
         && acceptance_tolerance > 0.0
         && acceptance_tolerance < 1.0)
@@ -132,44 +172,11 @@ pub(crate) fn reliability_json(
             "invalid value for `acceptance_tolerance`: {acceptance_tolerance} (an absolute error in (0, 1))"
         )));
     }
-    let system = match (system, system_tolerance) {
-        (None, None) => None,
-        (None, Some(_)) => {
-            return Err(value_error(
-                "system_tolerance is the allowable error of system=\"volumetric\": give system too",
-            ))
-        }
-        (Some("series"), None) => Some(System::Series),
-        (Some("series"), Some(_)) => {
-            return Err(value_error(
-                "system_tolerance applies to system=\"volumetric\", not \"series\"",
-            ))
-        }
-        (Some("volumetric"), t) => {
-            if let Some(t) = t.filter(|t| !(t.is_finite() && *t > 0.0)) {
-                return Err(value_error(format!(
-                    "invalid value for `system_tolerance`: {t} (a positive allowable volumetric error)"
-                )));
-            }
-            Some(
-                document::volumetric(&model.machine, t)
-                    .map_err(|e| study_error(py, &e, &model.file))?,
-            )
-        }
-        (Some(other), _) => {
-            return Err(value_error(format!(
-                "invalid value {other:?} for `system` [possible values: series, volumetric]"
-            )))
-        }
-    };
+    let system = study::system(&model.machine, system_choice(system, system_tolerance)?)
+        .map_err(|e| study_error(py, &e, &model.file))?;
     let posterior = read_posterior(py, model, values, approach)?;
     let study = model.study_with(py, &grid, &params, sided, system, posterior.as_ref())?;
-    let algorithm = document::algorithm(
-        method,
-        document::samples(method, samples, cov.is_some()),
-        seed,
-        cov,
-    );
+    let algorithm = options.algorithm();
     let wanted = acceptance
         || model
             .machine

@@ -3,7 +3,7 @@
 
 use chain_core::compensation::controllers::Controller;
 use chain_core::model::{Machine, Sided};
-use reliability::{Algorithm, Method, ReliabilityError, System};
+use reliability::{Method, ReliabilityError, System};
 
 /// `--param NAME=VALUE`: the values of the machine file's parameters.
 #[derive(Debug, clap::Args)]
@@ -55,24 +55,25 @@ pub struct AlgorithmArgs {
 }
 
 impl AlgorithmArgs {
-    /// The sampler options that need no model (`reliability::document::check_options`):
-    /// `--cov` with FORM or SORM, subset samples per level.
+    /// The options as the application layer takes them.
+    pub fn options(&self) -> chain::ops::study::AlgorithmOptions {
+        chain::ops::study::AlgorithmOptions {
+            method: self.method.method(),
+            samples: self.samples,
+            seed: self.seed,
+            cov: self.cov,
+        }
+    }
+
+    /// The sampler options that need no model
+    /// ([`chain::ops::study::AlgorithmOptions::check`]).
     pub fn check(&self) -> miette::Result<()> {
-        let method = self.method.method();
-        reliability::document::check_options(method, self.samples, self.cov).map_err(|p| {
-            miette::miette!(
-                code = "chain::cli::invalid_option",
-                "invalid value for '--{}': {}",
-                p.option,
-                p.message
-            )
-        })
+        Ok(self.options().check()?)
     }
 
     /// The library's algorithm for these options.
     pub fn algorithm(&self) -> reliability::Algorithm {
-        let samples = self.method.samples(self.samples, self.cov.is_some());
-        self.method.algorithm_with(samples, self.seed, self.cov)
+        self.options().algorithm()
     }
 }
 
@@ -109,13 +110,6 @@ pub enum MethodArg {
 }
 
 impl MethodArg {
-    /// The library's algorithm with these samples per case and seed (FORM
-    /// ignores both) and an optional target coefficient of variation
-    /// (`samples` is then the budget; for subset the samples per level).
-    pub(crate) fn algorithm_with(self, samples: u64, seed: u64, cov: Option<f64>) -> Algorithm {
-        reliability::document::algorithm(self.method(), samples, seed, cov)
-    }
-
     /// The library's method.
     pub(crate) fn method(self) -> Method {
         match self {
@@ -184,16 +178,22 @@ pub enum SystemArg {
     Volumetric,
 }
 
+impl SystemArgs {
+    /// The choice as the application layer takes it.
+    pub fn choice(&self) -> Option<chain::ops::study::SystemChoice> {
+        use chain::ops::study::SystemChoice;
+        self.system.map(|s| match s {
+            SystemArg::Series => SystemChoice::Series,
+            SystemArg::Volumetric => SystemChoice::Volumetric(self.tolerance),
+        })
+    }
+}
+
 pub(crate) fn system_of(
     machine: &Machine,
-    system: Option<SystemArg>,
-    tolerance: Option<f64>,
+    system: &SystemArgs,
 ) -> Result<Option<System>, ReliabilityError> {
-    Ok(match system {
-        None => None,
-        Some(SystemArg::Series) => Some(System::Series),
-        Some(SystemArg::Volumetric) => Some(reliability::document::volumetric(machine, tolerance)?),
-    })
+    chain::ops::study::system(machine, system.choice())
 }
 
 /// Parses `NAME=VALUE`.

@@ -5,7 +5,8 @@
 
 use std::path::Path;
 
-use chain::ops::inverse::{Orientation, PoseRow};
+use chain::ops::inverse::{PoseRow, AXIS_COLUMNS, ROTATION_COLUMNS};
+use chain::ops::resolve::AxesColumns;
 use chain_core::bounded;
 use chain_core::tabular::{self, CsvProblem};
 use chain_core::values::csv::CsvFile;
@@ -104,13 +105,6 @@ pub(crate) fn numeric_rows(input: &mut CsvInput) -> miette::Result<Vec<(usize, V
         .collect()
 }
 
-/// The header of a pose CSV with a tool axis (the spec's).
-const AXIS_HEADER: [&str; 6] = ["px", "py", "pz", "i", "j", "k"];
-/// The header of a pose CSV with a full rotation (an addition).
-const ROTATION_HEADER: [&str; 12] = [
-    "px", "py", "pz", "r11", "r12", "r13", "r21", "r22", "r23", "r31", "r32", "r33",
-];
-
 /// Reads a pose CSV: header `px,py,pz,i,j,k` (tool point and tool axis) or
 /// `px,py,pz,r11,…,r33` (tool point and the tool frame's rotation,
 /// row-major; refused unless orthonormal to 1e-6 with det +1, then replaced
@@ -122,87 +116,34 @@ pub(crate) fn read_poses(path: &Path) -> miette::Result<(bool, Vec<PoseRow>)> {
     let has_t = input.header.first().is_some_and(|h| h == "t");
     let skip = usize::from(has_t);
     let columns = &input.header[skip..];
-    let full = if columns == AXIS_HEADER {
-        false
-    } else if columns == ROTATION_HEADER {
-        true
-    } else {
+    if columns != AXIS_COLUMNS && columns != ROTATION_COLUMNS {
         miette::bail!(
             "{name}:1: expected the header `px,py,pz,i,j,k` or `px,py,pz,r11,r12,r13,r21,r22,r23,r31,r32,r33` (optionally after a first column `t`), found `{}`",
             input.header.join(",")
         );
-    };
+    }
     let rows = numeric_rows(&mut input)?;
     rows.into_iter()
         .map(|(line, all)| {
-            let v = &all[skip..];
-            let orientation = if full {
-                let r: [[f64; 3]; 3] =
-                    std::array::from_fn(|i| std::array::from_fn(|j| v[3 + 3 * i + j]));
-                Orientation::rotation(r)
-            } else {
-                Orientation::axis([v[3], v[4], v[5]])
-            }
-            .map_err(|e| miette::miette!("{name}:{line}: {e}"))?;
-            Ok(PoseRow {
-                t: has_t.then_some(all[0]),
-                point: [v[0], v[1], v[2]],
-                orientation,
-            })
+            PoseRow::from_values(has_t.then_some(all[0]), &all[skip..])
+                .map_err(|e| miette::miette!("{name}:{line}: {e}"))
         })
         .collect::<miette::Result<Vec<_>>>()
         .map(|rows| (has_t, rows))
 }
 
-/// The points of `--axes`: every row, in the machine's variable order.
+/// The points of `--axes`: every row, in the machine's variable order
+/// ([`AxesColumns`]: every variable has a column).
 pub(crate) fn axes_points(
     path: &std::path::Path,
     m: &chain_core::Machine,
 ) -> miette::Result<Vec<f64>> {
     let mut input = open_csv(path)?;
-    let name = input.name.clone();
-    let has_t = input.header.first().is_some_and(|h| h == "t")
-        && (m.variable_index("t").is_none() || input.header[1..].iter().any(|h| h == "t"));
-    let skip = usize::from(has_t);
-    let mut column_of: Vec<Option<usize>> = vec![None; m.variables.len()];
-    for (k, h) in input.header.iter().enumerate().skip(skip) {
-        let Some(v) = m.variable_index(h) else {
-            let hint =
-                chain_core::diagnostic::closest(h, m.variables.iter().map(|v| v.name.as_str()))
-                    .map(|c| format!(" (did you mean `{c}`?)"))
-                    .unwrap_or_default();
-            miette::bail!(
-                "{name}:1: column `{h}` is not an axis variable of machine `{}`{hint}; expected `t` (optional, first) and {}",
-                m.name,
-                variable_list(m)
-            );
-        };
-        column_of[v] = Some(k);
-    }
-    let missing: Vec<String> = (m.variables.iter().zip(&column_of))
-        .filter(|(_, c)| c.is_none())
-        .map(|(v, _)| format!("`{}`", v.name))
-        .collect();
-    if !missing.is_empty() {
-        miette::bail!(
-            "{name}:1: no column for axis variable{} {}; the header names every axis variable ({})",
-            if missing.len() > 1 { "s" } else { "" },
-            missing.join(", "),
-            variable_list(m)
-        );
-    }
+    let columns = AxesColumns::resolve(m, &input.name, &input.header, None)?;
     let rows = numeric_rows(&mut input)?;
     let mut points = Vec::with_capacity(rows.len() * m.variables.len());
     for (_, values) in rows {
-        points.extend(column_of.iter().map(|c| c.map_or(f64::NAN, |c| values[c])));
+        points.extend(columns.point(&values));
     }
     Ok(points)
-}
-
-pub(crate) fn variable_list(m: &chain_core::Machine) -> String {
-    m.variables
-        .iter()
-        .map(|v| format!("`{}`", v.name))
-        .collect::<Vec<_>>()
-        .join(", ")
 }

@@ -7,7 +7,6 @@
 use std::path::PathBuf;
 
 use chain::ops::inverse::{self, InverseDocument, InverseOpsError, InverseRequest};
-use chain_core::inverse::InverseError;
 
 use super::args::{parse_assignment, ParamArgs};
 use super::csv_input::read_poses;
@@ -57,26 +56,12 @@ pub fn exec(args: InverseArgs) -> miette::Result<()> {
     let doc = inverse::run(&loaded.machine, &request).map_err(|e| match e {
         InverseOpsError::Reliability(e) => loaded.report(e),
         InverseOpsError::Resolve(e) => miette::Report::new(e),
-        InverseOpsError::Machine { machine, error } => {
-            miette::Report::new(OnMachine { machine, error })
-        }
+        InverseOpsError::Machine(e) => miette::Report::new(e),
     })?;
     report::emit(&doc, args.format.into())
 }
 
 report::formats!(InverseFormat: Json, Csv);
-
-/// An [`InverseError`] of the machine `machine`: the library's error, its
-/// code and help, with the machine named in the message.
-#[derive(Debug, thiserror::Error, miette::Diagnostic)]
-#[error("machine `{machine}`: {error}")]
-#[diagnostic(forward(error))]
-pub(crate) struct OnMachine {
-    /// The machine's name.
-    pub(crate) machine: String,
-    /// What went wrong.
-    pub(crate) error: InverseError,
-}
 
 impl Report for InverseDocument {
     /// `chain inverse` has no table: its text form is the JSON document.

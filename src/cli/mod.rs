@@ -21,6 +21,7 @@ pub mod plot;
 pub mod positioning;
 pub mod reliability;
 mod reliability_plot;
+mod render;
 pub mod report;
 pub mod sensitivity;
 pub mod sobol;

@@ -8,12 +8,13 @@ use std::path::{Path, PathBuf};
 use crate::cli::plot::{Legend, Series, XyChart};
 use reliability::Quantity;
 
-use super::{label, PathDoc};
+use crate::cli::render::path::label;
+use chain::ops::path::PathDocument;
 
 /// Writes `path_reliability`, `path_std` and, when an orientation component
 /// is toleranced, `path_std_angular`; returns the files written. Writes
 /// nothing when no instant was evaluated.
-pub(super) fn write_all(dir: &Path, doc: &PathDoc) -> miette::Result<Vec<PathBuf>> {
+pub(super) fn write_all(dir: &Path, doc: &PathDocument) -> miette::Result<Vec<PathBuf>> {
     let r = &doc.result;
     if r.evaluated() == 0 {
         eprintln!("note: no evaluated instant; no chart written");

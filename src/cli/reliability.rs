@@ -84,8 +84,7 @@ pub struct ReliabilityArgs {
 pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     args.algorithm.check()?;
     let loaded = Loaded::new(&args.file)?;
-    let system = system_of(&loaded.machine, args.system.system, args.system.tolerance)
-        .map_err(|e| loaded.report(e))?;
+    let system = system_of(&loaded.machine, &args.system).map_err(|e| loaded.report(e))?;
     let posterior = loaded.posterior(args.values.as_deref(), &args.approach)?;
     let (study, _model) = loaded.study_with(
         &args.model.param.params,

@@ -8,37 +8,12 @@ use chain_core::model::Sided;
 use reliability::{FormCase, Method, Posterior, Study, StudyResult, Termination};
 
 use super::report;
-use serde::Serialize;
 
 /// FORM is exact only for one-sided components in normal inputs; say so on
-/// stderr when it is not.
+/// stderr when it is not ([`chain::ops::study::form_limits_note`]).
 pub(crate) fn note_form_limits(study: &Study) {
-    let limits = study.form_limits();
-    if !limits.is_empty() {
-        let why = limits
-            .iter()
-            .map(|l| l.reason())
-            .collect::<Vec<_>>()
-            .join(", ");
-        eprintln!(
-            "note: FORM is a first-order approximation here ({why}); `--method is` corrects it"
-        );
-    }
-}
-
-/// Pairs serialised as a JSON object, in their order (point coordinates,
-/// per-target values).
-#[derive(Debug, Clone)]
-pub(crate) struct Pairs<K, V>(pub(crate) Vec<(K, V)>);
-
-impl<K: Serialize, V: Serialize> Serialize for Pairs<K, V> {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::SerializeMap;
-        let mut map = serializer.serialize_map(Some(self.0.len()))?;
-        for (k, v) in &self.0 {
-            map.serialize_entry(k, v)?;
-        }
-        map.end()
+    if let Some(note) = chain::ops::study::form_limits_note(study) {
+        eprintln!("{note}");
     }
 }
 
@@ -90,55 +65,11 @@ pub(crate) fn posterior_lines(p: &Posterior) -> String {
     out
 }
 
-/// Warns on stderr about the cases on which FORM did not converge (their
-/// reliability is the last iterate's, not a FORM result).
+/// Warns on stderr about the cases that did not converge
+/// ([`chain::ops::study::unconverged_warnings`]).
 pub(crate) fn warn_unconverged(r: &StudyResult, variables: &[String]) {
-    warn_sampler_unconverged(r, variables);
-    let bad: Vec<&reliability::CaseResult> = r
-        .cases
-        .iter()
-        .filter(|c| c.form.is_some_and(|f| !f.converged))
-        .collect();
-    if let Some(first) = bad.first() {
-        let at = variables
-            .iter()
-            .zip(&first.point)
-            .map(|(v, x)| format!("{v} = {x}"))
-            .collect::<Vec<_>>()
-            .join(", ");
-        eprintln!(
-            "warning: FORM did not converge on {} of {} cases (first: {} at {at}); their reliabilities are the last iterates' (listed under the table, `converged: false` in JSON and CSV)",
-            bad.len(),
-            r.cases.len(),
-            first.target
-        );
-    }
-}
-
-/// Warns on stderr about the cases whose sampler stopped without meeting
-/// its rule (the `--cov` target not reached within the budget, or subset
-/// simulation out of levels).
-fn warn_sampler_unconverged(r: &StudyResult, variables: &[String]) {
-    let bad: Vec<&reliability::CaseResult> =
-        r.cases.iter().filter(|c| !c.sampler_converged()).collect();
-    if let Some(first) = bad.first() {
-        let at = variables
-            .iter()
-            .zip(&first.point)
-            .map(|(v, x)| format!("{v} = {x}"))
-            .collect::<Vec<_>>()
-            .join(", ");
-        let why = first.stopping.map_or("", |s| match s.stopped_by {
-            reliability::Stop::Levels => "subset simulation ran out of levels",
-            _ => "the sample budget ran out before the target coefficient of variation",
-        });
-        eprintln!(
-            "warning: the {} did not converge on {} of {} cases (first: {} at {at}: {why}); their values are not converged estimates (listed under the table, `converged: false` in JSON and CSV)",
-            r.method.title(),
-            bad.len(),
-            r.cases.len(),
-            first.target
-        );
+    for w in chain::ops::study::unconverged_warnings(r, variables) {
+        eprintln!("{w}");
     }
 }
 

@@ -87,6 +87,37 @@ pub struct PoseRow {
     pub orientation: Orientation,
 }
 
+/// The columns of a pose with a tool axis (docs/inverse.md).
+pub const AXIS_COLUMNS: [&str; 6] = ["px", "py", "pz", "i", "j", "k"];
+/// The columns of a pose with the tool frame's rotation, row-major.
+pub const ROTATION_COLUMNS: [&str; 12] = [
+    "px", "py", "pz", "r11", "r12", "r13", "r21", "r22", "r23", "r31", "r32", "r33",
+];
+
+impl PoseRow {
+    /// A pose from its values: 6 (`px, py, pz, i, j, k`) or 12 (`px, py,
+    /// pz, r11 … r33`); the orientation is checked by [`Orientation::axis`]
+    /// or [`Orientation::rotation`].
+    ///
+    /// # Panics
+    /// When `values` has neither 6 nor 12 entries (the callers check the
+    /// header or the array's shape first).
+    pub fn from_values(t: Option<f64>, values: &[f64]) -> Result<PoseRow, PoseError> {
+        let orientation = match values.len() {
+            6 => Orientation::axis([values[3], values[4], values[5]])?,
+            12 => Orientation::rotation(std::array::from_fn(|i| {
+                std::array::from_fn(|j| values[3 + 3 * i + j])
+            }))?,
+            n => panic!("a pose has 6 or 12 values, not {n}"),
+        };
+        Ok(PoseRow {
+            t,
+            point: [values[0], values[1], values[2]],
+            orientation,
+        })
+    }
+}
+
 /// The request of `chain inverse`.
 #[derive(Debug, Clone, Copy)]
 pub struct InverseRequest<'a> {
@@ -108,13 +139,43 @@ pub enum InverseOpsError {
     #[error(transparent)]
     Reliability(#[from] ReliabilityError),
     /// The machine has no inverse kinematics of this kind.
-    #[error("machine `{machine}`: {error}")]
-    Machine {
-        /// The machine's name.
-        machine: String,
-        /// What went wrong.
-        error: InverseError,
-    },
+    #[error(transparent)]
+    Machine(#[from] NoInverse),
+}
+
+/// The machine has no inverse kinematics of the kind asked (an
+/// [`InverseError`] with the machine named).
+#[derive(Debug, thiserror::Error)]
+#[error("machine `{machine}`: {error}")]
+pub struct NoInverse {
+    /// The machine's name.
+    pub machine: String,
+    /// What went wrong.
+    pub error: InverseError,
+}
+
+/// The CLI's rendering: the code and help of the [`InverseError`].
+#[cfg(feature = "cli")]
+impl miette::Diagnostic for NoInverse {
+    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        miette::Diagnostic::code(&self.error)
+    }
+
+    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        miette::Diagnostic::help(&self.error)
+    }
+}
+
+/// The solver of `machine` for `params` and the `fixed` variables.
+pub fn solver(
+    machine: &Machine,
+    params: &[f64],
+    fixed: &[(usize, f64)],
+) -> Result<Inverse, NoInverse> {
+    Inverse::for_machine(machine, params, fixed).map_err(|error| NoInverse {
+        machine: machine.name.clone(),
+        error,
+    })
 }
 
 /// The document of `chain inverse`: every pose row's status and solutions
@@ -139,11 +200,7 @@ pub fn run(
     let m = machine;
     let params = reliability::machine::parameters(m, request.params)?;
     let fixed = resolve::fixed(m, request.fix)?;
-    let solver =
-        Inverse::for_machine(m, &params, &fixed).map_err(|error| InverseOpsError::Machine {
-            machine: m.name.clone(),
-            error,
-        })?;
+    let solver = solver(m, &params, &fixed)?;
     Ok(InverseDocument {
         machine: m.name.clone(),
         method: solver.method(),

@@ -12,10 +12,12 @@
 
 //! - [`inverse`]: `chain inverse`'s request, poses and document;
 //! - [`positioning`]: `chain positioning`'s request, document and values file;
-//! - [`map`]: `chain map`'s preparation (values, approach, points, the built machine).
+//! - [`map`]: `chain map`'s preparation (values, approach, points, the built machine);
+//! - [`path`]: `chain path`'s request (axis values or poses) and document.
 
 pub mod inverse;
 pub mod map;
+pub mod path;
 pub mod positioning;
 pub mod resolve;
 pub mod study;

@@ -106,6 +106,55 @@ pub enum ResolveError {
         /// Every axis variable.
         variables: Vec<String>,
     },
+    /// A column of an axes table that names no axis variable.
+    #[error(
+        "{file}:1: column `{column}` is not an axis variable of machine `{machine}`{}{}; expected `t` (optional, first) and {}",
+        did_you_mean(suggestion),
+        if column == "t" { "; `t` (the instant) must be the first column" } else { "" },
+        quoted(variables)
+    )]
+    UnknownAxisColumn {
+        /// The table (file name, `<stdin>`, or Python's `axes`).
+        file: String,
+        /// The column's name.
+        column: String,
+        /// The machine.
+        machine: String,
+        /// The machine's axis variables.
+        variables: Vec<String>,
+        /// The closest variable, if one is close.
+        suggestion: Option<String>,
+    },
+    /// A variable with a column of an axes table and a `--fix` value.
+    #[error("{file}:1: variable `{variable}` has a column and a --fix value; give one of them")]
+    ColumnAndFix {
+        /// The table.
+        file: String,
+        /// The variable.
+        variable: String,
+    },
+    /// Axis variables with neither a column nor (where the command takes
+    /// one) a `--fix` value.
+    #[error(
+        "{file}:1: no column for axis variable{} {}; {}",
+        if missing.len() > 1 { "s" } else { "" },
+        quoted(missing),
+        if *fixable {
+            "add the column or hold it with --fix NAME=VALUE".to_string()
+        } else {
+            format!("the header names every axis variable ({})", quoted(variables))
+        }
+    )]
+    MissingAxisColumns {
+        /// The table.
+        file: String,
+        /// The variables without a column.
+        missing: Vec<String>,
+        /// Every axis variable.
+        variables: Vec<String>,
+        /// Whether the command takes `--fix`.
+        fixable: bool,
+    },
 }
 
 impl ResolveError {
@@ -135,6 +184,9 @@ impl ResolveError {
             ResolveError::NonFiniteAt { .. } => "chain::cli::at_not_finite",
             ResolveError::UnknownFixed { .. } => "chain::cli::fix_unknown_variable",
             ResolveError::MissingAt { .. } => "chain::cli::at_missing_variable",
+            ResolveError::UnknownAxisColumn { .. } => "chain::csv::unknown_column",
+            ResolveError::ColumnAndFix { .. } => "chain::cli::fix_and_column",
+            ResolveError::MissingAxisColumns { .. } => "chain::csv::missing_column",
         }
     }
 
@@ -190,6 +242,14 @@ fn did_you_mean(suggestion: &Option<String>) -> String {
         .as_ref()
         .map(|s| format!(" (did you mean `{s}`?)"))
         .unwrap_or_default()
+}
+
+/// `` `a`, `b` ``: names quoted and joined.
+fn quoted(names: &[String]) -> String {
+    (names.iter())
+        .map(|n| format!("`{n}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn variables(m: &Machine) -> Vec<String> {
@@ -340,6 +400,86 @@ pub fn fixed(m: &Machine, fix: &[(String, f64)]) -> Result<Vec<(usize, f64)>, Re
     Ok(out)
 }
 
+/// Where each axis variable's values come from in a table of axis values
+/// (`chain path --axes`, `chain map --points`, `chain export --points`,
+/// Python's arrays with named columns): its column, or a `--fix` value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AxesColumns {
+    /// Whether the first column is the instant `t`.
+    pub has_t: bool,
+    /// Per axis variable, its column.
+    columns: Vec<Option<usize>>,
+    /// `--fix` values of the variables without a column.
+    fixed: Vec<(usize, f64)>,
+}
+
+impl AxesColumns {
+    /// Resolves `header` against the machine: an optional first column `t`
+    /// (when the machine has no variable `t`, or the header names `t` again
+    /// later), then axis variables in any order; every variable has a column
+    /// or, where the command takes `--fix` (`fixed` is `Some`), a fixed value,
+    /// not both. `file` names the table in messages (line 1 is the header).
+    pub fn resolve(
+        m: &Machine,
+        file: &str,
+        header: &[String],
+        fixed: Option<&[(usize, f64)]>,
+    ) -> Result<AxesColumns, ResolveError> {
+        let has_t = header.first().is_some_and(|h| h == "t")
+            && (m.variable_index("t").is_none() || header[1..].iter().any(|h| h == "t"));
+        let held = fixed.unwrap_or(&[]);
+        let mut columns: Vec<Option<usize>> = vec![None; m.variables.len()];
+        for (k, h) in header.iter().enumerate().skip(usize::from(has_t)) {
+            let Some(v) = m.variable_index(h) else {
+                return Err(ResolveError::UnknownAxisColumn {
+                    file: file.to_string(),
+                    column: h.clone(),
+                    machine: m.name.clone(),
+                    variables: variables(m),
+                    suggestion: closest_variable(m, h),
+                });
+            };
+            if held.iter().any(|(i, _)| *i == v) {
+                return Err(ResolveError::ColumnAndFix {
+                    file: file.to_string(),
+                    variable: h.clone(),
+                });
+            }
+            columns[v] = Some(k);
+        }
+        let missing: Vec<String> = (m.variables.iter().enumerate())
+            .filter(|(v, _)| columns[*v].is_none() && !held.iter().any(|(i, _)| i == v))
+            .map(|(_, x)| x.name.clone())
+            .collect();
+        if !missing.is_empty() {
+            return Err(ResolveError::MissingAxisColumns {
+                file: file.to_string(),
+                missing,
+                variables: variables(m),
+                fixable: fixed.is_some(),
+            });
+        }
+        Ok(AxesColumns {
+            has_t,
+            columns,
+            fixed: held.to_vec(),
+        })
+    }
+
+    /// The point of a row (in the header's column order), in the machine's
+    /// variable order.
+    pub fn point(&self, row: &[f64]) -> Vec<f64> {
+        (self.columns.iter().enumerate())
+            .map(|(v, c)| match c {
+                Some(c) => row[*c],
+                None => (self.fixed.iter())
+                    .find(|(i, _)| *i == v)
+                    .map_or(f64::NAN, |(_, x)| *x),
+            })
+            .collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -405,6 +545,42 @@ mod tests {
         let e = at_point(&m, "m.yaml", &[("x".into(), f64::INFINITY)]).unwrap_err();
         assert_eq!(e.to_string(), "--at: `x` = inf is not finite");
         assert!(!e.names_the_machine());
+    }
+
+    #[test]
+    fn axes_columns_name_every_variable_once() {
+        let m = machine();
+        let h = |s: &str| s.split(',').map(String::from).collect::<Vec<_>>();
+        let c = AxesColumns::resolve(&m, "a.csv", &h("t,z,x"), None).unwrap();
+        assert!(c.has_t);
+        assert_eq!(c.point(&[0.5, 1.0, 2.0]), vec![2.0, 1.0]);
+        let c = AxesColumns::resolve(&m, "a.csv", &h("z"), Some(&[(0, 7.0)])).unwrap();
+        assert_eq!(c.point(&[1.0]), vec![7.0, 1.0]);
+        let e = AxesColumns::resolve(&m, "a.csv", &h("z,t"), None).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "a.csv:1: column `t` is not an axis variable of machine `m` (did you mean `x`?); `t` (the instant) must be the first column; expected `t` (optional, first) and `x`, `z`"
+        );
+        let e = AxesColumns::resolve(&m, "a.csv", &h("x,z"), Some(&[(0, 7.0)])).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "a.csv:1: variable `x` has a column and a --fix value; give one of them"
+        );
+        let e = AxesColumns::resolve(&m, "a.csv", &h("t"), Some(&[])).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "a.csv:1: no column for axis variables `x`, `z`; add the column or hold it with --fix NAME=VALUE"
+        );
+        let e = AxesColumns::resolve(&m, "a.csv", &h("xx"), None).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "a.csv:1: column `xx` is not an axis variable of machine `m` (did you mean `x`?); expected `t` (optional, first) and `x`, `z`"
+        );
+        let e = AxesColumns::resolve(&m, "a.csv", &h("x"), None).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "a.csv:1: no column for axis variable `z`; the header names every axis variable (`x`, `z`)"
+        );
     }
 
     #[test]

@@ -5,7 +5,9 @@
 
 use chain_core::model::Sided;
 use chain_core::{ErrorModel, Machine};
-use reliability::{Posterior, PosteriorError, ReliabilityError, Study, System};
+use reliability::{
+    Algorithm, Method, Posterior, PosteriorError, ReliabilityError, Study, StudyResult, System,
+};
 
 use super::resolve::{self, ResolveError};
 
@@ -78,4 +80,167 @@ pub fn study<M: ErrorModel + ?Sized>(
         Some(p) => p.apply(machine, study)?,
         None => study,
     })
+}
+
+/// The reliability algorithm of a study command: `--method`, `--samples`,
+/// `--seed`, `--cov`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AlgorithmOptions {
+    /// `--method`.
+    pub method: Method,
+    /// `--samples` per case (for subset simulation per level); `None`: the
+    /// method's default ([`reliability::document::samples`]).
+    pub samples: Option<u64>,
+    /// `--seed` of the random streams.
+    pub seed: u64,
+    /// `--cov`: a target coefficient of variation in (0, 1]; `samples` is
+    /// then the budget.
+    pub cov: Option<f64>,
+}
+
+impl Default for AlgorithmOptions {
+    /// FORM, the CLI's defaults.
+    fn default() -> AlgorithmOptions {
+        AlgorithmOptions {
+            method: Method::Form,
+            samples: None,
+            seed: 0,
+            cov: None,
+        }
+    }
+}
+
+/// An option refused before any model is built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("invalid value for '--{option}': {message}")]
+pub struct OptionError {
+    /// The option (the CLI's long name without `--`, Python's keyword).
+    pub option: &'static str,
+    /// Why.
+    pub message: String,
+}
+
+impl OptionError {
+    /// The diagnostic code.
+    pub fn code(&self) -> &'static str {
+        "chain::cli::invalid_option"
+    }
+}
+
+#[cfg(feature = "cli")]
+impl miette::Diagnostic for OptionError {
+    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        Some(Box::new(OptionError::code(self)))
+    }
+}
+
+impl AlgorithmOptions {
+    /// The checks that need no model: `--cov` in (0, 1] and not with FORM
+    /// or SORM, subset simulation's samples per level
+    /// ([`reliability::document::check_options`]).
+    pub fn check(&self) -> Result<(), OptionError> {
+        if let Some(c) = self.cov {
+            if !(c.is_finite() && c > 0.0 && c <= 1.0) {
+                return Err(OptionError {
+                    option: "cov",
+                    message: format!(
+                        "the target coefficient of variation must be in (0, 1] (found `{c}`)"
+                    ),
+                });
+            }
+        }
+        reliability::document::check_options(self.method, self.samples, self.cov).map_err(|p| {
+            OptionError {
+                option: p.option,
+                message: p.message,
+            }
+        })
+    }
+
+    /// The library's algorithm for these options
+    /// ([`reliability::document::algorithm`]).
+    pub fn algorithm(&self) -> Algorithm {
+        let samples = reliability::document::samples(self.method, self.samples, self.cov.is_some());
+        reliability::document::algorithm(self.method, samples, self.seed, self.cov)
+    }
+}
+
+/// `--system`: a system target besides the components.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SystemChoice {
+    /// Every toleranced component at once.
+    Series,
+    /// `|p| ≤ tolerance` (`--system-tolerance`; by default the smallest
+    /// position tolerance of the reliability section).
+    Volumetric(Option<f64>),
+}
+
+/// The library's system target of `choice` on `machine`
+/// ([`reliability::document::volumetric`]).
+pub fn system(
+    machine: &Machine,
+    choice: Option<SystemChoice>,
+) -> Result<Option<System>, ReliabilityError> {
+    Ok(match choice {
+        None => None,
+        Some(SystemChoice::Series) => Some(System::Series),
+        Some(SystemChoice::Volumetric(tolerance)) => {
+            Some(reliability::document::volumetric(machine, tolerance)?)
+        }
+    })
+}
+
+/// `note: FORM is a first-order approximation here (...)` when FORM is
+/// not exact for the study (a two-sided component, non-normal inputs).
+pub fn form_limits_note(study: &Study) -> Option<String> {
+    let limits = study.form_limits();
+    (!limits.is_empty()).then(|| {
+        let why = (limits.iter())
+            .map(|l| l.reason())
+            .collect::<Vec<_>>()
+            .join(", ");
+        format!("note: FORM is a first-order approximation here ({why}); `--method is` corrects it")
+    })
+}
+
+/// The warnings on a study's cases that did not converge: the samplers'
+/// (the `--cov` target not reached within the budget, subset simulation out
+/// of levels), then FORM's (the iteration limit).
+pub fn unconverged_warnings(r: &StudyResult, variables: &[String]) -> Vec<String> {
+    let at = |point: &[f64]| {
+        (variables.iter().zip(point))
+            .map(|(v, x)| format!("{v} = {x}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut out = Vec::new();
+    let bad: Vec<&reliability::CaseResult> =
+        r.cases.iter().filter(|c| !c.sampler_converged()).collect();
+    if let Some(first) = bad.first() {
+        let why = first.stopping.map_or("", |s| match s.stopped_by {
+            reliability::Stop::Levels => "subset simulation ran out of levels",
+            _ => "the sample budget ran out before the target coefficient of variation",
+        });
+        out.push(format!(
+            "warning: the {} did not converge on {} of {} cases (first: {} at {}: {why}); their values are not converged estimates (listed under the table, `converged: false` in JSON and CSV)",
+            r.method.title(),
+            bad.len(),
+            r.cases.len(),
+            first.target,
+            at(&first.point)
+        ));
+    }
+    let bad: Vec<&reliability::CaseResult> = (r.cases.iter())
+        .filter(|c| c.form.is_some_and(|f| !f.converged))
+        .collect();
+    if let Some(first) = bad.first() {
+        out.push(format!(
+            "warning: FORM did not converge on {} of {} cases (first: {} at {}); their reliabilities are the last iterates' (listed under the table, `converged: false` in JSON and CSV)",
+            bad.len(),
+            r.cases.len(),
+            first.target,
+            at(&first.point)
+        ));
+    }
+    out
 }

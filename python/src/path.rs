@@ -1,0 +1,115 @@
+//! `chain path --format json` over arrays, through `chain::ops::path` (the
+//! CLI's request, checks and document): axis values with named columns, or
+//! tool poses solved by the inverse kinematics.
+
+use chain::ops::path::{self, PathInput, PathOpsError, PathRequest};
+use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+
+use crate::inverse::pose_rows;
+use crate::reliability_v2::{algorithm_options, system_choice};
+use crate::{check_finite, resolve_error, sided_named, study_error, to_json, value_error, Model};
+
+/// Error and reliability along a path. Exactly one of `axes` (an `(N, C)`
+/// array whose columns `header` names: axis variables in any order, an
+/// optional first `t`) and `poses` (`(N, 6)` or `(N, 12)`, as `inverse`;
+/// `t` their instants) is given; the other keywords are the CLI's options.
+#[pyfunction]
+#[pyo3(signature = (model, header, axes, poses, t, fix, params, method, samples, seed, cov, sided, system, system_tolerance))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn path_json(
+    py: Python<'_>,
+    model: &Model,
+    header: Vec<String>,
+    axes: Option<PyReadonlyArray2<'_, f64>>,
+    poses: Option<PyReadonlyArray2<'_, f64>>,
+    t: Option<PyReadonlyArray1<'_, f64>>,
+    fix: Vec<(String, f64)>,
+    params: Vec<(String, f64)>,
+    method: &str,
+    samples: Option<u64>,
+    seed: u64,
+    cov: Option<f64>,
+    sided: Option<&str>,
+    system: Option<&str>,
+    system_tolerance: Option<f64>,
+) -> PyResult<String> {
+    let algorithm = algorithm_options(method, samples, seed, cov)?;
+    let sided = sided_named(sided)?;
+    let system = system_choice(system, system_tolerance)?;
+    let (rows, poses_read);
+    let input = match (&axes, &poses) {
+        (Some(a), None) => {
+            let width = a.shape()[1];
+            if width != header.len() {
+                return Err(value_error(format!(
+                    "axes has {width} columns but {} names",
+                    header.len()
+                )));
+            }
+            let flat = a.as_slice()?;
+            check_finite(flat, width, "axes")?;
+            rows = match width {
+                0 => vec![Vec::new(); a.shape()[0]],
+                _ => flat.chunks_exact(width).map(<[f64]>::to_vec).collect(),
+            };
+            PathInput::Axes {
+                source: "axes",
+                header: &header,
+                rows: &rows,
+            }
+        }
+        (None, Some(p)) => {
+            let width = p.shape()[1];
+            if width != 6 && width != 12 {
+                return Err(value_error(format!(
+                    "poses must have 6 columns (px, py, pz, i, j, k) or 12 (px, py, pz, r11 … r33), found {width}"
+                )));
+            }
+            let flat = p.as_slice()?;
+            check_finite(flat, width, "poses")?;
+            let mut read = pose_rows(flat, width)?;
+            if let Some(t) = &t {
+                let t = t.as_slice()?;
+                if t.len() != read.len() {
+                    return Err(value_error(format!(
+                        "t has {} values for {} poses",
+                        t.len(),
+                        read.len()
+                    )));
+                }
+                check_finite(t, 0, "t")?;
+                for (row, &t) in read.iter_mut().zip(t) {
+                    row.t = Some(t);
+                }
+            }
+            poses_read = read;
+            PathInput::Poses {
+                source: "poses",
+                has_t: t.is_some(),
+                rows: &poses_read,
+            }
+        }
+        _ => {
+            return Err(value_error(
+                "give the path as axes=... or poses=... (one of them)",
+            ))
+        }
+    };
+    let request = PathRequest {
+        params: &params,
+        fix: &fix,
+        sided,
+        system,
+        algorithm,
+        input,
+    };
+    let doc = py
+        .allow_threads(|| path::run(&model.machine, &request, &()))
+        .map_err(|e| match e {
+            PathOpsError::Reliability(e) => study_error(py, &e, &model.file),
+            PathOpsError::Resolve(e) => resolve_error(py, model, e),
+            e @ (PathOpsError::Option(_) | PathOpsError::Machine(_)) => value_error(e.to_string()),
+        })?;
+    to_json(&doc)
+}
