@@ -18,7 +18,7 @@ from ._results import Derivation, ReliabilityResult, Result
 from ._results import IdentifyResult, MapResult, PlanResult
 from ._results import Derivation, ReliabilityResult, Result, SobolResult
 from ._results import AllocationResult, GeometricSensitivityResult, SensitivityResult
-from ._results import CompensateResult, InverseResult, PathResult, PositioningResult
+from ._results import CompensateResult, ExportResult, InverseResult, PathResult, PositioningResult
 from ._positioning import positioning
 from ._compensate import compensate
 
@@ -26,6 +26,7 @@ __all__ = [
     "AllocationResult",
     "CompensateResult",
     "Derivation",
+    "ExportResult",
     "GeometricSensitivityResult",
     "IdentifyResult",
     "InverseResult",

@@ -182,6 +182,23 @@ def path_json(
 ) -> str: ...
 
 
+# -- compensation for a controller (python/src/export.rs) ------------------------
+
+def export_json(
+    model: Model,
+    values_path: Optional[str],
+    values_text: Optional[str],
+    values_file: str,
+    controller: str,
+    grid: Sequence[Tuple[str, Sequence[float]]],
+    points: Optional[npt.NDArray[np.float64]],
+    step: Optional[float],
+    cec_max_points: Optional[int],
+    beckhoff_max_records: Optional[int],
+    params: Sequence[Tuple[str, float]],
+) -> Tuple[str, List[Tuple[str, str]]]: ...
+
+
 # -- swing-angle compensation (python/src/compensate.rs) -------------------------
 
 def compensate_json(

@@ -396,6 +396,51 @@ class Machine:
         )
         return MapResult._from_json(text_json)
 
+    def export(
+        self,
+        values: Union[str, "os.PathLike[str]", Mapping[str, Any]],
+        controller: str = "grid",
+        grid: Optional[Mapping[str, Sequence[float]]] = None,
+        points: Optional[ArrayLike] = None,
+        step: Optional[float] = None,
+        cec_max_points: Optional[int] = None,
+        beckhoff_max_records: Optional[int] = None,
+        params: Params = None,
+        out: Union[None, str, "os.PathLike[str]"] = None,
+    ) -> "ExportResult":
+        """Compensation for a controller, ``chain export --values VALUES --controller NAME --format json``.
+
+        ``values`` as for :meth:`map`. ``controller``: ``"grid"`` (the
+        universal grid CSV), ``"beckhoff"``, ``"linuxcnc"``,
+        ``"siemens-cec"`` or ``"klipper"``. ``grid``: the grid's nodes
+        (``grid``) or each axis's travel (the per-axis tables), ``--grid``;
+        ``points``: the grid export's nodes as an ``(N, V)`` array
+        (``--axes``); ``step``, ``cec_max_points``, ``beckhoff_max_records``:
+        the per-axis tables' options. The result's ``files`` maps each file's
+        name to its text; ``out``: also write them into that folder (created
+        if missing), as ``--out DIR``.
+        """
+        from ._results import ExportResult
+
+        path, text, name = _values_input(self, values)
+        q = None
+        if points is not None:
+            q, _ = _rows(points, "points", len(self.variables), "the variables " + ", ".join(self.variables))
+        if not isinstance(controller, str):
+            raise ValueError(f"controller must be a str, not {type(controller).__name__}")
+        doc, files = _chain.export_json(
+            self._model, path, text, name, controller, _grid_axes(grid), q,
+            _optional_float(step, "step"), cec_max_points, beckhoff_max_records, _params(params),
+        )
+        result = ExportResult._from_json(doc)
+        result.__dict__["files"] = dict(files)
+        if out is not None:
+            os.makedirs(out, exist_ok=True)
+            for file_name, content in files:
+                with open(os.path.join(out, file_name), "w", encoding="utf-8", newline="") as f:
+                    f.write(content)
+        return result
+
     def identify(
         self,
         measurements: Union[str, "os.PathLike[str]", Mapping[str, ArrayLike]],

@@ -334,6 +334,31 @@ class PathResult(Result):
         return out
 
 
+class ExportResult(Result):
+    """``chain export --format json``: the compensation of a built machine for a controller.
+
+    Attributes: the summary the CLI prints (grid: ``values_file``, ``files``,
+    ``machine``, ``frame``, ``variables``, ``summary``; a per-axis format:
+    ``values_file``, ``controller``, ``files``, ``axes``, ``expressed``,
+    ``remaining``, ``residual``, ...), and ``files``: each file's name
+    mapped to its text (what ``--out DIR`` writes). Rows of
+    ``to_dataframe()``: the grid CSV's nodes (grid), or one per table axis.
+    """
+
+    command = "export"
+    files: Dict[str, str] = {}
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        import csv
+        import io
+
+        if "axes" in self._document:
+            return [dict(a) for a in self._document["axes"]]
+        (text,) = self.__dict__["files"].values()
+        lines = [line for line in text.splitlines() if line and not line.startswith("#")]
+        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(io.StringIO("\n".join(lines)))]
+
+
 class CompensateResult(Result):
     """``chain compensate --format json``: a swing-angle error identified from tool-tip heights.
 

@@ -48,7 +48,7 @@ fn read_measurements(
 
 /// A values file: read from `path` (tables relative to it), or parsed from
 /// `text` named `file` (tables relative to the working directory).
-fn read_values(
+pub(crate) fn read_values(
     py: Python<'_>,
     m: &Machine,
     path: Option<&str>,

@@ -17,6 +17,7 @@
 //! `column` and `key`.
 
 mod compensate;
+mod export;
 mod group_b;
 mod inverse;
 mod path;
@@ -541,6 +542,7 @@ fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(positioning::positioning_json, m)?)?;
     m.add_function(wrap_pyfunction!(inverse::inverse_json, m)?)?;
     m.add_function(wrap_pyfunction!(path::path_json, m)?)?;
+    m.add_function(wrap_pyfunction!(export::export_json, m)?)?;
     m.add_function(wrap_pyfunction!(compensate::compensate_json, m)?)?;
     Ok(())
 }

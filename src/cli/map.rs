@@ -33,7 +33,6 @@ use serde::Serialize;
 use super::args::ParamArgs;
 use super::args::{parse_grid_axis, ControllerName};
 use super::csv_input::axes_points;
-use super::diagnostics::export_error;
 use super::loaded::Loaded;
 use super::report::{self, Csv, Report};
 
@@ -234,9 +233,9 @@ fn compensate(
     if let Some(tables) = controller.tables() {
         // The map's own range of an axis, where it is one (a single value
         // keeps the machine file's travel); --compensation-grid over it.
-        let mut travel = super::export::travel_of(&args.grid);
+        let mut travel = chain::ops::export::travel_of(&args.grid);
         travel.retain(|(_, [lo, hi])| lo < hi);
-        for t in super::export::travel_of(&args.compensation_grid) {
+        for t in chain::ops::export::travel_of(&args.compensation_grid) {
             travel.retain(|(n, _)| *n != t.0);
             travel.push(t);
         }
@@ -245,13 +244,13 @@ fn compensate(
             travel,
             ..ExportOptions::default()
         };
-        let export = super::export::table_export(
+        let export = chain::ops::export::table_export(
             tables,
             built,
-            loaded,
+            &loaded.machine,
             &options,
             &args.compensation_grid,
-            &args.values,
+            &args.values.display().to_string(),
         )?;
         let result = built
             .compensated_map(export.correction.as_ref(), points)
@@ -707,6 +706,18 @@ impl Report for MapDoc {
         }
         Some(csv)
     }
+}
+
+/// A compensation error of the values file `values`, worded by
+/// [`chain::ops::export::ExportOpsError`].
+fn export_error(
+    error: chain_core::compensation::CompensationError,
+    values: &std::path::Path,
+) -> miette::Report {
+    miette::Report::new(chain::ops::export::ExportOpsError::Compensation {
+        values: values.display().to_string(),
+        error: Box::new(error),
+    })
 }
 
 #[cfg(test)]

@@ -8,7 +8,6 @@ mod atomic;
 pub mod compensate;
 mod csv_input;
 pub mod derive;
-mod diagnostics;
 pub mod export;
 pub mod identify;
 pub mod inverse;

@@ -10,11 +10,13 @@
 //! - [`study`]: a reliability study from a machine and the options every
 //!   study command takes (parameters, grid, sided, system, a posterior).
 
+//! - [`export`]: `chain export`'s request, document and the per-axis tables `map --compensated` shares;
 //! - [`inverse`]: `chain inverse`'s request, poses and document;
 //! - [`positioning`]: `chain positioning`'s request, document and values file;
 //! - [`map`]: `chain map`'s preparation (values, approach, points, the built machine);
 //! - [`path`]: `chain path`'s request (axis values or poses) and document.
 
+pub mod export;
 pub mod inverse;
 pub mod map;
 pub mod path;

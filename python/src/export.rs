@@ -1,0 +1,81 @@
+//! `chain export` over a values file or dict, through `chain::ops::export`
+//! (the CLI's request, checks and document): the summary document as JSON
+//! text and the files the controller reads, by name.
+
+use chain::ops::export::{self, ExportController, ExportOpsError, ExportRequest};
+use chain_core::compensation::controllers::Controller;
+use numpy::PyReadonlyArray2;
+use pyo3::prelude::*;
+
+use crate::group_b::read_values;
+use crate::{resolve_error, study_error, to_json, value_error, Model};
+
+/// `--controller`'s names, in the CLI's order.
+const CONTROLLERS: [&str; 5] = ["grid", "beckhoff", "linuxcnc", "siemens-cec", "klipper"];
+
+/// The compensation of the built machine `values` (a file `values_path`,
+/// or the text `values_text` named `values_file`) for `controller`; `grid`,
+/// `points` (rows in the machine's variable order, `--axes`), `step`,
+/// `cec_max_points`, `beckhoff_max_records` and `params` as the CLI's
+/// options. Returns the summary document and the files `(name, text)`.
+#[pyfunction]
+#[pyo3(signature = (model, values_path, values_text, values_file, controller, grid, points, step, cec_max_points, beckhoff_max_records, params))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn export_json(
+    py: Python<'_>,
+    model: &Model,
+    values_path: Option<&str>,
+    values_text: Option<&str>,
+    values_file: &str,
+    controller: &str,
+    grid: Vec<(String, Vec<f64>)>,
+    points: Option<PyReadonlyArray2<'_, f64>>,
+    step: Option<f64>,
+    cec_max_points: Option<usize>,
+    beckhoff_max_records: Option<usize>,
+    params: Vec<(String, f64)>,
+) -> PyResult<(String, Vec<(String, String)>)> {
+    let controller = match controller {
+        "grid" => ExportController::Grid,
+        name => ExportController::Tables(Controller::from_name(name).ok_or_else(|| {
+            value_error(format!(
+                "invalid value {name:?} for `controller` [possible values: {}]",
+                CONTROLLERS.join(", ")
+            ))
+        })?),
+    };
+    let rows = match &points {
+        Some(q) => {
+            if !grid.is_empty() {
+                return Err(value_error("give grid or points, not both"));
+            }
+            let (flat, _) = model.points(q)?;
+            Some(("points", flat.to_vec()))
+        }
+        None => None,
+    };
+    let request = ExportRequest {
+        controller,
+        params: &params,
+        grid: &grid,
+        rows,
+        step,
+        cec_max_points,
+        beckhoff_max_records,
+    };
+    let refused = |e: ExportOpsError| match e {
+        ExportOpsError::Reliability(e) => study_error(py, &e, &model.file),
+        ExportOpsError::Resolve(e) => resolve_error(py, model, e),
+        e => value_error(e.with_help()),
+    };
+    export::check(&request).map_err(refused)?;
+    let m = &model.machine;
+    let (values, name) = read_values(py, m, values_path, values_text, values_file)?;
+    let doc = py
+        .allow_threads(|| export::run(m, &model.file, values, &name, &request))
+        .map_err(refused)?;
+    let files = (doc.files().iter())
+        .map(|f| (f.name.clone(), f.text.clone()))
+        .collect();
+    Ok((to_json(&doc)?, files))
+}

@@ -1,0 +1,54 @@
+"""Machine.export: `chain export` through chain::ops::export (the CLI's request, checks and document)."""
+
+import numpy as np
+import pytest
+
+import chain
+from conftest import ROOT, flat
+
+MACHINE = ROOT / "examples/machines/vmc3.yaml"
+VALUES = ROOT / "examples/values/vmc3.yaml"
+
+
+@pytest.mark.parametrize("controller", ["grid", "beckhoff", "linuxcnc", "siemens-cec", "klipper"])
+def test_export_is_the_cli_s(cli, controller, tmp_path):
+    """The summary equals `chain export --format json`; the files equal the committed examples
+    (examples/export/, which tests/it/export_controllers.rs regenerates from the library)."""
+    m = chain.Machine.load(MACHINE)
+    got = m.export(VALUES, controller=controller, params={"L": 150}, out=tmp_path / "out")
+    want = cli("export", MACHINE, "--values", VALUES, "--controller", controller, "--param", "L=150")
+    assert got.to_dict() == want
+    expected = sorted(p.name for p in (ROOT / "examples/export" / controller).iterdir())
+    assert sorted(got.files) == expected
+    for name, text in got.files.items():
+        assert text == (ROOT / "examples/export" / controller / name).read_text()
+        assert (tmp_path / "out" / name).read_text() == text
+    if controller == "grid":
+        frame = got._rows()
+        assert len(frame) == got.summary["nodes"]
+        assert set(m.variables) <= set(frame[0])
+
+
+def test_export_points_and_refusals(cli_error, tmp_path):
+    """Nodes from rows (`--axes`); options a controller does not take and values outside a table: the CLI's words."""
+    m = chain.Machine.load(MACHINE)
+    q = np.array([[100.0, 50.0, 20.0], [200.0, 60.0, 30.0]])
+    got = m.export(VALUES, points=q, params={"L": 150})
+    assert got.summary["nodes"] == 2
+    with pytest.raises(ValueError) as info:
+        m.export(VALUES, controller="grid", step=5.0, params={"L": 150})
+    message = str(info.value)
+    assert message.startswith("--controller grid does not take --step\nhelp: the grid export corrects")
+    cli = flat(cli_error("export", MACHINE, "--values", VALUES, "--controller", "grid", "--step", "5"))
+    assert flat(message) in cli
+    with pytest.raises(ValueError, match="--controller linuxcnc does not take --axes"):
+        m.export(VALUES, controller="linuxcnc", points=q, params={"L": 150})
+    with pytest.raises(ValueError, match=r"invalid value \"fanuc\" for `controller` \[possible values: grid, beckhoff"):
+        m.export(VALUES, controller="fanuc")
+    with pytest.raises(ValueError) as info:
+        m.export(VALUES, controller="linuxcnc", grid={"x": [0, 900]}, params={"L": 150})
+    message = str(info.value)
+    assert "covers" in message and "nothing is extrapolated" in message
+    cli = flat(cli_error("export", MACHINE, "--values", VALUES, "--controller", "linuxcnc", "--grid", "x=0,900",
+                         "--param", "L=150"))
+    assert flat(message) in cli

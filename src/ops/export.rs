@@ -1,0 +1,471 @@
+//! `chain export` as a request and a document (measured-machines spec §6;
+//! docs/export.md, docs/export-controllers.md): the axis corrections that
+//! cancel a built machine's error, as the universal grid CSV or a
+//! controller's per-axis tables, with what they leave. The CLI writes the
+//! files into `--out` (or the one file to stdout) and prints the summary;
+//! Python returns both. `chain map --compensated` shares
+//! [`table_export`] and [`travel_of`].
+
+use chain_core::built::{BuiltMachine, MapError, Points};
+use chain_core::compensation::controllers::{
+    self, Controller, ControllerError, Export, ExportOptions, FormatReport,
+    BECKHOFF_DEFAULT_MAX_RECORDS, CEC_DEFAULT_MAX_POINTS, DEFAULT_STEP,
+};
+use chain_core::compensation::grid::{self, GridCompensation};
+use chain_core::compensation::{CompensationError, ExportedFile};
+use chain_core::kinematics::Kinematics;
+use chain_core::values::Values;
+use chain_core::Machine;
+use reliability::ReliabilityError;
+use serde::Serialize;
+
+use super::resolve::{self, ResolveError};
+
+/// What `chain export` writes for (`--controller`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExportController {
+    /// The universal grid CSV: `δq` at every node and the residual.
+    Grid,
+    /// A controller's per-axis tables.
+    Tables(Controller),
+}
+
+impl ExportController {
+    /// The name `--controller` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            ExportController::Grid => "grid",
+            ExportController::Tables(c) => c.name(),
+        }
+    }
+}
+
+/// The request of `chain export`.
+#[derive(Debug, Clone)]
+pub struct ExportRequest<'a> {
+    /// `--controller`.
+    pub controller: ExportController,
+    /// `--param NAME=VALUE`.
+    pub params: &'a [(String, f64)],
+    /// `--grid VAR=...`: the grid's nodes over `reliability.grid` (grid),
+    /// or each axis's travel (the per-axis tables).
+    pub grid: &'a [(String, Vec<f64>)],
+    /// `--axes`: the grid export's nodes as rows of axis values in the
+    /// machine's variable order, flat, with the rows' name in messages.
+    pub rows: Option<(&'a str, Vec<f64>)>,
+    /// `--step`: the largest table step (mm) of the per-axis tables.
+    pub step: Option<f64>,
+    /// `--cec-max-points`.
+    pub cec_max_points: Option<usize>,
+    /// `--beckhoff-max-records`.
+    pub beckhoff_max_records: Option<usize>,
+}
+
+/// Why `chain export` cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportOpsError {
+    /// An option the chosen controller does not take.
+    #[error("--controller {controller} does not take {option}")]
+    Option {
+        /// The controller.
+        controller: &'static str,
+        /// The option(s).
+        option: &'static str,
+        /// Why not, and what to give instead.
+        why: &'static str,
+    },
+    /// An option does not match the machine.
+    #[error(transparent)]
+    Resolve(#[from] ResolveError),
+    /// The parameters (located in the machine file).
+    #[error(transparent)]
+    Reliability(#[from] ReliabilityError),
+    /// Rows that are not points of the machine.
+    #[error("{rows}: {error}")]
+    Points {
+        /// The rows' name.
+        rows: String,
+        /// What is wrong.
+        error: MapError,
+    },
+    /// The values and the machine do not go together.
+    #[error("{values}: {message}")]
+    Built {
+        /// The values file.
+        values: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The grid export (a node outside a values table, ...).
+    #[error("{}", compensation_message(error))]
+    Compensation {
+        /// The values file.
+        values: String,
+        /// What went wrong.
+        error: Box<CompensationError>,
+    },
+    /// A per-axis format (an axis it cannot take, a table that does not
+    /// cover the travel, ...).
+    #[error("{}", controller_message(error))]
+    Controller {
+        /// The values file.
+        values: String,
+        /// What went wrong.
+        error: Box<ControllerError>,
+    },
+    /// A `--grid` value that is not a node of the per-axis tables.
+    #[error(
+        "--grid {variable}=...: the {controller} tables sample `{variable}` at {points} nodes every {step} mm from {min} to {max}, and {what}"
+    )]
+    GridNodes {
+        /// The controller.
+        controller: &'static str,
+        /// The axis variable.
+        variable: String,
+        /// The table's nodes.
+        points: usize,
+        /// Its step.
+        step: f64,
+        /// Its first node.
+        min: f64,
+        /// Its last node.
+        max: f64,
+        /// What does not fit.
+        what: String,
+    },
+}
+
+/// A [`CompensationError`]'s message: a node outside a values table names
+/// the table and its range.
+fn compensation_message(e: &CompensationError) -> String {
+    match e {
+        CompensationError::OutOfRange { point, at, source } => format!(
+            "at node {} ({at}): {} = {} is outside the table of `{}` ({}, {} = {} to {})",
+            point + 1,
+            source.variable,
+            source.value,
+            source.name,
+            source.table,
+            source.variable,
+            source.lo,
+            source.hi
+        ),
+        e => e.to_string(),
+    }
+}
+
+/// A [`ControllerError`]'s message: a table that does not cover the
+/// travel names the table, its range and the value needed.
+fn controller_message(e: &ControllerError) -> String {
+    match e {
+        ControllerError::OutOfTable {
+            variable,
+            lo,
+            hi,
+            source,
+        } => format!(
+            "the table of `{}` ({}) covers {} = {} to {}, and the export needs {} = {} (sampling axis `{variable}` over {lo} to {hi}, the other axes at their travel's start)",
+            source.name, source.table, source.variable, source.lo, source.hi, source.variable, source.value
+        ),
+        e => e.to_string(),
+    }
+}
+
+impl ExportOpsError {
+    /// The diagnostic code of the refusals worded here (`None`: the inner
+    /// error's own).
+    pub fn code(&self) -> Option<&'static str> {
+        match self {
+            ExportOpsError::Option { .. } => Some("chain::export::option"),
+            ExportOpsError::GridNodes { .. } => Some("chain::export::grid_nodes"),
+            ExportOpsError::Compensation { error, .. } => match **error {
+                CompensationError::OutOfRange { .. } => Some("chain::export::out_of_range"),
+                _ => None,
+            },
+            ExportOpsError::Controller { error, .. } => match **error {
+                ControllerError::OutOfTable { .. } => Some("chain::export::out_of_table"),
+                _ => None,
+            },
+            _ => None,
+        }
+    }
+
+    /// What to do about it, where this layer says more than the message.
+    pub fn help(&self) -> Option<String> {
+        match self {
+            ExportOpsError::Option { why, .. } => Some(why.to_string()),
+            ExportOpsError::GridNodes { .. } => Some(
+                "give the travel alone (--grid VAR=LO,HI) and the table step with --step".into(),
+            ),
+            ExportOpsError::Compensation { values, error } => match &**error {
+                CompensationError::OutOfRange { source, .. } => Some(format!(
+                    "the values file {values} does not cover the requested nodes: export inside {} = {} to {} (--grid), extend the table, or add `extrapolate: hold` to its entry",
+                    source.variable, source.lo, source.hi
+                )),
+                _ => None,
+            },
+            ExportOpsError::Controller { values, error } => match &**error {
+                ControllerError::OutOfTable { source, .. } => Some(format!(
+                    "the values file {values} does not cover the travel: give a travel inside the table (--grid {}={},{}), measure the table over the whole travel, or add `extrapolate: hold` to its entry; nothing is extrapolated",
+                    source.variable, source.lo, source.hi
+                )),
+                _ => None,
+            },
+            _ => None,
+        }
+    }
+
+    /// The message with its help, as one text (Python's exceptions).
+    pub fn with_help(&self) -> String {
+        match self.help() {
+            Some(help) => format!("{self}\nhelp: {help}"),
+            None => self.to_string(),
+        }
+    }
+}
+
+/// The CLI's rendering: this layer's code and help, else the inner error's.
+#[cfg(feature = "cli")]
+impl miette::Diagnostic for ExportOpsError {
+    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        if let Some(code) = ExportOpsError::code(self) {
+            return Some(Box::new(code));
+        }
+        match self {
+            ExportOpsError::Resolve(e) => miette::Diagnostic::code(e),
+            ExportOpsError::Compensation { error, .. } => miette::Diagnostic::code(&**error),
+            ExportOpsError::Controller { error, .. } => miette::Diagnostic::code(&**error),
+            _ => None,
+        }
+    }
+
+    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        if let Some(help) = ExportOpsError::help(self) {
+            return Some(Box::new(help));
+        }
+        match self {
+            ExportOpsError::Resolve(e) => miette::Diagnostic::help(e),
+            ExportOpsError::Compensation { error, .. } => miette::Diagnostic::help(&**error),
+            ExportOpsError::Controller { error, .. } => miette::Diagnostic::help(&**error),
+            _ => None,
+        }
+    }
+}
+
+/// The document of `chain export`: the grid export's summary and file, or
+/// a per-axis format's report and files. Its JSON is the summary (the
+/// files' names, not their text).
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum ExportDocument {
+    /// `--controller grid`.
+    Grid(GridExport),
+    /// A per-axis table format.
+    Tables(TablesExport),
+}
+
+/// The grid export's document.
+#[derive(Debug, Clone, Serialize)]
+pub struct GridExport {
+    /// The values file.
+    pub values_file: String,
+    /// The file's name.
+    pub files: Vec<String>,
+    /// The corrections, residuals and summary.
+    #[serde(flatten)]
+    pub grid: GridCompensation,
+    /// The file itself.
+    #[serde(skip)]
+    pub file: ExportedFile,
+}
+
+/// A per-axis format's document.
+#[derive(Debug, Clone, Serialize)]
+pub struct TablesExport {
+    /// The values file.
+    pub values_file: String,
+    /// What the format expresses, what it leaves, how large.
+    #[serde(flatten)]
+    pub report: FormatReport,
+    /// The files themselves.
+    #[serde(skip)]
+    pub files: Vec<ExportedFile>,
+}
+
+impl ExportDocument {
+    /// The files the export writes.
+    pub fn files(&self) -> &[ExportedFile] {
+        match self {
+            ExportDocument::Grid(g) => std::slice::from_ref(&g.file),
+            ExportDocument::Tables(t) => &t.files,
+        }
+    }
+}
+
+/// Refuses the options the chosen controller does not take, before
+/// anything is read.
+pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
+    let controller = request.controller.name();
+    let refuse = |option, why| {
+        Err(ExportOpsError::Option {
+            controller,
+            option,
+            why,
+        })
+    };
+    match request.controller {
+        ExportController::Grid => {
+            if request.step.is_some() {
+                return refuse(
+                    "--step",
+                    "the grid export corrects at the grid's nodes: give them with --grid VAR=LO:HI:N",
+                );
+            }
+            if request.cec_max_points.is_some() || request.beckhoff_max_records.is_some() {
+                return refuse(
+                    "--cec-max-points or --beckhoff-max-records",
+                    "they limit the siemens-cec and beckhoff tables",
+                );
+            }
+        }
+        ExportController::Tables(c) => {
+            if request.rows.is_some() {
+                return refuse(
+                    "--axes",
+                    "a per-axis table samples each axis over its travel: give the travel with --grid VAR=LO,HI and the table step with --step; --axes gives the nodes of --controller grid",
+                );
+            }
+            if request.cec_max_points.is_some() && c != Controller::SiemensCec {
+                return refuse("--cec-max-points", "it limits the siemens-cec tables");
+            }
+            if request.beckhoff_max_records.is_some() && c != Controller::Beckhoff {
+                return refuse("--beckhoff-max-records", "it limits the beckhoff tables");
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Runs `chain export` of `machine` (`file` names it) with `values` (read
+/// from `values_file`).
+pub fn run(
+    machine: &Machine,
+    file: &str,
+    values: Values,
+    values_file: &str,
+    request: &ExportRequest<'_>,
+) -> Result<ExportDocument, ExportOpsError> {
+    check(request)?;
+    let m = machine;
+    resolve::check_parameters(m, request.params)?;
+    let params = reliability::machine::parameters(m, request.params)?;
+    let built_error = |e: chain_core::built::BuiltError| ExportOpsError::Built {
+        values: values_file.to_string(),
+        message: e.to_string(),
+    };
+    match request.controller {
+        ExportController::Grid => {
+            let points = match &request.rows {
+                Some((rows, flat)) => {
+                    Points::list(m.variables.len(), flat.clone()).map_err(|error| {
+                        ExportOpsError::Points {
+                            rows: rows.to_string(),
+                            error,
+                        }
+                    })?
+                }
+                None => {
+                    let axes = resolve::grid_axes(m, file, request.grid)?;
+                    Points::Grid(axes.into_iter().map(|(_, v)| v).collect())
+                }
+            };
+            let built = BuiltMachine::compile(m, values, params).map_err(built_error)?;
+            let kin = Kinematics::from_machine(m);
+            let result = grid::export(&built, &kin, points).map_err(|error| {
+                ExportOpsError::Compensation {
+                    values: values_file.to_string(),
+                    error: Box::new(error),
+                }
+            })?;
+            let file = result.file();
+            Ok(ExportDocument::Grid(GridExport {
+                values_file: values_file.to_string(),
+                files: vec![file.name.clone()],
+                grid: result,
+                file,
+            }))
+        }
+        ExportController::Tables(c) => {
+            let built = BuiltMachine::compile(m, values, params).map_err(built_error)?;
+            let options = ExportOptions {
+                step: request.step.unwrap_or(DEFAULT_STEP),
+                travel: travel_of(request.grid),
+                cec_max_points: request.cec_max_points.unwrap_or(CEC_DEFAULT_MAX_POINTS),
+                beckhoff_max_records: (request.beckhoff_max_records)
+                    .unwrap_or(BECKHOFF_DEFAULT_MAX_RECORDS),
+            };
+            let export = table_export(c, &built, m, &options, request.grid, values_file)?;
+            Ok(ExportDocument::Tables(TablesExport {
+                values_file: values_file.to_string(),
+                report: export.report,
+                files: export.files,
+            }))
+        }
+    }
+}
+
+/// The per-axis export of `controller` with `options`, and `grid`'s values
+/// checked against the table nodes it gives (a value between nodes is
+/// refused, not dropped). Shared with `chain map --compensated`.
+pub fn table_export(
+    controller: Controller,
+    built: &BuiltMachine,
+    machine: &Machine,
+    options: &ExportOptions,
+    grid: &[(String, Vec<f64>)],
+    values_file: &str,
+) -> Result<Export, ExportOpsError> {
+    let export = controllers::export(controller, built, machine, options).map_err(|error| {
+        ExportOpsError::Controller {
+            values: values_file.to_string(),
+            error: Box::new(error),
+        }
+    })?;
+    for (name, given) in grid {
+        let Some(a) = export.report.axes.iter().find(|a| a.variable == *name) else {
+            continue;
+        };
+        let off_node = given.iter().find(|&&v| {
+            let k = ((v - a.min) / a.step).round();
+            (v - (a.min + k * a.step)).abs() > 1e-9 * a.step.max(1.0)
+        });
+        let what = match off_node {
+            Some(v) => format!("{v} is not one of its nodes"),
+            None if given.len() > 2 && given.len() != a.points => {
+                format!("it has {} values", given.len())
+            }
+            None => continue,
+        };
+        return Err(ExportOpsError::GridNodes {
+            controller: controller.name(),
+            variable: name.clone(),
+            points: a.points,
+            step: a.step,
+            min: a.min,
+            max: a.max,
+            what,
+        });
+    }
+    Ok(export)
+}
+
+/// `--grid` values as travels: each axis's smallest and largest value.
+pub fn travel_of(grid: &[(String, Vec<f64>)]) -> Vec<(String, [f64; 2])> {
+    grid.iter()
+        .map(|(n, v)| {
+            let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            (n.clone(), [lo, hi])
+        })
+        .collect()
+}
