@@ -18,7 +18,7 @@ from ._results import Derivation, ReliabilityResult, Result
 from ._results import IdentifyResult, MapResult, PlanResult
 from ._results import Derivation, ReliabilityResult, Result, SobolResult
 from ._results import AllocationResult, GeometricSensitivityResult, SensitivityResult
-from ._results import CompensateResult, ExportResult, InverseResult, PathResult, PositioningResult
+from ._results import CompensateResult, ExportResult, InverseResult, MotionResult, PathResult, PositioningResult
 from ._positioning import positioning
 from ._compensate import compensate
 
@@ -32,6 +32,7 @@ __all__ = [
     "InverseResult",
     "PathResult",
     "MapResult",
+    "MotionResult",
     "PlanResult",
     "PositioningResult",
     "Machine",

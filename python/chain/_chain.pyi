@@ -199,6 +199,23 @@ def export_json(
 ) -> Tuple[str, List[Tuple[str, str]]]: ...
 
 
+# -- motion conversion (python/src/motion.rs) ------------------------------------
+
+def motion_json(
+    model: Model,
+    path: Optional[str],
+    text: Optional[str],
+    file: str,
+    order: int,
+    max_order: int,
+    samples: int,
+    tolerance: Optional[float],
+    angular_tolerance: Optional[float],
+    params: Sequence[Tuple[str, float]],
+    fix: Sequence[Tuple[str, float]],
+) -> Tuple[str, List[float], List[float]]: ...
+
+
 # -- swing-angle compensation (python/src/compensate.rs) -------------------------
 
 def compensate_json(

@@ -441,6 +441,53 @@ class Machine:
                     f.write(content)
         return result
 
+    def motion(
+        self,
+        settings: Union[str, "os.PathLike[str]", Mapping[str, Any]],
+        order: int = 8,
+        max_order: int = 40,
+        samples: int = 1000,
+        tolerance: Optional[float] = None,
+        angular_tolerance: Optional[float] = None,
+        params: Params = None,
+        fix: Optional[Mapping[str, float]] = None,
+    ) -> "MotionResult":
+        """Motion conversion onto this CNC machine, ``chain motion FILE --settings SETTINGS --format json``.
+
+        ``settings``: a settings file's path, or its document as a dict
+        (relative paths in it are then resolved against the working
+        directory). ``order``, ``max_order``, ``samples``, ``tolerance``,
+        ``angular_tolerance``, ``params`` (``--param``) and ``fix``
+        (``--fix``) are the CLI's options. The result's ``times`` (``(K,)``)
+        and ``exact`` (``(K, V)``, :attr:`variables` order) are the exact
+        motion, the CLI's ``--format csv``.
+        """
+        import json
+
+        from ._results import MotionResult
+
+        if isinstance(settings, (str, os.PathLike)):
+            path, text, name = os.fspath(settings), None, os.fspath(settings)
+        elif isinstance(settings, Mapping):
+            try:
+                path, text, name = None, json.dumps(dict(settings), allow_nan=False), "<settings>"
+            except (TypeError, ValueError) as e:
+                raise ValueError(f"settings: {e}") from None
+        else:
+            raise ValueError(f"settings must be a settings file's path or a dict, not {type(settings).__name__}")
+        for key, value in (("order", order), ("max_order", max_order), ("samples", samples)):
+            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+                raise ValueError(f"{key} must be a non-negative integer, not {value!r}")
+        doc, times, exact = _chain.motion_json(
+            self._model, path, text, name, order, max_order, samples,
+            _optional_float(tolerance, "tolerance"), _optional_float(angular_tolerance, "angular_tolerance"),
+            _params(params), _params(fix),
+        )
+        result = MotionResult._from_json(doc)
+        result.__dict__["times"] = np.asarray(times, dtype=np.float64)
+        result.__dict__["exact"] = np.asarray(exact, dtype=np.float64).reshape(len(times), len(self.variables))
+        return result
+
     def identify(
         self,
         measurements: Union[str, "os.PathLike[str]", Mapping[str, ArrayLike]],

@@ -359,6 +359,28 @@ class ExportResult(Result):
         return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(io.StringIO("\n".join(lines)))]
 
 
+class MotionResult(Result):
+    """``chain motion --format json``: CNC axis motions reproducing a generator's roll, and their series.
+
+    Attributes: ``machine``, ``generator``, ``settings``, ``match``,
+    ``variables``, ``units``, ``parameters``, ``fixed``, ``generator_laws``,
+    ``interval``, ``samples``, ``equivalence``, ``order``, ``at_zero``,
+    ``coefficients``, ``derivatives``, ``truncation_error``,
+    ``errors_by_order``, ``required_order``; and ``times`` (``(K,)``) and
+    ``exact`` (``(K, V)``), the exact motion. Rows of ``to_dataframe()``: one
+    per instant (``t`` and the axes), as ``--format csv``.
+    """
+
+    command = "motion"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        names = self._document["variables"]
+        return [
+            dict({"t": float(t)}, **{v: float(x) for v, x in zip(names, q)})
+            for t, q in zip(self.__dict__["times"], self.__dict__["exact"])
+        ]
+
+
 class CompensateResult(Result):
     """``chain compensate --format json``: a swing-angle error identified from tool-tip heights.
 

@@ -20,6 +20,7 @@ mod compensate;
 mod export;
 mod group_b;
 mod inverse;
+mod motion;
 mod path;
 mod positioning;
 use std::mem::MaybeUninit;
@@ -543,6 +544,7 @@ fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(inverse::inverse_json, m)?)?;
     m.add_function(wrap_pyfunction!(path::path_json, m)?)?;
     m.add_function(wrap_pyfunction!(export::export_json, m)?)?;
+    m.add_function(wrap_pyfunction!(motion::motion_json, m)?)?;
     m.add_function(wrap_pyfunction!(compensate::compensate_json, m)?)?;
     Ok(())
 }

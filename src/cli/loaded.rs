@@ -134,14 +134,6 @@ impl Loaded {
     }
 }
 
-/// `--fix` names resolved to variable indices ([`chain::ops::resolve::fixed`]).
-pub(crate) fn resolve_fixed(
-    m: &Machine,
-    fix: &[(String, f64)],
-) -> miette::Result<Vec<(usize, f64)>> {
-    Ok(chain::ops::resolve::fixed(m, fix)?)
-}
-
 /// The values of `--at` in the machine's variable order
 /// ([`chain::ops::resolve::at_point`]).
 pub(crate) fn resolve_at(coords: &[(String, f64)], loaded: &Loaded) -> miette::Result<Vec<f64>> {

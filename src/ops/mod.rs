@@ -14,11 +14,13 @@
 //! - [`inverse`]: `chain inverse`'s request, poses and document;
 //! - [`positioning`]: `chain positioning`'s request, document and values file;
 //! - [`map`]: `chain map`'s preparation (values, approach, points, the built machine);
+//! - [`motion`]: `chain motion`'s request (the settings, the series' options) and document;
 //! - [`path`]: `chain path`'s request (axis values or poses) and document.
 
 pub mod export;
 pub mod inverse;
 pub mod map;
+pub mod motion;
 pub mod path;
 pub mod positioning;
 pub mod resolve;

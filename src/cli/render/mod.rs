@@ -2,4 +2,5 @@
 //! file per document; the JSON form is the document's own `Serialize`.
 
 pub(crate) mod export;
+pub(crate) mod motion;
 pub(crate) mod path;
