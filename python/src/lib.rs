@@ -487,7 +487,7 @@ impl Model {
         system: Option<reliability::System>,
         posterior: Option<&reliability::Posterior>,
     ) -> PyResult<Study> {
-        use chain::ops::study::{StudyError, StudyOptions};
+        use chain::ops::study::StudyOptions;
         let sided = sided_named(sided)?;
         self.parameter_vector(py, params)?;
         let options = StudyOptions {
@@ -497,17 +497,28 @@ impl Model {
             system,
             posterior,
         };
-        chain::ops::study::study(&self.machine, &self.file, &self.model, &options).map_err(|e| {
-            match e {
-                StudyError::Reliability(e) => study_error(py, &e, &self.file),
-                StudyError::Resolve(e) => resolve_error(py, self, e),
-                StudyError::Posterior(reliability::PosteriorError::Values(v)) => {
-                    load_error(py, v.diagnostics())
-                }
-                StudyError::Posterior(reliability::PosteriorError::File(d)) => load_error(py, &d),
-                StudyError::Posterior(e) => value_error(e.to_string()),
-            }
-        })
+        chain::ops::study::study(&self.machine, &self.file, &self.model, &options)
+            .map_err(|e| study_failure(py, self, e))
+    }
+}
+
+/// A study's refusal: a reliability error located in the machine file, an
+/// option as `resolve_error`, the posterior located in the values file, an
+/// approach the values do not have as `ValueError`.
+pub(crate) fn study_failure(
+    py: Python<'_>,
+    model: &Model,
+    e: chain::ops::study::StudyError,
+) -> PyErr {
+    use chain::ops::study::StudyError;
+    use reliability::PosteriorError;
+    match e {
+        StudyError::Reliability(e) => study_error(py, &e, &model.file),
+        StudyError::Resolve(e) => resolve_error(py, model, e),
+        StudyError::Posterior(PosteriorError::Values(v)) => load_error(py, v.diagnostics()),
+        StudyError::Posterior(PosteriorError::File(d)) => load_error(py, &d),
+        StudyError::Posterior(PosteriorError::Reliability(e)) => study_error(py, &e, &model.file),
+        e @ (StudyError::Posterior(_) | StudyError::Approach { .. }) => value_error(e.to_string()),
     }
 }
 

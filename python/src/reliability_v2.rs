@@ -2,23 +2,23 @@
 //! option of the command line (methods form, is, mc, sorm, subset,
 //! directional; `cov`; `system`; `values`; `acceptance`) and `chain sobol`.
 //!
-//! Each returns the library's document as JSON text, the document the CLI
-//! prints with `--format json` for the same input: [`ReliabilityDocument`]
-//! (with its [`AcceptanceDocument`]) and [`SobolDocument`], built by the same
-//! library functions the CLI calls ([`document::algorithm`],
-//! [`document::acceptance`], [`document::volumetric`]). Every option is
-//! checked before any work and refused with the CLI's wording, the option
-//! named as the Python keyword.
+//! Each returns the document the CLI prints with `--format json` for the
+//! same input: `chain reliability`'s through `chain::ops::reliability` (the
+//! CLI's request, checks and run), [`SobolDocument`] through the library
+//! functions the CLI calls. Every option is checked before any work and
+//! refused with the CLI's wording.
 
 use std::path::Path;
 
+use chain::ops::reliability::{self as ops_reliability, ReliabilityOpsError, ReliabilityRequest};
 use chain::ops::study::{self, AlgorithmOptions, SystemChoice};
+use chain_core::values::Approach;
 use pyo3::prelude::*;
-use reliability::document::{self, AcceptanceDocument, ReliabilityDocument, SobolDocument};
+use reliability::document::SobolDocument;
 use reliability::sobol::{Sobol, SobolError};
-use reliability::{Method, Posterior, PosteriorError, ReliabilityError, Study};
+use reliability::{Method, Posterior, ReliabilityError, Study};
 
-use crate::{load_error, study_error, to_json, value_error, Model};
+use crate::{sided_named, study_error, study_failure, to_json, value_error, Model};
 
 /// The methods of `method`, in the CLI's order of `--method`.
 const METHODS: [Method; 6] = [
@@ -97,7 +97,8 @@ pub(crate) fn system_choice(
 }
 
 /// The posterior of the values file at `path` (`--values`), its tables read
-/// for `approach` (`--approach`: `up`, `down`, `mean` or `x=up,...`).
+/// for `approach` (`--approach`: `up`, `down`, `mean` or `x=up,...`), by
+/// [`study::read_posterior`].
 pub(crate) fn read_posterior(
     py: Python<'_>,
     model: &Model,
@@ -110,26 +111,18 @@ pub(crate) fn read_posterior(
         }
         return Ok(None);
     };
-    let mut posterior = Posterior::read(Path::new(path), &model.machine)
-        .map_err(|e| posterior_error(py, model, e))?;
-    if let Some(text) = approach {
-        let choices = chain_core::values::parse_approaches(text)
-            .map_err(|e| value_error(format!("approach: {e}")))?;
-        posterior
-            .choose_approach(&choices)
-            .map_err(|e| value_error(format!("--approach: {e} (values {path})")))?;
-    }
-    Ok(Some(posterior))
+    let choices = parse_approach(approach)?;
+    study::read_posterior(&model.machine, Path::new(path), &choices)
+        .map(Some)
+        .map_err(|e| study_failure(py, model, e))
 }
 
-/// A posterior's refusal: located in the values file (`MachineError`), or
-/// a reliability error worded against the machine file.
-pub(crate) fn posterior_error(py: Python<'_>, model: &Model, e: PosteriorError) -> PyErr {
-    match e {
-        PosteriorError::Values(v) => load_error(py, v.diagnostics()),
-        PosteriorError::File(d) => load_error(py, &d),
-        PosteriorError::Reliability(e) => study_error(py, &e, &model.file),
-        e @ PosteriorError::Point { .. } => value_error(e.to_string()),
+/// `approach` (`up`, `down`, `mean` or `x=up,...`) as `--approach` parses it.
+fn parse_approach(approach: Option<&str>) -> PyResult<Vec<(Option<String>, Approach)>> {
+    match approach {
+        Some(text) => chain_core::values::parse_approaches(text)
+            .map_err(|e| value_error(format!("approach: {e}"))),
+        None => Ok(Vec::new()),
     }
 }
 
@@ -163,40 +156,33 @@ pub(crate) fn reliability_json(
     acceptance_tolerance: f64,
     approach: Option<&str>,
 ) -> PyResult<String> {
-    let options = algorithm_options(method, samples, seed, cov)?;
-    if !(acceptance_tolerance.is_finite()
-        && acceptance_tolerance > 0.0
-        && acceptance_tolerance < 1.0)
-    {
-        return Err(value_error(format!(
-            "invalid value for `acceptance_tolerance`: {acceptance_tolerance} (an absolute error in (0, 1))"
-        )));
+    let algorithm = algorithm_options(method, samples, seed, cov)?;
+    let system = system_choice(system, system_tolerance)?;
+    let sided = sided_named(sided)?;
+    if values.is_none() && approach.is_some() {
+        return Err(value_error("approach needs values"));
     }
-    let system = study::system(&model.machine, system_choice(system, system_tolerance)?)
-        .map_err(|e| study_error(py, &e, &model.file))?;
-    let posterior = read_posterior(py, model, values, approach)?;
-    let study = model.study_with(py, &grid, &params, sided, system, posterior.as_ref())?;
-    let algorithm = options.algorithm();
-    let wanted = acceptance
-        || model
-            .machine
-            .reliability
-            .as_ref()
-            .is_some_and(|r| r.acceptance);
-    let (result, accepted) = py
-        .allow_threads(|| {
-            let result = study.run(&algorithm, &|_| {})?;
-            let accepted = match wanted {
-                true => Some(document::acceptance(&study, acceptance_tolerance, seed)?),
-                false => None,
-            };
-            Ok::<_, ReliabilityError>((result, accepted))
-        })
-        .map_err(|e| study_error(py, &e, &model.file))?;
-    let mut doc = ReliabilityDocument::new(&model.machine.name, &study, &result);
-    doc.posterior = posterior.as_ref();
-    doc.acceptance = accepted.as_ref().map(AcceptanceDocument::of);
-    to_json(&doc)
+    let approach = parse_approach(approach)?;
+    model.parameter_vector(py, &params)?;
+    let request = ReliabilityRequest {
+        params: &params,
+        grid: &grid,
+        sided,
+        system,
+        algorithm,
+        values: values.map(Path::new),
+        approach: &approach,
+        acceptance,
+        acceptance_tolerance,
+    };
+    let run = py
+        .allow_threads(|| ops_reliability::run(&model.machine, &model.file, &request, &()))
+        .map_err(|e| match e {
+            ReliabilityOpsError::Option(e) => value_error(e.to_string()),
+            ReliabilityOpsError::Study(e) => study_failure(py, model, *e),
+            ReliabilityOpsError::Reliability(e) => study_error(py, &e, &model.file),
+        })?;
+    to_json(&run)
 }
 
 /// `chain sobol --format json`: first-order and total Sobol indices

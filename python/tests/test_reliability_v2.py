@@ -194,7 +194,7 @@ def test_other_bad_options_raise_value_error():
         ({"system": "series", "system_tolerance": 0.1}, "not \"series\""),
         ({"system": "volumetric", "system_tolerance": -1.0}, "invalid value for `system_tolerance`: -1"),
         ({"acceptance": "yes"}, "acceptance must be True or False"),
-        ({"acceptance": True, "acceptance_tolerance": 1.0}, "invalid value for `acceptance_tolerance`: 1"),
+        ({"acceptance": True, "acceptance_tolerance": 1.0}, "invalid value for '--acceptance-tolerance': 1 (an absolute error in (0, 1))"),
         ({"sided": "three"}, "sided must be \"upper\" or \"two\""),
     ]
     for kw, wording in bad:

@@ -2,8 +2,8 @@
 //! their argument structs with `#[command(flatten)]`.
 
 use chain_core::compensation::controllers::Controller;
-use chain_core::model::{Machine, Sided};
-use reliability::{Method, ReliabilityError, System};
+use chain_core::model::Sided;
+use reliability::Method;
 
 /// `--param NAME=VALUE`: the values of the machine file's parameters.
 #[derive(Debug, clap::Args)]
@@ -70,11 +70,6 @@ impl AlgorithmArgs {
     pub fn check(&self) -> miette::Result<()> {
         Ok(self.options().check()?)
     }
-
-    /// The library's algorithm for these options.
-    pub fn algorithm(&self) -> reliability::Algorithm {
-        self.options().algorithm()
-    }
 }
 
 /// `--system`, `--system-tolerance`: a system target besides the components.
@@ -121,12 +116,6 @@ impl MethodArg {
             MethodArg::Sorm => Method::Sorm,
         }
     }
-
-    /// The samples per case: `--samples` or the method's default
-    /// ([`reliability::document::samples`]; 0 for FORM, which draws none).
-    pub(crate) fn samples(self, given: Option<u64>, to_cov: bool) -> u64 {
-        reliability::document::samples(self.method(), given, to_cov)
-    }
 }
 
 /// Parses `--cov`: a finite number in (0, 1].
@@ -141,13 +130,6 @@ pub(crate) fn parse_cov(s: &str) -> Result<f64, String> {
         ));
     }
     Ok(v)
-}
-
-impl MethodArg {
-    /// Whether the method samples (all but FORM).
-    pub(crate) fn samples_anything(self) -> bool {
-        !matches!(self, MethodArg::Form | MethodArg::Sorm)
-    }
 }
 
 /// `--sided` override.
@@ -187,13 +169,6 @@ impl SystemArgs {
             SystemArg::Volumetric => SystemChoice::Volumetric(self.tolerance),
         })
     }
-}
-
-pub(crate) fn system_of(
-    machine: &Machine,
-    system: &SystemArgs,
-) -> Result<Option<System>, ReliabilityError> {
-    chain::ops::study::system(machine, system.choice())
 }
 
 /// Parses `NAME=VALUE`.

@@ -8,7 +8,7 @@ use std::path::Path;
 use chain::ops::study::{StudyError, StudyOptions};
 use chain_core::model::Machine;
 use miette::{LabeledSpan, MietteDiagnostic};
-use reliability::{Posterior, PosteriorError, ReliabilityError, Study, System};
+use reliability::{Posterior, ReliabilityError, Study, System};
 
 use super::args::SidedArg;
 
@@ -52,7 +52,8 @@ impl Loaded {
     }
 
     /// The posterior of `--values`, if given (its refusals located in the
-    /// values file), its tables read for the `--approach` choices.
+    /// values file), its tables read for the `--approach` choices
+    /// ([`chain::ops::study::read_posterior`]).
     pub(crate) fn posterior(
         &self,
         values: Option<&Path>,
@@ -61,18 +62,21 @@ impl Loaded {
         let Some(path) = values else {
             return Ok(None);
         };
-        let mut posterior = match Posterior::read(path, &self.machine) {
-            Ok(p) => p,
-            Err(PosteriorError::Reliability(e)) => return Err(self.report(e)),
-            Err(e) => return Err(e.into()),
-        };
         let choices: Vec<_> = approach.iter().flatten().cloned().collect();
-        if !choices.is_empty() {
-            posterior
-                .choose_approach(&choices)
-                .map_err(|e| miette::miette!("--approach: {e} (values {})", path.display()))?;
+        chain::ops::study::read_posterior(&self.machine, path, &choices)
+            .map(Some)
+            .map_err(|e| self.study_error(e))
+    }
+
+    /// A study's refusal rendered: a reliability error located in the
+    /// machine file, the others as they are.
+    pub(crate) fn study_error(&self, e: StudyError) -> miette::Report {
+        match e {
+            StudyError::Reliability(e) => self.report(e),
+            StudyError::Resolve(e) => miette::Report::new(e),
+            StudyError::Posterior(e) => e.into(),
+            e @ StudyError::Approach { .. } => miette::miette!("{e}"),
         }
-        Ok(Some(posterior))
     }
 
     /// [`Loaded::study`] with the inputs of a posterior (`None`: the
@@ -93,14 +97,8 @@ impl Loaded {
             system,
             posterior,
         };
-        let study =
-            chain::ops::study::study(&self.machine, &self.file, &model, &options).map_err(|e| {
-                match e {
-                    StudyError::Reliability(e) => self.report(e),
-                    StudyError::Resolve(e) => miette::Report::new(e),
-                    StudyError::Posterior(e) => e.into(),
-                }
-            })?;
+        let study = chain::ops::study::study(&self.machine, &self.file, &model, &options)
+            .map_err(|e| self.study_error(e))?;
         Ok((study, model))
     }
 

@@ -1,7 +1,6 @@
 //! Subcommands of the `chain` binary: one file per subcommand, each a thin
 //! `exec` over the libraries.
 
-mod acceptance;
 pub mod allocate;
 mod args;
 mod atomic;

@@ -9,14 +9,6 @@ use reliability::{FormCase, Method, Posterior, Study, StudyResult, Termination};
 
 use super::report;
 
-/// FORM is exact only for one-sided components in normal inputs; say so on
-/// stderr when it is not ([`chain::ops::study::form_limits_note`]).
-pub(crate) fn note_form_limits(study: &Study) {
-    if let Some(note) = chain::ops::study::form_limits_note(study) {
-        eprintln!("{note}");
-    }
-}
-
 /// The lines saying which inputs come from a posterior (before the table).
 pub(crate) fn posterior_lines(p: &Posterior) -> String {
     let with_std = p.values.iter().filter(|v| v.std.is_some()).count();
@@ -63,14 +55,6 @@ pub(crate) fn posterior_lines(p: &Posterior) -> String {
     }
     out.push('\n');
     out
-}
-
-/// Warns on stderr about the cases that did not converge
-/// ([`chain::ops::study::unconverged_warnings`]).
-pub(crate) fn warn_unconverged(r: &StudyResult, variables: &[String]) {
-    for w in chain::ops::study::unconverged_warnings(r, variables) {
-        eprintln!("{w}");
-    }
 }
 
 /// One target's reliabilities as maps over the two grid axes it varies along

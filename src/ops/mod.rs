@@ -15,6 +15,7 @@
 //! - [`positioning`]: `chain positioning`'s request, document and values file;
 //! - [`map`]: `chain map`'s preparation (values, approach, points, the built machine);
 //! - [`motion`]: `chain motion`'s request (the settings, the series' options) and document;
+//! - [`reliability`]: `chain reliability`'s request, the prepared study and the run's document;
 //! - [`path`]: `chain path`'s request (axis values or poses) and document.
 
 pub mod export;
@@ -23,5 +24,6 @@ pub mod map;
 pub mod motion;
 pub mod path;
 pub mod positioning;
+pub mod reliability;
 pub mod resolve;
 pub mod study;

@@ -3,7 +3,10 @@
 //! one function for the CLI's `reliability`, `sensitivity`, `sobol`,
 //! `allocate`, `acceptance`, `path` and Python's methods over them.
 
+use std::path::Path;
+
 use chain_core::model::Sided;
+use chain_core::values::{Approach, ApproachError};
 use chain_core::{ErrorModel, Machine};
 use reliability::{
     Algorithm, Method, Posterior, PosteriorError, ReliabilityError, Study, StudyResult, System,
@@ -39,6 +42,33 @@ pub enum StudyError {
     /// The posterior's inputs (located in the values file).
     #[error(transparent)]
     Posterior(PosteriorError),
+    /// `--approach` names what the values do not have.
+    #[error("--approach: {error} (values {values})")]
+    Approach {
+        /// The values file.
+        values: String,
+        /// What is wrong.
+        error: ApproachError,
+    },
+}
+
+/// The posterior of the values file at `path` (`--values`), its tables
+/// read for the `--approach` choices (none: each table's mean).
+pub fn read_posterior(
+    machine: &Machine,
+    path: &Path,
+    approach: &[(Option<String>, Approach)],
+) -> Result<Posterior, StudyError> {
+    let mut posterior = Posterior::read(path, machine)?;
+    if !approach.is_empty() {
+        posterior
+            .choose_approach(approach)
+            .map_err(|error| StudyError::Approach {
+                values: path.display().to_string(),
+                error,
+            })?;
+    }
+    Ok(posterior)
 }
 
 impl From<PosteriorError> for StudyError {

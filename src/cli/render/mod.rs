@@ -4,3 +4,4 @@
 pub(crate) mod export;
 pub(crate) mod motion;
 pub(crate) mod path;
+pub(crate) mod reliability;

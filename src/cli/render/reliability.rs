@@ -1,0 +1,437 @@
+//! The table and CSV of `chain reliability` ([`ReliabilityRun`]): per
+//! target the reliability maps over the grid like the paper's Tables 2-4,
+//! the summaries, the sampling and the calls; the whole-machine acceptance
+//! probability (docs/acceptance.md); the posterior's listing. One CSV row
+//! per (target, point), then the acceptance row.
+
+use chain::ops::reliability::ReliabilityRun;
+use reliability::acceptance::AcceptanceResult;
+use reliability::{normal, Stopping, Study, StudyResult, SubsetLevel};
+
+use crate::cli::report::{Csv, Report};
+use crate::cli::study_text::{
+    calls_text, fmt_num, posterior_lines, requirement_text, sided_title, target_map,
+};
+
+/// The grid axes in file order, as (name, index in the model's variables).
+fn axes(study: &Study) -> Vec<(String, usize)> {
+    study
+        .spec()
+        .grid
+        .axes
+        .iter()
+        .filter_map(|(n, _)| {
+            study
+                .variables()
+                .iter()
+                .position(|v| v == n)
+                .map(|i| (n.clone(), i))
+        })
+        .collect()
+}
+
+impl Report for ReliabilityRun {
+    fn table(&self) -> String {
+        let mut table = to_table(&self.machine, &self.study, &self.result);
+        if let Some(a) = &self.acceptance {
+            table.push_str(&acceptance_table(&self.study, a));
+        }
+        match &self.posterior {
+            None => table,
+            Some(p) => format!("{}{table}", posterior_lines(p)),
+        }
+    }
+
+    fn csv(&self) -> Option<Csv> {
+        let (study, r) = (&self.study, &self.result);
+        let ax = axes(study);
+        // With the acceptance row, the sampling columns are always there
+        // (empty for FORM cases).
+        let sampled =
+            r.cases.first().is_some_and(|c| c.samples.is_some()) || self.acceptance.is_some();
+        let mut header = vec!["component".to_string()];
+        header.extend(ax.iter().map(|(n, _)| n.clone()));
+        header.extend(["reliability", "pf", "beta"].map(String::from));
+        if sampled {
+            header.extend(["std_error", "cov", "samples"].map(String::from));
+        }
+        header.extend(
+            [
+                "termination",
+                "converged",
+                "iterations",
+                "exact",
+                "value_calls",
+                "gradient_calls",
+            ]
+            .map(String::from),
+        );
+        // The sampler's stopping rule, when it reports one (v1 runs do not).
+        let stopped = r.cases.iter().any(|c| c.stopping.is_some());
+        let leveled = r.cases.iter().any(|c| c.levels.is_some());
+        if stopped {
+            header.extend(["stopped_by", "sampler_converged"].map(String::from));
+        }
+        if leveled {
+            header.push("levels".to_string());
+        }
+        // SORM's three formulas (`--method sorm`), last.
+        let sorm = r.cases.iter().any(|c| c.sorm.is_some());
+        if sorm {
+            header.extend(
+                [
+                    "beta_breitung",
+                    "beta_hohenbichler_rackwitz",
+                    "beta_tvedt",
+                    "sorm_converged",
+                ]
+                .map(String::from),
+            );
+        }
+        let width = header.len();
+        let mut csv = Csv::new(header);
+        for c in &r.cases {
+            let mut row = vec![c.target.to_string()];
+            row.extend(ax.iter().map(|(_, i)| fmt_num(c.point[*i])));
+            row.extend([c.reliability, c.pf, c.beta].map(csv_number));
+            if sampled && self.acceptance.is_some() {
+                row.push(c.std_error.map_or(String::new(), csv_number));
+                row.push(c.cov.map_or(String::new(), csv_number));
+                row.push(c.samples.map_or(String::new(), |v| v.to_string()));
+            } else if sampled {
+                row.push(format!("{:?}", c.std_error.unwrap_or(0.0)));
+                row.push(format!("{:?}", c.cov.unwrap_or(0.0)));
+                row.push(c.samples.unwrap_or(0).to_string());
+            }
+            match &c.form {
+                Some(f) => row.extend([
+                    f.termination.to_string(),
+                    f.converged.to_string(),
+                    f.iterations.to_string(),
+                    f.exact.to_string(),
+                ]),
+                None => row.extend((0..4).map(|_| String::new())),
+            }
+            row.push(c.calls.values.to_string());
+            row.push(c.calls.gradients.to_string());
+            if stopped {
+                match &c.stopping {
+                    Some(st) => row.extend([st.stopped_by.to_string(), st.converged.to_string()]),
+                    None => row.extend([String::new(), String::new()]),
+                }
+            }
+            if leveled {
+                row.push(
+                    c.levels
+                        .as_ref()
+                        .map_or(String::new(), |l| l.len().to_string()),
+                );
+            }
+            if sorm {
+                match &c.sorm {
+                    Some(so) => {
+                        row.extend(
+                            [
+                                so.beta_breitung,
+                                so.beta_hohenbichler_rackwitz,
+                                so.beta_tvedt,
+                            ]
+                            .map(csv_number),
+                        );
+                        row.push(so.converged.to_string());
+                    }
+                    None => row.extend((0..4).map(|_| String::new())),
+                }
+            }
+            csv.row(row);
+        }
+        if let Some(a) = &self.acceptance {
+            let mut row = acceptance_csv_row(a, ax.len());
+            row.resize(width.max(row.len()), String::new());
+            csv.row(row);
+        }
+        Some(csv)
+    }
+}
+
+fn to_table(machine: &str, study: &Study, r: &StudyResult) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let sided = sided_title(study.spec().sided);
+    let _ = writeln!(
+        out,
+        "{machine}: machining-accuracy reliability ({}, {sided})",
+        r.method.title()
+    );
+    let mut marked = false;
+    for (t, target) in study.targets().iter().enumerate() {
+        let map = target_map(study, r, t);
+        let over = match (&map.rows, &map.cols) {
+            (Some(a), Some(b)) => format!(" over ({}, {})", a.0, b.0),
+            (Some(a), None) => format!(" over {}", a.0),
+            _ => String::new(),
+        };
+        let _ = writeln!(out, "\n{target}: reliability (%){over}");
+        for ((label, m), u) in map.maps.iter().zip(&map.unconverged) {
+            if !label.is_empty() {
+                let _ = writeln!(out, "  at {label}");
+            }
+            let corner = match (&map.rows, &map.cols) {
+                (Some(a), Some(b)) => format!("{} \\ {}", a.0, b.0),
+                (Some(a), None) => a.0.clone(),
+                _ => String::new(),
+            };
+            let _ = write!(out, "  {corner:>10}");
+            match &map.cols {
+                Some((_, vals)) => vals.iter().for_each(|v| {
+                    let _ = write!(out, " {:>9}", fmt_num(*v));
+                }),
+                None => {
+                    let _ = write!(out, " {:>9}", "");
+                }
+            }
+            out.push('\n');
+            for (i, row) in m.iter().enumerate() {
+                let head = map
+                    .rows
+                    .as_ref()
+                    .map_or(String::new(), |(_, v)| fmt_num(v[i]));
+                let _ = write!(out, "  {head:>10}");
+                for v in row {
+                    let _ = write!(out, " {:>9.2}", 100.0 * v);
+                }
+                out.push('\n');
+            }
+            // The cells FORM did not converge on, listed under the map (the
+            // map's own lines stay those of a converged study).
+            let mut bad = Vec::new();
+            for (i, urow) in u.iter().enumerate() {
+                for (j, unconverged) in urow.iter().enumerate() {
+                    if *unconverged {
+                        let coords: Vec<String> = [(&map.rows, i), (&map.cols, j)]
+                            .iter()
+                            .filter_map(|(axis, k)| {
+                                axis.as_ref()
+                                    .map(|(n, v)| format!("{n} = {}", fmt_num(v[*k])))
+                            })
+                            .collect();
+                        bad.push(if coords.is_empty() {
+                            "the point".to_string()
+                        } else {
+                            format!("({})", coords.join(", "))
+                        });
+                    }
+                }
+            }
+            if !bad.is_empty() {
+                marked = true;
+                let _ = writeln!(out, "  * not converged at {}", bad.join(", "));
+            }
+        }
+        if let Some(s) = r.summaries.get(t) {
+            let _ = write!(
+                out,
+                "  summary: mean {:.2} %, min {:.2} %, max {:.2} %",
+                100.0 * s.mean,
+                100.0 * s.min,
+                100.0 * s.max
+            );
+            if let (Some(req), Some(met)) = (r.requirement, s.met) {
+                out.push_str(&requirement_text(&req, met));
+            }
+            out.push('\n');
+        }
+        let cases = r.target_cases(t);
+        let se = cases
+            .iter()
+            .filter_map(|c| c.std_error)
+            .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))));
+        let rule = cases.iter().filter_map(|c| c.stopping).next();
+        match (se, cases.first().and_then(|c| c.samples), rule) {
+            (Some(se), Some(n), None) => {
+                let _ = writeln!(
+                    out,
+                    "  sampling: {n} samples per point, largest standard error {:.2e}",
+                    se
+                );
+            }
+            (Some(se), Some(_), Some(rule)) => {
+                let _ = writeln!(out, "  {}", sampling_text(cases, rule, se));
+            }
+            _ => {}
+        }
+        let _ = writeln!(out, "  {}", calls_text(cases.iter(), r.method));
+    }
+    if marked {
+        let sampler = r.cases.iter().any(|c| !c.sampler_converged());
+        let form = r.cases.iter().any(|c| c.form.is_some_and(|f| !f.converged));
+        if form {
+            let _ = writeln!(
+                out,
+                "\n* FORM stopped at the iteration limit there: the value shown is the last iterate's, not a converged reliability"
+            );
+        }
+        if sampler {
+            let _ = writeln!(
+                out,
+                "\n* the {} stopped there without meeting its rule (sample budget or levels exhausted): the value shown is not a converged estimate",
+                r.method.title()
+            );
+        }
+    }
+    out
+}
+
+/// The table line of a sampler that reports its stopping: the samples used
+/// (a range when the rule stopped the points apart), the target and how
+/// many points met it, the largest standard error; for subset simulation
+/// the levels and the chains' mean acceptance rate.
+fn sampling_text(cases: &[reliability::CaseResult], rule: Stopping, se: f64) -> String {
+    let ns: Vec<u64> = cases.iter().filter_map(|c| c.samples).collect();
+    let (lo, hi) = (
+        ns.iter().copied().min().unwrap_or(0),
+        ns.iter().copied().max().unwrap_or(0),
+    );
+    let samples = if lo == hi {
+        format!("{lo} samples per point")
+    } else {
+        format!("{lo} to {hi} samples per point")
+    };
+    let met = cases.iter().filter(|c| c.sampler_converged()).count();
+    let target = match rule.target_cov {
+        Some(t) => format!(", target CoV {t} met at {met} of {} points", cases.len()),
+        None if met < cases.len() => format!(", converged at {met} of {} points", cases.len()),
+        None => String::new(),
+    };
+    let mut text = format!("sampling: {samples}{target}, largest standard error {se:.2e}");
+    let levels: Vec<&Vec<SubsetLevel>> = cases.iter().filter_map(|c| c.levels.as_ref()).collect();
+    if !levels.is_empty() {
+        let counts = levels.iter().map(|l| l.len());
+        let (lmin, lmax) = (counts.clone().min().unwrap_or(0), counts.max().unwrap_or(0));
+        let rates: Vec<f64> = levels
+            .iter()
+            .flat_map(|l| l.iter().filter_map(|x| x.acceptance_rate))
+            .collect();
+        let levels = if lmin == lmax {
+            format!("{lmin} levels")
+        } else {
+            format!("{lmin} to {lmax} levels")
+        };
+        text.push_str(&format!("; subset: {levels}"));
+        if !rates.is_empty() {
+            let mean = rates.iter().sum::<f64>() / rates.len() as f64;
+            text.push_str(&format!(", mean acceptance {mean:.2}"));
+        }
+    }
+    text
+}
+
+/// A CSV cell of a number: shortest round-trip form when finite, an empty
+/// cell otherwise, as the JSON writes `null` (a sampled `pf` of exactly 1
+/// has `beta = −∞`; `docs/robustness.md`).
+fn csv_number(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:?}")
+    } else {
+        String::new()
+    }
+}
+
+/// The table section: the probability with its error and method, and the
+/// sensitivities sorted by `|∂P/∂σ|·σ` (the change for a 100 % larger σ).
+fn acceptance_table(study: &Study, a: &AcceptanceResult) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let np = study.points().len();
+    let comps: Vec<&str> = study
+        .spec()
+        .tolerances
+        .iter()
+        .map(|(c, _)| c.name())
+        .collect();
+    let _ = writeln!(
+        out,
+        "\nwhole-machine acceptance: {} at all {np} points at once ({} constraints, {} distinct, rank {})",
+        comps.join(", "),
+        a.constraints,
+        a.distinct,
+        a.rank
+    );
+    let status = if a.converged {
+        String::new()
+    } else {
+        format!(
+            "  NOT CONVERGED: 3 standard errors = {:.2e} exceed the tolerance {:.2e}",
+            3.0 * a.std_error,
+            a.tolerance.unwrap_or(0.0)
+        )
+    };
+    let _ = writeln!(
+        out,
+        "  P(accept) = {:.4} % ± {:.4} % (1 standard error; {}, {} samples){status}",
+        a.probability * 100.0,
+        a.std_error * 100.0,
+        a.method.title(),
+        a.samples
+    );
+    let stds = study.inputs().stds();
+    let mut order: Vec<usize> = (0..a.sensitivity.len()).collect();
+    order.sort_by(|&i, &j| {
+        (a.sensitivity[j].dr_dstd * stds[j])
+            .abs()
+            .total_cmp(&(a.sensitivity[i].dr_dstd * stds[i]).abs())
+    });
+    if !order.is_empty() {
+        let _ = writeln!(
+            out,
+            "  {:<8} {:>13} {:>11} {:>13} {:>11} {:>10}",
+            "error", "dP/dstd", "± se", "dP/dmean", "± se", "σ·dP/dstd"
+        );
+        for j in order {
+            let s = &a.sensitivity[j];
+            if s.dr_dstd == 0.0 && s.dr_dmean == 0.0 {
+                continue;
+            }
+            let _ = writeln!(
+                out,
+                "  {:<8} {:>13.5e} {:>11.2e} {:>13.5e} {:>11.2e} {:>10.5}",
+                s.error,
+                s.dr_dstd,
+                s.dr_dstd_std_error,
+                s.dr_dmean,
+                s.dr_dmean_std_error,
+                s.dr_dstd * stds[j]
+            );
+        }
+        let _ = writeln!(
+            out,
+            "  (errors no toleranced component depends on are not listed)"
+        );
+    }
+    out
+}
+
+/// The CSV row `acceptance` in the columns of the case rows (no grid
+/// coordinates; `std_error`, `cov` and `samples` of the estimate;
+/// `converged`; the samples as value calls).
+fn acceptance_csv_row(a: &AcceptanceResult, axes: usize) -> Vec<String> {
+    let pf = 1.0 - a.probability;
+    let mut row = vec!["acceptance".to_string()];
+    row.extend((0..axes).map(|_| String::new()));
+    row.push(format!("{:?}", a.probability));
+    row.push(format!("{pf:?}"));
+    row.push(format!("{:?}", normal::beta_from_pf(pf)));
+    row.push(format!("{:?}", a.std_error));
+    row.push(format!(
+        "{:?}",
+        if pf > 0.0 { a.std_error / pf } else { 0.0 }
+    ));
+    row.push(a.samples.to_string());
+    row.push(String::new());
+    row.push(a.converged.to_string());
+    row.push(String::new());
+    row.push(String::new());
+    row.push(a.samples.to_string());
+    row.push("0".to_string());
+    row
+}
