@@ -11,12 +11,12 @@
 use std::path::Path;
 
 use chain::ops::reliability::{self as ops_reliability, ReliabilityOpsError, ReliabilityRequest};
-use chain::ops::study::{self, AlgorithmOptions, SystemChoice};
+use chain::ops::study::{AlgorithmOptions, SystemChoice};
 use chain_core::values::Approach;
 use pyo3::prelude::*;
 use reliability::document::SobolDocument;
 use reliability::sobol::{Sobol, SobolError};
-use reliability::{Method, Posterior, ReliabilityError, Study};
+use reliability::{Method, ReliabilityError, Study};
 
 use crate::{sided_named, study_error, study_failure, to_json, value_error, Model};
 
@@ -96,29 +96,8 @@ pub(crate) fn system_choice(
     }
 }
 
-/// The posterior of the values file at `path` (`--values`), its tables read
-/// for `approach` (`--approach`: `up`, `down`, `mean` or `x=up,...`), by
-/// [`study::read_posterior`].
-pub(crate) fn read_posterior(
-    py: Python<'_>,
-    model: &Model,
-    path: Option<&str>,
-    approach: Option<&str>,
-) -> PyResult<Option<Posterior>> {
-    let Some(path) = path else {
-        if approach.is_some() {
-            return Err(value_error("approach needs values"));
-        }
-        return Ok(None);
-    };
-    let choices = parse_approach(approach)?;
-    study::read_posterior(&model.machine, Path::new(path), &choices)
-        .map(Some)
-        .map_err(|e| study_failure(py, model, e))
-}
-
 /// `approach` (`up`, `down`, `mean` or `x=up,...`) as `--approach` parses it.
-fn parse_approach(approach: Option<&str>) -> PyResult<Vec<(Option<String>, Approach)>> {
+pub(crate) fn parse_approach(approach: Option<&str>) -> PyResult<Vec<(Option<String>, Approach)>> {
     match approach {
         Some(text) => chain_core::values::parse_approaches(text)
             .map_err(|e| value_error(format!("approach: {e}"))),

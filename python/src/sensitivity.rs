@@ -1,26 +1,37 @@
-//! The sensitivity bindings (issue 16): `chain sensitivity --kind
-//! reliability` and `--kind geometric`.
-//!
-//! Each returns the library's document as JSON text, the document the CLI
-//! prints with `--format json` for the same input, built by the functions
-//! the CLI calls: [`document::sensitivity`] and [`SensitivityDocument`],
-//! [`geometric::grid_axes`], [`geometric::evaluate`] and
-//! [`GeometricDocument`].
+//! The sensitivity bindings: `chain sensitivity --kind reliability` and
+//! `--kind geometric`, through `chain::ops::sensitivity` (the CLI's
+//! request, checks and document), as JSON text.
 
-use chain_core::geometric::{self, GeometricDocument, GridAxisError, NominalSizes, Where};
+use std::path::Path;
+
+use chain::ops::sensitivity::{
+    self, SensitivityKind, SensitivityOpsError, SensitivityRequest, SensitivityValues,
+};
+use chain_core::geometric::NominalSizes;
 use pyo3::prelude::*;
-use reliability::document::{self, SensitivityDocument};
-use reliability::{Form, ReliabilityError};
 
-use crate::reliability_v2::{read_posterior, resolve_at};
-use crate::{study_error, to_json, value_error, Model};
+use crate::reliability_v2::parse_approach;
+use crate::{resolve_error, sided_named, study_error, study_failure, to_json, value_error, Model};
+
+/// Runs the request and returns its document's JSON.
+fn run(py: Python<'_>, model: &Model, request: &SensitivityRequest<'_>) -> PyResult<String> {
+    let doc = py
+        .allow_threads(|| sensitivity::run(&model.machine, &model.file, request))
+        .map_err(|e| match e {
+            SensitivityOpsError::Study(e) => study_failure(py, model, *e),
+            SensitivityOpsError::Reliability(e) => study_error(py, &e, &model.file),
+            SensitivityOpsError::Resolve(e) => resolve_error(py, model, e),
+            e => value_error(e.with_help()),
+        })?;
+    to_json(&doc)
+}
 
 /// `chain sensitivity --kind reliability --format json`: the reliability
 /// sensitivity of each component to every error's mean and standard
 /// deviation (Eq. 32-33) with its FORM importance factor, at the point
 /// `at` (every axis variable) or, without it, the mean over the
 /// reliability grid (`grid` replacing axes). `values`: a values file with
-/// a calibration's posterior (`--values`).
+/// a calibration's posterior (`--values`), its tables read for `approach`.
 #[pyfunction]
 #[pyo3(signature = (model, at, grid, params, sided, values, approach))]
 #[allow(clippy::too_many_arguments)]
@@ -34,30 +45,20 @@ pub(crate) fn sensitivity_reliability_json(
     values: Option<&str>,
     approach: Option<&str>,
 ) -> PyResult<String> {
-    let posterior = read_posterior(py, model, values, approach)?;
-    let study = model.study_with(py, &grid, &params, sided, None, posterior.as_ref())?;
-    let point = match &at {
-        None => None,
-        Some(coords) => Some(resolve_at(py, model, coords)?),
+    if values.is_none() && approach.is_some() {
+        return Err(value_error("approach needs values"));
+    }
+    let approach = parse_approach(approach)?;
+    let request = SensitivityRequest {
+        kind: SensitivityKind::Reliability,
+        at: at.as_deref(),
+        params: &params,
+        sided: sided_named(sided)?,
+        grid: &grid,
+        values: values.map(|v| SensitivityValues::File(Path::new(v))),
+        approach: &approach,
     };
-    let parameters = model.parameter_vector(py, &params)?;
-    let (at, result) = py
-        .allow_threads(|| {
-            document::sensitivity(
-                &study,
-                &model.model,
-                &parameters,
-                point.as_deref(),
-                &Form::default(),
-            )
-        })
-        .map_err(|e| study_error(py, &e, &model.file))?;
-    to_json(&SensitivityDocument::new(
-        &model.machine.name,
-        at,
-        &result,
-        posterior.as_ref(),
-    ))
+    run(py, model, &request)
 }
 
 /// `chain sensitivity --kind geometric --format json`: the geometric error
@@ -76,50 +77,22 @@ pub(crate) fn geometric_json(
     params: Vec<(String, f64)>,
     sizes: Option<&str>,
 ) -> PyResult<String> {
-    let m = &model.machine;
     let nominal = match sizes {
-        None => NominalSizes::default(),
-        Some(text) => NominalSizes::default()
-            .parse(text)
-            .map_err(|e| value_error(format!("invalid value {text:?} for `sizes`: {e}")))?,
+        None => None,
+        Some(text) => Some(
+            NominalSizes::default()
+                .parse(text)
+                .map_err(|e| value_error(format!("invalid value {text:?} for `sizes`: {e}")))?,
+        ),
     };
-    let parameters = model.parameter_vector(py, &params)?;
-    let vars: Vec<&str> = m.variables.iter().map(|v| v.name.as_str()).collect();
-    for (name, values) in &grid {
-        if let Some(x) = values.iter().find(|x| !x.is_finite()) {
-            return Err(value_error(format!(
-                "grid axis `{name}` has a non-finite value ({x})"
-            )));
-        }
-    }
-    let where_ = match &at {
-        Some(coords) => {
-            if !grid.is_empty() {
-                return Err(value_error(
-                    "grid cannot be combined with at (at evaluates at one point, grid sets the grid of the mean; give one)",
-                ));
-            }
-            let point = resolve_at(py, model, coords)?;
-            Where::At(
-                vars.iter()
-                    .zip(&point)
-                    .map(|(n, x)| (n.to_string(), *x))
-                    .collect(),
-            )
-        }
-        None => Where::Grid(geometric::grid_axes(m, &grid).map_err(|e| match e {
-            GridAxisError::UnknownVariable(name) => {
-                let e = ReliabilityError::unknown("axis variable", &name, vars.iter().copied());
-                study_error(py, &e, &model.file)
-            }
-            GridAxisError::NoValues(v) => value_error(format!(
-                "{}: no grid values for axis variable `{v}` (key `reliability.grid.{v}`); evaluate at one point with at=, or give grid={{{v:?}: [...]}}",
-                model.file
-            )),
-        })?),
+    let request = SensitivityRequest {
+        kind: SensitivityKind::Geometric,
+        at: at.as_deref(),
+        params: &params,
+        sided: None,
+        grid: &grid,
+        values: nominal.map(SensitivityValues::Nominal),
+        approach: &[],
     };
-    let sizes = nominal.of(m);
-    let result =
-        py.allow_threads(|| geometric::evaluate(&model.model, &where_, &parameters, &sizes));
-    to_json(&GeometricDocument::new(&m.name, &where_, &nominal, &result))
+    run(py, model, &request)
 }

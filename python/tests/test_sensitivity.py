@@ -126,8 +126,12 @@ def test_bad_options_are_refused_naming_the_keyword(cli_error):
     m = chain.Machine.load(GANTRY)
     with pytest.raises(ValueError, match="`sizes`: unknown error kind `volume`"):
         m.geometric_sensitivity(sizes={"volume": 1})
-    with pytest.raises(ValueError, match="grid cannot be combined with at"):
+    with pytest.raises(ValueError) as info:
         m.geometric_sensitivity(at=first_point(m), grid={"x": [0]})
+    assert str(info.value).startswith("--grid cannot be combined with --at\nhelp: --at evaluates at one point")
+    assert flat(str(info.value)) in flat(cli_error("sensitivity", GANTRY, "--kind", "geometric", "--at",
+                                                   ",".join(f"{k}={v}" for k, v in first_point(m).items()),
+                                                   "--grid", "x=0"))
     with pytest.raises(ValueError, match="at has no value for axis variable"):
         m.geometric_sensitivity(at={"x": 0})
     with pytest.raises(ValueError, match="at has no value for axis variable"):
@@ -137,7 +141,7 @@ def test_bad_options_are_refused_naming_the_keyword(cli_error):
     assert "unknown axis variable" in flat(cli_error("sensitivity", GANTRY, "--kind", "geometric", "--grid", "q=0"))
     with pytest.raises(ValueError, match="sided must be"):
         m.sensitivity_reliability(sided="three")
-    with pytest.raises(ValueError, match="non-finite"):
+    with pytest.raises(ValueError, match="--grid x: NaN is not finite"):
         m.geometric_sensitivity(grid={"x": [0, float("nan")]})
     with pytest.raises(ValueError, match="no-such.yaml"):
         m.sensitivity_reliability(values="no-such.yaml")

@@ -51,23 +51,6 @@ impl Loaded {
         self.study_with(params, grid, sided, system, None)
     }
 
-    /// The posterior of `--values`, if given (its refusals located in the
-    /// values file), its tables read for the `--approach` choices
-    /// ([`chain::ops::study::read_posterior`]).
-    pub(crate) fn posterior(
-        &self,
-        values: Option<&Path>,
-        approach: &[Vec<(Option<String>, chain_core::values::Approach)>],
-    ) -> miette::Result<Option<Posterior>> {
-        let Some(path) = values else {
-            return Ok(None);
-        };
-        let choices: Vec<_> = approach.iter().flatten().cloned().collect();
-        chain::ops::study::read_posterior(&self.machine, path, &choices)
-            .map(Some)
-            .map_err(|e| self.study_error(e))
-    }
-
     /// A study's refusal rendered: a reliability error located in the
     /// machine file, the others as they are.
     pub(crate) fn study_error(&self, e: StudyError) -> miette::Report {

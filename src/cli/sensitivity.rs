@@ -19,17 +19,17 @@ mod geometric_plot;
 
 use std::path::PathBuf;
 
-use chain_core::geometric::{
-    self, GeometricDocument, GeometricSensitivity, GridAxisError, NominalSizes, Where,
+use chain::ops::sensitivity::{
+    self, SensitivityKind as Kind, SensitivityOpsError, SensitivityReport, SensitivityRequest,
+    SensitivityValues,
 };
-use reliability::document::{self, SensitivityDocument};
-use reliability::{machine, Form, ReliabilityError};
-use serde::Serialize;
+use chain_core::geometric::NominalSizes;
 
 use super::args::{parse_axis, parse_point, AtPoint, ModelArgs};
-use super::loaded::{resolve_at, Loaded};
+use super::loaded::Loaded;
 use super::reliability_plot;
-use super::report::{self, Report};
+use super::render::sensitivity::{at_text, where_text};
+use super::report;
 
 /// What `chain sensitivity` computes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -107,312 +107,48 @@ fn parse_values(s: &str) -> Result<ValuesArg, String> {
     }
 }
 
-/// Runs `chain sensitivity`.
+/// Runs `chain sensitivity` ([`chain::ops::sensitivity`]).
 pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
-    if args.kind == SensitivityKind::Geometric {
-        return exec_geometric(args);
-    }
-    let file = match &args.values {
-        Some(ValuesArg::Nominal(_)) => {
-            return Err(miette::miette!(
-                help = "add --kind geometric, or give a values file for the posterior",
-                "--values applies only to --kind geometric when it gives nominal sizes (KIND=VALUE)"
-            ))
-        }
-        Some(ValuesArg::File(f)) => Some(f.as_path()),
-        None => None,
+    let approach: Vec<_> = args.approach.iter().flatten().cloned().collect();
+    let request = SensitivityRequest {
+        kind: match args.kind {
+            SensitivityKind::Reliability => Kind::Reliability,
+            SensitivityKind::Geometric => Kind::Geometric,
+        },
+        at: args.at.as_ref().map(|AtPoint(c)| c.as_slice()),
+        params: &args.model.param.params,
+        sided: args.model.sided.map(Into::into),
+        grid: &args.grid,
+        values: args.values.as_ref().map(|v| match v {
+            ValuesArg::File(f) => SensitivityValues::File(f),
+            ValuesArg::Nominal(n) => SensitivityValues::Nominal(*n),
+        }),
+        approach: &approach,
     };
+    sensitivity::check(&request)?;
     let loaded = Loaded::new(&args.file)?;
-    let posterior = loaded.posterior(file, &args.approach)?;
-    let (study, model) = loaded.study_with(
-        &args.model.param.params,
-        &args.grid,
-        args.model.sided,
-        None,
-        posterior.as_ref(),
-    )?;
-    let form = Form::default();
-    let point = match &args.at {
-        None => None,
-        Some(AtPoint(coords)) => Some(resolve_at(coords, &loaded)?),
-    };
-    let values = machine::parameters(&loaded.machine, &args.model.param.params)
-        .map_err(|e| loaded.report(e))?;
-    let (at, result) = document::sensitivity(&study, &model, &values, point.as_deref(), &form)
-        .map_err(|e| loaded.report(e))?;
+    let doc =
+        sensitivity::run(&loaded.machine, loaded.file_name(), &request).map_err(|e| match e {
+            SensitivityOpsError::Study(e) => loaded.study_error(*e),
+            SensitivityOpsError::Reliability(e) => loaded.report(e),
+            e => miette::Report::new(e),
+        })?;
     if let Some(dir) = &args.plot {
-        let where_ = match &at {
-            Some(a) => at_text(a),
-            None => "grid mean".to_string(),
+        let m = &loaded.machine.name;
+        let files = match &doc {
+            SensitivityReport::Reliability(r) => {
+                let where_ = r.at.as_deref().map_or("grid mean".to_string(), at_text);
+                reliability_plot::write_sensitivity(dir, m, &r.inputs, &r.result, &where_)?
+            }
+            SensitivityReport::Geometric(g) => {
+                geometric_plot::write_all(dir, m, &where_text(&g.where_), &g.result)?
+            }
         };
-        let files = reliability_plot::write_sensitivity(
-            dir,
-            &loaded.machine.name,
-            study.inputs().names(),
-            &result,
-            &where_,
-        )?;
         for f in files {
             eprintln!("wrote {}", f.display());
         }
     }
-    let doc = SensitivityDocument::new(&loaded.machine.name, at, &result, posterior.as_ref());
-    report::emit(&SensitivityDoc(doc), args.format.into())
-}
-
-report::formats!(SensitivityFormat: Table, Json);
-
-/// `at x = 0, y = 1500, z = 600`.
-fn at_text(a: &[(String, f64)]) -> String {
-    format!(
-        "at {}",
-        a.iter()
-            .map(|(n, v)| format!("{n} = {v}"))
-            .collect::<Vec<_>>()
-            .join(", ")
-    )
-}
-
-/// The document of `chain sensitivity --kind reliability` (the library's
-/// [`SensitivityDocument`]) with its table.
-#[derive(Serialize)]
-#[serde(transparent)]
-struct SensitivityDoc<'a>(SensitivityDocument<'a>);
-
-impl Report for SensitivityDoc<'_> {
-    fn table(&self) -> String {
-        use std::fmt::Write as _;
-        let d = &self.0;
-        let mut out = String::new();
-        let where_ = match &d.at {
-            Some(a) => at_text(&a.0),
-            None => "mean over the reliability grid".to_string(),
-        };
-        let _ = writeln!(
-            out,
-            "{}: reliability sensitivity (Eq. 32-33), {where_}",
-            d.machine
-        );
-        if let Some(p) = d.posterior {
-            let _ = write!(out, "{}", super::study_text::posterior_lines(p));
-            if !p.correlations.is_empty() {
-                let _ = writeln!(
-                    out,
-                    "dR/dstd with the correlations held fixed; importance: Der Kiureghian's gamma^2 (docs/posterior.md)"
-                );
-            }
-        }
-        for t in d.result {
-            let _ = writeln!(
-                out,
-                "\n{} ({}), sorted by |dR/dstd|:",
-                t.target,
-                t.method.name()
-            );
-            let _ = writeln!(
-                out,
-                "  {:<8} {:>14} {:>14} {:>11}",
-                "error", "dR/dstd", "dR/dmean", "importance"
-            );
-            for e in &t.errors {
-                let _ = writeln!(
-                    out,
-                    "  {:<8} {:>14.6e} {:>14.6e} {:>11.6}",
-                    e.error, e.dr_dstd, e.dr_dmean, e.importance
-                );
-            }
-        }
-        out
-    }
-}
-
-// ---------------------------------------------------------------------------
-// `--kind geometric` (seed 004, Eq. 4-6).
-
-fn unknown_variable(loaded: &Loaded, name: &str) -> miette::Report {
-    let m = &loaded.machine;
-    loaded.report(ReliabilityError::unknown(
-        "axis variable",
-        name,
-        m.variables.iter().map(|v| v.name.as_str()),
-    ))
-}
-
-fn exec_geometric(args: SensitivityArgs) -> miette::Result<()> {
-    if !args.approach.is_empty() {
-        return Err(miette::miette!(
-            help = "--approach chooses the direction of a values file's tables: use it with --kind reliability --values VALUES.yaml",
-            "--kind geometric does not take --approach"
-        ));
-    }
-    let loaded = Loaded::new(&args.file)?;
-    let m = &loaded.machine;
-    let params = machine::parameters(m, &args.model.param.params).map_err(|e| loaded.report(e))?;
-    let model = chain_core::compile(m);
-    let nominal = match args.values {
-        None => NominalSizes::default(),
-        Some(ValuesArg::Nominal(n)) => n,
-        Some(ValuesArg::File(f)) => {
-            return Err(miette::miette!(
-                help = "give nominal sizes, e.g. --values linear=0.001,angular=0.001deg, or use --kind reliability for a posterior",
-                "--values {}: a values file applies to --kind reliability (the posterior of a calibration)",
-                f.display()
-            ))
-        }
-    };
-    let sizes = nominal.of(m);
-    let vars: Vec<&str> = m.variables.iter().map(|v| v.name.as_str()).collect();
-    let where_ = match &args.at {
-        Some(AtPoint(coords)) => {
-            if !args.grid.is_empty() {
-                return Err(miette::miette!(
-                    help =
-                        "--at evaluates at one point, --grid sets the grid of the mean; give one",
-                    "--grid cannot be combined with --at"
-                ));
-            }
-            let point = resolve_at(coords, &loaded)?;
-            Where::At(
-                vars.iter()
-                    .zip(&point)
-                    .map(|(n, x)| (n.to_string(), *x))
-                    .collect(),
-            )
-        }
-        None => Where::Grid(geometric::grid_axes(m, &args.grid).map_err(|e| match e {
-            GridAxisError::UnknownVariable(name) => unknown_variable(&loaded, &name),
-            GridAxisError::NoValues(v) => miette::miette!(
-                help = format!(
-                    "evaluate at one point with --at {}, or give the grid with --grid {v}=V1,V2,...",
-                    vars.iter().map(|v| format!("{v}=…")).collect::<Vec<_>>().join(",")
-                ),
-                "{}: no grid values for axis variable `{v}` (key `reliability.grid.{v}`)",
-                loaded.machine.file.as_deref().unwrap_or("machine")
-            ),
-        })?),
-    };
-    let result = geometric::evaluate(&model, &where_, &params, &sizes);
-    if let Some(dir) = &args.plot {
-        let files = geometric_plot::write_all(dir, &m.name, &where_text(&where_), &result)?;
-        for f in files {
-            eprintln!("wrote {}", f.display());
-        }
-    }
-    let doc = GeometricDoc(GeometricDocument::new(&m.name, &where_, &nominal, &result));
     report::emit(&doc, args.format.into())
 }
 
-fn where_text(w: &Where) -> String {
-    match w {
-        Where::At(a) => format!(
-            "at {}",
-            a.iter()
-                .map(|(n, v)| format!("{n} = {v}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-        Where::Grid(g) => format!(
-            "mean over {} grid points",
-            g.iter().map(|(_, v)| v.len()).product::<usize>()
-        ),
-    }
-}
-
-/// The document of `chain sensitivity --kind geometric` (the library's
-/// [`GeometricDocument`]) with its table.
-#[derive(Serialize)]
-#[serde(transparent)]
-struct GeometricDoc<'a>(GeometricDocument<'a>);
-
-impl Report for GeometricDoc<'_> {
-    fn table(&self) -> String {
-        geometric_table(self.0.machine, self.0.where_, self.0.values, self.0.result)
-    }
-}
-
-fn geometric_table(
-    machine: &str,
-    where_: &Where,
-    nominal: &NominalSizes,
-    r: &GeometricSensitivity,
-) -> String {
-    use std::fmt::Write as _;
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "{machine}: geometric error sensitivity (seed 004 Eq. 5-6), {}",
-        where_text(where_)
-    );
-    let _ = writeln!(
-        out,
-        "S = |dE/de|, C = S·e / sum(S·e); e = {} (linear), {:.6e} rad = {}° (angular), {:.6e} rad (squareness)",
-        nominal.linear,
-        nominal.angular,
-        round(nominal.angular.to_degrees()),
-        nominal.squareness
-    );
-    let grid = matches!(where_, Where::Grid(_));
-    for c in &r.components {
-        let shown: Vec<_> = c.ranked.iter().filter(|e| e.s > 0.0).collect();
-        if shown.is_empty() {
-            let _ = writeln!(
-                out,
-                "\n{}: no error acts in this direction",
-                c.component.name()
-            );
-            continue;
-        }
-        let _ = writeln!(
-            out,
-            "\n{} (sum of S·e = {:.6e}), sorted by C:",
-            c.component.name(),
-            c.total
-        );
-        if grid {
-            let _ = writeln!(
-                out,
-                "  {:>4} {:<10} {:>14} {:>9} {:>9} {:>9}",
-                "rank", "error", "S (mean)", "C %", "min %", "max %"
-            );
-        } else {
-            let _ = writeln!(
-                out,
-                "  {:>4} {:<10} {:>14} {:>9}",
-                "rank", "error", "S", "C %"
-            );
-        }
-        for (i, e) in shown.iter().enumerate() {
-            if grid {
-                let _ = writeln!(
-                    out,
-                    "  {:>4} {:<10} {:>14.6} {:>9.2} {:>9.2} {:>9.2}",
-                    i + 1,
-                    e.error,
-                    e.s,
-                    100.0 * e.c,
-                    100.0 * e.c_min,
-                    100.0 * e.c_max
-                );
-            } else {
-                let _ = writeln!(
-                    out,
-                    "  {:>4} {:<10} {:>14.6} {:>9.2}",
-                    i + 1,
-                    e.error,
-                    e.s,
-                    100.0 * e.c
-                );
-            }
-        }
-        let zero = c.ranked.len() - shown.len();
-        if zero > 0 {
-            let _ = writeln!(out, "  ({zero} errors with S = 0 not listed)");
-        }
-    }
-    out
-}
-
-/// Rounds to 10 significant digits (no float noise in printed degrees).
-fn round(x: f64) -> f64 {
-    format!("{x:.9e}").parse().unwrap_or(x)
-}
+report::formats!(SensitivityFormat: Table, Json);

@@ -76,11 +76,10 @@ pub fn exec(args: SobolArgs) -> miette::Result<()> {
         }
         Some(AtPoint(coords)) => {
             if !args.grid.is_empty() {
-                return Err(miette::miette!(
-                    help =
-                        "--at evaluates at one point, --grid sets the grid to pool over; give one",
-                    "--grid cannot be combined with --at"
-                ));
+                return Err(chain::ops::resolve::ResolveError::AtWithGrid {
+                    grid_for: "the pooled indices",
+                }
+                .into());
             }
             let point = resolve_at(coords, &loaded)?;
             let m = &loaded.machine;

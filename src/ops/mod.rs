@@ -16,6 +16,7 @@
 //! - [`map`]: `chain map`'s preparation (values, approach, points, the built machine);
 //! - [`motion`]: `chain motion`'s request (the settings, the series' options) and document;
 //! - [`reliability`]: `chain reliability`'s request, the prepared study and the run's document;
+//! - [`sensitivity`]: `chain sensitivity`'s request (either kind) and document;
 //! - [`path`]: `chain path`'s request (axis values or poses) and document.
 
 pub mod export;
@@ -26,4 +27,5 @@ pub mod path;
 pub mod positioning;
 pub mod reliability;
 pub mod resolve;
+pub mod sensitivity;
 pub mod study;

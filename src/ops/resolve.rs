@@ -106,6 +106,12 @@ pub enum ResolveError {
         /// Every axis variable.
         variables: Vec<String>,
     },
+    /// `--at` (one point) and `--grid` (the grid of a mean) given together.
+    #[error("--grid cannot be combined with --at")]
+    AtWithGrid {
+        /// What the grid is for: `the mean`, `pooling`.
+        grid_for: &'static str,
+    },
     /// A column of an axes table that names no axis variable.
     #[error(
         "{file}:1: column `{column}` is not an axis variable of machine `{machine}`{}{}; expected `t` (optional, first) and {}",
@@ -184,6 +190,7 @@ impl ResolveError {
             ResolveError::NonFiniteAt { .. } => "chain::cli::at_not_finite",
             ResolveError::UnknownFixed { .. } => "chain::cli::fix_unknown_variable",
             ResolveError::MissingAt { .. } => "chain::cli::at_missing_variable",
+            ResolveError::AtWithGrid { .. } => "chain::cli::at_with_grid",
             ResolveError::UnknownAxisColumn { .. } => "chain::csv::unknown_column",
             ResolveError::ColumnAndFix { .. } => "chain::cli::fix_and_column",
             ResolveError::MissingAxisColumns { .. } => "chain::csv::missing_column",
@@ -202,6 +209,9 @@ impl ResolveError {
             ResolveError::UnknownAtVariable {
                 file, variables, ..
             } => format!("the axis variables of {file} are {}", variables.join(", ")),
+            ResolveError::AtWithGrid { grid_for } => format!(
+                "--at evaluates at one point, --grid sets the grid of {grid_for}; give one"
+            ),
             ResolveError::MissingAt { variables, .. } => format!(
                 "give every axis variable: --at {}",
                 (variables.iter())

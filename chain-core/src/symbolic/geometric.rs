@@ -405,52 +405,6 @@ pub enum Where {
     Grid(Vec<(String, Vec<f64>)>),
 }
 
-/// Why [`grid_axes`] has no grid.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum GridAxisError {
-    /// An override names no axis variable of the machine.
-    #[error("unknown axis variable `{0}`")]
-    UnknownVariable(String),
-    /// An axis variable has no grid values (neither the reliability grid nor an override).
-    #[error("no grid values for axis variable `{0}` (key `reliability.grid.{0}`)")]
-    NoValues(String),
-}
-
-/// The grid of the geometric mean: the machine's reliability grid with the
-/// axes of `overrides` replaced (or added), every axis variable in the
-/// model's variable order; each needs at least one value.
-pub fn grid_axes(
-    machine: &Machine,
-    overrides: &[(String, Vec<f64>)],
-) -> Result<Vec<(String, Vec<f64>)>, GridAxisError> {
-    let vars: Vec<&str> = machine.variables.iter().map(|v| v.name.as_str()).collect();
-    let mut axes: Vec<(String, Vec<f64>)> = machine
-        .reliability
-        .as_ref()
-        .map(|r| {
-            r.grid
-                .iter()
-                .map(|(i, v)| (vars[*i].to_string(), v.clone()))
-                .collect()
-        })
-        .unwrap_or_default();
-    for (name, values) in overrides {
-        if !vars.contains(&name.as_str()) {
-            return Err(GridAxisError::UnknownVariable(name.clone()));
-        }
-        match axes.iter_mut().find(|(n, _)| n == name) {
-            Some(axis) => axis.1 = values.clone(),
-            None => axes.push((name.clone(), values.clone())),
-        }
-    }
-    vars.iter()
-        .map(|v| match axes.iter().find(|(n, _)| n == v) {
-            Some((_, x)) if !x.is_empty() => Ok((v.to_string(), x.clone())),
-            _ => Err(GridAxisError::NoValues(v.to_string())),
-        })
-        .collect()
-}
-
 /// The coefficients at `where_`: at its point, or the mean over its grid.
 pub fn evaluate<M: ErrorModel + ?Sized>(
     model: &M,

@@ -5,3 +5,4 @@ pub(crate) mod export;
 pub(crate) mod motion;
 pub(crate) mod path;
 pub(crate) mod reliability;
+pub(crate) mod sensitivity;
