@@ -11,14 +11,13 @@
 use std::path::Path;
 
 use chain::ops::reliability::{self as ops_reliability, ReliabilityOpsError, ReliabilityRequest};
+use chain::ops::sobol::{self, SobolOpsError, SobolRequest};
 use chain::ops::study::{AlgorithmOptions, SystemChoice};
 use chain_core::values::Approach;
 use pyo3::prelude::*;
-use reliability::document::SobolDocument;
-use reliability::sobol::{Sobol, SobolError};
-use reliability::{Method, ReliabilityError, Study};
+use reliability::Method;
 
-use crate::{sided_named, study_error, study_failure, to_json, value_error, Model};
+use crate::{resolve_error, sided_named, study_error, study_failure, to_json, value_error, Model};
 
 /// The methods of `method`, in the CLI's order of `--method`.
 const METHODS: [Method; 6] = [
@@ -182,54 +181,22 @@ pub(crate) fn sobol_json(
     grid: Vec<(String, Vec<f64>)>,
     params: Vec<(String, f64)>,
 ) -> PyResult<String> {
-    let settings = Sobol {
-        samples: usize::try_from(samples).unwrap_or(usize::MAX),
+    let request = SobolRequest {
+        at: at.as_deref(),
+        samples,
         seed,
-        bootstrap: usize::try_from(bootstrap).unwrap_or(usize::MAX),
+        bootstrap,
         confidence,
+        grid: &grid,
+        params: &params,
     };
-    match settings.validate() {
-        Err(SobolError::InvalidSetting { what, rule, found }) => {
-            return Err(value_error(format!("{what} {found}: must be {rule}")))
-        }
-        Err(e) => return Err(value_error(e.to_string())),
-        Ok(()) => {}
-    }
-    let study = match &at {
-        None => model.study(py, &grid, &params, None)?,
-        Some(coords) => {
-            if !grid.is_empty() {
-                return Err(value_error(
-                    "grid cannot be combined with at (at evaluates at one point, grid sets the grid to pool over; give one)",
-                ));
-            }
-            let point = resolve_at(py, model, coords)?;
-            let m = &model.machine;
-            let err = |e: ReliabilityError| study_error(py, &e, &model.file);
-            let spec = reliability::machine::spec(m, None).map_err(err)?;
-            let inputs = reliability::machine::inputs(m).map_err(err)?;
-            let values = model.parameter_vector(py, &params)?;
-            Study::at_points(&model.model, &values, inputs, spec, vec![point]).map_err(err)?
-        }
-    };
-    let result = py
-        .allow_threads(|| settings.run_study(&study))
-        .map_err(|e| value_error(format!("{}: chain sobol: {e}", model.file)))?;
-    to_json(&SobolDocument::new(
-        &model.machine.name,
-        &study,
-        at.is_some(),
-        &result,
-    ))
-}
-
-/// The values of `at` in the machine's variable order, by the CLI's rule
-/// (`chain::ops::resolve::at_point`).
-pub(crate) fn resolve_at(
-    py: Python<'_>,
-    model: &Model,
-    coords: &[(String, f64)],
-) -> PyResult<Vec<f64>> {
-    chain::ops::resolve::at_point(&model.machine, &model.file, coords)
-        .map_err(|e| crate::resolve_error(py, model, e))
+    let run = py
+        .allow_threads(|| sobol::run(&model.machine, &model.file, &request))
+        .map_err(|e| match e {
+            SobolOpsError::Study(e) => study_failure(py, model, *e),
+            SobolOpsError::Reliability(e) => study_error(py, &e, &model.file),
+            SobolOpsError::Resolve(e) => resolve_error(py, model, e),
+            e => value_error(e.to_string()),
+        })?;
+    to_json(&run)
 }

@@ -217,10 +217,9 @@ def test_bad_sobol_options_are_refused_with_the_cli_wording(cli_error):
     ]:
         with pytest.raises(ValueError) as info:
             m.sobol(**kw)
-        assert wording in str(info.value)
-        assert wording in cli_error("sobol", GANTRY, *opts)
-        rule = str(info.value).split("must be ", 1)[1]
-        assert f"{wording}{rule}" in cli_error("sobol", GANTRY, *opts)
+        assert str(info.value).startswith("--" + wording)
+        # The CLI's message, word for word (chain::ops::sobol).
+        assert flat(str(info.value)) in flat(cli_error("sobol", GANTRY, *opts))
     with pytest.raises(ValueError) as info:
         m.sobol(at={"x": 0.0})
     assert "at has no value for axis variable `z`" in str(info.value)
@@ -231,8 +230,10 @@ def test_bad_sobol_options_are_refused_with_the_cli_wording(cli_error):
     wording = "--at: `w` is not an axis variable"
     assert wording in str(info.value)
     assert wording in cli_error("sobol", GANTRY, "--at", "x=0,y=0,z=0,w=1")
-    with pytest.raises(ValueError, match="grid cannot be combined with at"):
+    with pytest.raises(ValueError) as info:
         m.sobol(at={"x": 0.0, "y": 0.0, "z": 0.0}, grid={"x": [0.0]})
+    assert str(info.value).startswith("--grid cannot be combined with --at\nhelp: --at evaluates at one point")
+    assert flat(str(info.value)) in flat(cli_error("sobol", GANTRY, "--at", "x=0,y=0,z=0", "--grid", "x=0"))
     with pytest.raises(ValueError, match="not finite"):
         m.sobol(at={"x": math.inf, "y": 0.0, "z": 0.0})
     with pytest.raises(ValueError, match="samples must be a non-negative integer"):

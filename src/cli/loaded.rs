@@ -114,13 +114,3 @@ impl Loaded {
         miette::Report::new(diag)
     }
 }
-
-/// The values of `--at` in the machine's variable order
-/// ([`chain::ops::resolve::at_point`]).
-pub(crate) fn resolve_at(coords: &[(String, f64)], loaded: &Loaded) -> miette::Result<Vec<f64>> {
-    Ok(chain::ops::resolve::at_point(
-        &loaded.machine,
-        loaded.file_name(),
-        coords,
-    )?)
-}

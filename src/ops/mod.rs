@@ -17,6 +17,7 @@
 //! - [`motion`]: `chain motion`'s request (the settings, the series' options) and document;
 //! - [`reliability`]: `chain reliability`'s request, the prepared study and the run's document;
 //! - [`sensitivity`]: `chain sensitivity`'s request (either kind) and document;
+//! - [`sobol`]: `chain sobol`'s request and document;
 //! - [`path`]: `chain path`'s request (axis values or poses) and document.
 
 pub mod export;
@@ -28,4 +29,5 @@ pub mod positioning;
 pub mod reliability;
 pub mod resolve;
 pub mod sensitivity;
+pub mod sobol;
 pub mod study;

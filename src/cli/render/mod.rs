@@ -6,3 +6,4 @@ pub(crate) mod motion;
 pub(crate) mod path;
 pub(crate) mod reliability;
 pub(crate) mod sensitivity;
+pub(crate) mod sobol;
