@@ -103,6 +103,7 @@ def allocate_json(
     step: float,
     threshold: float,
     rank: str,
+    target: str,
     level: Optional[float],
     params: Sequence[Tuple[str, float]],
     sided: Optional[str],

@@ -660,15 +660,7 @@ class Machine:
         step = _optional_float(step, "step")
         threshold = _optional_float(threshold, "threshold")
         level = _optional_float(level, "level")
-        if target == "acceptance":
-            if level is None:
-                raise ValueError('target="acceptance" needs level (e.g. level=0.9)')
-        elif target == "requirement":
-            if level is not None:
-                raise ValueError('level applies to target="acceptance" only')
-        else:
-            raise ValueError(f"invalid value {target!r} for `target` [possible values: requirement, acceptance]")
-        text = _chain.allocate_json(self._model, strategy, step, threshold, rank, level, _params(params), sided)
+        text = _chain.allocate_json(self._model, strategy, step, threshold, rank, target, level, _params(params), sided)
         return AllocationResult._from_json(text)
 
 

@@ -156,7 +156,6 @@ pub(crate) fn map_json(
             .map_err(|e| value_error(format!("approach: {e}")))?,
         None => Vec::new(),
     };
-    model.parameter_vector(py, &params)?;
     let points = match &points {
         Some(q) => {
             if !grid.is_empty() {

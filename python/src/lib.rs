@@ -33,7 +33,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use reliability::document::describe;
-use reliability::{ReliabilityError, Study};
+use reliability::ReliabilityError;
 
 mod allocate;
 mod reliability_v2;
@@ -460,45 +460,6 @@ impl Model {
             }
             (start.elapsed().as_secs_f64(), sum)
         }))
-    }
-}
-
-impl Model {
-    /// The study of the reliability section, as `chain reliability` builds it.
-    pub(crate) fn study(
-        &self,
-        py: Python<'_>,
-        grid: &[(String, Vec<f64>)],
-        params: &[(String, f64)],
-        sided: Option<&str>,
-    ) -> PyResult<Study> {
-        self.study_with(py, grid, params, sided, None, None)
-    }
-
-    /// [`Model::study`] with a system target (`--system`) and the inputs of
-    /// a posterior (`--values`; `None`: the `statistics` section), through
-    /// [`chain::ops::study`] as the CLI builds it.
-    pub(crate) fn study_with(
-        &self,
-        py: Python<'_>,
-        grid: &[(String, Vec<f64>)],
-        params: &[(String, f64)],
-        sided: Option<&str>,
-        system: Option<reliability::System>,
-        posterior: Option<&reliability::Posterior>,
-    ) -> PyResult<Study> {
-        use chain::ops::study::StudyOptions;
-        let sided = sided_named(sided)?;
-        self.parameter_vector(py, params)?;
-        let options = StudyOptions {
-            params,
-            grid,
-            sided,
-            system,
-            posterior,
-        };
-        chain::ops::study::study(&self.machine, &self.file, &self.model, &options)
-            .map_err(|e| study_failure(py, self, e))
     }
 }
 

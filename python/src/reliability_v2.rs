@@ -141,7 +141,6 @@ pub(crate) fn reliability_json(
         return Err(value_error("approach needs values"));
     }
     let approach = parse_approach(approach)?;
-    model.parameter_vector(py, &params)?;
     let request = ReliabilityRequest {
         params: &params,
         grid: &grid,

@@ -69,12 +69,19 @@ def test_bad_options_are_refused_naming_the_keyword(cli_error):
         m.allocate(strategy="paper", rank="all")
     with pytest.raises(ValueError, match="for `target`"):
         m.allocate(target="everything")
-    with pytest.raises(ValueError, match="needs level"):
-        m.allocate(target="acceptance")
-    with pytest.raises(ValueError, match="invalid value for `level`: 1.5"):
-        m.allocate(target="acceptance", level=1.5)
-    with pytest.raises(ValueError, match='level applies to target="acceptance" only'):
-        m.allocate(level=0.5)
+    # The CLI's messages, word for word (chain::ops::allocate).
+    for kw, opts, wording in [
+        ({"target": "acceptance"}, ["--target", "acceptance"], "`--target acceptance` needs `--level L`"),
+        ({"target": "acceptance", "level": 1.5}, ["--target", "acceptance", "--level", "1.5"],
+         "invalid value for `--level`: 1.5 (an acceptance probability strictly between 0 and 1)"),
+        ({"level": 0.5}, ["--level", "0.5"], "`--level` applies to `--target acceptance` only"),
+    ]:
+        with pytest.raises(ValueError) as info:
+            m.allocate(**kw)
+        assert str(info.value) == wording
+        assert wording in flat(cli_error("allocate", GANTRY, *opts))
+    with pytest.raises(ValueError, match=r"the threshold is a fraction of the largest sensitivity, in \[0, 1\]"):
+        m.allocate(strategy="paper", threshold=1.5)
     with pytest.raises(ValueError, match="the step must be positive"):
         m.allocate(strategy="paper", step=0)
     assert "the step must be positive" in flat(cli_error("allocate", GANTRY, "--strategy", "paper", "--step", 0))

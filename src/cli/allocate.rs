@@ -8,16 +8,13 @@
 
 use std::path::PathBuf;
 
-use chain_core::model::Requirement;
+use chain::ops::allocate::{self as ops, AllocateOpsError, AllocateRequest, AllocationTarget};
 use miette::MietteDiagnostic;
-use reliability::allocate::{self, AllocateError, Allocation, ErrorBounds, Paper};
-use reliability::document::{self, AllocationDocument};
-use reliability::Summary;
-use serde::Serialize;
+use reliability::allocate::{self, Allocation, ErrorBounds, StrategyName};
 
 use super::args::ModelArgs;
 use super::loaded::Loaded;
-use super::report::{self, Report};
+use super::report;
 
 /// `--strategy`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -107,61 +104,44 @@ pub struct AllocateArgs {
     pub plot: Option<PathBuf>,
 }
 
-/// Runs `chain allocate`.
+/// Runs `chain allocate` ([`chain::ops::allocate`]).
 pub fn exec(args: AllocateArgs) -> miette::Result<()> {
-    let loaded = Loaded::new(&args.file)?;
-    let (study, model) = loaded.study(&args.model.param.params, &[], args.model.sided, None)?;
-    let values = reliability::machine::parameters(&loaded.machine, &args.model.param.params)
-        .map_err(|e| loaded.report(e))?;
-    let bounds = allocate::bounds(&loaded.machine, &study).map_err(|e| loaded.report(e))?;
-    let paper_options = Paper {
+    let request = AllocateRequest {
+        strategy: match args.strategy {
+            StrategyArg::Optimal => StrategyName::Optimal,
+            StrategyArg::Paper => StrategyName::Paper,
+        },
         step: args.step,
         threshold: args.threshold,
         pooled: args.rank == RankArg::Pooled,
-        ..Paper::default()
+        target: match args.target {
+            TargetArg::Requirement => AllocationTarget::Requirement,
+            TargetArg::Acceptance => AllocationTarget::Acceptance,
+        },
+        level: args.level,
+        params: &args.model.param.params,
+        sided: args.model.sided.map(Into::into),
     };
-    let level = match (args.target, args.level) {
-        (TargetArg::Acceptance, Some(l)) if l > 0.0 && l < 1.0 => Some(l),
-        (TargetArg::Acceptance, Some(l)) => {
-            return Err(miette::miette!(
-            code = "chain::allocate::invalid_level",
-            "invalid value for `--level`: {l} (an acceptance probability strictly between 0 and 1)"
-        ))
-        }
-        (TargetArg::Acceptance, None) => {
-            return Err(miette::miette!(
-                code = "chain::allocate::missing_level",
-                help = "e.g. --target acceptance --level 0.9",
-                "`--target acceptance` needs `--level L`"
-            ))
-        }
-        (TargetArg::Requirement, Some(_)) => {
-            return Err(miette::miette!(
-                code = "chain::allocate::invalid_level",
-                "`--level` applies to `--target acceptance` only"
-            ))
-        }
-        (TargetArg::Requirement, None) => None,
-    };
-    let strategy = match args.strategy {
-        StrategyArg::Optimal => allocate::AcceptanceStrategy::Optimal,
-        StrategyArg::Paper => allocate::AcceptanceStrategy::Paper(paper_options),
-    };
-    let result = document::allocation(&model, &values, &study, &bounds, strategy, level);
-    let result = result.map_err(|e| failure(&loaded, e))?;
+    ops::check(&request)?;
+    let loaded = Loaded::new(&args.file)?;
+    let run = ops::run(&loaded.machine, loaded.file_name(), &request).map_err(|e| match e {
+        AllocateOpsError::Study(e) => loaded.study_error(*e),
+        AllocateOpsError::Reliability(e) => loaded.report(e),
+        e => miette::Report::new(e),
+    })?;
     if let Some(dir) = &args.plot {
-        let stds: Vec<f64> = result.std.iter().map(|(_, s)| *s).collect();
-        let before = study
+        let stds: Vec<f64> = run.result.std.iter().map(|(_, s)| *s).collect();
+        let before = (run.study)
             .form(&reliability::Form::default())
             .map_err(|e| loaded.report(e))?;
-        let (_, after) =
-            allocate::evaluate(&model, &values, &study, &stds).map_err(|e| loaded.report(e))?;
+        let (_, after) = allocate::evaluate(&run.model, &run.parameters, &run.study, &stds)
+            .map_err(|e| loaded.report(e))?;
         let files = plot(
             dir,
-            &loaded.machine.name,
-            &study,
-            &bounds,
-            &result,
+            &run.machine,
+            &run.study,
+            &run.bounds,
+            &run.result,
             &before,
             &after,
         )?;
@@ -169,35 +149,13 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
             eprintln!("wrote {}", f.display());
         }
     }
-    let doc = AllocationReport {
-        document: AllocationDocument::new(
-            &loaded.machine.name,
-            study.spec().requirement,
-            &bounds,
-            &result,
-        ),
-        bounds: &bounds,
-        result: &result,
-    };
-    report::emit(&doc, args.format.into())?;
-    if !result.met {
-        return Err(miette::Report::new(
-            MietteDiagnostic::new(match &result.acceptance {
-                Some(a) => format!(
-                    "the acceptance level {} is not reached after {} rounds (P = {})",
-                    a.level,
-                    result.steps.len(),
-                    a.probability
-                ),
-                None => format!(
-                    "the requirement is not met after {} rounds",
-                    result.steps.len()
-                ),
-            })
-            .with_code("chain::allocate::not_met"),
-        ));
+    report::emit(&run, args.format.into())?;
+    match run.not_met() {
+        Some(message) => Err(miette::Report::new(
+            MietteDiagnostic::new(message).with_code("chain::allocate::not_met"),
+        )),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// Before/after reliability over the grid per component, and the tightening
@@ -278,156 +236,4 @@ fn plot(
     }
     files.extend(chart.write(dir, "allocate_tightening")?);
     Ok(files)
-}
-
-/// An allocation that failed, rendered as the library's error with the
-/// machine's name, a stable code and, where one helps, a hint.
-///
-/// The code and help are [`AllocateError`]'s own (its `miette::Diagnostic`
-/// derive, forwarded); the [`AllocateError::Reliability`] case goes through
-/// the located renderer of every reliability error instead, [`Loaded::report`].
-#[derive(Debug, thiserror::Error, miette::Diagnostic)]
-#[error("{machine}: {error}")]
-#[diagnostic(forward(error))]
-struct AllocateFailure {
-    machine: String,
-    error: AllocateError,
-}
-
-/// The one rendering of an [`AllocateError`]: reliability errors located in
-/// the machine file, the others as an [`AllocateFailure`].
-fn failure(loaded: &Loaded, error: AllocateError) -> miette::Report {
-    match error {
-        AllocateError::Reliability(e) => loaded.report(e),
-        error => miette::Report::new(AllocateFailure {
-            machine: loaded.machine.name.clone(),
-            error,
-        }),
-    }
-}
-
-/// The result document of `chain allocate` (the library's
-/// [`AllocationDocument`], JSON: docs/allocation.md) with its table.
-#[derive(Serialize)]
-#[serde(transparent)]
-struct AllocationReport<'a> {
-    document: AllocationDocument<'a>,
-    #[serde(skip)]
-    bounds: &'a [ErrorBounds],
-    #[serde(skip)]
-    result: &'a Allocation,
-}
-
-impl Report for AllocationReport<'_> {
-    /// Rounds like Tables 5-7, the changed tolerances, the cost and the KKT check.
-    fn table(&self) -> String {
-        to_table(
-            self.document.machine,
-            self.document.requirement,
-            self.bounds,
-            self.result,
-        )
-    }
-}
-
-/// σ in Table 1's tolerance units (σ·6 mm, σ·6000 or σ·3000 for angles).
-fn tolerance_units(b: &ErrorBounds, s: f64) -> f64 {
-    s / allocate::step_std(b.kind, 1.0)
-}
-
-fn to_table(
-    machine: &str,
-    req: Option<Requirement>,
-    bounds: &[ErrorBounds],
-    r: &Allocation,
-) -> String {
-    use std::fmt::Write as _;
-    let mut out = String::new();
-    let req_text = req.map_or("none".to_string(), |q| {
-        format!(
-            "min ≥ {:.2} %, mean ≥ {:.2} %",
-            q.min * 100.0,
-            q.mean * 100.0
-        )
-    });
-    let _ = writeln!(
-        out,
-        "{machine}: precision allocation ({}), requirement {req_text}",
-        r.strategy
-    );
-    let line = |out: &mut String, label: &str, s: &[Summary]| {
-        let cells: Vec<String> = s
-            .iter()
-            .map(|s| format!("{} {:6.2}/{:6.2}", s.target, s.mean * 100.0, s.min * 100.0))
-            .collect();
-        let _ = writeln!(out, "  {label:<8} {}", cells.join("   "));
-    };
-    let _ = writeln!(out, "\nmean/min reliability (%):");
-    line(&mut out, "initial", &r.initial);
-    for s in &r.steps {
-        line(&mut out, &format!("round {}", s.round), &s.summaries);
-        let _ = writeln!(out, "           tightened: {}", s.tightened.join(", "));
-    }
-    if r.strategy == reliability::allocate::StrategyName::Optimal {
-        line(&mut out, "optimal", &r.summaries);
-    }
-    let _ = writeln!(
-        out,
-        "\n  {:<8} {:>13} {:>13} {:>10} {:>10} {:>8}",
-        "error", "std0", "std", "tol0", "tol", "std0/std"
-    );
-    for (b, (_, s)) in bounds.iter().zip(&r.std) {
-        if (s - b.std0).abs() <= 1e-15 * b.std0 {
-            continue;
-        }
-        let _ = writeln!(
-            out,
-            "  {:<8} {:>13.6e} {:>13.6e} {:>10.5} {:>10.5} {:>8.4}",
-            b.error,
-            b.std0,
-            s,
-            tolerance_units(b, b.std0),
-            tolerance_units(b, *s),
-            b.std0 / s
-        );
-    }
-    let _ = writeln!(
-        out,
-        "  (tol in Table 1's units: std·6 mm, std·6000 angular, std·3000 squareness; unlisted errors unchanged)"
-    );
-    let _ = writeln!(
-        out,
-        "\ncost Σ w (std0/std − 1) = {:.6}; requirement {}",
-        r.cost,
-        if r.met { "met" } else { "NOT met" }
-    );
-    if let Some(a) = &r.acceptance {
-        let _ = writeln!(
-            out,
-            "whole-machine acceptance: {:.4} % → {:.4} % ± {:.4} % (level {:.4} %, {}; independent re-evaluation{}; {} evaluations)",
-            a.initial * 100.0,
-            a.probability * 100.0,
-            a.std_error * 100.0,
-            a.level * 100.0,
-            if r.met { "reached" } else { "NOT reached" },
-            if a.converged { "" } else { ", NOT CONVERGED" },
-            a.evaluations
-        );
-    }
-    if let Some(k) = &r.kkt {
-        let _ = writeln!(
-            out,
-            "KKT ({}): stationarity {:.2e}, complementarity {:.2e}, feasibility {:.2e}, dual feasibility {:.2e} ({} Newton iterations)",
-            if k.polished { "active-set Newton" } else { "barrier" },
-            k.stationarity,
-            k.complementarity,
-            k.feasibility,
-            k.dual_feasibility,
-            k.iterations
-        );
-        for (n, l) in &k.active {
-            let _ = writeln!(out, "  active: {n:<40} multiplier {l:.6}");
-        }
-    }
-    out
 }

@@ -1,16 +1,14 @@
 //! The machine file a command works on, loaded once with its text (for
-//! messages' snippets), and what every study command builds from it: the
-//! study ([`chain::ops::study`]), the posterior of `--values`, located
-//! diagnostics of reliability errors; `--fix` names resolved.
+//! messages' snippets), and the rendering of the errors located in it:
+//! reliability errors (worded by `reliability::document::describe`) and a
+//! study's refusals ([`chain::ops::study::StudyError`]).
 
 use std::path::Path;
 
-use chain::ops::study::{StudyError, StudyOptions};
+use chain::ops::study::StudyError;
 use chain_core::model::Machine;
 use miette::{LabeledSpan, MietteDiagnostic};
-use reliability::{Posterior, ReliabilityError, Study, System};
-
-use super::args::SidedArg;
+use reliability::ReliabilityError;
 
 /// A loaded machine with its source text (for diagnostics).
 pub(crate) struct Loaded {
@@ -39,18 +37,6 @@ impl Loaded {
         })
     }
 
-    /// The study of the machine's reliability section, with command-line
-    /// parameter values, grid axes and `sided`.
-    pub(crate) fn study(
-        &self,
-        params: &[(String, f64)],
-        grid: &[(String, Vec<f64>)],
-        sided: Option<SidedArg>,
-        system: Option<System>,
-    ) -> miette::Result<(Study, chain_core::CompiledModel)> {
-        self.study_with(params, grid, sided, system, None)
-    }
-
     /// A study's refusal rendered: a reliability error located in the
     /// machine file, the others as they are.
     pub(crate) fn study_error(&self, e: StudyError) -> miette::Report {
@@ -60,29 +46,6 @@ impl Loaded {
             StudyError::Posterior(e) => e.into(),
             e @ StudyError::Approach { .. } => miette::miette!("{e}"),
         }
-    }
-
-    /// [`Loaded::study`] with the inputs of a posterior (`None`: the
-    /// `statistics` section), through [`chain::ops::study`].
-    pub(crate) fn study_with(
-        &self,
-        params: &[(String, f64)],
-        grid: &[(String, Vec<f64>)],
-        sided: Option<SidedArg>,
-        system: Option<System>,
-        posterior: Option<&Posterior>,
-    ) -> miette::Result<(Study, chain_core::CompiledModel)> {
-        let model = chain_core::compile(&self.machine);
-        let options = StudyOptions {
-            params,
-            grid,
-            sided: sided.map(Into::into),
-            system,
-            posterior,
-        };
-        let study = chain::ops::study::study(&self.machine, &self.file, &model, &options)
-            .map_err(|e| self.study_error(e))?;
-        Ok((study, model))
     }
 
     /// A located, rendered diagnostic for a reliability error (worded by

@@ -98,6 +98,7 @@ pub fn prepare(
                 error,
             })?;
     }
+    resolve::check_parameters(m, request.params)?;
     let params = reliability::machine::parameters(m, request.params)?;
     let (points, grid) = match &request.points {
         MapPoints::Rows(flat) => {

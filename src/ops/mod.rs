@@ -10,6 +10,7 @@
 //! - [`study`]: a reliability study from a machine and the options every
 //!   study command takes (parameters, grid, sided, system, a posterior).
 
+//! - [`allocate`]: `chain allocate`'s request and document;
 //! - [`export`]: `chain export`'s request, document and the per-axis tables `map --compensated` shares;
 //! - [`inverse`]: `chain inverse`'s request, poses and document;
 //! - [`positioning`]: `chain positioning`'s request, document and values file;
@@ -20,6 +21,7 @@
 //! - [`sobol`]: `chain sobol`'s request and document;
 //! - [`path`]: `chain path`'s request (axis values or poses) and document.
 
+pub mod allocate;
 pub mod export;
 pub mod inverse;
 pub mod map;

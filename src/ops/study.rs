@@ -89,6 +89,7 @@ pub fn study<M: ErrorModel + ?Sized>(
     model: &M,
     options: &StudyOptions<'_>,
 ) -> Result<Study, StudyError> {
+    resolve::check_parameters(machine, options.params)?;
     let mut spec = reliability::machine::spec(machine, options.system)?;
     if let Some(s) = options.sided {
         spec.sided = s;

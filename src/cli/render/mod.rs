@@ -1,6 +1,7 @@
 //! The table and CSV forms of the commands' documents (`chain::ops`), one
 //! file per document; the JSON form is the document's own `Serialize`.
 
+pub(crate) mod allocate;
 pub(crate) mod export;
 pub(crate) mod motion;
 pub(crate) mod path;
