@@ -11,10 +11,11 @@
 
 use std::path::Path;
 
-use chain_core::measured::document::{identify_document, values_file, DocumentError};
+use chain::ops::identify::{self, IdentifyRequest};
+use chain::ops::plan::{self, PlanRequest};
 use chain_core::measured::{Layout, Measurements, MeasurementsError};
 use chain_core::model::Machine;
-use chain_core::plan::{self, Kind};
+use chain_core::plan::Kind;
 use chain_core::values::{Values, ValuesError};
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
@@ -85,14 +86,11 @@ pub(crate) fn identify_json(
     let m = &model.machine;
     chain::ops::resolve::check_parameters(m, &params).map_err(|e| resolve_error(py, model, e))?;
     let measurements = read_measurements(py, m, path, text, file, &params, Layout::Measurements)?;
-    let (doc, result) = py
-        .allow_threads(|| identify_document(m, &measurements, prior))
-        .map_err(|e| match e {
-            DocumentError::Design { .. } => value_error(e.to_string()),
-            DocumentError::Identify(e) => value_error(e.to_string()),
-        })?;
-    let values = values_file(m, &measurements.file, &result);
-    Ok((to_json(&doc)?, values))
+    let request = IdentifyRequest { prior };
+    let run = py
+        .allow_threads(|| identify::run(m, &measurements, &request))
+        .map_err(|e| value_error(e.to_string()))?;
+    Ok((to_json(&run)?, run.values_text))
 }
 
 /// `chain plan --format json`: `count` of the candidates from `path` or
@@ -111,7 +109,7 @@ pub(crate) fn plan_json(
     params: Vec<(String, f64)>,
 ) -> PyResult<String> {
     let m = &model.machine;
-    let asked = match kind {
+    let kind = match kind {
         None => None,
         Some("point") => Some(Kind::Point),
         Some("direction") => Some(Kind::Direction),
@@ -123,12 +121,10 @@ pub(crate) fn plan_json(
     };
     chain::ops::resolve::check_parameters(m, &params).map_err(|e| resolve_error(py, model, e))?;
     let candidates = read_measurements(py, m, path, text, file, &params, Layout::Candidates)?;
-    let kind = Kind::of(&candidates, asked)
-        .map_err(|e| value_error(e.to_string()))?
-        .unwrap_or(Kind::Point);
+    let request = PlanRequest { count, kind };
     let doc = py
-        .allow_threads(|| plan::plan_document(m, &candidates, count, kind))
-        .map_err(|e| value_error(format!("{}: {e}", candidates.file)))?;
+        .allow_threads(|| plan::run(m, &candidates, &request))
+        .map_err(|e| value_error(e.with_help()))?;
     to_json(&doc)
 }
 

@@ -12,6 +12,8 @@
 
 //! - [`allocate`]: `chain allocate`'s request and document;
 //! - [`export`]: `chain export`'s request, document and the per-axis tables `map --compensated` shares;
+//! - [`identify`]: `chain identify`'s request and document (with the values file);
+//! - [`plan`]: `chain plan`'s request, refusals and document;
 //! - [`inverse`]: `chain inverse`'s request, poses and document;
 //! - [`positioning`]: `chain positioning`'s request, document and values file;
 //! - [`map`]: `chain map`'s preparation (values, approach, points, the built machine);
@@ -23,10 +25,12 @@
 
 pub mod allocate;
 pub mod export;
+pub mod identify;
 pub mod inverse;
 pub mod map;
 pub mod motion;
 pub mod path;
+pub mod plan;
 pub mod positioning;
 pub mod reliability;
 pub mod resolve;

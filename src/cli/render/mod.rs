@@ -3,8 +3,10 @@
 
 pub(crate) mod allocate;
 pub(crate) mod export;
+pub(crate) mod identify;
 pub(crate) mod motion;
 pub(crate) mod path;
+pub(crate) mod plan;
 pub(crate) mod reliability;
 pub(crate) mod sensitivity;
 pub(crate) mod sobol;

@@ -1,0 +1,142 @@
+//! The table of `chain identify` ([`IdentifyRun`]): the estimates, what
+//! the data cannot separate (in words), the residuals and the likely
+//! outliers.
+
+use std::fmt::Write as _;
+
+use chain::ops::identify::IdentifyRun;
+use chain_core::measured::document::IdentifyDocument;
+
+use crate::cli::report::Report;
+
+impl Report for IdentifyRun {
+    fn table(&self) -> String {
+        table(&self.document)
+    }
+}
+
+/// `v` for a table: 4 significant digits.
+fn num(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if !v.is_finite() {
+        "—".into()
+    } else if (1e-3..1e5).contains(&v.abs()) {
+        format!("{v:.6}")
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string()
+    } else {
+        format!("{v:.4e}")
+    }
+}
+
+fn table(d: &IdentifyDocument) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "machine {}: {} measurements ({} rows) from {}, frame {}{}",
+        d.machine,
+        d.measurements,
+        d.rows,
+        d.file,
+        d.frame,
+        if d.weighted {
+            ", weighted by std"
+        } else {
+            ", equal weights"
+        }
+    );
+    let _ = writeln!(
+        s,
+        "{} unknowns, rank {}, condition {}{}",
+        d.parameters,
+        d.rank,
+        num(d.condition),
+        if d.prior {
+            "; posterior with the statistics prior"
+        } else {
+            ""
+        }
+    );
+    let width = d
+        .estimates
+        .0
+        .iter()
+        .map(|(n, _)| n.len())
+        .max()
+        .unwrap_or(5)
+        .max(5);
+    let _ = writeln!(s, "\n{:<width$}  {:>14}  {:>14}", "error", "value", "std");
+    for (name, e) in &d.estimates.0 {
+        let std = e.std.map_or("—".to_string(), num);
+        // Without a prior, an unknown in the null space has the
+        // minimum-norm value and the std of that solution only.
+        let note = if d.prior {
+            ""
+        } else {
+            match d
+                .unidentifiable
+                .iter()
+                .filter(|v| v.0.iter().any(|(n, _)| n == name))
+                .map(|v| v.0.len())
+                .min()
+            {
+                Some(1) => "  not seen by the data",
+                Some(_) => "  aliased (see below)",
+                None => "",
+            }
+        };
+        let _ = writeln!(s, "{name:<width$}  {:>14}  {std:>14}{note}", num(e.value));
+    }
+    if !d.groups.is_empty() {
+        let _ = writeln!(
+            s,
+            "\n{}",
+            if d.prior {
+                "not informed by the data:"
+            } else {
+                "cannot be separated by these measurements (estimates above: the minimum-norm solution):"
+            }
+        );
+        for g in &d.groups {
+            let _ = writeln!(s, "  - {}", g.explanation);
+        }
+        for (k, v) in d.unidentifiable.iter().enumerate() {
+            let parts: Vec<String> = v.0.iter().map(|(n, c)| format!("{n}: {c:.5}")).collect();
+            let _ = writeln!(s, "  vector {}: {{{}}}", k + 1, parts.join(", "));
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\nresidual: rms {}, max {}, {} degrees of freedom{}",
+        num(d.residual.rms),
+        num(d.residual.max),
+        d.residual.dof,
+        match (d.weighted, d.residual.scale) {
+            (true, Some(k)) => format!(", scatter / stated std = {}", num(k)),
+            (false, Some(k)) => format!(", noise estimate s = {}", num(k)),
+            _ => String::new(),
+        }
+    );
+    if !d.largest_residuals.is_empty() {
+        let _ = writeln!(
+            s,
+            "largest standardised residuals (|t| > {} flagged as a likely outlier): {} flagged",
+            chain_core::measured::identify::OUTLIER_LIMIT,
+            d.outliers
+        );
+        for r in d.largest_residuals.iter().take(5) {
+            let _ = writeln!(
+                s,
+                "  line {:>6} {:<3}  r = {:>12}  t = {:>8.3}{}",
+                r.line,
+                r.component,
+                num(r.residual),
+                r.standardised,
+                if r.outlier { "  likely outlier" } else { "" }
+            );
+        }
+    }
+    s
+}

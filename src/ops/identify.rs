@@ -1,0 +1,53 @@
+//! `chain identify` as a request and a document (measured-machines spec
+//! §4; docs/identify.md): the error parameters of a built machine from
+//! measurements, by weighted least squares through an SVD or the posterior
+//! of the `statistics` prior, with the values file `--values-out` writes.
+//! The measurements are read by the adapter (a file for the CLI, a path or
+//! columns for Python) through `chain_core::measured::Measurements`.
+
+use chain_core::measured::document::{
+    identify_document, values_file, DocumentError, IdentifyDocument,
+};
+use chain_core::measured::{Identification, Measurements};
+use chain_core::Machine;
+use serde::{Serialize, Serializer};
+
+/// The request of `chain identify`.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct IdentifyRequest {
+    /// `--prior`: the machine file's `statistics` as a Gaussian prior.
+    pub prior: bool,
+}
+
+/// The document of `chain identify` (JSON: [`IdentifyDocument`]) with the
+/// identification and the values file it gives.
+#[derive(Debug, Clone)]
+pub struct IdentifyRun {
+    /// The spec's document.
+    pub document: IdentifyDocument,
+    /// The identification.
+    pub result: Identification,
+    /// The values file of the estimates (`--values-out`).
+    pub values_text: String,
+}
+
+impl Serialize for IdentifyRun {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        self.document.serialize(serializer)
+    }
+}
+
+/// Runs `chain identify` of `machine` over `measurements`.
+pub fn run(
+    machine: &Machine,
+    measurements: &Measurements,
+    request: &IdentifyRequest,
+) -> Result<IdentifyRun, DocumentError> {
+    let (document, result) = identify_document(machine, measurements, request.prior)?;
+    let values_text = values_file(machine, &measurements.file, &result);
+    Ok(IdentifyRun {
+        document,
+        result,
+        values_text,
+    })
+}
