@@ -309,19 +309,19 @@ impl Model {
     /// `"tool"` / `"workpiece"`).
     #[pyo3(signature = (frame=None))]
     fn derive_json(&self, frame: Option<&str>) -> PyResult<String> {
+        use chain::ops::derive::{self, DeriveRequest};
         use chain_core::model::Frame;
         let frame = match frame {
-            None => self.machine.frame,
-            Some("tool") => Frame::Tool,
-            Some("workpiece") => Frame::Workpiece,
+            None => None,
+            Some("tool") => Some(Frame::Tool),
+            Some("workpiece") => Some(Frame::Workpiece),
             Some(other) => {
                 return Err(value_error(format!(
                     "frame must be \"tool\" or \"workpiece\", not {other:?}"
                 )))
             }
         };
-        let model = chain_core::derive_in(&self.machine, frame);
-        to_json(&chain_core::export::to_json(&model))
+        to_json(&derive::run(&self.machine, &DeriveRequest { frame }))
     }
 
     /// The sensitivity `∂E/∂e` at each row of `q` (`(N, V)`): a flat

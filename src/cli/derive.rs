@@ -1,7 +1,9 @@
-//! `chain derive FILE [--frame tool|workpiece] [--format text|json|latex|rust]`.
+//! `chain derive FILE [--frame tool|workpiece] [--format text|json|latex|rust]`:
+//! [`chain::ops::derive`] rendered in the format asked.
 
 use std::path::PathBuf;
 
+use chain::ops::derive::{self, DeriveRequest};
 use chain_core::emit::{emit_pretty, EmitOptions};
 use chain_core::export;
 use chain_core::model::Frame;
@@ -43,20 +45,22 @@ pub struct DeriveArgs {
     pub format: DeriveFormat,
 }
 
-/// Runs `chain derive`.
+/// Runs `chain derive` ([`chain::ops::derive`]).
 pub fn exec(args: DeriveArgs) -> miette::Result<()> {
     let machine = chain_core::load_file(&args.file)?;
-    let frame = match args.frame {
-        Some(FrameArg::Tool) => Frame::Tool,
-        Some(FrameArg::Workpiece) => Frame::Workpiece,
-        None => machine.frame,
+    let request = DeriveRequest {
+        frame: args.frame.map(|f| match f {
+            FrameArg::Tool => Frame::Tool,
+            FrameArg::Workpiece => Frame::Workpiece,
+        }),
     };
-    let model = chain_core::derive_in(&machine, frame);
+    let derivation = derive::run(&machine, &request);
+    let model = &derivation.model;
     let out = match args.format {
-        DeriveFormat::Text => export::to_text(&model),
-        DeriveFormat::Latex => export::to_latex(&model),
-        DeriveFormat::Json => report::json(&export::to_json(&model))?,
-        DeriveFormat::Rust => emit_pretty(&model, &EmitOptions::for_model(&model)),
+        DeriveFormat::Text => export::to_text(model),
+        DeriveFormat::Latex => export::to_latex(model),
+        DeriveFormat::Json => report::json(&derivation)?,
+        DeriveFormat::Rust => emit_pretty(model, &EmitOptions::for_model(model)),
     };
     report::write_stdout(&out)
 }

@@ -10,6 +10,7 @@
 //! - [`study`]: a reliability study from a machine and the options every
 //!   study command takes (parameters, grid, sided, system, a posterior).
 
+//! - [`derive`] (feature `json`): `chain derive`'s request and document;
 //! - [`allocate`]: `chain allocate`'s request and document;
 //! - [`export`]: `chain export`'s request, document and the per-axis tables `map --compensated` shares;
 //! - [`identify`]: `chain identify`'s request and document (with the values file);
@@ -24,6 +25,8 @@
 //! - [`path`]: `chain path`'s request (axis values or poses) and document.
 
 pub mod allocate;
+#[cfg(feature = "json")]
+pub mod derive;
 pub mod export;
 pub mod identify;
 pub mod inverse;
