@@ -1,11 +1,13 @@
 //! `chain compensate --format json` (seed 003's swing-angle workflow): the
 //! measurements from a path or as CSV text, read by the library reader the
-//! CLI uses (`chain::compensate::records`), analysed by
-//! `chain::compensate::analyze`.
+//! CLI uses (`chain::compensate::records`), run by `chain::ops::compensate`
+//! with the CLI's request.
 
 use std::path::Path;
 
-use chain::compensate::{self, records, Options, SelectionRule};
+use chain::compensate::{records, Options, SelectionRule};
+use chain::ops::compensate::{self, CompensateRequest};
+use chain::ops::study::OptionError;
 use pyo3::prelude::*;
 
 use crate::{to_json, value_error};
@@ -26,18 +28,15 @@ pub(crate) fn compensate_json(
     select: &str,
     order: Option<usize>,
 ) -> PyResult<String> {
-    const SELECT: &str = "loocv, adjusted-r2, aicc, bic";
-    let rule = match select {
-        "loocv" => SelectionRule::Loocv,
-        "adjusted-r2" => SelectionRule::AdjustedR2,
-        "aicc" => SelectionRule::Aicc,
-        "bic" => SelectionRule::Bic,
-        other => {
-            let message =
-                format!("invalid value {other:?} for `select` [possible values: {SELECT}]");
-            return Err(value_error(message));
-        }
-    };
+    let rule = select.parse::<SelectionRule>().map_err(|message| {
+        value_error(
+            OptionError {
+                option: "select",
+                message,
+            }
+            .to_string(),
+        )
+    })?;
     let measurements = match (path, text) {
         (Some(path), None) => records::read_measurements(Path::new(path)),
         (None, Some(text)) => records::parse_measurements(name, text.as_bytes()),
@@ -48,15 +47,18 @@ pub(crate) fn compensate_json(
         }
     }
     .map_err(|e| value_error(e.to_string()))?;
-    let options = Options {
-        length,
-        min_order,
-        max_order,
-        rule,
-        fixed_order: order,
+    let request = CompensateRequest {
+        options: Options {
+            length,
+            min_order,
+            max_order,
+            rule,
+            fixed_order: order,
+        },
+        table: None,
     };
-    let analysis = py
-        .allow_threads(|| compensate::analyze(&measurements, &options))
+    let run = py
+        .allow_threads(|| compensate::run(&measurements, &request))
         .map_err(|e| value_error(e.to_string()))?;
-    to_json(&analysis)
+    to_json(&run)
 }

@@ -20,7 +20,7 @@ use chain_core::values::{Values, ValuesError};
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 
-use chain::ops::map::{MapOpsError, MapPoints, MapRequest, PreparedMap};
+use chain::ops::map::{MapOpsError, MapPoints, MapRequest};
 
 use crate::{load_error, resolve_error, study_error, to_json, value_error, Model};
 
@@ -166,17 +166,18 @@ pub(crate) fn map_json(
         params: &params,
         approach: &choices,
         points,
+        compensated: None,
+        keep_points: true,
     };
-    let PreparedMap { built, points, .. } =
-        chain::ops::map::prepare(m, &model.file, values, &name, "points", &request).map_err(
-            |e| match e {
-                MapOpsError::Reliability(e) => study_error(py, &e, &model.file),
-                MapOpsError::Resolve(e) => resolve_error(py, model, e),
-                other => value_error(other.to_string()),
-            },
-        )?;
-    let result = py
-        .allow_threads(|| built.map(points))
-        .map_err(|e| value_error(e.to_string()))?;
-    to_json(&result)
+    let ops_error = |e: MapOpsError| match e {
+        MapOpsError::Reliability(e) => study_error(py, &e, &model.file),
+        MapOpsError::Resolve(e) => resolve_error(py, model, e),
+        other => value_error(other.with_help()),
+    };
+    let prepared = chain::ops::map::prepare(m, &model.file, values, &name, "points", &request)
+        .map_err(ops_error)?;
+    let doc = py
+        .allow_threads(|| prepared.run(m, &request, &|_| {}).map_err(Box::new))
+        .map_err(|e| ops_error(*e))?;
+    to_json(&doc)
 }

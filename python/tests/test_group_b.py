@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import chain
-from conftest import MACHINES, ROOT
+from conftest import MACHINES, ROOT, squeezed
 
 MEAS = ROOT / "examples/measurements"
 PROBE = MEAS / "vmc3_probe.yaml"
@@ -134,7 +134,6 @@ def test_plan_bad_input():
 
 def test_options_are_refused_in_the_cli_s_words(cli_error, tmp_path):
     """Grid axes, --at and --param go through chain::ops::resolve in both: the same message."""
-    from conftest import squeezed
 
     no_grid = tmp_path / "m.yaml"
     no_grid.write_text(
@@ -160,6 +159,23 @@ def test_options_are_refused_in_the_cli_s_words(cli_error, tmp_path):
         assert wording in str(info.value)
         if args is not None:
             assert squeezed(wording) in squeezed(cli_error(*args))
+
+
+def test_map_outside_a_table_is_the_cli_refusal(cli_error, tmp_path):
+    """A point outside a values table: Machine.map raises the CLI's message and help (chain::ops::map), word for word."""
+    values = tmp_path / "values.yaml"
+    values.write_text(
+        "machine: vmc3\nunits: {linear: um, angular: urad}\nvalues:\n"
+        f"  EXX: {{table: {ROOT / 'examples/values/x_axis.csv'}, column: EXX}}\n"
+    )
+    m = chain.Machine.load(VMC3)
+    with pytest.raises(ValueError) as info:
+        m.map(values, grid={"x": [0, 850], "y": [0], "z": [0]})
+    message, help_text = str(info.value).split("\nhelp: ")
+    assert message.startswith("at point 2 (y = 0, x = 850, z = 0): x = 850 is outside the table of `EXX`")
+    assert "extrapolate: hold" in help_text
+    err = cli_error("map", VMC3, "--values", values, "--grid", "x=0,850", "--grid", "y=0", "--grid", "z=0")
+    assert squeezed(message) in squeezed(err) and squeezed(help_text) in squeezed(err)
 
 
 def test_inverse_is_the_cli_json(cli, cli_error, tmp_path):

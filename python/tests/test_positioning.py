@@ -143,7 +143,7 @@ def test_compensate_is_the_cli_json(cli, cli_error):
     r = chain.compensate(path, length=577.11, select="bic", max_order=5)
     assert r.to_dict() == cli("compensate", path, "--length", "577.11", "--select", "bic", "--max-order", "5")
     assert len(r.to_dataframe()) == len(r.points)
-    with pytest.raises(ValueError, match="invalid value \"best\" for `select`"):
+    with pytest.raises(ValueError, match="invalid value for '--select': unknown selection rule `best`"):
         chain.compensate(path, length=577.11, select="best")
     bad = {k: v for k, v in cols.items() if k != "z3"}
     with pytest.raises(ValueError) as info:

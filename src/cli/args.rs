@@ -285,6 +285,15 @@ impl ControllerName {
     }
 }
 
+impl From<ControllerName> for chain::ops::export::ExportController {
+    fn from(c: ControllerName) -> Self {
+        match c.tables() {
+            None => chain::ops::export::ExportController::Grid,
+            Some(t) => chain::ops::export::ExportController::Tables(t),
+        }
+    }
+}
+
 /// The coordinates of `--at`, `(variable, value)` in the order given.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AtPoint(pub Vec<(String, f64)>);

@@ -94,10 +94,7 @@ pub struct ExportArgs {
 
 /// Runs `chain export` ([`chain::ops::export`]).
 pub fn exec(args: ExportArgs) -> miette::Result<()> {
-    let controller = match args.controller.tables() {
-        None => ExportController::Grid,
-        Some(c) => ExportController::Tables(c),
-    };
+    let controller = ExportController::from(args.controller);
     let mut request = ExportRequest {
         controller,
         params: &args.param.params,

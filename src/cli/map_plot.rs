@@ -28,8 +28,8 @@ use chain_core::{BuiltMachine, CompiledModel, ErrorModel, MapResult};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{Input, MapDoc};
 use crate::cli::plot::{ensure_fonts, ramp, Legend, Series, XyChart, GREY};
+use chain::ops::map::MapInput;
 
 const HEAT_SIZE: (u32, u32) = (1000, 760);
 const COMPONENTS: [&str; 6] = chain_core::model::Component::NAMES;
@@ -40,17 +40,15 @@ const UNITS: [&str; 6] = ["µm", "µm", "µm", "µrad", "µrad", "µrad"];
 /// Writes every chart into `dir`; returns the files written.
 pub(super) fn write_all(
     dir: &Path,
-    doc: &MapDoc,
+    r: &MapResult,
+    input: &MapInput,
     built: &BuiltMachine<CompiledModel>,
 ) -> miette::Result<Vec<PathBuf>> {
-    let Some(r) = doc.full() else {
-        return Ok(Vec::new());
-    };
     std::fs::create_dir_all(dir)
         .map_err(|e| miette::miette!("{}: cannot create the plot directory: {e}", dir.display()))?;
     ensure_fonts();
-    match &doc.input {
-        Input::Grid(axes) => {
+    match input {
+        MapInput::Grid(axes) => {
             let mut by_count: Vec<usize> =
                 (0..axes.len()).filter(|&k| axes[k].1.len() > 1).collect();
             by_count.sort_by_key(|&k| std::cmp::Reverse(axes[k].1.len()));
@@ -66,7 +64,7 @@ pub(super) fn write_all(
                 }
             }
         }
-        Input::Axes(_) => {
+        MapInput::Rows(_) => {
             let lines: Vec<(f64, usize)> = (0..r.len()).map(|i| ((i + 1) as f64, i)).collect();
             lines_charts(dir, r, "row", &lines, "")
         }

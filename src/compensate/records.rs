@@ -135,3 +135,69 @@ impl RecordsError {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use crate::compensate::{CompensateError, Measurements};
+
+    /// What the reader makes of the bytes of a file named `name`.
+    fn parse(name: &str, data: &[u8]) -> Result<Measurements, CompensateError> {
+        super::parse_measurements(name, data)
+    }
+
+    #[test]
+    fn reader_skips_comments_blank_lines_and_a_byte_order_mark() {
+        let m = parse(
+            "mem.csv",
+            b"# comment\n\nZ3, note, THETA_DEG ,z1\r\n-171.1,\"a, b\",1,-170.99\n\n# again\n-171.4275,b,2,-170.99\n",
+        )
+        .unwrap();
+        assert_eq!(m.header_line, 3);
+        assert_eq!(m.records.iter().map(|r| r.line).collect::<Vec<_>>(), [4, 7]);
+        assert_eq!(m.records[1].theta_deg, 2.0);
+        assert_eq!(m.records[1].z3, -171.4275);
+        let m = parse("bom.csv", b"\xEF\xBB\xBFtheta_deg,z1,z3\n1,0,-0.1\n").unwrap();
+        assert_eq!((m.header_line, m.records[0].line), (1, 2));
+    }
+
+    #[test]
+    fn reader_errors_name_the_file_and_line() {
+        let e = parse("bad.csv", b"theta_deg,z1,z3\n1,0,\xFF\n").unwrap_err();
+        assert!(
+            matches!(e, CompensateError::Malformed { line: 2, .. }),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .starts_with("bad.csv:2: the line is not valid UTF-8"),
+            "{e}"
+        );
+        let e = parse("empty.csv", b"# only a comment\n\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "empty.csv:1: the file is empty; expected a header line `theta_deg,z1,z3` (optionally with `z2`)"
+        );
+        let e = parse("short.csv", b"theta_deg,z1,z3\n1,0,-0.1\n2,0\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "short.csv:3: this row has 2 fields but the header has 3 columns"
+        );
+        let e = super::read_measurements(Path::new("/nonexistent/swing.csv")).unwrap_err();
+        assert!(matches!(e, CompensateError::Io { .. }), "{e}");
+        assert!(e
+            .to_string()
+            .starts_with("/nonexistent/swing.csv: cannot read the file: "));
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(256))]
+
+        /// No byte string makes the reader or the row checks panic.
+        #[test]
+        fn reader_never_panics(bytes in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..200)) {
+            let _ = parse("fuzz.csv", &bytes);
+        }
+    }
+}

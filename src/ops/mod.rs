@@ -12,6 +12,7 @@
 
 //! - [`derive`] (feature `json`): `chain derive`'s request and document;
 //! - [`allocate`]: `chain allocate`'s request and document;
+//! - [`compensate`]: `chain compensate`'s request (the fit's options, the table) and document;
 //! - [`export`]: `chain export`'s request, document and the per-axis tables `map --compensated` shares;
 //! - [`identify`]: `chain identify`'s request and document (with the values file);
 //! - [`plan`]: `chain plan`'s request, refusals and document;
@@ -25,6 +26,7 @@
 //! - [`path`]: `chain path`'s request (axis values or poses) and document.
 
 pub mod allocate;
+pub mod compensate;
 #[cfg(feature = "json")]
 pub mod derive;
 pub mod export;

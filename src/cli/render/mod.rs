@@ -2,11 +2,14 @@
 //! file per document; the JSON form is the document's own `Serialize`.
 
 pub(crate) mod allocate;
+pub(crate) mod compensate;
 pub(crate) mod export;
 pub(crate) mod identify;
+pub(crate) mod map;
 pub(crate) mod motion;
 pub(crate) mod path;
 pub(crate) mod plan;
+pub(crate) mod positioning;
 pub(crate) mod reliability;
 pub(crate) mod sensitivity;
 pub(crate) mod sobol;
