@@ -313,3 +313,26 @@ pub(crate) fn parse_point(s: &str) -> Result<AtPoint, String> {
     }
     Ok(AtPoint(point))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_ranges_are_evenly_spaced_and_end_at_hi() {
+        let (n, v) = parse_grid_axis("x=0:1000:5").unwrap();
+        assert_eq!(n, "x");
+        assert_eq!(v, [0.0, 250.0, 500.0, 750.0, 1000.0]);
+        let (_, v) = parse_grid_axis("z = 1:0:3").unwrap();
+        assert_eq!(v, [1.0, 0.5, 0.0]);
+        let (_, v) = parse_grid_axis("y=0.1:0.7:7").unwrap();
+        assert_eq!(v.len(), 7);
+        assert_eq!(v[6], 0.7);
+        assert_eq!(parse_grid_axis("x=1,2").unwrap().1, [1.0, 2.0]);
+        assert!(parse_grid_axis("x=0:1:1").unwrap_err().contains("N ≥ 2"));
+        assert!(parse_grid_axis("x=0:1").unwrap_err().contains("LO:HI:N"));
+        assert!(parse_grid_axis("x=0:0:3").unwrap_err().contains("LO ≠ HI"));
+        assert!(parse_grid_axis("x=0:inf:3").is_err());
+        assert!(parse_grid_axis("x=0:1:2.5").is_err());
+    }
+}

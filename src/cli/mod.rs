@@ -1,29 +1,24 @@
-//! Subcommands of the `chain` binary: one file per subcommand, each a thin
-//! `exec` over the libraries.
+//! The `chain` binary's adapter over [`chain::ops`]: the subcommands in
+//! `commands/` (one file each, clap arguments → a request → `ops` → the
+//! document to `report::emit`; no command imports another), the shared
+//! argument groups in `args.rs`, the table and CSV forms of the documents in
+//! `render/`, the charts in `plot/`.
 
-pub mod allocate;
 mod args;
 mod atomic;
-pub mod compensate;
+mod commands;
 mod csv_input;
-pub mod derive;
-pub mod export;
-pub mod identify;
-pub mod inverse;
 mod loaded;
-pub mod map;
-pub mod motion;
-pub mod path;
-pub mod plan;
 pub mod plot;
-pub mod positioning;
-pub mod reliability;
-mod reliability_plot;
+mod progress;
 mod render;
 pub mod report;
-pub mod sensitivity;
-pub mod sobol;
 mod study_text;
+
+use commands::{
+    allocate, compensate, derive, export, identify, inverse, map, motion, path, plan, positioning,
+    reliability, sensitivity, sobol,
+};
 
 use clap::{Parser, Subcommand};
 

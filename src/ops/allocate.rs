@@ -195,19 +195,24 @@ impl Serialize for AllocationRun {
     }
 }
 
-/// The checks that need no machine: the threshold and the level against
-/// the target.
-pub fn check(request: &AllocateRequest<'_>) -> Result<(), AllocateOpsError> {
-    let t = request.threshold;
+/// `--threshold`: a fraction of the largest sensitivity in [0, 1] (above 1
+/// no error is ever tightened, and NaN compares false with all).
+pub fn check_threshold(t: f64) -> Result<f64, OptionError> {
     if !(0.0..=1.0).contains(&t) {
         return Err(OptionError {
             option: "threshold",
             message: format!(
                 "the threshold is a fraction of the largest sensitivity, in [0, 1] (found `{t}`)"
             ),
-        }
-        .into());
+        });
     }
+    Ok(t)
+}
+
+/// The checks that need no machine: the threshold and the level against
+/// the target.
+pub fn check(request: &AllocateRequest<'_>) -> Result<(), AllocateOpsError> {
+    check_threshold(request.threshold)?;
     match (request.target, request.level) {
         (AllocationTarget::Acceptance, Some(l)) if l > 0.0 && l < 1.0 => Ok(()),
         (AllocationTarget::Acceptance, Some(l)) => Err(AllocateOpsError::Level(l)),

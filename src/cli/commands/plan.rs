@@ -14,9 +14,9 @@ use chain::ops::plan::{self, PlanRequest};
 use chain_core::measured::{Layout, Measurements};
 use chain_core::plan::Kind;
 
-use super::args::ParamArgs;
-use super::loaded::Loaded;
-use super::report;
+use crate::cli::args::ParamArgs;
+use crate::cli::loaded::Loaded;
+use crate::cli::report;
 
 /// Output formats of `chain plan`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -73,8 +73,10 @@ pub fn exec(args: PlanArgs) -> miette::Result<()> {
     args.param.check_names(m)?;
     let name = display(&args.candidates);
     let candidates = if args.candidates.as_os_str() == "-" {
-        let (_, bytes) =
-            super::csv_input::read_input(&args.candidates, chain_core::bounded::MEASUREMENT_BYTES)?;
+        let (_, bytes) = crate::cli::csv_input::read_input(
+            &args.candidates,
+            chain_core::bounded::MEASUREMENT_BYTES,
+        )?;
         let text = String::from_utf8(bytes)
             .map_err(|e| miette::miette!(code = "chain::utf8", "{name}: not UTF-8 text ({e})"))?;
         Measurements::parse(&text, &name, m, &args.param.params, Layout::Candidates)?

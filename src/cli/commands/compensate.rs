@@ -6,10 +6,9 @@ use std::path::PathBuf;
 use chain::compensate::{self, CompensateError, Grid, Options, SelectionRule};
 use chain::ops::{self, compensate::CompensateRequest, compensate::TableRequest};
 
-use super::report;
+use crate::cli::report;
 
-#[path = "compensate_plot.rs"]
-mod compensate_plot;
+use crate::cli::plot::compensate as compensate_plot;
 
 /// Output format of `chain compensate`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -116,7 +115,7 @@ pub fn exec(args: CompensateArgs) -> miette::Result<()> {
             file: out.display().to_string(),
             source,
         };
-        super::atomic::write_with(out, |file| {
+        crate::cli::atomic::write_with(out, |file| {
             compensate::write_table_csv(rows, std::io::BufWriter::new(file))
         })
         .map_err(write_error)?;

@@ -14,8 +14,7 @@
 //! `--values` giving the nominal error sizes and `--plot DIR` bar charts like
 //! the paper's Figures 3-5 (see `docs/geometric_sensitivity.md`).
 
-#[path = "geometric_plot.rs"]
-mod geometric_plot;
+use crate::cli::plot::geometric as geometric_plot;
 
 use std::path::PathBuf;
 
@@ -25,11 +24,11 @@ use chain::ops::sensitivity::{
 };
 use chain_core::geometric::NominalSizes;
 
-use super::args::{parse_axis, parse_point, AtPoint, ModelArgs};
-use super::loaded::Loaded;
-use super::reliability_plot;
-use super::render::sensitivity::{at_text, where_text};
-use super::report;
+use crate::cli::args::{parse_axis, parse_point, AtPoint, ModelArgs};
+use crate::cli::loaded::Loaded;
+use crate::cli::plot::reliability as reliability_plot;
+use crate::cli::render::sensitivity::{at_text, where_text};
+use crate::cli::report;
 
 /// What `chain sensitivity` computes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]

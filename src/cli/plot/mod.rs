@@ -15,6 +15,15 @@
 //! # Ok::<(), crate::cli::plot::PlotError>(())
 //! ```
 
+pub(crate) mod allocate;
+pub(crate) mod compensate;
+pub(crate) mod geometric;
+pub(crate) mod map;
+pub(crate) mod motion;
+pub(crate) mod path;
+pub(crate) mod positioning;
+pub(crate) mod reliability;
+
 use std::path::{Path, PathBuf};
 use std::sync::Once;
 
@@ -89,6 +98,65 @@ pub enum PlotError {
         /// The chart's title.
         title: String,
     },
+}
+
+/// The two backends behind one type, so that each chart is drawn by one
+/// function for both of its files.
+pub enum Area<'a> {
+    /// The PNG.
+    Bitmap(DrawingArea<BitMapBackend<'a>, Shift>),
+    /// The SVG.
+    Svg(DrawingArea<SVGBackend<'a>, Shift>),
+}
+
+/// Draws one chart as `dir/stem.png` and `dir/stem.svg` (creating `dir`),
+/// each written atomically (`cli/atomic.rs`); returns both paths.
+pub fn write_both(
+    dir: &Path,
+    stem: &str,
+    size: (u32, u32),
+    draw: impl Fn(Area<'_>) -> Result<(), String>,
+) -> Result<Vec<PathBuf>, PlotError> {
+    std::fs::create_dir_all(dir).map_err(|source| PlotError::Io {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    ensure_fonts();
+    let png = dir.join(format!("{stem}.png"));
+    let svg = dir.join(format!("{stem}.svg"));
+    for (path, bitmap) in [(&png, true), (&svg, false)] {
+        crate::cli::atomic::write_via(
+            path,
+            |tmp| {
+                let area = if bitmap {
+                    Area::Bitmap(BitMapBackend::new(tmp, size).into_drawing_area())
+                } else {
+                    Area::Svg(SVGBackend::new(tmp, size).into_drawing_area())
+                };
+                draw(area).map_err(|message| PlotError::Draw {
+                    path: path.display().to_string(),
+                    message,
+                })
+            },
+            |source| PlotError::Io {
+                path: path.display().to_string(),
+                source,
+            },
+        )?;
+    }
+    Ok(vec![png, svg])
+}
+
+/// Viridis, five stops, linearly interpolated (`t` in [0, 1]).
+pub fn viridis(t: f64) -> RGBColor {
+    const STOPS: [(f64, f64, f64); 5] = [
+        (68.0, 1.0, 84.0),
+        (59.0, 82.0, 139.0),
+        (33.0, 145.0, 140.0),
+        (94.0, 201.0, 98.0),
+        (253.0, 231.0, 37.0),
+    ];
+    ramp(&STOPS, t)
 }
 
 /// `((x_min, x_max), (y_min, y_max))` of a chart's axes.
@@ -244,57 +312,11 @@ impl XyChart {
     /// Writes `dir/stem.png` and `dir/stem.svg` (creating `dir`) and returns
     /// both paths.
     pub fn write(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, PlotError> {
-        std::fs::create_dir_all(dir).map_err(|source| PlotError::Io {
-            path: dir.display().to_string(),
-            source,
-        })?;
-        let png = dir.join(format!("{stem}.png"));
-        let svg = dir.join(format!("{stem}.svg"));
-        self.write_png(&png)?;
-        self.write_svg(&svg)?;
-        Ok(vec![png, svg])
-    }
-
-    /// Draws the chart into a PNG file (written atomically).
-    pub fn write_png(&self, path: &Path) -> Result<(), PlotError> {
         let ranges = self.ranges()?;
-        self.write_file(path, |tmp| {
-            self.draw(
-                BitMapBackend::new(tmp, self.size).into_drawing_area(),
-                ranges,
-            )
+        write_both(dir, stem, self.size, |area| match area {
+            Area::Bitmap(a) => self.draw(a, ranges),
+            Area::Svg(a) => self.draw(a, ranges),
         })
-    }
-
-    /// Draws the chart into an SVG file (written atomically).
-    pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
-        let ranges = self.ranges()?;
-        self.write_file(path, |tmp| {
-            self.draw(SVGBackend::new(tmp, self.size).into_drawing_area(), ranges)
-        })
-    }
-
-    /// Draws the chart through `draw` into a temporary file beside `path`,
-    /// then renames it into place (`cli/atomic.rs`).
-    fn write_file(
-        &self,
-        path: &Path,
-        draw: impl FnOnce(&Path) -> Result<(), String>,
-    ) -> Result<(), PlotError> {
-        ensure_fonts();
-        super::atomic::write_via(
-            path,
-            |tmp| {
-                draw(tmp).map_err(|message| PlotError::Draw {
-                    path: path.display().to_string(),
-                    message,
-                })
-            },
-            |source| PlotError::Io {
-                path: path.display().to_string(),
-                source,
-            },
-        )
     }
 
     /// Axis ranges: the explicit ones, or the finite data padded by 3 % (x)
@@ -523,40 +545,10 @@ impl BarChart {
     /// Writes `dir/stem.png` and `dir/stem.svg` (creating `dir`) and returns
     /// both paths.
     pub fn write(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, PlotError> {
-        std::fs::create_dir_all(dir).map_err(|source| PlotError::Io {
-            path: dir.display().to_string(),
-            source,
-        })?;
-        ensure_fonts();
-        let png = dir.join(format!("{stem}.png"));
-        let svg = dir.join(format!("{stem}.svg"));
-        let fail = |path: &Path, message: String| PlotError::Draw {
-            path: path.display().to_string(),
-            message,
-        };
-        let io = |path: String| {
-            move |source| PlotError::Io {
-                path: path.clone(),
-                source,
-            }
-        };
-        super::atomic::write_via(
-            &png,
-            |tmp| {
-                self.draw(BitMapBackend::new(tmp, self.size).into_drawing_area())
-                    .map_err(|m| fail(&png, m))
-            },
-            io(png.display().to_string()),
-        )?;
-        super::atomic::write_via(
-            &svg,
-            |tmp| {
-                self.draw(SVGBackend::new(tmp, self.size).into_drawing_area())
-                    .map_err(|m| fail(&svg, m))
-            },
-            io(svg.display().to_string()),
-        )?;
-        Ok(vec![png, svg])
+        write_both(dir, stem, self.size, |area| match area {
+            Area::Bitmap(a) => self.draw(a),
+            Area::Svg(a) => self.draw(a),
+        })
     }
 
     fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>

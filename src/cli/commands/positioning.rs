@@ -8,10 +8,9 @@ use std::path::PathBuf;
 use chain::ops::positioning as ops;
 use chain_core::measured::positioning::{Coverage, Runs};
 
-use super::report;
+use crate::cli::report;
 
-#[path = "positioning_plot.rs"]
-mod positioning_plot;
+use crate::cli::plot::positioning as positioning_plot;
 
 /// Output formats of `chain positioning`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -95,7 +94,7 @@ pub fn exec(args: PositioningArgs) -> miette::Result<()> {
     })?;
     let doc = done.document;
     if let (Some(out), Some(text)) = (&args.values_out, &done.values_text) {
-        super::atomic::write(out, text.as_bytes())
+        crate::cli::atomic::write(out, text.as_bytes())
             .map_err(|e| miette::miette!("cannot write {}: {e}", out.display()))?;
         let slot = args.slot.as_deref().unwrap_or_default();
         eprintln!("wrote {} ({slot})", out.display());

@@ -11,16 +11,16 @@
 //! seed 000 ([`chain::ops::reliability`]; the table and CSV in
 //! `cli/render/reliability.rs`).
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use ::reliability::Form;
 use chain::ops::reliability::{self, ReliabilityOpsError, ReliabilityRequest};
 
-use super::args::{parse_axis, AlgorithmArgs, ModelArgs, SystemArgs};
-use super::loaded::Loaded;
-use super::reliability_plot;
-use super::report;
+use crate::cli::args::{parse_axis, AlgorithmArgs, ModelArgs, SystemArgs};
+use crate::cli::loaded::Loaded;
+use crate::cli::plot::reliability as reliability_plot;
+use crate::cli::progress::Progress;
+use crate::cli::report;
 
 /// Output formats of `chain reliability`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -98,10 +98,11 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     };
     let prepared =
         reliability::prepare(&loaded.machine, loaded.file_name(), &request).map_err(refused)?;
-    let bar = match prepared.samples_anything() {
-        false => ProgressBar(None),
-        true => ProgressBar::new(prepared.planned_samples(), args.format),
-    };
+    // A bar over the samples when their count is known in advance (the
+    // fixed-count samplers), else a counter (subset simulation, whose
+    // levels are found as it runs, and every sampler stopped by `--cov`).
+    let show = prepared.samples_anything() && args.format != ReliabilityFormat::Json;
+    let bar = Progress::new(show, prepared.planned_samples(), "sampling", "samples");
     let run = prepared.run(&|n| bar.inc(n));
     bar.finish();
     let run = run.map_err(|e| loaded.report(e))?;
@@ -122,44 +123,3 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
 }
 
 report::formats!(ReliabilityFormat: Table, Json, Csv);
-
-/// A progress bar on stderr, only when stderr is a terminal and the output is
-/// not JSON.
-struct ProgressBar(Option<indicatif::ProgressBar>);
-
-impl ProgressBar {
-    /// A bar over `total` samples when the count is known in advance (the
-    /// fixed-count samplers); otherwise (subset simulation, whose levels are
-    /// found as it runs, and every sampler stopped by `--cov`) a counter of
-    /// the samples drawn, since any total would be a guess.
-    fn new(total: Option<u64>, format: ReliabilityFormat) -> ProgressBar {
-        if format == ReliabilityFormat::Json || !std::io::stderr().is_terminal() {
-            return ProgressBar(None);
-        }
-        let bar = indicatif::ProgressBar::with_draw_target(
-            total,
-            indicatif::ProgressDrawTarget::stderr(),
-        );
-        let template = if total.is_some() {
-            "{spinner} sampling [{bar:40}] {percent:>3}% {human_pos}/{human_len} samples, eta {eta}"
-        } else {
-            "{spinner} sampling: {human_pos} samples drawn, {elapsed}"
-        };
-        if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
-            bar.set_style(style.progress_chars("=> "));
-        }
-        ProgressBar(Some(bar))
-    }
-
-    fn inc(&self, n: u64) {
-        if let Some(b) = &self.0 {
-            b.inc(n);
-        }
-    }
-
-    fn finish(&self) {
-        if let Some(b) = &self.0 {
-            b.finish_and_clear();
-        }
-    }
-}

@@ -13,9 +13,9 @@ use std::path::PathBuf;
 use chain::ops::identify::{self, IdentifyRequest};
 use chain_core::measured::{Layout, Measurements};
 
-use super::args::ParamArgs;
-use super::loaded::Loaded;
-use super::report;
+use crate::cli::args::ParamArgs;
+use crate::cli::loaded::Loaded;
+use crate::cli::report;
 
 /// Output formats of `chain identify`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -68,7 +68,7 @@ pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
     let request = IdentifyRequest { prior: args.prior };
     let run = identify::run(m, &measurements, &request)?;
     if let Some(path) = &args.values_out {
-        super::atomic::write(path, run.values_text.as_bytes())
+        crate::cli::atomic::write(path, run.values_text.as_bytes())
             .map_err(|e| miette::miette!("cannot write {}: {e}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }

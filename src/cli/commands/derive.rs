@@ -8,7 +8,7 @@ use chain_core::emit::{emit_pretty, EmitOptions};
 use chain_core::export;
 use chain_core::model::Frame;
 
-use super::report;
+use crate::cli::report;
 
 /// Output formats of `chain derive`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

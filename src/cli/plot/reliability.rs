@@ -11,7 +11,8 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use reliability::{Study, StudyResult, TargetSensitivity};
 
-use super::study_text::target_map;
+use super::{viridis, write_both, Area};
+use crate::cli::study_text::target_map;
 
 const HEAT_SIZE: (u32, u32) = (900, 700);
 const BAR_SIZE: (u32, u32) = (1100, 600);
@@ -26,7 +27,7 @@ struct Heat {
 }
 
 /// Writes every chart into `dir`; returns the files written.
-pub(super) fn write_all(
+pub(crate) fn write_all(
     dir: &Path,
     machine: &str,
     study: &Study,
@@ -35,7 +36,7 @@ pub(super) fn write_all(
 ) -> miette::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir)
         .map_err(|e| miette::miette!("{}: cannot create the plot directory: {e}", dir.display()))?;
-    crate::cli::plot::ensure_fonts();
+    super::ensure_fonts();
     let method = result.method.title();
     let mut files = Vec::new();
     for (t, target) in study.targets().iter().enumerate() {
@@ -93,7 +94,7 @@ pub(crate) fn write_sensitivity(
 ) -> miette::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir)
         .map_err(|e| miette::miette!("{}: cannot create the plot directory: {e}", dir.display()))?;
-    crate::cli::plot::ensure_fonts();
+    super::ensure_fonts();
     let mut files = Vec::new();
     for s in sens {
         let values: Vec<f64> = order
@@ -105,9 +106,9 @@ pub(crate) fn write_sensitivity(
                     .map_or(0.0, |e| e.mean_abs_dr_dstd)
             })
             .collect();
-        let chart = crate::cli::plot::BarChart {
+        let chart = super::BarChart {
             size: BAR_SIZE,
-            ..crate::cli::plot::BarChart::new(
+            ..super::BarChart::new(
                 format!(
                     "{machine}: {} reliability sensitivity |∂R/∂σ| ({where_})",
                     s.target
@@ -122,42 +123,6 @@ pub(crate) fn write_sensitivity(
     Ok(files)
 }
 
-/// Draws one chart as `stem.png` and `stem.svg`.
-fn write_both(
-    dir: &Path,
-    stem: &str,
-    size: (u32, u32),
-    draw: impl Fn(Area<'_>) -> Result<(), String>,
-) -> miette::Result<Vec<PathBuf>> {
-    let png = dir.join(format!("{stem}.png"));
-    let svg = dir.join(format!("{stem}.svg"));
-    let fail = |p: &Path, e: String| miette::miette!("{}: cannot draw the chart: {e}", p.display());
-    let io = |p: String| move |e: std::io::Error| miette::miette!("cannot write {p}: {e}");
-    crate::cli::atomic::write_via(
-        &png,
-        |tmp| {
-            let root = BitMapBackend::new(tmp, size).into_drawing_area();
-            draw(Area::Bitmap(root)).map_err(|e| fail(&png, e))
-        },
-        io(png.display().to_string()),
-    )?;
-    crate::cli::atomic::write_via(
-        &svg,
-        |tmp| {
-            let root = SVGBackend::new(tmp, size).into_drawing_area();
-            draw(Area::Svg(root)).map_err(|e| fail(&svg, e))
-        },
-        io(svg.display().to_string()),
-    )?;
-    Ok(vec![png, svg])
-}
-
-/// The two backends behind one type, so each chart is written once.
-enum Area<'a> {
-    Bitmap(DrawingArea<BitMapBackend<'a>, Shift>),
-    Svg(DrawingArea<SVGBackend<'a>, Shift>),
-}
-
 fn draw_heat(area: Area<'_>, heat: &Heat) -> Result<(), String> {
     match area {
         Area::Bitmap(a) => heat_on(a, heat),
@@ -167,18 +132,6 @@ fn draw_heat(area: Area<'_>, heat: &Heat) -> Result<(), String> {
 
 fn err<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
-}
-
-/// Viridis, five stops, linearly interpolated.
-fn viridis(t: f64) -> RGBColor {
-    const STOPS: [(f64, f64, f64); 5] = [
-        (68.0, 1.0, 84.0),
-        (59.0, 82.0, 139.0),
-        (33.0, 145.0, 140.0),
-        (94.0, 201.0, 98.0),
-        (253.0, 231.0, 37.0),
-    ];
-    crate::cli::plot::ramp(&STOPS, t)
 }
 
 fn heat_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, heat: &Heat) -> Result<(), String>

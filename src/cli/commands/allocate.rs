@@ -10,11 +10,12 @@ use std::path::PathBuf;
 
 use chain::ops::allocate::{self as ops, AllocateOpsError, AllocateRequest, AllocationTarget};
 use miette::MietteDiagnostic;
-use reliability::allocate::{self, Allocation, ErrorBounds, StrategyName};
+use reliability::allocate::{self, StrategyName};
 
-use super::args::ModelArgs;
-use super::loaded::Loaded;
-use super::report;
+use crate::cli::args::ModelArgs;
+use crate::cli::loaded::Loaded;
+use crate::cli::plot::allocate as allocate_plot;
+use crate::cli::report;
 
 /// `--strategy`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -54,19 +55,10 @@ pub enum AllocateFormat {
 
 report::formats!(AllocateFormat: Table, Json);
 
-/// Parses `--threshold`: a fraction of the largest sensitivity in [0, 1]
-/// (above 1 no error is ever tightened, and NaN compares false with all).
-fn parse_threshold(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{s}` is not a number"))?;
-    if !(0.0..=1.0).contains(&v) {
-        return Err(format!(
-            "the threshold is a fraction of the largest sensitivity, in [0, 1] (found `{s}`)"
-        ));
-    }
-    Ok(v)
+/// `--threshold`, checked while parsing by [`ops::check_threshold`].
+fn threshold(text: &str) -> Result<f64, String> {
+    let t: f64 = (text.trim().parse()).map_err(|_| format!("`{text}` is not a number"))?;
+    ops::check_threshold(t).map_err(|e| e.message)
 }
 
 /// Arguments of `chain allocate`.
@@ -82,7 +74,7 @@ pub struct AllocateArgs {
     #[arg(long, value_name = "TOL", default_value_t = 0.005)]
     pub step: f64,
     /// Sensitivity threshold of `--strategy paper`, as a fraction of the largest, in [0, 1].
-    #[arg(long, default_value_t = 0.1, value_parser = parse_threshold, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.1, value_parser = threshold, allow_negative_numbers = true)]
     pub threshold: f64,
     /// Ranking of `--strategy paper`.
     #[arg(long, value_enum, default_value = "component")]
@@ -136,7 +128,7 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
             .map_err(|e| loaded.report(e))?;
         let (_, after) = allocate::evaluate(&run.model, &run.parameters, &run.study, &stds)
             .map_err(|e| loaded.report(e))?;
-        let files = plot(
+        let files = allocate_plot::write_all(
             dir,
             &run.machine,
             &run.study,
@@ -156,84 +148,4 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
         )),
         None => Ok(()),
     }
-}
-
-/// Before/after reliability over the grid per component, and the tightening
-/// `σ0/σ` per error (per round for the paper's procedure).
-fn plot(
-    dir: &std::path::Path,
-    machine: &str,
-    study: &reliability::Study,
-    bounds: &[ErrorBounds],
-    r: &Allocation,
-    before: &reliability::StudyResult,
-    after: &reliability::StudyResult,
-) -> Result<Vec<PathBuf>, crate::cli::plot::PlotError> {
-    use crate::cli::plot::{Legend, Series, XyChart};
-    let mut files = Vec::new();
-    let np = study.points().len();
-    let axes: Vec<&str> = study
-        .spec()
-        .grid
-        .axes
-        .iter()
-        .map(|(n, _)| n.as_str())
-        .collect();
-    let req = study.spec().requirement;
-    for (t, target) in study.targets().iter().enumerate() {
-        let pts = |res: &reliability::StudyResult| -> Vec<(f64, f64)> {
-            res.cases[t * np..(t + 1) * np]
-                .iter()
-                .enumerate()
-                .map(|(i, c)| ((i + 1) as f64, c.reliability * 100.0))
-                .collect()
-        };
-        let mut chart = XyChart::new(
-            format!(
-                "{machine}: {} reliability before and after allocation ({})",
-                target.name(),
-                r.strategy
-            ),
-            format!("grid point ({} order, first slowest)", axes.join(", ")),
-            "reliability (%)",
-        )
-        .series(Series::line_points("before", pts(before)))
-        .series(Series::line_points("after", pts(after)))
-        .legend(Legend::LowerRight);
-        if let Some(q) = req {
-            chart = chart.hline(q.min * 100.0);
-        }
-        files.extend(chart.write(dir, &format!("allocate_{}", target.name()))?);
-    }
-    let mut chart = XyChart::new(
-        format!("{machine}: tightening per error ({})", r.strategy),
-        if r.steps.is_empty() {
-            "initial (0) → allocated (1)"
-        } else {
-            "round"
-        },
-        "std0 / std",
-    )
-    .legend(Legend::UpperLeft);
-    for (j, b) in bounds.iter().enumerate() {
-        let last = r.std[j].1;
-        if (last - b.std0).abs() <= 1e-15 * b.std0 {
-            continue;
-        }
-        let mut points = vec![(0.0, 1.0)];
-        if r.steps.is_empty() {
-            points.push((1.0, b.std0 / last));
-        } else {
-            let mut s = b.std0;
-            for step in &r.steps {
-                if let Some((_, v)) = step.std.iter().find(|(n, _)| *n == b.error) {
-                    s = *v;
-                }
-                points.push((step.round as f64, b.std0 / s));
-            }
-        }
-        chart = chart.series(Series::line_points(b.error.clone(), points));
-    }
-    files.extend(chart.write(dir, "allocate_tightening")?);
-    Ok(files)
 }

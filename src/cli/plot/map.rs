@@ -28,7 +28,7 @@ use chain_core::{BuiltMachine, CompiledModel, ErrorModel, MapResult};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::cli::plot::{ensure_fonts, ramp, Legend, Series, XyChart, GREY};
+use super::{ensure_fonts, ramp, viridis, write_both, Area, Legend, Series, XyChart, GREY};
 use chain::ops::map::MapInput;
 
 const HEAT_SIZE: (u32, u32) = (1000, 760);
@@ -38,7 +38,7 @@ const MICRO: [f64; 6] = [1e3, 1e3, 1e3, 1e6, 1e6, 1e6];
 const UNITS: [&str; 6] = ["µm", "µm", "µm", "µrad", "µrad", "µrad"];
 
 /// Writes every chart into `dir`; returns the files written.
-pub(super) fn write_all(
+pub(crate) fn write_all(
     dir: &Path,
     r: &MapResult,
     input: &MapInput,
@@ -349,7 +349,7 @@ fn distortion(
         } else {
             Series::line(label, moved)
         };
-        chart = chart.series(series.color(crate::cli::plot::color(0)).width(2));
+        chart = chart.series(series.color(super::color(0)).width(2));
     }
     // Roughly equal scales on both axes.
     let (su, sw) = (spread(u).max(1e-9), spread(w).max(1e-9));
@@ -425,44 +425,6 @@ struct Heat {
     unit: &'static str,
 }
 
-/// The two backends behind one type, so each chart is written once.
-enum Area<'a> {
-    Bitmap(DrawingArea<BitMapBackend<'a>, Shift>),
-    Svg(DrawingArea<SVGBackend<'a>, Shift>),
-}
-
-/// Draws one chart as `stem.png` and `stem.svg`.
-fn write_both(
-    dir: &Path,
-    stem: &str,
-    size: (u32, u32),
-    draw: impl Fn(Area<'_>) -> Result<(), String>,
-) -> miette::Result<Vec<PathBuf>> {
-    let png = dir.join(format!("{stem}.png"));
-    let svg = dir.join(format!("{stem}.svg"));
-    let fail = |p: &Path, e: String| miette::miette!("{}: cannot draw the chart: {e}", p.display());
-    let io = |p: String| move |e: std::io::Error| miette::miette!("cannot write {p}: {e}");
-    crate::cli::atomic::write_via(
-        &png,
-        |tmp| {
-            draw(Area::Bitmap(
-                BitMapBackend::new(tmp, size).into_drawing_area(),
-            ))
-            .map_err(|e| fail(&png, e))
-        },
-        io(png.display().to_string()),
-    )?;
-    crate::cli::atomic::write_via(
-        &svg,
-        |tmp| {
-            draw(Area::Svg(SVGBackend::new(tmp, size).into_drawing_area()))
-                .map_err(|e| fail(&svg, e))
-        },
-        io(svg.display().to_string()),
-    )?;
-    Ok(vec![png, svg])
-}
-
 fn err<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
@@ -485,18 +447,6 @@ fn edges(sorted: &[f64]) -> Vec<f64> {
     }
     e.push(sorted[n - 1] + 0.5 * (sorted[n - 1] - sorted[n - 2]));
     e
-}
-
-/// Viridis, five stops, linearly interpolated (`t` in [0, 1]).
-fn viridis(t: f64) -> RGBColor {
-    const STOPS: [(f64, f64, f64); 5] = [
-        (68.0, 1.0, 84.0),
-        (59.0, 82.0, 139.0),
-        (33.0, 145.0, 140.0),
-        (94.0, 201.0, 98.0),
-        (253.0, 231.0, 37.0),
-    ];
-    ramp(&STOPS, t)
 }
 
 /// ColorBrewer's RdBu, blue for negative, white at zero, red for positive

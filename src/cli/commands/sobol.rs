@@ -11,11 +11,11 @@ use std::path::PathBuf;
 
 use chain::ops::sobol::{self, SobolOpsError, SobolRequest};
 
-use super::args::parse_axis;
-use super::args::ParamArgs;
-use super::args::{parse_point, AtPoint};
-use super::loaded::Loaded;
-use super::report;
+use crate::cli::args::parse_axis;
+use crate::cli::args::ParamArgs;
+use crate::cli::args::{parse_point, AtPoint};
+use crate::cli::loaded::Loaded;
+use crate::cli::report;
 
 /// Output formats of `chain sobol`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

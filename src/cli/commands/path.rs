@@ -4,18 +4,17 @@
 //! [--format table|json|csv] [--plot DIR]`: error and reliability along a
 //! path ([`chain::ops::path`], docs/path.md).
 
-#[path = "path_plot.rs"]
-mod path_plot;
+use crate::cli::plot::path as path_plot;
 
 use std::path::PathBuf;
 
 use chain::ops::path::{self, PathInput, PathOpsError, PathRequest};
 
-use super::args::parse_assignment;
-use super::args::{AlgorithmArgs, ModelArgs, SystemArgs};
-use super::csv_input::{numeric_rows, open_csv, read_poses};
-use super::loaded::Loaded;
-use super::report;
+use crate::cli::args::parse_assignment;
+use crate::cli::args::{AlgorithmArgs, ModelArgs, SystemArgs};
+use crate::cli::csv_input::{numeric_rows, open_csv, read_poses};
+use crate::cli::loaded::Loaded;
+use crate::cli::report;
 
 /// Output formats of `chain path`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

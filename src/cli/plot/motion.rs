@@ -5,12 +5,12 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::cli::plot::{Legend, Series as Line, XyChart};
+use super::{Legend, Series as Line, XyChart};
 use chain_core::model::JointKind;
 use chain_core::motion::Series;
 
 /// What the charts show.
-pub(super) struct View<'a> {
+pub(crate) struct View<'a> {
     /// Chart title prefix.
     pub title: String,
     /// CNC variables.
@@ -34,7 +34,7 @@ pub(super) struct View<'a> {
 /// Writes `motion_<variable>.{png,svg}` for every axis,
 /// `series_error.{png,svg}` and `truncation_error.{png,svg}`; returns the
 /// files written.
-pub(super) fn write_all(dir: &Path, v: &View<'_>) -> miette::Result<Vec<PathBuf>> {
+pub(crate) fn write_all(dir: &Path, v: &View<'_>) -> miette::Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for (k, name) in v.variables.iter().enumerate() {
         let unit = match v.kinds[k] {

@@ -8,10 +8,10 @@ use std::path::PathBuf;
 
 use chain::ops::inverse::{self, InverseDocument, InverseOpsError, InverseRequest};
 
-use super::args::{parse_assignment, ParamArgs};
-use super::csv_input::read_poses;
-use super::loaded::Loaded;
-use super::report::{self, Csv, Report};
+use crate::cli::args::{parse_assignment, ParamArgs};
+use crate::cli::csv_input::read_poses;
+use crate::cli::loaded::Loaded;
+use crate::cli::report::{self, Csv, Report};
 
 /// Arguments of `chain inverse`.
 #[derive(Debug, clap::Args)]

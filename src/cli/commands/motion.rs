@@ -8,16 +8,15 @@
 //! instant, and their Maclaurin expansion at `t = 0` with its truncation error
 //! over the roll and the order a tolerance needs.
 
-#[path = "motion_plot.rs"]
-mod motion_plot;
+use crate::cli::plot::motion as motion_plot;
 
 use std::path::PathBuf;
 
 use chain::ops::motion::{self, MotionDocument, MotionRequest};
 use chain_core::settings;
 
-use super::args::parse_assignment;
-use super::report;
+use crate::cli::args::parse_assignment;
+use crate::cli::report;
 
 /// Output formats of `chain motion`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

@@ -26,11 +26,11 @@ use chain_core::compensation::ExportedFile;
 use chain_core::values::Values;
 use miette::MietteDiagnostic;
 
-use super::args::ParamArgs;
-use super::args::{parse_grid_axis, ControllerName};
-use super::csv_input::axes_points;
-use super::loaded::Loaded;
-use super::report;
+use crate::cli::args::ParamArgs;
+use crate::cli::args::{parse_grid_axis, ControllerName};
+use crate::cli::csv_input::axes_points;
+use crate::cli::loaded::Loaded;
+use crate::cli::report;
 
 /// Output formats of `chain export`'s summary.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -161,7 +161,7 @@ fn write_files(dir: &std::path::Path, files: &[ExportedFile]) -> miette::Result<
         .map_err(|e| miette::miette!("cannot create {}: {e}", dir.display()))?;
     for f in files {
         let path = dir.join(&f.name);
-        super::atomic::write(&path, f.text.as_bytes())
+        crate::cli::atomic::write(&path, f.text.as_bytes())
             .map_err(|e| miette::miette!("cannot write {}: {e}", path.display()))?;
         eprintln!("wrote {}", path.display());
     }

@@ -1,11 +1,11 @@
 //! `--plot DIR` of `chain path`: the reliability of every target and the
 //! standard deviation of the toleranced error components along the path
-//! (PNG and SVG), drawn with the CLI's [`crate::cli::plot::XyChart`].
+//! (PNG and SVG), drawn with the CLI's [`super::XyChart`].
 //! Instants without axis values (unreachable poses) have no point.
 
 use std::path::{Path, PathBuf};
 
-use crate::cli::plot::{Legend, Series, XyChart};
+use super::{Legend, Series, XyChart};
 use reliability::Quantity;
 
 use crate::cli::render::path::label;
@@ -14,7 +14,7 @@ use chain::ops::path::PathDocument;
 /// Writes `path_reliability`, `path_std` and, when an orientation component
 /// is toleranced, `path_std_angular`; returns the files written. Writes
 /// nothing when no instant was evaluated.
-pub(super) fn write_all(dir: &Path, doc: &PathDocument) -> miette::Result<Vec<PathBuf>> {
+pub(crate) fn write_all(dir: &Path, doc: &PathDocument) -> miette::Result<Vec<PathBuf>> {
     let r = &doc.result;
     if r.evaluated() == 0 {
         eprintln!("note: no evaluated instant; no chart written");

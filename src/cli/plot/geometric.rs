@@ -4,12 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::cli::plot::BarChart;
+use super::BarChart;
 use chain_core::geometric::GeometricSensitivity;
 
 /// Writes `geometric_<component>.{png,svg}` for every direction in which
 /// some error acts; returns the files written.
-pub(super) fn write_all(
+pub(crate) fn write_all(
     dir: &Path,
     machine: &str,
     where_: &str,
@@ -22,7 +22,7 @@ pub(super) fn write_all(
             continue;
         }
         let chart = BarChart {
-            color: crate::cli::plot::color(k),
+            color: super::color(k),
             value_decimals: Some(1),
             ..BarChart::new(
                 format!(

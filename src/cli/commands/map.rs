@@ -15,22 +15,21 @@
 //! next to the uncompensated map (table, JSON `compensated`, CSV columns
 //! `*_after`, plots in `DIR/compensated/`).
 
-#[path = "map_plot.rs"]
-mod map_plot;
+use crate::cli::plot::map as map_plot;
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use chain::ops::export::ExportController;
 use chain::ops::map::{CompensationRequest, MapOpsError, MapPoints, MapRequest};
 use chain_core::values::{parse_approaches, Approach, Values};
 
-use super::args::ParamArgs;
-use super::args::{parse_grid_axis, ControllerName};
-use super::csv_input::axes_points;
-use super::loaded::Loaded;
-use super::render::map::TABLE_POINTS;
-use super::report;
+use crate::cli::args::ParamArgs;
+use crate::cli::args::{parse_grid_axis, ControllerName};
+use crate::cli::csv_input::axes_points;
+use crate::cli::loaded::Loaded;
+use crate::cli::progress::Progress;
+use crate::cli::render::map::TABLE_POINTS;
+use crate::cli::report;
 
 /// Maps with at least this many points show a progress bar (on a terminal).
 const PROGRESS_POINTS: usize = 200_000;
@@ -138,8 +137,9 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
     // error kept (the plots and the other formats do).
     request.keep_points =
         args.format != MapFormat::Table || args.plot.is_some() || count <= TABLE_POINTS;
-    let bar = Progress::new(count, args.format);
-    let doc = prepared.run(m, &request, &|n| bar.inc(n));
+    let show = count >= PROGRESS_POINTS && args.format != MapFormat::Json;
+    let bar = Progress::new(show, Some(count as u64), "mapping", "points");
+    let doc = prepared.run(m, &request, &|n| bar.inc(n as u64));
     bar.finish();
     let doc = doc.map_err(report)?;
     if let (Some(dir), Some(r)) = (&args.plot, doc.full()) {
@@ -156,62 +156,4 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
         }
     }
     report::emit(&doc, args.format.into())
-}
-
-/// A progress bar on stderr for large maps, only when stderr is a terminal
-/// and the output is not JSON.
-struct Progress(Option<indicatif::ProgressBar>);
-
-impl Progress {
-    fn new(points: usize, format: MapFormat) -> Progress {
-        if points < PROGRESS_POINTS || format == MapFormat::Json || !std::io::stderr().is_terminal()
-        {
-            return Progress(None);
-        }
-        let bar = indicatif::ProgressBar::with_draw_target(
-            Some(points as u64),
-            indicatif::ProgressDrawTarget::stderr(),
-        );
-        if let Ok(style) = indicatif::ProgressStyle::with_template(
-            "{spinner} mapping [{bar:40}] {percent:>3}% {human_pos}/{human_len} points, eta {eta}",
-        ) {
-            bar.set_style(style.progress_chars("=> "));
-        }
-        Progress(Some(bar))
-    }
-
-    fn inc(&self, n: usize) {
-        if let Some(b) = &self.0 {
-            b.inc(n as u64);
-        }
-    }
-
-    fn finish(&self) {
-        if let Some(b) = &self.0 {
-            b.finish_and_clear();
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn grid_ranges_are_evenly_spaced_and_end_at_hi() {
-        let (n, v) = parse_grid_axis("x=0:1000:5").unwrap();
-        assert_eq!(n, "x");
-        assert_eq!(v, [0.0, 250.0, 500.0, 750.0, 1000.0]);
-        let (_, v) = parse_grid_axis("z = 1:0:3").unwrap();
-        assert_eq!(v, [1.0, 0.5, 0.0]);
-        let (_, v) = parse_grid_axis("y=0.1:0.7:7").unwrap();
-        assert_eq!(v.len(), 7);
-        assert_eq!(v[6], 0.7);
-        assert_eq!(parse_grid_axis("x=1,2").unwrap().1, [1.0, 2.0]);
-        assert!(parse_grid_axis("x=0:1:1").unwrap_err().contains("N ≥ 2"));
-        assert!(parse_grid_axis("x=0:1").unwrap_err().contains("LO:HI:N"));
-        assert!(parse_grid_axis("x=0:0:3").unwrap_err().contains("LO ≠ HI"));
-        assert!(parse_grid_axis("x=0:inf:3").is_err());
-        assert!(parse_grid_axis("x=0:1:2.5").is_err());
-    }
 }
