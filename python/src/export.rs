@@ -3,6 +3,7 @@
 //! text and the files the controller reads, by name.
 
 use chain::ops::export::{self, ExportController, ExportOpsError, ExportRequest};
+use chain::ops::Worded;
 use chain_core::compensation::controllers::Controller;
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;

@@ -13,6 +13,7 @@ use std::path::Path;
 
 use chain::ops::identify::{self, IdentifyRequest};
 use chain::ops::plan::{self, PlanRequest};
+use chain::ops::Worded;
 use chain_core::measured::{Layout, Measurements, MeasurementsError};
 use chain_core::model::Machine;
 use chain_core::plan::Kind;

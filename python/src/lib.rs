@@ -25,6 +25,7 @@ mod path;
 mod positioning;
 use std::mem::MaybeUninit;
 
+use chain::ops::Worded;
 use chain_core::model::{Machine, Origin};
 use chain_core::{CompiledModel, Diagnostics, ErrorModel};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};

@@ -7,6 +7,7 @@ use std::path::Path;
 use chain::ops::sensitivity::{
     self, SensitivityKind, SensitivityOpsError, SensitivityRequest, SensitivityValues,
 };
+use chain::ops::Worded;
 use chain_core::geometric::NominalSizes;
 use pyo3::prelude::*;
 

@@ -16,6 +16,7 @@ use serde::{Serialize, Serializer};
 
 use super::resolve::ResolveError;
 use super::study::{self, OptionError, StudyError, StudyOptions};
+use super::worded::{diagnostic, Worded};
 
 /// What to allocate for (`--target`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -109,9 +110,8 @@ impl From<StudyError> for AllocateOpsError {
     }
 }
 
-impl AllocateOpsError {
-    /// The diagnostic code of a refusal worded here.
-    pub fn code(&self) -> Option<&'static str> {
+impl Worded for AllocateOpsError {
+    fn own_code(&self) -> Option<&'static str> {
         match self {
             AllocateOpsError::Level(_) | AllocateOpsError::LevelWithoutAcceptance => {
                 Some("chain::allocate::invalid_level")
@@ -120,29 +120,27 @@ impl AllocateOpsError {
             _ => None,
         }
     }
-}
 
-#[cfg(feature = "cli")]
-impl miette::Diagnostic for AllocateOpsError {
-    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+    fn own_help(&self) -> Option<String> {
         match self {
-            AllocateOpsError::Option(e) => miette::Diagnostic::code(e),
-            AllocateOpsError::Resolve(e) => miette::Diagnostic::code(e),
-            AllocateOpsError::Allocate { error, .. } => miette::Diagnostic::code(&**error),
-            e => AllocateOpsError::code(e).map(|c| Box::new(c) as Box<dyn std::fmt::Display>),
+            AllocateOpsError::MissingLevel => Some("e.g. --target acceptance --level 0.9".into()),
+            AllocateOpsError::Resolve(e) => e.own_help(),
+            _ => None,
         }
     }
 
-    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+    #[cfg(feature = "cli")]
+    fn inner(&self) -> Option<&dyn miette::Diagnostic> {
         match self {
-            AllocateOpsError::MissingLevel => {
-                Some(Box::new("e.g. --target acceptance --level 0.9"))
-            }
-            AllocateOpsError::Allocate { error, .. } => miette::Diagnostic::help(&**error),
+            AllocateOpsError::Option(e) => Some(e),
+            AllocateOpsError::Resolve(e) => Some(e),
+            AllocateOpsError::Allocate { error, .. } => Some(&**error),
             _ => None,
         }
     }
 }
+
+diagnostic!(AllocateOpsError);
 
 /// The document of `chain allocate` (JSON: the library's
 /// [`AllocationDocument`]).

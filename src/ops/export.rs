@@ -20,6 +20,7 @@ use reliability::ReliabilityError;
 use serde::Serialize;
 
 use super::resolve::{self, ResolveError};
+use super::worded::{diagnostic, Worded};
 
 /// What `chain export` writes for (`--controller`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -171,10 +172,8 @@ fn controller_message(e: &ControllerError) -> String {
     }
 }
 
-impl ExportOpsError {
-    /// The diagnostic code of the refusals worded here (`None`: the inner
-    /// error's own).
-    pub fn code(&self) -> Option<&'static str> {
+impl Worded for ExportOpsError {
+    fn own_code(&self) -> Option<&'static str> {
         match self {
             ExportOpsError::Option { .. } => Some("chain::export::option"),
             ExportOpsError::GridNodes { .. } => Some("chain::export::grid_nodes"),
@@ -190,8 +189,7 @@ impl ExportOpsError {
         }
     }
 
-    /// What to do about it, where this layer says more than the message.
-    pub fn help(&self) -> Option<String> {
+    fn own_help(&self) -> Option<String> {
         match self {
             ExportOpsError::Option { why, .. } => Some(why.to_string()),
             ExportOpsError::GridNodes { .. } => Some(
@@ -211,46 +209,23 @@ impl ExportOpsError {
                 )),
                 _ => None,
             },
+            ExportOpsError::Resolve(e) => e.own_help(),
             _ => None,
         }
     }
 
-    /// The message with its help, as one text (Python's exceptions).
-    pub fn with_help(&self) -> String {
-        match self.help() {
-            Some(help) => format!("{self}\nhelp: {help}"),
-            None => self.to_string(),
+    #[cfg(feature = "cli")]
+    fn inner(&self) -> Option<&dyn miette::Diagnostic> {
+        match self {
+            ExportOpsError::Resolve(e) => Some(e),
+            ExportOpsError::Compensation { error, .. } => Some(&**error),
+            ExportOpsError::Controller { error, .. } => Some(&**error),
+            _ => None,
         }
     }
 }
 
-/// The CLI's rendering: this layer's code and help, else the inner error's.
-#[cfg(feature = "cli")]
-impl miette::Diagnostic for ExportOpsError {
-    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        if let Some(code) = ExportOpsError::code(self) {
-            return Some(Box::new(code));
-        }
-        match self {
-            ExportOpsError::Resolve(e) => miette::Diagnostic::code(e),
-            ExportOpsError::Compensation { error, .. } => miette::Diagnostic::code(&**error),
-            ExportOpsError::Controller { error, .. } => miette::Diagnostic::code(&**error),
-            _ => None,
-        }
-    }
-
-    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        if let Some(help) = ExportOpsError::help(self) {
-            return Some(Box::new(help));
-        }
-        match self {
-            ExportOpsError::Resolve(e) => miette::Diagnostic::help(e),
-            ExportOpsError::Compensation { error, .. } => miette::Diagnostic::help(&**error),
-            ExportOpsError::Controller { error, .. } => miette::Diagnostic::help(&**error),
-            _ => None,
-        }
-    }
-}
+diagnostic!(ExportOpsError);
 
 /// The document of `chain export`: the grid export's summary and file, or
 /// a per-axis format's report and files. Its JSON is the summary (the

@@ -10,6 +10,7 @@ use reliability::ReliabilityError;
 use serde::{Serialize, Serializer};
 
 use super::resolve::{self, ResolveError};
+use super::worded::{diagnostic, Worded};
 
 /// The tool's orientation in a pose.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -154,17 +155,15 @@ pub struct NoInverse {
     pub error: InverseError,
 }
 
-/// The CLI's rendering: the code and help of the [`InverseError`].
-#[cfg(feature = "cli")]
-impl miette::Diagnostic for NoInverse {
-    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        miette::Diagnostic::code(&self.error)
-    }
-
-    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        miette::Diagnostic::help(&self.error)
+/// Worded by the [`InverseError`]: its code and help.
+impl Worded for NoInverse {
+    #[cfg(feature = "cli")]
+    fn inner(&self) -> Option<&dyn miette::Diagnostic> {
+        Some(&self.error)
     }
 }
+
+diagnostic!(NoInverse);
 
 /// The solver of `machine` for `params` and the `fixed` variables.
 pub fn solver(

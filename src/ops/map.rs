@@ -19,6 +19,7 @@ use serde::Serialize;
 
 use super::export::{self, ExportController, ExportOpsError};
 use super::resolve::{self, ResolveError};
+use super::worded::{diagnostic, Worded};
 
 /// The points of a map.
 #[derive(Debug, Clone)]
@@ -157,10 +158,8 @@ impl From<ExportOpsError> for MapOpsError {
     }
 }
 
-impl MapOpsError {
-    /// The diagnostic code of the refusals worded here (`None`: the inner
-    /// error's own).
-    pub fn code(&self) -> Option<&'static str> {
+impl Worded for MapOpsError {
+    fn own_code(&self) -> Option<&'static str> {
         match self {
             MapOpsError::Map { error, .. } => Some(match **error {
                 MapError::OutOfRange { .. } => "chain::map::out_of_range",
@@ -168,13 +167,12 @@ impl MapOpsError {
                 _ => "chain::map::points",
             }),
             MapOpsError::StepWithGrid => Some("chain::map::option"),
-            MapOpsError::Export(e) => e.code(),
+            MapOpsError::Export(e) => e.own_code(),
             _ => None,
         }
     }
 
-    /// What to do about it, where this layer says more than the message.
-    pub fn help(&self) -> Option<String> {
+    fn own_help(&self) -> Option<String> {
         match self {
             MapOpsError::Map { values, error } => match &**error {
                 MapError::OutOfRange { source, .. } => Some(format!(
@@ -190,47 +188,24 @@ impl MapOpsError {
                 "the grid correction is exported at the nodes of --compensation-grid VAR=LO:HI:N"
                     .into(),
             ),
-            MapOpsError::Export(e) => e.help(),
+            MapOpsError::Export(e) => e.own_help(),
+            MapOpsError::Resolve(e) => e.own_help(),
             _ => None,
         }
     }
 
-    /// The message with its help, as one text (Python's exceptions).
-    pub fn with_help(&self) -> String {
-        match self.help() {
-            Some(help) => format!("{self}\nhelp: {help}"),
-            None => self.to_string(),
+    #[cfg(feature = "cli")]
+    fn inner(&self) -> Option<&dyn miette::Diagnostic> {
+        match self {
+            MapOpsError::Resolve(e) => Some(e),
+            MapOpsError::Export(e) => Some(&**e),
+            MapOpsError::Correction(e) => Some(&**e),
+            _ => None,
         }
     }
 }
 
-/// The CLI's rendering: this layer's code and help, else the inner error's.
-#[cfg(feature = "cli")]
-impl miette::Diagnostic for MapOpsError {
-    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        if let Some(code) = MapOpsError::code(self) {
-            return Some(Box::new(code));
-        }
-        match self {
-            MapOpsError::Resolve(e) => miette::Diagnostic::code(e),
-            MapOpsError::Export(e) => miette::Diagnostic::code(&**e),
-            MapOpsError::Correction(e) => miette::Diagnostic::code(&**e),
-            _ => None,
-        }
-    }
-
-    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        if let Some(help) = MapOpsError::help(self) {
-            return Some(Box::new(help));
-        }
-        match self {
-            MapOpsError::Resolve(e) => miette::Diagnostic::help(e),
-            MapOpsError::Export(e) => miette::Diagnostic::help(&**e),
-            MapOpsError::Correction(e) => miette::Diagnostic::help(&**e),
-            _ => None,
-        }
-    }
-}
+diagnostic!(MapOpsError);
 
 /// Prepares `chain map` of `machine` (`file` names it) with `values` (read
 /// from `values_file`); `rows_name` names the rows of [`MapPoints::Rows`]

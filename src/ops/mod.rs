@@ -7,6 +7,9 @@
 //! - [`resolve`]: parameter names, grid axes (the machine file's
 //!   `reliability.grid` with overrides), one point given by name (`--at`).
 
+//! - [`worded`]: how an `ops` error reads ([`Worded`]: its code and help,
+//!   the error it wraps), for the CLI's diagnostics and Python's text.
+
 //! - [`study`]: a reliability study from a machine and the options every
 //!   study command takes (parameters, grid, sided, system, a posterior).
 
@@ -42,3 +45,6 @@ pub mod resolve;
 pub mod sensitivity;
 pub mod sobol;
 pub mod study;
+pub mod worded;
+
+pub use worded::Worded;

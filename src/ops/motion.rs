@@ -15,6 +15,7 @@ use chain_core::Machine;
 use serde::{Serialize, Serializer};
 
 use super::resolve::{self, ResolveError};
+use super::worded::{diagnostic, Worded};
 
 /// Highest order accepted for `--order` and `--max-order`: the JSON lists
 /// the derivatives `k!·a_k`, and 171! overflows `f64`.
@@ -96,9 +97,10 @@ pub enum MotionOpsError {
     Motion(#[from] MotionError),
 }
 
-impl MotionOpsError {
-    /// The diagnostic code of an option refused here.
-    pub fn code(&self) -> Option<&'static str> {
+/// The options' code, else the inner diagnostic's code, help, source and
+/// labels.
+impl Worded for MotionOpsError {
+    fn own_code(&self) -> Option<&'static str> {
         match self {
             MotionOpsError::Order { .. }
             | MotionOpsError::Samples(_)
@@ -107,12 +109,8 @@ impl MotionOpsError {
             _ => None,
         }
     }
-}
 
-/// The CLI's rendering: the options' code, else the inner diagnostic's
-/// code, help, source and labels.
-#[cfg(feature = "cli")]
-impl MotionOpsError {
+    #[cfg(feature = "cli")]
     fn inner(&self) -> Option<&dyn miette::Diagnostic> {
         match self {
             MotionOpsError::Generator(e) => Some(e),
@@ -124,43 +122,7 @@ impl MotionOpsError {
     }
 }
 
-#[cfg(feature = "cli")]
-impl miette::Diagnostic for MotionOpsError {
-    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        match self.inner() {
-            Some(d) => d.code(),
-            None => MotionOpsError::code(self).map(|c| Box::new(c) as Box<dyn std::fmt::Display>),
-        }
-    }
-
-    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        self.inner().and_then(|d| d.help())
-    }
-
-    fn source_code(&self) -> Option<&dyn miette::SourceCode> {
-        self.inner().and_then(|d| d.source_code())
-    }
-
-    fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
-        self.inner().and_then(|d| d.labels())
-    }
-
-    fn related<'a>(&'a self) -> Option<Box<dyn Iterator<Item = &'a dyn miette::Diagnostic> + 'a>> {
-        self.inner().and_then(|d| d.related())
-    }
-
-    fn severity(&self) -> Option<miette::Severity> {
-        self.inner().and_then(|d| d.severity())
-    }
-
-    fn url<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        self.inner().and_then(|d| d.url())
-    }
-
-    fn diagnostic_source(&self) -> Option<&dyn miette::Diagnostic> {
-        self.inner().and_then(|d| d.diagnostic_source())
-    }
-}
+diagnostic!(MotionOpsError);
 
 /// The document of `chain motion`: one conversion run with the settings it
 /// came from (JSON: docs/motion.md).

@@ -9,6 +9,8 @@ use chain_core::measured::Measurements;
 use chain_core::plan::{self, Kind, KindError, PlanDocument, PlanError};
 use chain_core::Machine;
 
+use super::worded::{diagnostic, Worded};
+
 /// The request of `chain plan`.
 #[derive(Debug, Clone, Copy)]
 pub struct PlanRequest {
@@ -35,9 +37,8 @@ pub enum PlanOpsError {
     },
 }
 
-impl PlanOpsError {
-    /// The diagnostic code.
-    pub fn code(&self) -> Option<&'static str> {
+impl Worded for PlanOpsError {
+    fn own_code(&self) -> Option<&'static str> {
         match self {
             PlanOpsError::Kind(_) => None,
             PlanOpsError::Plan { error, .. } => Some(match error {
@@ -49,47 +50,35 @@ impl PlanOpsError {
         }
     }
 
-    /// What to do about it.
-    pub fn help(&self) -> Option<&'static str> {
-        match self {
+    fn own_help(&self) -> Option<String> {
+        let help = match self {
             PlanOpsError::Plan { error, .. } => match error {
-                PlanError::Count { .. } | PlanError::TooFew { .. } => Some(
-                    "pass --count with a number of candidates that can inform every identifiable direction",
-                ),
-                PlanError::Uninformative => {
-                    Some("the machine's errors do not act on what the candidates measure")
+                PlanError::Count { .. } | PlanError::TooFew { .. } => {
+                    "pass --count with a number of candidates that can inform every identifiable direction"
                 }
-                PlanError::Singular { .. } => Some(
-                    "choose more candidates (--count) or add candidates that vary every axis",
-                ),
-                _ => None,
+                PlanError::Uninformative => {
+                    "the machine's errors do not act on what the candidates measure"
+                }
+                PlanError::Singular { .. } => {
+                    "choose more candidates (--count) or add candidates that vary every axis"
+                }
+                _ => return None,
             },
-            PlanOpsError::Kind(_) => None,
-        }
+            PlanOpsError::Kind(_) => return None,
+        };
+        Some(help.to_string())
     }
 
-    /// The message with its help, as one text (Python's exceptions).
-    pub fn with_help(&self) -> String {
-        match self.help() {
-            Some(help) => format!("{self}\nhelp: {help}"),
-            None => self.to_string(),
-        }
-    }
-}
-
-#[cfg(feature = "cli")]
-impl miette::Diagnostic for PlanOpsError {
-    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+    #[cfg(feature = "cli")]
+    fn inner(&self) -> Option<&dyn miette::Diagnostic> {
         match self {
-            PlanOpsError::Kind(e) => miette::Diagnostic::code(e),
-            e => PlanOpsError::code(e).map(|c| Box::new(c) as Box<dyn std::fmt::Display>),
+            PlanOpsError::Kind(e) => Some(e),
+            PlanOpsError::Plan { .. } => None,
         }
     }
-
-    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        PlanOpsError::help(self).map(|h| Box::new(h) as Box<dyn std::fmt::Display>)
-    }
 }
+
+diagnostic!(PlanOpsError);
 
 /// Runs `chain plan` of `machine` over `candidates` (read with
 /// `Layout::Candidates`).

@@ -7,6 +7,8 @@
 use chain_core::diagnostic::closest;
 use chain_core::Machine;
 
+use super::worded::{diagnostic, Worded};
+
 /// Why an option cannot be resolved against the machine.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ResolveError {
@@ -176,10 +178,11 @@ impl ResolveError {
                 | ResolveError::MissingGrid { .. }
         )
     }
+}
 
-    /// The diagnostic code (`chain::…`).
-    pub fn code(&self) -> &'static str {
-        match self {
+impl Worded for ResolveError {
+    fn own_code(&self) -> Option<&'static str> {
+        Some(match self {
             ResolveError::UnknownParameter { .. } => "chain::cli::unknown_parameter",
             ResolveError::NonFiniteParameter { .. } => "chain::cli::param_not_finite",
             ResolveError::UnknownGridAxis { .. } => "chain::reliability::unknown_name",
@@ -194,11 +197,10 @@ impl ResolveError {
             ResolveError::UnknownAxisColumn { .. } => "chain::csv::unknown_column",
             ResolveError::ColumnAndFix { .. } => "chain::cli::fix_and_column",
             ResolveError::MissingAxisColumns { .. } => "chain::csv::missing_column",
-        }
+        })
     }
 
-    /// What to do about it, if there is more to say than the message.
-    pub fn help(&self) -> Option<String> {
+    fn own_help(&self) -> Option<String> {
         Some(match self {
             ResolveError::UnknownGridAxis { variables, .. } => {
                 format!("the axis variables are {}", variables.join(", "))
@@ -222,29 +224,9 @@ impl ResolveError {
             _ => return None,
         })
     }
-
-    /// The message with its help, as one text (Python's exceptions, and
-    /// any renderer without miette).
-    pub fn with_help(&self) -> String {
-        match self.help() {
-            Some(help) => format!("{self}\nhelp: {help}"),
-            None => self.to_string(),
-        }
-    }
 }
 
-/// The CLI's rendering: the code and help of [`ResolveError::code`] and
-/// [`ResolveError::help`], written once.
-#[cfg(feature = "cli")]
-impl miette::Diagnostic for ResolveError {
-    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        Some(Box::new(ResolveError::code(self)))
-    }
-
-    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        ResolveError::help(self).map(|h| Box::new(h) as Box<dyn std::fmt::Display>)
-    }
-}
+diagnostic!(ResolveError);
 
 /// ` (did you mean `x`?)`, or nothing.
 fn did_you_mean(suggestion: &Option<String>) -> String {

@@ -18,6 +18,7 @@ use serde::{Serialize, Serializer};
 
 use super::resolve::{self, ResolveError};
 use super::study::{self, StudyError, StudyOptions};
+use super::worded::{diagnostic, Worded};
 
 /// What `chain sensitivity` computes (`--kind`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -86,39 +87,29 @@ impl From<StudyError> for SensitivityOpsError {
     }
 }
 
-impl SensitivityOpsError {
-    /// The diagnostic code of a kind mismatch.
-    pub fn code(&self) -> Option<&'static str> {
+impl Worded for SensitivityOpsError {
+    fn own_code(&self) -> Option<&'static str> {
         matches!(self, SensitivityOpsError::Kind { .. }).then_some("chain::sensitivity::option")
     }
 
-    /// The message with its help, as one text (Python's exceptions).
-    pub fn with_help(&self) -> String {
+    fn own_help(&self) -> Option<String> {
         match self {
-            SensitivityOpsError::Kind { message, help } => format!("{message}\nhelp: {help}"),
-            SensitivityOpsError::Resolve(e) => e.with_help(),
-            e => e.to_string(),
-        }
-    }
-}
-
-#[cfg(feature = "cli")]
-impl miette::Diagnostic for SensitivityOpsError {
-    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        match self {
-            SensitivityOpsError::Resolve(e) => miette::Diagnostic::code(e),
-            e => SensitivityOpsError::code(e).map(|c| Box::new(c) as Box<dyn std::fmt::Display>),
+            SensitivityOpsError::Kind { help, .. } => Some(help.to_string()),
+            SensitivityOpsError::Resolve(e) => e.own_help(),
+            _ => None,
         }
     }
 
-    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+    #[cfg(feature = "cli")]
+    fn inner(&self) -> Option<&dyn miette::Diagnostic> {
         match self {
-            SensitivityOpsError::Kind { help, .. } => Some(Box::new(*help)),
-            SensitivityOpsError::Resolve(e) => miette::Diagnostic::help(e),
+            SensitivityOpsError::Resolve(e) => Some(e),
             _ => None,
         }
     }
 }
+
+diagnostic!(SensitivityOpsError);
 
 /// The document of `chain sensitivity`.
 #[derive(Debug, Clone)]

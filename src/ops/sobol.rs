@@ -12,6 +12,7 @@ use serde::{Serialize, Serializer};
 
 use super::resolve::{self, ResolveError};
 use super::study::{self, StudyError, StudyOptions};
+use super::worded::{diagnostic, Worded};
 
 /// The request of `chain sobol`.
 #[derive(Debug, Clone, Copy)]
@@ -86,25 +87,32 @@ impl From<StudyError> for SobolOpsError {
     }
 }
 
-#[cfg(feature = "cli")]
-impl miette::Diagnostic for SobolOpsError {
-    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+impl Worded for SobolOpsError {
+    fn own_code(&self) -> Option<&'static str> {
         match self {
-            SobolOpsError::Setting { .. } => Some(Box::new("chain::sobol::invalid_setting")),
-            SobolOpsError::Resolve(e) => miette::Diagnostic::code(e),
-            SobolOpsError::Sobol { error, .. } => miette::Diagnostic::code(error),
+            SobolOpsError::Setting { .. } => Some("chain::sobol::invalid_setting"),
             _ => None,
         }
     }
 
-    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+    fn own_help(&self) -> Option<String> {
         match self {
-            SobolOpsError::Resolve(e) => miette::Diagnostic::help(e),
-            SobolOpsError::Sobol { error, .. } => miette::Diagnostic::help(error),
+            SobolOpsError::Resolve(e) => e.own_help(),
+            _ => None,
+        }
+    }
+
+    #[cfg(feature = "cli")]
+    fn inner(&self) -> Option<&dyn miette::Diagnostic> {
+        match self {
+            SobolOpsError::Resolve(e) => Some(e),
+            SobolOpsError::Sobol { error, .. } => Some(error),
             _ => None,
         }
     }
 }
+
+diagnostic!(SobolOpsError);
 
 /// The document of `chain sobol` (JSON: the library's [`SobolDocument`]).
 #[derive(Debug)]

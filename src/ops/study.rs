@@ -13,6 +13,7 @@ use reliability::{
 };
 
 use super::resolve::{self, ResolveError};
+use super::worded::{diagnostic, Worded};
 
 /// The options of a study.
 #[derive(Debug, Clone, Copy, Default)]
@@ -151,19 +152,13 @@ pub struct OptionError {
     pub message: String,
 }
 
-impl OptionError {
-    /// The diagnostic code.
-    pub fn code(&self) -> &'static str {
-        "chain::cli::invalid_option"
+impl Worded for OptionError {
+    fn own_code(&self) -> Option<&'static str> {
+        Some("chain::cli::invalid_option")
     }
 }
 
-#[cfg(feature = "cli")]
-impl miette::Diagnostic for OptionError {
-    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
-        Some(Box::new(OptionError::code(self)))
-    }
-}
+diagnostic!(OptionError);
 
 impl AlgorithmOptions {
     /// The checks that need no model: `--cov` in (0, 1] and not with FORM
