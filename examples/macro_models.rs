@@ -72,6 +72,7 @@ fn monte_carlo_px(model: &dyn ErrorModel, q: &[f64], stds: &[f64], tolerance: f6
     let mc = MonteCarlo {
         samples: 200_000,
         seed: 42,
+        cov: None,
     }
     .run(&event)
     .expect("monte carlo");

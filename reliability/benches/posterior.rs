@@ -87,6 +87,7 @@ fn benches(c: &mut Criterion) {
         let mc = MonteCarlo {
             samples: SAMPLES,
             seed: 1,
+            cov: None,
         };
         g.bench_function(*name, |b| {
             pool.install(|| b.iter(|| black_box(mc.run(&event).expect("mc"))))

@@ -86,6 +86,7 @@ fn benches(c: &mut Criterion) {
             samples: SAMPLES,
             seed: 1,
             form: Form::default(),
+            cov: None,
         };
         g.bench_with_input(BenchmarkId::new("threads", threads), &threads, |b, _| {
             pool.install(|| b.iter(|| black_box(is.run(&event).expect("is"))))
@@ -101,6 +102,7 @@ fn benches(c: &mut Criterion) {
         let mc = MonteCarlo {
             samples: SAMPLES,
             seed: 1,
+            cov: None,
         };
         g.bench_with_input(BenchmarkId::new("threads", threads), &threads, |b, _| {
             pool.install(|| b.iter(|| black_box(mc.run(&event).expect("mc"))))

@@ -53,9 +53,9 @@ fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
         })?;
         let (t_form1, pf_form) = best(&mut || Ok(Form::default().run(&event)?.pf))?;
         let (t_is, pf_is) = best(&mut || {
-            Ok(ImportanceSampling { samples, seed: 1, form: Form::default() }.run(&event)?.pf)
+            Ok(ImportanceSampling { samples, seed: 1, form: Form::default(), cov: None }.run(&event)?.pf)
         })?;
-        let (t_mc, pf_mc) = best(&mut || Ok(MonteCarlo { samples, seed: 1 }.run(&event)?.pf))?;
+        let (t_mc, pf_mc) = best(&mut || Ok(MonteCarlo { samples, seed: 1, cov: None }.run(&event)?.pf))?;
         println!(
             "{{\"samples\": {samples}, \"form_375_cases_s\": {t_form:e}, \"form_px_min\": {r_form}, \
              \"form_one_case_s\": {t_form1:e}, \"form_pf\": {pf_form}, \"is_s\": {t_is:e}, \"is_pf\": {pf_is}, \

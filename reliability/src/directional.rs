@@ -35,14 +35,15 @@ use statrs::function::gamma::{gamma_lr, gamma_ur};
 
 use crate::error::ReliabilityError;
 use crate::limit_state::{Event, LimitState};
+use crate::method::Method;
 use crate::normal;
-use crate::par::prelude::*;
 use crate::rng::CaseRng;
-use crate::simulation::{
-    check_cov, finish, illinois, Progress, SimulationResult, Stop, Stopping, MAX_SAMPLES,
+use crate::sampler::{
+    case_id, check_cov, check_samples, drive, finish, impl_sampler, Progress, SimulationResult,
+    Stop, Stopping, Sums,
 };
+use crate::simulation::illinois;
 use crate::standard::{Scratch, Standard};
-use crate::study::Method;
 
 /// Directions per block (the unit of parallel work, random streams and the
 /// stopping rule's checks).
@@ -102,15 +103,6 @@ fn chi2_mass(n: usize, r0: f64, r1: f64) -> f64 {
     }
 }
 
-/// Per-block sums of `p` and `p²`, and limit-state calls.
-#[derive(Debug, Clone, Copy, Default)]
-struct Sums {
-    s1: f64,
-    s2: f64,
-    count: u64,
-    calls: u64,
-}
-
 impl DirectionalSimulation {
     /// Runs one event (on stream case 0).
     pub fn run<L: LimitState>(
@@ -127,74 +119,52 @@ impl DirectionalSimulation {
         events: &[Event<'_, L>],
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
-        if self.samples == 0 || self.samples > MAX_SAMPLES {
-            return Err(ReliabilityError::InvalidSamples {
-                found: self.samples,
-                max: MAX_SAMPLES,
-            });
-        }
+        check_samples(self.samples)?;
         if let Some(c) = self.cov {
             check_cov(c)?;
         }
-        let blocks = self.samples.div_ceil(BLOCK);
-        let case = |i: usize| -> SimulationResult {
-            let std = Standard::new(&events[i]);
-            let case_id = u32::try_from(i).unwrap_or(u32::MAX);
-            let run_block = |b: u64| -> Sums {
-                let count = BLOCK.min(self.samples - b * BLOCK);
-                let s = self.block(&std, case_id, b, count);
-                progress.advance(count);
-                s
-            };
-            let (sums, stop) = match self.cov {
-                None => {
-                    let parts: Vec<Sums> = (0..blocks).into_par_iter().map(run_block).collect();
-                    (add(&parts), Stop::Samples)
-                }
-                Some(target) => {
-                    let width = crate::par::threads().max(1) as u64;
-                    let mut total = Sums::default();
-                    let mut next = 0u64;
-                    let mut stop = Stop::Budget;
-                    'outer: while next < blocks {
-                        let end = (next + width).min(blocks);
-                        let parts: Vec<Sums> = (next..end).into_par_iter().map(run_block).collect();
-                        next = end;
-                        for p in parts {
-                            total = add(&[total, p]);
-                            let (pf, se) = estimate(&total);
-                            if (pf > 0.0 && se <= target * pf) || (se == 0.0 && std.dim() == 0) {
-                                stop = Stop::TargetCov;
-                                break 'outer;
-                            }
-                        }
-                    }
-                    (total, stop)
-                }
-            };
-            let (pf, se) = estimate(&sums);
-            let mut r = finish(
-                Method::Directional,
-                pf.clamp(0.0, 1.0),
-                se,
-                sums.count,
-                sums.calls,
-                None,
-            );
-            r.stopping = Some(Stopping::new(stop, self.cov));
-            r
+        let stds: Vec<Standard<'_, '_, L>> = events.iter().map(Standard::new).collect();
+        let block = |case: usize, block: u32, count: u64, _: &mut [f64]| {
+            self.block(&stds[case], case_id(case), block, count)
         };
-        if events.len() == 1 {
-            return Ok(vec![case(0)]);
-        }
-        Ok((0..events.len()).into_par_iter().map(case).collect())
+        let runs = drive(
+            events.len(),
+            self.samples,
+            BLOCK,
+            0,
+            progress,
+            block,
+            self.cov.map(|target| {
+                let stds = &stds;
+                (target, move |case: usize, s: &Sums, n: u64| {
+                    let (pf, se) = estimate(s, n);
+                    (pf > 0.0 && se <= target * pf) || (se == 0.0 && stds[case].dim() == 0)
+                })
+            }),
+        );
+        Ok(runs
+            .into_iter()
+            .map(|(sums, samples, stopping)| {
+                let (pf, se) = estimate(&sums, samples);
+                let mut r = finish(
+                    Method::Directional,
+                    pf.clamp(0.0, 1.0),
+                    se,
+                    samples,
+                    sums.calls,
+                    None,
+                );
+                r.stopping = Some(stopping.unwrap_or(Stopping::new(Stop::Samples, None)));
+                r
+            })
+            .collect())
     }
 
     fn block<L: LimitState>(
         &self,
         std: &Standard<'_, '_, L>,
         case_id: u32,
-        block: u64,
+        block: u32,
         count: u64,
     ) -> Sums {
         let na = std.dim();
@@ -208,18 +178,14 @@ impl DirectionalSimulation {
             return Sums {
                 s1: p * count as f64,
                 s2: p * p * count as f64,
-                count,
                 calls: 1,
             };
         }
-        let mut rng = CaseRng::new(self.seed, case_id, u32::try_from(block).unwrap_or(u32::MAX));
+        let mut rng = CaseRng::new(self.seed, case_id, block);
         let mut a = vec![0.0; na];
         let mut ray = vec![0.0; na];
         let mut d = vec![0.0; std.affine.as_ref().map_or(0, |f| f.k)];
-        let mut s = Sums {
-            count,
-            ..Sums::default()
-        };
+        let mut s = Sums::default();
         for _ in 0..count {
             // A uniform direction: a normal vector normalised (zero has
             // probability zero; redraw if it occurs).
@@ -315,29 +281,22 @@ fn ray_pf_scan<L: LimitState>(
     p.min(1.0)
 }
 
-fn add(parts: &[Sums]) -> Sums {
-    parts.iter().fold(Sums::default(), |a, b| Sums {
-        s1: a.s1 + b.s1,
-        s2: a.s2 + b.s2,
-        count: a.count + b.count,
-        calls: a.calls + b.calls,
-    })
-}
-
-/// The mean and its standard error `√(s²/N)`.
-fn estimate(s: &Sums) -> (f64, f64) {
-    let n = s.count as f64;
-    if s.count == 0 {
+/// The mean of `count` values and its standard error `√(s²/N)`.
+fn estimate(s: &Sums, count: u64) -> (f64, f64) {
+    let n = count as f64;
+    if count == 0 {
         return (0.0, 0.0);
     }
     let mean = s.s1 / n;
-    let var = if s.count > 1 {
+    let var = if count > 1 {
         ((s.s2 - s.s1 * mean) / (n - 1.0)).max(0.0)
     } else {
         0.0
     };
     (mean, (var / n).sqrt())
 }
+
+impl_sampler!(DirectionalSimulation => Method::Directional);
 
 #[cfg(test)]
 mod tests {

@@ -280,29 +280,23 @@ pub const SUBSET_BUDGET_LEVELS: u64 = 1000;
 /// simulation the samples per level, [`SUBSET_BUDGET_LEVELS`] levels' worth
 /// at most). FORM and SORM take no target: callers refuse one before.
 pub fn algorithm(method: Method, samples: u64, seed: u64, cov: Option<f64>) -> Algorithm {
-    let is = ImportanceSampling {
-        samples,
-        seed,
-        form: Form::default(),
-    };
-    match (method, cov) {
-        (Method::MonteCarlo, Some(c)) => {
-            Algorithm::MonteCarloToCov(MonteCarlo { samples, seed }, c)
-        }
-        (Method::MonteCarlo, None) => Algorithm::MonteCarlo(MonteCarlo { samples, seed }),
-        (Method::ImportanceSampling, Some(c)) => Algorithm::ImportanceSamplingToCov(is, c),
-        (Method::ImportanceSampling, None) => Algorithm::ImportanceSampling(is),
-        (Method::Subset, _) => {
+    match method {
+        Method::MonteCarlo => Algorithm::MonteCarlo(MonteCarlo { samples, seed, cov }),
+        Method::ImportanceSampling => Algorithm::ImportanceSampling(ImportanceSampling {
+            samples,
+            seed,
+            form: Form::default(),
+            cov,
+        }),
+        Method::Subset => {
             let mut s = SubsetSimulation::new(samples, seed);
             s.cov = cov;
             s.budget = samples.saturating_mul(SUBSET_BUDGET_LEVELS);
             Algorithm::Subset(s)
         }
-        (Method::Directional, _) => {
-            Algorithm::Directional(DirectionalSimulation { samples, seed, cov })
-        }
-        (Method::Form, _) => Algorithm::Form(Form::default()),
-        (Method::Sorm, _) => Algorithm::Sorm(crate::sorm::Sorm::default()),
+        Method::Directional => Algorithm::Directional(DirectionalSimulation { samples, seed, cov }),
+        Method::Form => Algorithm::Form(Form::default()),
+        Method::Sorm => Algorithm::Sorm(crate::sorm::Sorm::default()),
     }
 }
 

@@ -496,6 +496,7 @@ mod tests {
             samples: 2000,
             seed: 3,
             form: Form::default(),
+            cov: None,
         };
         let a = is.run(&event).unwrap();
         let b = is

@@ -40,7 +40,7 @@
 //! let form = Form::default().run(&event).unwrap();
 //! assert!((form.reliability - 0.9884).abs() < 1e-4); // Table 2 prints 98.74 %
 //! // The importance sampling has zero variance on a linear-normal limit state.
-//! let is = ImportanceSampling { samples: 1000, seed: 1, form: Form::default() }.run(&event).unwrap();
+//! let is = ImportanceSampling { samples: 1000, seed: 1, form: Form::default(), cov: None }.run(&event).unwrap();
 //! assert!((is.pf - form.pf).abs() < 1e-12 && is.std_error < 1e-12);
 //! ```
 
@@ -56,12 +56,15 @@ pub mod form;
 pub mod inputs;
 pub mod limit_state;
 pub mod machine;
+pub mod marginal;
+pub mod method;
 pub mod nataf;
 pub mod normal;
 mod par;
 pub mod path;
 pub mod posterior;
 pub mod rng;
+pub mod sampler;
 pub mod sensitivity;
 pub mod simulation;
 pub mod sobol;

@@ -20,7 +20,7 @@
 
 use std::sync::OnceLock;
 
-use crate::inputs::{Family, Marginal};
+use crate::marginal::{Family, Marginal};
 
 /// Gauss–Hermite nodes per dimension (the 2-D rule has its square). 96
 /// nodes integrate the smooth families' products to ~1e-12 and the kinked

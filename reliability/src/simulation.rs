@@ -25,168 +25,46 @@
 //! inputs, a user's limit state) a bracketing scan refined by the Illinois
 //! method finds every sign change of `g` on the line.
 
-use serde::Serialize;
-
 use crate::error::ReliabilityError;
 use crate::form::{Form, FormResult, Termination};
 use crate::limit_state::{Criterion, Event, LimitState};
+use crate::method::Method;
 use crate::normal;
 use crate::par::prelude::*;
 use crate::rng::CaseRng;
-use crate::study::Method;
+use crate::sampler::{case_id, check_samples, drive, finish, impl_sampler, Sums};
+pub use crate::sampler::{check_cov, Progress, SimulationResult, Stop, Stopping, MAX_SAMPLES};
 use crate::util::dot;
 use chain_core::model::Sided;
 
 /// Samples per block (the unit of parallel work and of random streams).
 pub const BLOCK: u64 = 1 << 16;
 
-/// The largest number of samples per case (2³⁶ ≈ 6.9·10¹⁰).
-pub const MAX_SAMPLES: u64 = 1 << 36;
-
-/// A progress sink: told how many samples have been done, from any thread.
-pub trait Progress: Sync {
-    /// `samples` more samples are done.
-    fn advance(&self, samples: u64);
-}
-
-impl Progress for () {
-    fn advance(&self, _samples: u64) {}
-}
-
-impl<F: Fn(u64) + Sync> Progress for F {
-    fn advance(&self, samples: u64) {
-        self(samples)
-    }
-}
-
-/// The result of a simulation.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct SimulationResult {
-    /// [`Method::ImportanceSampling`] or [`Method::MonteCarlo`].
-    pub method: Method,
-    /// The failure-probability estimate.
-    pub pf: f64,
-    /// `1 − p_f`.
-    pub reliability: f64,
-    /// The standard error of `p_f`.
-    pub std_error: f64,
-    /// The coefficient of variation `std_error / p_f` (0 when `p_f = 0`).
-    pub cov: f64,
-    /// The generalised reliability index `−Φ⁻¹(p_f)`.
-    pub beta: f64,
-    /// Samples drawn.
-    pub samples: u64,
-    /// Limit-state evaluations.
-    pub calls: u64,
-    /// The FORM result that centred the importance sampling.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub form: Option<FormResult>,
-    /// How the sampling stopped, when a stopping rule other than the plain
-    /// sample count was in force (a target coefficient of variation) or the
-    /// method always reports it (directional simulation).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub stopping: Option<Stopping>,
-}
-
-/// What stopped a sampler.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Stop {
-    /// The requested number of samples was drawn (no target in force).
-    Samples,
-    /// The target coefficient of variation was reached.
-    TargetCov,
-    /// The sample budget ran out before the target was reached: the
-    /// estimate has not converged.
-    Budget,
-    /// Subset simulation used its largest number of levels without reaching
-    /// the failure set: the estimate has not converged.
-    Levels,
-}
-
-impl Stop {
-    /// `samples`, `target_cov`, `budget` or `levels`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Stop::Samples => "samples",
-            Stop::TargetCov => "target_cov",
-            Stop::Budget => "budget",
-            Stop::Levels => "levels",
-        }
-    }
-
-    /// Whether a result stopped this way is converged.
-    pub fn converged(self) -> bool {
-        matches!(self, Stop::Samples | Stop::TargetCov)
-    }
-}
-
-impl std::fmt::Display for Stop {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// How a sampler stopped and whether its estimate converged.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Stopping {
-    /// False when the sampler stopped without meeting its rule (budget or
-    /// levels exhausted): the estimate is not a converged result.
-    pub converged: bool,
-    /// Which rule stopped it.
-    pub stopped_by: Stop,
-    /// The target coefficient of variation, when one was set.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub target_cov: Option<f64>,
-}
-
-impl Stopping {
-    /// The account of a run stopped by `stop` with target `target_cov`.
-    pub fn new(stop: Stop, target_cov: Option<f64>) -> Stopping {
-        Stopping {
-            converged: stop.converged(),
-            stopped_by: stop,
-            target_cov,
-        }
-    }
-}
-
-/// Checks a target coefficient of variation: finite, in `(0, 1]`.
-pub fn check_cov(cov: f64) -> Result<(), ReliabilityError> {
-    if cov.is_finite() && cov > 0.0 && cov <= 1.0 {
-        Ok(())
-    } else {
-        Err(ReliabilityError::InvalidTargetCov(cov))
-    }
-}
-
 /// Crude Monte Carlo: `p_f ≈ (1/N)·Σ 1[g(x_i) ≤ 0]` with `x_i` drawn from the
 /// inputs; standard error `√(p_f(1 − p_f)/(N − 1))`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MonteCarlo {
-    /// Samples per case.
+    /// Samples per case (with a target CoV: the largest number).
     pub samples: u64,
     /// The seed of the random streams.
     pub seed: u64,
+    /// A target coefficient of variation of `p_f`: blocks are added until
+    /// it is reached or `samples` are used.
+    pub cov: Option<f64>,
 }
 
 /// The advanced importance sampling of Eq. 23-28, centred by FORM.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImportanceSampling {
-    /// Samples per case.
+    /// Samples per case (with a target CoV: the largest number).
     pub samples: u64,
     /// The seed of the random streams.
     pub seed: u64,
     /// The FORM settings for the design direction.
     pub form: Form,
-}
-
-/// Per-block sums of `(v − shift)` and `(v − shift)²`, and calls.
-#[derive(Debug, Clone, Copy, Default)]
-struct Sums {
-    s1: f64,
-    s2: f64,
-    calls: u64,
+    /// A target coefficient of variation of `p_f`: blocks are added until
+    /// it is reached or `samples` are used.
+    pub cov: Option<f64>,
 }
 
 impl MonteCarlo {
@@ -197,7 +75,7 @@ impl MonteCarlo {
     /// use chain_core::model::Sided;
     /// let inputs = Inputs::new(vec!["e".into()], vec![Marginal::normal(0.0, 1.0).unwrap()]).unwrap();
     /// let g = ToleranceLimitState::component(vec![1.0], 1.0, Sided::Upper).unwrap();
-    /// let r = MonteCarlo { samples: 100_000, seed: 1 }.run(&Event::new(&inputs, g).unwrap()).unwrap();
+    /// let r = MonteCarlo { samples: 100_000, seed: 1, cov: None }.run(&Event::new(&inputs, g).unwrap()).unwrap();
     /// assert!((r.pf - 0.158_655).abs() < 4.0 * r.std_error);
     /// ```
     pub fn run<L: LimitState>(
@@ -209,29 +87,23 @@ impl MonteCarlo {
     }
 
     /// Runs several events; case `i` draws from streams `i << 32 | block`.
+    ///
+    /// With a target coefficient of variation ([`MonteCarlo::cov`]) each
+    /// case runs until its estimate's CoV is at most the target (checked
+    /// after every block of [`BLOCK`] samples, in block order), `samples`
+    /// being the budget: a case that uses it up first is marked not
+    /// converged ([`Stop::Budget`]). A case with no failure yet has no CoV
+    /// and goes on. The estimate is bit-identical to a run of the same seed
+    /// with the number of samples it stopped at.
     pub fn run_cases<L: LimitState>(
         &self,
         events: &[Event<'_, L>],
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
-        self.run_rule(events, None, progress)
-    }
-
-    /// Runs several events until the coefficient of variation of each
-    /// case's estimate is at most `target` (checked after every block of
-    /// [`BLOCK`] samples, in block order), `self.samples` being the budget:
-    /// a case that uses it up first is marked not converged
-    /// ([`Stop::Budget`]). A case with no failure yet has no CoV and goes on.
-    /// The estimate is bit-identical to a run of the same seed with the
-    /// number of samples it stopped at.
-    pub fn run_cases_to_cov<L: LimitState>(
-        &self,
-        events: &[Event<'_, L>],
-        target: f64,
-        progress: &dyn Progress,
-    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
-        check_cov(target)?;
-        self.run_rule(events, Some(target), progress)
+        if let Some(target) = self.cov {
+            check_cov(target)?;
+        }
+        self.run_rule(events, self.cov, progress)
     }
 
     fn run_rule<L: LimitState>(
@@ -284,6 +156,7 @@ impl MonteCarlo {
         let runs = drive(
             events.len(),
             self.samples,
+            BLOCK,
             width,
             progress,
             block,
@@ -330,29 +203,22 @@ impl ImportanceSampling {
     }
 
     /// Runs several events with their FORM results already computed.
+    ///
+    /// With a target coefficient of variation ([`ImportanceSampling::cov`])
+    /// each case runs until its CoV is at most the target (checked after
+    /// every block of [`BLOCK`] samples, in block order), `samples` being
+    /// the budget ([`Stop::Budget`]: not converged). A zero-variance
+    /// estimate (the linear-normal case) stops after its first block.
     pub fn run_cases_with<L: LimitState>(
         &self,
         events: &[Event<'_, L>],
         forms: Vec<FormResult>,
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
-        self.run_rule(events, forms, None, progress)
-    }
-
-    /// [`ImportanceSampling::run_cases_with`] until each case's coefficient
-    /// of variation is at most `target` (checked after every block of
-    /// [`BLOCK`] samples, in block order), `self.samples` being the budget
-    /// ([`Stop::Budget`]: not converged). A zero-variance estimate (the
-    /// linear-normal case) stops after its first block.
-    pub fn run_cases_with_to_cov<L: LimitState>(
-        &self,
-        events: &[Event<'_, L>],
-        forms: Vec<FormResult>,
-        target: f64,
-        progress: &dyn Progress,
-    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
-        check_cov(target)?;
-        self.run_rule(events, forms, Some(target), progress)
+        if let Some(target) = self.cov {
+            check_cov(target)?;
+        }
+        self.run_rule(events, forms, self.cov, progress)
     }
 
     fn run_rule<L: LimitState>(
@@ -394,6 +260,7 @@ impl ImportanceSampling {
         let runs = drive(
             events.len(),
             self.samples,
+            BLOCK,
             width,
             progress,
             block,
@@ -426,118 +293,6 @@ impl ImportanceSampling {
             })
             .collect())
     }
-}
-
-pub(crate) fn finish(
-    method: Method,
-    pf: f64,
-    std_error: f64,
-    samples: u64,
-    calls: u64,
-    form: Option<FormResult>,
-) -> SimulationResult {
-    SimulationResult {
-        method,
-        pf,
-        reliability: 1.0 - pf,
-        std_error,
-        cov: if pf > 0.0 { std_error / pf } else { 0.0 },
-        beta: normal::beta_from_pf(pf),
-        samples,
-        calls,
-        form,
-        stopping: None,
-    }
-}
-
-fn case_id(case: usize) -> u32 {
-    u32::try_from(case).unwrap_or(u32::MAX)
-}
-
-/// Runs up to `samples` per case in blocks of [`BLOCK`], in parallel, and
-/// adds the block sums of each case in block order. Returns per case the
-/// sums, the samples used and, under a stopping rule, how it stopped.
-///
-/// Without a rule every block runs (all in parallel). With `rule = (target,
-/// done)` blocks run in parallel batches as wide as the thread pool;
-/// `done(case, sums, samples)` is asked after each block in block order,
-/// and the first block after which it holds ends the case
-/// ([`Stop::TargetCov`]; blocks of its batch beyond it are dropped, so the
-/// result does not depend on the thread count); running out of `samples`
-/// first is [`Stop::Budget`]. Either way the estimate is bit-identical to a
-/// fixed-count run of the samples used.
-fn drive<F, D>(
-    cases: usize,
-    samples: u64,
-    width: usize,
-    progress: &dyn Progress,
-    run: F,
-    rule: Option<(f64, D)>,
-) -> Vec<(Sums, u64, Option<Stopping>)>
-where
-    F: Fn(usize, u32, u64, &mut [f64]) -> Sums + Sync,
-    D: Fn(usize, &Sums, u64) -> bool + Sync,
-{
-    let blocks = samples.div_ceil(BLOCK);
-    let batch = match rule {
-        Some(_) => crate::par::threads().max(1) as u64,
-        None => blocks.max(1),
-    };
-    let stopping = |stop| rule.as_ref().map(|(t, _)| Stopping::new(stop, Some(*t)));
-    (0..cases)
-        .into_par_iter()
-        .map(|case| {
-            let mut total = Sums::default();
-            let mut used = 0u64;
-            let mut next = 0u64;
-            while next < blocks {
-                let end = (next + batch).min(blocks);
-                let parts: Vec<(Sums, u64)> = (next..end)
-                    .into_par_iter()
-                    .map_init(
-                        // Padded by a cache line on each side: the scratch
-                        // of two workers must not share a line (false
-                        // sharing).
-                        || vec![0.0; width + 16],
-                        |scratch, block| {
-                            let count = BLOCK.min(samples - block * BLOCK);
-                            let block_id = u32::try_from(block).unwrap_or(u32::MAX);
-                            let s = run(case, block_id, count, &mut scratch[8..8 + width]);
-                            progress.advance(count);
-                            (s, count)
-                        },
-                    )
-                    .collect();
-                next = end;
-                // Block order, whatever thread ran which block.
-                for (b, count) in parts {
-                    total = Sums {
-                        s1: total.s1 + b.s1,
-                        s2: total.s2 + b.s2,
-                        calls: total.calls + b.calls,
-                    };
-                    used += count;
-                    if let Some((_, done)) = &rule {
-                        if done(case, &total, used) {
-                            return (total, used, stopping(Stop::TargetCov));
-                        }
-                    }
-                }
-            }
-            (total, used, stopping(Stop::Budget))
-        })
-        .collect()
-}
-
-/// Checks a sample count: at least 1, at most [`MAX_SAMPLES`].
-fn check_samples(samples: u64) -> Result<(), ReliabilityError> {
-    if samples == 0 || samples > MAX_SAMPLES {
-        return Err(ReliabilityError::InvalidSamples {
-            found: samples,
-            max: MAX_SAMPLES,
-        });
-    }
-    Ok(())
 }
 
 /// A tolerance limit state in normal inputs seen on standard normal draws:
@@ -946,6 +701,11 @@ pub(crate) fn illinois(
     0.5 * (a + b)
 }
 
+impl_sampler!(
+    MonteCarlo => Method::MonteCarlo,
+    ImportanceSampling => Method::ImportanceSampling,
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -974,6 +734,7 @@ mod tests {
             samples: 1000,
             seed: 3,
             form: Form::default(),
+            cov: None,
         }
         .run(&event)
         .unwrap();
@@ -995,12 +756,14 @@ mod tests {
             samples: 20_000,
             seed: 1,
             form: Form::default(),
+            cov: None,
         }
         .run(&event)
         .unwrap();
         let mc = MonteCarlo {
             samples: 400_000,
             seed: 1,
+            cov: None,
         }
         .run(&event)
         .unwrap();
@@ -1028,6 +791,7 @@ mod tests {
                     let mc = MonteCarlo {
                         samples: 3 * BLOCK + 17,
                         seed: 11,
+                        cov: None,
                     }
                     .run(&event)
                     .unwrap();
@@ -1035,6 +799,7 @@ mod tests {
                         samples: 2 * BLOCK + 5,
                         seed: 11,
                         form: Form::default(),
+                        cov: None,
                     }
                     .run(&event)
                     .unwrap();

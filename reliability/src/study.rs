@@ -22,10 +22,12 @@ use crate::error::ReliabilityError;
 use crate::form::{Calls, Form, FormResult, Termination};
 use crate::inputs::Inputs;
 use crate::limit_state::{Criterion, Event, ToleranceLimitState};
+pub use crate::method::Method;
 use crate::normal;
 use crate::par::prelude::*;
+use crate::sampler::{Progress, Sampler, SimulationResult, Stopping};
 use crate::sensitivity::{sensitivity, SensitivityMethod, SensitivityResult};
-use crate::simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult, Stopping};
+use crate::simulation::{ImportanceSampling, MonteCarlo};
 use crate::sorm::{Sorm, SormResult};
 use crate::subset::{SubsetLevel, SubsetSimulation};
 
@@ -126,66 +128,6 @@ impl Serialize for Target {
     }
 }
 
-/// The algorithm behind a [`StudyResult`].
-///
-/// It serialises as the short name of `--method` (`form`, `is`, `mc`);
-/// [`Method::title`] is the name a report prints.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-pub enum Method {
-    /// FORM (Eq. 19-22, 31).
-    #[serde(rename = "form")]
-    Form,
-    /// The advanced importance sampling (Eq. 23-28), centred by FORM.
-    #[serde(rename = "is")]
-    ImportanceSampling,
-    /// Crude Monte Carlo.
-    #[serde(rename = "mc")]
-    MonteCarlo,
-    /// Subset simulation with adaptive conditional sampling
-    /// ([`crate::subset`]).
-    #[serde(rename = "subset")]
-    Subset,
-    /// Directional simulation ([`crate::directional`]).
-    #[serde(rename = "directional")]
-    Directional,
-    /// SORM ([`crate::sorm`]): FORM's design point and the exact
-    /// curvatures; the answer is Tvedt's.
-    #[serde(rename = "sorm")]
-    Sorm,
-}
-
-impl Method {
-    /// `form`, `is` or `mc` (the `--method` spelling, and the JSON's).
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Form => "form",
-            Method::ImportanceSampling => "is",
-            Method::MonteCarlo => "mc",
-            Method::Subset => "subset",
-            Method::Directional => "directional",
-            Method::Sorm => "sorm",
-        }
-    }
-
-    /// `FORM`, `importance sampling` or `Monte Carlo` (for reports).
-    pub fn title(self) -> &'static str {
-        match self {
-            Method::Form => "FORM",
-            Method::ImportanceSampling => "importance sampling",
-            Method::MonteCarlo => "Monte Carlo",
-            Method::Subset => "subset simulation",
-            Method::Directional => "directional simulation",
-            Method::Sorm => "SORM (Tvedt)",
-        }
-    }
-}
-
-impl std::fmt::Display for Method {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
 /// One of the study's algorithms with its settings (see [`Study::run`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Algorithm {
@@ -195,12 +137,6 @@ pub enum Algorithm {
     ImportanceSampling(ImportanceSampling),
     /// Crude Monte Carlo.
     MonteCarlo(MonteCarlo),
-    /// Crude Monte Carlo until a target coefficient of variation (its
-    /// `samples` the budget per case).
-    MonteCarloToCov(MonteCarlo, f64),
-    /// The importance sampling until a target coefficient of variation (its
-    /// `samples` the budget per case).
-    ImportanceSamplingToCov(ImportanceSampling, f64),
     /// Subset simulation ([`crate::subset`]).
     Subset(SubsetSimulation),
     /// Directional simulation ([`crate::directional`]).
@@ -215,8 +151,7 @@ impl Algorithm {
         match self {
             Algorithm::Form(_) => Method::Form,
             Algorithm::ImportanceSampling(_) => Method::ImportanceSampling,
-            Algorithm::MonteCarlo(_) | Algorithm::MonteCarloToCov(..) => Method::MonteCarlo,
-            Algorithm::ImportanceSamplingToCov(..) => Method::ImportanceSampling,
+            Algorithm::MonteCarlo(_) => Method::MonteCarlo,
             Algorithm::Subset(_) => Method::Subset,
             Algorithm::Directional(_) => Method::Directional,
             Algorithm::Sorm(_) => Method::Sorm,
@@ -964,10 +899,7 @@ impl Study {
         is: &ImportanceSampling,
         progress: &dyn Progress,
     ) -> Result<StudyResult, ReliabilityError> {
-        let events = self.events()?;
-        let forms = self.run_form(&events, &is.form)?;
-        let results = is.run_cases_with(&events, forms, progress)?;
-        Ok(self.finish(Method::ImportanceSampling, self.sampled(&results)))
+        self.sampled_by(is, progress)
     }
 
     /// Crude Monte Carlo on every case.
@@ -976,13 +908,22 @@ impl Study {
         mc: &MonteCarlo,
         progress: &dyn Progress,
     ) -> Result<StudyResult, ReliabilityError> {
+        self.sampled_by(mc, progress)
+    }
+
+    /// `sampler` on every case, under its own stop rule.
+    pub fn sampled_by(
+        &self,
+        sampler: &dyn Sampler,
+        progress: &dyn Progress,
+    ) -> Result<StudyResult, ReliabilityError> {
         let events = self.events()?;
-        let results = mc.run_cases(&events, progress)?;
-        Ok(self.finish(Method::MonteCarlo, self.sampled(&results)))
+        let results = sampler.run_events(&events, progress)?;
+        Ok(self.finish(sampler.method(), self.sampled(&results)))
     }
 
     /// Runs `algorithm` on every case (`progress` hears of the samples
-    /// drawn; FORM draws none).
+    /// drawn; FORM and SORM draw none).
     pub fn run(
         &self,
         algorithm: &Algorithm,
@@ -991,25 +932,10 @@ impl Study {
         match algorithm {
             Algorithm::Form(form) => self.form(form),
             Algorithm::Sorm(sorm) => self.sorm(sorm),
-            Algorithm::ImportanceSampling(is) => self.importance_sampling(is, progress),
-            Algorithm::MonteCarlo(mc) => self.monte_carlo(mc, progress),
-            Algorithm::MonteCarloToCov(mc, cov) => {
-                let events = self.events()?;
-                let results = mc.run_cases_to_cov(&events, *cov, progress)?;
-                Ok(self.finish(Method::MonteCarlo, self.sampled(&results)))
-            }
-            Algorithm::ImportanceSamplingToCov(is, cov) => {
-                let events = self.events()?;
-                let forms = self.run_form(&events, &is.form)?;
-                let results = is.run_cases_with_to_cov(&events, forms, *cov, progress)?;
-                Ok(self.finish(Method::ImportanceSampling, self.sampled(&results)))
-            }
             Algorithm::Subset(ss) => self.subset(ss, progress),
-            Algorithm::Directional(ds) => {
-                let events = self.events()?;
-                let results = ds.run_cases(&events, progress)?;
-                Ok(self.finish(Method::Directional, self.sampled(&results)))
-            }
+            Algorithm::ImportanceSampling(is) => self.sampled_by(is, progress),
+            Algorithm::MonteCarlo(mc) => self.sampled_by(mc, progress),
+            Algorithm::Directional(ds) => self.sampled_by(ds, progress),
         }
     }
 

@@ -64,7 +64,7 @@ use crate::limit_state::{Event, LimitState};
 use crate::normal;
 use crate::par::prelude::*;
 use crate::rng::CaseRng;
-use crate::simulation::{check_cov, Progress, Stop, Stopping};
+use crate::sampler::{check_cov, Progress, Stop, Stopping};
 use crate::standard::Standard;
 
 /// The target acceptance rate of the aCS adaptation (Papaioannou et al.

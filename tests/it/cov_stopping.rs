@@ -40,11 +40,15 @@ fn monte_carlo_stops_at_the_target() {
     let mc = MonteCarlo {
         samples: 100 * BLOCK,
         seed: 3,
+        cov: None,
     };
-    let r = mc
-        .run_cases_to_cov(std::slice::from_ref(&event), target, &())
-        .unwrap()
-        .remove(0);
+    let r = MonteCarlo {
+        cov: Some(target),
+        ..mc
+    }
+    .run_cases(std::slice::from_ref(&event), &())
+    .unwrap()
+    .remove(0);
     let st = r.stopping.unwrap();
     assert!(st.converged && st.stopped_by == Stop::TargetCov && st.target_cov == Some(target));
     assert!(r.cov <= target, "{}", r.cov);
@@ -59,6 +63,7 @@ fn monte_carlo_stops_at_the_target() {
     let fixed = MonteCarlo {
         samples: r.samples,
         seed: 3,
+        cov: None,
     }
     .run(&event)
     .unwrap();
@@ -67,6 +72,7 @@ fn monte_carlo_stops_at_the_target() {
     let fewer = MonteCarlo {
         samples: r.samples - BLOCK,
         seed: 3,
+        cov: None,
     }
     .run(&event)
     .unwrap();
@@ -75,11 +81,15 @@ fn monte_carlo_stops_at_the_target() {
     let small = MonteCarlo {
         samples: BLOCK,
         seed: 3,
+        cov: None,
     };
-    let r = small
-        .run_cases_to_cov(std::slice::from_ref(&event), target, &())
-        .unwrap()
-        .remove(0);
+    let r = MonteCarlo {
+        cov: Some(target),
+        ..small
+    }
+    .run_cases(std::slice::from_ref(&event), &())
+    .unwrap()
+    .remove(0);
     let st = r.stopping.unwrap();
     assert!(!st.converged && st.stopped_by == Stop::Budget);
     assert!(r.cov > target);
@@ -102,15 +112,19 @@ fn importance_sampling_stops_at_the_target() {
         samples: 8 * BLOCK,
         seed: 1,
         form: Form::default(),
+        cov: None,
     };
     let long = is.run(&event).unwrap();
     let var1 = long.std_error.powi(2) * long.samples as f64;
     let target = (var1 / (2.5 * BLOCK as f64)).sqrt() / long.pf;
     let form = Form::default().run(&event).unwrap();
-    let r = is
-        .run_cases_with_to_cov(std::slice::from_ref(&event), vec![form], target, &())
-        .unwrap()
-        .remove(0);
+    let r = ImportanceSampling {
+        cov: Some(target),
+        ..is
+    }
+    .run_cases_with(std::slice::from_ref(&event), vec![form], &())
+    .unwrap()
+    .remove(0);
     assert_eq!(r.stopping.unwrap().stopped_by, Stop::TargetCov);
     assert!(r.cov <= target);
     let implied = var1 / (long.pf * target).powi(2);
@@ -137,12 +151,16 @@ fn importance_sampling_on_a_linear_normal_case_stops_after_one_block() {
         samples: 10 * BLOCK,
         seed: 1,
         form: Form::default(),
+        cov: None,
     };
     let form = Form::default().run(&event).unwrap();
-    let r = is
-        .run_cases_with_to_cov(std::slice::from_ref(&event), vec![form], 0.01, &())
-        .unwrap()
-        .remove(0);
+    let r = ImportanceSampling {
+        cov: Some(0.01),
+        ..is
+    }
+    .run_cases_with(std::slice::from_ref(&event), vec![form], &())
+    .unwrap()
+    .remove(0);
     assert_eq!(r.samples, BLOCK);
     assert!(r.stopping.unwrap().converged);
     assert!((r.pf - normal::sf(6.0 / 2f64.sqrt())).abs() < 1e-12 * r.pf);
@@ -233,10 +251,14 @@ fn a_target_outside_zero_one_is_refused() {
         let mc = MonteCarlo {
             samples: BLOCK,
             seed: 1,
+            cov: None,
         };
-        let e = mc
-            .run_cases_to_cov(std::slice::from_ref(&event), bad, &())
-            .unwrap_err();
+        let e = MonteCarlo {
+            cov: Some(bad),
+            ..mc
+        }
+        .run_cases(std::slice::from_ref(&event), &())
+        .unwrap_err();
         assert!(matches!(e, ReliabilityError::InvalidTargetCov(_)), "{e:?}");
         let d = DirectionalSimulation {
             samples: 10,

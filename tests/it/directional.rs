@@ -134,6 +134,7 @@ fn a_general_limit_state_in_non_normal_inputs_agrees_with_monte_carlo() {
     let mc = MonteCarlo {
         samples: 4_000_000,
         seed: 4,
+        cov: None,
     }
     .run(&event)
     .unwrap();

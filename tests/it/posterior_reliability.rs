@@ -622,6 +622,7 @@ fn the_general_routes_meet_the_closed_form_with_correlated_inputs() {
             samples: 400,
             seed: 5,
             form: Form::default(),
+            cov: None,
         }
         .run(&event)
         .unwrap();
@@ -634,6 +635,7 @@ fn the_general_routes_meet_the_closed_form_with_correlated_inputs() {
         let mc = MonteCarlo {
             samples: 200_000,
             seed: 9,
+            cov: None,
         }
         .run(&event)
         .unwrap();

@@ -239,6 +239,7 @@ fn form_equals_the_closed_form_and_is_has_zero_variance() {
                 samples: 2_000,
                 seed: 2021,
                 form: Form::default(),
+                cov: None,
             },
             &(),
         )
@@ -271,6 +272,7 @@ fn monte_carlo_agrees_within_four_standard_errors() {
             &MonteCarlo {
                 samples: 40_000,
                 seed: 7,
+                cov: None,
             },
             &(),
         )
@@ -321,6 +323,7 @@ fn nonlinear_limit_states_importance_sampling_vs_ten_million_monte_carlo() {
     let mc = MonteCarlo {
         samples: 10_000_000,
         seed: 1,
+        cov: None,
     }
     .run_cases(&events, &())
     .expect("mc");
@@ -328,6 +331,7 @@ fn nonlinear_limit_states_importance_sampling_vs_ten_million_monte_carlo() {
         samples: 200_000,
         seed: 1,
         form: Form::default(),
+        cov: None,
     }
     .run_cases(&events, &())
     .expect("is");
@@ -398,12 +402,14 @@ fn non_normal_inputs_use_the_root_finder() {
         samples: 20_000,
         seed: 5,
         form: Form::default(),
+        cov: None,
     }
     .run(&event)
     .expect("is");
     let mc = MonteCarlo {
         samples: 2_000_000,
         seed: 5,
+        cov: None,
     }
     .run(&event)
     .expect("mc");
@@ -542,6 +548,7 @@ fn results_are_reproducible_whatever_the_thread_count() {
                         &MonteCarlo {
                             samples: 3_000,
                             seed: 3,
+                            cov: None,
                         },
                         &(),
                     )
@@ -552,6 +559,7 @@ fn results_are_reproducible_whatever_the_thread_count() {
                             samples: 3_000,
                             seed: 3,
                             form: Form::default(),
+                            cov: None,
                         },
                         &(),
                     )

@@ -176,6 +176,7 @@ fn non_normal_inputs_agree_with_monte_carlo() {
     let mc = MonteCarlo {
         samples: 4_000_000,
         seed: 5,
+        cov: None,
     }
     .run(&event)
     .unwrap();
