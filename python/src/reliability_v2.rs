@@ -12,7 +12,7 @@ use std::path::Path;
 
 use chain::ops::reliability::{self as ops_reliability, ReliabilityOpsError, ReliabilityRequest};
 use chain::ops::sobol::{self, SobolOpsError, SobolRequest};
-use chain::ops::study::{AlgorithmOptions, SystemChoice};
+use chain::ops::study::{AlgorithmOptions, SystemChoice, SystemKind};
 use chain_core::values::Approach;
 use pyo3::prelude::*;
 use reliability::Method;
@@ -72,27 +72,17 @@ pub(crate) fn system_choice(
     system: Option<&str>,
     tolerance: Option<f64>,
 ) -> PyResult<Option<SystemChoice>> {
-    match (system, tolerance) {
-        (None, None) => Ok(None),
-        (None, Some(_)) => Err(value_error(
-            "system_tolerance is the allowable error of system=\"volumetric\": give system too",
-        )),
-        (Some("series"), None) => Ok(Some(SystemChoice::Series)),
-        (Some("series"), Some(_)) => Err(value_error(
-            "system_tolerance applies to system=\"volumetric\", not \"series\"",
-        )),
-        (Some("volumetric"), t) => {
-            if let Some(t) = t.filter(|t| !(t.is_finite() && *t > 0.0)) {
-                return Err(value_error(format!(
-                    "invalid value for `system_tolerance`: {t} (a positive allowable volumetric error)"
-                )));
-            }
-            Ok(Some(SystemChoice::Volumetric(t)))
+    let kind = match system {
+        None => None,
+        Some("series") => Some(SystemKind::Series),
+        Some("volumetric") => Some(SystemKind::Volumetric),
+        Some(other) => {
+            return Err(value_error(format!(
+                "invalid value {other:?} for `system` [possible values: series, volumetric]"
+            )))
         }
-        (Some(other), _) => Err(value_error(format!(
-            "invalid value {other:?} for `system` [possible values: series, volumetric]"
-        ))),
-    }
+    };
+    SystemChoice::new(kind, tolerance).map_err(|e| value_error(e.to_string()))
 }
 
 /// `approach` (`up`, `down`, `mean` or `x=up,...`) as `--approach` parses it.

@@ -80,7 +80,12 @@ pub struct SystemArgs {
     pub system: Option<SystemArg>,
     /// Allowable volumetric error for `--system volumetric` (default: the
     /// smallest position tolerance).
-    #[arg(long = "system-tolerance", value_name = "I", requires = "system")]
+    #[arg(
+        long = "system-tolerance",
+        value_name = "I",
+        requires = "system",
+        allow_negative_numbers = true
+    )]
     pub tolerance: Option<f64>,
 }
 
@@ -161,13 +166,17 @@ pub enum SystemArg {
 }
 
 impl SystemArgs {
-    /// The choice as the application layer takes it.
-    pub fn choice(&self) -> Option<chain::ops::study::SystemChoice> {
-        use chain::ops::study::SystemChoice;
-        self.system.map(|s| match s {
-            SystemArg::Series => SystemChoice::Series,
-            SystemArg::Volumetric => SystemChoice::Volumetric(self.tolerance),
-        })
+    /// The choice as the application layer takes it
+    /// ([`chain::ops::study::SystemChoice::new`]).
+    pub fn choice(
+        &self,
+    ) -> Result<Option<chain::ops::study::SystemChoice>, chain::ops::study::OptionError> {
+        use chain::ops::study::{SystemChoice, SystemKind};
+        let kind = self.system.map(|s| match s {
+            SystemArg::Series => SystemKind::Series,
+            SystemArg::Volumetric => SystemKind::Volumetric,
+        });
+        SystemChoice::new(kind, self.tolerance)
     }
 }
 

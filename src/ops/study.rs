@@ -201,6 +201,44 @@ pub enum SystemChoice {
     Volumetric(Option<f64>),
 }
 
+/// `--system` without its tolerance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SystemKind {
+    /// Every toleranced component at once.
+    Series,
+    /// `|p| ≤ tolerance`.
+    Volumetric,
+}
+
+impl SystemChoice {
+    /// `--system` and `--system-tolerance` as one choice: the tolerance is
+    /// the volumetric target's allowable error, a positive length; given
+    /// with `series` or without a system it is refused, not dropped.
+    pub fn new(
+        kind: Option<SystemKind>,
+        tolerance: Option<f64>,
+    ) -> Result<Option<SystemChoice>, OptionError> {
+        let refuse = |message: String| OptionError {
+            option: "system-tolerance",
+            message,
+        };
+        match (kind, tolerance) {
+            (None, None) => Ok(None),
+            (None, Some(_)) => Err(refuse(
+                "the allowable error of --system volumetric: give --system volumetric too".into(),
+            )),
+            (Some(SystemKind::Series), Some(_)) => Err(refuse(
+                "the allowable error of --system volumetric, not series".into(),
+            )),
+            (Some(SystemKind::Series), None) => Ok(Some(SystemChoice::Series)),
+            (Some(SystemKind::Volumetric), Some(t)) if !(t.is_finite() && t > 0.0) => Err(refuse(
+                format!("`{t}` (a positive allowable volumetric error, mm)"),
+            )),
+            (Some(SystemKind::Volumetric), t) => Ok(Some(SystemChoice::Volumetric(t))),
+        }
+    }
+}
+
 /// The library's system target of `choice` on `machine`
 /// ([`reliability::document::volumetric`]).
 pub fn system(

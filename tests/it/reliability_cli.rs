@@ -6,7 +6,7 @@ use crate::common;
 
 use std::path::{Path, PathBuf};
 
-use common::cli::{chain, fails, ok, ok_json, ok_stdout, scratch};
+use common::cli::{chain, fails, ok, ok_json, ok_stdout, scratch, unwrapped};
 use common::example_path;
 use serde_json::Value;
 
@@ -525,4 +525,42 @@ fn unknown_names_get_a_close_suggestion_or_none() {
     ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("chain::reliability::invalid_samples"), "{err}");
+}
+
+/// `--system-tolerance` is the volumetric target's allowable error: given
+/// with `--system series` it is refused (not dropped), and a value that is
+/// not a positive length is refused naming the option
+/// (`chain::ops::study::SystemChoice::new`, the rule Python shares).
+#[test]
+fn system_tolerance_is_refused_where_it_does_not_apply() {
+    let file = gantry();
+    let file = file.to_str().unwrap();
+    let err = unwrapped(&fails(&[
+        "reliability",
+        file,
+        "--system",
+        "series",
+        "--system-tolerance",
+        "0.05",
+    ]));
+    assert!(
+        err.contains("invalid value for '--system-tolerance': the allowable error of --system volumetric, not series"),
+        "{err}"
+    );
+    assert!(err.contains("chain::cli::invalid_option"), "{err}");
+    for bad in ["-5", "0", "nan", "inf"] {
+        let err = unwrapped(&fails(&[
+            "reliability",
+            file,
+            "--system",
+            "volumetric",
+            "--system-tolerance",
+            bad,
+        ]));
+        assert!(
+            err.contains("invalid value for '--system-tolerance'")
+                && err.contains("a positive allowable volumetric error"),
+            "{bad}: {err}"
+        );
+    }
 }

@@ -101,7 +101,7 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
         params: &args.model.param.params,
         fix: &args.fix,
         sided: args.model.sided.map(Into::into),
-        system: args.system.choice(),
+        system: args.system.choice()?,
         algorithm: args.algorithm.options(),
         input,
     };

@@ -84,7 +84,7 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
         params: &args.model.param.params,
         grid: &args.grid,
         sided: args.model.sided.map(Into::into),
-        system: args.system.choice(),
+        system: args.system.choice()?,
         algorithm: args.algorithm.options(),
         values: args.values.as_deref(),
         approach: &approach,
