@@ -2,10 +2,13 @@
 //! `chain::ops::allocate` (the CLI's request, checks and document).
 
 use chain::ops::allocate::{self, AllocateOpsError, AllocateRequest, AllocationTarget};
+use chain::ops::Worded;
 use pyo3::prelude::*;
 use reliability::allocate::StrategyName;
 
-use crate::{resolve_error, sided_named, study_error, study_failure, to_json, value_error, Model};
+use crate::{
+    named, resolve_error, sided_named, study_error, study_failure, to_json, value_error, Model,
+};
 
 /// `chain allocate --format json`: `strategy` `optimal` (least cost, with
 /// the KKT check) or `paper` (Wang & Yuan 2021's rounds: `step` in Table
@@ -30,30 +33,26 @@ pub(crate) fn allocate_json(
     params: Vec<(String, f64)>,
     sided: Option<&str>,
 ) -> PyResult<String> {
-    let choice = |what: &str, given: &str, names: &[&str]| {
-        value_error(format!(
-            "invalid value {given:?} for `{what}` [possible values: {}]",
-            names.join(", ")
-        ))
-    };
     let request = AllocateRequest {
-        strategy: match strategy {
-            "optimal" => StrategyName::Optimal,
-            "paper" => StrategyName::Paper,
-            other => return Err(choice("strategy", other, &["optimal", "paper"])),
-        },
+        strategy: named(
+            "strategy",
+            strategy,
+            &[
+                ("optimal", StrategyName::Optimal),
+                ("paper", StrategyName::Paper),
+            ],
+        )?,
         step,
         threshold,
-        pooled: match rank {
-            "component" => false,
-            "pooled" => true,
-            other => return Err(choice("rank", other, &["component", "pooled"])),
-        },
-        target: match target {
-            "requirement" => AllocationTarget::Requirement,
-            "acceptance" => AllocationTarget::Acceptance,
-            other => return Err(choice("target", other, &["requirement", "acceptance"])),
-        },
+        pooled: named("rank", rank, &[("component", false), ("pooled", true)])?,
+        target: named(
+            "target",
+            target,
+            &[
+                ("requirement", AllocationTarget::Requirement),
+                ("acceptance", AllocationTarget::Acceptance),
+            ],
+        )?,
         level,
         params: &params,
         sided: sided_named(sided)?,
@@ -64,7 +63,7 @@ pub(crate) fn allocate_json(
             AllocateOpsError::Study(e) => study_failure(py, model, *e),
             AllocateOpsError::Reliability(e) => study_error(py, &e, &model.file),
             AllocateOpsError::Resolve(e) => resolve_error(py, model, e),
-            e => value_error(e.to_string()),
+            e => value_error(e.with_help()),
         })?;
     to_json(&run)
 }

@@ -4,15 +4,11 @@
 
 use chain::ops::export::{self, ExportController, ExportOpsError, ExportRequest};
 use chain::ops::Worded;
-use chain_core::compensation::controllers::Controller;
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 
 use crate::group_b::read_values;
-use crate::{resolve_error, study_error, to_json, value_error, Model};
-
-/// `--controller`'s names, in the CLI's order.
-const CONTROLLERS: [&str; 5] = ["grid", "beckhoff", "linuxcnc", "siemens-cec", "klipper"];
+use crate::{named, resolve_error, study_error, to_json, value_error, Model};
 
 /// The compensation of the built machine `values` (a file `values_path`,
 /// or the text `values_text` named `values_file`) for `controller`; `grid`,
@@ -36,15 +32,8 @@ pub(crate) fn export_json(
     beckhoff_max_records: Option<usize>,
     params: Vec<(String, f64)>,
 ) -> PyResult<(String, Vec<(String, String)>)> {
-    let controller = match controller {
-        "grid" => ExportController::Grid,
-        name => ExportController::Tables(Controller::from_name(name).ok_or_else(|| {
-            value_error(format!(
-                "invalid value {name:?} for `controller` [possible values: {}]",
-                CONTROLLERS.join(", ")
-            ))
-        })?),
-    };
+    let controllers = ExportController::ALL.map(|c| (c.name(), c));
+    let controller = named("controller", controller, &controllers)?;
     let rows = match &points {
         Some(q) => {
             if !grid.is_empty() {

@@ -485,6 +485,22 @@ pub(crate) fn study_failure(
 }
 
 /// `sided` as the CLI's `--sided` (`upper` or `two`).
+/// `given` as one of `choices` (the CLI's spelling of each value), or the
+/// refusal in clap's words: `invalid value "x" for `what` [possible values:
+/// a, b]`.
+pub(crate) fn named<T: Copy>(what: &str, given: &str, choices: &[(&str, T)]) -> PyResult<T> {
+    (choices.iter())
+        .find(|(name, _)| *name == given)
+        .map(|(_, value)| *value)
+        .ok_or_else(|| {
+            let names: Vec<&str> = choices.iter().map(|(name, _)| *name).collect();
+            value_error(format!(
+                "invalid value {given:?} for `{what}` [possible values: {}]",
+                names.join(", ")
+            ))
+        })
+}
+
 pub(crate) fn sided_named(sided: Option<&str>) -> PyResult<Option<chain_core::model::Sided>> {
     use chain_core::model::Sided;
     match sided {

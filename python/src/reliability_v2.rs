@@ -17,31 +17,9 @@ use chain_core::values::Approach;
 use pyo3::prelude::*;
 use reliability::Method;
 
-use crate::{resolve_error, sided_named, study_error, study_failure, to_json, value_error, Model};
-
-/// The methods of `method`, in the CLI's order of `--method`.
-const METHODS: [Method; 6] = [
-    Method::Form,
-    Method::ImportanceSampling,
-    Method::MonteCarlo,
-    Method::Subset,
-    Method::Directional,
-    Method::Sorm,
-];
-
-/// The method named `name` (`--method`'s spelling), or the CLI's refusal.
-fn method_named(name: &str) -> PyResult<Method> {
-    METHODS
-        .into_iter()
-        .find(|m| m.name() == name)
-        .ok_or_else(|| {
-            let all: Vec<&str> = METHODS.iter().map(|m| m.name()).collect();
-            value_error(format!(
-                "invalid value {name:?} for `method` [possible values: {}]",
-                all.join(", ")
-            ))
-        })
-}
+use crate::{
+    named, resolve_error, sided_named, study_error, study_failure, to_json, value_error, Model,
+};
 
 /// `method`, `samples`, `seed` and `cov` as the CLI's `--method`,
 /// `--samples`, `--seed` and `--cov`, checked by the same rule
@@ -53,7 +31,7 @@ pub(crate) fn algorithm_options(
     cov: Option<f64>,
 ) -> PyResult<AlgorithmOptions> {
     let options = AlgorithmOptions {
-        method: method_named(method)?,
+        method: named("method", method, &Method::ALL.map(|m| (m.name(), m)))?,
         samples,
         seed,
         cov,
@@ -72,16 +50,11 @@ pub(crate) fn system_choice(
     system: Option<&str>,
     tolerance: Option<f64>,
 ) -> PyResult<Option<SystemChoice>> {
-    let kind = match system {
-        None => None,
-        Some("series") => Some(SystemKind::Series),
-        Some("volumetric") => Some(SystemKind::Volumetric),
-        Some(other) => {
-            return Err(value_error(format!(
-                "invalid value {other:?} for `system` [possible values: series, volumetric]"
-            )))
-        }
-    };
+    let kinds = [
+        ("series", SystemKind::Series),
+        ("volumetric", SystemKind::Volumetric),
+    ];
+    let kind = system.map(|s| named("system", s, &kinds)).transpose()?;
     SystemChoice::new(kind, tolerance).map_err(|e| value_error(e.to_string()))
 }
 

@@ -33,6 +33,16 @@ pub enum Method {
 }
 
 impl Method {
+    /// Every method, in the order of `--method`'s values.
+    pub const ALL: [Method; 6] = [
+        Method::Form,
+        Method::ImportanceSampling,
+        Method::MonteCarlo,
+        Method::Subset,
+        Method::Directional,
+        Method::Sorm,
+    ];
+
     /// `form`, `is` or `mc` (the `--method` spelling, and the JSON's).
     pub fn name(self) -> &'static str {
         match self {

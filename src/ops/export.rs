@@ -32,6 +32,15 @@ pub enum ExportController {
 }
 
 impl ExportController {
+    /// Every controller, in the order of `--controller`'s values.
+    pub const ALL: [ExportController; 5] = [
+        ExportController::Grid,
+        ExportController::Tables(Controller::Beckhoff),
+        ExportController::Tables(Controller::Linuxcnc),
+        ExportController::Tables(Controller::SiemensCec),
+        ExportController::Tables(Controller::Klipper),
+    ];
+
     /// The name `--controller` takes.
     pub fn name(self) -> &'static str {
         match self {
