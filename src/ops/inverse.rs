@@ -197,6 +197,7 @@ pub fn run(
     request: &InverseRequest<'_>,
 ) -> Result<InverseDocument, InverseOpsError> {
     let m = machine;
+    resolve::check_parameters(m, request.params)?;
     let params = reliability::machine::parameters(m, request.params)?;
     let fixed = resolve::fixed(m, request.fix)?;
     let solver = solver(m, &params, &fixed)?;
