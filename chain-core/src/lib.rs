@@ -31,7 +31,7 @@ pub use built::{BuiltMachine, MapResult};
 pub use derive::{derive, derive_in, SymbolicModel};
 pub use diagnostic::Diagnostics;
 pub use eval::{compile, CompiledModel, BATCH_LANES};
-pub use load::{load_bytes, load_file, load_str};
+pub use load::{load_bytes, load_file, load_file_with_text, load_str};
 pub use measured::{identify, measurements};
 pub use model::Machine;
 pub use model_trait::{BatchError, ErrorModel, ErrorValues, OutOfRange, Pose};

@@ -20,12 +20,8 @@ pub(crate) struct Loaded {
 impl Loaded {
     /// Loads and validates a machine file.
     pub(crate) fn new(path: &Path) -> miette::Result<Loaded> {
-        let machine = chain_core::load_file(path)?;
-        // Read again for the messages' snippets, within the loader's bound.
-        let source = chain_core::bounded::read_path(path, chain_core::bounded::MACHINE_BYTES)
-            .ok()
-            .and_then(|b| String::from_utf8(b).ok())
-            .unwrap_or_default();
+        // Read once: the text stays for the messages' snippets.
+        let (machine, source) = chain_core::load_file_with_text(path)?;
         let file = machine
             .file
             .clone()

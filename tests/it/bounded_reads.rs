@@ -97,3 +97,21 @@ fn the_bound_is_exact() {
         Err(ReadError::TooLarge { limit: 1000 })
     ));
 }
+
+/// The machine file is read once: `load_file_with_text` gives the machine
+/// `load_file` gives and the file's text for the messages that quote it
+/// (the CLI's `Loaded`); a file that cannot be read is the same diagnostic.
+#[test]
+fn a_machine_file_is_read_once_with_its_text() {
+    let path = std::path::Path::new(GANTRY);
+    let (machine, text) = chain_core::load_file_with_text(path).unwrap();
+    assert_eq!(machine, chain_core::load_file(path).unwrap());
+    assert_eq!(text, std::fs::read_to_string(path).unwrap());
+    let missing = std::path::Path::new("/nonexistent/m.yaml");
+    assert_eq!(
+        chain_core::load_file_with_text(missing)
+            .unwrap_err()
+            .to_string(),
+        chain_core::load_file(missing).unwrap_err().to_string()
+    );
+}

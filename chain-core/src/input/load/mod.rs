@@ -116,8 +116,18 @@ pub fn load_bytes(bytes: &[u8], file: &str) -> Result<Machine, Diagnostics> {
 /// Loads a machine file. A file that cannot be read (missing, a directory,
 /// larger than [`MAX_FILE_BYTES`]) is a diagnostic too.
 pub fn load_file(path: &Path) -> Result<Machine, Diagnostics> {
+    load_file_with_text(path).map(|(machine, _)| machine)
+}
+
+/// [`load_file`], with the file's text read once for the messages that
+/// quote it later (a reliability error located in the file).
+pub fn load_file_with_text(path: &Path) -> Result<(Machine, String), Diagnostics> {
     let file = path.display().to_string();
-    load_bytes(&read_file(path, &file, MAX_FILE_BYTES)?, &file)
+    let bytes = read_file(path, &file, MAX_FILE_BYTES)?;
+    let machine = load_str(decode(&bytes, &file)?, &file)?;
+    // `decode` accepted the bytes as UTF-8.
+    let text = String::from_utf8(bytes).unwrap_or_default();
+    Ok((machine, text))
 }
 
 /// The bytes of the file at `path` (named `file` in diagnostics), at most
