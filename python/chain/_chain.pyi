@@ -119,6 +119,7 @@ def identify_json(
     file: str,
     params: Sequence[Tuple[str, float]],
     prior: bool,
+    validate: Optional[Tuple[Optional[str], Optional[str], str]] = None,
 ) -> Tuple[str, str]: ...
 def plan_json(
     model: Model,

@@ -495,6 +495,8 @@ class Machine:
         params: Params = None,
         values_out: Optional[Union[str, "os.PathLike[str]"]] = None,
         name: str = "<measurements>",
+        validate: Optional[Union[str, "os.PathLike[str]", Mapping[str, ArrayLike]]] = None,
+        validate_name: str = "<validation>",
     ) -> "IdentifyResult":
         """The error parameters from measurements, ``chain identify --measurements M --format json``.
 
@@ -504,12 +506,22 @@ class Machine:
         ``ux, uy, uz, d``, optionally ``std``; ``name`` names them in
         messages and in the document's ``file``. ``prior``: the
         ``statistics`` as a Gaussian prior (``--prior``); ``values_out``:
-        also write the estimates as a values file (``--values-out``).
+        also write the estimates as a values file (``--values-out``);
+        ``validate``: measurements held out of the fit, as ``measurements``
+        (``--validate``; ``validate_name`` names columns given as a dict):
+        the document's ``validation`` gives the error they show before and
+        after the estimates' correction.
         """
         from ._results import IdentifyResult
 
         path, text = _csv_input(measurements, "measurements")
-        doc, values_text = _chain.identify_json(self._model, path, text, name, _params(params), bool(prior))
+        held_out = None
+        if validate is not None:
+            v_path, v_text = _csv_input(validate, "validate")
+            held_out = (v_path, v_text, v_path if v_path is not None else validate_name)
+        doc, values_text = _chain.identify_json(
+            self._model, path, text, name, _params(params), bool(prior), held_out
+        )
         if values_out is not None:
             with open(os.fspath(values_out), "w", encoding="utf-8") as f:
                 f.write(values_text)

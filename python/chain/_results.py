@@ -139,7 +139,8 @@ class IdentifyResult(Result):
 
     Attributes: ``machine``, ``measurements``, ``parameters``, ``rank``,
     ``condition``, ``estimates`` (per error: value, std), ``unidentifiable``,
-    ``residual``, ``groups``, ``largest_residuals``, ... ``values_text`` is
+    ``residual``, ``groups``, ``largest_residuals``, ``validation`` (with
+    ``validate=``: the held-out error before and after), ... ``values_text`` is
     the values file ``--values-out`` writes (also written to ``values_out``
     when given). Rows of ``to_dataframe()``: one per error (error, value, std).
     """

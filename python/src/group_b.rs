@@ -72,9 +72,12 @@ pub(crate) fn read_values(
 }
 
 /// `chain identify --format json` (and the values file `--values-out`
-/// writes): the measurements from `path` or `text` (named `file`).
+/// writes): the measurements from `path` or `text` (named `file`); the
+/// held-out ones of `--validate`, if any, from `validate` (a path, or text
+/// and its name).
 #[pyfunction]
-#[pyo3(signature = (model, path, text, file, params, prior))]
+#[pyo3(signature = (model, path, text, file, params, prior, validate=None))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_json(
     py: Python<'_>,
     model: &Model,
@@ -83,11 +86,27 @@ pub(crate) fn identify_json(
     file: &str,
     params: Vec<(String, f64)>,
     prior: bool,
+    validate: Option<(Option<String>, Option<String>, String)>,
 ) -> PyResult<(String, String)> {
     let m = &model.machine;
     chain::ops::resolve::check_parameters(m, &params).map_err(|e| resolve_error(py, model, e))?;
     let measurements = read_measurements(py, m, path, text, file, &params, Layout::Measurements)?;
-    let request = IdentifyRequest { prior };
+    let validation = match &validate {
+        Some((path, text, file)) => Some(read_measurements(
+            py,
+            m,
+            path.as_deref(),
+            text.as_deref(),
+            file,
+            &params,
+            Layout::Measurements,
+        )?),
+        None => None,
+    };
+    let request = IdentifyRequest {
+        prior,
+        validation: validation.as_ref(),
+    };
     let run = py
         .allow_threads(|| identify::run(m, &measurements, &request))
         .map_err(|e| value_error(e.to_string()))?;

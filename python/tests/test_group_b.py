@@ -91,6 +91,20 @@ def test_identify_is_the_cli_json(name, cli, tmp_path):
     assert [row["error"] for row in r._rows()] == list(r.estimates)
 
 
+def test_identify_validate_is_the_cli_json(cli):
+    """Machine.identify(validate=...) equals `chain identify --validate` (issue 33, point 3): the
+    held-out measurements as a path or as columns give the same prediction."""
+    m = chain.Machine.load(PROBE)
+    ball, inter = MEAS / "ballplate.csv", MEAS / "interferometer.csv"
+    r = m.identify(ball, validate=inter)
+    assert r.to_dict() == cli("identify", PROBE, "--measurements", ball, "--validate", inter)
+    v = r.validation
+    assert v["file"] == str(inter) and v["after"]["rms"] < v["before"]["rms"]
+    columns = m.identify(ball, validate=_columns(inter), validate_name="held-out").validation
+    assert columns["file"] == "held-out"
+    assert {k: columns[k] for k in ("before", "after", "rows")} == {k: v[k] for k in ("before", "after", "rows")}
+
+
 def test_identify_bad_input():
     m = chain.Machine.load(PROBE)
     cols = _columns(MEAS / "ballplate.csv")

@@ -14,9 +14,12 @@ use serde::{Serialize, Serializer};
 
 /// The request of `chain identify`.
 #[derive(Debug, Clone, Copy, Default)]
-pub struct IdentifyRequest {
+pub struct IdentifyRequest<'a> {
     /// `--prior`: the machine file's `statistics` as a Gaussian prior.
     pub prior: bool,
+    /// `--validate`: measurements held out of the fit, where the estimates'
+    /// prediction is reported.
+    pub validation: Option<&'a Measurements>,
 }
 
 /// The document of `chain identify` (JSON: [`IdentifyDocument`]) with the
@@ -41,9 +44,10 @@ impl Serialize for IdentifyRun {
 pub fn run(
     machine: &Machine,
     measurements: &Measurements,
-    request: &IdentifyRequest,
+    request: &IdentifyRequest<'_>,
 ) -> Result<IdentifyRun, DocumentError> {
-    let (document, result) = identify_document(machine, measurements, request.prior)?;
+    let (document, result) =
+        identify_document(machine, measurements, request.prior, request.validation)?;
     let values_text = values_file(machine, &measurements.file, &result);
     Ok(IdentifyRun {
         document,

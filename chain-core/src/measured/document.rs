@@ -9,6 +9,7 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use super::identify::{Estimate, Prior, Residual};
+use super::predict::{predict, Prediction};
 use super::{identify, Design, DesignError, Identification, IdentifyError, Measurements};
 use crate::model::Machine;
 use crate::named::NameMap;
@@ -95,6 +96,20 @@ pub struct IdentifyDocument {
     pub largest_residuals: Vec<ResidualDoc>,
     /// How many of them are flagged as likely outliers.
     pub outliers: usize,
+    /// The prediction at held-out measurements (`--validate`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub validation: Option<Validation>,
+}
+
+/// The prediction of the estimates at measurements not used in the fit
+/// (`chain identify --validate M2.csv`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Validation {
+    /// The held-out measurement file as named in messages.
+    pub file: String,
+    /// Records, rows, the error before and after.
+    #[serde(flatten)]
+    pub prediction: Prediction,
 }
 
 /// `chain identify`: the design of `measurements` through the machine's
@@ -105,21 +120,31 @@ pub fn identify_document(
     machine: &Machine,
     measurements: &Measurements,
     prior: bool,
+    validation: Option<&Measurements>,
 ) -> Result<(IdentifyDocument, Identification), DocumentError> {
     let model = crate::compile(machine);
-    let design = Design::new(&model, machine, &measurements.rows).map_err(|source| {
-        DocumentError::Design {
-            file: measurements.file.clone(),
+    let design_of = |m: &Measurements| {
+        Design::new(&model, machine, &m.rows).map_err(|source| DocumentError::Design {
+            file: m.file.clone(),
             source,
-        }
-    })?;
+        })
+    };
+    let design = design_of(measurements)?;
+    let held_out = validation
+        .map(|v| design_of(v).map(|d| (v, d)))
+        .transpose()?;
     let prior = if prior {
         Some(Prior::from_machine(machine, &design.errors)?)
     } else {
         None
     };
     let result = identify(&design, prior.as_ref())?;
-    let doc = IdentifyDocument::new(machine, &measurements.file, measurements, &design, &result);
+    let mut doc =
+        IdentifyDocument::new(machine, &measurements.file, measurements, &design, &result);
+    doc.validation = held_out.map(|(v, d)| Validation {
+        file: v.file.clone(),
+        prediction: predict(&d, &result),
+    });
     Ok((doc, result))
 }
 
@@ -171,6 +196,7 @@ impl IdentifyDocument {
                 })
                 .collect(),
             outliers: r.outliers,
+            validation: None,
         }
     }
 }

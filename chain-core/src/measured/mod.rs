@@ -14,9 +14,11 @@ pub mod identify;
 pub mod measurements;
 pub mod positioning;
 pub mod positioning_values;
+pub mod predict;
 
 pub use identify::{identify, Identification, IdentifyError, IdentifyOptions};
 pub use measurements::{
     design_rows, Design, DesignError, Layout, Measurement, Measurements, MeasurementsError,
     Observed,
 };
+pub use predict::{predict, ErrorStats, Prediction};

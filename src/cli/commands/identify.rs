@@ -42,6 +42,11 @@ pub struct IdentifyArgs {
     /// is the posterior mean and covariance).
     #[arg(long)]
     pub prior: bool,
+    /// Measurements held out of the fit (the same columns as
+    /// `--measurements`): the error they show before and after the
+    /// estimates' correction.
+    #[arg(long, value_name = "M2.csv")]
+    pub validate: Option<PathBuf>,
     #[command(flatten)]
     pub param: ParamArgs,
     /// Output format.
@@ -65,7 +70,19 @@ pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
         &args.param.params,
         Layout::Measurements,
     )?;
-    let request = IdentifyRequest { prior: args.prior };
+    let validation = match &args.validate {
+        Some(path) => Some(Measurements::read(
+            path,
+            m,
+            &args.param.params,
+            Layout::Measurements,
+        )?),
+        None => None,
+    };
+    let request = IdentifyRequest {
+        prior: args.prior,
+        validation: validation.as_ref(),
+    };
     let run = identify::run(m, &measurements, &request)?;
     if let Some(path) = &args.values_out {
         crate::cli::atomic::write(path, run.values_text.as_bytes())

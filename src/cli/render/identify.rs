@@ -1,6 +1,6 @@
 //! The table of `chain identify` ([`IdentifyRun`]): the estimates, what
 //! the data cannot separate (in words), the residuals and the likely
-//! outliers.
+//! outliers, and the prediction at held-out measurements (`--validate`).
 
 use std::fmt::Write as _;
 
@@ -135,6 +135,23 @@ fn table(d: &IdentifyDocument) -> String {
                 num(r.residual),
                 r.standardised,
                 if r.outlier { "  likely outlier" } else { "" }
+            );
+        }
+    }
+    if let Some(v) = &d.validation {
+        let p = &v.prediction;
+        let _ = writeln!(
+            s,
+            "\nprediction at {} ({} measurements held out of the fit, {} rows):",
+            v.file, p.measurements, p.rows
+        );
+        for (label, e) in [("before", &p.before), ("after", &p.after)] {
+            let _ = writeln!(
+                s,
+                "  {label:<6} mean |error| {}, max {}, rms {}",
+                num(e.mean),
+                num(e.max),
+                num(e.rms)
             );
         }
     }

@@ -1,0 +1,91 @@
+//! How an identification predicts measurements it was not fitted to
+//! (issue 33, point 3): the error a machine shows at held-out poses before
+//! correction (the measured values `b`) and after it (`b − A x̂`, the
+//! measured values less what the estimates predict through the same exact
+//! sensitivity rows the fit used), the numbers a calibration engineer
+//! reports for a calibration (`docs/identify.md`, "Prediction at held-out
+//! poses").
+
+use serde::Serialize;
+
+use super::identify::Identification;
+use super::measurements::Design;
+
+/// The error of a set of measurements.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ErrorStats {
+    /// The mean over the records of each record's error: `|dp|` for a
+    /// tool-point deviation, `|d|` for a deviation along a direction (mm).
+    pub mean: f64,
+    /// The largest record error (mm).
+    pub max: f64,
+    /// The root mean square over the scalar rows (mm).
+    pub rms: f64,
+}
+
+impl ErrorStats {
+    /// The statistics of `values`, one per scalar row, each row's record
+    /// given by `record` (rows of one record consecutive).
+    fn of(values: &[f64], record: &[usize]) -> ErrorStats {
+        let rms = (values.iter().map(|v| v * v).sum::<f64>() / values.len().max(1) as f64).sqrt();
+        let mut magnitudes: Vec<f64> = Vec::new();
+        let mut last = None;
+        for (v, &r) in values.iter().zip(record) {
+            if last != Some(r) {
+                magnitudes.push(0.0);
+                last = Some(r);
+            }
+            if let Some(m) = magnitudes.last_mut() {
+                *m += v * v;
+            }
+        }
+        let magnitudes: Vec<f64> = magnitudes.into_iter().map(f64::sqrt).collect();
+        ErrorStats {
+            mean: magnitudes.iter().sum::<f64>() / magnitudes.len().max(1) as f64,
+            max: magnitudes.iter().copied().fold(0.0, f64::max),
+            rms,
+        }
+    }
+}
+
+/// The prediction of an identification at other measurements.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Prediction {
+    /// Measurement records (CSV rows).
+    pub measurements: usize,
+    /// Scalar rows (3 per point, 1 per direction).
+    pub rows: usize,
+    /// The measured error: what the machine shows uncorrected.
+    pub before: ErrorStats,
+    /// The measured error less the estimates' prediction: what the machine
+    /// would show corrected by them.
+    pub after: ErrorStats,
+}
+
+/// The prediction of `r`'s estimates at the rows of `design`, a design of
+/// other measurements of the same machine (its columns `r`'s unknowns, in
+/// the same order).
+pub fn predict(design: &Design, r: &Identification) -> Prediction {
+    let x: Vec<f64> = (r.errors.iter())
+        .map(|name| {
+            (r.estimates.0.iter())
+                .find(|(n, _)| n == name)
+                .map_or(0.0, |(_, e)| e.value)
+        })
+        .collect();
+    let after: Vec<f64> = (design.b.iter().enumerate())
+        .map(|(i, b)| {
+            let row = design.a.row(i);
+            b - row.iter().zip(&x).map(|(a, x)| a * x).sum::<f64>()
+        })
+        .collect();
+    let record: Vec<usize> = design.origin.iter().map(|(r, _)| *r).collect();
+    let mut records = record.clone();
+    records.dedup();
+    Prediction {
+        measurements: records.len(),
+        rows: design.b.len(),
+        before: ErrorStats::of(&design.b, &record),
+        after: ErrorStats::of(&after, &record),
+    }
+}
