@@ -121,42 +121,29 @@ fn lines_charts(
     } else {
         format!(" at {slice}")
     };
-    let mut files = Vec::new();
-    let mut position = XyChart::new(
-        format!("{}: position error{at}", r.machine),
-        x_label,
-        "error (µm)",
-    )
-    .legend(Legend::UpperLeft)
-    .hline(0.0);
-    for (c, name) in COMPONENTS.iter().enumerate().take(3) {
-        let pts = points
-            .iter()
-            .map(|&(x, i)| (x, r.errors[i][c] * 1e3))
-            .collect();
-        position = position.series(Series::line_points(*name, pts));
-    }
-    let vol = points
-        .iter()
+    // The components `range` in `unit` (µm or µrad), one series each.
+    let chart = |what: &str, unit: &str, range: std::ops::Range<usize>| {
+        let mut chart = XyChart::new(
+            format!("{}: {what} error{at}", r.machine),
+            x_label,
+            format!("error ({unit})"),
+        )
+        .legend(Legend::UpperLeft)
+        .hline(0.0);
+        for c in range {
+            let pts = (points.iter())
+                .map(|&(x, i)| (x, r.errors[i][c] * MICRO[c]))
+                .collect();
+            chart = chart.series(Series::line_points(COMPONENTS[c], pts));
+        }
+        chart
+    };
+    let vol = (points.iter())
         .map(|&(x, i)| (x, r.volumetric(i) * 1e3))
         .collect();
-    position = position.series(Series::line("|p|", vol).width(3));
-    files.extend(position.write(dir, "map_position")?);
-    let mut orientation = XyChart::new(
-        format!("{}: orientation error{at}", r.machine),
-        x_label,
-        "error (µrad)",
-    )
-    .legend(Legend::UpperLeft)
-    .hline(0.0);
-    for (c, name) in COMPONENTS.iter().enumerate().skip(3) {
-        let pts = points
-            .iter()
-            .map(|&(x, i)| (x, r.errors[i][c] * 1e6))
-            .collect();
-        orientation = orientation.series(Series::line_points(*name, pts));
-    }
-    files.extend(orientation.write(dir, "map_orientation")?);
+    let position = chart("position", "µm", 0..3).series(Series::line("|p|", vol).width(3));
+    let mut files = position.write(dir, "map_position")?;
+    files.extend(chart("orientation", "µrad", 3..6).write(dir, "map_orientation")?);
     Ok(files)
 }
 
