@@ -270,35 +270,17 @@ pub enum ControllerName {
     Klipper,
 }
 
-impl ControllerName {
-    /// The name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            ControllerName::Grid => "grid",
-            ControllerName::Beckhoff => "beckhoff",
-            ControllerName::Linuxcnc => "linuxcnc",
-            ControllerName::SiemensCec => "siemens-cec",
-            ControllerName::Klipper => "klipper",
-        }
-    }
-
-    /// The per-axis table format, or `None` for `grid`.
-    pub fn tables(self) -> Option<Controller> {
-        match self {
-            ControllerName::Grid => None,
-            ControllerName::Beckhoff => Some(Controller::Beckhoff),
-            ControllerName::Linuxcnc => Some(Controller::Linuxcnc),
-            ControllerName::SiemensCec => Some(Controller::SiemensCec),
-            ControllerName::Klipper => Some(Controller::Klipper),
-        }
-    }
-}
-
+/// The application layer's controller (its name, `--controller`'s, is
+/// [`chain::ops::export::ExportController::name`]).
 impl From<ControllerName> for chain::ops::export::ExportController {
     fn from(c: ControllerName) -> Self {
-        match c.tables() {
-            None => chain::ops::export::ExportController::Grid,
-            Some(t) => chain::ops::export::ExportController::Tables(t),
+        use chain::ops::export::ExportController::{Grid, Tables};
+        match c {
+            ControllerName::Grid => Grid,
+            ControllerName::Beckhoff => Tables(Controller::Beckhoff),
+            ControllerName::Linuxcnc => Tables(Controller::Linuxcnc),
+            ControllerName::SiemensCec => Tables(Controller::SiemensCec),
+            ControllerName::Klipper => Tables(Controller::Klipper),
         }
     }
 }

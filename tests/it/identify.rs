@@ -925,16 +925,15 @@ fn held_out_poses_are_predicted_as_the_exact_product_predicts_them() {
     let csv = |records: &[Measurement]| records_csv(records, &["x", "y"], &["tx", "ty", "tz"]);
     let fit_csv = write(&dir, "fit.csv", &csv(&fit_records));
     let held_csv = write(&dir, "held.csv", &csv(&held_records));
-    let doc = ok_json(&[
+    let args = [
         "identify",
         machine.to_str().unwrap(),
         "--measurements",
         fit_csv.to_str().unwrap(),
         "--validate",
         held_csv.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
+    ];
+    let doc = ok_json(&[&args[..], &["--format", "json"]].concat());
     let v = &doc["validation"];
     assert_eq!(v["file"], held_csv.to_str().unwrap());
     assert_eq!(
@@ -983,14 +982,7 @@ fn held_out_poses_are_predicted_as_the_exact_product_predicts_them() {
         "{rms_before} → {rms_after}"
     );
     // The table says it in words.
-    let table = ok_stdout(&[
-        "identify",
-        machine.to_str().unwrap(),
-        "--measurements",
-        fit_csv.to_str().unwrap(),
-        "--validate",
-        held_csv.to_str().unwrap(),
-    ]);
+    let table = ok_stdout(&args);
     assert!(
         table.contains("(40 measurements held out of the fit, 120 rows)"),
         "{table}"

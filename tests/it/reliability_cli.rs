@@ -564,3 +564,31 @@ fn system_tolerance_is_refused_where_it_does_not_apply() {
         );
     }
 }
+
+/// The `--system-tolerance` refusal comes before the machine file is read:
+/// a missing file is not what the user hears about.
+#[test]
+fn system_tolerance_is_refused_before_the_machine_is_read() {
+    for command in [
+        &["reliability"][..],
+        &["path", "--axes", "/nonexistent/axes.csv"],
+    ] {
+        let err = unwrapped(&fails(
+            &[
+                command,
+                &[
+                    "/nonexistent/machine.yaml",
+                    "--system",
+                    "series",
+                    "--system-tolerance",
+                    "0.05",
+                ],
+            ]
+            .concat(),
+        ));
+        assert!(
+            err.contains("invalid value for '--system-tolerance'") && !err.contains("nonexistent"),
+            "{command:?}: {err}"
+        );
+    }
+}

@@ -64,6 +64,8 @@ pub struct PathArgs {
 
 /// Runs `chain path`.
 pub fn exec(args: PathArgs) -> miette::Result<()> {
+    // Refused before the machine file is read.
+    let system = args.system.choice()?;
     let loaded = Loaded::new(&args.file)?;
     let display = |p: &std::path::Path| match p.as_os_str() == "-" {
         true => "<stdin>".to_string(),
@@ -101,7 +103,7 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
         params: &args.model.param.params,
         fix: &args.fix,
         sided: args.model.sided.map(Into::into),
-        system: args.system.choice()?,
+        system,
         algorithm: args.algorithm.options(),
         input,
     };

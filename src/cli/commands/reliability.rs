@@ -78,13 +78,15 @@ pub struct ReliabilityArgs {
 /// Runs `chain reliability` ([`chain::ops::reliability`]).
 pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     args.algorithm.check()?;
+    // Refused before the machine file is read.
+    let system = args.system.choice()?;
     let loaded = Loaded::new(&args.file)?;
     let approach: Vec<_> = args.approach.iter().flatten().cloned().collect();
     let request = ReliabilityRequest {
         params: &args.model.param.params,
         grid: &args.grid,
         sided: args.model.sided.map(Into::into),
-        system: args.system.choice()?,
+        system,
         algorithm: args.algorithm.options(),
         values: args.values.as_deref(),
         approach: &approach,
