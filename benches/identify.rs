@@ -111,7 +111,7 @@ fn bench(c: &mut Criterion) {
                     Measurements::parse(&text, "m.csv", &m, &[], Layout::Measurements).unwrap();
                 let model = chain::core::compile(&m);
                 let design = Design::new(&model, &m, &meas.rows).unwrap();
-                black_box(identify(&design, None).unwrap())
+                black_box(identify(&design, None, &Default::default()).unwrap())
             })
         });
         let meas = Measurements::parse(&text, "m.csv", &m, &[], Layout::Measurements).unwrap();
@@ -121,7 +121,7 @@ fn bench(c: &mut Criterion) {
         });
         let design = Design::new(&model, &m, &meas.rows).unwrap();
         g.bench_function(format!("solve_1e4{suffix}"), |b| {
-            b.iter(|| black_box(identify(&design, None).unwrap()))
+            b.iter(|| black_box(identify(&design, None, &Default::default()).unwrap()))
         });
     }
     g.finish();

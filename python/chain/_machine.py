@@ -497,6 +497,9 @@ class Machine:
         name: str = "<measurements>",
         validate: Optional[Union[str, "os.PathLike[str]", Mapping[str, ArrayLike]]] = None,
         validate_name: str = "<validation>",
+        rank_tol: Optional[float] = None,
+        fix: Optional[Sequence[str]] = None,
+        estimate: Optional[Sequence[str]] = None,
     ) -> "IdentifyResult":
         """The error parameters from measurements, ``chain identify --measurements M --format json``.
 
@@ -510,7 +513,11 @@ class Machine:
         ``validate``: measurements held out of the fit, as ``measurements``
         (``--validate``; ``validate_name`` names columns given as a dict):
         the document's ``validation`` gives the error they show before and
-        after the estimates' correction.
+        after the estimates' correction. ``rank_tol`` (``--rank-tol``): a
+        fixed relative tolerance instead of the noise rule; ``fix`` /
+        ``estimate`` (``--fix`` / ``--estimate``): the error parameters to
+        fix at 0, or the only ones to estimate, instead of the
+        elimination's choice (the document's ``subset``).
         """
         from ._results import IdentifyResult
 
@@ -520,7 +527,16 @@ class Machine:
             v_path, v_text = _csv_input(validate, "validate")
             held_out = (v_path, v_text, v_path if v_path is not None else validate_name)
         doc, values_text = _chain.identify_json(
-            self._model, path, text, name, _params(params), bool(prior), held_out
+            self._model,
+            path,
+            text,
+            name,
+            _params(params),
+            bool(prior),
+            held_out,
+            None if rank_tol is None else float(rank_tol),
+            None if fix is None else [str(n) for n in fix],
+            None if estimate is None else [str(n) for n in estimate],
         )
         if values_out is not None:
             with open(os.fspath(values_out), "w", encoding="utf-8") as f:

@@ -138,11 +138,16 @@ class IdentifyResult(Result):
     """``chain identify --format json``: the error parameters estimated from measurements.
 
     Attributes: ``machine``, ``measurements``, ``parameters``, ``rank``,
-    ``condition``, ``estimates`` (per error: value, std), ``unidentifiable``,
-    ``residual``, ``groups``, ``largest_residuals``, ``validation`` (with
+    ``condition``, ``estimates`` (per error: value, std; the minimum-norm
+    solution), ``unidentifiable``, ``residual``, ``groups``,
+    ``largest_residuals``, ``noise`` (how the rank was decided), ``subset``
+    (the estimated errors, their least-squares values, the fixed errors and
+    their relations; absent with ``prior``), ``validation`` (with
     ``validate=``: the held-out error before and after), ... ``values_text`` is
     the values file ``--values-out`` writes (also written to ``values_out``
-    when given). Rows of ``to_dataframe()``: one per error (error, value, std).
+    when given). Rows of ``to_dataframe()``: one per error (error, value, std;
+    with a subset also subset_value, subset_std and status: ``estimated`` or
+    why the error is fixed).
     """
 
     command = "identify"
@@ -152,7 +157,15 @@ class IdentifyResult(Result):
         self.__dict__["values_text"] = values_text
 
     def _rows(self) -> List[Dict[str, Any]]:
-        return [{"error": name, "value": e["value"], "std": e["std"]} for name, e in self._document["estimates"].items()]
+        d = self._document
+        rows = [{"error": name, "value": e["value"], "std": e["std"]} for name, e in d["estimates"].items()]
+        sub = d.get("subset")
+        if sub is not None:
+            status = {f["error"]: f["status"] for f in sub["fixed"]}
+            for row in rows:
+                s = sub["estimates"][row["error"]]
+                row.update(subset_value=s["value"], subset_std=s["std"], status=status.get(row["error"], "estimated"))
+        return rows
 
 
 class PlanResult(Result):

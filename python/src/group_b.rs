@@ -14,7 +14,9 @@ use std::path::Path;
 use chain::ops::identify::{self, IdentifyRequest};
 use chain::ops::plan::{self, PlanRequest};
 use chain::ops::Worded;
-use chain_core::measured::{Layout, Measurements, MeasurementsError};
+use chain_core::measured::{
+    IdentifyOptions, Layout, Measurements, MeasurementsError, SubsetChoice,
+};
 use chain_core::model::Machine;
 use chain_core::plan::Kind;
 use chain_core::values::{Values, ValuesError};
@@ -76,7 +78,7 @@ pub(crate) fn read_values(
 /// held-out ones of `--validate`, if any, from `validate` (a path, or text
 /// and its name).
 #[pyfunction]
-#[pyo3(signature = (model, path, text, file, params, prior, validate=None))]
+#[pyo3(signature = (model, path, text, file, params, prior, validate=None, rank_tol=None, fix=None, estimate=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_json(
     py: Python<'_>,
@@ -87,8 +89,13 @@ pub(crate) fn identify_json(
     params: Vec<(String, f64)>,
     prior: bool,
     validate: Option<(Option<String>, Option<String>, String)>,
+    rank_tol: Option<f64>,
+    fix: Option<Vec<String>>,
+    estimate: Option<Vec<String>>,
 ) -> PyResult<(String, String)> {
     let m = &model.machine;
+    let subset =
+        SubsetChoice::from_options(fix, estimate).map_err(|e| value_error(e.to_string()))?;
     chain::ops::resolve::check_parameters(m, &params).map_err(|e| resolve_error(py, model, e))?;
     let measurements = read_measurements(py, m, path, text, file, &params, Layout::Measurements)?;
     let validation = match &validate {
@@ -105,6 +112,7 @@ pub(crate) fn identify_json(
     };
     let request = IdentifyRequest {
         prior,
+        options: IdentifyOptions { rank_tol, subset },
         validation: validation.as_ref(),
     };
     let run = py

@@ -218,3 +218,27 @@ def test_inverse_is_the_cli_json(cli, cli_error, tmp_path):
     with pytest.raises(chain.MachineError) as info:
         m.inverse(poses, fix={"muu": 0.0})
     assert "--fix: `muu` is not an axis variable" in str(info.value)
+
+
+def test_identify_subset_options_are_the_cli_json(cli):
+    """Machine.identify(fix=, estimate=, rank_tol=) equals `chain identify --fix/--estimate/--rank-tol`
+    (issue 34): the same subset document; a bad name raises the CLI's message."""
+    m = chain.Machine.load(PROBE)
+    ball = MEAS / "ballplate.csv"
+    r = m.identify(ball)
+    fixed = [f["error"] for f in r.subset["fixed"]]
+    # keep EXX_0 instead of EXY_0 (the two act alike on the plate)
+    swapped = [("EXY_0" if f == "EXX_0" else f) for f in fixed]
+    a = m.identify(ball, fix=swapped)
+    assert a.to_dict() == cli("identify", PROBE, "--measurements", ball, "--fix", ",".join(swapped))
+    assert a.subset["chosen_by"] == "fix" and "EXX_0" in a.subset["estimated"]
+    b = m.identify(ball, estimate=r.subset["estimated"], rank_tol=1e-6)
+    assert b.to_dict() == cli(
+        "identify", PROBE, "--measurements", ball, "--estimate", ",".join(r.subset["estimated"]), "--rank-tol", 1e-6
+    )
+    rows = {row["error"]: row for row in r._rows()}
+    assert rows["EXX_0"]["status"] == "redundant" and rows["EXY_0"]["status"] == "estimated"
+    with pytest.raises(ValueError, match=r"--fix: `EXX_9` is not an error parameter of these measurements"):
+        m.identify(ball, fix=["EXX_9"])
+    with pytest.raises(ValueError, match="--fix: cannot be given with --estimate"):
+        m.identify(ball, fix=["EXX_0"], estimate=["EXY_0"])

@@ -8,15 +8,18 @@
 use chain_core::measured::document::{
     identify_document, values_file, DocumentError, IdentifyDocument,
 };
-use chain_core::measured::{Identification, Measurements};
+use chain_core::measured::{Identification, IdentifyOptions, Measurements};
 use chain_core::Machine;
 use serde::{Serialize, Serializer};
 
 /// The request of `chain identify`.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 pub struct IdentifyRequest<'a> {
     /// `--prior`: the machine file's `statistics` as a Gaussian prior.
     pub prior: bool,
+    /// `--rank-tol`, `--fix`, `--estimate`: the rank rule and the
+    /// estimated subset.
+    pub options: IdentifyOptions,
     /// `--validate`: measurements held out of the fit, where the estimates'
     /// prediction is reported.
     pub validation: Option<&'a Measurements>,
@@ -46,8 +49,13 @@ pub fn run(
     measurements: &Measurements,
     request: &IdentifyRequest<'_>,
 ) -> Result<IdentifyRun, DocumentError> {
-    let (document, result) =
-        identify_document(machine, measurements, request.prior, request.validation)?;
+    let (document, result) = identify_document(
+        machine,
+        measurements,
+        request.prior,
+        &request.options,
+        request.validation,
+    )?;
     let values_text = values_file(machine, &measurements.file, &result);
     Ok(IdentifyRun {
         document,

@@ -13,7 +13,7 @@ use crate::common;
 
 use chain::core::built::{BuiltMachine, Points};
 use chain::core::measured::identify::Prior;
-use chain::core::measured::{identify, Design, Measurement, Observed};
+use chain::core::measured::{identify, Design, IdentifyOptions, Measurement, Observed};
 use chain::core::values::{Values, ValuesBuilder};
 use chain::core::{ErrorModel, Machine};
 use chain::reliability::Posterior;
@@ -83,6 +83,18 @@ fn truth(name: &str) -> f64 {
     }
 }
 
+/// The fixed rank tolerance (`--rank-tol 1e-6`): the full-rank least
+/// squares the recovery tests below check. At these noise levels the
+/// weakest combination of the cubic and quadratic coefficients is within
+/// the noise, and the noise rule would leave it out
+/// (`tests/it/identify_subset.rs` tests the rule).
+fn full_rank() -> IdentifyOptions {
+    IdentifyOptions {
+        rank_tol: Some(chain::core::measured::identify::RANK_TOLERANCE),
+        ..Default::default()
+    }
+}
+
 fn xyz() -> Machine {
     chain::core::load_str(XYZ, "xyz3.yaml").expect("xyz3 loads")
 }
@@ -147,7 +159,7 @@ fn recovers_constants_and_coefficients_with_honest_std() {
     let mut rng = Rng::new(42);
     let records = simulate(&m, &poses, &e, sigma, &mut rng);
     let design = Design::new(&model, &m, &records).unwrap();
-    let r = identify(&design, None).unwrap();
+    let r = identify(&design, None, &full_rank()).unwrap();
     assert_eq!(r.parameters, 14);
     assert_eq!(
         r.rank, 14,
@@ -171,7 +183,7 @@ fn recovers_constants_and_coefficients_with_honest_std() {
     for _ in 0..runs {
         let records = simulate(&m, &poses, &e, sigma, &mut rng);
         let design = Design::new(&model, &m, &records).unwrap();
-        let r = identify(&design, None).unwrap();
+        let r = identify(&design, None, &full_rank()).unwrap();
         for (j, (_, est)) in r.estimates.0.iter().enumerate() {
             samples[j].push(est.value);
         }
@@ -205,11 +217,21 @@ fn without_std_the_covariance_is_scaled_by_the_residual() {
     let mut rng = Rng::new(3);
     let sigma = 2e-3;
     let mut records = simulate(&m, &poses(120), &e, sigma, &mut rng);
-    let weighted = identify(&Design::new(&model, &m, &records).unwrap(), None).unwrap();
+    let weighted = identify(
+        &Design::new(&model, &m, &records).unwrap(),
+        None,
+        &Default::default(),
+    )
+    .unwrap();
     for r in &mut records {
         r.std = None;
     }
-    let plain = identify(&Design::new(&model, &m, &records).unwrap(), None).unwrap();
+    let plain = identify(
+        &Design::new(&model, &m, &records).unwrap(),
+        None,
+        &Default::default(),
+    )
+    .unwrap();
     let s = plain.residual.scale.unwrap();
     // s² = RSS/(m − rank) by hand.
     let rss: f64 = plain.residuals.iter().map(|r| r * r).sum();
@@ -266,7 +288,12 @@ fn gantry_position_only_null_space_is_the_analytic_one() {
             std: None,
         })
         .collect();
-    let r = identify(&Design::new(&model, &m, &records).unwrap(), None).unwrap();
+    let r = identify(
+        &Design::new(&model, &m, &records).unwrap(),
+        None,
+        &Default::default(),
+    )
+    .unwrap();
     // The analytic null space from the structure of the columns: zero
     // columns, and columns identical or opposite to an earlier one.
     let a = gantry_columns(&m, &q);
@@ -384,7 +411,7 @@ fn prior_without_data_is_the_prior_and_with_much_data_the_least_squares() {
     let names: Vec<String> = m.errors.iter().map(|e| e.name.clone()).collect();
     let prior = Prior::from_machine(&m, &names).unwrap();
     let empty = Design::new(&model, &m, &[]).unwrap();
-    let r = identify(&empty, Some(&prior)).unwrap();
+    let r = identify(&empty, Some(&prior), &Default::default()).unwrap();
     for (j, (_, est)) in r.estimates.0.iter().enumerate() {
         assert_eq!(est.value, prior.mean[j]);
         assert!((est.std.unwrap() / prior.std[j] - 1.0).abs() < 1e-12);
@@ -395,8 +422,8 @@ fn prior_without_data_is_the_prior_and_with_much_data_the_least_squares() {
     let mut rng = Rng::new(5);
     let records = simulate(&m, &poses(3000), &e, 1e-4, &mut rng);
     let design = Design::new(&model, &m, &records).unwrap();
-    let ls = identify(&design, None).unwrap();
-    let post = identify(&design, Some(&prior)).unwrap();
+    let ls = identify(&design, None, &Default::default()).unwrap();
+    let post = identify(&design, Some(&prior), &Default::default()).unwrap();
     assert!(post.unidentifiable.is_empty(), "{:?}", post.unidentifiable);
     for ((name, a), (_, b)) in ls.estimates.0.iter().zip(&post.estimates.0) {
         let (sa, sb) = (a.std.unwrap(), b.std.unwrap());
@@ -440,12 +467,24 @@ fn values_out_reads_back_and_maps_like_the_estimates() {
     ]);
     let values = Values::read(&out, &m).expect("the written values file reads back");
     // The library's answer on the same records.
-    let lib = identify(&Design::new(&model, &m, &records).unwrap(), None).unwrap();
+    let lib = identify(
+        &Design::new(&model, &m, &records).unwrap(),
+        None,
+        &Default::default(),
+    )
+    .unwrap();
+    // The file holds the least-squares subset's values (issue 34).
+    let (solution, _) = lib.solution();
     let mut b = ValuesBuilder::new(&m);
-    for (name, est) in &lib.estimates.0 {
-        b.constant(name, est.value).unwrap();
+    for (j, (name, est)) in lib.estimates.0.iter().enumerate() {
+        b.constant(name, solution[j]).unwrap();
         let cli = json["estimates"][name]["value"].as_f64().unwrap();
         assert!((cli - est.value).abs() <= 1e-12 * est.value.abs(), "{name}");
+        let sub = json["subset"]["estimates"][name]["value"].as_f64().unwrap();
+        assert!(
+            (sub - solution[j]).abs() <= 1e-12 * solution[j].abs(),
+            "{name}"
+        );
     }
     let params = vec![0.0, 0.0, 100.0];
     let grid = Points::Grid(vec![vec![0.0, 400.0, 800.0], vec![0.0, 300.0, 600.0]]);
@@ -464,7 +503,7 @@ fn values_out_reads_back_and_maps_like_the_estimates() {
         }
     }
     // And the map is the model's error with the estimates.
-    let est: Vec<f64> = lib.estimates.0.iter().map(|(_, e)| e.value).collect();
+    let est = solution;
     let mut direct = [0.0; 6];
     model.error(&[800.0, 600.0], &[0.0, 0.0, 100.0], &est, &mut direct);
     let last = a.errors[8];
@@ -479,17 +518,18 @@ fn values_out_reads_back_and_maps_like_the_estimates() {
     // 17 digits written), and together they are positive definite.
     let post = Posterior::read(&out, &m).expect("the posterior reads the written file");
     let n = lib.errors.len();
-    let sd: Vec<f64> = (0..n).map(|j| lib.covariance[(j, j)].sqrt()).collect();
+    let (_, covariance) = lib.solution();
+    let sd: Vec<f64> = (0..n).map(|j| covariance[(j, j)].sqrt()).collect();
     for (j, name) in lib.errors.iter().enumerate() {
         let v = post.value(name).expect("every unknown is written");
-        assert_eq!(v.mean, lib.estimates.0[j].1.value, "{name}");
-        assert_eq!(v.std, Some(sd[j]), "{name}");
+        assert_eq!(v.mean, est[j], "{name}");
+        assert_eq!(v.std, Some(sd[j]).filter(|s| *s > 0.0), "{name}");
     }
     let index = |x: &str| lib.errors.iter().position(|e| e == x).unwrap();
     let mut seen = vec![vec![false; n]; n];
     for c in &post.correlations {
         let (i, j) = (index(&c.a), index(&c.b));
-        let rho = lib.covariance[(i, j)] / (sd[i] * sd[j]);
+        let rho = covariance[(i, j)] / (sd[i] * sd[j]);
         assert!(
             (c.rho - rho).abs() < 1e-15,
             "{} {}: {} vs {rho}",
@@ -502,7 +542,7 @@ fn values_out_reads_back_and_maps_like_the_estimates() {
     for i in 0..n {
         for j in i + 1..n {
             assert!(
-                seen[i][j] || lib.covariance[(i, j)] == 0.0,
+                seen[i][j] || covariance[(i, j)] == 0.0,
                 "pair {} {} missing",
                 lib.errors[i],
                 lib.errors[j]
@@ -622,7 +662,12 @@ fn directions_identify_like_points() {
             });
         }
     }
-    let r = identify(&Design::new(&model, &m, &records).unwrap(), None).unwrap();
+    let r = identify(
+        &Design::new(&model, &m, &records).unwrap(),
+        None,
+        &full_rank(),
+    )
+    .unwrap();
     assert_eq!(r.rank, 14);
     for (j, (name, est)) in r.estimates.0.iter().enumerate() {
         assert!((est.value - e[j]).abs() < 4.0 * est.std.unwrap(), "{name}");
@@ -692,7 +737,12 @@ fn a_planted_outlier_is_flagged_first() {
     let mut rng = Rng::new(21);
     let mut records = simulate(&m, &poses(120), &e, 1e-3, &mut rng);
     records[37].values[1] += 20e-3;
-    let r = identify(&Design::new(&model, &m, &records).unwrap(), None).unwrap();
+    let r = identify(
+        &Design::new(&model, &m, &records).unwrap(),
+        None,
+        &Default::default(),
+    )
+    .unwrap();
     let first = &r.largest_residuals[0];
     assert_eq!((first.row / 3, first.component), (37, "dpy"), "{first:?}");
     assert!(
@@ -703,7 +753,12 @@ fn a_planted_outlier_is_flagged_first() {
     // Without the planted error the same data flag at most a few rows and
     // none of them is that row.
     records[37].values[1] -= 20e-3;
-    let clean = identify(&Design::new(&model, &m, &records).unwrap(), None).unwrap();
+    let clean = identify(
+        &Design::new(&model, &m, &records).unwrap(),
+        None,
+        &Default::default(),
+    )
+    .unwrap();
     assert!(clean.outliers <= 3, "{} flagged", clean.outliers);
     assert!(clean
         .largest_residuals
@@ -763,9 +818,15 @@ fn cli_directions_and_prior_without_std_are_the_library_answer() {
         a
     };
     let run = |a: Vec<String>| ok_json(&a.iter().map(String::as_str).collect::<Vec<_>>());
-    let lib = identify(&Design::new(&model, &m, &records).unwrap(), None).unwrap();
-    assert_eq!(lib.rank, 14);
+    let lib = identify(
+        &Design::new(&model, &m, &records).unwrap(),
+        None,
+        &Default::default(),
+    )
+    .unwrap();
+    assert_eq!(lib.noise.structural_rank, 14);
     let json = run(args(&csv, false));
+    assert_eq!(json["rank"].as_u64(), Some(lib.rank as u64));
     same_estimates(&json, &lib);
     assert_eq!(json["measurements"].as_u64(), Some(200));
 
@@ -783,7 +844,12 @@ fn cli_directions_and_prior_without_std_are_the_library_answer() {
     );
     let names: Vec<String> = m.errors.iter().map(|x| x.name.clone()).collect();
     let prior = Prior::from_machine(&m, &names).unwrap();
-    let lib = identify(&Design::new(&model, &m, &points).unwrap(), Some(&prior)).unwrap();
+    let lib = identify(
+        &Design::new(&model, &m, &points).unwrap(),
+        Some(&prior),
+        &Default::default(),
+    )
+    .unwrap();
     let json = run(args(&csv, true));
     same_estimates(&json, &lib);
     assert_eq!(json["prior"].as_bool(), Some(true));
@@ -796,8 +862,8 @@ fn reliability_after_calibration_reads_the_identified_posterior() {
     // The whole workflow on the gantry grinder: measure tool-point
     // deviations (tool point 0, position only: rank deficient), identify,
     // write the values, run `chain reliability --values`. Without a prior
-    // the covariance is singular and the posterior is refused with a hint;
-    // with `--prior` it is full rank and the reliability runs on it.
+    // the values are the least-squares subset's (issue 34);
+    // with `--prior` it is full rank; both run through the reliability.
     let m = load_example("gantry_grinder.yaml");
     let means: Vec<f64> = m
         .errors
@@ -836,71 +902,85 @@ fn reliability_after_calibration_reads_the_identified_posterior() {
         }
         ok_json(&a)
     };
+    // Each case's β is the closed form of the correlated normal posterior:
+    // g = t − a·e (upper-sided, t = 0.03 mm), β = (t − a·μ) / √(aᵀ Σ a),
+    // Σ = D R D from the file's std and correlation triples; an error
+    // written without a std (fixed by the least-squares subset) keeps its
+    // statistics spread about the written value.
+    let n = m.errors.len();
+    let index = |x: &str| m.errors.iter().position(|e| e.name == x).unwrap();
+    let model = chain::core::compile(&m);
+    let check = |file: &std::path::Path| {
+        let out = ok_json(&[
+            "reliability",
+            machine.to_str().unwrap(),
+            "--values",
+            file.to_str().unwrap(),
+            "--format",
+            "json",
+        ]);
+        let posterior = Posterior::read(file, &m).unwrap();
+        posterior.inputs(&m).expect("a regular posterior");
+        let mu: Vec<f64> = m
+            .errors
+            .iter()
+            .map(|x| posterior.value(&x.name).unwrap().mean)
+            .collect();
+        let sd: Vec<f64> = m
+            .errors
+            .iter()
+            .enumerate()
+            .map(|(j, x)| {
+                posterior
+                    .value(&x.name)
+                    .unwrap()
+                    .std
+                    .unwrap_or_else(|| m.statistic(j).unwrap().distribution.std())
+            })
+            .collect();
+        let mut cov = DMatrix::from_fn(n, n, |i, j| if i == j { sd[i] * sd[i] } else { 0.0 });
+        for c in &posterior.correlations {
+            let (i, j) = (index(&c.a), index(&c.b));
+            cov[(i, j)] = c.rho * sd[i] * sd[j];
+            cov[(j, i)] = cov[(i, j)];
+        }
+        let results = out["results"].as_array().unwrap();
+        assert_eq!(results.len(), 3 * 125);
+        let mut s = vec![0.0; 6 * n];
+        for r in results {
+            let c = ["px", "py", "pz"]
+                .iter()
+                .position(|c| r["component"] == *c)
+                .unwrap();
+            let q: Vec<f64> = vars
+                .iter()
+                .map(|v| r["point"][*v].as_f64().unwrap())
+                .collect();
+            model.sensitivity(&q, &[], &mut s);
+            let a = nalgebra::DVector::from_column_slice(&s[c * n..(c + 1) * n]);
+            let mean: f64 = (0..n).map(|j| a[j] * mu[j]).sum();
+            let beta = (0.03 - mean) / (a.dot(&(&cov * &a))).sqrt();
+            let got = r["beta"].as_f64().unwrap();
+            assert!((got / beta - 1.0).abs() < 1e-9, "{r}: β {got} vs {beta}");
+        }
+    };
+    // Without a prior: the least-squares subset, the fixed errors written
+    // without a std (a comment says why) and no ±1 correlation.
     let ls = dir.join("ls.yaml");
     let json = identify_to(&ls, false);
     assert!(json["rank"].as_u64().unwrap() < m.errors.len() as u64);
-    let err = unwrapped(&fails(&[
-        "reliability",
-        machine.to_str().unwrap(),
-        "--values",
-        ls.to_str().unwrap(),
-    ]));
-    assert!(err.contains("--prior"), "{err}");
+    let text = std::fs::read_to_string(&ls).unwrap();
+    assert!(text.contains("fixed at their nominal value 0"), "{text}");
+    assert!(
+        !text.contains(", 1.0]") && !text.contains(", -1.0]"),
+        "{text}"
+    );
+    check(&ls);
 
     let post = dir.join("post.yaml");
     let json = identify_to(&post, true);
     assert_eq!(json["prior"].as_bool(), Some(true));
-    let out = ok_json(&[
-        "reliability",
-        machine.to_str().unwrap(),
-        "--values",
-        post.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
-    let posterior = Posterior::read(&post, &m).unwrap();
-    posterior.inputs(&m).expect("full rank with the prior");
-    // Each case's β is the closed form of the correlated normal posterior:
-    // g = t − a·e (upper-sided, t = 0.03 mm), β = (t − a·μ) / √(aᵀ Σ a),
-    // Σ = D R D from the file's std and correlation triples.
-    let n = m.errors.len();
-    let index = |x: &str| m.errors.iter().position(|e| e.name == x).unwrap();
-    let mu: Vec<f64> = m
-        .errors
-        .iter()
-        .map(|x| posterior.value(&x.name).unwrap().mean)
-        .collect();
-    let sd: Vec<f64> = m
-        .errors
-        .iter()
-        .map(|x| posterior.value(&x.name).unwrap().std.unwrap())
-        .collect();
-    let mut cov = DMatrix::from_fn(n, n, |i, j| if i == j { sd[i] * sd[i] } else { 0.0 });
-    for c in &posterior.correlations {
-        let (i, j) = (index(&c.a), index(&c.b));
-        cov[(i, j)] = c.rho * sd[i] * sd[j];
-        cov[(j, i)] = cov[(i, j)];
-    }
-    let model = chain::core::compile(&m);
-    let results = out["results"].as_array().unwrap();
-    assert_eq!(results.len(), 3 * 125);
-    let mut s = vec![0.0; 6 * n];
-    for r in results {
-        let c = ["px", "py", "pz"]
-            .iter()
-            .position(|c| r["component"] == *c)
-            .unwrap();
-        let q: Vec<f64> = vars
-            .iter()
-            .map(|v| r["point"][*v].as_f64().unwrap())
-            .collect();
-        model.sensitivity(&q, &[], &mut s);
-        let a = nalgebra::DVector::from_column_slice(&s[c * n..(c + 1) * n]);
-        let mean: f64 = (0..n).map(|j| a[j] * mu[j]).sum();
-        let beta = (0.03 - mean) / (a.dot(&(&cov * &a))).sqrt();
-        let got = r["beta"].as_f64().unwrap();
-        assert!((got / beta - 1.0).abs() < 1e-9, "{r}: β {got} vs {beta}");
-    }
+    check(&post);
 }
 
 /// `--validate` (issue 33, point 3): the estimates' prediction at poses held
@@ -940,8 +1020,10 @@ fn held_out_poses_are_predicted_as_the_exact_product_predicts_them() {
         (v["measurements"].as_u64(), v["rows"].as_u64()),
         (Some(40), Some(120))
     );
+    // The prediction is that of the least-squares subset (the values
+    // `--values-out` writes).
     let x: Vec<f64> = (names.iter())
-        .map(|n| doc["estimates"][n]["value"].as_f64().unwrap())
+        .map(|n| doc["subset"]["estimates"][n]["value"].as_f64().unwrap())
         .collect();
     let exact = Exact::new(&m);
     let (mut before, mut after) = (Vec::new(), Vec::new());

@@ -162,19 +162,40 @@ fn identify(csv: &str, dir: &Path) -> (Value, PathBuf) {
     (json, out)
 }
 
-/// The estimates (value, std) of the JSON in `machine.errors` order.
+/// The least-squares subset's estimates (value, std) of the JSON in
+/// `machine.errors` order (a fixed error: its nominal 0 and std 0).
 fn estimates(m: &Machine, json: &Value) -> (Vec<f64>, Vec<f64>) {
-    let est = &json["estimates"];
+    let est = &json["subset"]["estimates"];
     m.errors
         .iter()
         .map(|e| {
             let x = &est[e.name.as_str()];
             (
                 x["value"].as_f64().expect("value"),
-                x["std"].as_f64().expect("std"),
+                x["std"].as_f64().unwrap_or(0.0),
             )
         })
         .unzip()
+}
+
+/// Each estimated error's combination of the truth (issue 34): `e_k + Σ_j
+/// c_jk e_j` over the fixed errors' relations of the JSON; a fixed error's
+/// entry is its nominal 0.
+fn combinations(m: &Machine, json: &Value, e: &[f64]) -> Vec<f64> {
+    let sub = &json["subset"];
+    let mut t = vec![0.0; m.errors.len()];
+    for name in sub["estimated"].as_array().expect("estimated") {
+        let k = m.error_index(name.as_str().unwrap()).unwrap();
+        t[k] = e[k];
+    }
+    for f in sub["fixed"].as_array().expect("fixed") {
+        let j = m.error_index(f["error"].as_str().unwrap()).unwrap();
+        for (name, c) in f["relation"].as_object().expect("relation") {
+            let k = m.error_index(name).unwrap();
+            t[k] += c.as_f64().unwrap() * e[j];
+        }
+    }
+    t
 }
 
 /// The null-space basis of the JSON, vectors in `machine.errors` order.
@@ -195,7 +216,9 @@ fn null_space(m: &Machine, json: &Value) -> Vec<Vec<f64>> {
 
 /// The covariance of the `--values-out` file (its `std` and its
 /// `correlation` list of `[NAME, NAME, ρ]`), in `machine.errors` order; also
-/// checks that its values are the JSON's estimates.
+/// checks that its values are the JSON's subset estimates. An error written
+/// without a std is one the subset fixed: its value is 0 and it counts with
+/// variance 0 (what the estimates stand for carries it).
 fn covariance(m: &Machine, file: &Path, value: &[f64]) -> Vec<Vec<f64>> {
     let values = Values::read(file, m).expect("the written values file reads back");
     let mut order = Vec::new();
@@ -215,6 +238,14 @@ fn covariance(m: &Machine, file: &Path, value: &[f64]) -> Vec<Vec<f64>> {
                 );
                 order.push(j);
                 std.push(s);
+            }
+            Given::Constant {
+                value: v,
+                std: None,
+            } => {
+                assert!(v == 0.0 && value[j] == 0.0, "{}: {v}", entry.name);
+                order.push(j);
+                std.push(0.0);
             }
             ref other => panic!("{}: {other:?}", entry.name),
         }
@@ -253,116 +284,67 @@ fn covariance(m: &Machine, file: &Path, value: &[f64]) -> Vec<Vec<f64>> {
     c
 }
 
-/// `I − N Nᵀ`: the projector off the null space.
-fn projector(n: usize, null: &[Vec<f64>]) -> Vec<Vec<f64>> {
-    let mut p = vec![vec![0.0; n]; n];
-    for i in 0..n {
-        for j in 0..n {
-            p[i][j] = f64::from(u8::from(i == j)) - null.iter().map(|v| v[i] * v[j]).sum::<f64>();
-        }
-    }
-    p
-}
-
-/// Recovery: `P (estimate − truth)` against `P C Pᵀ`, component by component,
-/// 4 std. The minimum-norm estimate's mean differs from the truth by a null
-/// vector only (it solves the same normal equations), which `P` removes.
-/// Returns the number of errors outside every aliased group (recovered
-/// individually) and the largest ratio.
+/// Recovery of the least-squares subset (issue 34): each estimated error
+/// is unbiased for its combination of the truth ([`combinations`]), within
+/// 4 std of it, and all together `χ² = δᵀ C⁻¹ δ` over the estimated ones
+/// (`C` the file's covariance) is χ²(rank) distributed, refused beyond
+/// rank + 5·√(2 rank) (p < 1e-4). Returns the number of errors outside
+/// every aliased group of the null space (each its own combination:
+/// recovered individually) and the largest ratio.
 fn check_recovery(m: &Machine, json: &Value, file: &Path, e: &[f64]) -> (usize, f64) {
     let n = m.errors.len();
     let (value, std) = estimates(m, json);
     let null = null_space(m, json);
     let c = covariance(m, file, &value);
-    for j in 0..n {
+    let truth = combinations(m, json, e);
+    let kept: Vec<usize> = (0..n).filter(|&j| std[j] > 0.0).collect();
+    let rank = json["rank"].as_u64().expect("rank") as usize;
+    assert_eq!(kept.len(), rank);
+    let mut individual = 0;
+    let mut worst = 0.0f64;
+    for &j in &kept {
         assert!(
-            (c[j][j].sqrt() - std[j]).abs() <= 1e-9 * std[j].max(1e-30),
+            (c[j][j].sqrt() - std[j]).abs() <= 1e-9 * std[j],
             "{}: std {} in the file, {} in the JSON",
             m.errors[j].name,
             c[j][j].sqrt(),
             std[j]
         );
-    }
-    let p = projector(n, &null);
-    let delta: Vec<f64> = (0..n).map(|j| value[j] - e[j]).collect();
-    let pd: Vec<f64> = (0..n)
-        .map(|i| (0..n).map(|k| p[i][k] * delta[k]).sum())
-        .collect();
-    let pc: Vec<Vec<f64>> = (0..n)
-        .map(|i| {
-            (0..n)
-                .map(|k| (0..n).map(|l| p[i][l] * c[l][k]).sum())
-                .collect()
-        })
-        .collect();
-    let mut individual = 0;
-    let mut worst = 0.0f64;
-    for j in 0..n {
-        let var: f64 = (0..n).map(|k| pc[j][k] * p[j][k]).sum();
-        let sd = var.max(0.0).sqrt();
-        let alone = null.iter().all(|v| v[j] == 0.0);
-        if alone {
+        if null.iter().all(|v| v[j] == 0.0) {
             individual += 1;
             assert!(
-                (value[j] - e[j]).abs() <= 4.0 * std[j],
-                "{}: estimate {} truth {} std {}",
-                m.errors[j].name,
-                value[j],
-                e[j],
-                std[j]
+                (truth[j] - e[j]).abs() <= 1e-9 * e[j].abs(),
+                "{}",
+                m.errors[j].name
             );
         }
-        // Floor: the rounding of the null vectors times the size of the
-        // errors (1e-3 mm, 1e-5 rad) for a component the projector zeroes.
-        let floor = 1e-12;
+        let ratio = (value[j] - truth[j]).abs() / std[j];
         assert!(
-            pd[j].abs() <= 4.0 * sd + floor,
-            "{}: projected estimate − truth {} against std {sd}",
+            ratio <= 4.0,
+            "{}: estimate {} combination of the truth {} std {}",
             m.errors[j].name,
-            pd[j]
+            value[j],
+            truth[j],
+            std[j]
         );
-        if sd > 0.0 {
-            worst = worst.max(pd[j].abs() / sd);
-        }
+        worst = worst.max(ratio);
     }
-    // All together: `χ² = (Pδ)ᵀ (P C P)⁺ (Pδ)` over the `rank` identifiable
-    // directions is χ²(rank) distributed; refused beyond rank + 5·√(2 rank)
-    // (far in the tail: p < 1e-4). Columns scaled by their std first (mm
-    // against rad); errors with std 0 (wholly in the null space) left out.
-    let rank = json["rank"].as_u64().expect("rank") as usize;
-    let keep: Vec<usize> = (0..n).filter(|&j| pc[j][j] > 0.0).collect();
-    let scale: Vec<f64> = keep
-        .iter()
-        .map(|&j| (0..n).map(|k| pc[j][k] * p[j][k]).sum::<f64>().sqrt())
-        .collect();
-    let k = keep.len();
+    // χ² over the estimated ones, columns scaled by their std first (mm
+    // against rad).
+    let k = kept.len();
     let q = DMatrix::from_fn(k, k, |a, b| {
-        let (i, j) = (keep[a], keep[b]);
-        let v: f64 = (0..n).map(|l| pc[i][l] * p[j][l]).sum();
-        v / (scale[a] * scale[b])
+        let (i, j) = (kept[a], kept[b]);
+        c[i][j] / (std[i] * std[j])
     });
-    let x = DVector::from_fn(k, |a, _| pd[keep[a]] / scale[a]);
+    let x = DVector::from_fn(k, |a, _| (value[kept[a]] - truth[kept[a]]) / std[kept[a]]);
     let eig = SymmetricEigen::new(q);
-    let mut order: Vec<usize> = (0..k).collect();
-    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
-    if k > rank {
-        let (last, next) = (
-            eig.eigenvalues[order[rank - 1]],
-            eig.eigenvalues[order[rank]],
-        );
-        assert!(
-            next.abs() < 1e-6 * last,
-            "the projected covariance has rank > {rank}: {last} then {next}"
-        );
-    }
-    let chi2: f64 = order[..rank]
-        .iter()
-        .map(|&i| eig.eigenvectors.column(i).dot(&x).powi(2) / eig.eigenvalues[i])
+    let chi2: f64 = (0..k)
+        .map(|i| eig.eigenvectors.column(i).dot(&x).powi(2) / eig.eigenvalues[i])
         .sum();
     let r = rank as f64;
     assert!(
         chi2 < r + 5.0 * (2.0 * r).sqrt(),
-        "chi² of the identifiable part {chi2} for {rank} degrees of freedom"
+        "chi² of the estimates {chi2} for {rank} degrees of freedom"
     );
     (individual, worst)
 }

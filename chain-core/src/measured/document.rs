@@ -8,8 +8,9 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use super::identify::{Estimate, Prior, Residual};
+use super::identify::{Estimate, IdentifyOptions, NoiseRule, Prior, Residual};
 use super::predict::{predict, Prediction};
+use super::subset::{ChosenBy, FixedStatus, Subset, TERM_CUTOFF};
 use super::{identify, Design, DesignError, Identification, IdentifyError, Measurements};
 use crate::model::Machine;
 use crate::named::NameMap;
@@ -96,9 +97,181 @@ pub struct IdentifyDocument {
     pub largest_residuals: Vec<ResidualDoc>,
     /// How many of them are flagged as likely outliers.
     pub outliers: usize,
+    /// How the rank was decided (the noise rule or a fixed tolerance).
+    pub noise: NoiseRule,
+    /// The estimated subset, its least-squares solution and the fixed
+    /// unknowns' relations (absent with `--prior`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subset: Option<SubsetDoc>,
     /// The prediction at held-out measurements (`--validate`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub validation: Option<Validation>,
+}
+
+/// The estimated subset in the document (`docs/identify.md`, "What is
+/// estimated and what is fixed").
+#[derive(Debug, Clone, Serialize)]
+pub struct SubsetDoc {
+    /// How the subset was chosen, in words.
+    pub method: &'static str,
+    /// `elimination`, `fix` or `estimate`.
+    pub chosen_by: ChosenBy,
+    /// Relation weights (equilibrated) below this are left out of `words`
+    /// and `combinations`.
+    pub term_cutoff: f64,
+    /// The estimated unknowns.
+    pub estimated: Vec<String>,
+    /// The least-squares estimates of every unknown, the fixed ones at 0
+    /// with `std` null.
+    pub estimates: NameMap<String, Estimate>,
+    /// The fixed unknowns.
+    pub fixed: Vec<FixedDoc>,
+    /// For each estimated unknown that carries fixed ones: the combination
+    /// its estimate stands for, `{name: weight}` (itself with weight 1).
+    pub combinations: NameMap<String, NameMap<String, f64>>,
+    /// Root mean square of `b − A x` of this solution.
+    pub rms: f64,
+}
+
+/// A fixed unknown in the document.
+#[derive(Debug, Clone, Serialize)]
+pub struct FixedDoc {
+    /// Its name.
+    pub error: String,
+    /// `unseen`, `redundant`, `weak` or `fixed`.
+    pub status: FixedStatus,
+    /// Its design column as a combination of the estimated ones' (in the
+    /// unknowns' own units), every weight whose equilibrated share is
+    /// above the round-off [`ROUND_OFF`].
+    pub relation: NameMap<String, f64>,
+    /// The part of its effect the estimated ones do not carry (relative).
+    pub residual: f64,
+    /// The relation in words (weights below the cutoff left out).
+    pub words: String,
+}
+
+/// Relation weights whose equilibrated share is below this are round-off
+/// and left out of the JSON's `relation`.
+pub const ROUND_OFF: f64 = 1e-12;
+
+/// `c·NAME` in a sum: the sign as an operator unless first, a weight of ±1
+/// left out, 4 significant digits otherwise.
+fn term(c: f64, name: &str, first: bool) -> String {
+    let sign = if c < 0.0 {
+        if first {
+            "−"
+        } else {
+            " − "
+        }
+    } else if first {
+        ""
+    } else {
+        " + "
+    };
+    let a = c.abs();
+    if (a - 1.0).abs() < 1e-9 {
+        format!("{sign}{name}")
+    } else {
+        format!("{sign}{}·{name}", significant(a))
+    }
+}
+
+/// `v` to 4 significant digits, without trailing zeros.
+fn significant(v: f64) -> String {
+    if (1e-3..1e5).contains(&v) {
+        let digits = (3 - v.log10().floor() as i32).max(0) as usize;
+        let t = format!("{v:.digits$}");
+        if t.contains('.') {
+            t.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            t
+        }
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
+impl SubsetDoc {
+    /// The document of `s` over the unknowns `names`.
+    pub fn new(s: &Subset, names: &[String]) -> SubsetDoc {
+        let fixed: Vec<FixedDoc> = s
+            .fixed
+            .iter()
+            .map(|f| {
+                let terms: Vec<(usize, f64)> = (f.relation.iter().zip(&f.shares))
+                    .filter(|(_, share)| share.abs() >= TERM_CUTOFF)
+                    .map(|(&(k, c), _)| (k, c))
+                    .collect();
+                let sum: String = (terms.iter().enumerate())
+                    .map(|(i, &(k, c))| term(c, &names[k], i == 0))
+                    .collect();
+                let words = match f.status {
+                    FixedStatus::Unseen => {
+                        format!("{} has no effect on these measurements", names[f.index])
+                    }
+                    _ if terms.is_empty() => format!(
+                        "{} acts on these measurements independently of the estimated parameters",
+                        names[f.index]
+                    ),
+                    FixedStatus::Redundant => format!("{} acts as {sum}", names[f.index]),
+                    FixedStatus::Weak | FixedStatus::Fixed => format!(
+                        "{} acts almost as {sum} (its own part: {} of its effect)",
+                        names[f.index],
+                        significant(f.residual)
+                    ),
+                };
+                FixedDoc {
+                    error: names[f.index].clone(),
+                    status: f.status,
+                    relation: (f.relation.iter().zip(&f.shares))
+                        .filter(|(_, share)| share.abs() >= ROUND_OFF)
+                        .map(|(&(k, c), _)| (names[k].clone(), c))
+                        .collect(),
+                    residual: f.residual,
+                    words,
+                }
+            })
+            .collect();
+        let combinations = s
+            .estimated
+            .iter()
+            .filter_map(|&k| {
+                let carried: Vec<(String, f64)> = (s.fixed.iter())
+                    .filter_map(|f| {
+                        let at = f.relation.iter().position(|&(i, _)| i == k)?;
+                        (f.shares[at].abs() >= TERM_CUTOFF)
+                            .then(|| (names[f.index].clone(), f.relation[at].1))
+                    })
+                    .collect();
+                (!carried.is_empty()).then(|| {
+                    let mut all = vec![(names[k].clone(), 1.0)];
+                    all.extend(carried);
+                    (names[k].clone(), NameMap(all))
+                })
+            })
+            .collect();
+        SubsetDoc {
+            method: "column-pivoted QR (largest remaining column norm) of the weighted design, columns scaled to unit norm, truncated to the directions the data determine; least squares on the chosen columns with the others at 0",
+            chosen_by: s.chosen_by,
+            term_cutoff: TERM_CUTOFF,
+            estimated: s.estimated.iter().map(|&k| names[k].clone()).collect(),
+            estimates: names.iter().cloned().zip(s.estimates.iter().copied()).collect(),
+            fixed,
+            combinations,
+            rms: s.rms,
+        }
+    }
+
+    /// The combination the estimate of `name` stands for, in words
+    /// (`DZ2 + DZ3 + DZ4`), when it carries fixed unknowns.
+    pub fn combination_words(&self, name: &str) -> Option<String> {
+        let (_, terms) = self.combinations.0.iter().find(|(n, _)| n == name)?;
+        Some(
+            (terms.0.iter().enumerate())
+                .map(|(i, (n, c))| term(*c, n, i == 0))
+                .collect(),
+        )
+    }
 }
 
 /// The prediction of the estimates at measurements not used in the fit
@@ -120,6 +293,7 @@ pub fn identify_document(
     machine: &Machine,
     measurements: &Measurements,
     prior: bool,
+    options: &IdentifyOptions,
     validation: Option<&Measurements>,
 ) -> Result<(IdentifyDocument, Identification), DocumentError> {
     let model = crate::compile(machine);
@@ -138,7 +312,7 @@ pub fn identify_document(
     } else {
         None
     };
-    let result = identify(&design, prior.as_ref())?;
+    let result = identify(&design, prior.as_ref(), options)?;
     let mut doc =
         IdentifyDocument::new(machine, &measurements.file, measurements, &design, &result);
     doc.validation = held_out.map(|(v, d)| Validation {
@@ -196,6 +370,8 @@ impl IdentifyDocument {
                 })
                 .collect(),
             outliers: r.outliers,
+            noise: r.noise,
+            subset: r.subset.as_ref().map(|s| SubsetDoc::new(s, &r.errors)),
             validation: None,
         }
     }
@@ -283,7 +459,10 @@ fn explain(design: &Design, r: &Identification, members: &[usize], vectors: usiz
 /// The estimates as a values file (spec section 2, plus `std` per constant
 /// and the `correlation` list, one `[NAME, NAME, ρ]` per pair with ρ ≠ 0:
 /// the form `chain reliability --values` reads, docs/posterior.md);
-/// `source` names the measurement file in its first comment.
+/// `source` names the measurement file in its first comment. Without a
+/// prior the values are the subset's least-squares solution: a fixed
+/// unknown is written as its nominal value 0 without a `std` (a reader
+/// keeps its `statistics` spread), with a comment saying why it is fixed.
 pub fn values_file(m: &Machine, source: &str, r: &Identification) -> String {
     let mut s = String::new();
     let _ = writeln!(
@@ -299,17 +478,39 @@ pub fn values_file(m: &Machine, source: &str, r: &Identification) -> String {
             ""
         }
     );
-    if !r.unidentifiable.is_empty() && !r.prior {
-        let _ = writeln!(
-            s,
-            "# rank deficient: the values are the minimum-norm solution; see `chain identify` for what cannot be separated"
-        );
-    }
+    let estimates: Vec<Estimate> = match &r.subset {
+        Some(sub) => {
+            let doc = SubsetDoc::new(sub, &r.errors);
+            if !doc.fixed.is_empty() {
+                let _ = writeln!(
+                    s,
+                    "# least squares on {} of {} unknowns; fixed at their nominal value 0 (no std: the statistics spread is kept):",
+                    doc.estimated.len(),
+                    r.parameters
+                );
+                for f in &doc.fixed {
+                    let _ = writeln!(s, "#   {} ({}): {}", f.error, f.status.words(), f.words);
+                }
+                for name in &doc.estimated {
+                    if let Some(w) = doc.combination_words(name) {
+                        let _ = writeln!(s, "# {name} stands for {w}");
+                    }
+                }
+            }
+            sub.estimates.clone()
+        }
+        None => r.estimates.0.iter().map(|(_, e)| *e).collect(),
+    };
+    let (_, covariance) = r.solution();
     let _ = writeln!(s, "machine: {}", m.name);
     let _ = writeln!(s, "units: {{linear: mm, angular: rad}}");
     let _ = writeln!(s, "values:");
-    let all_std = r.estimates.0.iter().all(|(_, e)| e.std.is_some());
-    for (name, e) in &r.estimates.0 {
+    let fixed = |j: usize| {
+        r.subset
+            .as_ref()
+            .is_some_and(|sub| !sub.estimated.contains(&j))
+    };
+    for (name, e) in r.errors.iter().zip(&estimates) {
         match e.std {
             Some(std) => {
                 let _ = writeln!(s, "  {name}: {{value: {:?}, std: {:?}}}", e.value, std);
@@ -319,16 +520,15 @@ pub fn values_file(m: &Machine, source: &str, r: &Identification) -> String {
             }
         }
     }
+    let all_std = (0..r.parameters).all(|j| fixed(j) || estimates[j].std.is_some());
     if all_std {
         let n = r.parameters;
-        let sd: Vec<f64> = (0..n)
-            .map(|j| r.covariance[(j, j)].max(0.0).sqrt())
-            .collect();
+        let sd: Vec<f64> = (0..n).map(|j| covariance[(j, j)].max(0.0).sqrt()).collect();
         let mut pairs = Vec::new();
         for i in 0..n {
             for j in i + 1..n {
-                if sd[i] > 0.0 && sd[j] > 0.0 {
-                    let rho = (r.covariance[(i, j)] / (sd[i] * sd[j])).clamp(-1.0, 1.0);
+                if sd[i] > 0.0 && sd[j] > 0.0 && !fixed(i) && !fixed(j) {
+                    let rho = (covariance[(i, j)] / (sd[i] * sd[j])).clamp(-1.0, 1.0);
                     if rho != 0.0 {
                         pairs.push((i, j, rho));
                     }

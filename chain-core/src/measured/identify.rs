@@ -41,6 +41,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
 use super::measurements::Design;
+use super::subset::{self, Problem, Subset, SubsetChoice};
 use crate::model::Machine;
 use crate::named::NameMap;
 
@@ -61,10 +62,41 @@ pub const OUTLIER_LIMIT: f64 = 3.0;
 pub const LARGEST_RESIDUALS: usize = 10;
 
 /// Options of [`identify`].
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct IdentifyOptions {
-    /// Use the machine's `statistics` as a Gaussian prior.
-    pub prior: bool,
+    /// `--rank-tol`: count the singular values above this fraction of the
+    /// largest as determined (a manual override of the noise rule; in
+    /// `(0, 1)`). `None`: [`RANK_TOLERANCE`] for the structural rank, then
+    /// the noise rule ([`noise_rank`]).
+    pub rank_tol: Option<f64>,
+    /// Which unknowns are estimated (`--fix`, `--estimate`).
+    pub subset: SubsetChoice,
+}
+
+/// How the count of determined directions (the reported rank) was decided.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct NoiseRule {
+    /// `deviation` (the noise rule) or `rank-tol` (a fixed tolerance:
+    /// `--rank-tol`, or with `--prior`, or without a residual degree of
+    /// freedom to measure the noise with).
+    pub rule: &'static str,
+    /// The relative tolerance on the singular values that gave the
+    /// structural rank.
+    pub tolerance: f64,
+    /// The count of singular values above it.
+    pub structural_rank: usize,
+    /// The noise `σ̂` in units of the rows' stated std (1 without a `std`
+    /// column: then in the measurement units), from the residual outside
+    /// the structural rank.
+    pub noise: Option<f64>,
+    /// `‖y‖`: the whole measured deviation, in the same units.
+    pub deviation: f64,
+    /// The singular-value threshold `σ̂ √r₀ / ‖y‖` of the noise rule (for
+    /// unit-norm columns, like the singular values).
+    pub threshold: Option<f64>,
+    /// The directions left out as weakly determined (structural rank less
+    /// the rank).
+    pub weak: usize,
 }
 
 /// The Gaussian prior of the unknowns, in the design's error order.
@@ -144,6 +176,45 @@ pub enum IdentifyError {
         /// The rank.
         rank: usize,
     },
+    /// `--fix`/`--estimate` name an unknown that is not one, twice, or a
+    /// set the measurements cannot separate.
+    #[error("{option}: {message}")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(
+            code(chain::identify::subset),
+            help("--fix and --estimate take error parameter names separated by commas; `chain identify` without them shows which parameters the measurements can separate")
+        )
+    )]
+    Subset {
+        /// The option.
+        option: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// `--fix`/`--estimate` with `--prior`.
+    #[error("{option} chooses the parameters of a least-squares fit; with --prior every parameter is estimated from the data and its statistics")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(
+            code(chain::identify::subset_with_prior),
+            help("leave out --prior, or the subset option")
+        )
+    )]
+    SubsetWithPrior {
+        /// The option.
+        option: &'static str,
+    },
+    /// `--rank-tol` outside `(0, 1)`.
+    #[error("--rank-tol: {0} is not a relative tolerance in (0, 1)")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(
+            code(chain::identify::rank_tol),
+            help("e.g. --rank-tol 1e-6 (singular values of the equilibrated design below 1e-6 × the largest count as zero)")
+        )
+    )]
+    RankTolerance(f64),
     /// A non-finite value in the design (a pose where the model is not
     /// finite).
     #[error("the design matrix or the measured values are not finite")]
@@ -259,13 +330,109 @@ pub struct Identification {
     pub largest_residuals: Vec<Standardised>,
     /// How many standardised residuals exceed [`OUTLIER_LIMIT`].
     pub outliers: usize,
+    /// How the rank was decided.
+    pub noise: NoiseRule,
+    /// The estimated subset and its least-squares solution (`None` with a
+    /// prior; in the document as `subset`).
+    #[serde(skip)]
+    pub subset: Option<Subset>,
+}
+
+impl Identification {
+    /// The values and covariance a calibration uses: the subset's
+    /// least-squares solution, or with a prior the posterior.
+    pub fn solution(&self) -> (Vec<f64>, &DMatrix<f64>) {
+        match &self.subset {
+            Some(s) => (s.values(), &s.covariance),
+            None => (
+                self.estimates.0.iter().map(|(_, e)| e.value).collect(),
+                &self.covariance,
+            ),
+        }
+    }
+}
+
+/// Data coordinates along a direction at least this many standard
+/// deviations from zero count as determined, however weak the direction
+/// ([`noise_rule`]).
+pub const SIGNIFICANT: f64 = 5.0;
+
+/// The noise rule (issue 33, point 1): which of the structural directions
+/// of the equilibrated weighted design (singular values `s`, largest first;
+/// `c_i = u_iᵀ y` the data's coordinate along each) the data do not
+/// determine beyond their noise.
+///
+/// The noise is `σ̂ = √(RSS_⊥ / (m − r₀))`, from the residual outside the
+/// `r₀ = s.len()` structural directions (in the rows' weighted units: the
+/// stated std's with a `std` column, the measurement units without). Along
+/// the `i`-th direction the estimate's standard deviation, as an effect on
+/// the measurements (the norm over the rows of what the errors along it do
+/// alone, each error's column scaled to unit norm), is `σ̂ / s_i`, and the
+/// estimate is `c_i / s_i`. A direction is **weakly determined** when
+///
+/// - its standard deviation exceeds a direction's share of the measured
+///   deviation, `σ̂ / s_i > ‖y‖ / √r₀`: one standard deviation of noise
+///   alone would give the errors along it effects larger than each of the
+///   `r₀` directions would carry if the whole deviation `‖y‖` the machine
+///   shows were spread evenly over them (a Tikhonov filter factor below
+///   1/2 for the spread `τ = ‖y‖/√r₀` of the equilibrated errors); and
+/// - its estimate is within [`SIGNIFICANT`] standard deviations of zero,
+///   `|c_i| < 5 σ̂`: the data do not show it either.
+///
+/// Such a direction's estimate says nothing about the machine; it is left
+/// out (the errors it moves are fixed, [`super::subset`]). Returns the weak
+/// flags and `σ̂`; `None` when there is no residual degree of freedom
+/// (`m ≤ r₀`), no noise (`RSS_⊥ = 0`) or no deviation: then every
+/// structural direction counts.
+pub fn noise_rule(
+    s: &[f64],
+    c: &[f64],
+    rss_perp: f64,
+    m: usize,
+    deviation: f64,
+) -> Option<(Vec<bool>, f64)> {
+    let r0 = s.len();
+    let positive = |v: f64| v > 0.0 && v.is_finite();
+    if r0 == 0 || m <= r0 || !positive(rss_perp) || !positive(deviation) {
+        return None;
+    }
+    let sigma = (rss_perp / (m - r0) as f64).sqrt();
+    let share = deviation / (r0 as f64).sqrt();
+    let weak = s
+        .iter()
+        .zip(c)
+        .map(|(&si, &ci)| si * share < sigma && ci.abs() < SIGNIFICANT * sigma)
+        .collect();
+    Some((weak, sigma))
 }
 
 /// Identifies the unknowns of `design` (spec section 4): the minimum-norm
 /// weighted least-squares estimate, or with `prior` the posterior mean and
-/// covariance. See the module's formulas.
-pub fn identify(design: &Design, prior: Option<&Prior>) -> Result<Identification, IdentifyError> {
+/// covariance. See the module's formulas; `options` set the rank rule and
+/// the estimated subset ([`subset`]).
+pub fn identify(
+    design: &Design,
+    prior: Option<&Prior>,
+    options: &IdentifyOptions,
+) -> Result<Identification, IdentifyError> {
     let (m, n) = design.a.shape();
+    if let Some(t) = options.rank_tol {
+        if !(t > 0.0 && t < 1.0) {
+            return Err(IdentifyError::RankTolerance(t));
+        }
+    }
+    if prior.is_some() {
+        match &options.subset {
+            SubsetChoice::Elimination => {}
+            SubsetChoice::Fix(_) => return Err(IdentifyError::SubsetWithPrior { option: "--fix" }),
+            SubsetChoice::Estimate(_) => {
+                return Err(IdentifyError::SubsetWithPrior {
+                    option: "--estimate",
+                })
+            }
+        }
+    }
+    let tolerance = options.rank_tol.unwrap_or(RANK_TOLERANCE);
     if m == 0 && prior.is_none() {
         return Err(IdentifyError::NoRows);
     }
@@ -303,19 +470,77 @@ pub fn identify(design: &Design, prior: Option<&Prior>) -> Result<Identification
         d,
         lambda,
         vectors: v,
-        rank,
-    } = spectrum(&info);
+        rank: structural,
+    } = spectrum_with(&info, tolerance);
     let s_max = lambda.first().copied().unwrap_or(0.0).max(0.0).sqrt();
     let singular: Vec<f64> = lambda.iter().map(|l| l.max(0.0).sqrt()).collect();
+    // The data's coordinates along the structural directions, c_i = u_iᵀ y
+    // = v_iᵀ D g / s_i, and the residual outside them.
+    let dg0 = DVector::from_fn(n, |i, _| d[i] * g[i]);
+    let coords: Vec<f64> = (0..structural)
+        .map(|k| v.column(k).dot(&dg0) / singular[k])
+        .collect();
+    let rss_perp = y.norm_squared() - coords.iter().map(|c| c * c).sum::<f64>();
+    let deviation = y.norm();
+    let noisy = if options.rank_tol.is_none() && prior.is_none() {
+        noise_rule(
+            &singular[..structural],
+            &coords,
+            rss_perp.max(0.0),
+            m,
+            deviation,
+        )
+    } else {
+        None
+    };
+    let weak: Vec<bool> = match &noisy {
+        Some((w, _)) => w.clone(),
+        None => vec![false; structural],
+    };
+    // The determined directions first (largest first), then the weak ones,
+    // then those beyond the structural rank: every "leading `rank`" below
+    // is the determined set.
+    let order: Vec<usize> = (0..structural)
+        .filter(|&k| !weak[k])
+        .chain((0..structural).filter(|&k| weak[k]))
+        .chain(structural..n)
+        .collect();
+    let rank = structural - weak.iter().filter(|&&w| w).count();
+    let lambda: Vec<f64> = order.iter().map(|&k| lambda[k]).collect();
+    let v = DMatrix::from_fn(n, n, |i, c| v[(i, order[c])]);
+    let noise_rule = NoiseRule {
+        rule: if noisy.is_some() {
+            "deviation"
+        } else {
+            "rank-tol"
+        },
+        tolerance,
+        structural_rank: structural,
+        noise: noisy.as_ref().map(|(_, s)| *s),
+        deviation,
+        threshold: noisy
+            .as_ref()
+            .map(|(_, s)| s * (structural as f64).sqrt() / deviation),
+        weak: structural - rank,
+    };
     let condition = if rank > 0 {
-        s_max / singular[rank - 1]
+        s_max / lambda[rank - 1].max(0.0).sqrt()
     } else {
         f64::INFINITY
     };
-    // Null space in the unknowns' own coordinates: span(D V_null),
-    // orthonormalised.
-    let null_scaled = DMatrix::from_fn(n, n - rank, |i, k| d[i] * v[(i, rank + k)]);
-    let null = orthonormal(&null_scaled);
+    // What the data cannot tell, in the unknowns' own coordinates:
+    // span(D V_rest) over the weak and the structural null directions,
+    // orthonormalised (reported); the structural null space alone is what
+    // the minimum-norm solution is orthogonal to (a weak direction moves
+    // the prediction, so projecting along it would change the fit: it is
+    // left at zero in the equilibrated coordinates instead).
+    let basis_of = |from: usize| {
+        orthonormal(&DMatrix::from_fn(n, n - from, |i, k| {
+            d[i] * v[(i, from + k)]
+        }))
+    };
+    let unseen = basis_of(rank);
+    let null = basis_of(structural);
     let project = |x: &DVector<f64>| -> DVector<f64> {
         if null.ncols() == 0 {
             x.clone()
@@ -373,7 +598,7 @@ pub fn identify(design: &Design, prior: Option<&Prior>) -> Result<Identification
                     cov.column_mut(j).fill(0.0);
                 }
             }
-            (x, cov, null, noise)
+            (x, cov, unseen, noise)
         }
         Some(p) => {
             // The noise: the stated std, or s of the least-squares fit.
@@ -445,6 +670,33 @@ pub fn identify(design: &Design, prior: Option<&Prior>) -> Result<Identification
     largest.sort_by(|a, b| b.standardised.abs().total_cmp(&a.standardised.abs()));
     largest.truncate(LARGEST_RESIDUALS);
 
+    let subset = if prior.is_none() {
+        let problem = Problem {
+            a: &design.a,
+            b: &design.b,
+            inv_sigma: &inv_sigma,
+            weighted,
+            info: &info,
+            g: &g,
+            d: &d,
+            lambda: &lambda,
+            vectors: &v,
+            s_max,
+            tolerance,
+            names: &design.errors,
+        };
+        let (by, kept) = subset::choose(&problem, rank, structural, &options.subset)?;
+        // The elimination solves in the determined directions; a chosen
+        // subset in the structural ones (the choice is the user's).
+        let directions = if by == subset::ChosenBy::Elimination {
+            rank
+        } else {
+            structural
+        };
+        Some(subset::solve(&problem, by, &kept, directions))
+    } else {
+        None
+    };
     let (basis, groups) = grouped_basis(&unidentifiable_basis);
     let unidentifiable = (0..basis.ncols())
         .map(|k| {
@@ -489,6 +741,8 @@ pub fn identify(design: &Design, prior: Option<&Prior>) -> Result<Identification
         residuals,
         largest_residuals: largest,
         outliers,
+        noise: noise_rule,
+        subset,
     })
 }
 
@@ -568,6 +822,11 @@ pub(crate) struct Spectrum {
 /// its diagonal (a linear error in mm and an angular one in rad weigh
 /// alike), decomposed through nalgebra's SVD.
 pub(crate) fn spectrum(info: &DMatrix<f64>) -> Spectrum {
+    spectrum_with(info, RANK_TOLERANCE)
+}
+
+/// [`spectrum`] with the relative rank tolerance `tolerance`.
+pub(crate) fn spectrum_with(info: &DMatrix<f64>, tolerance: f64) -> Spectrum {
     let n = info.nrows();
     let d: Vec<f64> = (0..n)
         .map(|j| {
@@ -585,7 +844,7 @@ pub(crate) fn spectrum(info: &DMatrix<f64>) -> Spectrum {
     let rank = if s_max > 0.0 {
         lambda
             .iter()
-            .filter(|l| l.max(0.0).sqrt() > RANK_TOLERANCE * s_max)
+            .filter(|l| l.max(0.0).sqrt() > tolerance * s_max)
             .count()
     } else {
         0

@@ -15,10 +15,12 @@ pub mod measurements;
 pub mod positioning;
 pub mod positioning_values;
 pub mod predict;
+pub mod subset;
 
-pub use identify::{identify, Identification, IdentifyError, IdentifyOptions};
+pub use identify::{identify, Identification, IdentifyError, IdentifyOptions, NoiseRule};
 pub use measurements::{
     design_rows, Design, DesignError, Layout, Measurement, Measurements, MeasurementsError,
     Observed,
 };
 pub use predict::{predict, ErrorStats, Prediction};
+pub use subset::{ChosenBy, Fixed, FixedStatus, Subset, SubsetChoice};

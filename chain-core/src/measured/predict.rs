@@ -66,13 +66,7 @@ pub struct Prediction {
 /// other measurements of the same machine (its columns `r`'s unknowns, in
 /// the same order).
 pub fn predict(design: &Design, r: &Identification) -> Prediction {
-    let x: Vec<f64> = (r.errors.iter())
-        .map(|name| {
-            (r.estimates.0.iter())
-                .find(|(n, _)| n == name)
-                .map_or(0.0, |(_, e)| e.value)
-        })
-        .collect();
+    let (x, _) = r.solution();
     let after: Vec<f64> = (design.b.iter().enumerate())
         .map(|(i, b)| {
             let row = design.a.row(i);

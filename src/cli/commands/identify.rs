@@ -1,5 +1,6 @@
-//! `chain identify FILE --measurements M.csv [--prior] [--param NAME=VALUE]...
-//! [--format table|json] [--values-out VALUES.yaml]`.
+//! `chain identify FILE --measurements M.csv [--prior] [--validate M2.csv]
+//! [--rank-tol TOL] [--fix NAME,... | --estimate NAME,...]
+//! [--param NAME=VALUE]... [--format table|json] [--values-out VALUES.yaml]`.
 //!
 //! The error parameters of a built machine from measurements
 //! (measured-machines spec, section 4) through
@@ -11,7 +12,7 @@
 use std::path::PathBuf;
 
 use chain::ops::identify::{self, IdentifyRequest};
-use chain_core::measured::{Layout, Measurements};
+use chain_core::measured::{IdentifyOptions, Layout, Measurements, SubsetChoice};
 
 use crate::cli::args::ParamArgs;
 use crate::cli::loaded::Loaded;
@@ -47,6 +48,18 @@ pub struct IdentifyArgs {
     /// estimates' correction.
     #[arg(long, value_name = "M2.csv")]
     pub validate: Option<PathBuf>,
+    /// A fixed relative tolerance on the singular values of the
+    /// equilibrated design instead of the noise rule (directions above
+    /// TOL × the largest are estimated).
+    #[arg(long, value_name = "TOL")]
+    pub rank_tol: Option<f64>,
+    /// Fix these error parameters at 0 and estimate every other one
+    /// (instead of the elimination's choice).
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
+    pub fix: Option<Vec<String>>,
+    /// Estimate only these error parameters, every other one fixed at 0.
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
+    pub estimate: Option<Vec<String>>,
     #[command(flatten)]
     pub param: ParamArgs,
     /// Output format.
@@ -61,6 +74,7 @@ pub struct IdentifyArgs {
 
 /// Runs `chain identify` ([`chain::ops::identify`]).
 pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
+    let subset = SubsetChoice::from_options(args.fix, args.estimate)?;
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
     args.param.check_names(m)?;
@@ -81,6 +95,10 @@ pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
     };
     let request = IdentifyRequest {
         prior: args.prior,
+        options: IdentifyOptions {
+            rank_tol: args.rank_tol,
+            subset,
+        },
         validation: validation.as_ref(),
     };
     let run = identify::run(m, &measurements, &request)?;

@@ -49,10 +49,20 @@ fn table(d: &IdentifyDocument) -> String {
     );
     let _ = writeln!(
         s,
-        "{} unknowns, rank {}, condition {}{}",
+        "{} unknowns, rank {}, condition {}{}{}",
         d.parameters,
         d.rank,
         num(d.condition),
+        if d.noise.weak > 0 {
+            format!(
+                " ({} structurally; {} weakly determined direction{} left out by the noise rule)",
+                d.noise.structural_rank,
+                d.noise.weak,
+                if d.noise.weak == 1 { "" } else { "s" }
+            )
+        } else {
+            String::new()
+        },
         if d.prior {
             "; posterior with the statistics prior"
         } else {
@@ -68,26 +78,40 @@ fn table(d: &IdentifyDocument) -> String {
         .unwrap_or(5)
         .max(5);
     let _ = writeln!(s, "\n{:<width$}  {:>14}  {:>14}", "error", "value", "std");
-    for (name, e) in &d.estimates.0 {
-        let std = e.std.map_or("—".to_string(), num);
-        // Without a prior, an unknown in the null space has the
-        // minimum-norm value and the std of that solution only.
-        let note = if d.prior {
-            ""
-        } else {
-            match d
-                .unidentifiable
-                .iter()
-                .filter(|v| v.0.iter().any(|(n, _)| n == name))
-                .map(|v| v.0.len())
-                .min()
-            {
-                Some(1) => "  not seen by the data",
-                Some(_) => "  aliased (see below)",
-                None => "",
+    match &d.subset {
+        Some(sub) => {
+            for (name, e) in &sub.estimates.0 {
+                let std = e.std.map_or("—".to_string(), num);
+                let note = match sub.fixed.iter().find(|f| &f.error == name) {
+                    Some(f) => format!("  fixed, {}: {}", f.status.words(), f.words),
+                    None => match sub.combination_words(name) {
+                        Some(w) => format!("  estimated, stands for {w}"),
+                        None => "  estimated".to_string(),
+                    },
+                };
+                let _ = writeln!(s, "{name:<width$}  {:>14}  {std:>14}{note}", num(e.value));
             }
-        };
-        let _ = writeln!(s, "{name:<width$}  {:>14}  {std:>14}{note}", num(e.value));
+            if !sub.fixed.is_empty() {
+                let _ = writeln!(
+                    s,
+                    "(least squares on {} of {} with the fixed ones at 0{}; relation weights below {} of a parameter's effect left out; JSON `estimates`: the minimum-norm solution)",
+                    sub.estimated.len(),
+                    d.parameters,
+                    match sub.chosen_by {
+                        chain_core::measured::ChosenBy::Elimination => ", chosen by a column-pivoted QR",
+                        chain_core::measured::ChosenBy::Fix => ", as --fix chose",
+                        chain_core::measured::ChosenBy::Estimate => ", as --estimate chose",
+                    },
+                    sub.term_cutoff
+                );
+            }
+        }
+        None => {
+            for (name, e) in &d.estimates.0 {
+                let std = e.std.map_or("—".to_string(), num);
+                let _ = writeln!(s, "{name:<width$}  {:>14}  {std:>14}", num(e.value));
+            }
+        }
     }
     if !d.groups.is_empty() {
         let _ = writeln!(
@@ -96,15 +120,11 @@ fn table(d: &IdentifyDocument) -> String {
             if d.prior {
                 "not informed by the data:"
             } else {
-                "cannot be separated by these measurements (estimates above: the minimum-norm solution):"
+                "cannot be separated by these measurements (JSON `unidentifiable`: an orthonormal basis):"
             }
         );
         for g in &d.groups {
             let _ = writeln!(s, "  - {}", g.explanation);
-        }
-        for (k, v) in d.unidentifiable.iter().enumerate() {
-            let parts: Vec<String> = v.0.iter().map(|(n, c)| format!("{n}: {c:.5}")).collect();
-            let _ = writeln!(s, "  vector {}: {{{}}}", k + 1, parts.join(", "));
         }
     }
     let _ = writeln!(
