@@ -500,6 +500,7 @@ class Machine:
         rank_tol: Optional[float] = None,
         fix: Optional[Sequence[str]] = None,
         estimate: Optional[Sequence[str]] = None,
+        iterate: bool = False,
     ) -> "IdentifyResult":
         """The error parameters from measurements, ``chain identify --measurements M --format json``.
 
@@ -517,7 +518,9 @@ class Machine:
         fixed relative tolerance instead of the noise rule; ``fix`` /
         ``estimate`` (``--fix`` / ``--estimate``): the error parameters to
         fix at 0, or the only ones to estimate, instead of the
-        elimination's choice (the document's ``subset``).
+        elimination's choice (the document's ``subset``); ``iterate``
+        (``--iterate``): fit the exact kinematics from the linear estimate
+        (the document's ``iteration``).
         """
         from ._results import IdentifyResult
 
@@ -537,6 +540,7 @@ class Machine:
             None if rank_tol is None else float(rank_tol),
             None if fix is None else [str(n) for n in fix],
             None if estimate is None else [str(n) for n in estimate],
+            bool(iterate),
         )
         if values_out is not None:
             with open(os.fspath(values_out), "w", encoding="utf-8") as f:

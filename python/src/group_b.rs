@@ -78,7 +78,7 @@ pub(crate) fn read_values(
 /// held-out ones of `--validate`, if any, from `validate` (a path, or text
 /// and its name).
 #[pyfunction]
-#[pyo3(signature = (model, path, text, file, params, prior, validate=None, rank_tol=None, fix=None, estimate=None))]
+#[pyo3(signature = (model, path, text, file, params, prior, validate=None, rank_tol=None, fix=None, estimate=None, iterate=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_json(
     py: Python<'_>,
@@ -92,6 +92,7 @@ pub(crate) fn identify_json(
     rank_tol: Option<f64>,
     fix: Option<Vec<String>>,
     estimate: Option<Vec<String>>,
+    iterate: bool,
 ) -> PyResult<(String, String)> {
     let m = &model.machine;
     let subset =
@@ -113,6 +114,7 @@ pub(crate) fn identify_json(
     let request = IdentifyRequest {
         prior,
         options: IdentifyOptions { rank_tol, subset },
+        iterate,
         validation: validation.as_ref(),
     };
     let run = py

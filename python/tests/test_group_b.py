@@ -242,3 +242,14 @@ def test_identify_subset_options_are_the_cli_json(cli):
         m.identify(ball, fix=["EXX_9"])
     with pytest.raises(ValueError, match="--fix: cannot be given with --estimate"):
         m.identify(ball, fix=["EXX_0"], estimate=["EXY_0"])
+
+
+def test_identify_iterate_is_the_cli_json(cli):
+    """Machine.identify(iterate=True) equals `chain identify --iterate` (issue 33, point 2)."""
+    m = chain.Machine.load(PROBE)
+    ball = MEAS / "ballplate.csv"
+    r = m.identify(ball, iterate=True)
+    assert r.to_dict() == cli("identify", PROBE, "--measurements", ball, "--iterate")
+    assert r.iteration["converged"] and r.first_order["exceeds_noise"] is False
+    with pytest.raises(ValueError, match="--iterate fits the exact kinematics by least squares"):
+        m.identify(ball, iterate=True, prior=True)

@@ -20,6 +20,8 @@ pub struct IdentifyRequest<'a> {
     /// `--rank-tol`, `--fix`, `--estimate`: the rank rule and the
     /// estimated subset.
     pub options: IdentifyOptions,
+    /// `--iterate`: fit the exact kinematics from the linear estimate.
+    pub iterate: bool,
     /// `--validate`: measurements held out of the fit, where the estimates'
     /// prediction is reported.
     pub validation: Option<&'a Measurements>,
@@ -49,17 +51,18 @@ pub fn run(
     measurements: &Measurements,
     request: &IdentifyRequest<'_>,
 ) -> Result<IdentifyRun, DocumentError> {
-    let (document, result) = identify_document(
+    let identified = identify_document(
         machine,
         measurements,
         request.prior,
         &request.options,
+        request.iterate,
         request.validation,
     )?;
-    let values_text = values_file(machine, &measurements.file, &result);
+    let values_text = values_file(machine, &measurements.file, &identified);
     Ok(IdentifyRun {
-        document,
-        result,
+        document: identified.document,
+        result: identified.result,
         values_text,
     })
 }

@@ -32,6 +32,7 @@ mod generated_into;
 mod geometric_sensitivity;
 mod golden_outputs;
 mod identify;
+mod identify_iterate;
 mod identify_subset;
 mod inverse;
 mod inverse_pose;

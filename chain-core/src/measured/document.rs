@@ -9,7 +9,8 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use super::identify::{Estimate, IdentifyOptions, NoiseRule, Prior, Residual};
-use super::predict::{predict, Prediction};
+use super::iterate::{self, FirstOrderCheck, Iteration, ANGLE_LIMIT};
+use super::predict::{predict, predict_rows, Prediction};
 use super::subset::{ChosenBy, FixedStatus, Subset, TERM_CUTOFF};
 use super::{identify, Design, DesignError, Identification, IdentifyError, Measurements};
 use crate::model::Machine;
@@ -103,9 +104,116 @@ pub struct IdentifyDocument {
     /// unknowns' relations (absent with `--prior`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub subset: Option<SubsetDoc>,
+    /// The linear estimate against the exact kinematics at the measured
+    /// poses.
+    pub first_order: FirstOrderDoc,
+    /// `--iterate`: the fit on the exact kinematics.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub iteration: Option<IterationDoc>,
     /// The prediction at held-out measurements (`--validate`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub validation: Option<Validation>,
+}
+
+/// The first-order check in the document.
+#[derive(Debug, Clone, Serialize)]
+pub struct FirstOrderDoc {
+    /// `max |f_i(x̂) − a_i x̂|` (measurement units).
+    pub max: f64,
+    /// Its root mean square.
+    pub rms: f64,
+    /// The noise scale it is compared with (weighted units).
+    pub noise: Option<f64>,
+    /// Whether some row's difference exceeds the noise.
+    pub exceeds_noise: bool,
+    /// The angle limit of the flags (rad).
+    pub angle_limit: f64,
+    /// Angular errors beyond it at the measured poses: the largest angle.
+    pub large_angles: NameMap<String, f64>,
+    /// The same in words.
+    pub words: String,
+}
+
+impl FirstOrderDoc {
+    fn new(c: &FirstOrderCheck, iterated: bool) -> FirstOrderDoc {
+        let mut words = if c.exceeds_noise {
+            format!(
+                "the first-order model differs from the exact kinematics by up to {} at the measured poses, more than the noise{}",
+                significant(c.max),
+                if iterated { "" } else { ": identify with --iterate" }
+            )
+        } else {
+            format!(
+                "the first-order model is within the noise of the exact kinematics at the measured poses (differences up to {})",
+                significant(c.max)
+            )
+        };
+        if !c.large_angles.is_empty() {
+            let names: Vec<String> = (c.large_angles.iter())
+                .map(|(n, a)| format!("{n} ({} rad)", significant(*a)))
+                .collect();
+            let _ = write!(
+                words,
+                "; beyond the first-order range of {ANGLE_LIMIT} rad: {}",
+                and_list(&names)
+            );
+        }
+        FirstOrderDoc {
+            max: c.max,
+            rms: c.rms,
+            noise: c.noise,
+            exceeds_noise: c.exceeds_noise,
+            angle_limit: ANGLE_LIMIT,
+            large_angles: c.large_angles.iter().cloned().collect(),
+            words,
+        }
+    }
+}
+
+/// `--iterate` in the document.
+#[derive(Debug, Clone, Serialize)]
+pub struct IterationDoc {
+    /// `levenberg-marquardt`.
+    pub method: &'static str,
+    /// Iterations (Jacobian evaluations).
+    pub iterations: usize,
+    /// Whether it converged.
+    pub converged: bool,
+    /// The weighted sum of squares of the exact model at the linear
+    /// estimate, and at the solution.
+    pub rss_linear: f64,
+    /// At the solution.
+    pub rss: f64,
+    /// Root mean square of `b − f(x)` at the solution.
+    pub rms: f64,
+    /// The largest `|b − f(x)|` at the solution.
+    pub max: f64,
+    /// Every error's value and std at the solution (fixed ones 0, null).
+    pub estimates: NameMap<String, Estimate>,
+    /// The solution less the linear estimate, per estimated error.
+    pub change: NameMap<String, f64>,
+}
+
+impl IterationDoc {
+    fn new(it: &Iteration, names: &[String]) -> IterationDoc {
+        IterationDoc {
+            method: "levenberg-marquardt",
+            iterations: it.iterations,
+            converged: it.converged,
+            rss_linear: it.rss_linear,
+            rss: it.rss,
+            rms: it.rms,
+            max: it.max,
+            estimates: names
+                .iter()
+                .cloned()
+                .zip(it.estimates.iter().copied())
+                .collect(),
+            change: (it.estimated.iter())
+                .map(|&j| (names[j].clone(), it.change[j]))
+                .collect(),
+        }
+    }
 }
 
 /// The estimated subset in the document (`docs/identify.md`, "What is
@@ -285,17 +393,36 @@ pub struct Validation {
     pub prediction: Prediction,
 }
 
+/// What [`identify_document`] gives: the document, the typed
+/// identification, the first-order check and `--iterate`'s fit.
+#[derive(Debug, Clone)]
+pub struct Identified {
+    /// The document.
+    pub document: IdentifyDocument,
+    /// The identification.
+    pub result: Identification,
+    /// The first-order check.
+    pub check: FirstOrderCheck,
+    /// `--iterate`'s fit.
+    pub iteration: Option<Iteration>,
+}
+
 /// `chain identify`: the design of `measurements` through the machine's
 /// exact sensitivity, the weighted least-squares solve (or the posterior of
-/// the `statistics` prior when `prior`), and its document. Returns the
-/// typed identification too (for [`values_file`]).
+/// the `statistics` prior when `prior`), the first-order check against the
+/// exact kinematics, with `iterate` the fit on the exact kinematics, and
+/// the document.
 pub fn identify_document(
     machine: &Machine,
     measurements: &Measurements,
     prior: bool,
     options: &IdentifyOptions,
+    iterate: bool,
     validation: Option<&Measurements>,
-) -> Result<(IdentifyDocument, Identification), DocumentError> {
+) -> Result<Identified, DocumentError> {
+    if iterate && prior {
+        return Err(IdentifyError::IterateWithPrior.into());
+    }
     let model = crate::compile(machine);
     let design_of = |m: &Measurements| {
         Design::new(&model, machine, &m.rows).map_err(|source| DocumentError::Design {
@@ -313,24 +440,58 @@ pub fn identify_document(
         None
     };
     let result = identify(&design, prior.as_ref(), options)?;
-    let mut doc =
-        IdentifyDocument::new(machine, &measurements.file, measurements, &design, &result);
+    let (linear, _) = result.solution();
+    let check = iterate::check(machine, &measurements.rows, &design, &result, &linear);
+    let iteration = match (&result.subset, iterate) {
+        (Some(sub), true) => Some(iterate::iterate(
+            machine,
+            &measurements.rows,
+            &design,
+            &sub.estimated,
+            &linear,
+        )),
+        _ => None,
+    };
+    let mut doc = IdentifyDocument::new(
+        machine,
+        &measurements.file,
+        measurements,
+        &design,
+        &result,
+        &check,
+        iteration.as_ref(),
+    );
     doc.validation = held_out.map(|(v, d)| Validation {
         file: v.file.clone(),
-        prediction: predict(&d, &result),
+        prediction: match &iteration {
+            Some(it) => {
+                let x: Vec<f64> = it.estimates.iter().map(|e| e.value).collect();
+                let (rows, _) = iterate::exact_rows(machine, &v.rows, &d, &x, false);
+                predict_rows(&d, &rows)
+            }
+            None => predict(&d, &result),
+        },
     });
-    Ok((doc, result))
+    Ok(Identified {
+        document: doc,
+        result,
+        check,
+        iteration,
+    })
 }
 
 impl IdentifyDocument {
     /// The document of `r`, the identification from `measurements` (named
-    /// `file`) through `design`.
+    /// `file`) through `design`, with its first-order check and
+    /// `--iterate`'s fit.
     pub fn new(
         m: &Machine,
         file: &str,
         measurements: &Measurements,
         design: &Design,
         r: &Identification,
+        check: &FirstOrderCheck,
+        iteration: Option<&Iteration>,
     ) -> IdentifyDocument {
         let groups = r
             .groups
@@ -370,6 +531,8 @@ impl IdentifyDocument {
                 })
                 .collect(),
             outliers: r.outliers,
+            first_order: FirstOrderDoc::new(check, iteration.is_some()),
+            iteration: iteration.map(|it| IterationDoc::new(it, &r.errors)),
             noise: r.noise,
             subset: r.subset.as_ref().map(|s| SubsetDoc::new(s, &r.errors)),
             validation: None,
@@ -462,8 +625,11 @@ fn explain(design: &Design, r: &Identification, members: &[usize], vectors: usiz
 /// `source` names the measurement file in its first comment. Without a
 /// prior the values are the subset's least-squares solution: a fixed
 /// unknown is written as its nominal value 0 without a `std` (a reader
-/// keeps its `statistics` spread), with a comment saying why it is fixed.
-pub fn values_file(m: &Machine, source: &str, r: &Identification) -> String {
+/// keeps its `statistics` spread), with a comment saying why it is fixed;
+/// with `--iterate` the values are the exact fit's. Angular errors beyond
+/// the first-order range are named in a comment.
+pub fn values_file(m: &Machine, source: &str, identified: &Identified) -> String {
+    let r = &identified.result;
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -497,11 +663,38 @@ pub fn values_file(m: &Machine, source: &str, r: &Identification) -> String {
                     }
                 }
             }
-            sub.estimates.clone()
+            match &identified.iteration {
+                Some(it) => it.estimates.clone(),
+                None => sub.estimates.clone(),
+            }
         }
         None => r.estimates.0.iter().map(|(_, e)| *e).collect(),
     };
-    let (_, covariance) = r.solution();
+    let covariance = match &identified.iteration {
+        Some(it) => &it.covariance,
+        None => r.solution().1,
+    };
+    if let Some(it) = &identified.iteration {
+        let _ = writeln!(
+            s,
+            "# --iterate: Levenberg-Marquardt on the exact kinematics from the linear estimate, {} iterations{}, weighted residual sum of squares {:e} -> {:e}",
+            it.iterations,
+            if it.converged { ", converged" } else { ", NOT converged" },
+            it.rss_linear,
+            it.rss
+        );
+    }
+    for (name, angle) in &identified.check.large_angles {
+        let _ = writeln!(
+            s,
+            "# {name} reaches {angle:e} rad at the measured poses: beyond the first-order range ({ANGLE_LIMIT} rad){}",
+            if identified.iteration.is_some() {
+                ""
+            } else {
+                "; identify with --iterate"
+            }
+        );
+    }
     let _ = writeln!(s, "machine: {}", m.name);
     let _ = writeln!(s, "units: {{linear: mm, angular: rad}}");
     let _ = writeln!(s, "values:");

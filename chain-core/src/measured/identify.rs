@@ -205,6 +205,16 @@ pub enum IdentifyError {
         /// The option.
         option: &'static str,
     },
+    /// `--iterate` with `--prior`.
+    #[error("--iterate fits the exact kinematics by least squares; it does not take --prior")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(
+            code(chain::identify::iterate_with_prior),
+            help("identify with --iterate alone, or with --prior alone")
+        )
+    )]
+    IterateWithPrior,
     /// `--rank-tol` outside `(0, 1)`.
     #[error("--rank-tol: {0} is not a relative tolerance in (0, 1)")]
     #[cfg_attr(

@@ -10,7 +10,9 @@
 //! [`positioning_values`] writes them into a values file.
 
 pub mod document;
+pub mod exact;
 pub mod identify;
+pub mod iterate;
 pub mod measurements;
 pub mod positioning;
 pub mod positioning_values;

@@ -67,11 +67,18 @@ pub struct Prediction {
 /// the same order).
 pub fn predict(design: &Design, r: &Identification) -> Prediction {
     let (x, _) = r.solution();
-    let after: Vec<f64> = (design.b.iter().enumerate())
-        .map(|(i, b)| {
-            let row = design.a.row(i);
-            b - row.iter().zip(&x).map(|(a, x)| a * x).sum::<f64>()
-        })
+    let predicted: Vec<f64> = (0..design.b.len())
+        .map(|i| design.a.row(i).iter().zip(&x).map(|(a, x)| a * x).sum())
+        .collect();
+    predict_rows(design, &predicted)
+}
+
+/// The prediction at the rows of `design` when the model predicts
+/// `predicted` there (one value per scalar row): the exact kinematics of
+/// `--iterate`'s values, say.
+pub fn predict_rows(design: &Design, predicted: &[f64]) -> Prediction {
+    let after: Vec<f64> = (design.b.iter().zip(predicted))
+        .map(|(b, p)| b - p)
         .collect();
     let record: Vec<usize> = design.origin.iter().map(|(r, _)| *r).collect();
     let mut records = record.clone();

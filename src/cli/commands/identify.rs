@@ -1,5 +1,5 @@
 //! `chain identify FILE --measurements M.csv [--prior] [--validate M2.csv]
-//! [--rank-tol TOL] [--fix NAME,... | --estimate NAME,...]
+//! [--rank-tol TOL] [--fix NAME,... | --estimate NAME,...] [--iterate]
 //! [--param NAME=VALUE]... [--format table|json] [--values-out VALUES.yaml]`.
 //!
 //! The error parameters of a built machine from measurements
@@ -60,6 +60,10 @@ pub struct IdentifyArgs {
     /// Estimate only these error parameters, every other one fixed at 0.
     #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
     pub estimate: Option<Vec<String>>,
+    /// Fit the exact (not linearised) kinematics by Levenberg–Marquardt
+    /// from the linear estimate, for errors too large for first order.
+    #[arg(long)]
+    pub iterate: bool,
     #[command(flatten)]
     pub param: ParamArgs,
     /// Output format.
@@ -99,6 +103,7 @@ pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
             rank_tol: args.rank_tol,
             subset,
         },
+        iterate: args.iterate,
         validation: validation.as_ref(),
     };
     let run = identify::run(m, &measurements, &request)?;

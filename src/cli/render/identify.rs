@@ -80,7 +80,12 @@ fn table(d: &IdentifyDocument) -> String {
     let _ = writeln!(s, "\n{:<width$}  {:>14}  {:>14}", "error", "value", "std");
     match &d.subset {
         Some(sub) => {
-            for (name, e) in &sub.estimates.0 {
+            // With --iterate the values are the exact fit's.
+            let values = d
+                .iteration
+                .as_ref()
+                .map_or(&sub.estimates, |it| &it.estimates);
+            for (name, e) in &values.0 {
                 let std = e.std.map_or("—".to_string(), num);
                 let note = match sub.fixed.iter().find(|f| &f.error == name) {
                     Some(f) => format!("  fixed, {}: {}", f.status.words(), f.words),
@@ -139,6 +144,19 @@ fn table(d: &IdentifyDocument) -> String {
             _ => String::new(),
         }
     );
+    let _ = writeln!(s, "first order: {}", d.first_order.words);
+    if let Some(it) = &d.iteration {
+        let _ = writeln!(
+            s,
+            "--iterate: {} Levenberg–Marquardt iterations{}, weighted residual sum of squares {} → {}; residual rms {}, max {} (the estimates above are the exact fit's)",
+            it.iterations,
+            if it.converged { ", converged" } else { ", not converged" },
+            num(it.rss_linear),
+            num(it.rss),
+            num(it.rms),
+            num(it.max)
+        );
+    }
     if !d.largest_residuals.is_empty() {
         let _ = writeln!(
             s,

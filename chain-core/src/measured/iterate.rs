@@ -1,0 +1,319 @@
+//! The first-order fit checked against the exact kinematics, and the
+//! exact fit (`chain identify --iterate`, issue 33, point 2;
+//! `docs/identify.md`, "When first order is not enough").
+//!
+//! # Formulas
+//!
+//! With `f_i(x)` the exact model of scalar row `i` (a component of the
+//! exact deviation [`super::exact::ExactChain`], or `uᵀ` of it along a
+//! direction) and `a_i x` its first-order model:
+//!
+//! - **check**: `δ_i = f_i(x̂) − a_i x̂` at the measured poses with the
+//!   linear estimate `x̂`; the first order is **not adequate** when some
+//!   `|δ_i| / σ_i` exceeds the noise scale (`σ_i` the row's std, 1
+//!   without a `std` column; the noise scale `s` of the fit, or 1 with a
+//!   `std` column when the fit has no degree of freedom).
+//! - **angles**: an angular error whose largest angle at the measured poses,
+//!   `max_q |w_j(q) x_j|`, exceeds [`ANGLE_LIMIT`] is flagged: beyond it the
+//!   dropped second-order terms (`θ²/2` of the angle times the lever) are
+//!   no longer negligible against the first-order ones on a metre-sized
+//!   machine.
+//! - **iteration**: Levenberg–Marquardt on `Σ ((b_i − f_i(x))/σ_i)²` over
+//!   the estimated errors (the others fixed at 0), started from the linear
+//!   estimate, with the exact Jacobian of [`super::exact::ExactChain`]:
+//!   `(H + μ diag H) δ = Jᵀ W r`, `H = Jᵀ W J` (equilibrated Cholesky); a
+//!   step that lowers the sum is taken and `μ /= 3`, else `μ *= 4`.
+//!   Converged when an accepted step lowers the sum by less than 1e-12 of
+//!   it, or no step can (`μ > 1e10`); at most [`MAX_ITERATIONS`]. The
+//!   covariance is `s² H⁻¹` (`s² = RSS/(m − k)`) without a `std` column,
+//!   `H⁻¹` with one, at the solution.
+
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+use super::exact::ExactChain;
+use super::identify::{Estimate, Identification};
+use super::measurements::{Design, Measurement, Observed};
+use crate::model::{ErrorKind, Machine};
+
+/// Identified angles beyond this (rad) are outside the first-order range.
+pub const ANGLE_LIMIT: f64 = 1e-2;
+/// The most Levenberg–Marquardt iterations.
+pub const MAX_ITERATIONS: usize = 100;
+
+/// The first-order fit against the exact kinematics at the measured poses.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FirstOrderCheck {
+    /// `max |f_i(x̂) − a_i x̂|` (measurement units).
+    pub max: f64,
+    /// Its root mean square over the rows.
+    pub rms: f64,
+    /// The noise scale it is compared with (weighted units).
+    pub noise: Option<f64>,
+    /// Whether some row's difference exceeds the noise.
+    pub exceeds_noise: bool,
+    /// The angular errors beyond [`ANGLE_LIMIT`] at the measured poses,
+    /// with their largest angle (rad).
+    pub large_angles: Vec<(String, f64)>,
+}
+
+/// The exact fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Iteration {
+    /// Iterations taken (Jacobian evaluations).
+    pub iterations: usize,
+    /// Whether the convergence test was met.
+    pub converged: bool,
+    /// The weighted sum of squares of the exact model at the linear
+    /// estimate.
+    pub rss_linear: f64,
+    /// The same at the solution.
+    pub rss: f64,
+    /// Root mean square of `b − f(x)` at the solution (measurement units).
+    pub rms: f64,
+    /// The largest `|b − f(x)|` at the solution.
+    pub max: f64,
+    /// The estimated errors (indices).
+    pub estimated: Vec<usize>,
+    /// Every error's value (fixed ones 0) and std.
+    pub estimates: Vec<Estimate>,
+    /// The covariance (`n × n`, zero for fixed errors).
+    pub covariance: DMatrix<f64>,
+    /// The solution less the linear estimate, per error.
+    pub change: Vec<f64>,
+}
+
+/// The exact rows at `x`: `f(x)` and, with `jacobian`, `∂f/∂x` (`m × n`).
+pub fn exact_rows(
+    machine: &Machine,
+    records: &[Measurement],
+    design: &Design,
+    x: &[f64],
+    jacobian: bool,
+) -> (Vec<f64>, Option<DMatrix<f64>>) {
+    let chain = ExactChain::new(machine);
+    let m = design.b.len();
+    let n = x.len();
+    let mut f = vec![0.0; m];
+    let mut jac = jacobian.then(|| DMatrix::zeros(m, n));
+    let mut i = 0;
+    while i < m {
+        let r = design.origin[i].0;
+        let rec = &records[r];
+        let (dev, j) = if jacobian {
+            let (d, j) = chain.deviation_and_jacobian(&rec.q, &rec.p, x);
+            (d, Some(j))
+        } else {
+            (chain.deviation(&rec.q, &rec.p, x), None)
+        };
+        match rec.observed {
+            Observed::Point => {
+                for c in 0..3 {
+                    f[i + c] = dev[c];
+                    if let (Some(out), Some(j)) = (jac.as_mut(), &j) {
+                        out.row_mut(i + c).copy_from(&j.row(c));
+                    }
+                }
+                i += 3;
+            }
+            Observed::Direction { u } => {
+                f[i] = (0..3).map(|c| u[c] * dev[c]).sum();
+                if let (Some(out), Some(j)) = (jac.as_mut(), &j) {
+                    for k in 0..n {
+                        out[(i, k)] = (0..3).map(|c| u[c] * j[(c, k)]).sum();
+                    }
+                }
+                i += 1;
+            }
+        }
+    }
+    (f, jac)
+}
+
+/// `1/σ_i` per row.
+fn inv_sigma(design: &Design) -> Vec<f64> {
+    match &design.std {
+        Some(s) => s.iter().map(|s| 1.0 / s).collect(),
+        None => vec![1.0; design.b.len()],
+    }
+}
+
+/// Checks the first-order fit `x` (every error) against the exact
+/// kinematics at the measured poses (module docs).
+pub fn check(
+    machine: &Machine,
+    records: &[Measurement],
+    design: &Design,
+    r: &Identification,
+    x: &[f64],
+) -> FirstOrderCheck {
+    let (f, _) = exact_rows(machine, records, design, x, false);
+    let w = inv_sigma(design);
+    let ax = &design.a * DVector::from_column_slice(x);
+    let diff: Vec<f64> = f.iter().zip(ax.iter()).map(|(f, a)| f - a).collect();
+    let m = diff.len().max(1);
+    let max = diff.iter().fold(0.0f64, |a, d| a.max(d.abs()));
+    let rms = (diff.iter().map(|d| d * d).sum::<f64>() / m as f64).sqrt();
+    let noise = r.residual.scale.or(r.weighted.then_some(1.0));
+    let worst = diff
+        .iter()
+        .zip(&w)
+        .fold(0.0f64, |a, (d, w)| a.max((d * w).abs()));
+    let exceeds_noise = noise.is_some_and(|s| worst > s);
+    let chain_weights = |q: &[f64]| -> Vec<f64> {
+        let mut wj = vec![1.0; machine.errors.len()];
+        for func in &machine.functions {
+            for (k, b) in &func.coefficients {
+                wj[*k] = b.value(q[func.variable]);
+            }
+        }
+        wj
+    };
+    let mut largest = vec![0.0f64; x.len()];
+    for rec in records {
+        let wj = chain_weights(&rec.q);
+        for (j, l) in largest.iter_mut().enumerate() {
+            *l = l.max((wj[j] * x[j]).abs());
+        }
+    }
+    let large_angles = (0..x.len())
+        .filter(|&j| {
+            matches!(
+                machine.errors[j].kind,
+                ErrorKind::Angular | ErrorKind::Squareness
+            ) && largest[j] > ANGLE_LIMIT
+        })
+        .map(|j| (r.errors[j].clone(), largest[j]))
+        .collect();
+    FirstOrderCheck {
+        max,
+        rms,
+        noise,
+        exceeds_noise,
+        large_angles,
+    }
+}
+
+/// Levenberg–Marquardt on the exact kinematics over `estimated`, from the
+/// linear estimate `start` (module docs).
+pub fn iterate(
+    machine: &Machine,
+    records: &[Measurement],
+    design: &Design,
+    estimated: &[usize],
+    start: &[f64],
+) -> Iteration {
+    let n = start.len();
+    let k = estimated.len();
+    let m = design.b.len();
+    let w = inv_sigma(design);
+    let weighted = design.std.is_some();
+    let rss_of = |f: &[f64]| -> f64 {
+        (design.b.iter().zip(f).zip(&w))
+            .map(|((b, f), w)| ((b - f) * w).powi(2))
+            .sum()
+    };
+    let mut x = start.to_vec();
+    let (f0, _) = exact_rows(machine, records, design, &x, false);
+    let rss_linear = rss_of(&f0);
+    let mut rss = rss_linear;
+    let mut mu = 1e-3;
+    let mut iterations = 0;
+    let mut converged = false;
+    let mut h = DMatrix::zeros(k, k);
+    while iterations < MAX_ITERATIONS {
+        iterations += 1;
+        let (f, jac) = exact_rows(machine, records, design, &x, true);
+        let Some(jac) = jac else { break };
+        // Weighted rows of the estimated columns.
+        let js = DMatrix::from_fn(m, k, |i, a| jac[(i, estimated[a])] * w[i]);
+        let r = DVector::from_fn(m, |i, _| (design.b[i] - f[i]) * w[i]);
+        h = js.tr_mul(&js);
+        let g = js.tr_mul(&r);
+        let mut improved = false;
+        while mu <= 1e10 {
+            let e: Vec<f64> = (0..k)
+                .map(|a| {
+                    let d = h[(a, a)];
+                    if d > 0.0 {
+                        1.0 / d.sqrt()
+                    } else {
+                        1.0
+                    }
+                })
+                .collect();
+            let a_mat = DMatrix::from_fn(k, k, |a, b| {
+                e[a] * (h[(a, b)] + if a == b { mu * h[(a, a)] } else { 0.0 }) * e[b]
+            });
+            let Some(ch) = nalgebra::Cholesky::new(a_mat) else {
+                mu *= 4.0;
+                continue;
+            };
+            let z = ch.solve(&DVector::from_fn(k, |a, _| e[a] * g[a]));
+            let mut trial = x.clone();
+            for (a, &j) in estimated.iter().enumerate() {
+                trial[j] += e[a] * z[a];
+            }
+            let (ft, _) = exact_rows(machine, records, design, &trial, false);
+            let rt = rss_of(&ft);
+            if rt < rss {
+                let gain = rss - rt;
+                x = trial;
+                rss = rt;
+                mu = (mu / 3.0).max(1e-12);
+                improved = true;
+                if gain <= 1e-12 * rss {
+                    converged = true;
+                }
+                break;
+            }
+            mu *= 4.0;
+        }
+        if !improved {
+            converged = true;
+        }
+        if converged {
+            break;
+        }
+    }
+    let (f, _) = exact_rows(machine, records, design, &x, false);
+    let res: Vec<f64> = design.b.iter().zip(&f).map(|(b, f)| b - f).collect();
+    let rms = (res.iter().map(|r| r * r).sum::<f64>() / m.max(1) as f64).sqrt();
+    let max = res.iter().fold(0.0f64, |a, r| a.max(r.abs()));
+    let scale2 = if weighted {
+        Some(1.0)
+    } else if m > k {
+        Some(rss / (m - k) as f64)
+    } else {
+        None
+    };
+    let hinv = h
+        .clone()
+        .try_inverse()
+        .unwrap_or_else(|| DMatrix::zeros(k, k));
+    let mut covariance = DMatrix::zeros(n, n);
+    for (a, &i) in estimated.iter().enumerate() {
+        for (b, &j) in estimated.iter().enumerate() {
+            covariance[(i, j)] = scale2.map_or(f64::NAN, |s2| s2 * hinv[(a, b)]);
+        }
+    }
+    let estimates = (0..n)
+        .map(|j| Estimate {
+            value: x[j],
+            std: (estimated.contains(&j) && scale2.is_some())
+                .then(|| covariance[(j, j)].max(0.0).sqrt()),
+        })
+        .collect();
+    Iteration {
+        iterations,
+        converged,
+        rss_linear,
+        rss,
+        rms,
+        max,
+        estimated: estimated.to_vec(),
+        estimates,
+        covariance,
+        change: x.iter().zip(start).map(|(a, b)| a - b).collect(),
+    }
+}
