@@ -501,6 +501,8 @@ class Machine:
         fix: Optional[Sequence[str]] = None,
         estimate: Optional[Sequence[str]] = None,
         iterate: bool = False,
+        holdout: Optional[float] = None,
+        seed: Optional[int] = None,
     ) -> "IdentifyResult":
         """The error parameters from measurements, ``chain identify --measurements M --format json``.
 
@@ -520,7 +522,9 @@ class Machine:
         fix at 0, or the only ones to estimate, instead of the
         elimination's choice (the document's ``subset``); ``iterate``
         (``--iterate``): fit the exact kinematics from the linear estimate
-        (the document's ``iteration``).
+        (the document's ``iteration``); ``holdout`` / ``seed``
+        (``--holdout`` / ``--seed``): hold that fraction of the records out
+        of the fit and report the prediction at them (``validation``).
         """
         from ._results import IdentifyResult
 
@@ -541,6 +545,8 @@ class Machine:
             None if fix is None else [str(n) for n in fix],
             None if estimate is None else [str(n) for n in estimate],
             bool(iterate),
+            None if holdout is None else float(holdout),
+            None if seed is None else int(seed),
         )
         if values_out is not None:
             with open(os.fspath(values_out), "w", encoding="utf-8") as f:

@@ -15,7 +15,7 @@ use chain::ops::identify::{self, IdentifyRequest};
 use chain::ops::plan::{self, PlanRequest};
 use chain::ops::Worded;
 use chain_core::measured::{
-    IdentifyOptions, Layout, Measurements, MeasurementsError, SubsetChoice,
+    Holdout, IdentifyOptions, Layout, Measurements, MeasurementsError, SubsetChoice,
 };
 use chain_core::model::Machine;
 use chain_core::plan::Kind;
@@ -78,7 +78,7 @@ pub(crate) fn read_values(
 /// held-out ones of `--validate`, if any, from `validate` (a path, or text
 /// and its name).
 #[pyfunction]
-#[pyo3(signature = (model, path, text, file, params, prior, validate=None, rank_tol=None, fix=None, estimate=None, iterate=false))]
+#[pyo3(signature = (model, path, text, file, params, prior, validate=None, rank_tol=None, fix=None, estimate=None, iterate=false, holdout=None, seed=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_json(
     py: Python<'_>,
@@ -93,10 +93,13 @@ pub(crate) fn identify_json(
     fix: Option<Vec<String>>,
     estimate: Option<Vec<String>>,
     iterate: bool,
+    holdout: Option<f64>,
+    seed: Option<u64>,
 ) -> PyResult<(String, String)> {
     let m = &model.machine;
     let subset =
         SubsetChoice::from_options(fix, estimate).map_err(|e| value_error(e.to_string()))?;
+    let holdout = Holdout::from_options(holdout, seed).map_err(|e| value_error(e.to_string()))?;
     chain::ops::resolve::check_parameters(m, &params).map_err(|e| resolve_error(py, model, e))?;
     let measurements = read_measurements(py, m, path, text, file, &params, Layout::Measurements)?;
     let validation = match &validate {
@@ -115,6 +118,7 @@ pub(crate) fn identify_json(
         prior,
         options: IdentifyOptions { rank_tol, subset },
         iterate,
+        holdout,
         validation: validation.as_ref(),
     };
     let run = py

@@ -253,3 +253,16 @@ def test_identify_iterate_is_the_cli_json(cli):
     assert r.iteration["converged"] and r.first_order["exceeds_noise"] is False
     with pytest.raises(ValueError, match="--iterate fits the exact kinematics by least squares"):
         m.identify(ball, iterate=True, prior=True)
+
+
+def test_identify_holdout_is_the_cli_json(cli):
+    """Machine.identify(holdout=, seed=) equals `chain identify --holdout --seed` (issue 33, point 3)."""
+    m = chain.Machine.load(PROBE)
+    ball = MEAS / "ballplate.csv"
+    r = m.identify(ball, holdout=0.25, seed=7)
+    assert r.to_dict() == cli("identify", PROBE, "--measurements", ball, "--holdout", 0.25, "--seed", 7)
+    v = r.validation
+    assert v["holdout"] == {"fraction": 0.25, "seed": 7} and len(v["lines"]) == 113  # 112.5 rounded half away from zero
+    assert r.measurements == 450 - len(v["lines"])
+    with pytest.raises(ValueError, match="--holdout: --seed chooses the records --holdout holds out"):
+        m.identify(ball, seed=7)

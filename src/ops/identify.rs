@@ -8,7 +8,7 @@
 use chain_core::measured::document::{
     identify_document, values_file, DocumentError, IdentifyDocument,
 };
-use chain_core::measured::{Identification, IdentifyOptions, Measurements};
+use chain_core::measured::{Holdout, HoldoutError, Identification, IdentifyOptions, Measurements};
 use chain_core::Machine;
 use serde::{Serialize, Serializer};
 
@@ -22,6 +22,10 @@ pub struct IdentifyRequest<'a> {
     pub options: IdentifyOptions,
     /// `--iterate`: fit the exact kinematics from the linear estimate.
     pub iterate: bool,
+    /// `--holdout FRACTION --seed S`: records of the measurements held out
+    /// of the fit, where the estimates' prediction is reported (not with
+    /// `validation`).
+    pub holdout: Option<Holdout>,
     /// `--validate`: measurements held out of the fit, where the estimates'
     /// prediction is reported.
     pub validation: Option<&'a Measurements>,
@@ -51,14 +55,32 @@ pub fn run(
     measurements: &Measurements,
     request: &IdentifyRequest<'_>,
 ) -> Result<IdentifyRun, DocumentError> {
-    let identified = identify_document(
+    let split = match request.holdout {
+        Some(_) if request.validation.is_some() => {
+            return Err(HoldoutError {
+                message: "cannot be given with --validate (one holds records of the measurements out, the other reads them from a file)".into(),
+            }
+            .into())
+        }
+        Some(h) => Some(measurements.holdout(h.fraction, h.seed)?),
+        None => None,
+    };
+    let (fitted, validation) = match &split {
+        Some((fit, held)) => (fit, Some(held)),
+        None => (measurements, request.validation),
+    };
+    let mut identified = identify_document(
         machine,
-        measurements,
+        fitted,
         request.prior,
         &request.options,
         request.iterate,
-        request.validation,
+        validation,
     )?;
+    if let (Some(v), Some((_, held))) = (identified.document.validation.as_mut(), &split) {
+        v.holdout = request.holdout;
+        v.lines = Some(held.rows.iter().map(|r| r.line).collect());
+    }
     let values_text = values_file(machine, &measurements.file, &identified);
     Ok(IdentifyRun {
         document: identified.document,

@@ -327,3 +327,112 @@ fn the_cli_iterates_as_the_library_does() {
         "{err}"
     );
 }
+
+/// `--holdout 0.2 --seed 3` on the simulated arm: the held-out records are
+/// the JSON's `validation.lines` (a fifth of them, none fitted), and the
+/// prediction numbers there equal an independent computation, the tests'
+/// 4×4 product with the written values: through the exact kinematics
+/// (`--iterate`) to 1e-9 mm, and the first-order prediction to the second
+/// order of the errors (2e-5 mm at 0.02 mm and 2e-5 rad). A seed alone, a
+/// fraction outside (0, 1) and `--holdout` with `--validate` are refused.
+#[test]
+fn held_out_records_are_predicted_as_the_product_predicts_them() {
+    use common::cli::{fails, ok_json, scratch, unwrapped, write};
+    let m = arm();
+    let mut rng = Rng::new(53);
+    let e = truth(&m, 0.02, &mut rng);
+    let data = measured(&m, &e, 200, 1e-3, &mut rng);
+    let mut csv = String::from("q1,q2,q3,q4,q5,q6,dpx,dpy,dpz\n");
+    for r in &data.rows {
+        let cells: Vec<String> =
+            r.q.iter()
+                .chain(&r.values)
+                .map(|v| format!("{v:?}"))
+                .collect();
+        csv.push_str(&(cells.join(",") + "\n"));
+    }
+    let dir = scratch("identify-holdout");
+    let file = write(&dir, "arm.csv", &csv);
+    let machine = example_file("robots/arm6_offsets.yaml");
+    let base = [
+        "identify",
+        machine.to_str().unwrap(),
+        "--measurements",
+        file.to_str().unwrap(),
+        "--holdout",
+        "0.2",
+        "--seed",
+        "3",
+        "--format",
+        "json",
+    ];
+    let exact = Exact::new(&m);
+    let p = exact.file_parameters();
+    for (iterate, tolerance) in [(true, 1e-9), (false, 2e-5)] {
+        let args: Vec<&str> = if iterate {
+            [&base[..], &["--iterate"]].concat()
+        } else {
+            base.to_vec()
+        };
+        let json = ok_json(&args);
+        let v = &json["validation"];
+        let lines: Vec<usize> = (v["lines"].as_array().unwrap().iter())
+            .map(|l| l.as_u64().unwrap() as usize)
+            .collect();
+        assert_eq!(lines.len(), 40);
+        assert_eq!(json["measurements"].as_u64(), Some(160));
+        assert_eq!(v["holdout"]["seed"].as_u64(), Some(3));
+        let values = if iterate {
+            &json["iteration"]["estimates"]
+        } else {
+            &json["subset"]["estimates"]
+        };
+        let x: Vec<f64> = (m.errors.iter())
+            .map(|er| values[&er.name]["value"].as_f64().unwrap())
+            .collect();
+        let (mut before, mut after) = (Vec::new(), Vec::new());
+        for r in data.rows.iter().filter(|r| lines.contains(&r.line)) {
+            let predicted = exact.exact_error(&r.q, &p, &x);
+            before.push(r.values.iter().map(|v| v * v).sum::<f64>());
+            after.push(
+                (0..3)
+                    .map(|c| (r.values[c] - predicted[c]).powi(2))
+                    .sum::<f64>(),
+            );
+        }
+        let stats = |squares: &[f64]| {
+            let mean = squares.iter().map(|s| s.sqrt()).sum::<f64>() / squares.len() as f64;
+            let max = squares.iter().map(|s| s.sqrt()).fold(0.0, f64::max);
+            let rms = (squares.iter().sum::<f64>() / (3 * squares.len()) as f64).sqrt();
+            [mean, max, rms]
+        };
+        for (key, expected, tol) in [
+            ("before", stats(&before), 1e-12),
+            ("after", stats(&after), tolerance),
+        ] {
+            for (k, field) in ["mean", "max", "rms"].iter().enumerate() {
+                let got = v[key][field].as_f64().unwrap();
+                assert!(
+                    (got - expected[k]).abs() <= tol,
+                    "iterate {iterate}: {key}.{field} {got} vs the product's {}",
+                    expected[k]
+                );
+            }
+        }
+        // The correction takes the held-out error to the noise.
+        assert!(v["after"]["rms"].as_f64().unwrap() < 1.3e-3);
+    }
+    let with = |extra: &[&str]| -> String {
+        let mut a: Vec<&str> = base[..4].to_vec();
+        a.extend_from_slice(extra);
+        unwrapped(&fails(&a))
+    };
+    assert!(with(&["--seed", "3"])
+        .contains("--holdout: --seed chooses the records --holdout holds out"));
+    assert!(with(&["--holdout", "1.5"]).contains("--holdout: 1.5 is not a fraction in (0, 1)"));
+    assert!(with(&["--holdout", "0.001"]).contains("both sides need a record"));
+    assert!(
+        with(&["--holdout", "0.2", "--validate", file.to_str().unwrap()])
+            .contains("--holdout: cannot be given with --validate")
+    );
+}

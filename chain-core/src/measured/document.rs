@@ -32,6 +32,10 @@ pub enum DocumentError {
     #[error(transparent)]
     #[cfg_attr(feature = "miette", diagnostic(transparent))]
     Identify(#[from] IdentifyError),
+    /// `--holdout` refused.
+    #[error(transparent)]
+    #[cfg_attr(feature = "miette", diagnostic(transparent))]
+    Holdout(#[from] super::HoldoutError),
 }
 
 /// One group of unknowns the data cannot separate.
@@ -388,6 +392,13 @@ impl SubsetDoc {
 pub struct Validation {
     /// The held-out measurement file as named in messages.
     pub file: String,
+    /// `--holdout`: the fraction and seed that chose the held-out records
+    /// from the measurements (absent with `--validate`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub holdout: Option<super::Holdout>,
+    /// `--holdout`: the CSV lines of the held-out records.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lines: Option<Vec<usize>>,
     /// Records, rows, the error before and after.
     #[serde(flatten)]
     pub prediction: Prediction,
@@ -463,6 +474,8 @@ pub fn identify_document(
     );
     doc.validation = held_out.map(|(v, d)| Validation {
         file: v.file.clone(),
+        holdout: None,
+        lines: None,
         prediction: match &iteration {
             Some(it) => {
                 let x: Vec<f64> = it.estimates.iter().map(|e| e.value).collect();

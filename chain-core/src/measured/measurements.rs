@@ -125,7 +125,110 @@ impl MeasurementsError {
     }
 }
 
+/// `--holdout FRACTION` outside `(0, 1)`, or a split that leaves no record
+/// on one side.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
+#[error("--holdout: {message}")]
+#[cfg_attr(
+    feature = "miette",
+    diagnostic(
+        code(chain::identify::holdout),
+        help("--holdout takes the fraction of the records to hold out of the fit, e.g. --holdout 0.2 (with --seed S to choose another split)")
+    )
+)]
+pub struct HoldoutError {
+    /// What is wrong.
+    pub message: String,
+}
+
+/// `--holdout FRACTION [--seed S]`: the fraction of the records held out
+/// of the fit and the seed of the split.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Holdout {
+    /// The fraction held out.
+    pub fraction: f64,
+    /// The seed of the shuffle.
+    pub seed: u64,
+}
+
+impl Holdout {
+    /// The seed when `--seed` is not given.
+    pub const DEFAULT_SEED: u64 = 1;
+
+    /// The choice of `--holdout` and `--seed` (a seed alone is refused: it
+    /// would choose nothing).
+    pub fn from_options(
+        fraction: Option<f64>,
+        seed: Option<u64>,
+    ) -> Result<Option<Holdout>, HoldoutError> {
+        match (fraction, seed) {
+            (None, Some(_)) => Err(HoldoutError {
+                message:
+                    "--seed chooses the records --holdout holds out; give --holdout FRACTION too"
+                        .into(),
+            }),
+            (None, None) => Ok(None),
+            (Some(fraction), seed) => Ok(Some(Holdout {
+                fraction,
+                seed: seed.unwrap_or(Holdout::DEFAULT_SEED),
+            })),
+        }
+    }
+}
+
 impl Measurements {
+    /// Splits the records into those fitted and those held out
+    /// (`chain identify --holdout FRACTION --seed S`): `round(FRACTION × n)`
+    /// records chosen by a seeded shuffle (`rand`'s `SliceRandom::shuffle`,
+    /// Fisher–Yates, over xoshiro256++ seeded from `seed` through
+    /// SplitMix64, which `rand` documents as portable: the same split on
+    /// every platform), each side kept in file order. The held-out side is
+    /// named `FILE (held out)`.
+    pub fn holdout(
+        &self,
+        fraction: f64,
+        seed: u64,
+    ) -> Result<(Measurements, Measurements), HoldoutError> {
+        use rand::seq::SliceRandom;
+        use rand::SeedableRng;
+        if !(fraction > 0.0 && fraction < 1.0) {
+            return Err(HoldoutError {
+                message: format!("{fraction} is not a fraction in (0, 1)"),
+            });
+        }
+        let n = self.rows.len();
+        let held = (fraction * n as f64).round() as usize;
+        if held == 0 || held == n {
+            return Err(HoldoutError {
+                message: format!(
+                    "{fraction} of {n} records holds out {held}, leaving {} to fit: both sides need a record",
+                    n - held
+                ),
+            });
+        }
+        let mut order: Vec<usize> = (0..n).collect();
+        let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(seed);
+        order.shuffle(&mut rng);
+        let mut out = vec![false; n];
+        for &i in &order[..held] {
+            out[i] = true;
+        }
+        let side = |keep: bool, file: String| Measurements {
+            file,
+            machine: self.machine.clone(),
+            weighted: self.weighted,
+            rows: (self.rows.iter().zip(&out))
+                .filter(|(_, &o)| o == keep)
+                .map(|(r, _)| r.clone())
+                .collect(),
+        };
+        Ok((
+            side(false, self.file.clone()),
+            side(true, format!("{} (held out)", self.file)),
+        ))
+    }
+
     /// The number of scalar design rows (3 per point, 1 per direction).
     pub fn row_count(&self) -> usize {
         self.rows.iter().map(|r| r.observed.rows()).sum()

@@ -1,5 +1,6 @@
 //! `chain identify FILE --measurements M.csv [--prior] [--validate M2.csv]
-//! [--rank-tol TOL] [--fix NAME,... | --estimate NAME,...] [--iterate]
+//! [--holdout FRACTION [--seed S]] [--rank-tol TOL]
+//! [--fix NAME,... | --estimate NAME,...] [--iterate]
 //! [--param NAME=VALUE]... [--format table|json] [--values-out VALUES.yaml]`.
 //!
 //! The error parameters of a built machine from measurements
@@ -12,7 +13,7 @@
 use std::path::PathBuf;
 
 use chain::ops::identify::{self, IdentifyRequest};
-use chain_core::measured::{IdentifyOptions, Layout, Measurements, SubsetChoice};
+use chain_core::measured::{Holdout, IdentifyOptions, Layout, Measurements, SubsetChoice};
 
 use crate::cli::args::ParamArgs;
 use crate::cli::loaded::Loaded;
@@ -60,6 +61,13 @@ pub struct IdentifyArgs {
     /// Estimate only these error parameters, every other one fixed at 0.
     #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
     pub estimate: Option<Vec<String>>,
+    /// Hold this fraction of the measurement records out of the fit (a
+    /// seeded shuffle) and report the estimates' prediction at them.
+    #[arg(long, value_name = "FRACTION")]
+    pub holdout: Option<f64>,
+    /// The seed of `--holdout`'s split (default 1).
+    #[arg(long, value_name = "S")]
+    pub seed: Option<u64>,
     /// Fit the exact (not linearised) kinematics by Levenberg–Marquardt
     /// from the linear estimate, for errors too large for first order.
     #[arg(long)]
@@ -79,6 +87,7 @@ pub struct IdentifyArgs {
 /// Runs `chain identify` ([`chain::ops::identify`]).
 pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
     let subset = SubsetChoice::from_options(args.fix, args.estimate)?;
+    let holdout = Holdout::from_options(args.holdout, args.seed)?;
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
     args.param.check_names(m)?;
@@ -104,6 +113,7 @@ pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
             subset,
         },
         iterate: args.iterate,
+        holdout,
         validation: validation.as_ref(),
     };
     let run = identify::run(m, &measurements, &request)?;
