@@ -112,8 +112,9 @@ impl<'m> ExactChain<'m> {
         ExactChain { machine }
     }
 
-    /// The weight `w_j(q)` of error `j` in its slots.
-    fn weights(&self, q: &[f64]) -> Vec<f64> {
+    /// The weight `w_j(q)` of every error in its slots: the basis function
+    /// of a function-slot coefficient at its joint variable, else 1.
+    pub fn weights(&self, q: &[f64]) -> Vec<f64> {
         let mut w = vec![1.0; self.machine.errors.len()];
         for f in &self.machine.functions {
             for (k, b) in &f.coefficients {

@@ -160,18 +160,10 @@ pub fn check(
         .zip(&w)
         .fold(0.0f64, |a, (d, w)| a.max((d * w).abs()));
     let exceeds_noise = noise.is_some_and(|s| worst > s);
-    let chain_weights = |q: &[f64]| -> Vec<f64> {
-        let mut wj = vec![1.0; machine.errors.len()];
-        for func in &machine.functions {
-            for (k, b) in &func.coefficients {
-                wj[*k] = b.value(q[func.variable]);
-            }
-        }
-        wj
-    };
+    let chain = ExactChain::new(machine);
     let mut largest = vec![0.0f64; x.len()];
     for rec in records {
-        let wj = chain_weights(&rec.q);
+        let wj = chain.weights(&rec.q);
         for (j, l) in largest.iter_mut().enumerate() {
             *l = l.max((wj[j] * x[j]).abs());
         }
