@@ -600,8 +600,13 @@ fn the_cli_chooses_the_subset_as_the_library_does() {
         ),
         (
             &["--estimate", "DY2,DY3"][..],
-            "--estimate: the measurements cannot separate DY2, DY3 from the other estimated parameters",
+            "--estimate: the measurements cannot separate DY3 from the other estimated parameters; fix it too",
         ),
+        (
+            &["--estimate", "DX1,DY2,DY3"][..],
+            "--estimate: the measurements cannot separate DY3 from the other estimated parameters; fix it too",
+        ),
+        (&["--estimate", ""][..], "--estimate: names no error parameter"),
         (&["--rank-tol", "0"][..], "--rank-tol: 0 is not a relative tolerance in (0, 1)"),
         (&["--rank-tol", "1.5"][..], "--rank-tol: 1.5 is not a relative tolerance in (0, 1)"),
     ] {

@@ -139,12 +139,23 @@ pub struct FirstOrderDoc {
 }
 
 impl FirstOrderDoc {
-    fn new(c: &FirstOrderCheck, iterated: bool) -> FirstOrderDoc {
-        let mut words = if c.exceeds_noise {
+    fn new(c: &FirstOrderCheck, iterated: bool, prior: bool) -> FirstOrderDoc {
+        let advice = if iterated {
+            ""
+        } else if prior {
+            ": identify without --prior and with --iterate"
+        } else {
+            ": identify with --iterate"
+        };
+        let mut words = if c.noise.is_none() {
             format!(
-                "the first-order model differs from the exact kinematics by up to {} at the measured poses, more than the noise{}",
-                significant(c.max),
-                if iterated { "" } else { ": identify with --iterate" }
+                "the first-order model differs from the exact kinematics by up to {} at the measured poses (no noise estimate to compare with)",
+                significant(c.max)
+            )
+        } else if c.exceeds_noise {
+            format!(
+                "the first-order model differs from the exact kinematics by up to {} at the measured poses, more than the noise{advice}",
+                significant(c.max)
             )
         } else {
             format!(
@@ -544,7 +555,7 @@ impl IdentifyDocument {
                 })
                 .collect(),
             outliers: r.outliers,
-            first_order: FirstOrderDoc::new(check, iteration.is_some()),
+            first_order: FirstOrderDoc::new(check, iteration.is_some(), r.prior),
             iteration: iteration.map(|it| IterationDoc::new(it, &r.errors)),
             noise: r.noise,
             subset: r.subset.as_ref().map(|s| SubsetDoc::new(s, &r.errors)),
@@ -703,6 +714,8 @@ pub fn values_file(m: &Machine, source: &str, identified: &Identified) -> String
             "# {name} reaches {angle:e} rad at the measured poses: beyond the first-order range ({ANGLE_LIMIT} rad){}",
             if identified.iteration.is_some() {
                 ""
+            } else if r.prior {
+                "; identify without --prior and with --iterate"
             } else {
                 "; identify with --iterate"
             }

@@ -24,7 +24,8 @@
 //!   `(H + μ diag H) δ = Jᵀ W r`, `H = Jᵀ W J` (equilibrated Cholesky); a
 //!   step that lowers the sum is taken and `μ /= 3`, else `μ *= 4`.
 //!   Converged when an accepted step lowers the sum by less than 1e-12 of
-//!   it, or no step can (`μ > 1e10`); at most [`MAX_ITERATIONS`]. The
+//!   it, or no step can (`μ > 1e10`); at most [`MAX_ITERATIONS`]; not
+//!   converged when the exact model is not finite. The
 //!   covariance is `s² H⁻¹` (`s² = RSS/(m − k)`) without a `std` column,
 //!   `H⁻¹` with one, at the solution.
 
@@ -213,10 +214,15 @@ pub fn iterate(
     let mut iterations = 0;
     let mut converged = false;
     let mut h = DMatrix::zeros(k, k);
-    while iterations < MAX_ITERATIONS {
+    let mut finite = rss_linear.is_finite();
+    while k > 0 && finite && iterations < MAX_ITERATIONS {
         iterations += 1;
         let (f, jac) = exact_rows(machine, records, design, &x, true);
         let Some(jac) = jac else { break };
+        if !jac.iter().chain(&f).all(|v| v.is_finite()) {
+            finite = false;
+            break;
+        }
         // Weighted rows of the estimated columns.
         let js = DMatrix::from_fn(m, k, |i, a| jac[(i, estimated[a])] * w[i]);
         let r = DVector::from_fn(m, |i, _| (design.b[i] - f[i]) * w[i]);
@@ -262,13 +268,21 @@ pub fn iterate(
             mu *= 4.0;
         }
         if !improved {
+            // No step lowers the sum: a minimum to the model's precision.
             converged = true;
         }
         if converged {
             break;
         }
     }
-    let (f, _) = exact_rows(machine, records, design, &x, false);
+    // The Hessian at the solution (the loop's is that of the point before
+    // its last step).
+    let (f, jac) = exact_rows(machine, records, design, &x, true);
+    if let Some(jac) = jac {
+        let js = DMatrix::from_fn(m, k, |i, a| jac[(i, estimated[a])] * w[i]);
+        h = js.tr_mul(&js);
+    }
+    let converged = converged && finite;
     let res: Vec<f64> = design.b.iter().zip(&f).map(|(b, f)| b - f).collect();
     let rms = (res.iter().map(|r| r * r).sum::<f64>() / m.max(1) as f64).sqrt();
     let max = res.iter().fold(0.0f64, |a, r| a.max(r.abs()));
@@ -279,10 +293,19 @@ pub fn iterate(
     } else {
         None
     };
-    let hinv = h
-        .clone()
-        .try_inverse()
-        .unwrap_or_else(|| DMatrix::zeros(k, k));
+    // Equilibrated Cholesky; a singular H leaves the std unknown (NaN),
+    // never 0.
+    let e: Vec<f64> = (0..k)
+        .map(|a| 1.0 / h[(a, a)].max(f64::MIN_POSITIVE).sqrt())
+        .collect();
+    let scaled = DMatrix::from_fn(k, k, |a, b| e[a] * h[(a, b)] * e[b]);
+    let hinv = match nalgebra::Cholesky::new(scaled) {
+        Some(ch) => {
+            let inv = ch.inverse();
+            DMatrix::from_fn(k, k, |a, b| e[a] * inv[(a, b)] * e[b])
+        }
+        None => DMatrix::from_element(k, k, f64::NAN),
+    };
     let mut covariance = DMatrix::zeros(n, n);
     for (a, &i) in estimated.iter().enumerate() {
         for (b, &j) in estimated.iter().enumerate() {
@@ -292,7 +315,7 @@ pub fn iterate(
     let estimates = (0..n)
         .map(|j| Estimate {
             value: x[j],
-            std: (estimated.contains(&j) && scale2.is_some())
+            std: (estimated.contains(&j) && scale2.is_some() && covariance[(j, j)].is_finite())
                 .then(|| covariance[(j, j)].max(0.0).sqrt()),
         })
         .collect();

@@ -84,6 +84,18 @@ impl SubsetChoice {
                 option: "--fix",
                 message: "cannot be given with --estimate (one names the fixed parameters, the other the estimated ones)".into(),
             }),
+            (Some(names), None) if names.iter().all(|n| n.trim().is_empty()) => {
+                Err(IdentifyError::Subset {
+                    option: "--fix",
+                    message: "names no error parameter".into(),
+                })
+            }
+            (None, Some(names)) if names.iter().all(|n| n.trim().is_empty()) => {
+                Err(IdentifyError::Subset {
+                    option: "--estimate",
+                    message: "names no error parameter".into(),
+                })
+            }
             (Some(names), None) => Ok(SubsetChoice::Fix(names)),
             (None, Some(names)) => Ok(SubsetChoice::Estimate(names)),
             (None, None) => Ok(SubsetChoice::Elimination),
@@ -222,7 +234,7 @@ impl Problem<'_> {
 /// `steps` pivots, each the candidate with the largest remaining norm (ties
 /// within 1e-9 relative to the first), stopping when the largest is at most
 /// `floor`. Returns the pivots in order and every candidate's remaining
-/// norm after them.
+/// norm after them (infinite for a pivot).
 fn pivots(
     c: &DMatrix<f64>,
     candidates: &[usize],
@@ -263,7 +275,9 @@ fn pivots(
         }
         cols[p].fill(0.0);
     }
-    let remaining = cols.iter().map(|v| v.norm()).collect();
+    let remaining = (cols.iter().zip(&taken))
+        .map(|(v, &t)| if t { f64::INFINITY } else { v.norm() })
+        .collect();
     (chosen, remaining)
 }
 
