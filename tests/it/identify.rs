@@ -18,7 +18,7 @@ use chain::core::values::{Values, ValuesBuilder};
 use chain::core::{ErrorModel, Machine};
 use chain::reliability::Posterior;
 use common::cli::{fails, ok_json, ok_stdout, scratch, unwrapped, write};
-use common::{load_example, Exact, Rng};
+use common::{gauss, load_example, Exact, Rng};
 use nalgebra::DMatrix;
 
 /// A three-axis machine with constants and function-slot coefficients
@@ -97,13 +97,6 @@ fn full_rank() -> IdentifyOptions {
 
 fn xyz() -> Machine {
     chain::core::load_str(XYZ, "xyz3.yaml").expect("xyz3 loads")
-}
-
-/// A standard normal deviate (Box–Muller over the tests' generator).
-fn gauss(rng: &mut Rng) -> f64 {
-    let u1 = rng.unit().max(1e-300);
-    let u2 = rng.unit();
-    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
 /// `count` poses with tool offsets, deterministic.
@@ -1036,12 +1029,7 @@ fn held_out_poses_are_predicted_as_the_exact_product_predicts_them() {
                 .sum::<f64>(),
         );
     }
-    let stats = |squares: &[f64]| {
-        let mean = squares.iter().map(|s| s.sqrt()).sum::<f64>() / squares.len() as f64;
-        let max = squares.iter().map(|s| s.sqrt()).fold(0.0, f64::max);
-        let rms = (squares.iter().sum::<f64>() / (3 * squares.len()) as f64).sqrt();
-        [mean, max, rms]
-    };
+    let stats = common::point_error_stats;
     for (key, expected, tolerance) in [
         ("before", stats(&before), 1e-12),
         ("after", stats(&after), 1e-7),

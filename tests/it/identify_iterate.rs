@@ -10,7 +10,7 @@ use crate::common;
 
 use chain::core::measured::exact::ExactChain;
 use chain::core::Machine;
-use common::{example_file, load_example, Exact, Rng};
+use common::{example_file, gauss, load_example, Exact, Rng};
 
 /// Random poses and errors of `size` (mm, and 1e-3 × size rad).
 fn random_case(m: &Machine, rng: &mut Rng, size: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
@@ -107,13 +107,6 @@ fn the_exact_deviation_and_its_derivatives_are_the_products() {
 
 use chain::core::measured::document::identify_document;
 use chain::core::measured::{IdentifyOptions, Measurement, Measurements, Observed, SubsetChoice};
-
-/// A standard normal deviate (Box–Muller over the tests' generator).
-fn gauss(rng: &mut Rng) -> f64 {
-    let u1 = rng.unit().max(1e-300);
-    let u2 = rng.unit();
-    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-}
 
 /// The example arm.
 fn arm() -> Machine {
@@ -274,15 +267,7 @@ fn the_cli_iterates_as_the_library_does() {
     let mut rng = Rng::new(47);
     let e = truth(&m, 1.0, &mut rng);
     let data = measured(&m, &e, 150, 1e-3, &mut rng);
-    let mut csv = String::from("q1,q2,q3,q4,q5,q6,dpx,dpy,dpz\n");
-    for r in &data.rows {
-        let cells: Vec<String> =
-            r.q.iter()
-                .chain(&r.values)
-                .map(|v| format!("{v:?}"))
-                .collect();
-        csv.push_str(&(cells.join(",") + "\n"));
-    }
+    let csv = common::point_csv("q1,q2,q3,q4,q5,q6,dpx,dpy,dpz", &data.rows);
     let dir = scratch("identify-iterate");
     let file = write(&dir, "arm.csv", &csv);
     let machine = example_file("robots/arm6_offsets.yaml");
@@ -342,15 +327,7 @@ fn held_out_records_are_predicted_as_the_product_predicts_them() {
     let mut rng = Rng::new(53);
     let e = truth(&m, 0.02, &mut rng);
     let data = measured(&m, &e, 200, 1e-3, &mut rng);
-    let mut csv = String::from("q1,q2,q3,q4,q5,q6,dpx,dpy,dpz\n");
-    for r in &data.rows {
-        let cells: Vec<String> =
-            r.q.iter()
-                .chain(&r.values)
-                .map(|v| format!("{v:?}"))
-                .collect();
-        csv.push_str(&(cells.join(",") + "\n"));
-    }
+    let csv = common::point_csv("q1,q2,q3,q4,q5,q6,dpx,dpy,dpz", &data.rows);
     let dir = scratch("identify-holdout");
     let file = write(&dir, "arm.csv", &csv);
     let machine = example_file("robots/arm6_offsets.yaml");
@@ -400,12 +377,7 @@ fn held_out_records_are_predicted_as_the_product_predicts_them() {
                     .sum::<f64>(),
             );
         }
-        let stats = |squares: &[f64]| {
-            let mean = squares.iter().map(|s| s.sqrt()).sum::<f64>() / squares.len() as f64;
-            let max = squares.iter().map(|s| s.sqrt()).fold(0.0, f64::max);
-            let rms = (squares.iter().sum::<f64>() / (3 * squares.len()) as f64).sqrt();
-            [mean, max, rms]
-        };
+        let stats = common::point_error_stats;
         for (key, expected, tol) in [
             ("before", stats(&before), 1e-12),
             ("after", stats(&after), tolerance),

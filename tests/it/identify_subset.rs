@@ -16,7 +16,7 @@ use chain::core::measured::{
     SubsetChoice,
 };
 use chain::core::{ErrorModel, Machine};
-use common::{example_file, Exact, Rng};
+use common::{example_file, gauss, Exact, Rng};
 
 /// The example arm (examples/robots/arm6_offsets.yaml).
 fn arm() -> Machine {
@@ -24,13 +24,6 @@ fn arm() -> Machine {
         Ok(m) => m,
         Err(d) => panic!("the arm does not load:\n{d}"),
     }
-}
-
-/// A standard normal deviate (Box–Muller over the tests' generator).
-fn gauss(rng: &mut Rng) -> f64 {
-    let u1 = rng.unit().max(1e-300);
-    let u2 = rng.unit();
-    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
 /// `count` arm poses, each joint uniform in `±range[k]` rad.
@@ -485,16 +478,7 @@ fn weak_directions_are_left_out_not_estimated_wildly() {
 
 /// The arm's records as a measurement CSV (`q1..q6,dpx,dpy,dpz`).
 fn arm_csv(records: &[Measurement]) -> String {
-    let mut csv = String::from("q1,q2,q3,q4,q5,q6,dpx,dpy,dpz\n");
-    for r in records {
-        let cells: Vec<String> =
-            r.q.iter()
-                .chain(&r.values)
-                .map(|v| format!("{v:?}"))
-                .collect();
-        csv.push_str(&(cells.join(",") + "\n"));
-    }
-    csv
+    common::point_csv("q1,q2,q3,q4,q5,q6,dpx,dpy,dpz", records)
 }
 
 /// `--fix`, `--estimate` and `--rank-tol` through the CLI: the JSON's

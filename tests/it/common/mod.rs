@@ -165,6 +165,39 @@ pub fn vee_skew(m: &Mat3) -> [f64; 3] {
     ]
 }
 
+/// A standard normal deviate (Box–Muller over the tests' generator).
+pub fn gauss(rng: &mut Rng) -> f64 {
+    let u1 = rng.unit().max(1e-300);
+    let u2 = rng.unit();
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+}
+
+/// Point records as a measurement CSV: `header` (the pose columns, then
+/// `dpx,dpy,dpz`), each row the pose then the measured values, in full
+/// precision.
+pub fn point_csv(header: &str, records: &[chain_core::measured::Measurement]) -> String {
+    let mut csv = format!("{header}\n");
+    for r in records {
+        let cells: Vec<String> =
+            r.q.iter()
+                .chain(&r.values)
+                .map(|v| format!("{v:?}"))
+                .collect();
+        csv.push_str(&(cells.join(",") + "\n"));
+    }
+    csv
+}
+
+/// `[mean, max, rms]` of per-record squared 3-vector errors, as
+/// `chain identify`'s prediction reports them (mean and max of `|dp|`, rms
+/// over the scalar rows).
+pub fn point_error_stats(squares: &[f64]) -> [f64; 3] {
+    let mean = squares.iter().map(|s| s.sqrt()).sum::<f64>() / squares.len() as f64;
+    let max = squares.iter().map(|s| s.sqrt()).fold(0.0, f64::max);
+    let rms = (squares.iter().sum::<f64>() / (3 * squares.len()) as f64).sqrt();
+    [mean, max, rms]
+}
+
 /// Random axis values: angles in [-angle, angle) rad, slides in
 /// [-500, 500) mm.
 pub fn random_q(kinds: &[JointKind], rng: &mut Rng, angle: f64) -> Vec<f64> {
