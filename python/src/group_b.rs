@@ -100,6 +100,9 @@ pub(crate) fn identify_json(
     let subset =
         SubsetChoice::from_options(fix, estimate).map_err(|e| value_error(e.to_string()))?;
     let holdout = Holdout::from_options(holdout, seed).map_err(|e| value_error(e.to_string()))?;
+    let options = IdentifyOptions { rank_tol, subset };
+    identify::check_options(prior, &options, iterate, holdout, validate.is_some())
+        .map_err(|e| value_error(e.to_string()))?;
     chain::ops::resolve::check_parameters(m, &params).map_err(|e| resolve_error(py, model, e))?;
     let measurements = read_measurements(py, m, path, text, file, &params, Layout::Measurements)?;
     let validation = match &validate {
@@ -116,7 +119,7 @@ pub(crate) fn identify_json(
     };
     let request = IdentifyRequest {
         prior,
-        options: IdentifyOptions { rank_tol, subset },
+        options,
         iterate,
         holdout,
         validation: validation.as_ref(),

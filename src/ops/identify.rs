@@ -49,19 +49,45 @@ impl Serialize for IdentifyRun {
     }
 }
 
+/// The checks of `chain identify`'s options that need no file (the CLI
+/// and Python run them before reading the machine and the measurements):
+/// `--rank-tol`, `--fix`/`--estimate` with `--prior`, `--iterate` with
+/// `--prior`, `--holdout` with `--validate` (the fraction is checked where
+/// the [`Holdout`] is made).
+pub fn check_options(
+    prior: bool,
+    options: &IdentifyOptions,
+    iterate: bool,
+    holdout: Option<Holdout>,
+    validate: bool,
+) -> Result<(), DocumentError> {
+    options.check(prior)?;
+    if iterate && prior {
+        return Err(chain_core::measured::IdentifyError::IterateWithPrior.into());
+    }
+    if holdout.is_some() && validate {
+        return Err(HoldoutError {
+            message: "cannot be given with --validate (one holds records of the measurements out, the other reads them from a file)".into(),
+        }
+        .into());
+    }
+    Ok(())
+}
+
 /// Runs `chain identify` of `machine` over `measurements`.
 pub fn run(
     machine: &Machine,
     measurements: &Measurements,
     request: &IdentifyRequest<'_>,
 ) -> Result<IdentifyRun, DocumentError> {
+    check_options(
+        request.prior,
+        &request.options,
+        request.iterate,
+        request.holdout,
+        request.validation.is_some(),
+    )?;
     let split = match request.holdout {
-        Some(_) if request.validation.is_some() => {
-            return Err(HoldoutError {
-                message: "cannot be given with --validate (one holds records of the measurements out, the other reads them from a file)".into(),
-            }
-            .into())
-        }
         Some(h) => Some(measurements.holdout(h.fraction, h.seed)?),
         None => None,
     };

@@ -1018,22 +1018,9 @@ fn held_out_poses_are_predicted_as_the_exact_product_predicts_them() {
     let x: Vec<f64> = (names.iter())
         .map(|n| doc["subset"]["estimates"][n]["value"].as_f64().unwrap())
         .collect();
-    let exact = Exact::new(&m);
-    let (mut before, mut after) = (Vec::new(), Vec::new());
-    for r in &held_records {
-        let predicted = exact.exact_error(&r.q, &r.p, &x);
-        before.push(r.values.iter().map(|v| v * v).sum::<f64>());
-        after.push(
-            (0..3)
-                .map(|c| (r.values[c] - predicted[c]).powi(2))
-                .sum::<f64>(),
-        );
-    }
-    let stats = common::point_error_stats;
-    for (key, expected, tolerance) in [
-        ("before", stats(&before), 1e-12),
-        ("after", stats(&after), 1e-7),
-    ] {
+    let held: Vec<&Measurement> = held_records.iter().collect();
+    let (before, after) = common::held_out_stats(&Exact::new(&m), &held, &x);
+    for (key, expected, tolerance) in [("before", before, 1e-12), ("after", after, 1e-7)] {
         for (k, field) in ["mean", "max", "rms"].iter().enumerate() {
             let got = v[key][field].as_f64().unwrap();
             assert!(

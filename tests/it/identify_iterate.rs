@@ -152,6 +152,23 @@ fn measured(m: &Machine, e: &[f64], count: usize, sigma: f64, rng: &mut Rng) -> 
     }
 }
 
+/// `count` records of the arm with its kept errors at `size` (σ = 1e-3
+/// mm, from `seed`), and their CSV written to a scratch directory `name`.
+fn arm_file(
+    m: &Machine,
+    size: f64,
+    count: usize,
+    seed: u64,
+    name: &str,
+) -> (Vec<f64>, Measurements, std::path::PathBuf) {
+    let mut rng = Rng::new(seed);
+    let e = truth(m, size, &mut rng);
+    let data = measured(m, &e, count, 1e-3, &mut rng);
+    let csv = common::point_csv("q1,q2,q3,q4,q5,q6,dpx,dpy,dpz", &data.rows);
+    let file = common::cli::write(&common::cli::scratch(name), "arm.csv", &csv);
+    (e, data, file)
+}
+
 /// The arm's kept errors at `size` × (1 mm, 5e-3 rad), the others 0.
 fn truth(m: &Machine, size: f64, rng: &mut Rng) -> Vec<f64> {
     m.errors
@@ -262,14 +279,9 @@ fn iterate_changes_nothing_on_small_errors() {
 /// `--prior` it is refused naming both options.
 #[test]
 fn the_cli_iterates_as_the_library_does() {
-    use common::cli::{fails, ok_json, scratch, unwrapped, write};
+    use common::cli::{fails, ok_json, unwrapped};
     let m = arm();
-    let mut rng = Rng::new(47);
-    let e = truth(&m, 1.0, &mut rng);
-    let data = measured(&m, &e, 150, 1e-3, &mut rng);
-    let csv = common::point_csv("q1,q2,q3,q4,q5,q6,dpx,dpy,dpz", &data.rows);
-    let dir = scratch("identify-iterate");
-    let file = write(&dir, "arm.csv", &csv);
+    let (_, data, file) = arm_file(&m, 1.0, 150, 47, "identify-iterate");
     let machine = example_file("robots/arm6_offsets.yaml");
     let kept = KEPT.join(",");
     let args = [
@@ -304,7 +316,8 @@ fn the_cli_iterates_as_the_library_does() {
         );
     }
     assert_eq!(json["first_order"]["exceeds_noise"], true);
-    let err = unwrapped(&fails(&[&args[..], &["--prior"]].concat()));
+    // Without --estimate (which --prior refuses by itself).
+    let err = unwrapped(&fails(&[&args[..4], &["--iterate", "--prior"]].concat()));
     assert!(
         err.contains(
             "--iterate fits the exact kinematics by least squares; it does not take --prior"
@@ -322,14 +335,9 @@ fn the_cli_iterates_as_the_library_does() {
 /// fraction outside (0, 1) and `--holdout` with `--validate` are refused.
 #[test]
 fn held_out_records_are_predicted_as_the_product_predicts_them() {
-    use common::cli::{fails, ok_json, scratch, unwrapped, write};
+    use common::cli::{fails, ok_json, unwrapped};
     let m = arm();
-    let mut rng = Rng::new(53);
-    let e = truth(&m, 0.02, &mut rng);
-    let data = measured(&m, &e, 200, 1e-3, &mut rng);
-    let csv = common::point_csv("q1,q2,q3,q4,q5,q6,dpx,dpy,dpz", &data.rows);
-    let dir = scratch("identify-holdout");
-    let file = write(&dir, "arm.csv", &csv);
+    let (_, data, file) = arm_file(&m, 0.02, 200, 53, "identify-holdout");
     let machine = example_file("robots/arm6_offsets.yaml");
     let base = [
         "identify",
@@ -344,7 +352,6 @@ fn held_out_records_are_predicted_as_the_product_predicts_them() {
         "json",
     ];
     let exact = Exact::new(&m);
-    let p = exact.file_parameters();
     for (iterate, tolerance) in [(true, 1e-9), (false, 2e-5)] {
         let args: Vec<&str> = if iterate {
             [&base[..], &["--iterate"]].concat()
@@ -367,21 +374,11 @@ fn held_out_records_are_predicted_as_the_product_predicts_them() {
         let x: Vec<f64> = (m.errors.iter())
             .map(|er| values[&er.name]["value"].as_f64().unwrap())
             .collect();
-        let (mut before, mut after) = (Vec::new(), Vec::new());
-        for r in data.rows.iter().filter(|r| lines.contains(&r.line)) {
-            let predicted = exact.exact_error(&r.q, &p, &x);
-            before.push(r.values.iter().map(|v| v * v).sum::<f64>());
-            after.push(
-                (0..3)
-                    .map(|c| (r.values[c] - predicted[c]).powi(2))
-                    .sum::<f64>(),
-            );
-        }
-        let stats = common::point_error_stats;
-        for (key, expected, tol) in [
-            ("before", stats(&before), 1e-12),
-            ("after", stats(&after), tolerance),
-        ] {
+        let held: Vec<&Measurement> = (data.rows.iter())
+            .filter(|r| lines.contains(&r.line))
+            .collect();
+        let (before, after) = common::held_out_stats(&exact, &held, &x);
+        for (key, expected, tol) in [("before", before, 1e-12), ("after", after, tolerance)] {
             for (k, field) in ["mean", "max", "rms"].iter().enumerate() {
                 let got = v[key][field].as_f64().unwrap();
                 assert!(
@@ -407,4 +404,46 @@ fn held_out_records_are_predicted_as_the_product_predicts_them() {
         with(&["--holdout", "0.2", "--validate", file.to_str().unwrap()])
             .contains("--holdout: cannot be given with --validate")
     );
+}
+
+/// The option checks that need no file run before any file is read: with
+/// a measurement file that does not exist, each bad option is still the
+/// refusal (not the missing file).
+#[test]
+fn bad_options_are_refused_before_the_files_are_read() {
+    use common::cli::{fails, unwrapped};
+    let machine = example_file("robots/arm6_offsets.yaml");
+    let base = [
+        "identify",
+        machine.to_str().unwrap(),
+        "--measurements",
+        "/nonexistent/arm.csv",
+    ];
+    for (extra, wanted) in [
+        (
+            &["--rank-tol", "2"][..],
+            "--rank-tol: 2 is not a relative tolerance",
+        ),
+        (
+            &["--fix", "DY2", "--prior"][..],
+            "--fix chooses the parameters of a least-squares fit",
+        ),
+        (
+            &["--iterate", "--prior"][..],
+            "--iterate fits the exact kinematics",
+        ),
+        (
+            &["--holdout", "0"][..],
+            "--holdout: 0 is not a fraction in (0, 1)",
+        ),
+        (
+            &["--holdout", "0.2", "--validate", "/nonexistent/v.csv"][..],
+            "--holdout: cannot be given with --validate",
+        ),
+    ] {
+        let args: Vec<&str> = base.iter().chain(extra).copied().collect();
+        let err = unwrapped(&fails(&args));
+        assert!(err.contains(wanted), "{extra:?}: {err}");
+        assert!(!err.contains("nonexistent"), "{extra:?}: {err}");
+    }
 }

@@ -117,6 +117,15 @@ fn arm_truth(m: &Machine, rng: &mut Rng) -> (Vec<f64>, Vec<f64>) {
 
 const FULL: [f64; 6] = [3.0, 1.5, 1.5, 3.0, 2.0, 3.0];
 
+/// `count` arm records over the full joint ranges, σ = 0.01 mm, realistic
+/// errors, from `seed`.
+fn arm_records(m: &Machine, count: usize, seed: u64) -> Vec<Measurement> {
+    let mut rng = Rng::new(seed);
+    let (e, _) = arm_truth(m, &mut rng);
+    let qs = arm_poses(count, FULL, &mut rng);
+    simulate(m, &qs, &e, 0.01, &mut rng)
+}
+
 /// Each estimated unknown's combination of the truth, `e_k + Σ_j c_jk e_j`
 /// over the fixed unknowns' relations (every weight), and the same
 /// combination's scale `√(s_k² + Σ_j (c_jk s_j)²)` from the unknowns'
@@ -147,14 +156,7 @@ fn combinations(r: &Identification, e: &[f64], scale: &[f64]) -> (Vec<f64>, Vec<
 #[test]
 fn parallel_axes_act_through_their_sum() {
     let m = arm();
-    let mut rng = Rng::new(11);
-    let (e, _) = arm_truth(&m, &mut rng);
-    let qs = arm_poses(200, FULL, &mut rng);
-    let r = solve(
-        &m,
-        &simulate(&m, &qs, &e, 0.01, &mut rng),
-        &IdentifyOptions::default(),
-    );
+    let r = solve(&m, &arm_records(&m, 200, 11), &IdentifyOptions::default());
     // 4 per revolute joint + 6 − 3 for position-only data.
     assert_eq!((r.rank, r.noise.weak), (27, 0));
     for (kept, fixed) in [
@@ -191,14 +193,7 @@ fn parallel_axes_act_through_their_sum() {
 #[test]
 fn a_tool_offset_along_the_last_axis_is_its_location_error() {
     let m = arm();
-    let mut rng = Rng::new(12);
-    let (e, _) = arm_truth(&m, &mut rng);
-    let qs = arm_poses(200, FULL, &mut rng);
-    let r = solve(
-        &m,
-        &simulate(&m, &qs, &e, 0.01, &mut rng),
-        &IdentifyOptions::default(),
-    );
+    let r = solve(&m, &arm_records(&m, 200, 12), &IdentifyOptions::default());
     let (status, terms) = relation(&r, "TX");
     assert_eq!(status, FixedStatus::Redundant);
     assert_eq!(terms.len(), 1, "{terms:?}");
@@ -272,10 +267,8 @@ tool: tool
 fn every_valid_subset_predicts_alike_everywhere() {
     let m = arm();
     let model = chain::core::compile(&m);
-    let mut rng = Rng::new(14);
-    let (e, _) = arm_truth(&m, &mut rng);
-    let qs = arm_poses(200, FULL, &mut rng);
-    let records = simulate(&m, &qs, &e, 0.01, &mut rng);
+    let records = arm_records(&m, 200, 14);
+    let mut rng = Rng::new(114);
     let exact = IdentifyOptions {
         rank_tol: Some(1e-6),
         ..Default::default()
@@ -489,10 +482,7 @@ fn arm_csv(records: &[Measurement]) -> String {
 fn the_cli_chooses_the_subset_as_the_library_does() {
     use common::cli::{fails, ok_json, ok_stdout, scratch, unwrapped, write};
     let m = arm();
-    let mut rng = Rng::new(16);
-    let (e, _) = arm_truth(&m, &mut rng);
-    let qs = arm_poses(120, FULL, &mut rng);
-    let records = simulate(&m, &qs, &e, 0.01, &mut rng);
+    let records = arm_records(&m, 120, 16);
     let dir = scratch("identify-subset");
     let csv = write(&dir, "arm.csv", &arm_csv(&records));
     let machine = example_file("robots/arm6_offsets.yaml");

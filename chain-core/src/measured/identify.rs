@@ -73,6 +73,26 @@ pub struct IdentifyOptions {
     pub subset: SubsetChoice,
 }
 
+impl IdentifyOptions {
+    /// The checks that need no data: `--rank-tol` in `(0, 1)`, no subset
+    /// choice with a prior. [`identify`] runs them; front ends run them
+    /// before reading any file.
+    pub fn check(&self, prior: bool) -> Result<(), IdentifyError> {
+        if let Some(t) = self.rank_tol {
+            if !(t > 0.0 && t < 1.0) {
+                return Err(IdentifyError::RankTolerance(t));
+            }
+        }
+        match (&self.subset, prior) {
+            (SubsetChoice::Fix(_), true) => Err(IdentifyError::SubsetWithPrior { option: "--fix" }),
+            (SubsetChoice::Estimate(_), true) => Err(IdentifyError::SubsetWithPrior {
+                option: "--estimate",
+            }),
+            _ => Ok(()),
+        }
+    }
+}
+
 /// How the count of determined directions (the reported rank) was decided.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct NoiseRule {
@@ -426,22 +446,7 @@ pub fn identify(
     options: &IdentifyOptions,
 ) -> Result<Identification, IdentifyError> {
     let (m, n) = design.a.shape();
-    if let Some(t) = options.rank_tol {
-        if !(t > 0.0 && t < 1.0) {
-            return Err(IdentifyError::RankTolerance(t));
-        }
-    }
-    if prior.is_some() {
-        match &options.subset {
-            SubsetChoice::Elimination => {}
-            SubsetChoice::Fix(_) => return Err(IdentifyError::SubsetWithPrior { option: "--fix" }),
-            SubsetChoice::Estimate(_) => {
-                return Err(IdentifyError::SubsetWithPrior {
-                    option: "--estimate",
-                })
-            }
-        }
-    }
+    options.check(prior.is_some())?;
     let tolerance = options.rank_tol.unwrap_or(RANK_TOLERANCE);
     if m == 0 && prior.is_none() {
         return Err(IdentifyError::NoRows);

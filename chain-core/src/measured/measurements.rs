@@ -169,10 +169,25 @@ impl Holdout {
                         .into(),
             }),
             (None, None) => Ok(None),
-            (Some(fraction), seed) => Ok(Some(Holdout {
-                fraction,
-                seed: seed.unwrap_or(Holdout::DEFAULT_SEED),
-            })),
+            (Some(fraction), seed) => {
+                let h = Holdout {
+                    fraction,
+                    seed: seed.unwrap_or(Holdout::DEFAULT_SEED),
+                };
+                h.check()?;
+                Ok(Some(h))
+            }
+        }
+    }
+
+    /// The fraction in `(0, 1)`.
+    pub fn check(&self) -> Result<(), HoldoutError> {
+        if self.fraction > 0.0 && self.fraction < 1.0 {
+            Ok(())
+        } else {
+            Err(HoldoutError {
+                message: format!("{} is not a fraction in (0, 1)", self.fraction),
+            })
         }
     }
 }
@@ -192,11 +207,7 @@ impl Measurements {
     ) -> Result<(Measurements, Measurements), HoldoutError> {
         use rand::seq::SliceRandom;
         use rand::SeedableRng;
-        if !(fraction > 0.0 && fraction < 1.0) {
-            return Err(HoldoutError {
-                message: format!("{fraction} is not a fraction in (0, 1)"),
-            });
-        }
+        Holdout { fraction, seed }.check()?;
         let n = self.rows.len();
         let held = (fraction * n as f64).round() as usize;
         if held == 0 || held == n {

@@ -88,6 +88,17 @@ pub struct IdentifyArgs {
 pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
     let subset = SubsetChoice::from_options(args.fix, args.estimate)?;
     let holdout = Holdout::from_options(args.holdout, args.seed)?;
+    let options = IdentifyOptions {
+        rank_tol: args.rank_tol,
+        subset,
+    };
+    identify::check_options(
+        args.prior,
+        &options,
+        args.iterate,
+        holdout,
+        args.validate.is_some(),
+    )?;
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
     args.param.check_names(m)?;
@@ -108,10 +119,7 @@ pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
     };
     let request = IdentifyRequest {
         prior: args.prior,
-        options: IdentifyOptions {
-            rank_tol: args.rank_tol,
-            subset,
-        },
+        options,
         iterate: args.iterate,
         holdout,
         validation: validation.as_ref(),

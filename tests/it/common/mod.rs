@@ -191,11 +191,34 @@ pub fn point_csv(header: &str, records: &[chain_core::measured::Measurement]) ->
 /// `[mean, max, rms]` of per-record squared 3-vector errors, as
 /// `chain identify`'s prediction reports them (mean and max of `|dp|`, rms
 /// over the scalar rows).
-pub fn point_error_stats(squares: &[f64]) -> [f64; 3] {
+fn point_error_stats(squares: &[f64]) -> [f64; 3] {
     let mean = squares.iter().map(|s| s.sqrt()).sum::<f64>() / squares.len() as f64;
     let max = squares.iter().map(|s| s.sqrt()).fold(0.0, f64::max);
     let rms = (squares.iter().sum::<f64>() / (3 * squares.len()) as f64).sqrt();
     [mean, max, rms]
+}
+
+/// The held-out error statistics `[mean, max, rms]` of point records
+/// before correction (the measured values) and after it (less the exact
+/// product's deviation with the values `x` at each record's pose): the
+/// independent computation `chain identify`'s prediction is checked
+/// against.
+pub fn held_out_stats(
+    exact: &Exact,
+    records: &[&chain_core::measured::Measurement],
+    x: &[f64],
+) -> ([f64; 3], [f64; 3]) {
+    let (mut before, mut after) = (Vec::new(), Vec::new());
+    for r in records {
+        let predicted = exact.exact_error(&r.q, &r.p, x);
+        before.push(r.values.iter().map(|v| v * v).sum::<f64>());
+        after.push(
+            (0..3)
+                .map(|c| (r.values[c] - predicted[c]).powi(2))
+                .sum::<f64>(),
+        );
+    }
+    (point_error_stats(&before), point_error_stats(&after))
 }
 
 /// Random axis values: angles in [-angle, angle) rad, slides in
