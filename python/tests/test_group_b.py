@@ -266,3 +266,19 @@ def test_identify_holdout_is_the_cli_json(cli):
     assert r.measurements == 450 - len(v["lines"])
     with pytest.raises(ValueError, match="--holdout: --seed chooses the records --holdout holds out"):
         m.identify(ball, seed=7)
+
+
+def test_dh_robot_calibration_is_the_cli_json(cli):
+    """The PUMA 560 from its DH table (examples/robots/, docs/identify.md) gives the CLI's fit, from
+    the file or from numpy columns: rank 23 of 28 with the four position-only redundancies."""
+    robots = ROOT / "examples/robots"
+    m = chain.Machine.load(robots / "puma560_dh.yaml")
+    assert m.errors[:6] == ["DD1", "DT1", "DA1", "DAL1", "DD2", "DT2"]
+    fit, held = robots / "puma560_tracker.csv", robots / "puma560_validate.csv"
+    r = m.identify(fit, validate=held)
+    assert r.to_dict() == cli("identify", robots / "puma560_dh.yaml", "--measurements", fit, "--validate", held)
+    assert (r.to_dict()["rank"], len(r.to_dict()["groups"])) == (23, 4)
+    assert m.identify(_columns(fit), name=str(fit)).estimates == r.estimates
+    # Held-out rms before/after (docs/identify.md): 0.682 mm -> 0.0224 mm.
+    assert r.validation["before"]["rms"] == pytest.approx(0.6818, abs=1e-4)
+    assert r.validation["after"]["rms"] == pytest.approx(0.02236, abs=1e-5)

@@ -13,6 +13,32 @@ chain::machine!(pub GantryFile = "examples/machines/gantry_grinder.yaml");
 chain::machine!(pub InternalGrinder = "examples/machines/internal_grinder.yaml");
 chain::machine!(pub Cnc5Bevel = "examples/machines/cnc5_bevel.yaml");
 chain::machine!(pub AcTrunnion = "examples/machines/ac_trunnion.yaml");
+chain::machine!(pub Puma560Dh = "examples/robots/puma560_dh.yaml");
+chain::machine!(pub PandaMdh = "examples/robots/panda_mdh.yaml");
+
+// A `dh` and an `mdh` row in the inline form (docs/yaml.md,
+// "Denavit–Hartenberg bodies").
+chain::machine! {
+    pub DhInline {
+        machine: two_link,
+        bodies {
+            base {},
+            l1 {
+                parent: base,
+                dh: { theta: 90deg, d: 100, a: 25, alpha: -90deg, joint: rotary, variable: q1,
+                      errors: { theta: T1, d: D1, a: A1, alpha: AL1, beta: B1 } },
+                errors: { ez: EC1 },
+            },
+            l2 {
+                parent: l1,
+                mdh: { theta: 0, d: 50, a: 300, alpha: 0, joint: prismatic, variable: q2,
+                       errors: { a: A2, d: D2 } },
+            },
+        },
+        workpiece: base,
+        tool: l2,
+    }
+}
 
 chain::machine! {
     pub GantryInline {
@@ -202,6 +228,38 @@ fn generated_code_equals_runtime_evaluator_on_every_example() {
     );
     compare_with_runtime(&Cnc5Bevel, "examples/machines/cnc5_bevel.yaml", 3);
     compare_with_runtime(&AcTrunnion, "examples/machines/ac_trunnion.yaml", 4);
+    compare_with_runtime(&Puma560Dh, "examples/robots/puma560_dh.yaml", 5);
+    compare_with_runtime(&PandaMdh, "examples/robots/panda_mdh.yaml", 6);
+}
+
+/// The inline form takes `dh` / `mdh` rows: their errors in the documented
+/// order (dh: Δd, Δθ, motion errors, Δa, Δα, β; mdh: Δa, Δα, β, Δd, Δθ), and
+/// the tool point is the DH product's at q = 0: `l1` at Rot_z(90°) then
+/// (25, 0, 100), `l2` 300 along l1's x after Rot_x(−90°), then 50 along z.
+#[test]
+fn inline_dh_rows_generate_the_documented_model() {
+    assert_eq!(
+        DhInline::ERRORS,
+        ["D1", "T1", "EC1", "A1", "AL1", "B1", "A2", "D2"]
+    );
+    assert_eq!(DhInline::VARIABLES, ["q1", "q2"]);
+    // Frame 1 = Rot_z(90°)·Trans_z(100)·Trans_x(25)·Rot_x(−90°): origin
+    // (0, 25, 100), x1 = (0, 1, 0), y1 = (0, 0, −1), z1 = (−1, 0, 0). The
+    // mdh row adds Trans_x(300)·Trans_z(50 + q2) in frame 1.
+    for (q2, expected) in [(0.0, [-50.0, 325.0, 100.0]), (10.0, [-60.0, 325.0, 100.0])] {
+        let nominal = ErrorModel::nominal(&DhInline, &[0.0, q2], &[]);
+        for (got, want) in nominal.position.iter().zip(expected) {
+            assert!(
+                (got - want).abs() < 1e-12,
+                "q2 {q2}: {:?}",
+                nominal.position
+            );
+        }
+        let r = [[0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]];
+        for (got, want) in nominal.rotation.iter().flatten().zip(r.iter().flatten()) {
+            assert!((got - want).abs() < 1e-15, "{:?}", nominal.rotation);
+        }
+    }
 }
 
 #[test]

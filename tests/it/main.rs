@@ -18,6 +18,7 @@ mod compensate;
 mod cov_stopping;
 mod csv_messages;
 mod derivation_routes;
+mod dh;
 mod directional;
 mod downstream;
 mod export_cli;

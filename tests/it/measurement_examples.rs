@@ -27,13 +27,12 @@
 
 use crate::common;
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use chain::core::values::{Given, Values};
 use chain::core::Machine;
 use common::cli::{ok_json, scratch, write};
-use common::{example_file, Exact};
+use common::{example_file, subset_combinations, subset_estimates, values_of, Exact};
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use serde_json::Value;
 
@@ -58,14 +57,7 @@ fn path_str(p: &Path) -> &str {
 
 /// The errors of `truth.yaml` in `machine.errors` order (mm, rad).
 fn truth(m: &Machine) -> Vec<f64> {
-    let values = Values::read(&example_file("measurements/truth.yaml"), m).expect("truth reads");
-    let by_name: HashMap<&str, f64> = values
-        .errors()
-        .iter()
-        .map(String::as_str)
-        .zip(values.constants().iter().copied())
-        .collect();
-    m.errors.iter().map(|e| by_name[e.name.as_str()]).collect()
+    values_of(m, "measurements/truth.yaml")
 }
 
 /// One row of a measurement CSV: the pose and tool offset, the direction
@@ -160,42 +152,6 @@ fn identify(csv: &str, dir: &Path) -> (Value, PathBuf) {
         path_str(&out),
     ]);
     (json, out)
-}
-
-/// The least-squares subset's estimates (value, std) of the JSON in
-/// `machine.errors` order (a fixed error: its nominal 0 and std 0).
-fn estimates(m: &Machine, json: &Value) -> (Vec<f64>, Vec<f64>) {
-    let est = &json["subset"]["estimates"];
-    m.errors
-        .iter()
-        .map(|e| {
-            let x = &est[e.name.as_str()];
-            (
-                x["value"].as_f64().expect("value"),
-                x["std"].as_f64().unwrap_or(0.0),
-            )
-        })
-        .unzip()
-}
-
-/// Each estimated error's combination of the truth (issue 34): `e_k + Σ_j
-/// c_jk e_j` over the fixed errors' relations of the JSON; a fixed error's
-/// entry is its nominal 0.
-fn combinations(m: &Machine, json: &Value, e: &[f64]) -> Vec<f64> {
-    let sub = &json["subset"];
-    let mut t = vec![0.0; m.errors.len()];
-    for name in sub["estimated"].as_array().expect("estimated") {
-        let k = m.error_index(name.as_str().unwrap()).unwrap();
-        t[k] = e[k];
-    }
-    for f in sub["fixed"].as_array().expect("fixed") {
-        let j = m.error_index(f["error"].as_str().unwrap()).unwrap();
-        for (name, c) in f["relation"].as_object().expect("relation") {
-            let k = m.error_index(name).unwrap();
-            t[k] += c.as_f64().unwrap() * e[j];
-        }
-    }
-    t
 }
 
 /// The null-space basis of the JSON, vectors in `machine.errors` order.
@@ -293,10 +249,10 @@ fn covariance(m: &Machine, file: &Path, value: &[f64]) -> Vec<Vec<f64>> {
 /// recovered individually) and the largest ratio.
 fn check_recovery(m: &Machine, json: &Value, file: &Path, e: &[f64]) -> (usize, f64) {
     let n = m.errors.len();
-    let (value, std) = estimates(m, json);
+    let (value, std) = subset_estimates(m, json);
     let null = null_space(m, json);
     let c = covariance(m, file, &value);
-    let truth = combinations(m, json, e);
+    let truth = subset_combinations(m, json, e);
     let kept: Vec<usize> = (0..n).filter(|&j| std[j] > 0.0).collect();
     let rank = json["rank"].as_u64().expect("rank") as usize;
     assert_eq!(kept.len(), rank);
@@ -591,7 +547,7 @@ fn ball_plate_identifies_the_truth() {
     check_residual(&json, &rows);
 
     // The map where the plate was measured, with each stylus.
-    let values = estimates(&m, &json).0;
+    let values = subset_estimates(&m, &json).0;
     let c = covariance(&m, &out, &values);
     let mut points = Vec::new();
     for x in [150.0, 400.0, 650.0] {
@@ -690,7 +646,7 @@ fn interferometer_lines_identify_what_they_can() {
 
     // The map along the measured lines: u·p is what the lines determine
     // (at any point of a line, between the measured positions too).
-    let values = estimates(&m, &json).0;
+    let values = subset_estimates(&m, &json).0;
     let c = covariance(&m, &out, &values);
     let mut points = Vec::new();
     let mut dirs = Vec::new();

@@ -176,6 +176,14 @@ pub enum Problem {
         /// The body whose joint it already drives.
         body: String,
     },
+    /// A declared body with the name a `dh` / `mdh` row gives its extra
+    /// frame.
+    GeneratedBodyName {
+        /// The name.
+        name: String,
+        /// The body whose DH row generates it.
+        body: String,
+    },
     /// Two kinds of names that must differ are the same.
     NameCollision {
         /// The name.
@@ -694,6 +702,18 @@ impl Problem {
                 "chain::duplicate_variable",
                 "duplicate variable",
                 format!("variable `{name}` already drives the joint of body `{body}`"),
+            ),
+            Problem::GeneratedBodyName { name, body } => D::new(
+                "chain::generated_body_name",
+                "name taken",
+                format!(
+                    "body `{name}` has the name of the extra frame of body `{body}`'s DH row"
+                ),
+            )
+            .help(
+                "a `dh` row of body NAME adds the frame NAME.joint and an `mdh` row \
+                 NAME.link; rename this body"
+                    .to_string(),
             ),
             Problem::NameCollision { name, what, other } => D::new(
                 "chain::name_collision",

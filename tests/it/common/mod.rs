@@ -691,6 +691,62 @@ pub fn example_file(path: &str) -> std::path::PathBuf {
     root().join("examples").join(path)
 }
 
+/// The constant errors of a values file under `examples/` in
+/// `machine.errors` order (mm, rad; every error must be given).
+pub fn values_of(m: &Machine, file: &str) -> Vec<f64> {
+    let values = chain_core::values::Values::read(&example_file(file), m)
+        .unwrap_or_else(|d| panic!("{file} does not read:\n{d}"));
+    let by_name: std::collections::HashMap<&str, f64> = values
+        .errors()
+        .iter()
+        .map(String::as_str)
+        .zip(values.constants().iter().copied())
+        .collect();
+    m.errors
+        .iter()
+        .map(|e| match by_name.get(e.name.as_str()) {
+            Some(&v) => v,
+            None => panic!("{file} gives no value of {}", e.name),
+        })
+        .collect()
+}
+
+/// The least-squares subset's estimates (value, std) of the JSON in
+/// `machine.errors` order (a fixed error: its nominal 0 and std 0).
+pub fn subset_estimates(m: &Machine, json: &serde_json::Value) -> (Vec<f64>, Vec<f64>) {
+    let est = &json["subset"]["estimates"];
+    m.errors
+        .iter()
+        .map(|e| {
+            let x = &est[e.name.as_str()];
+            (
+                x["value"].as_f64().expect("value"),
+                x["std"].as_f64().unwrap_or(0.0),
+            )
+        })
+        .unzip()
+}
+
+/// Each estimated error's combination of the truth (issue 34): `e_k + Σ_j
+/// c_jk e_j` over the fixed errors' relations of the JSON; a fixed error's
+/// entry is its nominal 0.
+pub fn subset_combinations(m: &Machine, json: &serde_json::Value, e: &[f64]) -> Vec<f64> {
+    let sub = &json["subset"];
+    let mut t = vec![0.0; m.errors.len()];
+    for name in sub["estimated"].as_array().expect("estimated") {
+        let k = m.error_index(name.as_str().unwrap()).unwrap();
+        t[k] = e[k];
+    }
+    for f in sub["fixed"].as_array().expect("fixed") {
+        let j = m.error_index(f["error"].as_str().unwrap()).unwrap();
+        for (name, c) in f["relation"].as_object().expect("relation") {
+            let k = m.error_index(name).unwrap();
+            t[k] += c.as_f64().unwrap() * e[j];
+        }
+    }
+    t
+}
+
 /// Path of an example machine file, `examples/machines/<file>`.
 pub fn example_path(file: &str) -> std::path::PathBuf {
     example_file("machines").join(file)

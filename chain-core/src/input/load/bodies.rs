@@ -21,7 +21,18 @@ pub const BODY_KEYS: &[&str] = &[
     "errors",
     "squareness",
     "location_errors",
+    "dh",
+    "mdh",
 ];
+/// Keys of a `dh` / `mdh` row (docs/yaml.md, "Denavit–Hartenberg bodies").
+pub const DH_KEYS: &[&str] = &["theta", "d", "a", "alpha", "joint", "variable", "errors"];
+/// Keys of a `dh` / `mdh` row's `errors`: one error per DH parameter, and
+/// `beta`, Hayati's rotation about the link frame's y axis (the parameter a
+/// DH table lacks for nearly parallel consecutive axes).
+pub const DH_ERROR_KEYS: &[&str] = &["theta", "d", "a", "alpha", "beta"];
+/// The body keys a `dh` / `mdh` row replaces (it gives the body's offset,
+/// rotation, joint and location errors).
+const DH_REPLACES: &[&str] = &["offset", "rotation", "joint", "location_errors"];
 /// Keys of a joint.
 pub const JOINT_KEYS: &[&str] = &["type", "axis", "variable"];
 /// Keys of a fixed rotation.
@@ -127,8 +138,10 @@ enum JointState {
 
 /// Where a slot is, for the checks of its items.
 struct SlotContext<'a> {
-    /// 0: location_errors, 1: errors, 2: squareness.
+    /// 0: location_errors (and a DH row's errors), 1: errors, 2: squareness.
     group: usize,
+    /// The group's key as written, for messages.
+    label: &'static str,
     /// The body's name.
     body: &'a str,
     /// The body's joint.
@@ -162,12 +175,43 @@ enum Parent {
     Bad,
 }
 
+/// A body's offset as written.
+enum Offset<'n> {
+    /// `offset: [x, y, z]` (absent: the origin).
+    Written(Option<&'n Node>),
+    /// From a DH row: `a` along x and `d` along z, each with its key path
+    /// (absent: 0).
+    Dh {
+        a: Option<(&'n Node, String)>,
+        d: Option<(&'n Node, String)>,
+    },
+}
+
+/// A `dh` / `mdh` row as read (docs/yaml.md, "Denavit–Hartenberg bodies").
+struct RawDh<'n> {
+    /// `mdh` (Craig's modified convention) rather than `dh`.
+    modified: bool,
+    /// `theta` as a rotation about z (`None` when 0 or invalid).
+    theta: Option<FixedRotation>,
+    /// `alpha` as a rotation about x (`None` when 0 or invalid).
+    alpha: Option<FixedRotation>,
+    /// `a`, with its key path.
+    a: Option<(&'n Node, String)>,
+    /// `d`, with its key path.
+    d: Option<(&'n Node, String)>,
+    /// The errors of `theta`, `d`, `a`, `alpha`, `beta` (in
+    /// [`DH_ERROR_KEYS`] order).
+    errors: [Vec<Item>; 5],
+}
+
 struct RawBody<'n> {
     name: String,
+    /// For the extra frame of a `dh` / `mdh` row: the row's body.
+    generated_for: Option<String>,
     span: Span,
     path: String,
     parent: Parent,
-    offset: Option<&'n Node>,
+    offset: Offset<'n>,
     rotation: Vec<FixedRotation>,
     joint: Option<RawJoint>,
     /// Items per group (0: location_errors, 1: errors, 2: squareness) and slot.
@@ -206,14 +250,25 @@ impl Loader {
                 );
                 continue;
             }
-            raws.push(self.body(k, v, name, path));
+            raws.extend(self.body(k, v, name, path));
         }
+        self.generated_clashes(&raws);
         let all_names: Vec<String> = raws.iter().map(|r| r.name.clone()).collect();
 
         // Offsets need every parameter and (for hints) every variable.
         let offsets: Vec<Option<[crate::model::Expr; 3]>> = raws
             .iter()
-            .map(|r| self.vec3(r.offset, &join(&r.path, "offset")))
+            .map(|r| match &r.offset {
+                Offset::Written(node) => self.vec3(*node, &join(&r.path, "offset")),
+                Offset::Dh { a, d } => {
+                    let mut part = |v: &Option<(&Node, String)>| match v {
+                        Some((node, path)) => self.expr(node, path),
+                        None => Some(crate::model::Expr::Num(0.0)),
+                    };
+                    let (x, z) = (part(a), part(d));
+                    Some([x?, crate::model::Expr::Num(0.0), z?])
+                }
+            })
             .collect();
 
         let (parents, order) = self.tree(&raws, key.span);
@@ -280,20 +335,28 @@ impl Loader {
         })
     }
 
-    /// One body's keys.
-    fn body<'n>(&mut self, key: &Node, value: &'n Node, name: String, path: String) -> RawBody<'n> {
+    /// One body's keys: the body, or the two a `dh` / `mdh` row stands
+    /// for.
+    fn body<'n>(
+        &mut self,
+        key: &Node,
+        value: &'n Node,
+        name: String,
+        path: String,
+    ) -> Vec<RawBody<'n>> {
         let mut raw = RawBody {
             name,
+            generated_for: None,
             span: key.span,
             path: path.clone(),
             parent: Parent::Bad,
-            offset: None,
+            offset: Offset::Written(None),
             rotation: Vec::new(),
             joint: None,
             slots: Default::default(),
         };
         let Some(f) = self.fields(value, key.span, &path, BODY_KEYS) else {
-            return raw;
+            return vec![raw];
         };
         raw.parent = match f.get("parent") {
             // A misspelt `parent` key: neither a root nor placed.
@@ -312,13 +375,46 @@ impl Loader {
         for (_, node) in &f.unknown {
             self.note_all_names(node);
         }
-        raw.offset = f.get("offset");
-        if let Some(n) = f.get("rotation") {
-            raw.rotation = self.rotations(n, &f.path("rotation"));
-        }
-        if let Some((k, v)) = f.entry("joint") {
-            raw.joint = Some(self.joint(k, v, &f.path("joint")));
-        }
+        let dh = match (f.entry("dh"), f.entry("mdh")) {
+            (Some(_), Some((k, _))) => {
+                let problem = Problem::Conflict {
+                    first: "dh",
+                    second: "mdh",
+                };
+                self.report(k.span, f.path("mdh"), problem);
+                None
+            }
+            (Some((k, v)), None) => Some((k, v, false)),
+            (None, Some((k, v))) => Some((k, v, true)),
+            (None, None) => None,
+        };
+        let dh = match dh {
+            Some((k, v, modified)) => {
+                let form = if modified { "mdh" } else { "dh" };
+                for &other in DH_REPLACES {
+                    if let Some((ok, _)) = f.entry(other) {
+                        let problem = Problem::Conflict {
+                            first: form,
+                            second: other,
+                        };
+                        self.report(ok.span, f.path(other), problem);
+                    }
+                }
+                let (row, joint) = self.dh_row(k, v, &f.path(form), modified, &raw.name);
+                raw.joint = joint;
+                row
+            }
+            None => {
+                raw.offset = Offset::Written(f.get("offset"));
+                if let Some(n) = f.get("rotation") {
+                    raw.rotation = self.rotations(n, &f.path("rotation"));
+                }
+                if let Some((k, v)) = f.entry("joint") {
+                    raw.joint = Some(self.joint(k, v, &f.path("joint")));
+                }
+                None
+            }
+        };
         // A misspelt `joint` key is reported once, not again by every
         // function slot or `iso` that needs the joint.
         let joint = match &raw.joint {
@@ -330,6 +426,10 @@ impl Loader {
             let Some((k, v)) = f.entry(group) else {
                 continue;
             };
+            if g == 0 && dh.is_some() {
+                // Refused beside the DH row above.
+                continue;
+            }
             let gpath = f.path(group);
             if let Some(text) = v.as_str() {
                 self.group_scalar(&mut raw, g, v, text, &gpath, joint);
@@ -344,6 +444,7 @@ impl Loader {
                 };
                 let ctx = SlotContext {
                     group: g,
+                    label: group,
                     body: &raw.name,
                     joint,
                 };
@@ -356,7 +457,134 @@ impl Loader {
                 self.note_error_names(node);
             }
         }
-        raw
+        match dh {
+            Some(row) => split_dh(raw, row),
+            None => vec![raw],
+        }
+    }
+
+    /// A `dh` / `mdh` row: its four parameters, its joint (`joint:
+    /// rotary | prismatic` with `variable`, along +z; none for a fixed row)
+    /// and the errors of its parameters.
+    fn dh_row<'n>(
+        &mut self,
+        key: &Node,
+        value: &'n Node,
+        path: &str,
+        modified: bool,
+        body: &str,
+    ) -> (Option<RawDh<'n>>, Option<RawJoint>) {
+        let Some(f) = self.fields(value, key.span, path, DH_KEYS) else {
+            return (None, None);
+        };
+        for (_, node) in &f.unknown {
+            self.note_all_names(node);
+        }
+        let rotation = |l: &mut Self, name: &'static str, about: Axis| {
+            let node = l.required(&f, name)?;
+            let p = f.path(name);
+            let angle = l.angle(node, &p)?;
+            (angle != 0.0).then(|| FixedRotation {
+                about,
+                angle,
+                origin: node.span.origin(p),
+            })
+        };
+        let theta = rotation(self, "theta", Axis::Z);
+        let alpha = rotation(self, "alpha", Axis::X);
+        let a = self.required(&f, "a").map(|n| (n, f.path("a")));
+        let d = self.required(&f, "d").map(|n| (n, f.path("d")));
+        let joint = match (f.entry("joint"), f.get("variable")) {
+            (None, None) => None,
+            (None, Some(_)) => {
+                self.missing(&f, "joint");
+                None
+            }
+            (Some((k, n)), variable) => {
+                let kind = match self.keyword(n, &f.path("joint"), "joint type", JOINT_TYPES) {
+                    Some("prismatic") => Some(JointKind::Prismatic),
+                    Some(_) => Some(JointKind::Rotary),
+                    None => None,
+                };
+                let mut j = RawJoint {
+                    kind,
+                    axis: Some(SignedAxis {
+                        axis: Axis::Z,
+                        negative: false,
+                    }),
+                    variable: None,
+                    variable_text: None,
+                    span: k.span,
+                    path: f.path("joint"),
+                };
+                match variable {
+                    Some(n) => {
+                        if let Some(s) = n.as_str() {
+                            self.seen_variables.insert(s.to_string());
+                            j.variable_text = Some(s.to_string());
+                        }
+                        let p = f.path("variable");
+                        j.variable = self.ident(n, &p, "variable").map(|name| Use {
+                            name,
+                            span: n.span,
+                            path: p,
+                        });
+                    }
+                    None => self.missing(&f, "variable"),
+                }
+                Some(j)
+            }
+        };
+        let mut errors: [Vec<Item>; 5] = Default::default();
+        if let Some((k, v)) = f.entry("errors") {
+            let epath = f.path("errors");
+            if let Some(ef) = self.fields(v, k.span, &epath, DH_ERROR_KEYS) {
+                let ctx = SlotContext {
+                    group: 0,
+                    label: if modified { "mdh.errors" } else { "dh.errors" },
+                    body,
+                    joint: JointState::Absent,
+                };
+                for (param, _, node) in &ef.known {
+                    let items = self.slot_items(node, &ef.path(param), &ctx);
+                    if let Some(i) = DH_ERROR_KEYS.iter().position(|k| k == param) {
+                        if let Some(list) = errors.get_mut(i) {
+                            list.extend(items);
+                        }
+                    }
+                }
+                for (_, node) in &ef.unknown {
+                    self.note_error_names(node);
+                }
+            }
+        }
+        let row = RawDh {
+            modified,
+            theta,
+            alpha,
+            a,
+            d,
+            errors,
+        };
+        (Some(row), joint)
+    }
+
+    /// Reports a declared body whose name is one a `dh` / `mdh` row gives
+    /// its extra frame (`NAME.joint`, `NAME.link`).
+    fn generated_clashes(&mut self, raws: &[RawBody<'_>]) {
+        let generated: HashMap<&str, &str> = raws
+            .iter()
+            .filter_map(|r| Some((r.name.as_str(), r.generated_for.as_deref()?)))
+            .collect();
+        for raw in raws.iter().filter(|r| r.generated_for.is_none()) {
+            if let Some(owner) = generated.get(raw.name.as_str()) {
+                let problem = Problem::GeneratedBodyName {
+                    name: raw.name.clone(),
+                    body: (*owner).to_string(),
+                };
+                self.report(raw.span, raw.path.clone(), problem);
+            }
+        }
     }
 
     /// Remembers the error names written in a node, valid or not, so that
@@ -481,7 +709,7 @@ impl Loader {
             None
         };
         if ctx.group != 1 {
-            let group = GROUPS.get(ctx.group).map_or("errors", |(name, _)| *name);
+            let group = ctx.label;
             return refused(self, Some(Problem::FunctionNotAllowed { group }));
         }
         let kind = match ctx.joint {
@@ -1299,6 +1527,80 @@ impl Loader {
         });
         indices
     }
+}
+
+/// The two bodies a `dh` / `mdh` row stands for (docs/yaml.md,
+/// "Denavit–Hartenberg bodies"), each an ordinary body of the machine
+/// format, `T = Trans(offset)·Rot(rotation)·E(location_errors)·J(q)·E(errors)`:
+///
+/// - `dh` (standard, `Rot_z(θ+q)·Trans_z(d)·Trans_x(a)·Rot_x(α)`):
+///   `NAME.joint` = `Rot_z(θ)·E(dz: Δd, ez: Δθ)·J(q about/along +z)·E(errors)`
+///   under the declared parent, then `NAME` = `Trans(a, 0, d)·Rot_x(α)·E(dx: Δa,
+///   ex: Δα, ey: β)`;
+/// - `mdh` (Craig's modified, `Rot_x(α)·Trans_x(a)·Rot_z(θ+q)·Trans_z(d)`):
+///   `NAME.link` = `Trans(a, 0, 0)·Rot_x(α)·E(dx: Δa, ex: Δα, ey: β)` under the
+///   declared parent, then `NAME` = `Trans(0, 0, d)·Rot_z(θ)·E(dz: Δd, ez:
+///   Δθ)·J(q)·E(errors)`.
+///
+/// Translations along and rotations about one axis commute, so each DH
+/// parameter's error is exactly a location error slot (β, Hayati's
+/// `Rot_y(β)` after `Rot_x(α)`, is the `ey` slot there). The row's body keeps
+/// its name for the frame the DH convention calls frame i, so children,
+/// the tool and the workpiece attach where a DH table puts them.
+fn split_dh<'n>(raw: RawBody<'n>, row: RawDh<'n>) -> Vec<RawBody<'n>> {
+    let [theta_e, d_e, a_e, alpha_e, beta_e] = row.errors;
+    let link = |name: String, parent: Parent, generated_for: Option<String>| RawBody {
+        name,
+        generated_for,
+        span: raw.span,
+        path: raw.path.clone(),
+        parent,
+        offset: Offset::Dh { a: None, d: None },
+        rotation: Vec::new(),
+        joint: None,
+        slots: Default::default(),
+    };
+    let (suffix, first_is_joint) = if row.modified {
+        (".link", false)
+    } else {
+        (".joint", true)
+    };
+    let extra = format!("{}{suffix}", raw.name);
+    let mut first = link(extra.clone(), raw.parent, Some(raw.name.clone()));
+    let second_parent = Parent::Named(Use {
+        name: extra,
+        span: raw.span,
+        path: raw.path.clone(),
+    });
+    let mut second = link(raw.name, second_parent, None);
+    let (joint_body, link_body) = if first_is_joint {
+        (&mut first, &mut second)
+    } else {
+        (&mut second, &mut first)
+    };
+    // The joint's body: θ, d's error, the joint and its motion errors.
+    joint_body.rotation.extend(row.theta);
+    joint_body.joint = raw.joint;
+    // `location_errors` beside a DH row was refused and not read.
+    let [_, errors, squareness] = raw.slots;
+    joint_body.slots[1] = errors;
+    joint_body.slots[2] = squareness;
+    joint_body.slots[0][2] = d_e;
+    joint_body.slots[0][5] = theta_e;
+    // The link's body: a, α, their errors and β.
+    link_body.rotation.extend(row.alpha);
+    link_body.slots[0][0] = a_e;
+    link_body.slots[0][3] = alpha_e;
+    link_body.slots[0][4] = beta_e;
+    // d goes where the convention puts it: on the link in `dh` (after the
+    // joint), on the joint's body in `mdh` (before it, after α).
+    if row.modified {
+        link_body.offset = Offset::Dh { a: row.a, d: None };
+        joint_body.offset = Offset::Dh { a: None, d: row.d };
+    } else {
+        link_body.offset = Offset::Dh { a: row.a, d: row.d };
+    }
+    vec![first, second]
 }
 
 /// The error parameters and function slots found so far, in the walk over

@@ -1,7 +1,7 @@
 //! Unit tests of the loader on the spec's example and on ordering rules.
 
 use super::*;
-use crate::model::{Basis, Distribution, ErrorKind, JointKind, Sided};
+use crate::model::{Axis, Basis, Distribution, ErrorKind, JointKind, Sided};
 
 const GANTRY: &str = r#"machine: gantry_grinder                # identifier
 description: Large CNC gantry guide-rail grinder
@@ -215,4 +215,210 @@ fn inline_form_takes_function_slots_and_iso() {
         ]
     );
     assert_eq!(m.functions[3].variable, m.variable_index("A").unwrap());
+}
+
+/// A body's structure without origins: name, parent's name, offset at the
+/// parameter values `p`, rotations, location slots, joint, error slots, all
+/// by name.
+fn structure(m: &Machine, p: &[f64]) -> Vec<String> {
+    let names = |slots: &crate::model::ErrorSlots| -> Vec<Vec<String>> {
+        slots
+            .slots
+            .iter()
+            .map(|s| s.iter().map(|&e| m.errors[e].name.clone()).collect())
+            .collect()
+    };
+    m.bodies
+        .iter()
+        .map(|b| {
+            let offset: Vec<f64> = b.offset.iter().map(|e| e.eval(p)).collect();
+            let rotation: Vec<(Axis, f64)> =
+                b.rotation.iter().map(|r| (r.about, r.angle)).collect();
+            let joint = b.joint.as_ref().map(|j| {
+                (
+                    j.kind,
+                    j.axis,
+                    m.variables[j.variable].name.clone(),
+                )
+            });
+            format!(
+                "{} <- {:?} offset {offset:?} rotation {rotation:?} location {:?} joint {joint:?} errors {:?}",
+                b.name,
+                b.parent.map(|i| &m.bodies[i].name),
+                names(&b.location_errors),
+                names(&b.errors),
+            )
+        })
+        .collect()
+}
+
+/// Loads `text`, panicking with the diagnostics.
+fn load_ok(text: &str) -> Machine {
+    match load_str(text, "m.yaml") {
+        Ok(m) => m,
+        Err(d) => panic!("{d:#}"),
+    }
+}
+
+/// A standard and a modified DH row load as the two bodies docs/yaml.md
+/// writes out by hand (split_dh): the same names, parents, offsets,
+/// rotations, slots, joints and error order.
+#[test]
+fn dh_rows_load_as_their_hand_expansion() {
+    let dh = "machine: m\nparameters: {L: 300}\nbodies:
+  base: {}
+  l1:
+    parent: base
+    dh: {theta: 90deg, d: L/2, a: 25, alpha: -pi/2, joint: rotary, variable: q1,
+         errors: {theta: T1, d: D1, a: A1, alpha: AL1, beta: B1}}
+    errors: {ez: EC1}
+  l2:
+    parent: l1
+    dh: {theta: 0, d: 0, a: L, alpha: 0, joint: prismatic, variable: q2, errors: {d: D2, a: A2}}
+    squareness: {ex: S2}
+  tip: {parent: l2, offset: [0, 0, 10]}
+workpiece: base\ntool: tip\n";
+    let dh_expanded = "machine: m\nparameters: {L: 300}\nbodies:
+  base: {}
+  l1.joint:
+    parent: base
+    rotation: [{about: z, angle: 90deg}]
+    location_errors: {dz: D1, ez: T1}
+    joint: {type: rotary, axis: +z, variable: q1}
+    errors: {ez: EC1}
+  l1:
+    parent: l1.joint
+    offset: [25, 0, L/2]
+    rotation: [{about: x, angle: -pi/2}]
+    location_errors: {dx: A1, ex: AL1, ey: B1}
+  l2.joint:
+    parent: l1
+    location_errors: {dz: D2}
+    joint: {type: prismatic, axis: +z, variable: q2}
+    squareness: {ex: S2}
+  l2:
+    parent: l2.joint
+    offset: [L, 0, 0]
+    location_errors: {dx: A2}
+  tip: {parent: l2, offset: [0, 0, 10]}
+workpiece: base\ntool: tip\n";
+    let p = [300.0];
+    let a = load_ok(dh);
+    let b = load_ok(dh_expanded);
+    assert_eq!(structure(&a, &p), structure(&b, &p));
+    let names = |m: &Machine| m.errors.iter().map(|e| e.name.clone()).collect::<Vec<_>>();
+    assert_eq!(
+        names(&a),
+        ["D1", "T1", "EC1", "A1", "AL1", "B1", "D2", "S2", "A2"]
+    );
+    assert_eq!(names(&a), names(&b));
+    let kinds: Vec<ErrorKind> = a.errors.iter().map(|e| e.kind).collect();
+    assert_eq!(kinds, b.errors.iter().map(|e| e.kind).collect::<Vec<_>>());
+
+    let mdh = "machine: m\nbodies:
+  base: {}
+  l1:
+    parent: base
+    mdh: {theta: 0.1, d: 5, a: 25, alpha: 30deg, joint: rotary, variable: q1,
+          errors: {theta: T1, d: D1, a: A1, alpha: AL1, beta: B1}}
+    errors: iso
+  flange:
+    parent: l1
+    mdh: {theta: 0, d: 107, a: 0, alpha: 0}
+workpiece: base\ntool: flange\n";
+    let mdh_expanded = "machine: m\nbodies:
+  base: {}
+  l1.link:
+    parent: base
+    offset: [25, 0, 0]
+    rotation: [{about: x, angle: 30deg}]
+    location_errors: {dx: A1, ex: AL1, ey: B1}
+  l1:
+    parent: l1.link
+    offset: [0, 0, 5]
+    rotation: [{about: z, angle: 0.1}]
+    location_errors: {dz: D1, ez: T1}
+    joint: {type: rotary, axis: +z, variable: q1}
+    errors: iso
+  flange.link:
+    parent: l1
+  flange:
+    parent: flange.link
+    offset: [0, 0, 107]
+workpiece: base\ntool: flange\n";
+    let a = load_ok(mdh);
+    let b = load_ok(mdh_expanded);
+    assert_eq!(structure(&a, &[]), structure(&b, &[]));
+    assert_eq!(
+        names(&a),
+        ["A1", "AL1", "B1", "D1", "T1", "EXQ1", "EYQ1", "EZQ1", "EAQ1", "EBQ1", "ECQ1"]
+    );
+    assert_eq!(names(&a), names(&b));
+}
+
+/// What a DH row refuses, each named by its key.
+#[test]
+fn dh_rows_refuse_what_they_replace_and_what_they_lack() {
+    let body = |row: &str| {
+        format!("machine: m\nbodies:\n  base: {{}}\n  l1:\n    parent: base\n{row}workpiece: base\ntool: l1\n")
+    };
+    let cases: &[(&str, &str, &str)] = &[
+        (
+            "    dh: {theta: 0, d: 0, a: 1, alpha: 0}\n    offset: [0, 0, 1]\n",
+            "bodies.l1.offset",
+            "chain::conflicting_keys",
+        ),
+        (
+            "    dh: {theta: 0, d: 0, a: 1, alpha: 0}\n    location_errors: {dx: A}\n",
+            "bodies.l1.location_errors",
+            "chain::conflicting_keys",
+        ),
+        (
+            "    dh: {theta: 0, d: 0, a: 1, alpha: 0}\n    mdh: {theta: 0, d: 0, a: 1, alpha: 0}\n",
+            "bodies.l1.mdh",
+            "chain::conflicting_keys",
+        ),
+        (
+            "    dh: {theta: 0, d: 0, alpha: 0}\n",
+            "bodies.l1.dh",
+            "chain::missing_key",
+        ),
+        (
+            "    dh: {theta: 0, d: 0, a: 1, alpha: 0, joint: rotary}\n",
+            "bodies.l1.dh",
+            "chain::missing_key",
+        ),
+        (
+            "    dh: {theta: 0, d: 0, a: 1, alpha: 0, variable: q}\n",
+            "bodies.l1.dh",
+            "chain::missing_key",
+        ),
+        (
+            "    dh: {theta: 0, d: 0, a: 1, alpha: 0, joint: helical, variable: q}\n",
+            "bodies.l1.dh.joint",
+            "chain::unknown_value",
+        ),
+        (
+            "    dh: {theta: 0, d: 0, a: 1, alpha: 0, joint: rotary, variable: q,\n         errors: {a: {name: A, powers: [1]}}}\n",
+            "bodies.l1.dh.errors.a",
+            "chain::function_not_allowed",
+        ),
+        (
+            "    dh: {theta: 0, d: 0, a: 1, alpha: 0, errors: {gamma: G}}\n",
+            "bodies.l1.dh.errors.gamma",
+            "chain::unknown_key",
+        ),
+    ];
+    for (row, key, code) in cases {
+        let problems = from_tree(&yaml::parse(&body(row)).root.expect("yaml")).expect_err(row);
+        assert_eq!(problems.len(), 1, "{row}: {problems:?}");
+        assert_eq!(problems[0].0.key, *key, "{row}");
+        assert_eq!(problems[0].1.code(), *code, "{row}");
+    }
+    // A declared body named like a row's generated frame.
+    let text = "machine: m\nbodies:\n  base: {}\n  l1:\n    parent: base\n    dh: {theta: 0, d: 0, a: 1, alpha: 0}\n  l1.joint: {parent: base}\nworkpiece: base\ntool: l1\n";
+    let problems = from_tree(&yaml::parse(text).root.expect("yaml")).unwrap_err();
+    assert_eq!(problems.len(), 1, "{problems:?}");
+    assert_eq!(problems[0].0.key, "bodies.l1.joint");
+    assert_eq!(problems[0].1.code(), "chain::generated_body_name");
 }
