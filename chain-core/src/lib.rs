@@ -15,6 +15,7 @@ pub mod built;
 pub mod compensation;
 pub mod input;
 pub mod kinematics;
+pub mod lanes;
 pub mod measured;
 mod model_trait;
 pub mod named;

@@ -428,7 +428,142 @@ fn every_machine(c: &mut Criterion) {
     g.finish();
 }
 
+/// Issue 35 §1: the batched generated kernel (`sensitivity_batch_into`,
+/// four points per lane group) against the same type's per-point
+/// `sensitivity_into` and, on the B-head/C-table machine, SymPy's per-point
+/// code, `POINTS` points per iteration (throughput per point); the batch
+/// writes `CHUNK` matrices into one reused buffer at a time, as the per-point
+/// routes write one. `batch_2_thread`: two halves on a pool of two threads.
+macro_rules! batched {
+    ($g:expr, $pools:expr, $ty:ident, $name:literal, $p:expr, $sympy:expr) => {{
+        const NV: usize = $ty::VARIABLES.len();
+        const NE: usize = $ty::ERRORS.len();
+        let p = $p;
+        let flat = bench_points(NV);
+        let qs: Vec<[f64; NV]> = flat
+            .chunks_exact(NV)
+            .map(|q| q.try_into().expect("NV values"))
+            .collect();
+        let mut chunk = vec![[[0.0; NE]; 6]; CHUNK];
+        $ty::sensitivity_batch_into(&qs[..CHUNK], &p, &mut chunk);
+        for (q, s) in qs.iter().zip(&chunk) {
+            let one = $ty::sensitivity(q, &p);
+            for (a, b) in one.iter().flatten().zip(s.iter().flatten()) {
+                assert!(
+                    (a - b).abs() <= 1e-13 * a.abs().max(1.0),
+                    "{}: {a} vs {b}",
+                    $name
+                );
+            }
+        }
+        // Every route writes `CHUNK` matrices into one reused buffer, one
+        // matrix per point, as a batch consumer does.
+        $g.bench_function(concat!($name, "/sensitivity_into"), |b| {
+            b.iter(|| {
+                for qc in qs.chunks_exact(CHUNK) {
+                    for (q, o) in qc.iter().zip(chunk.iter_mut()) {
+                        $ty::sensitivity_into(black_box(q), black_box(&p), o);
+                    }
+                    black_box(&mut chunk);
+                }
+            })
+        });
+        if let Some(per_point) = $sympy {
+            $g.bench_function(concat!($name, "/sympy_per_point"), |b| {
+                b.iter(|| {
+                    for qc in qs.chunks_exact(CHUNK) {
+                        for (q, o) in qc.iter().zip(chunk.iter_mut()) {
+                            per_point(black_box(q), o);
+                        }
+                        black_box(&mut chunk);
+                    }
+                })
+            });
+        }
+        $g.bench_function(concat!($name, "/batch_into"), |b| {
+            b.iter(|| {
+                for qc in qs.chunks_exact(CHUNK) {
+                    $ty::sensitivity_batch_into(black_box(qc), black_box(&p), &mut chunk);
+                    black_box(&mut chunk);
+                }
+            })
+        });
+        // Threads: `REPEAT` passes over the points per iteration, so that
+        // waking the pool's threads (tens of µs on this VM) does not count.
+        let mut halves = vec![vec![[[0.0; NE]; 6]; CHUNK]; 2];
+        for (threads, pool) in [(1usize, &$pools[0]), (2, &$pools[1])] {
+            let id = format!("{}/batch_into_{threads}_thread_x{REPEAT}", $name);
+            $g.bench_function(id, |b| {
+                b.iter(|| {
+                    pool.install(|| {
+                        use rayon::prelude::*;
+                        (qs.par_chunks(qs.len() / threads))
+                            .zip(halves.par_iter_mut())
+                            .for_each(|(part, buf)| {
+                                for _ in 0..REPEAT {
+                                    for qc in part.chunks_exact(CHUNK) {
+                                        $ty::sensitivity_batch_into(
+                                            black_box(qc),
+                                            black_box(&p),
+                                            buf,
+                                        );
+                                        black_box(&mut *buf);
+                                    }
+                                }
+                            })
+                    })
+                })
+            });
+        }
+    }};
+}
+
+/// Passes over the points per iteration of the thread benchmarks of the
+/// `batched` group (their time is for `REPEAT · POINTS` points).
+const REPEAT: usize = 16;
+
+/// The `batched` group (see [`batched!`]).
+fn batched(c: &mut Criterion) {
+    let pools: Vec<rayon::ThreadPool> = [1, 2]
+        .into_iter()
+        .map(|t| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .expect("a pool")
+        })
+        .collect();
+    let mut g = c.benchmark_group("batched");
+    g.throughput(criterion::Throughput::Elements(POINTS as u64));
+    g.sample_size(20)
+        .warm_up_time(std::time::Duration::from_millis(700))
+        .measurement_time(std::time::Duration::from_millis(2000));
+    /// A per-point function of the gantry (none to compare with).
+    type GantryPerPoint = fn(&[f64; 3], &mut [[f64; 21]; 6]);
+    batched!(
+        g,
+        pools,
+        GantryGrinder,
+        "gantry_grinder",
+        [0.0f64; 0],
+        None::<GantryPerPoint>
+    );
+    let sympy = |q: &[f64; 5], out: &mut [[f64; 33]; 6]| {
+        sympy::sensitivity_sympy(q, black_box(&[150.0]), out)
+    };
+    batched!(
+        g,
+        pools,
+        BcHeadTable,
+        "bc_head_table",
+        [150.0f64],
+        Some(sympy)
+    );
+    g.finish();
+}
+
 criterion_group!(benches, gantry, five_axis, two_rotary_axes, bc_head_table);
+criterion_group!(batch, batched);
 criterion_group!(machines, every_machine);
 /// `CHAIN_CALLGRIND=NAME:COUNT` runs one function of the `bc_head_table`
 /// group COUNT times and exits (no criterion): instruction counts under
@@ -441,6 +576,13 @@ fn callgrind(spec: &str) {
     let q = [120.0, 0.7, -40.0, 250.0, -0.4];
     let mut out = [[0.0; 33]; 6];
     let mut nz = [0.0; BcHeadTable::NONZEROS.len()];
+    let q4 = [
+        q,
+        [100.0, 0.3, -20.0, 200.0, 0.4],
+        [90.0, -0.7, 10.0, 150.0, 1.4],
+        [80.0, 1.1, 40.0, 100.0, -1.4],
+    ];
+    let mut out4 = [[[0.0; 33]; 6]; 4];
     for _ in 0..count {
         match name {
             "v1_sensitivity" => {
@@ -461,6 +603,11 @@ fn callgrind(spec: &str) {
                 sympy::sensitivity_sympy(black_box(&q), black_box(&p), &mut out);
                 black_box(&mut out);
             }
+            "batch_into" => {
+                // One group of four points per count.
+                BcHeadTable::sensitivity_batch_into(black_box(&q4), black_box(&p), &mut out4);
+                black_box(&mut out4);
+            }
             "sin_cos" => {
                 let (s, c) = black_box(q[1]).sin_cos();
                 let (t, d) = black_box(q[4]).sin_cos();
@@ -478,5 +625,6 @@ fn main() {
     }
     benches();
     machines();
+    batch();
     Criterion::default().configure_from_args().final_summary();
 }

@@ -592,8 +592,9 @@ impl Study {
             }
         }
         // Every point at once through the model's batch entry point (a
-        // compiled model's tape over blocks of points; the same values as
-        // `sensitivity` point by point).
+        // compiled model's tape over blocks of points, a `machine!` type's
+        // batched kernels; the values of `sensitivity` point by point, to
+        // rounding).
         let qs: Vec<f64> = points.iter().flatten().copied().collect();
         let mut flat = vec![0.0; points.len() * 6 * n];
         if model

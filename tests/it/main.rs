@@ -13,6 +13,7 @@ mod acceptance_rare;
 mod allocate;
 mod atomic_writes;
 mod batch;
+mod batch_kernels;
 mod bounded_reads;
 mod compensate;
 mod cov_stopping;

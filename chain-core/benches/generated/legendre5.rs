@@ -4210,6 +4210,2715 @@ impl Legendre5 {
         out[431] = -k295;
         out[432] = -sin_A;
     }
+    /// The sensitivity matrices at many points: `out[i]` is
+    /// [`Self::sensitivity`] at `qs[i]` (every entry written). Four
+    /// points at a time: `sin`/`cos` of the rotary variables by the
+    /// vectorised kernel of `chain_core::lanes` (≤ 2 ulp from the
+    /// standard library's, so values agree with the per-point
+    /// functions to rounding, not bit for bit).
+    ///
+    /// # Panics
+    /// When `out.len() != qs.len()`.
+    #[inline]
+    pub fn sensitivity_batch_into(
+        qs: &[[f64; 5]],
+        p: &[f64; 2],
+        out: &mut [[[f64; 131]; 6]],
+    ) {
+        assert!(
+            qs.len() == out.len(),
+            "sensitivity_batch_into: {} points but {} output matrices", qs.len(), out
+            .len()
+        );
+        Self::sensitivity_lanes_over(
+            qs.as_flattened(),
+            p,
+            &[],
+            true,
+            out.as_flattened_mut().as_flattened_mut(),
+        );
+    }
+    /// [`Self::sensitivity_nonzeros`] at many points: `out[i]` holds the
+    /// entries [`Self::NONZEROS`] at `qs[i]`, four points at a time as
+    /// [`Self::sensitivity_batch_into`].
+    ///
+    /// # Panics
+    /// When `out.len() != qs.len()`.
+    #[inline]
+    pub fn sensitivity_nonzeros_batch_into(
+        qs: &[[f64; 5]],
+        p: &[f64; 2],
+        out: &mut [[f64; 433]],
+    ) {
+        assert!(
+            qs.len() == out.len(),
+            "sensitivity_nonzeros_batch_into: {} points but {} output rows", qs.len(),
+            out.len()
+        );
+        Self::nonzeros_lanes_over(
+            qs.as_flattened(),
+            p,
+            &[],
+            true,
+            out.as_flattened_mut(),
+        );
+    }
+    /// [`Self::error`] at many points with one error vector `e` for all
+    /// of them (a built machine's errors along a path or a grid), four
+    /// points at a time as [`Self::sensitivity_batch_into`].
+    ///
+    /// # Panics
+    /// When `out.len() != qs.len()`.
+    #[inline]
+    pub fn error_batch_into(
+        qs: &[[f64; 5]],
+        p: &[f64; 2],
+        e: &[f64; 131],
+        out: &mut [[f64; 6]],
+    ) {
+        assert!(
+            qs.len() == out.len(), "error_batch_into: {} points but {} output rows", qs
+            .len(), out.len()
+        );
+        Self::error_lanes_over(qs.as_flattened(), p, e, true, out.as_flattened_mut());
+    }
+    /// [`Self::error`] at many points, each with its own error vector:
+    /// `out[i]` is the error at `qs[i]` with `es[i]` (sampled errors).
+    ///
+    /// # Panics
+    /// When `es.len()` or `out.len()` differs from `qs.len()`.
+    #[inline]
+    pub fn error_batch_each_into(
+        qs: &[[f64; 5]],
+        p: &[f64; 2],
+        es: &[[f64; 131]],
+        out: &mut [[f64; 6]],
+    ) {
+        assert!(
+            qs.len() == out.len() && qs.len() == es.len(),
+            "error_batch_each_into: {} points, {} error vectors and {} output rows", qs
+            .len(), es.len(), out.len()
+        );
+        Self::error_lanes_over(
+            qs.as_flattened(),
+            p,
+            es.as_flattened(),
+            false,
+            out.as_flattened_mut(),
+        );
+    }
+    /// [`Self::sensitivity_flat_into`] with `sin`/`cos` of each rotary
+    /// variable `k` given as `sc[k]`.
+    #[inline(always)]
+    fn sensitivity_given(
+        q: &[f64; 5],
+        p: &[f64; 2],
+        sc: &[[f64; 2]; 5],
+        out: &mut [f64; 786],
+    ) {
+        let p_tool_length = p[0];
+        let p_cradle_height = p[1];
+        let v_y = q[0];
+        let v_A = q[1];
+        let v_C = q[2];
+        let v_x = q[3];
+        let v_z = q[4];
+        let [sin_A, cos_A] = sc[1];
+        let [sin_C, cos_C] = sc[2];
+        let m0 = v_y * cos_C;
+        let m1 = v_y * v_y;
+        let m2 = cos_A * sin_C;
+        let m3 = v_y * cos_A;
+        let m4 = m3 * sin_C;
+        let m5 = sin_A * sin_C;
+        let m6 = v_y * sin_A;
+        let m7 = m6 * sin_C;
+        let m8 = v_x * sin_A;
+        let m9 = m8 * sin_C;
+        let m10 = v_x * cos_A;
+        let m11 = m10 * sin_C;
+        let m12 = v_A * cos_C;
+        let m13 = v_A * v_A;
+        let m14 = v_A * sin_C;
+        let m15 = v_x * sin_C;
+        let m16 = v_C * v_C;
+        let m17 = v_x * cos_C;
+        let m18 = v_x * v_x;
+        let m19 = v_z * cos_C;
+        let m20 = v_z * v_z;
+        let m21 = v_z * cos_A;
+        let m22 = m21 * sin_C;
+        let m23 = v_z * sin_A;
+        let m24 = m23 * sin_C;
+        let m25 = p_tool_length * cos_A;
+        let m26 = m25 * sin_C;
+        let m27 = p_tool_length * v_z;
+        let m28 = m27 * cos_A;
+        let m29 = m28 * sin_C;
+        let m30 = p_tool_length * cos_C;
+        let m31 = m27 * cos_C;
+        let m32 = v_y * sin_C;
+        let m33 = cos_A * cos_C;
+        let m34 = m3 * cos_C;
+        let m35 = cos_C * sin_A;
+        let m36 = m0 * sin_A;
+        let m37 = m17 * sin_A;
+        let m38 = m10 * cos_C;
+        let m39 = v_z * sin_C;
+        let m40 = m21 * cos_C;
+        let m41 = m19 * sin_A;
+        let m42 = m25 * cos_C;
+        let m43 = m28 * cos_C;
+        let m44 = p_tool_length * sin_C;
+        let m45 = m27 * sin_C;
+        let m46 = v_y * v_x;
+        let m47 = m46 * cos_A;
+        let m48 = m46 * sin_A;
+        let m49 = v_A * v_x;
+        let m50 = p_tool_length * sin_A;
+        let m51 = m27 * sin_A;
+        let k0 = 0.000009375000000000001 * m1 - 0.5;
+        let k1 = cos_C * (k0);
+        let k2 = 0.00375 - 0.00000003906250000000001 * m1;
+        let k3 = cos_C * (k2);
+        let k4 = v_y * (k3);
+        let k5 = sin_C * (k0);
+        let k6 = cos_A * (k5);
+        let k7 = sin_C * (k2);
+        let k8 = cos_A * (k7);
+        let k9 = v_y * (k8);
+        let k10 = sin_A * (k5);
+        let k11 = sin_A * (k7);
+        let k12 = v_y * (k11);
+        let k13 = p_tool_length + v_z;
+        let k14 = cos_A * (k13) + m6;
+        let k15 = sin_C * (k14);
+        let k16 = 0.0025 * p_tool_length + 0.0025 * v_z;
+        let k17 = cos_A * (k16) + 0.0025 * m6;
+        let k18 = sin_C * (k17);
+        let k19 = v_y * (k18);
+        let k20 = 0.000009375000000000001 * p_tool_length
+            + 0.000009375000000000001 * v_z;
+        let k21 = cos_A * (k20) + 0.000009375000000000001 * m6;
+        let k22 = v_y * (k21) - 0.5 * sin_A;
+        let k23 = 0.5 * p_tool_length + 0.5 * v_z;
+        let k24 = v_y * (k22) + cos_A * (-k23);
+        let k25 = sin_C * (k24);
+        let k26 = 0.00000003906250000000001 * p_tool_length
+            + 0.00000003906250000000001 * v_z;
+        let k27 = cos_A * (k26) + 0.00000003906250000000001 * m6;
+        let k28 = v_y * (k27) - 0.00375 * sin_A;
+        let k29 = 0.00375 * p_tool_length + 0.00375 * v_z;
+        let k30 = v_y * (-k28) + cos_A * (k29);
+        let k31 = sin_C * (k30);
+        let k32 = v_y * (k31);
+        let k33 = cos_C * (k13) - m9;
+        let k34 = cos_C * (k16) - 0.0025 * m9;
+        let k35 = v_y * (k34);
+        let k36 = p_tool_length * (k0) + v_z * (k0);
+        let k37 = cos_C * (k36) + v_x * (-k10);
+        let k38 = p_tool_length * (k2) + v_z * (k2);
+        let k39 = cos_C * (k38) + v_x * (-k11);
+        let k40 = v_y * (k39);
+        let k41 = m0 + m11;
+        let k42 = 0.0025 * m11 + 0.0025 * m0;
+        let k43 = v_y * (k42);
+        let k44 = 0.000009375000000000001 * m11 + 0.000009375000000000001 * m0;
+        let k45 = v_y * (-k44) + 0.5 * cos_C;
+        let k46 = v_y * (k45) + 0.5 * m11;
+        let k47 = 0.00000003906250000000001 * m11 + 0.00000003906250000000001 * m0;
+        let k48 = v_y * (-k47) + 0.00375 * cos_C;
+        let k49 = v_y * (k48) + 0.00375 * m11;
+        let k50 = v_y * (k49);
+        let k51 = p_tool_length - p_cradle_height + v_z;
+        let k52 = cos_C * (k51) - m9;
+        let k53 = 0.34195899479289005 * m13 - 0.5;
+        let k54 = cos_C * (k53);
+        let k55 = 0.7161972439135291 - 0.27212232178012075 * m13;
+        let k56 = cos_C * (k55);
+        let k57 = v_A * (k56);
+        let k58 = sin_C * (k53);
+        let k59 = sin_C * (k55);
+        let k60 = v_A * (k59);
+        let k61 = cos_A * (k51) + m6;
+        let k62 = sin_C * (k61);
+        let k63 = 0.47746482927568606 * p_tool_length
+            - 0.47746482927568606 * p_cradle_height + 0.47746482927568606 * v_z;
+        let k64 = cos_A * (k63) + 0.47746482927568606 * m6;
+        let k65 = sin_C * (k64);
+        let k66 = v_A * (k65);
+        let k67 = 0.34195899479289005 * p_tool_length
+            - 0.34195899479289005 * p_cradle_height + 0.34195899479289005 * v_z;
+        let k68 = v_A * (k67);
+        let k69 = v_A * (k68) - 0.5 * p_tool_length + 0.5 * p_cradle_height - 0.5 * v_z;
+        let k70 = sin_A * (k53);
+        let k71 = cos_A * (k69) + v_y * (k70);
+        let k72 = sin_C * (k71);
+        let k73 = 0.27212232178012075 * p_tool_length
+            - 0.27212232178012075 * p_cradle_height + 0.27212232178012075 * v_z;
+        let k74 = v_A * (k73);
+        let k75 = v_A * (-k74) + 0.7161972439135291 * p_tool_length
+            - 0.7161972439135291 * p_cradle_height + 0.7161972439135291 * v_z;
+        let k76 = sin_A * (k55);
+        let k77 = cos_A * (k75) + v_y * (k76);
+        let k78 = sin_C * (k77);
+        let k79 = v_A * (k78);
+        let k80 = cos_C * (k61);
+        let k81 = cos_C * (k64);
+        let k82 = v_A * (k81);
+        let k83 = cos_C * (k71);
+        let k84 = cos_C * (k77);
+        let k85 = v_A * (k84);
+        let k86 = sin_A * (k51) - m3;
+        let k87 = cos_C * (k86) - m15;
+        let k88 = sin_A * (k63) - 0.47746482927568606 * m3;
+        let k89 = cos_C * (k88) - 0.47746482927568606 * m15;
+        let k90 = v_A * (k89);
+        let k91 = cos_A * (k53);
+        let k92 = sin_A * (k69) + v_y * (-k91);
+        let k93 = cos_C * (k92) + v_x * (-k58);
+        let k94 = cos_A * (k55);
+        let k95 = sin_A * (k75) + v_y * (-k94);
+        let k96 = cos_C * (k95) + v_x * (-k59);
+        let k97 = v_A * (k96);
+        let k98 = cos_A * (k51) + p_cradle_height + m6;
+        let k99 = sin_C * (k98);
+        let k100 = cos_C * (k98);
+        let k101 = 0.5 - 0.1519817754635067 * m16;
+        let k102 = 0.47746482927568606 - 0.08062883608299874 * m16;
+        let k103 = v_C * (k102);
+        let k104 = cos_A * (k51) + p_cradle_height + m6;
+        let k105 = 0.3183098861837907 * p_tool_length
+            - 0.3183098861837907 * p_cradle_height + 0.3183098861837907 * v_z;
+        let k106 = cos_A * (k105) + 0.3183098861837907 * p_cradle_height
+            + 0.3183098861837907 * m6;
+        let k107 = v_C * (k106);
+        let k108 = 0.1519817754635067 * p_tool_length
+            - 0.1519817754635067 * p_cradle_height + 0.1519817754635067 * v_z;
+        let k109 = v_C * (k108);
+        let k110 = v_C * (k109) - 0.5 * p_tool_length + 0.5 * p_cradle_height
+            - 0.5 * v_z;
+        let k111 = 0.1519817754635067 * m16 - 0.5;
+        let k112 = sin_A * (k111);
+        let k113 = cos_A * (k110) + p_cradle_height * (-k101) + v_y * (k112);
+        let k114 = 0.08062883608299874 * p_tool_length
+            - 0.08062883608299874 * p_cradle_height + 0.08062883608299874 * v_z;
+        let k115 = v_C * (k114);
+        let k116 = v_C * (-k115) + 0.47746482927568606 * p_tool_length
+            - 0.47746482927568606 * p_cradle_height + 0.47746482927568606 * v_z;
+        let k117 = sin_A * (k102);
+        let k118 = cos_A * (k116) + p_cradle_height * (k102) + v_y * (k117);
+        let k119 = v_C * (k118);
+        let k120 = sin_A * (k105) - 0.3183098861837907 * m3;
+        let k121 = cos_C * (k120) - 0.3183098861837907 * m15;
+        let k122 = v_C * (k121);
+        let k123 = cos_A * (k111);
+        let k124 = sin_A * (k110) + v_y * (-k123);
+        let k125 = sin_C * (k111);
+        let k126 = cos_C * (k124) + v_x * (-k125);
+        let k127 = cos_A * (k102);
+        let k128 = sin_A * (k116) + v_y * (-k127);
+        let k129 = sin_C * (k102);
+        let k130 = cos_C * (k128) + v_x * (-k129);
+        let k131 = v_C * (k130);
+        let k132 = 0.000009375000000000001 * m18 - 0.5;
+        let k133 = cos_C * (k132);
+        let k134 = 0.00375 - 0.00000003906250000000001 * m18;
+        let k135 = cos_C * (k134);
+        let k136 = v_x * (k135);
+        let k137 = sin_C * (k132);
+        let k138 = cos_A * (k137);
+        let k139 = sin_C * (k134);
+        let k140 = cos_A * (k139);
+        let k141 = v_x * (k140);
+        let k142 = sin_A * (k137);
+        let k143 = sin_A * (k139);
+        let k144 = v_x * (k143);
+        let k145 = sin_C * (k13);
+        let k146 = cos_A * (k145);
+        let k147 = sin_C * (k16);
+        let k148 = cos_A * (k147);
+        let k149 = v_x * (k148);
+        let k150 = p_tool_length * (k132) + v_z * (k132);
+        let k151 = sin_C * (k150);
+        let k152 = cos_A * (k151);
+        let k153 = p_tool_length * (k134) + v_z * (k134);
+        let k154 = sin_C * (k153);
+        let k155 = cos_A * (k154);
+        let k156 = v_x * (k155);
+        let k157 = cos_C * (k13);
+        let k158 = cos_C * (k16);
+        let k159 = v_x * (k158);
+        let k160 = cos_C * (k150);
+        let k161 = cos_C * (k153);
+        let k162 = v_x * (k161);
+        let k163 = 0.000009375000000000001 * m20 - 0.5;
+        let k164 = cos_C * (k163);
+        let k165 = 0.00375 - 0.00000003906250000000001 * m20;
+        let k166 = cos_C * (k165);
+        let k167 = v_z * (k166);
+        let k168 = sin_C * (k163);
+        let k169 = cos_A * (k168);
+        let k170 = sin_C * (k165);
+        let k171 = cos_A * (k170);
+        let k172 = v_z * (k171);
+        let k173 = sin_A * (k168);
+        let k174 = sin_A * (k170);
+        let k175 = v_z * (k174);
+        let k176 = p_tool_length * (k169);
+        let k177 = p_tool_length * (k172);
+        let k178 = p_tool_length * (k164);
+        let k179 = p_tool_length * (k167);
+        let k180 = v_y * (k7);
+        let k181 = cos_A * (k1);
+        let k182 = cos_A * (k3);
+        let k183 = v_y * (k182);
+        let k184 = sin_A * (k0);
+        let k185 = cos_C * (k184);
+        let k186 = sin_A * (k2);
+        let k187 = cos_C * (k186);
+        let k188 = v_y * (k187);
+        let k189 = cos_C * (k14);
+        let k190 = cos_C * (k17);
+        let k191 = v_y * (k190);
+        let k192 = cos_C * (k24);
+        let k193 = cos_C * (k30);
+        let k194 = v_y * (k193);
+        let k195 = sin_C * (k13) + m37;
+        let k196 = sin_C * (k16) + 0.0025 * m37;
+        let k197 = v_y * (k196);
+        let k198 = sin_C * (k36) + v_x * (k185);
+        let k199 = sin_C * (k38) + v_x * (k187);
+        let k200 = v_y * (k199);
+        let k201 = m32 - m38;
+        let k202 = 0.0025 * m38 - 0.0025 * m32;
+        let k203 = v_y * (k202);
+        let k204 = 0.000009375000000000001 * m38 - 0.000009375000000000001 * m32;
+        let k205 = v_y * (k204) + 0.5 * sin_C;
+        let k206 = v_y * (k205) - 0.5 * m38;
+        let k207 = 0.00000003906250000000001 * m38 - 0.00000003906250000000001 * m32;
+        let k208 = v_y * (k207) + 0.00375 * sin_C;
+        let k209 = v_y * (-k208) + 0.00375 * m38;
+        let k210 = v_y * (k209);
+        let k211 = sin_C * (k51) + m37;
+        let k212 = sin_C * (k86) + m17;
+        let k213 = sin_C * (k88) + 0.47746482927568606 * m17;
+        let k214 = v_A * (k213);
+        let k215 = sin_C * (k92) + v_x * (k54);
+        let k216 = sin_C * (k95) + v_x * (k56);
+        let k217 = v_A * (k216);
+        let k218 = sin_C * (k120) + 0.3183098861837907 * m17;
+        let k219 = v_C * (k218);
+        let k220 = cos_C * (k111);
+        let k221 = sin_C * (k124) + v_x * (k220);
+        let k222 = cos_C * (k102);
+        let k223 = sin_C * (k128) + v_x * (k222);
+        let k224 = v_C * (k223);
+        let k225 = v_x * (k139);
+        let k226 = cos_A * (k133);
+        let k227 = cos_A * (k135);
+        let k228 = v_x * (k227);
+        let k229 = sin_A * (k132);
+        let k230 = cos_C * (k229);
+        let k231 = sin_A * (k134);
+        let k232 = cos_C * (k231);
+        let k233 = v_x * (k232);
+        let k234 = cos_A * (k157);
+        let k235 = cos_A * (k158);
+        let k236 = v_x * (k235);
+        let k237 = cos_A * (k160);
+        let k238 = cos_A * (k161);
+        let k239 = v_x * (k238);
+        let k240 = v_x * (k147);
+        let k241 = v_x * (k154);
+        let k242 = v_z * (k170);
+        let k243 = cos_A * (k164);
+        let k244 = cos_A * (k166);
+        let k245 = v_z * (k244);
+        let k246 = sin_A * (k163);
+        let k247 = cos_C * (k246);
+        let k248 = sin_A * (k165);
+        let k249 = cos_C * (k248);
+        let k250 = v_z * (k249);
+        let k251 = p_tool_length * (k243);
+        let k252 = p_tool_length * (k245);
+        let k253 = p_tool_length * (k168);
+        let k254 = p_tool_length * (k242);
+        let k255 = v_y * (k186);
+        let k256 = cos_A * (k0);
+        let k257 = cos_A * (k2);
+        let k258 = v_y * (k257);
+        let k259 = sin_A * (k13) - m3;
+        let k260 = sin_A * (k16) - 0.0025 * m3;
+        let k261 = v_y * (k260);
+        let k262 = sin_A * (k20) - 0.000009375000000000001 * m3;
+        let k263 = v_y * (k262) + 0.5 * cos_A;
+        let k264 = v_y * (k263) + sin_A * (-k23);
+        let k265 = sin_A * (k26) - 0.00000003906250000000001 * m3;
+        let k266 = v_y * (k265) + 0.00375 * cos_A;
+        let k267 = v_y * (-k266) + sin_A * (k29);
+        let k268 = v_y * (k267);
+        let k269 = v_x * (k256);
+        let k270 = v_x * (k257);
+        let k271 = v_y * (k270);
+        let k272 = v_x * (k184);
+        let k273 = v_x * (k186);
+        let k274 = v_y * (k273);
+        let k275 = 0.5 - 0.34195899479289005 * m13;
+        let k276 = v_A * (k55);
+        let k277 = v_A * (k88);
+        let k278 = v_A * (k95);
+        let k279 = v_x * (k53);
+        let k280 = v_x * (k55);
+        let k281 = v_A * (k280);
+        let k282 = v_x * (k231);
+        let k283 = cos_A * (k132);
+        let k284 = cos_A * (k134);
+        let k285 = v_x * (k284);
+        let k286 = sin_A * (k13);
+        let k287 = sin_A * (k16);
+        let k288 = v_x * (k287);
+        let k289 = sin_A * (k150);
+        let k290 = sin_A * (k153);
+        let k291 = v_x * (k290);
+        let k292 = v_z * (k248);
+        let k293 = cos_A * (k163);
+        let k294 = cos_A * (k165);
+        let k295 = v_z * (k294);
+        let k296 = p_tool_length * (k246);
+        let k297 = p_tool_length * (k292);
+        out[0] = -cos_C;
+        out[1] = -0.0025 * m0;
+        out[2] = -k1;
+        out[3] = k4;
+        out[4] = -m2;
+        out[5] = -0.0025 * m4;
+        out[6] = -k6;
+        out[7] = k9;
+        out[8] = -m5;
+        out[9] = -0.0025 * m7;
+        out[10] = -k10;
+        out[11] = k12;
+        out[12] = k15;
+        out[13] = k19;
+        out[14] = k25;
+        out[15] = -k32;
+        out[16] = -k33;
+        out[17] = -k35;
+        out[18] = -k37;
+        out[19] = k40;
+        out[20] = -k41;
+        out[21] = -k43;
+        out[22] = k46;
+        out[23] = k50;
+        out[24] = -m2;
+        out[25] = -m5;
+        out[26] = -k52;
+        out[27] = -k41;
+        out[28] = -cos_C;
+        out[29] = -0.47746482927568606 * m12;
+        out[30] = -k54;
+        out[31] = k57;
+        out[32] = -sin_C;
+        out[33] = -0.47746482927568606 * m14;
+        out[34] = -k58;
+        out[35] = k60;
+        out[36] = 0.0;
+        out[37] = 0.0;
+        out[38] = 0.0;
+        out[39] = 0.0;
+        out[40] = k62;
+        out[41] = k66;
+        out[42] = k72;
+        out[43] = -k79;
+        out[44] = -k80;
+        out[45] = -k82;
+        out[46] = -k83;
+        out[47] = k85;
+        out[48] = k87;
+        out[49] = k90;
+        out[50] = k93;
+        out[51] = -k97;
+        out[52] = -cos_C;
+        out[53] = -sin_C;
+        out[54] = k99;
+        out[55] = -k100;
+        out[56] = -1.0;
+        out[57] = -0.3183098861837907 * v_C;
+        out[58] = k101;
+        out[59] = k103;
+        out[60] = 0.0;
+        out[61] = 0.0;
+        out[62] = 0.0;
+        out[63] = 0.0;
+        out[64] = 0.0;
+        out[65] = 0.0;
+        out[66] = 0.0;
+        out[67] = 0.0;
+        out[68] = 0.0;
+        out[69] = 0.0;
+        out[70] = 0.0;
+        out[71] = 0.0;
+        out[72] = -k104;
+        out[73] = -k107;
+        out[74] = -k113;
+        out[75] = k119;
+        out[76] = k87;
+        out[77] = k122;
+        out[78] = k126;
+        out[79] = -k131;
+        out[80] = cos_C;
+        out[81] = 0.0025 * m17;
+        out[82] = k133;
+        out[83] = -k136;
+        out[84] = m2;
+        out[85] = 0.0025 * m11;
+        out[86] = k138;
+        out[87] = -k141;
+        out[88] = m5;
+        out[89] = 0.0025 * m9;
+        out[90] = k142;
+        out[91] = -k144;
+        out[92] = -k146;
+        out[93] = -k149;
+        out[94] = -k152;
+        out[95] = k156;
+        out[96] = k157;
+        out[97] = k159;
+        out[98] = k160;
+        out[99] = -k162;
+        out[100] = 0.0;
+        out[101] = 0.0;
+        out[102] = 0.0;
+        out[103] = 0.0;
+        out[104] = 0.0;
+        out[105] = cos_C;
+        out[106] = 0.0025 * m19;
+        out[107] = k164;
+        out[108] = -k167;
+        out[109] = m2;
+        out[110] = 0.0025 * m22;
+        out[111] = k169;
+        out[112] = -k172;
+        out[113] = m5;
+        out[114] = 0.0025 * m24;
+        out[115] = k173;
+        out[116] = -k175;
+        out[117] = -m26;
+        out[118] = -0.0025 * m29;
+        out[119] = -k176;
+        out[120] = k177;
+        out[121] = m30;
+        out[122] = 0.0025 * m31;
+        out[123] = k178;
+        out[124] = -k179;
+        out[125] = 0.0;
+        out[126] = 0.0;
+        out[127] = 0.0;
+        out[128] = 0.0;
+        out[129] = -m26;
+        out[130] = m30;
+        out[131] = sin_C;
+        out[132] = 0.0025 * m32;
+        out[133] = k5;
+        out[134] = -k180;
+        out[135] = -m33;
+        out[136] = -0.0025 * m34;
+        out[137] = -k181;
+        out[138] = k183;
+        out[139] = -m35;
+        out[140] = -0.0025 * m36;
+        out[141] = -k185;
+        out[142] = k188;
+        out[143] = k189;
+        out[144] = k191;
+        out[145] = k192;
+        out[146] = -k194;
+        out[147] = k195;
+        out[148] = k197;
+        out[149] = k198;
+        out[150] = -k200;
+        out[151] = k201;
+        out[152] = -k203;
+        out[153] = -k206;
+        out[154] = k210;
+        out[155] = -m33;
+        out[156] = -m35;
+        out[157] = k211;
+        out[158] = k201;
+        out[159] = sin_C;
+        out[160] = 0.47746482927568606 * m14;
+        out[161] = k58;
+        out[162] = -k60;
+        out[163] = -cos_C;
+        out[164] = -0.47746482927568606 * m12;
+        out[165] = -k54;
+        out[166] = k57;
+        out[167] = 0.0;
+        out[168] = 0.0;
+        out[169] = 0.0;
+        out[170] = 0.0;
+        out[171] = k80;
+        out[172] = k82;
+        out[173] = k83;
+        out[174] = -k85;
+        out[175] = k62;
+        out[176] = k66;
+        out[177] = k72;
+        out[178] = -k79;
+        out[179] = -k212;
+        out[180] = -k214;
+        out[181] = -k215;
+        out[182] = k217;
+        out[183] = sin_C;
+        out[184] = -cos_C;
+        out[185] = k100;
+        out[186] = k99;
+        out[187] = 0.0;
+        out[188] = 0.0;
+        out[189] = 0.0;
+        out[190] = 0.0;
+        out[191] = -1.0;
+        out[192] = -0.3183098861837907 * v_C;
+        out[193] = k101;
+        out[194] = k103;
+        out[195] = 0.0;
+        out[196] = 0.0;
+        out[197] = 0.0;
+        out[198] = 0.0;
+        out[199] = k104;
+        out[200] = k107;
+        out[201] = k113;
+        out[202] = -k119;
+        out[203] = 0.0;
+        out[204] = 0.0;
+        out[205] = 0.0;
+        out[206] = 0.0;
+        out[207] = -k212;
+        out[208] = -k219;
+        out[209] = -k221;
+        out[210] = k224;
+        out[211] = -sin_C;
+        out[212] = -0.0025 * m15;
+        out[213] = -k137;
+        out[214] = k225;
+        out[215] = m33;
+        out[216] = 0.0025 * m38;
+        out[217] = k226;
+        out[218] = -k228;
+        out[219] = m35;
+        out[220] = 0.0025 * m37;
+        out[221] = k230;
+        out[222] = -k233;
+        out[223] = -k234;
+        out[224] = -k236;
+        out[225] = -k237;
+        out[226] = k239;
+        out[227] = -k145;
+        out[228] = -k240;
+        out[229] = -k151;
+        out[230] = k241;
+        out[231] = 0.0;
+        out[232] = 0.0;
+        out[233] = 0.0;
+        out[234] = 0.0;
+        out[235] = 0.0;
+        out[236] = -sin_C;
+        out[237] = -0.0025 * m39;
+        out[238] = -k168;
+        out[239] = k242;
+        out[240] = m33;
+        out[241] = 0.0025 * m40;
+        out[242] = k243;
+        out[243] = -k245;
+        out[244] = m35;
+        out[245] = 0.0025 * m41;
+        out[246] = k247;
+        out[247] = -k250;
+        out[248] = -m42;
+        out[249] = -0.0025 * m43;
+        out[250] = -k251;
+        out[251] = k252;
+        out[252] = -m44;
+        out[253] = -0.0025 * m45;
+        out[254] = -k253;
+        out[255] = k254;
+        out[256] = 0.0;
+        out[257] = 0.0;
+        out[258] = 0.0;
+        out[259] = 0.0;
+        out[260] = -m42;
+        out[261] = -m44;
+        out[262] = 0.0;
+        out[263] = 0.0;
+        out[264] = 0.0;
+        out[265] = 0.0;
+        out[266] = sin_A;
+        out[267] = 0.0025 * m6;
+        out[268] = k184;
+        out[269] = -k255;
+        out[270] = -cos_A;
+        out[271] = -0.0025 * m3;
+        out[272] = -k256;
+        out[273] = k258;
+        out[274] = -k259;
+        out[275] = -k261;
+        out[276] = -k264;
+        out[277] = k268;
+        out[278] = m10;
+        out[279] = 0.0025 * m47;
+        out[280] = k269;
+        out[281] = -k271;
+        out[282] = m8;
+        out[283] = 0.0025 * m48;
+        out[284] = k272;
+        out[285] = -k274;
+        out[286] = sin_A;
+        out[287] = -cos_A;
+        out[288] = m10;
+        out[289] = m8;
+        out[290] = 0.0;
+        out[291] = 0.0;
+        out[292] = 0.0;
+        out[293] = 0.0;
+        out[294] = 0.0;
+        out[295] = 0.0;
+        out[296] = 0.0;
+        out[297] = 0.0;
+        out[298] = -1.0;
+        out[299] = -0.47746482927568606 * v_A;
+        out[300] = k275;
+        out[301] = k276;
+        out[302] = -k86;
+        out[303] = -k277;
+        out[304] = -k92;
+        out[305] = k278;
+        out[306] = v_x;
+        out[307] = 0.47746482927568606 * m49;
+        out[308] = k279;
+        out[309] = -k281;
+        out[310] = 0.0;
+        out[311] = 0.0;
+        out[312] = 0.0;
+        out[313] = 0.0;
+        out[314] = 0.0;
+        out[315] = 0.0;
+        out[316] = -k86;
+        out[317] = v_x;
+        out[318] = 0.0;
+        out[319] = 0.0;
+        out[320] = 0.0;
+        out[321] = 0.0;
+        out[322] = 0.0;
+        out[323] = 0.0;
+        out[324] = 0.0;
+        out[325] = 0.0;
+        out[326] = -1.0;
+        out[327] = -0.3183098861837907 * v_C;
+        out[328] = k101;
+        out[329] = k103;
+        out[330] = -k87;
+        out[331] = -k122;
+        out[332] = -k126;
+        out[333] = k131;
+        out[334] = k212;
+        out[335] = k219;
+        out[336] = k221;
+        out[337] = -k224;
+        out[338] = 0.0;
+        out[339] = 0.0;
+        out[340] = 0.0;
+        out[341] = 0.0;
+        out[342] = 0.0;
+        out[343] = 0.0;
+        out[344] = 0.0;
+        out[345] = 0.0;
+        out[346] = -sin_A;
+        out[347] = -0.0025 * m8;
+        out[348] = -k229;
+        out[349] = k282;
+        out[350] = cos_A;
+        out[351] = 0.0025 * m10;
+        out[352] = k283;
+        out[353] = -k285;
+        out[354] = k286;
+        out[355] = k288;
+        out[356] = k289;
+        out[357] = -k291;
+        out[358] = 0.0;
+        out[359] = 0.0;
+        out[360] = 0.0;
+        out[361] = 0.0;
+        out[362] = 0.0;
+        out[363] = 0.0;
+        out[364] = 0.0;
+        out[365] = 0.0;
+        out[366] = 0.0;
+        out[367] = 0.0;
+        out[368] = 0.0;
+        out[369] = 0.0;
+        out[370] = 0.0;
+        out[371] = -sin_A;
+        out[372] = -0.0025 * m23;
+        out[373] = -k246;
+        out[374] = k292;
+        out[375] = cos_A;
+        out[376] = 0.0025 * m21;
+        out[377] = k293;
+        out[378] = -k295;
+        out[379] = m50;
+        out[380] = 0.0025 * m51;
+        out[381] = k296;
+        out[382] = -k297;
+        out[383] = 0.0;
+        out[384] = 0.0;
+        out[385] = 0.0;
+        out[386] = 0.0;
+        out[387] = 0.0;
+        out[388] = 0.0;
+        out[389] = 0.0;
+        out[390] = 0.0;
+        out[391] = m50;
+        out[392] = 0.0;
+        out[393] = 0.0;
+        out[394] = 0.0;
+        out[395] = 0.0;
+        out[396] = 0.0;
+        out[397] = 0.0;
+        out[398] = 0.0;
+        out[399] = 0.0;
+        out[400] = 0.0;
+        out[401] = 0.0;
+        out[402] = 0.0;
+        out[403] = 0.0;
+        out[404] = 0.0;
+        out[405] = -cos_C;
+        out[406] = -0.0025 * m0;
+        out[407] = -k1;
+        out[408] = k4;
+        out[409] = -m2;
+        out[410] = -0.0025 * m4;
+        out[411] = -k6;
+        out[412] = k9;
+        out[413] = -m5;
+        out[414] = -0.0025 * m7;
+        out[415] = -k10;
+        out[416] = k12;
+        out[417] = 0.0;
+        out[418] = 0.0;
+        out[419] = -m2;
+        out[420] = -m5;
+        out[421] = 0.0;
+        out[422] = 0.0;
+        out[423] = 0.0;
+        out[424] = 0.0;
+        out[425] = 0.0;
+        out[426] = 0.0;
+        out[427] = 0.0;
+        out[428] = 0.0;
+        out[429] = 0.0;
+        out[430] = 0.0;
+        out[431] = 0.0;
+        out[432] = 0.0;
+        out[433] = -cos_C;
+        out[434] = -0.47746482927568606 * m12;
+        out[435] = -k54;
+        out[436] = k57;
+        out[437] = -sin_C;
+        out[438] = -0.47746482927568606 * m14;
+        out[439] = -k58;
+        out[440] = k60;
+        out[441] = 0.0;
+        out[442] = 0.0;
+        out[443] = 0.0;
+        out[444] = 0.0;
+        out[445] = 0.0;
+        out[446] = 0.0;
+        out[447] = -cos_C;
+        out[448] = -sin_C;
+        out[449] = 0.0;
+        out[450] = 0.0;
+        out[451] = 0.0;
+        out[452] = 0.0;
+        out[453] = 0.0;
+        out[454] = 0.0;
+        out[455] = 0.0;
+        out[456] = 0.0;
+        out[457] = 0.0;
+        out[458] = 0.0;
+        out[459] = 0.0;
+        out[460] = 0.0;
+        out[461] = -1.0;
+        out[462] = -0.3183098861837907 * v_C;
+        out[463] = k101;
+        out[464] = k103;
+        out[465] = 0.0;
+        out[466] = 0.0;
+        out[467] = 0.0;
+        out[468] = 0.0;
+        out[469] = 0.0;
+        out[470] = 0.0;
+        out[471] = 0.0;
+        out[472] = 0.0;
+        out[473] = 0.0;
+        out[474] = 0.0;
+        out[475] = 0.0;
+        out[476] = 0.0;
+        out[477] = 0.0;
+        out[478] = 0.0;
+        out[479] = 0.0;
+        out[480] = 0.0;
+        out[481] = 0.0;
+        out[482] = 0.0;
+        out[483] = 0.0;
+        out[484] = 0.0;
+        out[485] = cos_C;
+        out[486] = 0.0025 * m17;
+        out[487] = k133;
+        out[488] = -k136;
+        out[489] = m2;
+        out[490] = 0.0025 * m11;
+        out[491] = k138;
+        out[492] = -k141;
+        out[493] = m5;
+        out[494] = 0.0025 * m9;
+        out[495] = k142;
+        out[496] = -k144;
+        out[497] = m5;
+        out[498] = 0.0;
+        out[499] = 0.0;
+        out[500] = 0.0;
+        out[501] = 0.0;
+        out[502] = 0.0;
+        out[503] = 0.0;
+        out[504] = 0.0;
+        out[505] = 0.0;
+        out[506] = 0.0;
+        out[507] = 0.0;
+        out[508] = 0.0;
+        out[509] = 0.0;
+        out[510] = cos_C;
+        out[511] = 0.0025 * m19;
+        out[512] = k164;
+        out[513] = -k167;
+        out[514] = m2;
+        out[515] = 0.0025 * m22;
+        out[516] = k169;
+        out[517] = -k172;
+        out[518] = m5;
+        out[519] = 0.0025 * m24;
+        out[520] = k173;
+        out[521] = -k175;
+        out[522] = cos_C;
+        out[523] = m2;
+        out[524] = 0.0;
+        out[525] = 0.0;
+        out[526] = 0.0;
+        out[527] = 0.0;
+        out[528] = 0.0;
+        out[529] = 0.0;
+        out[530] = 0.0;
+        out[531] = 0.0;
+        out[532] = 0.0;
+        out[533] = 0.0;
+        out[534] = 0.0;
+        out[535] = 0.0;
+        out[536] = sin_C;
+        out[537] = 0.0025 * m32;
+        out[538] = k5;
+        out[539] = -k180;
+        out[540] = -m33;
+        out[541] = -0.0025 * m34;
+        out[542] = -k181;
+        out[543] = k183;
+        out[544] = -m35;
+        out[545] = -0.0025 * m36;
+        out[546] = -k185;
+        out[547] = k188;
+        out[548] = 0.0;
+        out[549] = 0.0;
+        out[550] = -m33;
+        out[551] = -m35;
+        out[552] = 0.0;
+        out[553] = 0.0;
+        out[554] = 0.0;
+        out[555] = 0.0;
+        out[556] = 0.0;
+        out[557] = 0.0;
+        out[558] = 0.0;
+        out[559] = 0.0;
+        out[560] = 0.0;
+        out[561] = 0.0;
+        out[562] = 0.0;
+        out[563] = 0.0;
+        out[564] = sin_C;
+        out[565] = 0.47746482927568606 * m14;
+        out[566] = k58;
+        out[567] = -k60;
+        out[568] = -cos_C;
+        out[569] = -0.47746482927568606 * m12;
+        out[570] = -k54;
+        out[571] = k57;
+        out[572] = 0.0;
+        out[573] = 0.0;
+        out[574] = 0.0;
+        out[575] = 0.0;
+        out[576] = 0.0;
+        out[577] = 0.0;
+        out[578] = sin_C;
+        out[579] = -cos_C;
+        out[580] = 0.0;
+        out[581] = 0.0;
+        out[582] = 0.0;
+        out[583] = 0.0;
+        out[584] = 0.0;
+        out[585] = 0.0;
+        out[586] = 0.0;
+        out[587] = 0.0;
+        out[588] = 0.0;
+        out[589] = 0.0;
+        out[590] = 0.0;
+        out[591] = 0.0;
+        out[592] = 0.0;
+        out[593] = 0.0;
+        out[594] = 0.0;
+        out[595] = 0.0;
+        out[596] = -1.0;
+        out[597] = -0.3183098861837907 * v_C;
+        out[598] = k101;
+        out[599] = k103;
+        out[600] = 0.0;
+        out[601] = 0.0;
+        out[602] = 0.0;
+        out[603] = 0.0;
+        out[604] = 0.0;
+        out[605] = 0.0;
+        out[606] = 0.0;
+        out[607] = 0.0;
+        out[608] = 0.0;
+        out[609] = 0.0;
+        out[610] = 0.0;
+        out[611] = 0.0;
+        out[612] = 0.0;
+        out[613] = 0.0;
+        out[614] = 0.0;
+        out[615] = 0.0;
+        out[616] = -sin_C;
+        out[617] = -0.0025 * m15;
+        out[618] = -k137;
+        out[619] = k225;
+        out[620] = m33;
+        out[621] = 0.0025 * m38;
+        out[622] = k226;
+        out[623] = -k228;
+        out[624] = m35;
+        out[625] = 0.0025 * m37;
+        out[626] = k230;
+        out[627] = -k233;
+        out[628] = m35;
+        out[629] = 0.0;
+        out[630] = 0.0;
+        out[631] = 0.0;
+        out[632] = 0.0;
+        out[633] = 0.0;
+        out[634] = 0.0;
+        out[635] = 0.0;
+        out[636] = 0.0;
+        out[637] = 0.0;
+        out[638] = 0.0;
+        out[639] = 0.0;
+        out[640] = 0.0;
+        out[641] = -sin_C;
+        out[642] = -0.0025 * m39;
+        out[643] = -k168;
+        out[644] = k242;
+        out[645] = m33;
+        out[646] = 0.0025 * m40;
+        out[647] = k243;
+        out[648] = -k245;
+        out[649] = m35;
+        out[650] = 0.0025 * m41;
+        out[651] = k247;
+        out[652] = -k250;
+        out[653] = -sin_C;
+        out[654] = m33;
+        out[655] = 0.0;
+        out[656] = 0.0;
+        out[657] = 0.0;
+        out[658] = 0.0;
+        out[659] = 0.0;
+        out[660] = 0.0;
+        out[661] = 0.0;
+        out[662] = 0.0;
+        out[663] = 0.0;
+        out[664] = 0.0;
+        out[665] = 0.0;
+        out[666] = 0.0;
+        out[667] = 0.0;
+        out[668] = 0.0;
+        out[669] = 0.0;
+        out[670] = 0.0;
+        out[671] = sin_A;
+        out[672] = 0.0025 * m6;
+        out[673] = k184;
+        out[674] = -k255;
+        out[675] = -cos_A;
+        out[676] = -0.0025 * m3;
+        out[677] = -k256;
+        out[678] = k258;
+        out[679] = 0.0;
+        out[680] = 0.0;
+        out[681] = sin_A;
+        out[682] = -cos_A;
+        out[683] = 0.0;
+        out[684] = 0.0;
+        out[685] = 0.0;
+        out[686] = 0.0;
+        out[687] = 0.0;
+        out[688] = 0.0;
+        out[689] = 0.0;
+        out[690] = 0.0;
+        out[691] = 0.0;
+        out[692] = 0.0;
+        out[693] = 0.0;
+        out[694] = 0.0;
+        out[695] = 0.0;
+        out[696] = 0.0;
+        out[697] = 0.0;
+        out[698] = 0.0;
+        out[699] = 0.0;
+        out[700] = 0.0;
+        out[701] = 0.0;
+        out[702] = 0.0;
+        out[703] = -1.0;
+        out[704] = -0.47746482927568606 * v_A;
+        out[705] = k275;
+        out[706] = k276;
+        out[707] = 0.0;
+        out[708] = 0.0;
+        out[709] = 0.0;
+        out[710] = 0.0;
+        out[711] = 0.0;
+        out[712] = 0.0;
+        out[713] = 0.0;
+        out[714] = 0.0;
+        out[715] = 0.0;
+        out[716] = 0.0;
+        out[717] = 0.0;
+        out[718] = 0.0;
+        out[719] = 0.0;
+        out[720] = 0.0;
+        out[721] = 0.0;
+        out[722] = 0.0;
+        out[723] = 0.0;
+        out[724] = 0.0;
+        out[725] = 0.0;
+        out[726] = 0.0;
+        out[727] = 0.0;
+        out[728] = 0.0;
+        out[729] = 0.0;
+        out[730] = 0.0;
+        out[731] = -1.0;
+        out[732] = -0.3183098861837907 * v_C;
+        out[733] = k101;
+        out[734] = k103;
+        out[735] = 0.0;
+        out[736] = 0.0;
+        out[737] = 0.0;
+        out[738] = 0.0;
+        out[739] = 0.0;
+        out[740] = 0.0;
+        out[741] = 0.0;
+        out[742] = 0.0;
+        out[743] = 0.0;
+        out[744] = 0.0;
+        out[745] = 0.0;
+        out[746] = 0.0;
+        out[747] = 0.0;
+        out[748] = 0.0;
+        out[749] = 0.0;
+        out[750] = 0.0;
+        out[751] = -sin_A;
+        out[752] = -0.0025 * m8;
+        out[753] = -k229;
+        out[754] = k282;
+        out[755] = cos_A;
+        out[756] = 0.0025 * m10;
+        out[757] = k283;
+        out[758] = -k285;
+        out[759] = cos_A;
+        out[760] = 0.0;
+        out[761] = 0.0;
+        out[762] = 0.0;
+        out[763] = 0.0;
+        out[764] = 0.0;
+        out[765] = 0.0;
+        out[766] = 0.0;
+        out[767] = 0.0;
+        out[768] = 0.0;
+        out[769] = 0.0;
+        out[770] = 0.0;
+        out[771] = 0.0;
+        out[772] = 0.0;
+        out[773] = 0.0;
+        out[774] = 0.0;
+        out[775] = 0.0;
+        out[776] = -sin_A;
+        out[777] = -0.0025 * m23;
+        out[778] = -k246;
+        out[779] = k292;
+        out[780] = cos_A;
+        out[781] = 0.0025 * m21;
+        out[782] = k293;
+        out[783] = -k295;
+        out[784] = 0.0;
+        out[785] = -sin_A;
+    }
+    /// [`Self::sensitivity_nonzeros`] with `sin`/`cos` given.
+    #[inline(always)]
+    fn nonzeros_given(
+        q: &[f64; 5],
+        p: &[f64; 2],
+        sc: &[[f64; 2]; 5],
+        out: &mut [f64; 433],
+    ) {
+        let p_tool_length = p[0];
+        let p_cradle_height = p[1];
+        let v_y = q[0];
+        let v_A = q[1];
+        let v_C = q[2];
+        let v_x = q[3];
+        let v_z = q[4];
+        let [sin_A, cos_A] = sc[1];
+        let [sin_C, cos_C] = sc[2];
+        let m0 = v_y * cos_C;
+        let m1 = v_y * v_y;
+        let m2 = cos_A * sin_C;
+        let m3 = v_y * cos_A;
+        let m4 = m3 * sin_C;
+        let m5 = sin_A * sin_C;
+        let m6 = v_y * sin_A;
+        let m7 = m6 * sin_C;
+        let m8 = v_x * sin_A;
+        let m9 = m8 * sin_C;
+        let m10 = v_x * cos_A;
+        let m11 = m10 * sin_C;
+        let m12 = v_A * cos_C;
+        let m13 = v_A * v_A;
+        let m14 = v_A * sin_C;
+        let m15 = v_x * sin_C;
+        let m16 = v_C * v_C;
+        let m17 = v_x * cos_C;
+        let m18 = v_x * v_x;
+        let m19 = v_z * cos_C;
+        let m20 = v_z * v_z;
+        let m21 = v_z * cos_A;
+        let m22 = m21 * sin_C;
+        let m23 = v_z * sin_A;
+        let m24 = m23 * sin_C;
+        let m25 = p_tool_length * cos_A;
+        let m26 = m25 * sin_C;
+        let m27 = p_tool_length * v_z;
+        let m28 = m27 * cos_A;
+        let m29 = m28 * sin_C;
+        let m30 = p_tool_length * cos_C;
+        let m31 = m27 * cos_C;
+        let m32 = v_y * sin_C;
+        let m33 = cos_A * cos_C;
+        let m34 = m3 * cos_C;
+        let m35 = cos_C * sin_A;
+        let m36 = m0 * sin_A;
+        let m37 = m17 * sin_A;
+        let m38 = m10 * cos_C;
+        let m39 = v_z * sin_C;
+        let m40 = m21 * cos_C;
+        let m41 = m19 * sin_A;
+        let m42 = m25 * cos_C;
+        let m43 = m28 * cos_C;
+        let m44 = p_tool_length * sin_C;
+        let m45 = m27 * sin_C;
+        let m46 = v_y * v_x;
+        let m47 = m46 * cos_A;
+        let m48 = m46 * sin_A;
+        let m49 = v_A * v_x;
+        let m50 = p_tool_length * sin_A;
+        let m51 = m27 * sin_A;
+        let k0 = 0.000009375000000000001 * m1 - 0.5;
+        let k1 = cos_C * (k0);
+        let k2 = 0.00375 - 0.00000003906250000000001 * m1;
+        let k3 = cos_C * (k2);
+        let k4 = v_y * (k3);
+        let k5 = sin_C * (k0);
+        let k6 = cos_A * (k5);
+        let k7 = sin_C * (k2);
+        let k8 = cos_A * (k7);
+        let k9 = v_y * (k8);
+        let k10 = sin_A * (k5);
+        let k11 = sin_A * (k7);
+        let k12 = v_y * (k11);
+        let k13 = p_tool_length + v_z;
+        let k14 = cos_A * (k13) + m6;
+        let k15 = sin_C * (k14);
+        let k16 = 0.0025 * p_tool_length + 0.0025 * v_z;
+        let k17 = cos_A * (k16) + 0.0025 * m6;
+        let k18 = sin_C * (k17);
+        let k19 = v_y * (k18);
+        let k20 = 0.000009375000000000001 * p_tool_length
+            + 0.000009375000000000001 * v_z;
+        let k21 = cos_A * (k20) + 0.000009375000000000001 * m6;
+        let k22 = v_y * (k21) - 0.5 * sin_A;
+        let k23 = 0.5 * p_tool_length + 0.5 * v_z;
+        let k24 = v_y * (k22) + cos_A * (-k23);
+        let k25 = sin_C * (k24);
+        let k26 = 0.00000003906250000000001 * p_tool_length
+            + 0.00000003906250000000001 * v_z;
+        let k27 = cos_A * (k26) + 0.00000003906250000000001 * m6;
+        let k28 = v_y * (k27) - 0.00375 * sin_A;
+        let k29 = 0.00375 * p_tool_length + 0.00375 * v_z;
+        let k30 = v_y * (-k28) + cos_A * (k29);
+        let k31 = sin_C * (k30);
+        let k32 = v_y * (k31);
+        let k33 = cos_C * (k13) - m9;
+        let k34 = cos_C * (k16) - 0.0025 * m9;
+        let k35 = v_y * (k34);
+        let k36 = p_tool_length * (k0) + v_z * (k0);
+        let k37 = cos_C * (k36) + v_x * (-k10);
+        let k38 = p_tool_length * (k2) + v_z * (k2);
+        let k39 = cos_C * (k38) + v_x * (-k11);
+        let k40 = v_y * (k39);
+        let k41 = m0 + m11;
+        let k42 = 0.0025 * m11 + 0.0025 * m0;
+        let k43 = v_y * (k42);
+        let k44 = 0.000009375000000000001 * m11 + 0.000009375000000000001 * m0;
+        let k45 = v_y * (-k44) + 0.5 * cos_C;
+        let k46 = v_y * (k45) + 0.5 * m11;
+        let k47 = 0.00000003906250000000001 * m11 + 0.00000003906250000000001 * m0;
+        let k48 = v_y * (-k47) + 0.00375 * cos_C;
+        let k49 = v_y * (k48) + 0.00375 * m11;
+        let k50 = v_y * (k49);
+        let k51 = p_tool_length - p_cradle_height + v_z;
+        let k52 = cos_C * (k51) - m9;
+        let k53 = 0.34195899479289005 * m13 - 0.5;
+        let k54 = cos_C * (k53);
+        let k55 = 0.7161972439135291 - 0.27212232178012075 * m13;
+        let k56 = cos_C * (k55);
+        let k57 = v_A * (k56);
+        let k58 = sin_C * (k53);
+        let k59 = sin_C * (k55);
+        let k60 = v_A * (k59);
+        let k61 = cos_A * (k51) + m6;
+        let k62 = sin_C * (k61);
+        let k63 = 0.47746482927568606 * p_tool_length
+            - 0.47746482927568606 * p_cradle_height + 0.47746482927568606 * v_z;
+        let k64 = cos_A * (k63) + 0.47746482927568606 * m6;
+        let k65 = sin_C * (k64);
+        let k66 = v_A * (k65);
+        let k67 = 0.34195899479289005 * p_tool_length
+            - 0.34195899479289005 * p_cradle_height + 0.34195899479289005 * v_z;
+        let k68 = v_A * (k67);
+        let k69 = v_A * (k68) - 0.5 * p_tool_length + 0.5 * p_cradle_height - 0.5 * v_z;
+        let k70 = sin_A * (k53);
+        let k71 = cos_A * (k69) + v_y * (k70);
+        let k72 = sin_C * (k71);
+        let k73 = 0.27212232178012075 * p_tool_length
+            - 0.27212232178012075 * p_cradle_height + 0.27212232178012075 * v_z;
+        let k74 = v_A * (k73);
+        let k75 = v_A * (-k74) + 0.7161972439135291 * p_tool_length
+            - 0.7161972439135291 * p_cradle_height + 0.7161972439135291 * v_z;
+        let k76 = sin_A * (k55);
+        let k77 = cos_A * (k75) + v_y * (k76);
+        let k78 = sin_C * (k77);
+        let k79 = v_A * (k78);
+        let k80 = cos_C * (k61);
+        let k81 = cos_C * (k64);
+        let k82 = v_A * (k81);
+        let k83 = cos_C * (k71);
+        let k84 = cos_C * (k77);
+        let k85 = v_A * (k84);
+        let k86 = sin_A * (k51) - m3;
+        let k87 = cos_C * (k86) - m15;
+        let k88 = sin_A * (k63) - 0.47746482927568606 * m3;
+        let k89 = cos_C * (k88) - 0.47746482927568606 * m15;
+        let k90 = v_A * (k89);
+        let k91 = cos_A * (k53);
+        let k92 = sin_A * (k69) + v_y * (-k91);
+        let k93 = cos_C * (k92) + v_x * (-k58);
+        let k94 = cos_A * (k55);
+        let k95 = sin_A * (k75) + v_y * (-k94);
+        let k96 = cos_C * (k95) + v_x * (-k59);
+        let k97 = v_A * (k96);
+        let k98 = cos_A * (k51) + p_cradle_height + m6;
+        let k99 = sin_C * (k98);
+        let k100 = cos_C * (k98);
+        let k101 = 0.5 - 0.1519817754635067 * m16;
+        let k102 = 0.47746482927568606 - 0.08062883608299874 * m16;
+        let k103 = v_C * (k102);
+        let k104 = cos_A * (k51) + p_cradle_height + m6;
+        let k105 = 0.3183098861837907 * p_tool_length
+            - 0.3183098861837907 * p_cradle_height + 0.3183098861837907 * v_z;
+        let k106 = cos_A * (k105) + 0.3183098861837907 * p_cradle_height
+            + 0.3183098861837907 * m6;
+        let k107 = v_C * (k106);
+        let k108 = 0.1519817754635067 * p_tool_length
+            - 0.1519817754635067 * p_cradle_height + 0.1519817754635067 * v_z;
+        let k109 = v_C * (k108);
+        let k110 = v_C * (k109) - 0.5 * p_tool_length + 0.5 * p_cradle_height
+            - 0.5 * v_z;
+        let k111 = 0.1519817754635067 * m16 - 0.5;
+        let k112 = sin_A * (k111);
+        let k113 = cos_A * (k110) + p_cradle_height * (-k101) + v_y * (k112);
+        let k114 = 0.08062883608299874 * p_tool_length
+            - 0.08062883608299874 * p_cradle_height + 0.08062883608299874 * v_z;
+        let k115 = v_C * (k114);
+        let k116 = v_C * (-k115) + 0.47746482927568606 * p_tool_length
+            - 0.47746482927568606 * p_cradle_height + 0.47746482927568606 * v_z;
+        let k117 = sin_A * (k102);
+        let k118 = cos_A * (k116) + p_cradle_height * (k102) + v_y * (k117);
+        let k119 = v_C * (k118);
+        let k120 = sin_A * (k105) - 0.3183098861837907 * m3;
+        let k121 = cos_C * (k120) - 0.3183098861837907 * m15;
+        let k122 = v_C * (k121);
+        let k123 = cos_A * (k111);
+        let k124 = sin_A * (k110) + v_y * (-k123);
+        let k125 = sin_C * (k111);
+        let k126 = cos_C * (k124) + v_x * (-k125);
+        let k127 = cos_A * (k102);
+        let k128 = sin_A * (k116) + v_y * (-k127);
+        let k129 = sin_C * (k102);
+        let k130 = cos_C * (k128) + v_x * (-k129);
+        let k131 = v_C * (k130);
+        let k132 = 0.000009375000000000001 * m18 - 0.5;
+        let k133 = cos_C * (k132);
+        let k134 = 0.00375 - 0.00000003906250000000001 * m18;
+        let k135 = cos_C * (k134);
+        let k136 = v_x * (k135);
+        let k137 = sin_C * (k132);
+        let k138 = cos_A * (k137);
+        let k139 = sin_C * (k134);
+        let k140 = cos_A * (k139);
+        let k141 = v_x * (k140);
+        let k142 = sin_A * (k137);
+        let k143 = sin_A * (k139);
+        let k144 = v_x * (k143);
+        let k145 = sin_C * (k13);
+        let k146 = cos_A * (k145);
+        let k147 = sin_C * (k16);
+        let k148 = cos_A * (k147);
+        let k149 = v_x * (k148);
+        let k150 = p_tool_length * (k132) + v_z * (k132);
+        let k151 = sin_C * (k150);
+        let k152 = cos_A * (k151);
+        let k153 = p_tool_length * (k134) + v_z * (k134);
+        let k154 = sin_C * (k153);
+        let k155 = cos_A * (k154);
+        let k156 = v_x * (k155);
+        let k157 = cos_C * (k13);
+        let k158 = cos_C * (k16);
+        let k159 = v_x * (k158);
+        let k160 = cos_C * (k150);
+        let k161 = cos_C * (k153);
+        let k162 = v_x * (k161);
+        let k163 = 0.000009375000000000001 * m20 - 0.5;
+        let k164 = cos_C * (k163);
+        let k165 = 0.00375 - 0.00000003906250000000001 * m20;
+        let k166 = cos_C * (k165);
+        let k167 = v_z * (k166);
+        let k168 = sin_C * (k163);
+        let k169 = cos_A * (k168);
+        let k170 = sin_C * (k165);
+        let k171 = cos_A * (k170);
+        let k172 = v_z * (k171);
+        let k173 = sin_A * (k168);
+        let k174 = sin_A * (k170);
+        let k175 = v_z * (k174);
+        let k176 = p_tool_length * (k169);
+        let k177 = p_tool_length * (k172);
+        let k178 = p_tool_length * (k164);
+        let k179 = p_tool_length * (k167);
+        let k180 = v_y * (k7);
+        let k181 = cos_A * (k1);
+        let k182 = cos_A * (k3);
+        let k183 = v_y * (k182);
+        let k184 = sin_A * (k0);
+        let k185 = cos_C * (k184);
+        let k186 = sin_A * (k2);
+        let k187 = cos_C * (k186);
+        let k188 = v_y * (k187);
+        let k189 = cos_C * (k14);
+        let k190 = cos_C * (k17);
+        let k191 = v_y * (k190);
+        let k192 = cos_C * (k24);
+        let k193 = cos_C * (k30);
+        let k194 = v_y * (k193);
+        let k195 = sin_C * (k13) + m37;
+        let k196 = sin_C * (k16) + 0.0025 * m37;
+        let k197 = v_y * (k196);
+        let k198 = sin_C * (k36) + v_x * (k185);
+        let k199 = sin_C * (k38) + v_x * (k187);
+        let k200 = v_y * (k199);
+        let k201 = m32 - m38;
+        let k202 = 0.0025 * m38 - 0.0025 * m32;
+        let k203 = v_y * (k202);
+        let k204 = 0.000009375000000000001 * m38 - 0.000009375000000000001 * m32;
+        let k205 = v_y * (k204) + 0.5 * sin_C;
+        let k206 = v_y * (k205) - 0.5 * m38;
+        let k207 = 0.00000003906250000000001 * m38 - 0.00000003906250000000001 * m32;
+        let k208 = v_y * (k207) + 0.00375 * sin_C;
+        let k209 = v_y * (-k208) + 0.00375 * m38;
+        let k210 = v_y * (k209);
+        let k211 = sin_C * (k51) + m37;
+        let k212 = sin_C * (k86) + m17;
+        let k213 = sin_C * (k88) + 0.47746482927568606 * m17;
+        let k214 = v_A * (k213);
+        let k215 = sin_C * (k92) + v_x * (k54);
+        let k216 = sin_C * (k95) + v_x * (k56);
+        let k217 = v_A * (k216);
+        let k218 = sin_C * (k120) + 0.3183098861837907 * m17;
+        let k219 = v_C * (k218);
+        let k220 = cos_C * (k111);
+        let k221 = sin_C * (k124) + v_x * (k220);
+        let k222 = cos_C * (k102);
+        let k223 = sin_C * (k128) + v_x * (k222);
+        let k224 = v_C * (k223);
+        let k225 = v_x * (k139);
+        let k226 = cos_A * (k133);
+        let k227 = cos_A * (k135);
+        let k228 = v_x * (k227);
+        let k229 = sin_A * (k132);
+        let k230 = cos_C * (k229);
+        let k231 = sin_A * (k134);
+        let k232 = cos_C * (k231);
+        let k233 = v_x * (k232);
+        let k234 = cos_A * (k157);
+        let k235 = cos_A * (k158);
+        let k236 = v_x * (k235);
+        let k237 = cos_A * (k160);
+        let k238 = cos_A * (k161);
+        let k239 = v_x * (k238);
+        let k240 = v_x * (k147);
+        let k241 = v_x * (k154);
+        let k242 = v_z * (k170);
+        let k243 = cos_A * (k164);
+        let k244 = cos_A * (k166);
+        let k245 = v_z * (k244);
+        let k246 = sin_A * (k163);
+        let k247 = cos_C * (k246);
+        let k248 = sin_A * (k165);
+        let k249 = cos_C * (k248);
+        let k250 = v_z * (k249);
+        let k251 = p_tool_length * (k243);
+        let k252 = p_tool_length * (k245);
+        let k253 = p_tool_length * (k168);
+        let k254 = p_tool_length * (k242);
+        let k255 = v_y * (k186);
+        let k256 = cos_A * (k0);
+        let k257 = cos_A * (k2);
+        let k258 = v_y * (k257);
+        let k259 = sin_A * (k13) - m3;
+        let k260 = sin_A * (k16) - 0.0025 * m3;
+        let k261 = v_y * (k260);
+        let k262 = sin_A * (k20) - 0.000009375000000000001 * m3;
+        let k263 = v_y * (k262) + 0.5 * cos_A;
+        let k264 = v_y * (k263) + sin_A * (-k23);
+        let k265 = sin_A * (k26) - 0.00000003906250000000001 * m3;
+        let k266 = v_y * (k265) + 0.00375 * cos_A;
+        let k267 = v_y * (-k266) + sin_A * (k29);
+        let k268 = v_y * (k267);
+        let k269 = v_x * (k256);
+        let k270 = v_x * (k257);
+        let k271 = v_y * (k270);
+        let k272 = v_x * (k184);
+        let k273 = v_x * (k186);
+        let k274 = v_y * (k273);
+        let k275 = 0.5 - 0.34195899479289005 * m13;
+        let k276 = v_A * (k55);
+        let k277 = v_A * (k88);
+        let k278 = v_A * (k95);
+        let k279 = v_x * (k53);
+        let k280 = v_x * (k55);
+        let k281 = v_A * (k280);
+        let k282 = v_x * (k231);
+        let k283 = cos_A * (k132);
+        let k284 = cos_A * (k134);
+        let k285 = v_x * (k284);
+        let k286 = sin_A * (k13);
+        let k287 = sin_A * (k16);
+        let k288 = v_x * (k287);
+        let k289 = sin_A * (k150);
+        let k290 = sin_A * (k153);
+        let k291 = v_x * (k290);
+        let k292 = v_z * (k248);
+        let k293 = cos_A * (k163);
+        let k294 = cos_A * (k165);
+        let k295 = v_z * (k294);
+        let k296 = p_tool_length * (k246);
+        let k297 = p_tool_length * (k292);
+        out[0] = -cos_C;
+        out[1] = -0.0025 * m0;
+        out[2] = -k1;
+        out[3] = k4;
+        out[4] = -m2;
+        out[5] = -0.0025 * m4;
+        out[6] = -k6;
+        out[7] = k9;
+        out[8] = -m5;
+        out[9] = -0.0025 * m7;
+        out[10] = -k10;
+        out[11] = k12;
+        out[12] = k15;
+        out[13] = k19;
+        out[14] = k25;
+        out[15] = -k32;
+        out[16] = -k33;
+        out[17] = -k35;
+        out[18] = -k37;
+        out[19] = k40;
+        out[20] = -k41;
+        out[21] = -k43;
+        out[22] = k46;
+        out[23] = k50;
+        out[24] = -m2;
+        out[25] = -m5;
+        out[26] = -k52;
+        out[27] = -k41;
+        out[28] = -cos_C;
+        out[29] = -0.47746482927568606 * m12;
+        out[30] = -k54;
+        out[31] = k57;
+        out[32] = -sin_C;
+        out[33] = -0.47746482927568606 * m14;
+        out[34] = -k58;
+        out[35] = k60;
+        out[36] = k62;
+        out[37] = k66;
+        out[38] = k72;
+        out[39] = -k79;
+        out[40] = -k80;
+        out[41] = -k82;
+        out[42] = -k83;
+        out[43] = k85;
+        out[44] = k87;
+        out[45] = k90;
+        out[46] = k93;
+        out[47] = -k97;
+        out[48] = -cos_C;
+        out[49] = -sin_C;
+        out[50] = k99;
+        out[51] = -k100;
+        out[52] = -1.0;
+        out[53] = -0.3183098861837907 * v_C;
+        out[54] = k101;
+        out[55] = k103;
+        out[56] = -k104;
+        out[57] = -k107;
+        out[58] = -k113;
+        out[59] = k119;
+        out[60] = k87;
+        out[61] = k122;
+        out[62] = k126;
+        out[63] = -k131;
+        out[64] = cos_C;
+        out[65] = 0.0025 * m17;
+        out[66] = k133;
+        out[67] = -k136;
+        out[68] = m2;
+        out[69] = 0.0025 * m11;
+        out[70] = k138;
+        out[71] = -k141;
+        out[72] = m5;
+        out[73] = 0.0025 * m9;
+        out[74] = k142;
+        out[75] = -k144;
+        out[76] = -k146;
+        out[77] = -k149;
+        out[78] = -k152;
+        out[79] = k156;
+        out[80] = k157;
+        out[81] = k159;
+        out[82] = k160;
+        out[83] = -k162;
+        out[84] = cos_C;
+        out[85] = 0.0025 * m19;
+        out[86] = k164;
+        out[87] = -k167;
+        out[88] = m2;
+        out[89] = 0.0025 * m22;
+        out[90] = k169;
+        out[91] = -k172;
+        out[92] = m5;
+        out[93] = 0.0025 * m24;
+        out[94] = k173;
+        out[95] = -k175;
+        out[96] = -m26;
+        out[97] = -0.0025 * m29;
+        out[98] = -k176;
+        out[99] = k177;
+        out[100] = m30;
+        out[101] = 0.0025 * m31;
+        out[102] = k178;
+        out[103] = -k179;
+        out[104] = -m26;
+        out[105] = m30;
+        out[106] = sin_C;
+        out[107] = 0.0025 * m32;
+        out[108] = k5;
+        out[109] = -k180;
+        out[110] = -m33;
+        out[111] = -0.0025 * m34;
+        out[112] = -k181;
+        out[113] = k183;
+        out[114] = -m35;
+        out[115] = -0.0025 * m36;
+        out[116] = -k185;
+        out[117] = k188;
+        out[118] = k189;
+        out[119] = k191;
+        out[120] = k192;
+        out[121] = -k194;
+        out[122] = k195;
+        out[123] = k197;
+        out[124] = k198;
+        out[125] = -k200;
+        out[126] = k201;
+        out[127] = -k203;
+        out[128] = -k206;
+        out[129] = k210;
+        out[130] = -m33;
+        out[131] = -m35;
+        out[132] = k211;
+        out[133] = k201;
+        out[134] = sin_C;
+        out[135] = 0.47746482927568606 * m14;
+        out[136] = k58;
+        out[137] = -k60;
+        out[138] = -cos_C;
+        out[139] = -0.47746482927568606 * m12;
+        out[140] = -k54;
+        out[141] = k57;
+        out[142] = k80;
+        out[143] = k82;
+        out[144] = k83;
+        out[145] = -k85;
+        out[146] = k62;
+        out[147] = k66;
+        out[148] = k72;
+        out[149] = -k79;
+        out[150] = -k212;
+        out[151] = -k214;
+        out[152] = -k215;
+        out[153] = k217;
+        out[154] = sin_C;
+        out[155] = -cos_C;
+        out[156] = k100;
+        out[157] = k99;
+        out[158] = -1.0;
+        out[159] = -0.3183098861837907 * v_C;
+        out[160] = k101;
+        out[161] = k103;
+        out[162] = k104;
+        out[163] = k107;
+        out[164] = k113;
+        out[165] = -k119;
+        out[166] = -k212;
+        out[167] = -k219;
+        out[168] = -k221;
+        out[169] = k224;
+        out[170] = -sin_C;
+        out[171] = -0.0025 * m15;
+        out[172] = -k137;
+        out[173] = k225;
+        out[174] = m33;
+        out[175] = 0.0025 * m38;
+        out[176] = k226;
+        out[177] = -k228;
+        out[178] = m35;
+        out[179] = 0.0025 * m37;
+        out[180] = k230;
+        out[181] = -k233;
+        out[182] = -k234;
+        out[183] = -k236;
+        out[184] = -k237;
+        out[185] = k239;
+        out[186] = -k145;
+        out[187] = -k240;
+        out[188] = -k151;
+        out[189] = k241;
+        out[190] = -sin_C;
+        out[191] = -0.0025 * m39;
+        out[192] = -k168;
+        out[193] = k242;
+        out[194] = m33;
+        out[195] = 0.0025 * m40;
+        out[196] = k243;
+        out[197] = -k245;
+        out[198] = m35;
+        out[199] = 0.0025 * m41;
+        out[200] = k247;
+        out[201] = -k250;
+        out[202] = -m42;
+        out[203] = -0.0025 * m43;
+        out[204] = -k251;
+        out[205] = k252;
+        out[206] = -m44;
+        out[207] = -0.0025 * m45;
+        out[208] = -k253;
+        out[209] = k254;
+        out[210] = -m42;
+        out[211] = -m44;
+        out[212] = sin_A;
+        out[213] = 0.0025 * m6;
+        out[214] = k184;
+        out[215] = -k255;
+        out[216] = -cos_A;
+        out[217] = -0.0025 * m3;
+        out[218] = -k256;
+        out[219] = k258;
+        out[220] = -k259;
+        out[221] = -k261;
+        out[222] = -k264;
+        out[223] = k268;
+        out[224] = m10;
+        out[225] = 0.0025 * m47;
+        out[226] = k269;
+        out[227] = -k271;
+        out[228] = m8;
+        out[229] = 0.0025 * m48;
+        out[230] = k272;
+        out[231] = -k274;
+        out[232] = sin_A;
+        out[233] = -cos_A;
+        out[234] = m10;
+        out[235] = m8;
+        out[236] = -1.0;
+        out[237] = -0.47746482927568606 * v_A;
+        out[238] = k275;
+        out[239] = k276;
+        out[240] = -k86;
+        out[241] = -k277;
+        out[242] = -k92;
+        out[243] = k278;
+        out[244] = v_x;
+        out[245] = 0.47746482927568606 * m49;
+        out[246] = k279;
+        out[247] = -k281;
+        out[248] = -k86;
+        out[249] = v_x;
+        out[250] = -1.0;
+        out[251] = -0.3183098861837907 * v_C;
+        out[252] = k101;
+        out[253] = k103;
+        out[254] = -k87;
+        out[255] = -k122;
+        out[256] = -k126;
+        out[257] = k131;
+        out[258] = k212;
+        out[259] = k219;
+        out[260] = k221;
+        out[261] = -k224;
+        out[262] = -sin_A;
+        out[263] = -0.0025 * m8;
+        out[264] = -k229;
+        out[265] = k282;
+        out[266] = cos_A;
+        out[267] = 0.0025 * m10;
+        out[268] = k283;
+        out[269] = -k285;
+        out[270] = k286;
+        out[271] = k288;
+        out[272] = k289;
+        out[273] = -k291;
+        out[274] = -sin_A;
+        out[275] = -0.0025 * m23;
+        out[276] = -k246;
+        out[277] = k292;
+        out[278] = cos_A;
+        out[279] = 0.0025 * m21;
+        out[280] = k293;
+        out[281] = -k295;
+        out[282] = m50;
+        out[283] = 0.0025 * m51;
+        out[284] = k296;
+        out[285] = -k297;
+        out[286] = m50;
+        out[287] = -cos_C;
+        out[288] = -0.0025 * m0;
+        out[289] = -k1;
+        out[290] = k4;
+        out[291] = -m2;
+        out[292] = -0.0025 * m4;
+        out[293] = -k6;
+        out[294] = k9;
+        out[295] = -m5;
+        out[296] = -0.0025 * m7;
+        out[297] = -k10;
+        out[298] = k12;
+        out[299] = -m2;
+        out[300] = -m5;
+        out[301] = -cos_C;
+        out[302] = -0.47746482927568606 * m12;
+        out[303] = -k54;
+        out[304] = k57;
+        out[305] = -sin_C;
+        out[306] = -0.47746482927568606 * m14;
+        out[307] = -k58;
+        out[308] = k60;
+        out[309] = -cos_C;
+        out[310] = -sin_C;
+        out[311] = -1.0;
+        out[312] = -0.3183098861837907 * v_C;
+        out[313] = k101;
+        out[314] = k103;
+        out[315] = cos_C;
+        out[316] = 0.0025 * m17;
+        out[317] = k133;
+        out[318] = -k136;
+        out[319] = m2;
+        out[320] = 0.0025 * m11;
+        out[321] = k138;
+        out[322] = -k141;
+        out[323] = m5;
+        out[324] = 0.0025 * m9;
+        out[325] = k142;
+        out[326] = -k144;
+        out[327] = m5;
+        out[328] = cos_C;
+        out[329] = 0.0025 * m19;
+        out[330] = k164;
+        out[331] = -k167;
+        out[332] = m2;
+        out[333] = 0.0025 * m22;
+        out[334] = k169;
+        out[335] = -k172;
+        out[336] = m5;
+        out[337] = 0.0025 * m24;
+        out[338] = k173;
+        out[339] = -k175;
+        out[340] = cos_C;
+        out[341] = m2;
+        out[342] = sin_C;
+        out[343] = 0.0025 * m32;
+        out[344] = k5;
+        out[345] = -k180;
+        out[346] = -m33;
+        out[347] = -0.0025 * m34;
+        out[348] = -k181;
+        out[349] = k183;
+        out[350] = -m35;
+        out[351] = -0.0025 * m36;
+        out[352] = -k185;
+        out[353] = k188;
+        out[354] = -m33;
+        out[355] = -m35;
+        out[356] = sin_C;
+        out[357] = 0.47746482927568606 * m14;
+        out[358] = k58;
+        out[359] = -k60;
+        out[360] = -cos_C;
+        out[361] = -0.47746482927568606 * m12;
+        out[362] = -k54;
+        out[363] = k57;
+        out[364] = sin_C;
+        out[365] = -cos_C;
+        out[366] = -1.0;
+        out[367] = -0.3183098861837907 * v_C;
+        out[368] = k101;
+        out[369] = k103;
+        out[370] = -sin_C;
+        out[371] = -0.0025 * m15;
+        out[372] = -k137;
+        out[373] = k225;
+        out[374] = m33;
+        out[375] = 0.0025 * m38;
+        out[376] = k226;
+        out[377] = -k228;
+        out[378] = m35;
+        out[379] = 0.0025 * m37;
+        out[380] = k230;
+        out[381] = -k233;
+        out[382] = m35;
+        out[383] = -sin_C;
+        out[384] = -0.0025 * m39;
+        out[385] = -k168;
+        out[386] = k242;
+        out[387] = m33;
+        out[388] = 0.0025 * m40;
+        out[389] = k243;
+        out[390] = -k245;
+        out[391] = m35;
+        out[392] = 0.0025 * m41;
+        out[393] = k247;
+        out[394] = -k250;
+        out[395] = -sin_C;
+        out[396] = m33;
+        out[397] = sin_A;
+        out[398] = 0.0025 * m6;
+        out[399] = k184;
+        out[400] = -k255;
+        out[401] = -cos_A;
+        out[402] = -0.0025 * m3;
+        out[403] = -k256;
+        out[404] = k258;
+        out[405] = sin_A;
+        out[406] = -cos_A;
+        out[407] = -1.0;
+        out[408] = -0.47746482927568606 * v_A;
+        out[409] = k275;
+        out[410] = k276;
+        out[411] = -1.0;
+        out[412] = -0.3183098861837907 * v_C;
+        out[413] = k101;
+        out[414] = k103;
+        out[415] = -sin_A;
+        out[416] = -0.0025 * m8;
+        out[417] = -k229;
+        out[418] = k282;
+        out[419] = cos_A;
+        out[420] = 0.0025 * m10;
+        out[421] = k283;
+        out[422] = -k285;
+        out[423] = cos_A;
+        out[424] = -sin_A;
+        out[425] = -0.0025 * m23;
+        out[426] = -k246;
+        out[427] = k292;
+        out[428] = cos_A;
+        out[429] = 0.0025 * m21;
+        out[430] = k293;
+        out[431] = -k295;
+        out[432] = -sin_A;
+    }
+    /// [`Self::error_into`] with `sin`/`cos` given.
+    #[inline(always)]
+    fn error_given(
+        q: &[f64; 5],
+        p: &[f64; 2],
+        sc: &[[f64; 2]; 5],
+        e: &[f64; 131],
+        out: &mut [f64; 6],
+    ) {
+        let p_tool_length = p[0];
+        let p_cradle_height = p[1];
+        let v_y = q[0];
+        let v_A = q[1];
+        let v_C = q[2];
+        let v_x = q[3];
+        let v_z = q[4];
+        let [sin_A, cos_A] = sc[1];
+        let [sin_C, cos_C] = sc[2];
+        let m0 = v_y * cos_C;
+        let m1 = v_y * v_y;
+        let m2 = cos_A * sin_C;
+        let m3 = v_y * cos_A;
+        let m4 = m3 * sin_C;
+        let m5 = sin_A * sin_C;
+        let m6 = v_y * sin_A;
+        let m7 = m6 * sin_C;
+        let m8 = v_x * sin_A;
+        let m9 = m8 * sin_C;
+        let m10 = v_x * cos_A;
+        let m11 = m10 * sin_C;
+        let m12 = v_A * cos_C;
+        let m13 = v_A * v_A;
+        let m14 = v_A * sin_C;
+        let m15 = v_x * sin_C;
+        let m16 = v_C * v_C;
+        let m17 = v_x * cos_C;
+        let m18 = v_x * v_x;
+        let m19 = v_z * cos_C;
+        let m20 = v_z * v_z;
+        let m21 = v_z * cos_A;
+        let m22 = m21 * sin_C;
+        let m23 = v_z * sin_A;
+        let m24 = m23 * sin_C;
+        let m25 = p_tool_length * cos_A;
+        let m26 = m25 * sin_C;
+        let m27 = p_tool_length * v_z;
+        let m28 = m27 * cos_A;
+        let m29 = m28 * sin_C;
+        let m30 = p_tool_length * cos_C;
+        let m31 = m27 * cos_C;
+        let m32 = v_y * sin_C;
+        let m33 = cos_A * cos_C;
+        let m34 = m3 * cos_C;
+        let m35 = cos_C * sin_A;
+        let m36 = m0 * sin_A;
+        let m37 = m17 * sin_A;
+        let m38 = m10 * cos_C;
+        let m39 = v_z * sin_C;
+        let m40 = m21 * cos_C;
+        let m41 = m19 * sin_A;
+        let m42 = m25 * cos_C;
+        let m43 = m28 * cos_C;
+        let m44 = p_tool_length * sin_C;
+        let m45 = m27 * sin_C;
+        let m46 = v_y * v_x;
+        let m47 = m46 * cos_A;
+        let m48 = m46 * sin_A;
+        let m49 = v_A * v_x;
+        let m50 = p_tool_length * sin_A;
+        let m51 = m27 * sin_A;
+        let k0 = 0.000009375000000000001 * m1 - 0.5;
+        let k1 = cos_C * (k0);
+        let k2 = 0.00375 - 0.00000003906250000000001 * m1;
+        let k3 = cos_C * (k2);
+        let k4 = v_y * (k3);
+        let k5 = sin_C * (k0);
+        let k6 = cos_A * (k5);
+        let k7 = sin_C * (k2);
+        let k8 = cos_A * (k7);
+        let k9 = v_y * (k8);
+        let k10 = sin_A * (k5);
+        let k11 = sin_A * (k7);
+        let k12 = v_y * (k11);
+        let k13 = p_tool_length + v_z;
+        let k14 = cos_A * (k13) + m6;
+        let k15 = sin_C * (k14);
+        let k16 = 0.0025 * p_tool_length + 0.0025 * v_z;
+        let k17 = cos_A * (k16) + 0.0025 * m6;
+        let k18 = sin_C * (k17);
+        let k19 = v_y * (k18);
+        let k20 = 0.000009375000000000001 * p_tool_length
+            + 0.000009375000000000001 * v_z;
+        let k21 = cos_A * (k20) + 0.000009375000000000001 * m6;
+        let k22 = v_y * (k21) - 0.5 * sin_A;
+        let k23 = 0.5 * p_tool_length + 0.5 * v_z;
+        let k24 = v_y * (k22) + cos_A * (-k23);
+        let k25 = sin_C * (k24);
+        let k26 = 0.00000003906250000000001 * p_tool_length
+            + 0.00000003906250000000001 * v_z;
+        let k27 = cos_A * (k26) + 0.00000003906250000000001 * m6;
+        let k28 = v_y * (k27) - 0.00375 * sin_A;
+        let k29 = 0.00375 * p_tool_length + 0.00375 * v_z;
+        let k30 = v_y * (-k28) + cos_A * (k29);
+        let k31 = sin_C * (k30);
+        let k32 = v_y * (k31);
+        let k33 = cos_C * (k13) - m9;
+        let k34 = cos_C * (k16) - 0.0025 * m9;
+        let k35 = v_y * (k34);
+        let k36 = p_tool_length * (k0) + v_z * (k0);
+        let k37 = cos_C * (k36) + v_x * (-k10);
+        let k38 = p_tool_length * (k2) + v_z * (k2);
+        let k39 = cos_C * (k38) + v_x * (-k11);
+        let k40 = v_y * (k39);
+        let k41 = m0 + m11;
+        let k42 = 0.0025 * m11 + 0.0025 * m0;
+        let k43 = v_y * (k42);
+        let k44 = 0.000009375000000000001 * m11 + 0.000009375000000000001 * m0;
+        let k45 = v_y * (-k44) + 0.5 * cos_C;
+        let k46 = v_y * (k45) + 0.5 * m11;
+        let k47 = 0.00000003906250000000001 * m11 + 0.00000003906250000000001 * m0;
+        let k48 = v_y * (-k47) + 0.00375 * cos_C;
+        let k49 = v_y * (k48) + 0.00375 * m11;
+        let k50 = v_y * (k49);
+        let k51 = p_tool_length - p_cradle_height + v_z;
+        let k52 = cos_C * (k51) - m9;
+        let k53 = 0.34195899479289005 * m13 - 0.5;
+        let k54 = cos_C * (k53);
+        let k55 = 0.7161972439135291 - 0.27212232178012075 * m13;
+        let k56 = cos_C * (k55);
+        let k57 = v_A * (k56);
+        let k58 = sin_C * (k53);
+        let k59 = sin_C * (k55);
+        let k60 = v_A * (k59);
+        let k61 = cos_A * (k51) + m6;
+        let k62 = sin_C * (k61);
+        let k63 = 0.47746482927568606 * p_tool_length
+            - 0.47746482927568606 * p_cradle_height + 0.47746482927568606 * v_z;
+        let k64 = cos_A * (k63) + 0.47746482927568606 * m6;
+        let k65 = sin_C * (k64);
+        let k66 = v_A * (k65);
+        let k67 = 0.34195899479289005 * p_tool_length
+            - 0.34195899479289005 * p_cradle_height + 0.34195899479289005 * v_z;
+        let k68 = v_A * (k67);
+        let k69 = v_A * (k68) - 0.5 * p_tool_length + 0.5 * p_cradle_height - 0.5 * v_z;
+        let k70 = sin_A * (k53);
+        let k71 = cos_A * (k69) + v_y * (k70);
+        let k72 = sin_C * (k71);
+        let k73 = 0.27212232178012075 * p_tool_length
+            - 0.27212232178012075 * p_cradle_height + 0.27212232178012075 * v_z;
+        let k74 = v_A * (k73);
+        let k75 = v_A * (-k74) + 0.7161972439135291 * p_tool_length
+            - 0.7161972439135291 * p_cradle_height + 0.7161972439135291 * v_z;
+        let k76 = sin_A * (k55);
+        let k77 = cos_A * (k75) + v_y * (k76);
+        let k78 = sin_C * (k77);
+        let k79 = v_A * (k78);
+        let k80 = cos_C * (k61);
+        let k81 = cos_C * (k64);
+        let k82 = v_A * (k81);
+        let k83 = cos_C * (k71);
+        let k84 = cos_C * (k77);
+        let k85 = v_A * (k84);
+        let k86 = sin_A * (k51) - m3;
+        let k87 = cos_C * (k86) - m15;
+        let k88 = sin_A * (k63) - 0.47746482927568606 * m3;
+        let k89 = cos_C * (k88) - 0.47746482927568606 * m15;
+        let k90 = v_A * (k89);
+        let k91 = cos_A * (k53);
+        let k92 = sin_A * (k69) + v_y * (-k91);
+        let k93 = cos_C * (k92) + v_x * (-k58);
+        let k94 = cos_A * (k55);
+        let k95 = sin_A * (k75) + v_y * (-k94);
+        let k96 = cos_C * (k95) + v_x * (-k59);
+        let k97 = v_A * (k96);
+        let k98 = cos_A * (k51) + p_cradle_height + m6;
+        let k99 = sin_C * (k98);
+        let k100 = cos_C * (k98);
+        let k101 = 0.5 - 0.1519817754635067 * m16;
+        let k102 = 0.47746482927568606 - 0.08062883608299874 * m16;
+        let k103 = v_C * (k102);
+        let k104 = cos_A * (k51) + p_cradle_height + m6;
+        let k105 = 0.3183098861837907 * p_tool_length
+            - 0.3183098861837907 * p_cradle_height + 0.3183098861837907 * v_z;
+        let k106 = cos_A * (k105) + 0.3183098861837907 * p_cradle_height
+            + 0.3183098861837907 * m6;
+        let k107 = v_C * (k106);
+        let k108 = 0.1519817754635067 * p_tool_length
+            - 0.1519817754635067 * p_cradle_height + 0.1519817754635067 * v_z;
+        let k109 = v_C * (k108);
+        let k110 = v_C * (k109) - 0.5 * p_tool_length + 0.5 * p_cradle_height
+            - 0.5 * v_z;
+        let k111 = 0.1519817754635067 * m16 - 0.5;
+        let k112 = sin_A * (k111);
+        let k113 = cos_A * (k110) + p_cradle_height * (-k101) + v_y * (k112);
+        let k114 = 0.08062883608299874 * p_tool_length
+            - 0.08062883608299874 * p_cradle_height + 0.08062883608299874 * v_z;
+        let k115 = v_C * (k114);
+        let k116 = v_C * (-k115) + 0.47746482927568606 * p_tool_length
+            - 0.47746482927568606 * p_cradle_height + 0.47746482927568606 * v_z;
+        let k117 = sin_A * (k102);
+        let k118 = cos_A * (k116) + p_cradle_height * (k102) + v_y * (k117);
+        let k119 = v_C * (k118);
+        let k120 = sin_A * (k105) - 0.3183098861837907 * m3;
+        let k121 = cos_C * (k120) - 0.3183098861837907 * m15;
+        let k122 = v_C * (k121);
+        let k123 = cos_A * (k111);
+        let k124 = sin_A * (k110) + v_y * (-k123);
+        let k125 = sin_C * (k111);
+        let k126 = cos_C * (k124) + v_x * (-k125);
+        let k127 = cos_A * (k102);
+        let k128 = sin_A * (k116) + v_y * (-k127);
+        let k129 = sin_C * (k102);
+        let k130 = cos_C * (k128) + v_x * (-k129);
+        let k131 = v_C * (k130);
+        let k132 = 0.000009375000000000001 * m18 - 0.5;
+        let k133 = cos_C * (k132);
+        let k134 = 0.00375 - 0.00000003906250000000001 * m18;
+        let k135 = cos_C * (k134);
+        let k136 = v_x * (k135);
+        let k137 = sin_C * (k132);
+        let k138 = cos_A * (k137);
+        let k139 = sin_C * (k134);
+        let k140 = cos_A * (k139);
+        let k141 = v_x * (k140);
+        let k142 = sin_A * (k137);
+        let k143 = sin_A * (k139);
+        let k144 = v_x * (k143);
+        let k145 = sin_C * (k13);
+        let k146 = cos_A * (k145);
+        let k147 = sin_C * (k16);
+        let k148 = cos_A * (k147);
+        let k149 = v_x * (k148);
+        let k150 = p_tool_length * (k132) + v_z * (k132);
+        let k151 = sin_C * (k150);
+        let k152 = cos_A * (k151);
+        let k153 = p_tool_length * (k134) + v_z * (k134);
+        let k154 = sin_C * (k153);
+        let k155 = cos_A * (k154);
+        let k156 = v_x * (k155);
+        let k157 = cos_C * (k13);
+        let k158 = cos_C * (k16);
+        let k159 = v_x * (k158);
+        let k160 = cos_C * (k150);
+        let k161 = cos_C * (k153);
+        let k162 = v_x * (k161);
+        let k163 = 0.000009375000000000001 * m20 - 0.5;
+        let k164 = cos_C * (k163);
+        let k165 = 0.00375 - 0.00000003906250000000001 * m20;
+        let k166 = cos_C * (k165);
+        let k167 = v_z * (k166);
+        let k168 = sin_C * (k163);
+        let k169 = cos_A * (k168);
+        let k170 = sin_C * (k165);
+        let k171 = cos_A * (k170);
+        let k172 = v_z * (k171);
+        let k173 = sin_A * (k168);
+        let k174 = sin_A * (k170);
+        let k175 = v_z * (k174);
+        let k176 = p_tool_length * (k169);
+        let k177 = p_tool_length * (k172);
+        let k178 = p_tool_length * (k164);
+        let k179 = p_tool_length * (k167);
+        let k180 = v_y * (k7);
+        let k181 = cos_A * (k1);
+        let k182 = cos_A * (k3);
+        let k183 = v_y * (k182);
+        let k184 = sin_A * (k0);
+        let k185 = cos_C * (k184);
+        let k186 = sin_A * (k2);
+        let k187 = cos_C * (k186);
+        let k188 = v_y * (k187);
+        let k189 = cos_C * (k14);
+        let k190 = cos_C * (k17);
+        let k191 = v_y * (k190);
+        let k192 = cos_C * (k24);
+        let k193 = cos_C * (k30);
+        let k194 = v_y * (k193);
+        let k195 = sin_C * (k13) + m37;
+        let k196 = sin_C * (k16) + 0.0025 * m37;
+        let k197 = v_y * (k196);
+        let k198 = sin_C * (k36) + v_x * (k185);
+        let k199 = sin_C * (k38) + v_x * (k187);
+        let k200 = v_y * (k199);
+        let k201 = m32 - m38;
+        let k202 = 0.0025 * m38 - 0.0025 * m32;
+        let k203 = v_y * (k202);
+        let k204 = 0.000009375000000000001 * m38 - 0.000009375000000000001 * m32;
+        let k205 = v_y * (k204) + 0.5 * sin_C;
+        let k206 = v_y * (k205) - 0.5 * m38;
+        let k207 = 0.00000003906250000000001 * m38 - 0.00000003906250000000001 * m32;
+        let k208 = v_y * (k207) + 0.00375 * sin_C;
+        let k209 = v_y * (-k208) + 0.00375 * m38;
+        let k210 = v_y * (k209);
+        let k211 = sin_C * (k51) + m37;
+        let k212 = sin_C * (k86) + m17;
+        let k213 = sin_C * (k88) + 0.47746482927568606 * m17;
+        let k214 = v_A * (k213);
+        let k215 = sin_C * (k92) + v_x * (k54);
+        let k216 = sin_C * (k95) + v_x * (k56);
+        let k217 = v_A * (k216);
+        let k218 = sin_C * (k120) + 0.3183098861837907 * m17;
+        let k219 = v_C * (k218);
+        let k220 = cos_C * (k111);
+        let k221 = sin_C * (k124) + v_x * (k220);
+        let k222 = cos_C * (k102);
+        let k223 = sin_C * (k128) + v_x * (k222);
+        let k224 = v_C * (k223);
+        let k225 = v_x * (k139);
+        let k226 = cos_A * (k133);
+        let k227 = cos_A * (k135);
+        let k228 = v_x * (k227);
+        let k229 = sin_A * (k132);
+        let k230 = cos_C * (k229);
+        let k231 = sin_A * (k134);
+        let k232 = cos_C * (k231);
+        let k233 = v_x * (k232);
+        let k234 = cos_A * (k157);
+        let k235 = cos_A * (k158);
+        let k236 = v_x * (k235);
+        let k237 = cos_A * (k160);
+        let k238 = cos_A * (k161);
+        let k239 = v_x * (k238);
+        let k240 = v_x * (k147);
+        let k241 = v_x * (k154);
+        let k242 = v_z * (k170);
+        let k243 = cos_A * (k164);
+        let k244 = cos_A * (k166);
+        let k245 = v_z * (k244);
+        let k246 = sin_A * (k163);
+        let k247 = cos_C * (k246);
+        let k248 = sin_A * (k165);
+        let k249 = cos_C * (k248);
+        let k250 = v_z * (k249);
+        let k251 = p_tool_length * (k243);
+        let k252 = p_tool_length * (k245);
+        let k253 = p_tool_length * (k168);
+        let k254 = p_tool_length * (k242);
+        let k255 = v_y * (k186);
+        let k256 = cos_A * (k0);
+        let k257 = cos_A * (k2);
+        let k258 = v_y * (k257);
+        let k259 = sin_A * (k13) - m3;
+        let k260 = sin_A * (k16) - 0.0025 * m3;
+        let k261 = v_y * (k260);
+        let k262 = sin_A * (k20) - 0.000009375000000000001 * m3;
+        let k263 = v_y * (k262) + 0.5 * cos_A;
+        let k264 = v_y * (k263) + sin_A * (-k23);
+        let k265 = sin_A * (k26) - 0.00000003906250000000001 * m3;
+        let k266 = v_y * (k265) + 0.00375 * cos_A;
+        let k267 = v_y * (-k266) + sin_A * (k29);
+        let k268 = v_y * (k267);
+        let k269 = v_x * (k256);
+        let k270 = v_x * (k257);
+        let k271 = v_y * (k270);
+        let k272 = v_x * (k184);
+        let k273 = v_x * (k186);
+        let k274 = v_y * (k273);
+        let k275 = 0.5 - 0.34195899479289005 * m13;
+        let k276 = v_A * (k55);
+        let k277 = v_A * (k88);
+        let k278 = v_A * (k95);
+        let k279 = v_x * (k53);
+        let k280 = v_x * (k55);
+        let k281 = v_A * (k280);
+        let k282 = v_x * (k231);
+        let k283 = cos_A * (k132);
+        let k284 = cos_A * (k134);
+        let k285 = v_x * (k284);
+        let k286 = sin_A * (k13);
+        let k287 = sin_A * (k16);
+        let k288 = v_x * (k287);
+        let k289 = sin_A * (k150);
+        let k290 = sin_A * (k153);
+        let k291 = v_x * (k290);
+        let k292 = v_z * (k248);
+        let k293 = cos_A * (k163);
+        let k294 = cos_A * (k165);
+        let k295 = v_z * (k294);
+        let k296 = p_tool_length * (k246);
+        let k297 = p_tool_length * (k292);
+        out[0] = -cos_C * e[0] - 0.0025 * m0 * e[1] - k1 * e[2] + k4 * e[3] - m2 * e[4]
+            - 0.0025 * m4 * e[5] - k6 * e[6] + k9 * e[7] - m5 * e[8] - 0.0025 * m7 * e[9]
+            - k10 * e[10] + k12 * e[11] + k15 * e[12] + k19 * e[13] + k25 * e[14]
+            - k32 * e[15] - k33 * e[16] - k35 * e[17] - k37 * e[18] + k40 * e[19]
+            - k41 * e[20] - k43 * e[21] + k46 * e[22] + k50 * e[23] - m2 * e[24]
+            - m5 * e[25] - k52 * e[26] - k41 * e[27] - cos_C * e[28]
+            - 0.47746482927568606 * m12 * e[29] - k54 * e[30] + k57 * e[31]
+            - sin_C * e[32] - 0.47746482927568606 * m14 * e[33] - k58 * e[34]
+            + k60 * e[35] + k62 * e[40] + k66 * e[41] + k72 * e[42] - k79 * e[43]
+            - k80 * e[44] - k82 * e[45] - k83 * e[46] + k85 * e[47] + k87 * e[48]
+            + k90 * e[49] + k93 * e[50] - k97 * e[51] - cos_C * e[52] - sin_C * e[53]
+            + k99 * e[54] - k100 * e[55] - e[56] - 0.3183098861837907 * v_C * e[57]
+            + k101 * e[58] + k103 * e[59] - k104 * e[72] - k107 * e[73] - k113 * e[74]
+            + k119 * e[75] + k87 * e[76] + k122 * e[77] + k126 * e[78] - k131 * e[79]
+            + cos_C * e[80] + 0.0025 * m17 * e[81] + k133 * e[82] - k136 * e[83]
+            + m2 * e[84] + 0.0025 * m11 * e[85] + k138 * e[86] - k141 * e[87]
+            + m5 * e[88] + 0.0025 * m9 * e[89] + k142 * e[90] - k144 * e[91]
+            - k146 * e[92] - k149 * e[93] - k152 * e[94] + k156 * e[95] + k157 * e[96]
+            + k159 * e[97] + k160 * e[98] - k162 * e[99] + cos_C * e[105]
+            + 0.0025 * m19 * e[106] + k164 * e[107] - k167 * e[108] + m2 * e[109]
+            + 0.0025 * m22 * e[110] + k169 * e[111] - k172 * e[112] + m5 * e[113]
+            + 0.0025 * m24 * e[114] + k173 * e[115] - k175 * e[116] - m26 * e[117]
+            - 0.0025 * m29 * e[118] - k176 * e[119] + k177 * e[120] + m30 * e[121]
+            + 0.0025 * m31 * e[122] + k178 * e[123] - k179 * e[124] - m26 * e[129]
+            + m30 * e[130];
+        out[1] = sin_C * e[0] + 0.0025 * m32 * e[1] + k5 * e[2] - k180 * e[3]
+            - m33 * e[4] - 0.0025 * m34 * e[5] - k181 * e[6] + k183 * e[7] - m35 * e[8]
+            - 0.0025 * m36 * e[9] - k185 * e[10] + k188 * e[11] + k189 * e[12]
+            + k191 * e[13] + k192 * e[14] - k194 * e[15] + k195 * e[16] + k197 * e[17]
+            + k198 * e[18] - k200 * e[19] + k201 * e[20] - k203 * e[21] - k206 * e[22]
+            + k210 * e[23] - m33 * e[24] - m35 * e[25] + k211 * e[26] + k201 * e[27]
+            + sin_C * e[28] + 0.47746482927568606 * m14 * e[29] + k58 * e[30]
+            - k60 * e[31] - cos_C * e[32] - 0.47746482927568606 * m12 * e[33]
+            - k54 * e[34] + k57 * e[35] + k80 * e[40] + k82 * e[41] + k83 * e[42]
+            - k85 * e[43] + k62 * e[44] + k66 * e[45] + k72 * e[46] - k79 * e[47]
+            - k212 * e[48] - k214 * e[49] - k215 * e[50] + k217 * e[51] + sin_C * e[52]
+            - cos_C * e[53] + k100 * e[54] + k99 * e[55] - e[60]
+            - 0.3183098861837907 * v_C * e[61] + k101 * e[62] + k103 * e[63]
+            + k104 * e[68] + k107 * e[69] + k113 * e[70] - k119 * e[71] - k212 * e[76]
+            - k219 * e[77] - k221 * e[78] + k224 * e[79] - sin_C * e[80]
+            - 0.0025 * m15 * e[81] - k137 * e[82] + k225 * e[83] + m33 * e[84]
+            + 0.0025 * m38 * e[85] + k226 * e[86] - k228 * e[87] + m35 * e[88]
+            + 0.0025 * m37 * e[89] + k230 * e[90] - k233 * e[91] - k234 * e[92]
+            - k236 * e[93] - k237 * e[94] + k239 * e[95] - k145 * e[96] - k240 * e[97]
+            - k151 * e[98] + k241 * e[99] - sin_C * e[105] - 0.0025 * m39 * e[106]
+            - k168 * e[107] + k242 * e[108] + m33 * e[109] + 0.0025 * m40 * e[110]
+            + k243 * e[111] - k245 * e[112] + m35 * e[113] + 0.0025 * m41 * e[114]
+            + k247 * e[115] - k250 * e[116] - m42 * e[117] - 0.0025 * m43 * e[118]
+            - k251 * e[119] + k252 * e[120] - m44 * e[121] - 0.0025 * m45 * e[122]
+            - k253 * e[123] + k254 * e[124] - m42 * e[129] - m44 * e[130];
+        out[2] = sin_A * e[4] + 0.0025 * m6 * e[5] + k184 * e[6] - k255 * e[7]
+            - cos_A * e[8] - 0.0025 * m3 * e[9] - k256 * e[10] + k258 * e[11]
+            - k259 * e[12] - k261 * e[13] - k264 * e[14] + k268 * e[15] + m10 * e[16]
+            + 0.0025 * m47 * e[17] + k269 * e[18] - k271 * e[19] + m8 * e[20]
+            + 0.0025 * m48 * e[21] + k272 * e[22] - k274 * e[23] + sin_A * e[24]
+            - cos_A * e[25] + m10 * e[26] + m8 * e[27] - e[36]
+            - 0.47746482927568606 * v_A * e[37] + k275 * e[38] + k276 * e[39]
+            - k86 * e[40] - k277 * e[41] - k92 * e[42] + k278 * e[43] + v_x * e[44]
+            + 0.47746482927568606 * m49 * e[45] + k279 * e[46] - k281 * e[47]
+            - k86 * e[54] + v_x * e[55] - e[64] - 0.3183098861837907 * v_C * e[65]
+            + k101 * e[66] + k103 * e[67] - k87 * e[68] - k122 * e[69] - k126 * e[70]
+            + k131 * e[71] + k212 * e[72] + k219 * e[73] + k221 * e[74] - k224 * e[75]
+            - sin_A * e[84] - 0.0025 * m8 * e[85] - k229 * e[86] + k282 * e[87]
+            + cos_A * e[88] + 0.0025 * m10 * e[89] + k283 * e[90] - k285 * e[91]
+            + k286 * e[92] + k288 * e[93] + k289 * e[94] - k291 * e[95] - sin_A * e[109]
+            - 0.0025 * m23 * e[110] - k246 * e[111] + k292 * e[112] + cos_A * e[113]
+            + 0.0025 * m21 * e[114] + k293 * e[115] - k295 * e[116] + m50 * e[117]
+            + 0.0025 * m51 * e[118] + k296 * e[119] - k297 * e[120] + m50 * e[129];
+        out[3] = -cos_C * e[12] - 0.0025 * m0 * e[13] - k1 * e[14] + k4 * e[15]
+            - m2 * e[16] - 0.0025 * m4 * e[17] - k6 * e[18] + k9 * e[19] - m5 * e[20]
+            - 0.0025 * m7 * e[21] - k10 * e[22] + k12 * e[23] - m2 * e[26] - m5 * e[27]
+            - cos_C * e[40] - 0.47746482927568606 * m12 * e[41] - k54 * e[42]
+            + k57 * e[43] - sin_C * e[44] - 0.47746482927568606 * m14 * e[45]
+            - k58 * e[46] + k60 * e[47] - cos_C * e[54] - sin_C * e[55] - e[68]
+            - 0.3183098861837907 * v_C * e[69] + k101 * e[70] + k103 * e[71]
+            + cos_C * e[92] + 0.0025 * m17 * e[93] + k133 * e[94] - k136 * e[95]
+            + m2 * e[96] + 0.0025 * m11 * e[97] + k138 * e[98] - k141 * e[99]
+            + m5 * e[100] + 0.0025 * m9 * e[101] + k142 * e[102] - k144 * e[103]
+            + m5 * e[104] + cos_C * e[117] + 0.0025 * m19 * e[118] + k164 * e[119]
+            - k167 * e[120] + m2 * e[121] + 0.0025 * m22 * e[122] + k169 * e[123]
+            - k172 * e[124] + m5 * e[125] + 0.0025 * m24 * e[126] + k173 * e[127]
+            - k175 * e[128] + cos_C * e[129] + m2 * e[130];
+        out[4] = sin_C * e[12] + 0.0025 * m32 * e[13] + k5 * e[14] - k180 * e[15]
+            - m33 * e[16] - 0.0025 * m34 * e[17] - k181 * e[18] + k183 * e[19]
+            - m35 * e[20] - 0.0025 * m36 * e[21] - k185 * e[22] + k188 * e[23]
+            - m33 * e[26] - m35 * e[27] + sin_C * e[40]
+            + 0.47746482927568606 * m14 * e[41] + k58 * e[42] - k60 * e[43]
+            - cos_C * e[44] - 0.47746482927568606 * m12 * e[45] - k54 * e[46]
+            + k57 * e[47] + sin_C * e[54] - cos_C * e[55] - e[72]
+            - 0.3183098861837907 * v_C * e[73] + k101 * e[74] + k103 * e[75]
+            - sin_C * e[92] - 0.0025 * m15 * e[93] - k137 * e[94] + k225 * e[95]
+            + m33 * e[96] + 0.0025 * m38 * e[97] + k226 * e[98] - k228 * e[99]
+            + m35 * e[100] + 0.0025 * m37 * e[101] + k230 * e[102] - k233 * e[103]
+            + m35 * e[104] - sin_C * e[117] - 0.0025 * m39 * e[118] - k168 * e[119]
+            + k242 * e[120] + m33 * e[121] + 0.0025 * m40 * e[122] + k243 * e[123]
+            - k245 * e[124] + m35 * e[125] + 0.0025 * m41 * e[126] + k247 * e[127]
+            - k250 * e[128] - sin_C * e[129] + m33 * e[130];
+        out[5] = sin_A * e[16] + 0.0025 * m6 * e[17] + k184 * e[18] - k255 * e[19]
+            - cos_A * e[20] - 0.0025 * m3 * e[21] - k256 * e[22] + k258 * e[23]
+            + sin_A * e[26] - cos_A * e[27] - e[48] - 0.47746482927568606 * v_A * e[49]
+            + k275 * e[50] + k276 * e[51] - e[76] - 0.3183098861837907 * v_C * e[77]
+            + k101 * e[78] + k103 * e[79] - sin_A * e[96] - 0.0025 * m8 * e[97]
+            - k229 * e[98] + k282 * e[99] + cos_A * e[100] + 0.0025 * m10 * e[101]
+            + k283 * e[102] - k285 * e[103] + cos_A * e[104] - sin_A * e[121]
+            - 0.0025 * m23 * e[122] - k246 * e[123] + k292 * e[124] + cos_A * e[125]
+            + 0.0025 * m21 * e[126] + k293 * e[127] - k295 * e[128] - sin_A * e[130];
+    }
+    /// Every point of `qs` (flat, `V` values each) into `out` (its
+    /// length gives the number of points; the callers check that
+    /// it holds whole points, so every chunk converts): `sin`/`cos`
+    /// for four points at a time when the body has rotary
+    /// variables, then the per-point body.
+    fn sensitivity_lanes_over(
+        qs: &[f64],
+        p: &[f64; 2],
+        es: &[f64],
+        broadcast: bool,
+        out: &mut [f64],
+    ) {
+        if 786 == 0 {
+            return;
+        }
+        let _ = (es, broadcast);
+        for (g, group) in out.chunks_mut(4 * 786).enumerate() {
+            let q4 = &crate::shim::core::lanes::points::<
+                5,
+            >(qs.get(g * 4 * 5..).unwrap_or(&[]));
+            let mut sc = [[[0.0f64; 2]; 5]; 4];
+            let (s, c) = crate::shim::core::lanes::sin_cos(
+                crate::shim::core::lanes::load(q4, 1),
+            );
+            for l in 0..4 {
+                sc[l][1] = [s[l], c[l]];
+            }
+            let (s, c) = crate::shim::core::lanes::sin_cos(
+                crate::shim::core::lanes::load(q4, 2),
+            );
+            for l in 0..4 {
+                sc[l][2] = [s[l], c[l]];
+            }
+            for (l, o) in group.chunks_mut(786).enumerate() {
+                let e = if broadcast {
+                    es
+                } else {
+                    es.get((4 * g + l) * 131..).unwrap_or(&[])
+                };
+                let _ = e;
+                let (q, sc) = (&q4[l], &sc[l]);
+                if let ::core::result::Result::Ok(o) = <&mut [f64; 786]>::try_from(o) {
+                    Self::sensitivity_given(q, p, sc, o);
+                }
+            }
+        }
+    }
+    /// Every point of `qs` (flat, `V` values each) into `out` (its
+    /// length gives the number of points; the callers check that
+    /// it holds whole points, so every chunk converts): `sin`/`cos`
+    /// for four points at a time when the body has rotary
+    /// variables, then the per-point body.
+    fn nonzeros_lanes_over(
+        qs: &[f64],
+        p: &[f64; 2],
+        es: &[f64],
+        broadcast: bool,
+        out: &mut [f64],
+    ) {
+        if 433 == 0 {
+            return;
+        }
+        let _ = (es, broadcast);
+        for (g, group) in out.chunks_mut(4 * 433).enumerate() {
+            let q4 = &crate::shim::core::lanes::points::<
+                5,
+            >(qs.get(g * 4 * 5..).unwrap_or(&[]));
+            let mut sc = [[[0.0f64; 2]; 5]; 4];
+            let (s, c) = crate::shim::core::lanes::sin_cos(
+                crate::shim::core::lanes::load(q4, 1),
+            );
+            for l in 0..4 {
+                sc[l][1] = [s[l], c[l]];
+            }
+            let (s, c) = crate::shim::core::lanes::sin_cos(
+                crate::shim::core::lanes::load(q4, 2),
+            );
+            for l in 0..4 {
+                sc[l][2] = [s[l], c[l]];
+            }
+            for (l, o) in group.chunks_mut(433).enumerate() {
+                let e = if broadcast {
+                    es
+                } else {
+                    es.get((4 * g + l) * 131..).unwrap_or(&[])
+                };
+                let _ = e;
+                let (q, sc) = (&q4[l], &sc[l]);
+                if let ::core::result::Result::Ok(o) = <&mut [f64; 433]>::try_from(o) {
+                    Self::nonzeros_given(q, p, sc, o);
+                }
+            }
+        }
+    }
+    /// Every point of `qs` (flat, `V` values each) into `out` (its
+    /// length gives the number of points; the callers check that
+    /// it holds whole points, so every chunk converts): `sin`/`cos`
+    /// for four points at a time when the body has rotary
+    /// variables, then the per-point body.
+    fn error_lanes_over(
+        qs: &[f64],
+        p: &[f64; 2],
+        es: &[f64],
+        broadcast: bool,
+        out: &mut [f64],
+    ) {
+        if 6 == 0 {
+            return;
+        }
+        let _ = (es, broadcast);
+        for (g, group) in out.chunks_mut(4 * 6).enumerate() {
+            let q4 = &crate::shim::core::lanes::points::<
+                5,
+            >(qs.get(g * 4 * 5..).unwrap_or(&[]));
+            let mut sc = [[[0.0f64; 2]; 5]; 4];
+            let (s, c) = crate::shim::core::lanes::sin_cos(
+                crate::shim::core::lanes::load(q4, 1),
+            );
+            for l in 0..4 {
+                sc[l][1] = [s[l], c[l]];
+            }
+            let (s, c) = crate::shim::core::lanes::sin_cos(
+                crate::shim::core::lanes::load(q4, 2),
+            );
+            for l in 0..4 {
+                sc[l][2] = [s[l], c[l]];
+            }
+            for (l, o) in group.chunks_mut(6).enumerate() {
+                let e = if broadcast {
+                    es
+                } else {
+                    es.get((4 * g + l) * 131..).unwrap_or(&[])
+                };
+                let _ = e;
+                let (q, sc) = (&q4[l], &sc[l]);
+                if let ::core::result::Result::Ok(o) = <&mut [f64; 6]>::try_from(o) {
+                    if let ::core::option::Option::Some(e) = crate::shim::core::lanes::row::<
+                        131,
+                    >(e) {
+                        Self::error_given(q, p, sc, e, o);
+                    }
+                }
+            }
+        }
+    }
     /// The nominal pose `R_wt(q, 0)` and `T_wt(q, 0)·tool_point`:
     ///
     /// - `R` row: `[cos(C), cos(A)*sin(C), sin(A)*sin(C)]`
@@ -4291,6 +7000,47 @@ impl crate::shim::core::ErrorModel for Legendre5 {
             }
             _ => false,
         }
+    }
+    fn sensitivity_points(
+        &self,
+        qs: &[f64],
+        p: &[f64],
+        out: &mut [f64],
+    ) -> ::core::result::Result<(), crate::shim::core::BatchError> {
+        crate::shim::core::lanes::sensitivity_shape(5, 131, qs.len(), out.len())?;
+        match <&[f64; 2]>::try_from(p) {
+            ::core::result::Result::Ok(p) => {
+                Self::sensitivity_lanes_over(qs, p, &[], true, out)
+            }
+            ::core::result::Result::Err(_) => {
+                out.iter_mut().for_each(|slot| *slot = f64::NAN)
+            }
+        }
+        ::core::result::Result::Ok(())
+    }
+    fn error_points(
+        &self,
+        qs: &[f64],
+        p: &[f64],
+        es: &[f64],
+        out: &mut [f64],
+    ) -> ::core::result::Result<(), crate::shim::core::BatchError> {
+        let broadcast = crate::shim::core::lanes::error_shape(
+            5,
+            131,
+            qs.len(),
+            es.len(),
+            out.len(),
+        )?;
+        match <&[f64; 2]>::try_from(p) {
+            ::core::result::Result::Ok(p) => {
+                Self::error_lanes_over(qs, p, es, broadcast, out)
+            }
+            ::core::result::Result::Err(_) => {
+                out.iter_mut().for_each(|slot| *slot = f64::NAN)
+            }
+        }
+        ::core::result::Result::Ok(())
     }
     fn nominal(&self, q: &[f64], p: &[f64]) -> crate::shim::core::Pose {
         match (<&[f64; 5]>::try_from(q), <&[f64; 2]>::try_from(p)) {

@@ -289,6 +289,7 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
                 #(#nonzero_stores)*
             }
         };
+        let batch_fns = batch_functions(model, krate, (&sens, &sens_entries), (&err, &err_rows));
         let model_fns = quote! {
             fn error(&self, q: &[f64], p: &[f64], e: &[f64], out: &mut [f64; 6]) {
                 match (
@@ -333,6 +334,9 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
                 }
             }
         };
+        let (batch_fns, batch_model_fns) = batch_fns;
+        let sensitivity_fns = quote!(#sensitivity_fns #batch_fns);
+        let model_fns = quote!(#model_fns #batch_model_fns);
         (error_fns, sensitivity_fns, model_fns)
     } else {
         let error_fns = quote! {
@@ -536,6 +540,292 @@ pub fn emit_pretty(model: &SymbolicModel, options: &EmitOptions) -> String {
         Ok(file) => prettyplease::unparse(&file),
         Err(_) => tokens.to_string(),
     }
+}
+
+/// The batched kernels of [`Emission::Direct`] (issue 35; docs/macro.md,
+/// "The generated type"): `sensitivity_batch_into`,
+/// `sensitivity_nonzeros_batch_into`, `error_batch_into` and
+/// `error_batch_each_into` over slices of points, and the `ErrorModel`
+/// batch methods (`sensitivity_points`, `error_points`) through them.
+///
+/// Points go in groups of [`crate::lanes::LANES`]: `sin`/`cos` of each
+/// rotary variable for the whole group at once with the vectorised
+/// [`crate::lanes::sin_cos`], then the per-point body with those values
+/// (`*_given` functions: the statements of the per-point functions, `sin`
+/// and `cos` read from `sc`). A body of lane vectors throughout measured
+/// slower than this (docs/performance.md, "Batched generated kernels"):
+/// the per-point bodies' stores of adjacent entries merge into vector
+/// stores, which lanes of different points cannot. Returns the inherent
+/// functions and the trait methods.
+fn batch_functions(
+    model: &SymbolicModel,
+    krate: &TokenStream,
+    (sens, sens_entries): (&Body<'_>, &[(usize, usize, bool, TokenStream)]),
+    (err, err_rows): (&Body<'_>, &[TokenStream]),
+) -> (TokenStream, TokenStream) {
+    let lanes = quote!(#krate::core::lanes);
+    let (nv, np, n) = (
+        model.variables.len(),
+        model.parameters.len(),
+        model.errors.len(),
+    );
+    let (v, p_len, n_len) = (lit(nv), lit(np), lit(n));
+    let width = 6 * n;
+    let k = sens_entries.len();
+    let signed = |negative: bool, e: &TokenStream| {
+        if negative {
+            quote!(-#e)
+        } else {
+            quote!(#e)
+        }
+    };
+    let mut flat: Vec<TokenStream> = vec![quote!(0.0); width];
+    for (c, j, negative, e) in sens_entries {
+        flat[c * n + j] = signed(*negative, e);
+    }
+    let flat_stores = flat.iter().enumerate().map(|(i, value)| {
+        let i = lit(i);
+        quote!(out[#i] = #value;)
+    });
+    let nz_stores = sens_entries
+        .iter()
+        .enumerate()
+        .map(|(i, (_, _, negative, e))| {
+            let value = signed(*negative, e);
+            let i = lit(i);
+            quote!(out[#i] = #value;)
+        });
+    let err_stores = err_rows.iter().enumerate().map(|(c, row)| {
+        let c = lit(c);
+        quote!(out[#c] = #row;)
+    });
+    let sens_prelude = sens.prelude_given_sin_cos();
+    let err_prelude = err.prelude_given_sin_cos();
+    // `sin`/`cos` of four points of each rotary variable `k` into `sc[l][k]`.
+    let lane_sin_cos = |rotary: Vec<usize>| {
+        let ks = rotary.into_iter().map(lit);
+        quote! {
+            let mut sc = [[[0.0f64; 2]; #v]; 4];
+            #(
+                let (s, c) = #lanes::sin_cos(#lanes::load(q4, #ks));
+                for l in 0..4 {
+                    sc[l][#ks] = [s[l], c[l]];
+                }
+            )*
+        }
+    };
+    let (w, k_lit) = (lit(width), lit(k));
+    // One group of four points over a flat output: whole groups in place,
+    // the last partial group through a padded copy. `$per` writes one
+    // point's `$width` values.
+    let over = |name: &str, width: &TokenStream, rotary: Vec<usize>, call: TokenStream| {
+        let name = Ident::new(name, Span::call_site());
+        let loops = if rotary.is_empty() {
+            // No `sin`/`cos` to share: point after point, `q` in place.
+            quote! {
+                let sc = &[[0.0f64; 2]; #v];
+                for (i, o) in out.chunks_mut(#width).enumerate() {
+                    let e = if broadcast {
+                        es
+                    } else {
+                        es.get(i * #n_len..).unwrap_or(&[])
+                    };
+                    let _ = e;
+                    if let (::core::option::Option::Some(q), ::core::result::Result::Ok(o)) = (
+                        #lanes::row::<#v>(qs.get(i * #v..).unwrap_or(&[])),
+                        <&mut [f64; #width]>::try_from(o),
+                    ) {
+                        #call
+                    }
+                }
+            }
+        } else {
+            let sc = lane_sin_cos(rotary);
+            quote! {
+                for (g, group) in out.chunks_mut(4 * #width).enumerate() {
+                    let q4 = &#lanes::points::<#v>(qs.get(g * 4 * #v..).unwrap_or(&[]));
+                    #sc
+                    for (l, o) in group.chunks_mut(#width).enumerate() {
+                        let e = if broadcast {
+                            es
+                        } else {
+                            es.get((4 * g + l) * #n_len..).unwrap_or(&[])
+                        };
+                        let _ = e;
+                        let (q, sc) = (&q4[l], &sc[l]);
+                        if let ::core::result::Result::Ok(o) = <&mut [f64; #width]>::try_from(o) {
+                            #call
+                        }
+                    }
+                }
+            }
+        };
+        quote! {
+            /// Every point of `qs` (flat, `V` values each) into `out` (its
+            /// length gives the number of points; the callers check that
+            /// it holds whole points, so every chunk converts): `sin`/`cos`
+            /// for four points at a time when the body has rotary
+            /// variables, then the per-point body.
+            fn #name(qs: &[f64], p: &[f64; #p_len], es: &[f64], broadcast: bool, out: &mut [f64]) {
+                if #width == 0 {
+                    return;
+                }
+                let _ = (es, broadcast);
+                #loops
+            }
+        }
+    };
+    let sens_over = over(
+        "sensitivity_lanes_over",
+        &quote!(#w),
+        sens.rotary(),
+        quote!(Self::sensitivity_given(q, p, sc, o);),
+    );
+    let nz_over = over(
+        "nonzeros_lanes_over",
+        &quote!(#k_lit),
+        sens.rotary(),
+        quote!(Self::nonzeros_given(q, p, sc, o);),
+    );
+    let err_over = over(
+        "error_lanes_over",
+        &quote!(6),
+        err.rotary(),
+        quote! {
+            if let ::core::option::Option::Some(e) = #lanes::row::<#n_len>(e) {
+                Self::error_given(q, p, sc, e, o);
+            }
+        },
+    );
+
+    let inherent = quote! {
+        /// The sensitivity matrices at many points: `out[i]` is
+        /// [`Self::sensitivity`] at `qs[i]` (every entry written). Four
+        /// points at a time: `sin`/`cos` of the rotary variables by the
+        /// vectorised kernel of `chain_core::lanes` (≤ 2 ulp from the
+        /// standard library's, so values agree with the per-point
+        /// functions to rounding, not bit for bit).
+        ///
+        /// # Panics
+        /// When `out.len() != qs.len()`.
+        #[inline]
+        pub fn sensitivity_batch_into(qs: &[[f64; #v]], p: &[f64; #p_len], out: &mut [[[f64; #n_len]; 6]]) {
+            assert!(
+                qs.len() == out.len(),
+                "sensitivity_batch_into: {} points but {} output matrices",
+                qs.len(),
+                out.len()
+            );
+            Self::sensitivity_lanes_over(qs.as_flattened(), p, &[], true, out.as_flattened_mut().as_flattened_mut());
+        }
+
+        /// [`Self::sensitivity_nonzeros`] at many points: `out[i]` holds the
+        /// entries [`Self::NONZEROS`] at `qs[i]`, four points at a time as
+        /// [`Self::sensitivity_batch_into`].
+        ///
+        /// # Panics
+        /// When `out.len() != qs.len()`.
+        #[inline]
+        pub fn sensitivity_nonzeros_batch_into(qs: &[[f64; #v]], p: &[f64; #p_len], out: &mut [[f64; #k_lit]]) {
+            assert!(
+                qs.len() == out.len(),
+                "sensitivity_nonzeros_batch_into: {} points but {} output rows",
+                qs.len(),
+                out.len()
+            );
+            Self::nonzeros_lanes_over(qs.as_flattened(), p, &[], true, out.as_flattened_mut());
+        }
+
+        /// [`Self::error`] at many points with one error vector `e` for all
+        /// of them (a built machine's errors along a path or a grid), four
+        /// points at a time as [`Self::sensitivity_batch_into`].
+        ///
+        /// # Panics
+        /// When `out.len() != qs.len()`.
+        #[inline]
+        pub fn error_batch_into(qs: &[[f64; #v]], p: &[f64; #p_len], e: &[f64; #n_len], out: &mut [[f64; 6]]) {
+            assert!(
+                qs.len() == out.len(),
+                "error_batch_into: {} points but {} output rows",
+                qs.len(),
+                out.len()
+            );
+            Self::error_lanes_over(qs.as_flattened(), p, e, true, out.as_flattened_mut());
+        }
+
+        /// [`Self::error`] at many points, each with its own error vector:
+        /// `out[i]` is the error at `qs[i]` with `es[i]` (sampled errors).
+        ///
+        /// # Panics
+        /// When `es.len()` or `out.len()` differs from `qs.len()`.
+        #[inline]
+        pub fn error_batch_each_into(qs: &[[f64; #v]], p: &[f64; #p_len], es: &[[f64; #n_len]], out: &mut [[f64; 6]]) {
+            assert!(
+                qs.len() == out.len() && qs.len() == es.len(),
+                "error_batch_each_into: {} points, {} error vectors and {} output rows",
+                qs.len(),
+                es.len(),
+                out.len()
+            );
+            Self::error_lanes_over(qs.as_flattened(), p, es.as_flattened(), false, out.as_flattened_mut());
+        }
+
+        /// [`Self::sensitivity_flat_into`] with `sin`/`cos` of each rotary
+        /// variable `k` given as `sc[k]`.
+        #[inline(always)]
+        fn sensitivity_given(q: &[f64; #v], p: &[f64; #p_len], sc: &[[f64; 2]; #v], out: &mut [f64; #w]) {
+            #sens_prelude
+            #(#flat_stores)*
+        }
+
+        /// [`Self::sensitivity_nonzeros`] with `sin`/`cos` given.
+        #[inline(always)]
+        fn nonzeros_given(q: &[f64; #v], p: &[f64; #p_len], sc: &[[f64; 2]; #v], out: &mut [f64; #k_lit]) {
+            #sens_prelude
+            #(#nz_stores)*
+        }
+
+        /// [`Self::error_into`] with `sin`/`cos` given.
+        #[inline(always)]
+        fn error_given(q: &[f64; #v], p: &[f64; #p_len], sc: &[[f64; 2]; #v], e: &[f64; #n_len], out: &mut [f64; 6]) {
+            #err_prelude
+            #(#err_stores)*
+        }
+
+        #sens_over
+        #nz_over
+        #err_over
+    };
+    let trait_fns = quote! {
+        fn sensitivity_points(
+            &self,
+            qs: &[f64],
+            p: &[f64],
+            out: &mut [f64],
+        ) -> ::core::result::Result<(), #krate::core::BatchError> {
+            #lanes::sensitivity_shape(#v, #n_len, qs.len(), out.len())?;
+            match <&[f64; #p_len]>::try_from(p) {
+                ::core::result::Result::Ok(p) => Self::sensitivity_lanes_over(qs, p, &[], true, out),
+                ::core::result::Result::Err(_) => out.iter_mut().for_each(|slot| *slot = f64::NAN),
+            }
+            ::core::result::Result::Ok(())
+        }
+        fn error_points(
+            &self,
+            qs: &[f64],
+            p: &[f64],
+            es: &[f64],
+            out: &mut [f64],
+        ) -> ::core::result::Result<(), #krate::core::BatchError> {
+            let broadcast = #lanes::error_shape(#v, #n_len, qs.len(), es.len(), out.len())?;
+            match <&[f64; #p_len]>::try_from(p) {
+                ::core::result::Result::Ok(p) => Self::error_lanes_over(qs, p, es, broadcast, out),
+                ::core::result::Result::Err(_) => out.iter_mut().for_each(|slot| *slot = f64::NAN),
+            }
+            ::core::result::Result::Ok(())
+        }
+    };
+    (inherent, trait_fns)
 }
 
 fn index_constants(model: &SymbolicModel) -> Vec<TokenStream> {
@@ -791,8 +1081,40 @@ impl<'a> Body<'a> {
         quote!(#id)
     }
 
+    /// The rotary variables whose `sin`/`cos` the body uses, in index order.
+    fn rotary(&self) -> Vec<usize> {
+        let mut out: Vec<usize> = self
+            .symbols
+            .iter()
+            .filter_map(|s| match s {
+                Symbol::Sin(i) | Symbol::Cos(i) => Some(usize::from(*i)),
+                _ => None,
+            })
+            .filter(|&k| {
+                self.model
+                    .variables
+                    .get(k)
+                    .is_some_and(|v| v.1 == JointKind::Rotary)
+            })
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
     /// The `let` statements: symbols, monomials, shared coefficients.
     fn prelude(&self) -> TokenStream {
+        self.prelude_in(false)
+    }
+
+    /// The `let` statements of the same body with `sin`/`cos` of each
+    /// rotary variable `k` taken from `sc[k] = [sin, cos]` (computed by the
+    /// caller, four points at a time, in the batched kernels).
+    fn prelude_given_sin_cos(&self) -> TokenStream {
+        self.prelude_in(true)
+    }
+
+    fn prelude_in(&self, given_sin_cos: bool) -> TokenStream {
         let mut out = TokenStream::new();
         let mut symbols = self.symbols.clone();
         symbols.sort();
@@ -826,7 +1148,11 @@ impl<'a> Body<'a> {
                         .is_some_and(|v| v.1 == JointKind::Rotary);
                     if is_rotary {
                         let k = lit(k);
-                        out.extend(quote!(let (#sn, #cs) = q[#k].sin_cos();));
+                        out.extend(if given_sin_cos {
+                            quote!(let [#sn, #cs] = sc[#k];)
+                        } else {
+                            quote!(let (#sn, #cs) = q[#k].sin_cos();)
+                        });
                     }
                 }
             }
