@@ -41,7 +41,7 @@ DH = [
     (0.0, 0.0, 0.0),
 ]
 REFLECTOR = (40.0, 0.0, 90.0)
-# Joint ranges (rad), the Robotics Toolbox's Puma560 limits.
+# Joint ranges (degrees; converted by poses()), the Robotics Toolbox's Puma560 limits.
 LIMITS = [(-160, 160), (-45, 225), (-225, 45), (-110, 170), (-100, 100), (-266, 266)]
 
 # The truth: angles in urad, lengths in mm.

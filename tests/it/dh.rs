@@ -9,15 +9,16 @@
 //! modified (mdh): A_i = Rot_x(α + Δα)·Trans_x(a + Δa)·Rot_y(β)·Rot_z(θ + Δθ + q)·Trans_z(d + Δd)
 //! ```
 //!
-//! (β: Hayati's rotation for nearly parallel axes). At random joint values:
+//! (β: Hayati's rotation for nearly parallel axes). For the two example arms
+//! and a made-up table with what they lack (θ offsets, a prismatic row, β
+//! on every row of both forms, a fixed row), at random joint values:
 //!
 //! - the nominal tool point and rotation of the loaded file through the
 //!   numeric product of `tests/it/common` (the machine as offsets and
-//!   rotations) equal the DH product's, and with finite DH errors (β = 0,
-//!   where the two agree exactly) so do the deviations;
+//!   rotations) equal the DH product's, and with finite errors of every DH
+//!   parameter and β so do the deviations (each is one error slot, exactly);
 //! - the derived model's sensitivity equals a 5-point central difference of
-//!   the DH product in each error (β included: its first-order effect is
-//!   exact).
+//!   the DH product in each error.
 //!
 //! Then the worked example of `examples/robots/`: the simulated
 //! laser-tracker calibration of the PUMA 560 (written by `generate.py` with
@@ -45,8 +46,11 @@ struct Row {
     a: f64,
     alpha: f64,
     joint: bool,
+    /// A prismatic joint (its variable adds to d, not to θ).
+    prismatic: bool,
 }
 
+/// A row with a rotary joint (`joint`) or none.
 const fn row(theta: f64, d: f64, a: f64, alpha: f64, joint: bool) -> Row {
     Row {
         theta,
@@ -54,6 +58,19 @@ const fn row(theta: f64, d: f64, a: f64, alpha: f64, joint: bool) -> Row {
         a,
         alpha,
         joint,
+        prismatic: false,
+    }
+}
+
+/// A row with a prismatic joint.
+const fn slide(theta: f64, d: f64, a: f64, alpha: f64) -> Row {
+    Row {
+        theta,
+        d,
+        a,
+        alpha,
+        joint: true,
+        prismatic: true,
     }
 }
 
@@ -87,6 +104,8 @@ const PANDA: [Row; 8] = [
 /// the tool point with its error names (in the last frame).
 struct Dh {
     file: &'static str,
+    /// The machine text, when it is not the example `file`.
+    yaml: Option<String>,
     modified: bool,
     rows: Vec<Row>,
     errors: Vec<[Option<String>; 5]>,
@@ -97,6 +116,7 @@ struct Dh {
 fn puma() -> Dh {
     Dh {
         file: "robots/puma560_dh.yaml",
+        yaml: None,
         modified: false,
         rows: PUMA.to_vec(),
         errors: (1..=6)
@@ -118,6 +138,7 @@ fn puma() -> Dh {
 fn panda() -> Dh {
     Dh {
         file: "robots/panda_mdh.yaml",
+        yaml: None,
         modified: true,
         rows: PANDA.to_vec(),
         errors: (1..=8)
@@ -139,6 +160,57 @@ fn panda() -> Dh {
     }
 }
 
+/// A table with what the two arms lack: θ offsets, a prismatic row, β on
+/// every row (in `mdh` too), a fixed last row and a tool point off every
+/// axis; written as `dh` or `mdh` rows.
+fn mixed(modified: bool) -> Dh {
+    let rows = vec![
+        row(0.3, 100.0, 50.0, 0.4, true),
+        slide(-0.7, 20.0, 300.0, -H),
+        row(1.1, 0.0, 40.0, H, true),
+        row(0.2, 80.0, 10.0, -0.5, false),
+    ];
+    let form = if modified { "mdh" } else { "dh" };
+    let mut yaml = String::from("machine: mixed\nbodies:\n  base: {}\n");
+    let mut parent = "base".to_string();
+    for (i, r) in rows.iter().enumerate() {
+        let k = i + 1;
+        let joint = match (r.joint, r.prismatic) {
+            (false, _) => String::new(),
+            (true, false) => format!(", joint: rotary, variable: q{k}"),
+            (true, true) => format!(", joint: prismatic, variable: q{k}"),
+        };
+        yaml += &format!(
+            "  l{k}:\n    parent: {parent}\n    {form}: {{theta: {}, d: {}, a: {}, alpha: {}{joint},\n      errors: {{theta: DT{k}, d: DD{k}, a: DA{k}, alpha: DAL{k}, beta: B{k}}}}}\n",
+            r.theta, r.d, r.a, r.alpha
+        );
+        parent = format!("l{k}");
+    }
+    yaml += &format!(
+        "  tip: {{parent: {parent}, offset: [15, -25, 35]}}\nworkpiece: base\ntool: tip\n"
+    );
+    Dh {
+        file: if modified {
+            "mixed (mdh)"
+        } else {
+            "mixed (dh)"
+        },
+        yaml: Some(yaml),
+        modified,
+        errors: (1..=rows.len())
+            .map(|k| ["DT", "DD", "DA", "DAL", "B"].map(|p| Some(format!("{p}{k}"))))
+            .collect(),
+        rows,
+        tool: [15.0, -25.0, 35.0],
+        tool_errors: [None; 3],
+    }
+}
+
+/// Every table the tests check.
+fn robots() -> [Dh; 4] {
+    [puma(), panda(), mixed(false), mixed(true)]
+}
+
 fn rot4(k: usize, angle: f64) -> Mat4 {
     rigid(&rot_axis(k, angle), [0.0; 3])
 }
@@ -149,7 +221,10 @@ fn trans4(t: [f64; 3]) -> Mat4 {
 
 impl Dh {
     fn load(&self) -> Machine {
-        chain::core::load_file(&example_file(self.file)).expect("the example loads")
+        match &self.yaml {
+            Some(text) => chain::core::load_str(text, self.file).unwrap_or_else(|d| panic!("{d}")),
+            None => chain::core::load_file(&example_file(self.file)).expect("the example loads"),
+        }
     }
 
     /// The DH product to the tool, with the errors `e` (machine order;
@@ -169,8 +244,9 @@ impl Dh {
                 0.0
             };
             let [dt, dd, da, dal, beta] = names.each_ref().map(err);
-            let theta = rot4(2, r.theta + dt + q);
-            let d = trans4([0.0, 0.0, r.d + dd]);
+            let (q_theta, q_d) = if r.prismatic { (0.0, q) } else { (q, 0.0) };
+            let theta = rot4(2, r.theta + dt + q_theta);
+            let d = trans4([0.0, 0.0, r.d + dd + q_d]);
             let a = trans4([r.a + da, 0.0, 0.0]);
             let alpha = rot4(0, r.alpha + dal);
             let beta = rot4(1, beta);
@@ -219,10 +295,11 @@ fn random_joints(rng: &mut Rng, n: usize) -> Vec<f64> {
 
 /// The loaded file through the tests' numeric product (offsets, rotations,
 /// location errors: the machine format's semantics) is the DH product:
-/// nominal pose, and the deviation with finite DH errors (β = 0).
+/// nominal pose, and the deviation with finite errors of every DH
+/// parameter and β.
 #[test]
 fn dh_and_mdh_files_are_the_dh_product() {
-    for robot in [puma(), panda()] {
+    for robot in robots() {
         let m = robot.load();
         let exact = Exact::new(&m);
         let mut rng = Rng::new(33);
@@ -246,19 +323,9 @@ fn dh_and_mdh_files_are_the_dh_product() {
                     assert!((r[c][k] - rd[c][k]).abs() < 1e-12, "{}: R", robot.file);
                 }
             }
-            // Finite errors of 1e-3 (rad or mm) on every parameter but β:
-            // then each row's errors are exactly its location error slots.
-            let e: Vec<f64> = m
-                .errors
-                .iter()
-                .map(|x| {
-                    if x.name == "B2" {
-                        0.0
-                    } else {
-                        1e-3 * gauss(&mut rng)
-                    }
-                })
-                .collect();
+            // Finite errors of 1e-3 (rad or mm) on every parameter and β:
+            // each is exactly one error slot of its row's bodies.
+            let e: Vec<f64> = m.errors.iter().map(|_| 1e-3 * gauss(&mut rng)).collect();
             let a = exact.exact_error(&q, &[], &e);
             let b = robot.deviation(&m, &q, &e);
             for c in 0..6 {
@@ -279,7 +346,7 @@ fn dh_and_mdh_files_are_the_dh_product() {
 /// the arm's length, rounding ~1e-11 of it).
 #[test]
 fn dh_and_mdh_models_are_the_derivative_of_the_dh_product() {
-    for robot in [puma(), panda()] {
+    for robot in robots() {
         let m = robot.load();
         let model = chain::core::compile(&m);
         let exact = Exact::new(&m);
@@ -326,9 +393,7 @@ fn tracker_rows(file: &str) -> Vec<(Vec<f64>, [f64; 3], f64)> {
 /// `generate.py`'s data are the truth through the tests' numeric product of
 /// the DH file plus noise of the stated std (the rms of the standardised
 /// differences within 12 % of 1 over 330 values, none beyond 4.5): the
-/// generator's DH product and the file agree (β's second-order difference
-/// between `Rot_x·Rot_y` and one `exp`, ~1e-6 mm here, is far below the
-/// noise).
+/// generator's DH product and the file agree.
 #[test]
 fn puma_tracker_data_are_the_truth_plus_noise() {
     let m = puma().load();
@@ -426,4 +491,74 @@ fn puma_calibration_recovers_the_truth() {
     assert!(before["rms"].as_f64().unwrap() > 0.5, "{before}");
     let rms = after["rms"].as_f64().unwrap();
     assert!(rms > 0.015 && rms < 0.03, "validation rms {rms}");
+
+    // The numbers docs/identify.md and examples/robots/README.md quote
+    // ("Worked example: a PUMA 560"), to their printed digits.
+    let number = |v: &serde_json::Value| v.as_f64().expect("a number");
+    let close = |got: f64, want: f64, tol: f64, what: &str| {
+        assert!(
+            (got - want).abs() <= tol,
+            "{what}: {got} against the documented {want}"
+        );
+    };
+    close(number(&json["condition"]), 21.8, 0.05, "condition");
+    close(
+        number(&json["residual"]["rms"]),
+        0.0198,
+        5e-5,
+        "residual rms",
+    );
+    close(ratio, 1.04, 0.005, "scatter / std");
+    close(
+        number(&json["first_order"]["max"]),
+        0.0039,
+        1e-4,
+        "first-order difference",
+    );
+    for (set, key, want, tol) in [
+        (before, "mean", 1.094, 5e-4),
+        (before, "max", 1.968, 5e-4),
+        (before, "rms", 0.682, 5e-4),
+        (after, "mean", 0.0356, 5e-5),
+        (after, "max", 0.0740, 5e-5),
+        (after, "rms", 0.0224, 5e-5),
+    ] {
+        close(number(&set[key]), want, tol, key);
+    }
+    // The four combinations (value ± std), where DD2, DD6, DA6 and DT6
+    // stand for their groups.
+    for (name, want, want_std) in [
+        ("DD2", 0.2000, 0.0167),
+        ("DD6", 0.7499, 0.0032),
+        ("DA6", 0.4016, 0.0025),
+        ("DT6", -4.324e-3, 7.1e-5),
+    ] {
+        let k = m.error_index(name).unwrap();
+        close(value[k], want, want.abs() * 1e-3 + 1e-4, name);
+        close(std[k], want_std, want_std * 0.02, name);
+    }
+    // --iterate: converged in 4 Levenberg–Marquardt iterations; the
+    // prediction moves by less than 1e-4 mm.
+    let iterated = ok_json(&[
+        "identify",
+        example_file("robots/puma560_dh.yaml").to_str().unwrap(),
+        "--measurements",
+        example_file("robots/puma560_tracker.csv").to_str().unwrap(),
+        "--validate",
+        example_file("robots/puma560_validate.csv")
+            .to_str()
+            .unwrap(),
+        "--iterate",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(iterated["iteration"]["converged"], true);
+    assert_eq!(iterated["iteration"]["iterations"], 4);
+    for key in ["mean", "max", "rms"] {
+        let moved = number(&iterated["validation"]["after"][key]) - number(&after[key]);
+        assert!(
+            moved.abs() < 1e-4,
+            "--iterate moved the held-out {key} by {moved}"
+        );
+    }
 }

@@ -376,12 +376,16 @@ impl Loader {
             self.note_all_names(node);
         }
         let dh = match (f.entry("dh"), f.entry("mdh")) {
-            (Some(_), Some((k, _))) => {
+            (Some((_, first)), Some((k, second))) => {
                 let problem = Problem::Conflict {
                     first: "dh",
                     second: "mdh",
                 };
                 self.report(k.span, f.path("mdh"), problem);
+                // Neither row is read: their names are not reported again
+                // (by `statistics` or a `grid`).
+                self.note_all_names(first);
+                self.note_all_names(second);
                 None
             }
             (Some((k, v)), None) => Some((k, v, false)),
@@ -392,12 +396,13 @@ impl Loader {
             Some((k, v, modified)) => {
                 let form = if modified { "mdh" } else { "dh" };
                 for &other in DH_REPLACES {
-                    if let Some((ok, _)) = f.entry(other) {
+                    if let Some((ok, refused)) = f.entry(other) {
                         let problem = Problem::Conflict {
                             first: form,
                             second: other,
                         };
                         self.report(ok.span, f.path(other), problem);
+                        self.note_all_names(refused);
                     }
                 }
                 let (row, joint) = self.dh_row(k, v, &f.path(form), modified, &raw.name);
@@ -496,8 +501,9 @@ impl Loader {
         let d = self.required(&f, "d").map(|n| (n, f.path("d")));
         let joint = match (f.entry("joint"), f.get("variable")) {
             (None, None) => None,
-            (None, Some(_)) => {
+            (None, Some(variable)) => {
                 self.missing(&f, "joint");
+                self.note_all_names(variable);
                 None
             }
             (Some((k, n)), variable) => {
@@ -1536,17 +1542,21 @@ impl Loader {
 /// - `dh` (standard, `Rot_z(θ+q)·Trans_z(d)·Trans_x(a)·Rot_x(α)`):
 ///   `NAME.joint` = `Rot_z(θ)·E(dz: Δd, ez: Δθ)·J(q about/along +z)·E(errors)`
 ///   under the declared parent, then `NAME` = `Trans(a, 0, d)·Rot_x(α)·E(dx: Δa,
-///   ex: Δα, ey: β)`;
+///   ex: Δα)·E(ey: β)`;
 /// - `mdh` (Craig's modified, `Rot_x(α)·Trans_x(a)·Rot_z(θ+q)·Trans_z(d)`):
-///   `NAME.link` = `Trans(a, 0, 0)·Rot_x(α)·E(dx: Δa, ex: Δα, ey: β)` under the
-///   declared parent, then `NAME` = `Trans(0, 0, d)·Rot_z(θ)·E(dz: Δd, ez:
+///   `NAME.link` = `Trans(a, 0, 0)·Rot_x(α)·E(dx: Δa, ex: Δα)·E(ey: β)` under
+///   the declared parent, then `NAME` = `Trans(0, 0, d)·Rot_z(θ)·E(dz: Δd, ez:
 ///   Δθ)·J(q)·E(errors)`.
 ///
 /// Translations along and rotations about one axis commute, so each DH
-/// parameter's error is exactly a location error slot (β, Hayati's
-/// `Rot_y(β)` after `Rot_x(α)`, is the `ey` slot there). The row's body keeps
-/// its name for the frame the DH convention calls frame i, so children,
-/// the tool and the workpiece attach where a DH table puts them.
+/// parameter's error is exactly a location error slot. β, Hayati's
+/// `Rot_y(β)` after `Rot_x(α + Δα)`, is the `ey` slot of the link body's
+/// `errors` (after its location errors; the body has no joint), so that the
+/// product is exactly `Rot_x(α + Δα)·Rot_y(β)`: in the location slots
+/// beside `ex: Δα` it would be the one rotation `exp(Δα·x + β·y)`. The
+/// row's body keeps its name for the frame the DH convention calls frame
+/// i, so children, the tool and the workpiece attach where a DH table puts
+/// them.
 fn split_dh<'n>(raw: RawBody<'n>, row: RawDh<'n>) -> Vec<RawBody<'n>> {
     let [theta_e, d_e, a_e, alpha_e, beta_e] = row.errors;
     let link = |name: String, parent: Parent, generated_for: Option<String>| RawBody {
@@ -1591,7 +1601,7 @@ fn split_dh<'n>(raw: RawBody<'n>, row: RawDh<'n>) -> Vec<RawBody<'n>> {
     link_body.rotation.extend(row.alpha);
     link_body.slots[0][0] = a_e;
     link_body.slots[0][3] = alpha_e;
-    link_body.slots[0][4] = beta_e;
+    link_body.slots[1][4] = beta_e;
     // d goes where the convention puts it: on the link in `dh` (after the
     // joint), on the joint's body in `mdh` (before it, after α).
     if row.modified {

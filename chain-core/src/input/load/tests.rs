@@ -290,7 +290,8 @@ workpiece: base\ntool: tip\n";
     parent: l1.joint
     offset: [25, 0, L/2]
     rotation: [{about: x, angle: -pi/2}]
-    location_errors: {dx: A1, ex: AL1, ey: B1}
+    location_errors: {dx: A1, ex: AL1}
+    errors: {ey: B1}
   l2.joint:
     parent: l1
     location_errors: {dz: D2}
@@ -332,7 +333,8 @@ workpiece: base\ntool: flange\n";
     parent: base
     offset: [25, 0, 0]
     rotation: [{about: x, angle: 30deg}]
-    location_errors: {dx: A1, ex: AL1, ey: B1}
+    location_errors: {dx: A1, ex: AL1}
+    errors: {ey: B1}
   l1:
     parent: l1.link
     offset: [0, 0, 5]
@@ -414,6 +416,17 @@ fn dh_rows_refuse_what_they_replace_and_what_they_lack() {
         assert_eq!(problems.len(), 1, "{row}: {problems:?}");
         assert_eq!(problems[0].0.key, *key, "{row}");
         assert_eq!(problems[0].1.code(), *code, "{row}");
+    }
+    // Names under a refused key or row are not reported again where
+    // `statistics` names them.
+    for row in [
+        "    dh: {theta: 0, d: 0, a: 1, alpha: 0}\n    location_errors: {dx: A}\n",
+        "    dh: {theta: 0, d: 0, a: 1, alpha: 0, errors: {a: A}}\n    mdh: {theta: 0, d: 0, a: 1, alpha: 0}\n",
+    ] {
+        let text = format!("{}statistics: {{A: {{std: 1}}}}\n", body(row));
+        let problems = from_tree(&yaml::parse(&text).root.expect("yaml")).expect_err(row);
+        assert_eq!(problems.len(), 1, "{row}: {problems:?}");
+        assert_eq!(problems[0].1.code(), "chain::conflicting_keys", "{row}");
     }
     // A declared body named like a row's generated frame.
     let text = "machine: m\nbodies:\n  base: {}\n  l1:\n    parent: base\n    dh: {theta: 0, d: 0, a: 1, alpha: 0}\n  l1.joint: {parent: base}\nworkpiece: base\ntool: l1\n";
