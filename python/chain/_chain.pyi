@@ -34,6 +34,12 @@ class Model:
     def sensitivity(
         self, q: npt.NDArray[np.float64], params: Sequence[Tuple[str, float]]
     ) -> npt.NDArray[np.float64]: ...
+    def sensitivity_into(
+        self,
+        q: npt.NDArray[np.float64],
+        params: Sequence[Tuple[str, float]],
+        out: npt.NDArray[np.float64],
+    ) -> None: ...
     def error(
         self,
         q: npt.NDArray[np.float64],

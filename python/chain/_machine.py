@@ -146,17 +146,36 @@ class Machine:
                 m[c, errors.index(error)] = sympy.sympify(expression, locals=local)
         return m
 
-    def sensitivity(self, q: ArrayLike, params: Params = None) -> np.ndarray:
+    def sensitivity(self, q: ArrayLike, params: Params = None, out: Optional[np.ndarray] = None) -> np.ndarray:
         """The exact sensitivity ``∂E_c/∂e_j`` at axis values ``q``.
 
         ``q`` of shape ``(V,)`` gives ``(6, N_err)``; ``(N, V)`` gives
         ``(N, 6, N_err)`` (float64, C-contiguous). Rows px, py, pz, ox, oy,
-        oz; columns ``errors``. Computed on all cores, the GIL released.
+        oz; columns ``errors``. Computed on all cores, the GIL released, each
+        value written once into the result.
+
+        ``out``: an array of that shape (float64, C-contiguous, writeable) to
+        write into instead of a new one, e.g. reused over batches of points;
+        it is returned.
         """
         rows, single = _rows(q, "q", len(self.variables), "the variables " + ", ".join(self.variables))
         ne = len(self.errors)
-        out = self._model.sensitivity(rows, _params(params)).reshape(rows.shape[0], 6, ne)
-        return out[0] if single else out
+        shape = (6, ne) if single else (rows.shape[0], 6, ne)
+        if out is None:
+            result = self._model.sensitivity(rows, _params(params)).reshape(rows.shape[0], 6, ne)
+            return result[0] if single else result
+        if not isinstance(out, np.ndarray):
+            raise TypeError(f"out must be a numpy array, not {type(out).__name__}")
+        if out.dtype != np.float64:
+            raise ValueError(f"out must be float64, not {out.dtype}")
+        if out.shape != shape:
+            raise ValueError(f"out has shape {out.shape}, expected {shape}")
+        if not out.flags.c_contiguous:
+            raise ValueError("out must be C-contiguous")
+        if not out.flags.writeable:
+            raise ValueError("out must be writeable")
+        self._model.sensitivity_into(rows, _params(params), out.reshape(-1))
+        return out
 
     def error(self, q: ArrayLike, e: ArrayLike, params: Params = None) -> np.ndarray:
         """The first-order error ``E = S(q)·e`` (px, py, pz, ox, oy, oz).

@@ -327,7 +327,8 @@ impl Model {
 
     /// The sensitivity `∂E/∂e` at each row of `q` (`(N, V)`): a flat
     /// `N·6·N_err` array (row-major `(N, 6, N_err)`), computed in parallel
-    /// blocks with the GIL released.
+    /// blocks with the GIL released, written once into numpy's zeroed
+    /// (calloc'ed, so lazily zeroed by the kernel) array.
     #[pyo3(signature = (q, params))]
     fn sensitivity<'py>(
         &self,
@@ -335,24 +336,44 @@ impl Model {
         q: PyReadonlyArray2<'py, f64>,
         params: Vec<(String, f64)>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let p = self.parameter_vector(py, &params)?;
-        let (q, n) = self.points(&q)?;
-        let width = 6 * self.model.errors().len();
-        let model = &self.model;
-        let (array, out) = uninit_array(py, n * width);
-        let v = model.variables().len();
-        py.allow_threads(|| {
-            if v == 0 {
-                // No coordinates to count the points by: one after another.
-                par_rows(out, width, |_, row| model.sensitivity(&[], &p, row));
-                return Ok(());
-            }
-            let out = zeroed(out);
-            // The batched tape, in parallel blocks (`points` gave whole rows).
-            model.sensitivity_batch(q, &p, out)
-        })
-        .map_err(|e| value_error(e.to_string()))?;
+        let n = q.shape()[0];
+        let array = PyArray1::<f64>::zeros(py, n * 6 * self.model.errors().len(), false);
+        {
+            let mut out = array.readwrite();
+            let out = out
+                .as_slice_mut()
+                .map_err(|_| value_error("the output array is not contiguous"))?;
+            self.sensitivity_fill(py, &q, &params, out)?;
+        }
         Ok(array)
+    }
+
+    /// [`Model::sensitivity`] written into the caller's array `out` (the
+    /// flat view of a C-contiguous float64 array of `N·6·N_err` values,
+    /// checked here): `Machine.sensitivity(q, out=...)`.
+    #[pyo3(signature = (q, params, out))]
+    fn sensitivity_into<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray2<'py, f64>,
+        params: Vec<(String, f64)>,
+        out: Bound<'py, numpy::PyArrayDyn<f64>>,
+    ) -> PyResult<()> {
+        let want = q.shape()[0] * 6 * self.model.errors().len();
+        let mut out = out
+            .try_readwrite()
+            .map_err(|_| value_error("out must be a writeable array not borrowed elsewhere"))?;
+        let out = out
+            .as_slice_mut()
+            .map_err(|_| value_error("out must be a C-contiguous float64 array"))?;
+        if out.len() != want {
+            return Err(value_error(format!(
+                "out holds {} values, expected {want} (one 6 x {} matrix per point)",
+                out.len(),
+                self.model.errors().len()
+            )));
+        }
+        self.sensitivity_fill(py, &q, &params, out)
     }
 
     /// The error `E = S·e` at each row of `q` (`(N, V)`) with the errors of
@@ -461,6 +482,38 @@ impl Model {
             }
             (start.elapsed().as_secs_f64(), sum)
         }))
+    }
+}
+
+impl Model {
+    /// Every point's sensitivity into `out` (`N·6·N_err` values, any
+    /// previous contents): the batched tape in parallel blocks, the GIL
+    /// released. The one body of `sensitivity` and `sensitivity_into`.
+    fn sensitivity_fill(
+        &self,
+        py: Python<'_>,
+        q: &PyReadonlyArray2<'_, f64>,
+        params: &[(String, f64)],
+        out: &mut [f64],
+    ) -> PyResult<()> {
+        let p = self.parameter_vector(py, params)?;
+        let (q, _) = self.points(q)?;
+        let width = 6 * self.model.errors().len();
+        let model = &self.model;
+        let v = model.variables().len();
+        py.allow_threads(|| {
+            if v == 0 {
+                // No coordinates to count the points by: one after another.
+                if width > 0 {
+                    out.par_chunks_mut(width)
+                        .for_each(|row| model.sensitivity(&[], &p, row));
+                }
+                return Ok(());
+            }
+            // The batched tape, in parallel blocks (`points` gave whole rows).
+            model.sensitivity_batch(q, &p, out)
+        })
+        .map_err(|e| value_error(e.to_string()))
     }
 }
 

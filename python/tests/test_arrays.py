@@ -33,6 +33,34 @@ def test_shapes_and_dtypes(ac):
     assert ac.sensitivity(np.ones(V, dtype=np.int64)).dtype == np.float64
 
 
+def test_sensitivity_into_a_callers_array(ac):
+    """``out=``: the same values written into the caller's array (returned, no new one), reused
+    over batches; every value overwritten (NaN beforehand); a wrong array refused by name."""
+    V, NE = len(ac.variables), len(ac.errors)
+    rng = np.random.default_rng(1)
+    out = np.full((9, 6, NE), np.nan)
+    for _ in range(3):
+        q = rng.uniform(-1, 1, size=(9, V))
+        got = ac.sensitivity(q, out=out)
+        assert got is out
+        np.testing.assert_array_equal(out, ac.sensitivity(q))
+    one = np.full((6, NE), np.nan)
+    assert ac.sensitivity(q[2], out=one) is one
+    np.testing.assert_array_equal(one, ac.sensitivity(q[2]))
+    for bad, kind, msg in [
+        (np.zeros((9, 6, NE - 1)), ValueError, f"out has shape (9, 6, {NE - 1}), expected (9, 6, {NE})"),
+        (np.zeros((9, 6, NE), dtype=np.float32), ValueError, "out must be float64, not float32"),
+        (np.zeros((6, NE, 9)).transpose(2, 0, 1), ValueError, "out must be C-contiguous"),
+        ([[0.0] * NE] * 6, TypeError, "out must be a numpy array, not list"),
+    ]:
+        with pytest.raises(kind, match=re.escape(msg)):
+            ac.sensitivity(q, out=bad)
+    frozen = np.zeros((9, 6, NE))
+    frozen.flags.writeable = False
+    with pytest.raises(ValueError, match="out must be writeable"):
+        ac.sensitivity(q, out=frozen)
+
+
 def test_error_broadcasts(ac):
     V, NE = len(ac.variables), len(ac.errors)
     rng = np.random.default_rng(1)
