@@ -1,9 +1,9 @@
-"""The batch calls release the GIL: Python threads run while Rust computes."""
+"""The batch calls release the GIL: Python threads run while Rust computes.
 
-import os
-import subprocess
-import sys
-import textwrap
+The test looks at when the main thread ran, not at how fast anything ran, so a loaded or
+single-core machine cannot fail it: with the GIL held by a call, the main thread could not
+run at all between the call's entry and exit, leaving a gap as long as the call."""
+
 import threading
 import time
 
@@ -15,50 +15,50 @@ from conftest import ROOT
 AC = ROOT / "examples/machines/ac_trunnion.yaml"
 
 
-def test_python_runs_during_a_batch():
-    """While one thread is inside `sensitivity`, the main thread keeps executing Python
-    (with the GIL held by the call it could not run at all)."""
-    m = chain.Machine.load(AC)
-    q = np.random.default_rng(0).uniform(-1, 1, size=(200_000, 5))
-    done = threading.Event()
-    ticks = 0
+def _largest_gaps(calls, ticks):
+    """For each call interval (t0, t1), the longest stretch of it without a main-thread tick,
+    as a fraction of the call's length."""
+    ticks = np.asarray(ticks)
+    out = []
+    for t0, t1 in calls:
+        inside = ticks[(ticks > t0) & (ticks < t1)]
+        edges = np.concatenate([[t0], inside, [t1]])
+        out.append(np.max(np.diff(edges)) / (t1 - t0))
+    return out
 
-    def batch():
-        for _ in range(3):
-            m.sensitivity(q)
+
+def _run_beside_ticks(workers):
+    """Start the worker threads, tick (record the time) in the main thread until they are
+    done, and return the ticks."""
+    done = threading.Event()
+    ts = [threading.Thread(target=w) for w in workers]
+    [t.start() for t in ts]
+
+    def watch():
+        [t.join() for t in ts]
         done.set()
 
-    t = threading.Thread(target=batch)
-    t.start()
+    threading.Thread(target=watch).start()
+    ticks = []
     while not done.is_set():
-        ticks += 1
-        time.sleep(0.001)
-    t.join()
-    assert ticks >= 20, f"the main thread ran only {ticks} times during the batches"
+        ticks.append(time.perf_counter())
+    return ticks
 
 
-def test_two_batches_concurrently_beat_twice_one():
-    """On a one-thread pool (RAYON_NUM_THREADS=1, in a subprocess), two batches in two Python
-    threads take less than 1.9x one batch: they ran in parallel, so the GIL was released."""
-    script = textwrap.dedent(f"""
-        import threading, time, numpy as np, chain
-        m = chain.Machine.load({str(AC)!r})
-        q = np.random.default_rng(0).uniform(-1, 1, size=(300_000, 5))
-        m.sensitivity(q[:1000])
-        def one():
+def test_python_runs_during_a_batch():
+    """While one thread is inside `sensitivity`, the main thread keeps executing Python: in
+    most calls no stretch of half the call passes without it running."""
+    m = chain.Machine.load(AC)
+    q = np.random.default_rng(0).uniform(-1, 1, size=(200_000, 5))
+    m.sensitivity(q[:1000])
+    calls = []
+
+    def batch():
+        for _ in range(5):
+            t0 = time.perf_counter()
             m.sensitivity(q)
-        best = 1e9
-        for _ in range(3):
-            t = time.perf_counter(); one(); one_t = time.perf_counter() - t
-            ts = [threading.Thread(target=one) for _ in range(2)]
-            t = time.perf_counter()
-            [x.start() for x in ts]; [x.join() for x in ts]
-            best = min(best, (time.perf_counter() - t) / one_t)
-        print(best)
-    """)
-    env = {**os.environ, "RAYON_NUM_THREADS": "1"}
-    out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
-    ratio = float(out.stdout.strip())
-    if os.cpu_count() == 1:
-        return
-    assert ratio < 1.9, f"two concurrent batches took {ratio:.2f}x one"
+            calls.append((t0, time.perf_counter()))
+
+    gaps = _largest_gaps(calls, _run_beside_ticks([batch]))
+    assert np.median(gaps) < 0.5, f"the main thread stood still for {gaps} of each call"
+

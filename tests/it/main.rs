@@ -30,6 +30,7 @@ mod finite_difference;
 mod function_slot_input;
 mod function_slot_reliability;
 mod function_slots;
+mod fuzz;
 mod generated_into;
 mod geometric_sensitivity;
 mod golden_outputs;

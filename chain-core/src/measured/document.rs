@@ -21,12 +21,12 @@ use crate::named::NameMap;
 #[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
 pub enum DocumentError {
     /// The records do not give a design (named by their file).
-    #[error("{file}: {source}")]
+    #[error("{file}: {reason}")]
     Design {
         /// The measurement file.
         file: String,
         /// The design's refusal.
-        source: DesignError,
+        reason: DesignError,
     },
     /// The prior or the solve refused.
     #[error(transparent)]
@@ -447,9 +447,9 @@ pub fn identify_document(
     }
     let model = crate::compile(machine);
     let design_of = |m: &Measurements| {
-        Design::new(&model, machine, &m.rows).map_err(|source| DocumentError::Design {
+        Design::new(&model, machine, &m.rows).map_err(|reason| DocumentError::Design {
             file: m.file.clone(),
-            source,
+            reason,
         })
     };
     let design = design_of(measurements)?;

@@ -637,6 +637,11 @@ pub fn design_rows<M: ErrorModel + ?Sized>(
     }
 }
 
+/// The largest magnitude of a design entry or a measured value, weighted
+/// ([`DesignError::NotFinite`]): its square summed over millions of rows
+/// stays finite (the limit of statistics numbers, docs/robustness.md).
+pub const DESIGN_LIMIT: f64 = 1e100;
+
 /// The design matrix of a set of records, in the model's orders.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Design {
@@ -670,6 +675,21 @@ pub enum DesignError {
     /// Some records have a std and others not.
     #[error("some records have a standard deviation and others not")]
     MixedStd,
+    /// A record's design rows (the model's sensitivity at its pose, divided
+    /// by its std when weighted) or its weighted values are not finite or
+    /// beyond [`DESIGN_LIMIT`]: a pose, parameter or std beyond what the
+    /// model can evaluate. Refused here so that no solver sees an infinity,
+    /// a NaN or a square that overflows (an SVD would not converge).
+    #[error(
+        "line {line}: the model's sensitivity at this record's pose{weighted} is not finite \
+         or beyond 1e100 in magnitude (a pose value, a parameter or a std out of range)"
+    )]
+    NotFinite {
+        /// The record's line in its CSV.
+        line: usize,
+        /// `, divided by its std,` when the record is weighted.
+        weighted: &'static str,
+    },
 }
 
 impl Design {
@@ -723,6 +743,23 @@ impl Design {
                 &mut scratch,
                 &mut flat[at * n..(at + k) * n],
             );
+            // Every value the solvers will see, weighted as they will see it.
+            let w = r.std.map_or(1.0, |s| 1.0 / s);
+            let rows = &flat[at * n..(at + k) * n];
+            let within = |x: f64| x.abs() <= DESIGN_LIMIT;
+            let finite = w.is_finite()
+                && rows.iter().all(|a| within(a * w))
+                && r.values.iter().all(|v| within(v * w));
+            if !finite {
+                return Err(DesignError::NotFinite {
+                    line: r.line,
+                    weighted: if r.std.is_some() {
+                        ", divided by its std,"
+                    } else {
+                        ""
+                    },
+                });
+            }
             let names: &[&'static str] = match r.observed {
                 Observed::Point => &["dpx", "dpy", "dpz"],
                 Observed::Direction { .. } => &["d"],
