@@ -225,7 +225,9 @@ pub struct Study {
     spec: StudySpec,
     points: Vec<Vec<f64>>,
     /// Per point, the `6 × N` sensitivity matrix.
-    sensitivities: Vec<Vec<f64>>,
+    /// `∂E/∂e` at every point, flat: point `p`, component `c`, error `j` at
+    /// `(p·6 + c)·n + j` (one allocation; `n` = the number of errors).
+    sensitivities: Vec<f64>,
     targets: Vec<Target>,
 }
 
@@ -610,11 +612,7 @@ impl Study {
         if flat.iter().any(|v| !v.is_finite()) {
             return Err(ReliabilityError::NonFinite("the model's sensitivities"));
         }
-        let sensitivities: Vec<Vec<f64>> = if n == 0 {
-            vec![Vec::new(); points.len()]
-        } else {
-            flat.chunks_exact(6 * n).map(<[f64]>::to_vec).collect()
-        };
+        let sensitivities = flat;
         let mut targets: Vec<Target> = spec
             .tolerances
             .iter()
@@ -778,7 +776,8 @@ impl Study {
     /// The sensitivity row `∂E_c/∂e` at point `p`.
     pub fn row(&self, p: usize, c: Component) -> &[f64] {
         let n = self.inputs.len();
-        &self.sensitivities[p][c.index() * n..(c.index() + 1) * n]
+        let start = (p * 6 + c.index()) * n;
+        &self.sensitivities[start..start + n]
     }
 
     /// The mean and covariance of the six error components at point `p`
@@ -860,37 +859,63 @@ impl Study {
 
     /// FORM on every case (exact for one-sided components in normal inputs).
     pub fn form(&self, form: &Form) -> Result<StudyResult, ReliabilityError> {
-        let events = self.events()?;
-        let results = self.run_form(&events, form)?;
-        let cases = results
-            .iter()
-            .enumerate()
-            .map(|(i, r)| {
+        let cases = self.cases_in_blocks(
+            |e| form.run(e),
+            |i, r| {
                 let mut c = self.case(i, r.reliability, r.pf, r.beta);
-                c.form = Some(FormCase::of(r));
+                c.form = Some(FormCase::of(&r));
                 c.calls = r.calls;
                 c
-            })
-            .collect();
+            },
+        )?;
         Ok(self.finish(Method::Form, cases))
+    }
+
+    /// Runs `run` on every case's event and keeps `keep` of its result, a
+    /// block of [`CASE_BLOCK`] cases at a time (in parallel within the
+    /// block): an event and its full result (design point, direction
+    /// cosines) live only while their block runs, so a study of a million
+    /// points keeps only its cases (issue 36, point 1). The cases come in
+    /// case order whatever the blocks.
+    fn cases_in_blocks<T: Send>(
+        &self,
+        run: impl Fn(&Event<'_>) -> Result<T, ReliabilityError> + Sync + Send,
+        keep: impl Fn(usize, T) -> CaseResult,
+    ) -> Result<Vec<CaseResult>, ReliabilityError> {
+        let np = self.points.len();
+        let total = self.targets.len() * np;
+        let mut cases = Vec::with_capacity(total);
+        let mut start = 0;
+        while start < total {
+            let end = (start + CASE_BLOCK).min(total);
+            let events = (start..end)
+                .map(|i| self.event(self.targets[i / np], i % np))
+                .collect::<Result<Vec<_>, _>>()?;
+            let results = per_event(&events, &run)?;
+            cases.extend(
+                results
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, r)| keep(start + k, r)),
+            );
+            start = end;
+        }
+        Ok(cases)
     }
 
     /// SORM on every case: FORM, then the exact curvatures at its design
     /// point ([`crate::sorm`]); the case's probability is Tvedt's.
     pub fn sorm(&self, sorm: &Sorm) -> Result<StudyResult, ReliabilityError> {
-        let events = self.events()?;
-        let results: Vec<SormResult> = per_event(&events, |e| sorm.run(e))?;
-        let cases = results
-            .iter()
-            .enumerate()
-            .map(|(i, r)| {
+        let cases = self.cases_in_blocks(
+            |e| sorm.run(e),
+            |i, r: SormResult| {
                 let mut c = self.case(i, r.reliability, r.pf, r.beta);
                 c.form = Some(FormCase::of(&r.form));
                 c.calls = r.form.calls;
-                c.sorm = Some(SormCase::of(r));
+                c.sorm = Some(SormCase::of(&r));
                 c
-            })
-            .collect();
+            },
+        )?;
         Ok(self.finish(Method::Sorm, cases))
     }
 
@@ -966,14 +991,6 @@ impl Study {
             })
             .collect();
         Ok(self.finish(Method::Subset, cases))
-    }
-
-    fn run_form(
-        &self,
-        events: &[Event<'_>],
-        form: &Form,
-    ) -> Result<Vec<FormResult>, ReliabilityError> {
-        per_event(events, |e| form.run(e))
     }
 
     fn sampled(&self, results: &[SimulationResult]) -> Vec<CaseResult> {
@@ -1230,6 +1247,9 @@ pub fn closed_form_reliability(tolerance: f64, sigma_e: f64) -> f64 {
 
 /// `f` on every event: in parallel from 64 events on (below that the
 /// threads cost more than they save); results in event order.
+/// The cases [`Study::form`] and [`Study::sorm`] run at a time.
+const CASE_BLOCK: usize = 4096;
+
 fn per_event<T: Send>(
     events: &[Event<'_>],
     f: impl Fn(&Event<'_>) -> Result<T, ReliabilityError> + Sync + Send,
@@ -1246,6 +1266,50 @@ mod tests {
     use super::*;
     use crate::machine;
     use crate::util::fixtures::gantry;
+
+    #[test]
+    fn form_and_sorm_in_blocks_equal_each_event_run_alone() {
+        // A grid of 12 × 12 × 12 points with the volumetric system: 4 targets,
+        // 6,912 cases, so the cases cross a block boundary (CASE_BLOCK = 4096).
+        let (m, model) = gantry();
+        let system = Some(System::Volumetric { tolerance: 0.04 });
+        let mut spec = machine::spec(&m, system).unwrap();
+        let axis = |lo: f64, hi: f64| (0..12).map(|k| lo + (hi - lo) * k as f64 / 11.0).collect();
+        spec.grid = Grid {
+            axes: vec![
+                ("x".into(), axis(0.0, 1000.0)),
+                ("y".into(), axis(-1500.0, 1500.0)),
+                ("z".into(), axis(600.0, 1400.0)),
+            ],
+        };
+        let inputs = machine::inputs(&m).unwrap();
+        let params = machine::parameters(&m, &[]).unwrap();
+        let study = Study::new(&model, &params, inputs, spec).unwrap();
+        let total = study.targets().len() * study.points().len();
+        assert!(total > CASE_BLOCK, "{total} cases");
+        let form = Form::default();
+        let r = study.form(&form).unwrap();
+        let events = study.events().unwrap();
+        assert_eq!(r.cases.len(), events.len());
+        for (c, e) in r.cases.iter().zip(&events) {
+            let alone = form.run(e).unwrap();
+            assert_eq!(c.reliability.to_bits(), alone.reliability.to_bits());
+            assert_eq!(c.beta.to_bits(), alone.beta.to_bits());
+            assert_eq!(c.calls, alone.calls);
+        }
+        // Every case names its own target and point, in case order.
+        let np = study.points().len();
+        for (i, c) in r.cases.iter().enumerate() {
+            assert_eq!(c.target, study.targets()[i / np]);
+            assert_eq!(c.point, study.points()[i % np]);
+        }
+        let sorm = Sorm::default();
+        let s = study.sorm(&sorm).unwrap();
+        for i in [0, CASE_BLOCK - 1, CASE_BLOCK, total - 1] {
+            let alone = sorm.run(&events[i]).unwrap();
+            assert_eq!(s.cases[i].pf.to_bits(), alone.pf.to_bits(), "case {i}");
+        }
+    }
 
     #[test]
     fn at_points_equals_the_grid_study_at_the_same_points() {

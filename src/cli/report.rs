@@ -7,11 +7,12 @@
 //! - JSON: [`json`], `serde_json` over the document itself (the document's
 //!   fields, in declaration order, are the JSON keys; non-finite numbers
 //!   become `null`);
-//! - CSV: [`Csv`], one writer (the `csv` crate) over the rows the document
-//!   lists in [`Report::csv`];
+//! - CSV: [`Csv`], one writer (the `csv` crate) that the document's
+//!   [`Report::csv`] writes its header and rows into, each as it is formed;
 //! - tables: [`Report::table`], the human-readable text of each document.
 //!
-//! [`emit`] renders a document in the chosen format and writes it to stdout
+//! [`emit`] renders a document in the chosen format straight into a buffered
+//! stdout (JSON and CSV are never held as one string: issue 36, point 1)
 //! with one error rule ([`write_stdout`]): a closed pipe ends the output
 //! quietly, any other write error is reported and the exit is non-zero.
 
@@ -59,82 +60,146 @@ pub trait Report: Serialize {
     /// The human-readable table (ends with a newline).
     fn table(&self) -> String;
 
-    /// The CSV form, for documents that have one (`None`: the command does
-    /// not offer `--format csv`).
-    fn csv(&self) -> Option<Csv> {
+    /// Writes the CSV form into `out`, a header and then each row as it is
+    /// formed (nothing is collected, so a million-row map streams);
+    /// `None` when the document has no CSV form (the command does not offer
+    /// `--format csv`), having written nothing.
+    fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
+        let _ = out;
         None
     }
 }
 
-/// A CSV table: a header and rows of already formatted cells.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct Csv {
-    header: Vec<String>,
-    rows: Vec<Vec<String>>,
+/// The CSV writer a [`Report::csv`] writes into: a header, then rows of
+/// already formatted cells (RFC 4180 quoting, `\n` line ends, through the
+/// `csv` crate), each written as it comes. The first write error is kept
+/// (the rows after it are dropped unwritten) and returned when the table is
+/// finished.
+pub struct Csv<'a> {
+    writer: csv::Writer<&'a mut dyn Write>,
+    width: usize,
+    failed: Option<csv::Error>,
 }
 
-impl Csv {
-    /// A table with these column names and no row yet.
-    pub fn new<I, S>(header: I) -> Csv
-    where
-        I: IntoIterator<Item = S>,
-        S: Into<String>,
-    {
+impl<'a> Csv<'a> {
+    /// A CSV table written into `out`.
+    pub fn new(out: &'a mut dyn Write) -> Csv<'a> {
         Csv {
-            header: header.into_iter().map(Into::into).collect(),
-            rows: Vec::new(),
+            writer: csv::Writer::from_writer(out),
+            width: 0,
+            failed: None,
         }
     }
 
-    /// Appends one row (as many cells as the header has columns).
+    /// Writes the header: the column names.
+    pub fn header<I, S>(&mut self, columns: I)
+    where
+        I: IntoIterator<Item = S>,
+        S: AsRef<[u8]>,
+    {
+        let columns: Vec<S> = columns.into_iter().collect();
+        self.width = columns.len();
+        self.write(columns);
+    }
+
+    /// Writes one row (as many cells as the header has columns).
     pub fn row<I, S>(&mut self, cells: I)
     where
         I: IntoIterator<Item = S>,
-        S: Into<String>,
+        S: AsRef<[u8]>,
     {
-        let row: Vec<String> = cells.into_iter().map(Into::into).collect();
-        debug_assert_eq!(row.len(), self.header.len(), "CSV row width");
-        self.rows.push(row);
+        let cells: Vec<S> = cells.into_iter().collect();
+        debug_assert_eq!(cells.len(), self.width, "CSV row width");
+        self.write(cells);
     }
 
-    /// The CSV text (RFC 4180 quoting, `\n` line ends).
-    pub fn render(&self) -> miette::Result<String> {
-        let mut w = csv::Writer::from_writer(Vec::new());
-        let err = |e: csv::Error| miette::miette!("cannot write CSV: {e}");
-        w.write_record(&self.header).map_err(err)?;
-        for row in &self.rows {
-            w.write_record(row).map_err(err)?;
+    fn write<S: AsRef<[u8]>>(&mut self, cells: Vec<S>) {
+        if self.failed.is_none() {
+            if let Err(e) = self.writer.write_record(cells) {
+                self.failed = Some(e);
+            }
         }
-        let bytes = w
-            .into_inner()
-            .map_err(|e| miette::miette!("cannot write CSV: {e}"))?;
-        String::from_utf8(bytes).into_diagnostic()
+    }
+
+    /// Flushes the table; the first error of any write.
+    fn finish(mut self) -> std::io::Result<()> {
+        if let Some(e) = self.failed.take() {
+            return Err(csv_io(e));
+        }
+        self.writer.flush()
+    }
+}
+
+/// A CSV writer's error as the I/O error it wraps (a record of the wrong
+/// width, a bug of the document, as `InvalidData`).
+fn csv_io(e: csv::Error) -> std::io::Error {
+    let kind = match e.kind() {
+        csv::ErrorKind::Io(io) => io.kind(),
+        _ => std::io::ErrorKind::InvalidData,
+    };
+    match e.into_kind() {
+        csv::ErrorKind::Io(io) => io,
+        other => std::io::Error::new(kind, format!("{other:?}")),
     }
 }
 
 /// The pretty-printed JSON of any serialisable document, with a final newline.
 pub fn json<T: Serialize + ?Sized>(doc: &T) -> miette::Result<String> {
-    let mut s = serde_json::to_string_pretty(doc)
-        .map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
-    s.push('\n');
-    Ok(s)
+    let mut out = Vec::new();
+    write_json(doc, &mut out).map_err(|e| miette::miette!("cannot serialise the result: {e}"))?;
+    String::from_utf8(out).into_diagnostic()
 }
 
-/// A document rendered in `format`.
-pub fn render<R: Report>(doc: &R, format: Format) -> miette::Result<String> {
+/// Writes a document's pretty-printed JSON (and a final newline) into `out`
+/// as it is serialised (no string of the whole document is formed).
+fn write_json<T: Serialize + ?Sized>(doc: &T, out: &mut dyn Write) -> std::io::Result<()> {
+    serde_json::to_writer_pretty(&mut *out, doc)?;
+    out.write_all(b"\n")
+}
+
+/// Writes a document in `format` into `out`: the one place each format is
+/// rendered. `Ok(false)`: the document has no CSV form.
+fn write_to<R: Report>(doc: &R, format: Format, out: &mut dyn Write) -> std::io::Result<bool> {
     match format {
-        Format::Table => Ok(doc.table()),
-        Format::Json => json(doc),
-        Format::Csv => match doc.csv() {
-            Some(csv) => csv.render(),
-            None => Err(miette::miette!("this command has no CSV output")),
-        },
+        Format::Table => out.write_all(doc.table().as_bytes())?,
+        Format::Json => write_json(doc, out)?,
+        Format::Csv => {
+            let mut csv = Csv::new(out);
+            if doc.csv(&mut csv).is_none() {
+                return Ok(false);
+            }
+            csv.finish()?;
+        }
+    }
+    Ok(true)
+}
+
+/// A document rendered in `format`, as a string (what [`emit`] writes).
+#[cfg(test)]
+pub fn render<R: Report>(doc: &R, format: Format) -> miette::Result<String> {
+    let mut out = Vec::new();
+    match write_to(doc, format, &mut out) {
+        Ok(true) => String::from_utf8(out).into_diagnostic(),
+        Ok(false) => Err(no_csv()),
+        Err(e) => Err(miette::miette!("cannot render the result: {e}")),
     }
 }
 
-/// Renders a document in `format` and writes it to stdout.
+fn no_csv() -> miette::Report {
+    miette::miette!("this command has no CSV output")
+}
+
+/// Renders a document in `format` straight into stdout (buffered; a
+/// million-point JSON or CSV document is never held as one string), with
+/// [`write_stdout`]'s error rule.
 pub fn emit<R: Report>(doc: &R, format: Format) -> miette::Result<()> {
-    write_stdout(&render(doc, format)?)
+    let stdout = std::io::stdout().lock();
+    let mut out = std::io::BufWriter::with_capacity(1 << 16, stdout);
+    match write_to(doc, format, &mut out).and_then(|has| out.flush().map(|()| has)) {
+        Ok(true) => Ok(()),
+        Ok(false) => Err(no_csv()),
+        Err(e) => written(e),
+    }
 }
 
 /// Writes to stdout; a closed pipe (`| head`) ends the output quietly, any
@@ -143,8 +208,16 @@ pub fn write_stdout(text: &str) -> miette::Result<()> {
     let mut out = std::io::stdout().lock();
     match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
         Ok(()) => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        Err(e) => Err(miette::miette!("cannot write the output: {e}")),
+        Err(e) => written(e),
+    }
+}
+
+/// The one rule for a failed write to stdout.
+fn written(e: std::io::Error) -> miette::Result<()> {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        Ok(())
+    } else {
+        Err(miette::miette!("cannot write the output: {e}"))
     }
 }
 
@@ -162,10 +235,10 @@ mod tests {
         fn table(&self) -> String {
             format!("{} = {}\n", self.name, self.value)
         }
-        fn csv(&self) -> Option<Csv> {
-            let mut c = Csv::new(["name", "value"]);
-            c.row([self.name.to_string(), format!("{:?}", self.value)]);
-            Some(c)
+        fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
+            out.header(["name", "value"]);
+            out.row([self.name.to_string(), format!("{:?}", self.value)]);
+            Some(())
         }
     }
 

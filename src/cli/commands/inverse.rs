@@ -71,8 +71,8 @@ impl Report for InverseDocument {
 
     /// `row,status,solution,<variables>`, one line per solution; an
     /// unreachable row has one line with empty values.
-    fn csv(&self) -> Option<Csv> {
-        let mut csv = Csv::new(
+    fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
+        out.header(
             ["row", "status", "solution"]
                 .into_iter()
                 .chain(self.variables.iter().map(String::as_str)),
@@ -80,20 +80,20 @@ impl Report for InverseDocument {
         for (k, s) in self.rows.iter().enumerate() {
             let (row, status) = ((k + 1).to_string(), s.status.name());
             if s.solutions.is_empty() {
-                csv.row(
+                out.row(
                     [row.clone(), status.to_string(), String::new()]
                         .into_iter()
                         .chain(self.variables.iter().map(|_| String::new())),
                 );
             }
             for (j, q) in s.solutions.iter().enumerate() {
-                csv.row(
+                out.row(
                     [row.clone(), status.to_string(), (j + 1).to_string()]
                         .into_iter()
                         .chain(q.iter().map(f64::to_string)),
                 );
             }
         }
-        Some(csv)
+        Some(())
     }
 }

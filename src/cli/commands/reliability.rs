@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use ::reliability::Form;
 use chain::ops::reliability::{self, ReliabilityOpsError, ReliabilityRequest};
 
-use crate::cli::args::{parse_axis, AlgorithmArgs, ModelArgs, SystemArgs};
+use crate::cli::args::{parse_grid_axis, AlgorithmArgs, ModelArgs, SystemArgs};
 use crate::cli::loaded::Loaded;
 use crate::cli::plot::reliability as reliability_plot;
 use crate::cli::progress::Progress;
@@ -48,8 +48,8 @@ pub struct ReliabilityArgs {
     pub plot: Option<PathBuf>,
     #[command(flatten)]
     pub model: ModelArgs,
-    /// Replace the grid values of one axis, `VAR=v1,v2,...` (repeatable).
-    #[arg(long = "grid", value_name = "VAR=V1,V2,...", value_parser = parse_axis)]
+    /// Replace the grid values of one axis, `VAR=V1,V2,...`, or `VAR=LO:HI:N` for N evenly spaced values from LO to HI (repeatable).
+    #[arg(long = "grid", value_name = "VAR=V1,V2,...|VAR=LO:HI:N", value_parser = parse_grid_axis)]
     pub grid: Vec<(String, Vec<f64>)>,
     #[command(flatten)]
     pub system: SystemArgs,

@@ -24,7 +24,7 @@ use chain::ops::sensitivity::{
 };
 use chain_core::geometric::NominalSizes;
 
-use crate::cli::args::{parse_axis, parse_point, AtPoint, ModelArgs};
+use crate::cli::args::{parse_grid_axis, parse_point, AtPoint, ModelArgs};
 use crate::cli::loaded::Loaded;
 use crate::cli::plot::reliability as reliability_plot;
 use crate::cli::render::sensitivity::{at_text, where_text};
@@ -78,8 +78,8 @@ pub struct SensitivityArgs {
     /// or per axis `x=up,y=down` (docs/values.md, "Direction").
     #[arg(long, value_name = "DIR|VAR=DIR,...", value_parser = chain_core::values::parse_approaches, requires = "values")]
     pub approach: Vec<Vec<(Option<String>, chain_core::values::Approach)>>,
-    /// Replace the grid values of one axis for the grid mean, `VAR=v1,v2,...` (repeatable).
-    #[arg(long = "grid", value_name = "VAR=V1,V2,...", value_parser = parse_axis)]
+    /// Replace the grid values of one axis for the grid mean, `VAR=V1,V2,...`, or `VAR=LO:HI:N` for N evenly spaced values from LO to HI (repeatable).
+    #[arg(long = "grid", value_name = "VAR=V1,V2,...|VAR=LO:HI:N", value_parser = parse_grid_axis)]
     pub grid: Vec<(String, Vec<f64>)>,
     /// Write bar charts (PNG and SVG) into DIR: `|∂R/∂σ|` per component
     /// (`--kind reliability`, like Figures 6-8 of Wang & Yuan 2021) or the

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use chain::ops::sobol::{self, SobolOpsError, SobolRequest};
 
-use crate::cli::args::parse_axis;
+use crate::cli::args::parse_grid_axis;
 use crate::cli::args::ParamArgs;
 use crate::cli::args::{parse_point, AtPoint};
 use crate::cli::loaded::Loaded;
@@ -52,8 +52,8 @@ pub struct SobolArgs {
     /// Confidence level of the bootstrap percentile intervals, in (0, 1).
     #[arg(long, default_value_t = 0.95)]
     pub confidence: f64,
-    /// Replace the grid values of one axis, `VAR=v1,v2,...` (repeatable; not with --at).
-    #[arg(long = "grid", value_name = "VAR=V1,V2,...", value_parser = parse_axis)]
+    /// Replace the grid values of one axis, `VAR=V1,V2,...`, or `VAR=LO:HI:N` for N evenly spaced values from LO to HI (repeatable; not with --at).
+    #[arg(long = "grid", value_name = "VAR=V1,V2,...|VAR=LO:HI:N", value_parser = parse_grid_axis)]
     pub grid: Vec<(String, Vec<f64>)>,
     #[command(flatten)]
     pub param: ParamArgs,

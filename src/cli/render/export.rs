@@ -16,10 +16,10 @@ impl Report for ExportDocument {
         }
     }
 
-    fn csv(&self) -> Option<Csv> {
+    fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
         match self {
-            ExportDocument::Grid(g) => g.csv(),
-            ExportDocument::Tables(t) => t.csv(),
+            ExportDocument::Grid(g) => g.csv(out),
+            ExportDocument::Tables(t) => t.csv(out),
         }
     }
 }
@@ -82,9 +82,9 @@ impl Report for GridExport {
         out
     }
 
-    fn csv(&self) -> Option<Csv> {
+    fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
         let g = &self.grid;
-        let mut csv = Csv::new(g.header());
+        out.header(g.header());
         let nv = g.variables.len();
         let mut q = vec![0.0; nv];
         for i in 0..g.len() {
@@ -92,9 +92,9 @@ impl Report for GridExport {
             let mut row: Vec<String> = q.iter().map(|x| format!("{x}")).collect();
             row.extend(g.delta(i).iter().map(|x| format!("{x}")));
             row.push(format!("{}", g.residuals[i]));
-            csv.row(row);
+            out.row(row);
         }
-        Some(csv)
+        Some(())
     }
 }
 

@@ -197,7 +197,7 @@ impl Report for MapDocument {
         out
     }
 
-    fn csv(&self) -> Option<Csv> {
+    fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
         let r = self.full()?;
         let mut header: Vec<String> = r.variables.clone();
         header.extend(Component::NAMES.map(String::from));
@@ -207,7 +207,7 @@ impl Report for MapDocument {
             let names = Component::NAMES.iter().chain(&["volumetric"]);
             header.extend(names.map(|c| format!("{c}_after")));
         }
-        let mut csv = Csv::new(header);
+        out.header(header);
         for i in 0..r.len() {
             let mut row: Vec<String> = r.point(i).iter().map(|x| format!("{x}")).collect();
             row.extend(r.errors[i].iter().map(|x| format!("{x}")));
@@ -216,8 +216,8 @@ impl Report for MapDocument {
                 row.extend(a.errors[i].iter().map(|x| format!("{x}")));
                 row.push(format!("{}", a.volumetric(i)));
             }
-            csv.row(row);
+            out.row(row);
         }
-        Some(csv)
+        Some(())
     }
 }

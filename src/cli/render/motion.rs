@@ -18,14 +18,13 @@ impl Report for MotionDocument {
     }
 
     /// The exact motion: `t,<CNC variables>`, one line per instant.
-    fn csv(&self) -> Option<Csv> {
+    fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
         let run = &self.conversion;
-        let mut csv =
-            Csv::new(std::iter::once("t").chain(run.motion.variables().iter().map(String::as_str)));
+        out.header(std::iter::once("t").chain(run.motion.variables().iter().map(String::as_str)));
         for (t, q) in run.times.iter().zip(&run.exact) {
-            csv.row(std::iter::once(t.to_string()).chain(q.iter().map(f64::to_string)));
+            out.row(std::iter::once(t.to_string()).chain(q.iter().map(f64::to_string)));
         }
-        Some(csv)
+        Some(())
     }
 }
 

@@ -13,7 +13,7 @@ impl Report for PathDocument {
         to_table(self)
     }
 
-    fn csv(&self) -> Option<Csv> {
+    fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
         let r = &self.result;
         let sampled = r.cases().any(|c| c.std_error.is_some());
         let names: Vec<&str> = r.targets.iter().map(|t| t.target.name()).collect();
@@ -37,7 +37,7 @@ impl Report for PathDocument {
             header.extend(names.iter().map(|t| format!("{key}_{t}")));
         }
         let width = header.len();
-        let mut csv = Csv::new(header);
+        out.header(header);
         for rec in &r.records {
             let i = &rec.instant;
             let mut row = vec![i.row.to_string(), format!("{:?}", i.t)];
@@ -74,9 +74,9 @@ impl Report for PathDocument {
                 row.extend(e.cases.iter().map(|c| c.calls.gradients.to_string()));
             }
             row.resize(width, String::new());
-            csv.row(row);
+            out.row(row);
         }
-        Some(csv)
+        Some(())
     }
 }
 

@@ -112,8 +112,8 @@ impl Report for PositioningDocument {
         out
     }
 
-    fn csv(&self) -> Option<Csv> {
-        let mut c = Csv::new([
+    fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
+        out.header([
             "target",
             "mean_up",
             "mean_down",
@@ -126,7 +126,7 @@ impl Report for PositioningDocument {
             "repeatability",
         ]);
         for t in &self.targets {
-            c.row(
+            out.row(
                 [
                     t.target,
                     t.mean_up,
@@ -142,6 +142,6 @@ impl Report for PositioningDocument {
                 .map(|v| format!("{v:?}")),
             );
         }
-        Some(c)
+        Some(())
     }
 }

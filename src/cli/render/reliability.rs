@@ -42,7 +42,7 @@ impl Report for ReliabilityRun {
         }
     }
 
-    fn csv(&self) -> Option<Csv> {
+    fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
         let (study, r) = (&self.study, &self.result);
         let ax = axes(study);
         // With the acceptance row, the sampling columns are always there
@@ -89,7 +89,7 @@ impl Report for ReliabilityRun {
             );
         }
         let width = header.len();
-        let mut csv = Csv::new(header);
+        out.header(header);
         for c in &r.cases {
             let mut row = vec![c.target.to_string()];
             row.extend(ax.iter().map(|(_, i)| fmt_num(c.point[*i])));
@@ -143,14 +143,14 @@ impl Report for ReliabilityRun {
                     None => row.extend((0..4).map(|_| String::new())),
                 }
             }
-            csv.row(row);
+            out.row(row);
         }
         if let Some(a) = &self.acceptance {
             let mut row = acceptance_csv_row(a, ax.len());
             row.resize(width.max(row.len()), String::new());
-            csv.row(row);
+            out.row(row);
         }
-        Some(csv)
+        Some(())
     }
 }
 

@@ -21,8 +21,8 @@ impl Report for SobolRun {
         table(&doc)
     }
 
-    fn csv(&self) -> Option<Csv> {
-        csv(&self.document())
+    fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
+        csv(&self.document(), out)
     }
 }
 
@@ -97,8 +97,8 @@ fn table(d: &SobolDocument<'_>) -> String {
     out
 }
 
-fn csv(d: &SobolDocument<'_>) -> Option<Csv> {
-    let mut c = Csv::new([
+fn csv(d: &SobolDocument<'_>, out: &mut Csv<'_>) -> Option<()> {
+    out.header([
         "output",
         "error",
         "first",
@@ -112,7 +112,7 @@ fn csv(d: &SobolDocument<'_>) -> Option<Csv> {
     let num = |v: f64| format!("{v:?}");
     for o in &d.result.outputs {
         for e in &o.errors {
-            c.row([
+            out.row([
                 o.output.name().to_string(),
                 e.error.clone(),
                 num(e.first.value),
@@ -125,5 +125,5 @@ fn csv(d: &SobolDocument<'_>) -> Option<Csv> {
             ]);
         }
     }
-    Some(c)
+    Some(())
 }
