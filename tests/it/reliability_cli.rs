@@ -592,3 +592,28 @@ fn system_tolerance_is_refused_before_the_machine_is_read() {
         );
     }
 }
+
+#[test]
+fn grid_ranges_are_the_same_grid_as_the_listed_values() {
+    // `--grid VAR=LO:HI:N` (as in `chain map`) against the values listed:
+    // the same document, for reliability, sensitivity and sobol alike.
+    for command in ["reliability", "sensitivity"] {
+        let range = gantry_json(command, &["--grid", "x=0:1000:3", "--grid", "z=600:1400:5"]);
+        let listed = gantry_json(
+            command,
+            &[
+                "--grid",
+                "x=0,500,1000",
+                "--grid",
+                "z=600,800,1000,1200,1400",
+            ],
+        );
+        assert_eq!(range, listed, "{command}");
+    }
+    let doc = gantry_json("reliability", &["--grid", "x=0:1000:3"]);
+    // 3 x values × 5 y × 5 z, three components.
+    assert_eq!(doc["results"].as_array().unwrap().len(), 3 * 25 * 3);
+    // sobol reads ranges with the same parser: its refusal of a one-value range.
+    let err = fails(&["sobol", gantry().to_str().unwrap(), "--grid", "x=0:1000:1"]);
+    assert!(err.contains("N ≥ 2"), "{err}");
+}
