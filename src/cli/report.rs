@@ -133,13 +133,9 @@ impl<'a> Csv<'a> {
 /// A CSV writer's error as the I/O error it wraps (a record of the wrong
 /// width, a bug of the document, as `InvalidData`).
 fn csv_io(e: csv::Error) -> std::io::Error {
-    let kind = match e.kind() {
-        csv::ErrorKind::Io(io) => io.kind(),
-        _ => std::io::ErrorKind::InvalidData,
-    };
     match e.into_kind() {
         csv::ErrorKind::Io(io) => io,
-        other => std::io::Error::new(kind, format!("{other:?}")),
+        other => std::io::Error::new(std::io::ErrorKind::InvalidData, format!("{other:?}")),
     }
 }
 

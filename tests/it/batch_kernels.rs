@@ -11,6 +11,7 @@
 //! value or 1e-15 of the row's largest magnitude (an entry that is a small
 //! difference of large terms inherits the terms' rounding, not its own).
 
+use crate::common::Points;
 use chain::core::ErrorModel;
 
 chain::machine!(pub AcTrunnion = "examples/machines/ac_trunnion.yaml");
@@ -64,18 +65,6 @@ fn every_example_machine_is_declared() {
     }
     found.sort();
     assert_eq!(found, DECLARED);
-}
-
-/// xorshift64 in `[-range, range]`.
-struct Points(u64);
-
-impl Points {
-    fn next(&mut self, range: f64) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        ((self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * range
-    }
 }
 
 /// Distance in ulp of two doubles (0 when equal; `u64::MAX` across signs).

@@ -417,6 +417,26 @@ fn puma_tracker_data_are_the_truth_plus_noise() {
     assert!(worst < 4.5, "a noise value of {worst} std");
 }
 
+/// `chain identify` of the PUMA 560's simulated tracker data, validated on
+/// its 30 held-out poses, with `extra` options; the JSON document.
+fn identify_puma(extra: &[&str]) -> serde_json::Value {
+    let file = example_file("robots/puma560_dh.yaml");
+    let measurements = example_file("robots/puma560_tracker.csv");
+    let validate = example_file("robots/puma560_validate.csv");
+    let mut args = vec![
+        "identify",
+        file.to_str().unwrap(),
+        "--measurements",
+        measurements.to_str().unwrap(),
+        "--validate",
+        validate.to_str().unwrap(),
+        "--format",
+        "json",
+    ];
+    args.extend_from_slice(extra);
+    ok_json(&args)
+}
+
 /// `chain identify` on the simulated calibration: rank 23 of 28, the five
 /// redundancies of the DH analysis (parallel joints 2 and 3 share `d`; the
 /// last joint's `a`, `d`, `θ`, `α` act as the reflector's offsets), every
@@ -426,18 +446,7 @@ fn puma_tracker_data_are_the_truth_plus_noise() {
 fn puma_calibration_recovers_the_truth() {
     let m = puma().load();
     let e = values_of(&m, "robots/puma560_truth.yaml");
-    let json = ok_json(&[
-        "identify",
-        example_file("robots/puma560_dh.yaml").to_str().unwrap(),
-        "--measurements",
-        example_file("robots/puma560_tracker.csv").to_str().unwrap(),
-        "--validate",
-        example_file("robots/puma560_validate.csv")
-            .to_str()
-            .unwrap(),
-        "--format",
-        "json",
-    ]);
+    let json = identify_puma(&[]);
     assert_eq!(json["rank"], 23, "{json:#}");
     let mut groups: Vec<Vec<String>> = json["groups"]
         .as_array()
@@ -539,19 +548,7 @@ fn puma_calibration_recovers_the_truth() {
     }
     // --iterate: converged in 4 Levenberg–Marquardt iterations; the
     // prediction moves by less than 1e-4 mm.
-    let iterated = ok_json(&[
-        "identify",
-        example_file("robots/puma560_dh.yaml").to_str().unwrap(),
-        "--measurements",
-        example_file("robots/puma560_tracker.csv").to_str().unwrap(),
-        "--validate",
-        example_file("robots/puma560_validate.csv")
-            .to_str()
-            .unwrap(),
-        "--iterate",
-        "--format",
-        "json",
-    ]);
+    let iterated = identify_puma(&["--iterate"]);
     assert_eq!(iterated["iteration"]["converged"], true);
     assert_eq!(iterated["iteration"]["iterations"], 4);
     for key in ["mean", "max", "rms"] {

@@ -12,6 +12,7 @@
 //! as `f64` (`==`) and bit for bit when non-zero: the new bodies share a
 //! sum and its negation, exact in IEEE 754 but for the sign of a zero.
 
+use crate::common::Points;
 use chain::core::ErrorModel;
 
 mod v1 {
@@ -77,21 +78,6 @@ fn v1_files_are_current() {
             "tests/generated_v1/{name}.rs is not the v1 emission of {file}: \
              rerun `chain derive {file} --format rust > tests/generated_v1/{name}.rs`"
         );
-    }
-}
-
-/// A small deterministic generator of points (xorshift), in `[-range, range]`.
-struct Points(u64);
-
-impl Points {
-    fn next(&mut self, range: f64) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        ((self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * range
-    }
-    fn fill(&mut self, out: &mut [f64], range: f64) {
-        out.iter_mut().for_each(|x| *x = self.next(range));
     }
 }
 

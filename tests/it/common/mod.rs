@@ -871,3 +871,21 @@ pub fn with_function_slots(
     }
     m
 }
+
+/// A small deterministic generator of points (xorshift64), in `[-range, range]`
+/// (the batch and `_into` equality tests).
+pub struct Points(pub u64);
+
+impl Points {
+    /// The next value.
+    pub fn next(&mut self, range: f64) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * range
+    }
+    /// Fills `out` with values in `[-range, range]`.
+    pub fn fill(&mut self, out: &mut [f64], range: f64) {
+        out.iter_mut().for_each(|x| *x = self.next(range));
+    }
+}
