@@ -33,9 +33,10 @@ use crate::allocate::{
 };
 use crate::sobol::{Estimate, OutputIndices, SobolResult};
 use crate::{
-    Algorithm, Calls, DirectionalSimulation, ErrorModel, Form, FormCase, ImportanceSampling,
-    Method, MonteCarlo, Posterior, ReliabilityError, SensitivityMethod, SormCase, Stopping, Study,
-    StudyResult, SubsetLevel, SubsetSimulation, Summary, System, Target, TargetSensitivity,
+    Algorithm, Calls, CaseResult, DirectionalSimulation, ErrorModel, Form, FormCase,
+    ImportanceSampling, Method, MonteCarlo, Posterior, ReliabilityError, SensitivityMethod,
+    SormCase, Stopping, Study, StudyResult, SubsetLevel, SubsetSimulation, Summary, System, Target,
+    TargetSensitivity,
 };
 
 /// The document of a grid study (the spec's `reliability` JSON contract).
@@ -47,8 +48,9 @@ pub struct ReliabilityDocument<'a> {
     pub method: Method,
     /// One- or two-sided tolerances.
     pub sided: Sided,
-    /// Every case, target-major.
-    pub results: Vec<CaseDocument<'a>>,
+    /// Every case, target-major (each case's document formed as it is
+    /// written).
+    pub results: CaseDocuments<'a>,
     /// Each target's summary over the grid.
     pub summary: NameMap<Target, SummaryDocument>,
     /// The requirement and whether every target meets it.
@@ -104,6 +106,59 @@ pub struct CaseDocument<'a> {
     pub sorm: Option<&'a SormCase>,
 }
 
+/// The cases of a [`ReliabilityDocument`]: serialised as the list of their
+/// [`CaseDocument`]s, each formed when it is written, so that a document of
+/// a million cases is not a second copy of them (issue 36, point 1).
+#[derive(Debug)]
+pub struct CaseDocuments<'a> {
+    /// The grid's axes in file order, with their index in the model's
+    /// variables.
+    axes: Vec<(&'a str, usize)>,
+    /// The cases, target-major.
+    cases: &'a [CaseResult],
+}
+
+impl<'a> CaseDocuments<'a> {
+    /// The number of cases.
+    pub fn len(&self) -> usize {
+        self.cases.len()
+    }
+
+    /// True when there is no case.
+    pub fn is_empty(&self) -> bool {
+        self.cases.is_empty()
+    }
+
+    /// Each case's document, target-major.
+    pub fn iter(&self) -> impl Iterator<Item = CaseDocument<'a>> + '_ {
+        self.cases.iter().map(|c| CaseDocument {
+            component: c.target,
+            point: NameMap(self.axes.iter().map(|&(n, i)| (n, c.point[i])).collect()),
+            reliability: c.reliability,
+            pf: c.pf,
+            beta: c.beta,
+            std_error: c.std_error,
+            samples: c.samples,
+            cov: c.cov,
+            form: c.form,
+            converged: match (&c.form, &c.stopping) {
+                (None, Some(st)) => Some(st.converged),
+                _ => None,
+            },
+            calls: c.calls,
+            sampling: c.stopping,
+            levels: c.levels.as_deref(),
+            sorm: c.sorm.as_deref(),
+        })
+    }
+}
+
+impl Serialize for CaseDocuments<'_> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_seq(self.iter())
+    }
+}
+
 /// One target's summary of a [`ReliabilityDocument`].
 #[derive(Debug, Serialize)]
 pub struct SummaryDocument {
@@ -154,29 +209,10 @@ impl<'a> ReliabilityDocument<'a> {
                 Some((n.as_str(), i))
             })
             .collect();
-        let results = r
-            .cases
-            .iter()
-            .map(|c| CaseDocument {
-                component: c.target,
-                point: NameMap(ax.iter().map(|&(n, i)| (n, c.point[i])).collect()),
-                reliability: c.reliability,
-                pf: c.pf,
-                beta: c.beta,
-                std_error: c.std_error,
-                samples: c.samples,
-                cov: c.cov,
-                form: c.form,
-                converged: match (&c.form, &c.stopping) {
-                    (None, Some(st)) => Some(st.converged),
-                    _ => None,
-                },
-                calls: c.calls,
-                sampling: c.stopping,
-                levels: c.levels.as_deref(),
-                sorm: c.sorm.as_ref(),
-            })
-            .collect();
+        let results = CaseDocuments {
+            axes: ax,
+            cases: &r.cases,
+        };
         let summary = NameMap(
             r.summaries
                 .iter()
@@ -504,7 +540,12 @@ impl<'a> SobolDocument<'a> {
         let at = at_point.then(|| {
             NameMap::zip(
                 study.variables().iter().cloned(),
-                study.points().first().into_iter().flatten().copied(),
+                study
+                    .points()
+                    .first()
+                    .into_iter()
+                    .flat_map(|q| q.iter())
+                    .copied(),
             )
         });
         let grid = (!at_point).then(|| NameMap(study.spec().grid.axes.clone()));

@@ -59,9 +59,10 @@ pub(crate) use impl_sampler;
 /// The largest number of samples per case (2³⁶ ≈ 6.9·10¹⁰).
 pub const MAX_SAMPLES: u64 = 1 << 36;
 
-/// A progress sink: told how many samples have been done, from any thread.
+/// A progress sink: told how much has been done, from any thread: samples
+/// for the samplers, cases for FORM and SORM (which draw none).
 pub trait Progress: Sync {
-    /// `samples` more samples are done.
+    /// `samples` more samples (FORM, SORM: cases) are done.
     fn advance(&self, samples: u64);
 }
 

@@ -357,12 +357,7 @@ impl Sobol {
     pub fn run_study(&self, study: &Study) -> Result<SobolResult, SobolError> {
         let k = study.inputs().len();
         let rows: Vec<Vec<f64>> = (0..study.points().len())
-            .map(|p| {
-                Component::ALL
-                    .iter()
-                    .flat_map(|c| study.row(p, *c).iter().copied())
-                    .collect::<Vec<f64>>()
-            })
+            .map(|p| study.sensitivities(p..p + 1).into_owned())
             .collect();
         debug_assert!(rows.iter().all(|r| r.len() == 6 * k));
         self.run(study.inputs(), &rows, &study_outputs(study))

@@ -13,6 +13,10 @@
 //! gives the mean and covariance of the error components at a point (exact
 //! linear propagation), with [`VolumetricMoments`] for the norm `|p|`.
 
+use std::borrow::Cow;
+use std::ops::Range;
+use std::sync::Arc;
+
 use chain_core::model::{Component, Requirement, Sided};
 use chain_core::ErrorModel;
 use serde::Serialize;
@@ -223,12 +227,41 @@ pub struct Study {
     point_inputs: Option<Vec<Inputs>>,
     variables: Vec<String>,
     spec: StudySpec,
-    points: Vec<Vec<f64>>,
-    /// Per point, the `6 × N` sensitivity matrix.
+    /// The points, each shared with the cases at it.
+    points: Vec<Arc<[f64]>>,
+    /// Per point, the `6 × N` sensitivity matrix `∂E/∂e`: kept, or
+    /// evaluated when a case needs it.
+    rows: Rows,
+    targets: Vec<Target>,
+}
+
+/// A model a study evaluates when its cases run ([`Study::on_demand`]).
+pub type SharedModel = Arc<dyn ErrorModel + Send + Sync>;
+
+/// Where a study's sensitivity matrices come from.
+#[derive(Clone)]
+enum Rows {
     /// `∂E/∂e` at every point, flat: point `p`, component `c`, error `j` at
     /// `(p·6 + c)·n + j` (one allocation; `n` = the number of errors).
-    sensitivities: Vec<f64>,
-    targets: Vec<Target>,
+    Stored(Vec<f64>),
+    /// Evaluated a block of points at a time when cases, moments or rows
+    /// ask for them, and dropped with the block (issue 36, point 1: a
+    /// million-point grid keeps no `6 × N` matrix per point).
+    OnDemand {
+        model: SharedModel,
+        parameters: Vec<f64>,
+    },
+}
+
+impl std::fmt::Debug for Rows {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Rows::Stored(s) => write!(f, "Stored({} values)", s.len()),
+            Rows::OnDemand { parameters, .. } => {
+                write!(f, "OnDemand {{ parameters: {parameters:?} }}")
+            }
+        }
+    }
 }
 
 /// The outcome of one case.
@@ -236,8 +269,9 @@ pub struct Study {
 pub struct CaseResult {
     /// The target.
     pub target: Target,
-    /// The axis values, in the model's variable order.
-    pub point: Vec<f64>,
+    /// The axis values, in the model's variable order (shared with the
+    /// study's point and the other targets' cases there).
+    pub point: Arc<[f64]>,
     /// `R = 1 − p_f`.
     pub reliability: f64,
     /// `p_f`.
@@ -263,9 +297,10 @@ pub struct CaseResult {
     /// Subset simulation's levels (of its first run).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub levels: Option<Vec<SubsetLevel>>,
-    /// SORM's account of the case (`--method sorm`).
+    /// SORM's account of the case (`--method sorm`; boxed: a FORM case
+    /// carries no room for it).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sorm: Option<SormCase>,
+    pub sorm: Option<Box<SormCase>>,
 }
 
 /// SORM's account of one case: the three asymptotic formulas and the
@@ -516,7 +551,7 @@ fn adjugate3(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
 }
 
 impl Study {
-    /// Evaluates the model's sensitivities over the grid.
+    /// Evaluates the model's sensitivities over the grid and keeps them.
     ///
     /// `parameters` are the model's parameter values (in
     /// [`ErrorModel::parameters`] order); `inputs` must name every error of
@@ -529,7 +564,41 @@ impl Study {
     ) -> Result<Study, ReliabilityError> {
         let (inputs, variables) = checked_inputs(model, parameters, inputs)?;
         let points = grid_points(&spec.grid, &variables)?;
-        Study::assemble(model, parameters, inputs, variables, spec, points)
+        let targets = targets(&spec)?;
+        let rows = Rows::Stored(evaluate(model, parameters, &points)?);
+        Ok(Study::assemble(
+            inputs, variables, spec, points, rows, targets,
+        ))
+    }
+
+    /// The grid study of [`Study::new`] that keeps the model instead of the
+    /// sensitivities: a block of points is evaluated when its cases run
+    /// (and a point's when its moments, rows or events are asked for), so
+    /// the study holds per point only the point. For a model whose
+    /// [`ErrorModel::sensitivity_points`] equals its per-point values bit
+    /// for bit (the runtime tape), every result equals [`Study::new`]'s.
+    ///
+    /// The sensitivities are evaluated once here, a block at a time, to
+    /// refuse non-finite values as [`Study::new`] does.
+    pub fn on_demand(
+        model: SharedModel,
+        parameters: &[f64],
+        inputs: Inputs,
+        spec: StudySpec,
+    ) -> Result<Study, ReliabilityError> {
+        let (inputs, variables) = checked_inputs(&*model, parameters, inputs)?;
+        let points = grid_points(&spec.grid, &variables)?;
+        let targets = targets(&spec)?;
+        for block in points.chunks(CASE_BLOCK) {
+            evaluate(&*model, parameters, block)?;
+        }
+        let rows = Rows::OnDemand {
+            model,
+            parameters: parameters.to_vec(),
+        };
+        Ok(Study::assemble(
+            inputs, variables, spec, points, rows, targets,
+        ))
     }
 
     /// Evaluates the model's sensitivities at an explicit list of points
@@ -567,90 +636,32 @@ impl Study {
             grid: Grid { axes: Vec::new() },
             ..spec
         };
-        Study::assemble(model, parameters, inputs, variables, spec, points)
+        let targets = targets(&spec)?;
+        let points: Vec<Arc<[f64]>> = points.into_iter().map(Arc::from).collect();
+        let rows = Rows::Stored(evaluate(model, parameters, &points)?);
+        Ok(Study::assemble(
+            inputs, variables, spec, points, rows, targets,
+        ))
     }
 
-    /// The shared part of [`Study::new`] and [`Study::at_points`]: checks the
-    /// tolerances and the system, and evaluates the sensitivities at the
-    /// (already validated) points.
-    fn assemble<M: ErrorModel + ?Sized>(
-        model: &M,
-        parameters: &[f64],
+    /// The shared part of the constructors, after their checks.
+    fn assemble(
         inputs: Inputs,
         variables: Vec<String>,
         spec: StudySpec,
-        points: Vec<Vec<f64>>,
-    ) -> Result<Study, ReliabilityError> {
-        let n = inputs.len();
-        if spec.tolerances.is_empty() {
-            return Err(ReliabilityError::EmptyGrid("no tolerance is given".into()));
-        }
-        for (c, t) in &spec.tolerances {
-            if !t.is_finite() || *t <= 0.0 {
-                return Err(ReliabilityError::InvalidTolerance {
-                    component: c.name().into(),
-                    value: *t,
-                });
-            }
-        }
-        // Every point at once through the model's batch entry point (a
-        // compiled model's tape over blocks of points, a `machine!` type's
-        // batched kernels; the values of `sensitivity` point by point, to
-        // rounding).
-        let qs: Vec<f64> = points.iter().flatten().copied().collect();
-        let mut flat = vec![0.0; points.len() * 6 * n];
-        if model
-            .sensitivity_points(&qs, parameters, &mut flat)
-            .is_err()
-        {
-            // The points were checked against the model's variables; a model
-            // whose lengths still disagree is evaluated point by point.
-            for (q, s) in points.iter().zip(flat.chunks_exact_mut(6 * n.max(1))) {
-                model.sensitivity(q, parameters, s);
-            }
-        }
-        if flat.iter().any(|v| !v.is_finite()) {
-            return Err(ReliabilityError::NonFinite("the model's sensitivities"));
-        }
-        let sensitivities = flat;
-        let mut targets: Vec<Target> = spec
-            .tolerances
-            .iter()
-            .map(|(c, _)| Target::Component(*c))
-            .collect();
-        match spec.system {
-            Some(System::Series) => targets.push(Target::Series),
-            Some(System::Volumetric { tolerance }) => {
-                if !tolerance.is_finite() || tolerance <= 0.0 {
-                    return Err(ReliabilityError::InvalidTolerance {
-                        component: "volumetric".into(),
-                        value: tolerance,
-                    });
-                }
-                if !spec
-                    .tolerances
-                    .iter()
-                    .any(|(c, _)| matches!(c, Component::Px | Component::Py | Component::Pz))
-                {
-                    return Err(ReliabilityError::UnknownName {
-                        kind: "component",
-                        name: "volumetric (needs px, py or pz in the tolerances)".into(),
-                        hint: None,
-                    });
-                }
-                targets.push(Target::Volumetric)
-            }
-            None => {}
-        }
-        Ok(Study {
+        points: Vec<Arc<[f64]>>,
+        rows: Rows,
+        targets: Vec<Target>,
+    ) -> Study {
+        Study {
             inputs,
             variables,
             spec,
             points,
-            sensitivities,
+            rows,
             targets,
             point_inputs: None,
-        })
+        }
     }
 
     /// The inputs, in the model's error order. With inputs per point
@@ -728,7 +739,7 @@ impl Study {
     }
 
     /// The grid points, in the model's variable order.
-    pub fn points(&self) -> &[Vec<f64>] {
+    pub fn points(&self) -> &[Arc<[f64]>] {
         &self.points
     }
 
@@ -773,11 +784,30 @@ impl Study {
         }
     }
 
+    /// The sensitivity matrices (`6 × N` each, component-major) of the
+    /// points `range`: borrowed when the study keeps them, evaluated
+    /// otherwise ([`Study::on_demand`]).
+    pub fn sensitivities(&self, range: Range<usize>) -> Cow<'_, [f64]> {
+        let n6 = 6 * self.inputs.len();
+        match &self.rows {
+            Rows::Stored(s) => Cow::Borrowed(&s[range.start * n6..range.end * n6]),
+            Rows::OnDemand { model, parameters } => {
+                // The constructor evaluated every point and found them finite;
+                // the same evaluation gives the same values.
+                let s = evaluate(&**model, parameters, &self.points[range]);
+                Cow::Owned(s.expect("sensitivities checked finite when the study was built"))
+            }
+        }
+    }
+
     /// The sensitivity row `∂E_c/∂e` at point `p`.
-    pub fn row(&self, p: usize, c: Component) -> &[f64] {
+    pub fn row(&self, p: usize, c: Component) -> Cow<'_, [f64]> {
         let n = self.inputs.len();
-        let start = (p * 6 + c.index()) * n;
-        &self.sensitivities[start..start + n]
+        let at = c.index() * n..(c.index() + 1) * n;
+        match self.sensitivities(p..p + 1) {
+            Cow::Borrowed(s) => Cow::Borrowed(&s[at]),
+            Cow::Owned(s) => Cow::Owned(s[at].to_vec()),
+        }
     }
 
     /// The mean and covariance of the six error components at point `p`
@@ -787,13 +817,16 @@ impl Study {
     pub fn moments(&self, p: usize) -> ErrorMoments {
         let inputs = self.inputs_at(p);
         let means = inputs.means();
+        let s = self.sensitivities(p..p + 1);
+        let n = self.inputs.len();
+        let row = |c: Component| &s[c.index() * n..(c.index() + 1) * n];
         let mut mean = [0.0; 6];
         let mut covariance = [[0.0; 6]; 6];
         for a in Component::ALL {
-            let ra = self.row(p, a);
+            let ra = row(a);
             mean[a.index()] = ra.iter().zip(means).map(|(s, m)| s * m).sum();
             for b in Component::ALL {
-                covariance[a.index()][b.index()] = inputs.covariance(ra, self.row(p, b));
+                covariance[a.index()][b.index()] = inputs.covariance(ra, row(b));
             }
         }
         ErrorMoments { mean, covariance }
@@ -805,7 +838,18 @@ impl Study {
         target: Target,
         p: usize,
     ) -> Result<ToleranceLimitState, ReliabilityError> {
+        self.limit_state_of(target, &self.sensitivities(p..p + 1))
+    }
+
+    /// The limit state of `target` at the point whose `6 × N` sensitivity
+    /// matrix is `s`.
+    fn limit_state_of(
+        &self,
+        target: Target,
+        s: &[f64],
+    ) -> Result<ToleranceLimitState, ReliabilityError> {
         let n = self.inputs.len();
+        let row = |c: &Component| &s[c.index() * n..(c.index() + 1) * n];
         let tol = &self.spec.tolerances;
         match target {
             Target::Component(c) => {
@@ -816,13 +860,10 @@ impl Study {
                         hint: None,
                     },
                 )?;
-                ToleranceLimitState::component(self.row(p, c).to_vec(), i, self.spec.sided)
+                ToleranceLimitState::component(row(&c).to_vec(), i, self.spec.sided)
             }
             Target::Series => {
-                let rows = tol
-                    .iter()
-                    .flat_map(|(c, _)| self.row(p, *c).to_vec())
-                    .collect();
+                let rows = tol.iter().flat_map(|(c, _)| row(c).to_vec()).collect();
                 let t = tol.iter().map(|(_, t)| *t).collect();
                 ToleranceLimitState::new(n, rows, t, Criterion::Each(self.spec.sided))
             }
@@ -834,7 +875,7 @@ impl Study {
                 let rows = tol
                     .iter()
                     .filter(|(c, _)| matches!(c, Component::Px | Component::Py | Component::Pz))
-                    .flat_map(|(c, _)| self.row(p, *c).to_vec())
+                    .flat_map(|(c, _)| row(c).to_vec())
                     .collect();
                 ToleranceLimitState::new(n, rows, vec![tolerance], Criterion::Norm)
             }
@@ -848,18 +889,43 @@ impl Study {
 
     /// Every case's event, target-major.
     pub fn events(&self) -> Result<Vec<Event<'_>>, ReliabilityError> {
-        let mut out = Vec::with_capacity(self.targets.len() * self.points.len());
-        for &t in &self.targets {
-            for p in 0..self.points.len() {
-                out.push(self.event(t, p)?);
+        self.events_of(0..self.targets.len() * self.points.len())
+    }
+
+    /// The events of the cases `cases` (target-major indices), the
+    /// sensitivities of each target's run of points evaluated (or borrowed)
+    /// once, [`CASE_BLOCK`] points at a time.
+    fn events_of(&self, cases: Range<usize>) -> Result<Vec<Event<'_>>, ReliabilityError> {
+        let np = self.points.len();
+        let n6 = 6 * self.inputs.len();
+        let mut out = Vec::with_capacity(cases.len());
+        let mut i = cases.start;
+        while i < cases.end {
+            let (t, p) = (i / np, i % np);
+            let last = (cases.end - t * np).min(np).min(p + CASE_BLOCK);
+            let s = self.sensitivities(p..last);
+            for k in 0..last - p {
+                let state = self.limit_state_of(self.targets[t], &s[k * n6..(k + 1) * n6])?;
+                out.push(Event::new(self.inputs_at(p + k), state)?);
             }
+            i = t * np + last;
         }
         Ok(out)
     }
 
     /// FORM on every case (exact for one-sided components in normal inputs).
     pub fn form(&self, form: &Form) -> Result<StudyResult, ReliabilityError> {
+        self.form_reporting(form, &())
+    }
+
+    /// [`Study::form`], telling `progress` of each block of cases done.
+    fn form_reporting(
+        &self,
+        form: &Form,
+        progress: &dyn Progress,
+    ) -> Result<StudyResult, ReliabilityError> {
         let cases = self.cases_in_blocks(
+            progress,
             |e| form.run(e),
             |i, r| {
                 let mut c = self.case(i, r.reliability, r.pf, r.beta);
@@ -879,6 +945,7 @@ impl Study {
     /// case order whatever the blocks.
     fn cases_in_blocks<T: Send>(
         &self,
+        progress: &dyn Progress,
         run: impl Fn(&Event<'_>) -> Result<T, ReliabilityError> + Sync + Send,
         keep: impl Fn(usize, T) -> CaseResult,
     ) -> Result<Vec<CaseResult>, ReliabilityError> {
@@ -888,9 +955,7 @@ impl Study {
         let mut start = 0;
         while start < total {
             let end = (start + CASE_BLOCK).min(total);
-            let events = (start..end)
-                .map(|i| self.event(self.targets[i / np], i % np))
-                .collect::<Result<Vec<_>, _>>()?;
+            let events = self.events_of(start..end)?;
             let results = per_event(&events, &run)?;
             cases.extend(
                 results
@@ -898,6 +963,7 @@ impl Study {
                     .enumerate()
                     .map(|(k, r)| keep(start + k, r)),
             );
+            progress.advance((end - start) as u64);
             start = end;
         }
         Ok(cases)
@@ -906,13 +972,23 @@ impl Study {
     /// SORM on every case: FORM, then the exact curvatures at its design
     /// point ([`crate::sorm`]); the case's probability is Tvedt's.
     pub fn sorm(&self, sorm: &Sorm) -> Result<StudyResult, ReliabilityError> {
+        self.sorm_reporting(sorm, &())
+    }
+
+    /// [`Study::sorm`], telling `progress` of each block of cases done.
+    fn sorm_reporting(
+        &self,
+        sorm: &Sorm,
+        progress: &dyn Progress,
+    ) -> Result<StudyResult, ReliabilityError> {
         let cases = self.cases_in_blocks(
+            progress,
             |e| sorm.run(e),
             |i, r: SormResult| {
                 let mut c = self.case(i, r.reliability, r.pf, r.beta);
                 c.form = Some(FormCase::of(&r.form));
                 c.calls = r.form.calls;
-                c.sorm = Some(SormCase::of(&r));
+                c.sorm = Some(Box::new(SormCase::of(&r)));
                 c
             },
         )?;
@@ -949,15 +1025,15 @@ impl Study {
     }
 
     /// Runs `algorithm` on every case (`progress` hears of the samples
-    /// drawn; FORM and SORM draw none).
+    /// drawn, or for FORM and SORM, which draw none, of the cases done).
     pub fn run(
         &self,
         algorithm: &Algorithm,
         progress: &dyn Progress,
     ) -> Result<StudyResult, ReliabilityError> {
         match algorithm {
-            Algorithm::Form(form) => self.form(form),
-            Algorithm::Sorm(sorm) => self.sorm(sorm),
+            Algorithm::Form(form) => self.form_reporting(form, progress),
+            Algorithm::Sorm(sorm) => self.sorm_reporting(sorm, progress),
             Algorithm::Subset(ss) => self.subset(ss, progress),
             Algorithm::ImportanceSampling(is) => self.sampled_by(is, progress),
             Algorithm::MonteCarlo(mc) => self.sampled_by(mc, progress),
@@ -1018,7 +1094,7 @@ impl Study {
         let np = self.points.len();
         CaseResult {
             target: self.targets[i / np],
-            point: self.points[i % np].clone(),
+            point: Arc::clone(&self.points[i % np]),
             reliability,
             pf,
             beta,
@@ -1203,9 +1279,83 @@ fn checked_inputs<M: ErrorModel + ?Sized>(
     Ok((inputs, variables))
 }
 
+/// The targets of `spec` in case order (its toleranced components, then its
+/// system), the tolerances and the system checked.
+fn targets(spec: &StudySpec) -> Result<Vec<Target>, ReliabilityError> {
+    if spec.tolerances.is_empty() {
+        return Err(ReliabilityError::EmptyGrid("no tolerance is given".into()));
+    }
+    for (c, t) in &spec.tolerances {
+        if !t.is_finite() || *t <= 0.0 {
+            return Err(ReliabilityError::InvalidTolerance {
+                component: c.name().into(),
+                value: *t,
+            });
+        }
+    }
+    let mut targets: Vec<Target> = spec
+        .tolerances
+        .iter()
+        .map(|(c, _)| Target::Component(*c))
+        .collect();
+    match spec.system {
+        Some(System::Series) => targets.push(Target::Series),
+        Some(System::Volumetric { tolerance }) => {
+            if !tolerance.is_finite() || tolerance <= 0.0 {
+                return Err(ReliabilityError::InvalidTolerance {
+                    component: "volumetric".into(),
+                    value: tolerance,
+                });
+            }
+            if !spec
+                .tolerances
+                .iter()
+                .any(|(c, _)| matches!(c, Component::Px | Component::Py | Component::Pz))
+            {
+                return Err(ReliabilityError::UnknownName {
+                    kind: "component",
+                    name: "volumetric (needs px, py or pz in the tolerances)".into(),
+                    hint: None,
+                });
+            }
+            targets.push(Target::Volumetric)
+        }
+        None => {}
+    }
+    Ok(targets)
+}
+
+/// The `6 × N` sensitivity matrices of `points` (checked against the
+/// model's variables), flat, through the model's batch entry point (a
+/// compiled model's tape over blocks of points, a `machine!` type's batched
+/// kernels; the values of `sensitivity` point by point, to rounding).
+fn evaluate<M: ErrorModel + ?Sized>(
+    model: &M,
+    parameters: &[f64],
+    points: &[Arc<[f64]>],
+) -> Result<Vec<f64>, ReliabilityError> {
+    let n6 = 6 * model.errors().len();
+    let qs: Vec<f64> = points.iter().flat_map(|q| q.iter()).copied().collect();
+    let mut flat = vec![0.0; points.len() * n6];
+    if model
+        .sensitivity_points(&qs, parameters, &mut flat)
+        .is_err()
+    {
+        // The points were checked against the model's variables; a model
+        // whose lengths still disagree is evaluated point by point.
+        for (q, s) in points.iter().zip(flat.chunks_exact_mut(n6.max(1))) {
+            model.sensitivity(q, parameters, s);
+        }
+    }
+    if flat.iter().any(|v| !v.is_finite()) {
+        return Err(ReliabilityError::NonFinite("the model's sensitivities"));
+    }
+    Ok(flat)
+}
+
 /// The points of a grid in the model's variable order (first grid axis
 /// slowest); a model without variables has the one empty point.
-fn grid_points(grid: &Grid, variables: &[String]) -> Result<Vec<Vec<f64>>, ReliabilityError> {
+fn grid_points(grid: &Grid, variables: &[String]) -> Result<Vec<Arc<[f64]>>, ReliabilityError> {
     let mut axis_of = vec![None; variables.len()];
     for (a, (name, values)) in grid.axes.iter().enumerate() {
         let v = variables.iter().position(|x| x == name).ok_or_else(|| {
@@ -1234,7 +1384,8 @@ fn grid_points(grid: &Grid, variables: &[String]) -> Result<Vec<Vec<f64>>, Relia
             axis_of
                 .iter()
                 .map(|a| a.map_or(0.0, |a| grid.axes[a].1[idx[a]]))
-                .collect()
+                .collect::<Vec<f64>>()
+                .into()
         })
         .collect())
 }
@@ -1318,7 +1469,7 @@ mod tests {
         let grid = machine::study(&m, &model, &[], system).unwrap();
         // Every 7th grid point, in a shuffled order.
         let picked: Vec<usize> = (0..grid.points().len()).step_by(7).rev().collect();
-        let points = picked.iter().map(|&p| grid.points()[p].clone()).collect();
+        let points = picked.iter().map(|&p| grid.points()[p].to_vec()).collect();
         let spec = machine::spec(&m, system).unwrap();
         let inputs = machine::inputs(&m).unwrap();
         let at = Study::at_points(&model, &[], inputs, spec, points).unwrap();

@@ -164,6 +164,25 @@ impl Prepared {
         !matches!(self.algorithm.method, Method::Form | Method::Sorm)
     }
 
+    /// What the run's progress counts: the samples (with their total when
+    /// it is known in advance, [`Prepared::planned_samples`]), or for FORM
+    /// and SORM, which draw none, the cases.
+    pub fn progress_plan(&self) -> ProgressPlan {
+        if self.samples_anything() {
+            ProgressPlan {
+                total: self.planned_samples(),
+                verb: "sampling",
+                unit: "samples",
+            }
+        } else {
+            ProgressPlan {
+                total: Some(self.cases()),
+                verb: self.algorithm.method.title(),
+                unit: "cases",
+            }
+        }
+    }
+
     /// Runs the study (and the acceptance probability when asked),
     /// reporting the samples drawn to `progress`.
     pub fn run(self, progress: &dyn Progress) -> Result<ReliabilityRun, ReliabilityError> {
@@ -197,6 +216,17 @@ impl Prepared {
             notes,
         })
     }
+}
+
+/// What a run's progress counts ([`Prepared::progress_plan`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ProgressPlan {
+    /// The total, when it is known in advance.
+    pub total: Option<u64>,
+    /// What is being done (`sampling`, `FORM`).
+    pub verb: &'static str,
+    /// What is counted (`samples`, `cases`).
+    pub unit: &'static str,
 }
 
 /// The document of `chain reliability`: the study, its result, the

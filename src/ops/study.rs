@@ -4,10 +4,11 @@
 //! `allocate`, `acceptance`, `path` and Python's methods over them.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use chain_core::model::Sided;
 use chain_core::values::{Approach, ApproachError};
-use chain_core::{ErrorModel, Machine};
+use chain_core::{CompiledModel, Machine};
 use reliability::{
     Algorithm, Method, Posterior, PosteriorError, ReliabilityError, Study, StudyResult, System,
 };
@@ -84,10 +85,16 @@ impl From<PosteriorError> for StudyError {
 /// The study of `machine`'s reliability section (evaluated through
 /// `model`, compiled from it) with `options`; `file` names the machine
 /// file in messages.
-pub fn study<M: ErrorModel + ?Sized>(
+///
+/// The study keeps a copy of the model, not the sensitivities
+/// ([`Study::on_demand`]): every command over it uses each point's a few
+/// times at most, and a million-point grid then holds only its points
+/// (issue 36; the tape's blocks equal its points bit for bit, so the results
+/// are those of a study that keeps them).
+pub fn study(
     machine: &Machine,
     file: &str,
-    model: &M,
+    model: &CompiledModel,
     options: &StudyOptions<'_>,
 ) -> Result<Study, StudyError> {
     resolve::check_parameters(machine, options.params)?;
@@ -107,7 +114,7 @@ pub fn study<M: ErrorModel + ?Sized>(
         Some(p) => p.inputs(machine)?,
     };
     let parameters = reliability::machine::parameters(machine, options.params)?;
-    let study = Study::new(model, &parameters, inputs, spec)?;
+    let study = Study::on_demand(Arc::new(model.clone()), &parameters, inputs, spec)?;
     Ok(match options.posterior {
         Some(p) => p.apply(machine, study)?,
         None => study,

@@ -61,6 +61,7 @@ mod seed002_pose;
 mod seed004_model;
 mod sobol;
 mod sorm_cli;
+mod streamed;
 mod subset;
 mod values;
 mod wide_lines;

@@ -825,6 +825,71 @@ fn the_gantry_grinder_maps_like_its_numeric_product() {
     }
 }
 
+/// examples/values/gantry_grinder.yaml (the million-point map of
+/// docs/performance.md): its constants, read here line by line, times the
+/// numeric product's sensitivities.
+#[test]
+fn the_example_gantry_values_map_like_the_numeric_product() {
+    let m = load_example("gantry_grinder.yaml");
+    let file = example_file("values/gantry_grinder.yaml");
+    let text = std::fs::read_to_string(&file).unwrap();
+    let constants: HashMap<String, f64> = text
+        .lines()
+        .skip_while(|l| !l.starts_with("values:"))
+        .skip(1)
+        .filter(|l| !l.trim_start().starts_with('#'))
+        .map(|l| {
+            let (name, value) = l.trim().split_once(": ").unwrap();
+            (name.to_string(), value.parse::<f64>().unwrap())
+        })
+        .collect();
+    assert_eq!(constants.len(), 21);
+    let doc = ok_json(&[
+        "map",
+        "examples/machines/gantry_grinder.yaml",
+        "--values",
+        file.to_str().unwrap(),
+        "--grid",
+        "x=0:1000:3",
+        "--grid",
+        "y=-1500:1500:3",
+        "--grid",
+        "z=600:1400:3",
+        "--format",
+        "json",
+    ]);
+    let points = doc["points"].as_array().unwrap();
+    assert_eq!(points.len(), 27);
+    let exact = Exact::new(&m);
+    let n = m.errors.len();
+    // units: {linear: um, angular: urad}; the names starting with `d` are
+    // the translations.
+    let v: Vec<f64> = (m.errors.iter())
+        .map(|e| {
+            let value = constants[e.name.as_str()];
+            value * if e.name.starts_with('d') { 1e-3 } else { 1e-6 }
+        })
+        .collect();
+    let mut largest = 0.0f64;
+    for p in points {
+        let q = q_of(&m, &p["point"]);
+        let s = exact.fd_sensitivity(&q, &[], 1e-3);
+        let got = components(&p["error"]);
+        for c in 0..6 {
+            let expect: f64 = (0..n).map(|j| s[c * n + j] * v[j]).sum();
+            let mag: f64 = (0..n).map(|j| (s[c * n + j] * v[j]).abs()).sum();
+            assert!(
+                (got[c] - expect).abs() <= 1e-9 * mag + 1e-13,
+                "{c} at {q:?}: {} vs {expect}",
+                got[c]
+            );
+            largest = largest.max(expect.abs());
+        }
+    }
+    // Some tens of µm at the corners, as one-sigma errors over metres give.
+    assert!(largest > 0.01 && largest < 0.1, "{largest}");
+}
+
 // -------------------------------------------------------------------- plots
 
 #[test]

@@ -312,7 +312,7 @@ fn nonlinear_limit_states_importance_sampling_vs_ten_million_monte_carlo() {
     .expect("event");
     let mut rows = Vec::new();
     for c in [Component::Px, Component::Py, Component::Pz] {
-        rows.extend_from_slice(study.row(p, c));
+        rows.extend_from_slice(&study.row(p, c));
     }
     let series = Event::new(
         study.inputs(),

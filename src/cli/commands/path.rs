@@ -9,11 +9,13 @@ use crate::cli::plot::path as path_plot;
 use std::path::PathBuf;
 
 use chain::ops::path::{self, PathInput, PathOpsError, PathRequest};
+use reliability::Method;
 
 use crate::cli::args::parse_assignment;
 use crate::cli::args::{AlgorithmArgs, ModelArgs, SystemArgs};
 use crate::cli::csv_input::{numeric_rows, open_csv, read_poses};
 use crate::cli::loaded::Loaded;
+use crate::cli::progress::Progress;
 use crate::cli::report;
 
 /// Output formats of `chain path`.
@@ -107,7 +109,16 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
         algorithm: args.algorithm.options(),
         input,
     };
-    let doc = path::run(&loaded.machine, &request, &()).map_err(|e| match e {
+    // A counter of the cases (FORM, SORM) or samples done: the instants
+    // with axis values are known only once the path is solved.
+    let (verb, unit) = match request.algorithm.method {
+        Method::Form | Method::Sorm => (request.algorithm.method.title(), "cases"),
+        _ => ("sampling", "samples"),
+    };
+    let bar = Progress::new(args.format != PathFormat::Json, None, verb, unit);
+    let doc = path::run(&loaded.machine, &request, &|n| bar.inc(n));
+    bar.finish();
+    let doc = doc.map_err(|e| match e {
         PathOpsError::Reliability(e) => loaded.report(e),
         PathOpsError::Resolve(e) => miette::Report::new(e),
         PathOpsError::Option(e) => miette::Report::new(e),

@@ -101,10 +101,16 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     let prepared =
         reliability::prepare(&loaded.machine, loaded.file_name(), &request).map_err(refused)?;
     // A bar over the samples when their count is known in advance (the
-    // fixed-count samplers), else a counter (subset simulation, whose
-    // levels are found as it runs, and every sampler stopped by `--cov`).
-    let show = prepared.samples_anything() && args.format != ReliabilityFormat::Json;
-    let bar = Progress::new(show, prepared.planned_samples(), "sampling", "samples");
+    // fixed-count samplers) or over the cases (FORM, SORM), else a counter
+    // (subset simulation, whose levels are found as it runs, and every
+    // sampler stopped by `--cov`).
+    let plan = prepared.progress_plan();
+    let bar = Progress::new(
+        args.format != ReliabilityFormat::Json,
+        plan.total,
+        plan.verb,
+        plan.unit,
+    );
     let run = prepared.run(&|n| bar.inc(n));
     bar.finish();
     let run = run.map_err(|e| loaded.report(e))?;

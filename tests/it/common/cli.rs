@@ -29,6 +29,34 @@ pub fn chain(args: &[&str]) -> Output {
     command(args).output().expect("run chain")
 }
 
+/// Runs `chain args` with its output thrown away and returns its exit code
+/// and peak resident memory in bytes (its own `ru_maxrss`, from `wait4`).
+// The child is reaped by wait4 below, which std's `Child::wait` cannot
+// replace: it does not return the rusage.
+#[allow(clippy::zombie_processes)]
+pub fn peak_memory(args: &[&str]) -> (i32, u64) {
+    let child = command(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .expect("run chain");
+    let pid = child.id() as libc::pid_t;
+    let mut status = 0;
+    // SAFETY: an all-zero `rusage` is a valid value for wait4 to fill.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: `pid` is our own child, not yet waited for; both pointers
+    // are to live locals.
+    let waited = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    assert_eq!(waited, pid, "wait4 on chain");
+    let code = if libc::WIFEXITED(status) {
+        libc::WEXITSTATUS(status)
+    } else {
+        -1
+    };
+    // Linux reports ru_maxrss in kilobytes.
+    (code, usage.ru_maxrss as u64 * 1024)
+}
+
 /// Runs `chain args` with `input` on its stdin.
 pub fn chain_stdin(args: &[&str], input: &[u8]) -> Output {
     let mut child = command(args)

@@ -1,0 +1,200 @@
+//! Issue 36, point 1: a study that keeps the model instead of every point's
+//! sensitivities (`Study::on_demand`, what every study command builds) gives
+//! the results of one that keeps them (`Study::new`) bit for bit, on every
+//! example machine with a reliability section and on a grid larger than one
+//! block of cases.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use chain_core::{CompiledModel, Machine};
+use common::example_file;
+use reliability::{
+    machine, Algorithm, DirectionalSimulation, Form, ImportanceSampling, MonteCarlo, Sobol, Study,
+    StudySpec, SubsetSimulation, System,
+};
+
+use crate::common;
+use reliability::sorm::Sorm;
+
+/// Every example machine with a reliability section and statistics for
+/// all its errors.
+fn machines() -> Vec<(PathBuf, Machine)> {
+    let dir = example_file("machines");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("examples/machines exists")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
+        .collect();
+    files.sort();
+    files
+        .into_iter()
+        .filter_map(|f| {
+            let m = chain_core::load_file(&f).expect("example loads");
+            let ready = m.reliability.is_some() && machine::inputs(&m).is_ok();
+            ready.then_some((f, m))
+        })
+        .collect()
+}
+
+/// The study that keeps its sensitivities and the one that evaluates them
+/// when asked, over `spec`.
+fn both(machine: &Machine, model: &CompiledModel, spec: StudySpec) -> (Study, Study) {
+    let inputs = machine::inputs(machine).expect("inputs");
+    let params = machine::parameters(machine, &[]).expect("parameters");
+    let kept = Study::new(model, &params, inputs.clone(), spec.clone()).expect("kept study");
+    let shared = Arc::new(model.clone());
+    let lazy = Study::on_demand(shared, &params, inputs, spec).expect("on-demand study");
+    (kept, lazy)
+}
+
+#[test]
+fn on_demand_studies_equal_kept_ones_on_every_example_machine() {
+    let found = machines();
+    assert!(found.len() >= 3, "expected the paper machines: {found:?}");
+    let algorithms = [
+        Algorithm::Form(Form::default()),
+        Algorithm::Sorm(Sorm::default()),
+        Algorithm::ImportanceSampling(ImportanceSampling {
+            samples: 200,
+            seed: 3,
+            form: Form::default(),
+            cov: None,
+        }),
+        Algorithm::MonteCarlo(MonteCarlo {
+            samples: 300,
+            seed: 5,
+            cov: None,
+        }),
+        Algorithm::Directional(DirectionalSimulation {
+            samples: 50,
+            seed: 7,
+            cov: None,
+        }),
+        Algorithm::Subset(SubsetSimulation::new(100, 11)),
+    ];
+    for (file, m) in &found {
+        let model = chain_core::compile(m);
+        for system in [None, Some(System::Series)] {
+            let spec = machine::spec(m, system).expect("spec");
+            let (kept, lazy) = both(m, &model, spec);
+            assert_eq!(kept.points(), lazy.points(), "{}", file.display());
+            for p in 0..kept.points().len() {
+                assert_eq!(kept.moments(p), lazy.moments(p), "{}", file.display());
+            }
+            for a in &algorithms {
+                let k = kept.run(a, &()).expect("kept run");
+                let l = lazy.run(a, &()).expect("on-demand run");
+                assert_eq!(k, l, "{} with {:?}", file.display(), a.method());
+            }
+            let form = Form::default();
+            assert_eq!(
+                kept.sensitivity_mean(&form).expect("kept sensitivities"),
+                lazy.sensitivity_mean(&form)
+                    .expect("on-demand sensitivities"),
+                "{}",
+                file.display()
+            );
+            let sobol = Sobol {
+                samples: 256,
+                seed: 1,
+                bootstrap: 20,
+                confidence: 0.9,
+            };
+            assert_eq!(
+                sobol.run_study(&kept).expect("kept Sobol"),
+                sobol.run_study(&lazy).expect("on-demand Sobol"),
+                "{}",
+                file.display()
+            );
+        }
+    }
+}
+
+#[test]
+fn on_demand_form_equals_kept_across_case_blocks() {
+    // 17 × 17 × 17 = 4913 points: more than one block of 4096 cases per
+    // target, and blocks that straddle two targets.
+    let file = example_file("machines/gantry_grinder.yaml");
+    let m = chain_core::load_file(&file).expect("gantry loads");
+    let model = chain_core::compile(&m);
+    let mut spec = machine::spec(&m, Some(System::Series)).expect("spec");
+    for (_, values) in &mut spec.grid.axes {
+        let (lo, hi) = (values[0], values[values.len() - 1]);
+        *values = (0..17).map(|i| lo + (hi - lo) * i as f64 / 16.0).collect();
+    }
+    let (kept, lazy) = both(&m, &model, spec);
+    assert_eq!(kept.points().len(), 4913);
+    let form = Algorithm::Form(Form::default());
+    let k = kept.run(&form, &()).expect("kept FORM");
+    let l = lazy.run(&form, &()).expect("on-demand FORM");
+    assert_eq!(k.cases.len(), 4 * 4913);
+    assert_eq!(k, l);
+}
+
+/// A gibibyte, the bound of issue 36, point 1.
+const GIB: u64 = 1 << 30;
+
+/// The million-point runs of docs/performance.md under 1 GiB each (`map`
+/// and FORM `reliability` over a 100³ grid of the gantry grinder, every
+/// output format). Ignored in the test command (about a minute on two
+/// cores); `cargo test --profile ci --test it -- --ignored million` runs it,
+/// `scripts/peak_memory.sh` prints the figures.
+#[test]
+#[ignore]
+fn a_million_point_map_and_reliability_stay_under_a_gibibyte() {
+    let grid = [
+        "--grid",
+        "x=0:1000:100",
+        "--grid",
+        "y=-1500:1500:100",
+        "--grid",
+        "z=600:1400:100",
+    ];
+    let gantry = "examples/machines/gantry_grinder.yaml";
+    let values = "examples/values/gantry_grinder.yaml";
+    for format in ["table", "csv", "json"] {
+        for command in ["map", "reliability"] {
+            let mut args = vec![command, gantry];
+            if command == "map" {
+                args.extend(["--values", values]);
+            }
+            args.extend(grid);
+            args.extend(["--format", format]);
+            let (code, peak) = common::cli::peak_memory(&args);
+            assert_eq!(code, 0, "{args:?}");
+            eprintln!("{command} --format {format}: {} MB", peak >> 20);
+            assert!(peak < GIB, "{args:?}: {} MB", peak >> 20);
+        }
+    }
+}
+
+/// FORM and SORM, which draw no samples, tell the progress sink of their
+/// cases, a block at a time, so that `chain reliability` and `chain path`
+/// can show how far a large grid has come.
+#[test]
+fn form_and_sorm_report_every_case_to_the_progress_sink() {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    let file = example_file("machines/gantry_grinder.yaml");
+    let m = chain_core::load_file(&file).expect("gantry loads");
+    let model = chain_core::compile(&m);
+    let mut spec = machine::spec(&m, None).expect("spec");
+    spec.grid.axes[0].1 = (0..400).map(f64::from).collect();
+    let (_, lazy) = both(&m, &model, spec);
+    let cases = 3 * 400 * 25;
+    for algorithm in [
+        Algorithm::Form(Form::default()),
+        Algorithm::Sorm(Sorm::default()),
+    ] {
+        let done = AtomicU64::new(0);
+        let calls = AtomicU64::new(0);
+        let progress = |n: u64| {
+            done.fetch_add(n, Ordering::Relaxed);
+            calls.fetch_add(1, Ordering::Relaxed);
+        };
+        lazy.run(&algorithm, &progress).expect("run");
+        assert_eq!(done.into_inner(), cases);
+        // 30,000 cases in blocks of 4,096.
+        assert_eq!(calls.into_inner(), 8);
+    }
+}
