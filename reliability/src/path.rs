@@ -7,7 +7,7 @@
 //!
 //! - the nominal tool point `T_wt(q, 0)·tool_point`;
 //! - the mean and covariance of the six error components, propagated exactly
-//!   through the linear model `E = S(q)·e` ([`ErrorMoments`]), and the mean
+//!   through the linear model `E = S(q)·e` ([`ErrorMoments`](crate::ErrorMoments)), and the mean
 //!   and standard deviation of the volumetric position error `|p|`
 //!   ([`VolumetricMoments`]);
 //! - the reliability of every target, through [`Study::at_points`] (the same
@@ -24,9 +24,10 @@ use serde::Serialize;
 
 use crate::error::ReliabilityError;
 use crate::inputs::Inputs;
+use crate::par::prelude::*;
 use crate::simulation::Progress;
 use crate::study::{
-    Algorithm, CaseResult, ErrorMoments, Method, Study, StudyResult, StudySpec, System, Target,
+    Algorithm, CaseResult, Method, SharedModel, Study, StudyResult, StudySpec, System, Target,
     VolumetricMoments,
 };
 
@@ -90,19 +91,25 @@ impl Serialize for Quantity {
 pub struct InstantResult {
     /// `T_wt(q, 0)·tool_point` (a negative zero is written as 0).
     pub nominal: [f64; 3],
-    /// Mean and covariance of the six components.
-    pub moments: ErrorMoments,
+    /// The means of the six components (`px, py, pz, ox, oy, oz`), from
+    /// their exact moments ([`Study::moments`], which also has the
+    /// covariance this record does not keep).
+    pub component_mean: [f64; 6],
+    /// Their standard deviations.
+    pub component_std: [f64; 6],
     /// Mean and standard deviation of `|p|`.
     pub volumetric: VolumetricMoments,
-    /// One case per target, in [`PathResult::targets`] order.
-    pub cases: Vec<CaseResult>,
+    /// The instant's place among the evaluated ones: its cases (one per
+    /// target) are [`PathResult::cases_of`], kept once in
+    /// [`PathResult::study`] rather than copied here.
+    pub evaluated: usize,
 }
 
 impl InstantResult {
     /// The mean of a quantity (`E[E_c]`, or `E|p|`).
     pub fn mean(&self, q: Quantity) -> f64 {
         match q {
-            Quantity::Component(c) => self.moments.mean[c.index()],
+            Quantity::Component(c) => self.component_mean[c.index()],
             Quantity::Volumetric => self.volumetric.mean,
         }
     }
@@ -110,7 +117,7 @@ impl InstantResult {
     /// The standard deviation of a quantity.
     pub fn std(&self, q: Quantity) -> f64 {
         match q {
-            Quantity::Component(c) => self.moments.std(c),
+            Quantity::Component(c) => self.component_std[c.index()],
             Quantity::Volumetric => self.volumetric.std,
         }
     }
@@ -166,8 +173,8 @@ pub struct PathResult {
     pub targets: Vec<PathTarget>,
     /// One record per instant, in input order.
     pub records: Vec<PathRecord>,
-    /// The engine's result over the evaluated instants (`None` when no
-    /// instant has axis values).
+    /// The engine's result over the evaluated instants, every case
+    /// target-major (`None` when no instant has axis values).
     pub study: Option<StudyResult>,
 }
 
@@ -219,14 +226,34 @@ impl PathResult {
         self.arg_max(|e| e.std(q))
     }
 
+    /// The case of target `t` (its index in [`PathResult::targets`]) at an
+    /// evaluated instant.
+    pub fn case(&self, e: &InstantResult, t: usize) -> &CaseResult {
+        let r = self
+            .study
+            .as_ref()
+            .expect("an evaluated instant has a study result");
+        let np = r.cases.len() / self.targets.len().max(1);
+        &r.cases[t * np + e.evaluated]
+    }
+
+    /// The cases of an evaluated instant, one per target in
+    /// [`PathResult::targets`] order.
+    pub fn cases_of<'a>(
+        &'a self,
+        e: &'a InstantResult,
+    ) -> impl ExactSizeIterator<Item = &'a CaseResult> + Clone + 'a {
+        (0..self.targets.len()).map(move |t| self.case(e, t))
+    }
+
     /// The reliability of target `t` (its index in [`PathResult::targets`])
     /// over the evaluated instants.
     pub fn summary(&self, t: usize) -> Option<TargetSummary> {
-        let worst = self.arg_max(|e| -e.cases[t].reliability)?;
+        let worst = self.arg_max(|e| -self.case(e, t).reliability)?;
         let values: Vec<f64> = self
             .records
             .iter()
-            .filter_map(|r| r.result.as_ref().map(|e| e.cases[t].reliability))
+            .filter_map(|r| r.result.as_ref().map(|e| self.case(e, t).reliability))
             .collect();
         Some(TargetSummary {
             min: Extreme {
@@ -242,12 +269,12 @@ impl PathResult {
         })
     }
 
-    /// Every case of every evaluated instant.
+    /// Every case of every evaluated instant (instant by instant).
     pub fn cases(&self) -> impl Iterator<Item = &CaseResult> + Clone {
         self.records
             .iter()
             .filter_map(|r| r.result.as_ref())
-            .flat_map(|e| &e.cases)
+            .flat_map(|e| self.cases_of(e))
     }
 }
 
@@ -264,7 +291,8 @@ pub struct PathStudy {
 }
 
 impl PathStudy {
-    /// Evaluates the model's sensitivities at every instant with axis values.
+    /// Evaluates the model's sensitivities at every instant with axis values
+    /// and keeps them.
     ///
     /// `parameters`, `inputs` and `spec` are as in [`Study::new`] (`spec.grid`
     /// is not used). An instant without axis values is kept and reported
@@ -276,6 +304,45 @@ impl PathStudy {
         inputs: Inputs,
         spec: StudySpec,
         instants: Vec<PathInstant>,
+    ) -> Result<PathStudy, ReliabilityError> {
+        PathStudy::build(
+            model,
+            instants,
+            spec,
+            |spec, points| Study::at_points(model, parameters, inputs, spec, points),
+            parameters,
+        )
+    }
+
+    /// [`PathStudy::new`] over a study that keeps the model instead of the
+    /// sensitivities ([`Study::at_points_on_demand`]): what `chain path`
+    /// builds, so that a path of a million instants holds no `6 × N` matrix
+    /// per instant. The results are [`PathStudy::new`]'s.
+    pub fn on_demand(
+        model: SharedModel,
+        parameters: &[f64],
+        inputs: Inputs,
+        spec: StudySpec,
+        instants: Vec<PathInstant>,
+    ) -> Result<PathStudy, ReliabilityError> {
+        let shared = model.clone();
+        PathStudy::build(
+            &*model,
+            instants,
+            spec,
+            |spec, points| Study::at_points_on_demand(shared, parameters, inputs, spec, points),
+            parameters,
+        )
+    }
+
+    /// The shared part of the constructors: the nominal points and the
+    /// study `study(spec, points)` of the instants with axis values.
+    fn build<M: ErrorModel + ?Sized>(
+        model: &M,
+        instants: Vec<PathInstant>,
+        spec: StudySpec,
+        study: impl FnOnce(StudySpec, Vec<Vec<f64>>) -> Result<Study, ReliabilityError>,
+        parameters: &[f64],
     ) -> Result<PathStudy, ReliabilityError> {
         let points: Vec<Vec<f64>> = instants.iter().filter_map(|i| i.axes.clone()).collect();
         let sided = spec.sided;
@@ -292,7 +359,7 @@ impl PathStudy {
             .iter()
             .map(|q| model.nominal(q, parameters).position.map(|x| x + 0.0))
             .collect();
-        let study = Study::at_points(model, parameters, inputs, spec, points)?;
+        let study = study(spec, points)?;
         let targets = study
             .targets()
             .iter()
@@ -335,31 +402,41 @@ impl PathStudy {
             Some(study) => Some(study.run(algorithm, progress)?),
             None => None,
         };
+        // The moments of the evaluated instants, a block at a time in
+        // parallel (in instant order whatever the threads).
         let mut records = Vec::with_capacity(self.instants.len());
         let mut k = 0;
-        for instant in &self.instants {
-            let result = match (&self.study, &study_result, &instant.axes) {
-                (Some(study), Some(r), Some(_)) => {
-                    let np = study.points().len();
-                    let moments = study.moments(k);
-                    let cases = (0..self.targets.len())
-                        .map(|t| r.cases[t * np + k].clone())
-                        .collect();
-                    let e = InstantResult {
-                        nominal: self.nominal[k],
-                        volumetric: moments.volumetric(),
-                        moments,
-                        cases,
-                    };
-                    k += 1;
-                    Some(e)
-                }
-                _ => None,
-            };
-            records.push(PathRecord {
-                instant: instant.clone(),
-                result,
-            });
+        for block in self.instants.chunks(MOMENT_BLOCK) {
+            let from = k;
+            let to = from + block.iter().filter(|i| i.axes.is_some()).count();
+            k = to;
+            let mut results = match (&self.study, &study_result) {
+                (Some(study), Some(_)) => (from..to)
+                    .into_par_iter()
+                    .map(|k| {
+                        let moments = study.moments(k);
+                        InstantResult {
+                            nominal: self.nominal[k],
+                            component_mean: moments.mean,
+                            component_std: Component::ALL.map(|c| moments.std(c)),
+                            volumetric: moments.volumetric(),
+                            evaluated: k,
+                        }
+                    })
+                    .collect(),
+                _ => Vec::new(),
+            }
+            .into_iter();
+            for instant in block {
+                let result = match instant.axes {
+                    Some(_) => results.next(),
+                    None => None,
+                };
+                records.push(PathRecord {
+                    instant: instant.clone(),
+                    result,
+                });
+            }
         }
         Ok(PathResult {
             method: algorithm.method(),
@@ -370,6 +447,9 @@ impl PathStudy {
         })
     }
 }
+
+/// The instants whose moments are computed at a time ([`PathStudy::run`]).
+const MOMENT_BLOCK: usize = 4096;
 
 /// The targets a study of this spec would have, with their tolerances.
 fn spec_targets(spec: &StudySpec) -> Vec<PathTarget> {
@@ -450,7 +530,9 @@ mod tests {
         let (means, stds) = (inputs.means().to_vec(), inputs.stds().to_vec());
         for (k, rec) in [&r.records[0], &r.records[2]].into_iter().enumerate() {
             let e = rec.result.as_ref().unwrap();
-            for (t, c) in e.cases.iter().enumerate() {
+            let moments = path.study().unwrap().moments(k);
+            assert_eq!(r.cases_of(e).len(), 4);
+            for (t, c) in r.cases_of(e).enumerate() {
                 assert_eq!(c, &direct.cases[t * 2 + k]);
             }
             // Independent propagation: S from the model, then S·μ and S·Σ·Sᵀ.
@@ -462,7 +544,7 @@ mod tests {
                 let mean: f64 = (0..n)
                     .map(|i| ra[i] * means[inputs.index(names[i]).unwrap()])
                     .sum();
-                assert!((e.moments.mean[a] - mean).abs() <= 1e-15 + 1e-12 * mean.abs());
+                assert!((e.component_mean[a] - mean).abs() <= 1e-15 + 1e-12 * mean.abs());
                 for b in 0..6 {
                     let rb = &s[b * n..(b + 1) * n];
                     let cov: f64 = (0..n)
@@ -471,17 +553,21 @@ mod tests {
                             ra[i] * rb[i] * sd * sd
                         })
                         .sum();
-                    let got = e.moments.covariance[a][b];
+                    let got = moments.covariance[a][b];
                     assert!(
                         (got - cov).abs() <= 1e-12 * cov.abs().max(1e-20),
                         "{got} {cov}"
                     );
                 }
             }
+            for c in Component::ALL {
+                assert_eq!(e.component_std[c.index()], moments.std(c));
+                assert!(e.component_std[c.index()] > 0.0 || c.index() >= 3);
+            }
             assert!(e.mean(Quantity::Component(Component::Px)).abs() > 1e-3);
             assert_eq!(
                 e.std(Quantity::Volumetric),
-                e.moments.volumetric().std,
+                moments.volumetric().std,
                 "|p| moments"
             );
             let pose = model.nominal(&points[k], &[]);
@@ -489,7 +575,7 @@ mod tests {
         }
         // Extremes point at records, not at evaluated indices.
         let worst = r.summary(0).unwrap();
-        let rel = |k: usize| r.records[k].result.as_ref().unwrap().cases[0].reliability;
+        let rel = |k: usize| r.case(r.records[k].result.as_ref().unwrap(), 0).reliability;
         assert_eq!(worst.min.value, rel(0).min(rel(2)));
         assert!(worst.min.record == 0 || worst.min.record == 2);
         assert!((worst.mean - 0.5 * (rel(0) + rel(2))).abs() < 1e-15);

@@ -589,6 +589,20 @@ impl Study {
         let (inputs, variables) = checked_inputs(&*model, parameters, inputs)?;
         let points = grid_points(&spec.grid, &variables)?;
         let targets = targets(&spec)?;
+        Study::lazy(model, parameters, inputs, variables, spec, points, targets)
+    }
+
+    /// The study of checked points that evaluates `model` when asked, after
+    /// checking every point's sensitivities finite a block at a time.
+    fn lazy(
+        model: SharedModel,
+        parameters: &[f64],
+        inputs: Inputs,
+        variables: Vec<String>,
+        spec: StudySpec,
+        points: Vec<Arc<[f64]>>,
+        targets: Vec<Target>,
+    ) -> Result<Study, ReliabilityError> {
         for block in points.chunks(CASE_BLOCK) {
             evaluate(&*model, parameters, block)?;
         }
@@ -617,31 +631,25 @@ impl Study {
         points: Vec<Vec<f64>>,
     ) -> Result<Study, ReliabilityError> {
         let (inputs, variables) = checked_inputs(model, parameters, inputs)?;
-        if points.is_empty() {
-            return Err(ReliabilityError::EmptyGrid("no point is given".into()));
-        }
-        for q in &points {
-            if q.len() != variables.len() {
-                return Err(ReliabilityError::Dimension {
-                    what: "point coordinates",
-                    expected: variables.len(),
-                    found: q.len(),
-                });
-            }
-            if q.iter().any(|x| !x.is_finite()) {
-                return Err(ReliabilityError::NonFinite("the points"));
-            }
-        }
-        let spec = StudySpec {
-            grid: Grid { axes: Vec::new() },
-            ..spec
-        };
-        let targets = targets(&spec)?;
-        let points: Vec<Arc<[f64]>> = points.into_iter().map(Arc::from).collect();
+        let (spec, points, targets) = listed_points(spec, points, &variables)?;
         let rows = Rows::Stored(evaluate(model, parameters, &points)?);
         Ok(Study::assemble(
             inputs, variables, spec, points, rows, targets,
         ))
+    }
+
+    /// [`Study::at_points`] keeping the model instead of the sensitivities,
+    /// as [`Study::on_demand`] does for a grid.
+    pub fn at_points_on_demand(
+        model: SharedModel,
+        parameters: &[f64],
+        inputs: Inputs,
+        spec: StudySpec,
+        points: Vec<Vec<f64>>,
+    ) -> Result<Study, ReliabilityError> {
+        let (inputs, variables) = checked_inputs(&*model, parameters, inputs)?;
+        let (spec, points, targets) = listed_points(spec, points, &variables)?;
+        Study::lazy(model, parameters, inputs, variables, spec, points, targets)
     }
 
     /// The shared part of the constructors, after their checks.
@@ -1277,6 +1285,38 @@ fn checked_inputs<M: ErrorModel + ?Sized>(
     let inputs = inputs.select(&order)?;
     let variables = model.variables().iter().map(|v| v.to_string()).collect();
     Ok((inputs, variables))
+}
+
+/// An explicit list of points checked against the model's variables (none
+/// empty, each of the model's length, finite), with the spec (its grid
+/// emptied) and its targets.
+#[allow(clippy::type_complexity)]
+fn listed_points(
+    spec: StudySpec,
+    points: Vec<Vec<f64>>,
+    variables: &[String],
+) -> Result<(StudySpec, Vec<Arc<[f64]>>, Vec<Target>), ReliabilityError> {
+    if points.is_empty() {
+        return Err(ReliabilityError::EmptyGrid("no point is given".into()));
+    }
+    for q in &points {
+        if q.len() != variables.len() {
+            return Err(ReliabilityError::Dimension {
+                what: "point coordinates",
+                expected: variables.len(),
+                found: q.len(),
+            });
+        }
+        if q.iter().any(|x| !x.is_finite()) {
+            return Err(ReliabilityError::NonFinite("the points"));
+        }
+    }
+    let spec = StudySpec {
+        grid: Grid { axes: Vec::new() },
+        ..spec
+    };
+    let targets = targets(&spec)?;
+    Ok((spec, points.into_iter().map(Arc::from).collect(), targets))
 }
 
 /// The targets of `spec` in case order (its toleranced components, then its

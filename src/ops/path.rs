@@ -9,6 +9,8 @@
 //! Python from arrays; both build a [`PathRequest`] and get the same
 //! [`PathDocument`].
 
+use std::sync::Arc;
+
 use chain_core::inverse::Status;
 use chain_core::model::Sided;
 use chain_core::named::NameMap;
@@ -164,8 +166,10 @@ pub fn run(
             (has_t, instants)
         }
     };
-    let model = chain_core::compile(m);
-    let path = PathStudy::new(&model, &params, inputs, spec, instants)?;
+    // The study keeps the model, not every instant's sensitivities
+    // (issue 36): a path of a million instants holds its points only.
+    let model = Arc::new(chain_core::compile(m));
+    let path = PathStudy::on_demand(model, &params, inputs, spec, instants)?;
     let mut notes = Vec::new();
     match path.study() {
         None => notes
@@ -259,8 +263,19 @@ struct PathJson<'a> {
     sided: Sided,
     tolerances: NameMap<Target, f64>,
     variables: &'a [String],
-    instants: Vec<InstantJson<'a>>,
+    instants: InstantsJson<'a>,
     summary: SummaryJson,
+}
+
+/// The instants of [`PathJson`], each object formed as it is written (a
+/// million instants are not a second list in memory; issue 36).
+struct InstantsJson<'a>(&'a PathDocument);
+
+impl Serialize for InstantsJson<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let doc = self.0;
+        serializer.collect_seq(doc.result.records.iter().map(|rec| doc.instant_json(rec)))
+    }
 }
 
 /// One instant of [`PathJson`]; the results are `null` for an instant
@@ -357,41 +372,41 @@ impl Serialize for PathDocument {
 }
 
 impl PathDocument {
+    /// The JSON object of one instant.
+    fn instant_json<'a>(&'a self, rec: &'a reliability::PathRecord) -> InstantJson<'a> {
+        let r = &self.result;
+        let i = &rec.instant;
+        let e = rec.result.as_ref();
+        let moments = |pick: fn(&InstantResult, Quantity) -> f64| {
+            e.map(|e| NameMap(Quantity::ALL.iter().map(|&q| (q, pick(e, q))).collect()))
+        };
+        InstantJson {
+            row: i.row,
+            t: i.t,
+            axes: i.axes.as_ref().map(|q| {
+                NameMap::zip(self.variables.iter().map(String::as_str), q.iter().copied())
+            }),
+            status: i.status,
+            nominal: e.map(|e| e.nominal),
+            mean: moments(InstantResult::mean),
+            std: moments(InstantResult::std),
+            reliability: e.map(|e| self.per_target(r.cases_of(e).map(|c| c.reliability))),
+            std_error: e.and_then(|e| {
+                let se: Option<Vec<f64>> = r.cases_of(e).map(|c| c.std_error).collect();
+                se.map(|se| self.per_target(se.into_iter()))
+            }),
+            cases: e.map(|e| {
+                self.per_target(r.cases_of(e).map(|c| CaseJson {
+                    form: c.form,
+                    calls: c.calls,
+                }))
+            }),
+        }
+    }
+
     fn json(&self) -> PathJson<'_> {
         let r = &self.result;
-        let instants = r
-            .records
-            .iter()
-            .map(|rec| {
-                let i = &rec.instant;
-                let e = rec.result.as_ref();
-                let moments = |pick: fn(&InstantResult, Quantity) -> f64| {
-                    e.map(|e| NameMap(Quantity::ALL.iter().map(|&q| (q, pick(e, q))).collect()))
-                };
-                InstantJson {
-                    row: i.row,
-                    t: i.t,
-                    axes: i.axes.as_ref().map(|q| {
-                        NameMap::zip(self.variables.iter().map(String::as_str), q.iter().copied())
-                    }),
-                    status: i.status,
-                    nominal: e.map(|e| e.nominal),
-                    mean: moments(InstantResult::mean),
-                    std: moments(InstantResult::std),
-                    reliability: e.map(|e| self.per_target(e.cases.iter().map(|c| c.reliability))),
-                    std_error: e.and_then(|e| {
-                        let se: Option<Vec<f64>> = e.cases.iter().map(|c| c.std_error).collect();
-                        se.map(|se| self.per_target(se.into_iter()))
-                    }),
-                    cases: e.map(|e| {
-                        self.per_target(e.cases.iter().map(|c| CaseJson {
-                            form: c.form,
-                            calls: c.calls,
-                        }))
-                    }),
-                }
-            })
-            .collect();
+        let instants = InstantsJson(self);
         let reliability = self.per_target((0..r.targets.len()).map(|t| {
             r.summary(t).map(|s| TargetJson {
                 min: s.min.value,

@@ -198,3 +198,52 @@ fn form_and_sorm_report_every_case_to_the_progress_sink() {
         assert_eq!(calls.into_inner(), 8);
     }
 }
+
+/// `chain path`'s study (`PathStudy::on_demand`) gives the records of one
+/// that keeps the sensitivities (`PathStudy::new`) bit for bit, with an
+/// instant without axis values among them, for FORM and a sampler.
+#[test]
+fn on_demand_paths_equal_kept_ones() {
+    use chain_core::inverse::Status;
+    use reliability::{PathInstant, PathStudy};
+    let file = example_file("machines/gantry_grinder.yaml");
+    let m = chain_core::load_file(&file).expect("gantry loads");
+    let model = chain_core::compile(&m);
+    let spec = machine::spec(&m, Some(System::Volumetric { tolerance: 0.04 })).expect("spec");
+    let inputs = machine::inputs(&m).expect("inputs");
+    // 5,000 instants along a diagonal (x, z, y: the model's order), the
+    // 7th unreachable.
+    let instants: Vec<PathInstant> = (0..5000)
+        .map(|k| {
+            let s = k as f64 / 4999.0;
+            let reachable = k != 6;
+            PathInstant {
+                row: k + 1,
+                t: 0.01 * k as f64,
+                status: if reachable {
+                    Status::Ok
+                } else {
+                    Status::Unreachable
+                },
+                axes: reachable.then(|| vec![1000.0 * s, 600.0 + 800.0 * s, -1500.0 + 3000.0 * s]),
+            }
+        })
+        .collect();
+    let kept = PathStudy::new(&model, &[], inputs.clone(), spec.clone(), instants.clone())
+        .expect("kept path");
+    let lazy = PathStudy::on_demand(Arc::new(model.clone()), &[], inputs, spec, instants)
+        .expect("on-demand path");
+    for algorithm in [
+        Algorithm::Form(Form::default()),
+        Algorithm::MonteCarlo(MonteCarlo {
+            samples: 100,
+            seed: 2,
+            cov: None,
+        }),
+    ] {
+        let k = kept.run(&algorithm, &()).expect("kept run");
+        let l = lazy.run(&algorithm, &()).expect("on-demand run");
+        assert_eq!(k.evaluated(), 4999);
+        assert_eq!(k, l);
+    }
+}

@@ -36,7 +36,7 @@ pub(crate) fn write_all(dir: &Path, doc: &PathDocument) -> miette::Result<Vec<Pa
             .iter()
             .filter_map(|rec| {
                 let e = rec.result.as_ref()?;
-                Some((rec.instant.t, 100.0 * e.cases[t].reliability))
+                Some((rec.instant.t, 100.0 * r.case(e, t).reliability))
             })
             .collect();
         chart = chart.series(Series::line_points(target.target.name(), points));

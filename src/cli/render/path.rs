@@ -50,11 +50,10 @@ impl Report for PathDocument {
                 row.extend(e.nominal.iter().map(|x| format!("{x:?}")));
                 row.extend(Quantity::ALL.iter().map(|&q| format!("{:?}", e.mean(q))));
                 row.extend(Quantity::ALL.iter().map(|&q| format!("{:?}", e.std(q))));
-                row.extend(e.cases.iter().map(|c| format!("{:?}", c.reliability)));
+                row.extend(r.cases_of(e).map(|c| format!("{:?}", c.reliability)));
                 if sampled {
-                    match e
-                        .cases
-                        .iter()
+                    match r
+                        .cases_of(e)
                         .map(|c| c.std_error)
                         .collect::<Option<Vec<_>>>()
                     {
@@ -63,15 +62,14 @@ impl Report for PathDocument {
                     }
                 }
                 let form = |f: fn(&FormCase) -> String| {
-                    e.cases
-                        .iter()
+                    r.cases_of(e)
                         .map(move |c| c.form.as_ref().map(f).unwrap_or_default())
                 };
                 row.extend(form(|f| f.termination.to_string()));
                 row.extend(form(|f| f.converged.to_string()));
                 row.extend(form(|f| f.iterations.to_string()));
-                row.extend(e.cases.iter().map(|c| c.calls.values.to_string()));
-                row.extend(e.cases.iter().map(|c| c.calls.gradients.to_string()));
+                row.extend(r.cases_of(e).map(|c| c.calls.values.to_string()));
+                row.extend(r.cases_of(e).map(|c| c.calls.gradients.to_string()));
             }
             row.resize(width, String::new());
             out.row(row);
@@ -188,7 +186,7 @@ fn to_table(doc: &PathDocument) -> String {
         let t = if doc.has_t { num(i.t) } else { String::new() };
         let _ = write!(out, "{:>5} {t:>10}", i.row);
         match &rec.result {
-            Some(e) => e.cases.iter().for_each(|c| {
+            Some(e) => r.cases_of(e).for_each(|c| {
                 let _ = write!(out, " {:>10.3}", 100.0 * c.reliability);
                 if !c.converged() {
                     bad.push(format!("{} at {}", c.target, at_text(i, doc.has_t)));
