@@ -622,6 +622,23 @@ pub fn describe<'e>(err: &'e ReliabilityError, file: &str) -> Described<'e> {
             "",
             format!("add `{v}: [...]` to reliability.grid, or pass --grid {v}=VALUE"),
         ),
+        ReliabilityError::GridTooLarge {
+            points,
+            limit,
+            strategy,
+            why,
+            origin,
+        } => (
+            format!(
+                "{file}{}: key `reliability.grid`: the grid has {points} points; {strategy} runs on at most {limit} ({why})",
+                at(origin)
+            ),
+            Some(origin),
+            "the grid of this section",
+            format!(
+                "allocate on a coarser grid (a copy of the file with at most {limit} grid points), then check the allocated standard deviations on this grid: put them in `statistics` and run `chain reliability`"
+            ),
+        ),
         other => (format!("{file}: {other}"), None, "", String::new()),
     };
     Described {

@@ -89,6 +89,26 @@ pub enum ReliabilityError {
     #[error("the reliability grid is empty: {0}")]
     #[cfg_attr(feature = "miette", diagnostic(code(chain::reliability::empty_grid)))]
     EmptyGrid(String),
+    /// The reliability grid has more points than an allocation strategy can
+    /// run on within minutes ([`crate::allocate::check_grid`]); refused
+    /// before anything is derived.
+    #[error("the reliability grid has {points} points; {strategy} runs on at most {limit}")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::reliability::grid_too_large))
+    )]
+    GridTooLarge {
+        /// The grid's points.
+        points: usize,
+        /// The strategy's limit.
+        limit: usize,
+        /// The strategy (`the least-cost allocation`, ...).
+        strategy: &'static str,
+        /// Why it has a limit.
+        why: &'static str,
+        /// The reliability section.
+        origin: Origin,
+    },
     /// A point misses a value for an axis variable.
     #[error("no value for axis variable `{0}`")]
     #[cfg_attr(

@@ -8,7 +8,7 @@
 use chain_core::model::Sided;
 use chain_core::{CompiledModel, Machine};
 use reliability::allocate::{
-    self, AcceptanceStrategy, AllocateError, Allocation, ErrorBounds, Paper, StrategyName,
+    self, AcceptanceStrategy, AllocateError, Allocation, ErrorBounds, GridUse, Paper, StrategyName,
 };
 use reliability::document::AllocationDocument;
 use reliability::{ReliabilityError, Study};
@@ -227,6 +227,13 @@ pub fn run(
     request: &AllocateRequest<'_>,
 ) -> Result<AllocationRun, AllocateOpsError> {
     check(request)?;
+    // Refused from the file before the derivation (issue 36, point 2).
+    let what = match (request.target, request.strategy) {
+        (AllocationTarget::Acceptance, _) => GridUse::Acceptance,
+        (AllocationTarget::Requirement, StrategyName::Optimal) => GridUse::Optimal,
+        (AllocationTarget::Requirement, StrategyName::Paper) => GridUse::Paper,
+    };
+    allocate::check_grid(machine, what)?;
     let model = chain_core::compile(machine);
     let options = StudyOptions {
         params: request.params,

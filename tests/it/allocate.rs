@@ -431,3 +431,79 @@ fn cli_plot_writes_maps_and_the_tightening_chart() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The gantry grinder with an `nx × ny × nz` grid over its strokes and
+/// `parameters` for its empty parameter section (a scratch file).
+fn gantry_grid(name: &str, n: [usize; 3], parameters: &str) -> PathBuf {
+    let text = std::fs::read_to_string(gantry_path()).unwrap();
+    let axis = |lo: f64, hi: f64, n: usize| {
+        let v: Vec<String> = (0..n)
+            .map(|i| format!("{}", lo + (hi - lo) * i as f64 / (n - 1) as f64))
+            .collect();
+        format!("[{}]", v.join(", "))
+    };
+    let grid = format!(
+        "    x: {}\n    y: {}\n    z: {}\n",
+        axis(0.0, 1000.0, n[0]),
+        axis(-1500.0, 1500.0, n[1]),
+        axis(600.0, 1400.0, n[2])
+    );
+    let start = text.find("    x: [0, 250").unwrap();
+    let end = start + text[start..].find("  requirement").unwrap();
+    let text = format!("{}{grid}{}", &text[..start], &text[end..]);
+    let text = text.replacen("parameters: {}", parameters, 1);
+    common::cli::scratch_file(name, &text)
+}
+
+/// Issue 36, point 2: each allocation refuses a grid larger than it runs on
+/// within about a minute, from the machine file before the derivation (a
+/// symbolic parameter, which the study would refuse, is not reached),
+/// naming the reliability section, the counts and what to do instead.
+#[test]
+fn allocations_refuse_grids_too_large_for_them_before_deriving() {
+    let cases = [
+        ([60, 60, 14], vec![], 50_400, 50_000, "--strategy optimal"),
+        (
+            [60, 60, 28],
+            vec!["--strategy", "paper"],
+            100_800,
+            100_000,
+            "--strategy paper",
+        ),
+        (
+            [40, 40, 19],
+            vec!["--target", "acceptance", "--level", "0.9"],
+            30_400,
+            30_000,
+            "--target acceptance",
+        ),
+    ];
+    for (n, options, points, limit, what) in cases {
+        // A symbolic parameter nobody gives a value.
+        let file = gantry_grid(
+            &format!("allocate_grid_{points}.yaml"),
+            n,
+            "parameters: {unused: null}",
+        );
+        let mut args = vec!["allocate", file.to_str().unwrap()];
+        args.extend(options.iter().copied());
+        let err = common::cli::unwrapped(&fails(&args));
+        mentions(
+            &err,
+            &[
+                "chain::reliability::grid_too_large",
+                "key `reliability.grid`",
+                &format!("the grid has {points} points"),
+                &format!("runs on at most {limit}"),
+                what,
+                "allocate on a coarser grid",
+                "chain reliability",
+            ],
+        );
+        assert!(err.contains(":88:1"), "located at `reliability:`: {err}");
+        assert!(!err.contains("unused"), "refused before the study: {err}");
+    }
+    // At the limit the grid is taken (the paper's tightening, the fastest).
+    let file = gantry_grid("allocate_grid_ok.yaml", [50, 50, 40], "parameters: {}");
+    ok(&["allocate", file.to_str().unwrap(), "--strategy", "paper"]);
+}

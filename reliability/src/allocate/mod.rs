@@ -51,6 +51,77 @@ pub use acceptance::{acceptance, AcceptanceAllocation, Strategy as AcceptanceStr
 pub use optimal::optimal;
 pub use paper::paper;
 
+/// What an allocation runs, for the size of grid it takes
+/// ([`check_grid`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GridUse {
+    /// [`optimal()`] for the requirement.
+    Optimal,
+    /// [`paper()`] for the requirement.
+    Paper,
+    /// [`acceptance()`] (either strategy) for the whole-machine acceptance.
+    Acceptance,
+}
+
+impl GridUse {
+    /// The most grid points the allocation takes: what it runs on within
+    /// about a minute on two cores (docs/performance.md, "Allocation on
+    /// large grids", with the measured times).
+    pub fn limit(self) -> usize {
+        match self {
+            GridUse::Optimal => 50_000,
+            GridUse::Paper => 100_000,
+            GridUse::Acceptance => 30_000,
+        }
+    }
+
+    /// The allocation, as a message names it.
+    fn name(self) -> &'static str {
+        match self {
+            GridUse::Optimal => "the least-cost allocation (--strategy optimal)",
+            GridUse::Paper => "the paper's tightening (--strategy paper)",
+            GridUse::Acceptance => "the allocation for the acceptance (--target acceptance)",
+        }
+    }
+
+    /// Why it has a limit.
+    fn why(self) -> &'static str {
+        match self {
+            GridUse::Optimal => {
+                "its interior-point method carries a constraint per point and component: 40 s at 43,000 points, growing faster than the grid"
+            }
+            GridUse::Paper => {
+                "each round keeps every case's FORM result for its sensitivities: about 4.8 KB a point, 460 MB at 97,000 points"
+            }
+            GridUse::Acceptance => {
+                "every step estimates the probability that all points hold at once: 9 s at 27,000 points"
+            }
+        }
+    }
+}
+
+/// Refuses a machine whose reliability grid is larger than `what` takes
+/// ([`GridUse::limit`]), from the machine file alone: before the model is
+/// derived, with the advice to allocate on a coarser grid and check the
+/// result on the fine one (issue 36, point 2). A machine without a
+/// reliability section passes (the study refuses it).
+pub fn check_grid(machine: &Machine, what: GridUse) -> Result<(), ReliabilityError> {
+    let Some(r) = &machine.reliability else {
+        return Ok(());
+    };
+    let points = (r.grid.iter()).fold(1usize, |n, (_, v)| n.saturating_mul(v.len()));
+    if points > what.limit() {
+        return Err(ReliabilityError::GridTooLarge {
+            points,
+            limit: what.limit(),
+            strategy: what.name(),
+            why: what.why(),
+            origin: r.origin.clone(),
+        });
+    }
+    Ok(())
+}
+
 /// The allocation data of one error parameter.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ErrorBounds {
