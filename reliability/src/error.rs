@@ -120,6 +120,17 @@ pub enum ReliabilityError {
     #[error("non-finite value in {0}")]
     #[cfg_attr(feature = "miette", diagnostic(code(chain::reliability::non_finite)))]
     NonFinite(&'static str),
+    /// The error's mean or standard deviation at a point is not finite
+    /// (axis values too large for the model: sensitivities near 1e300
+    /// times the inputs' spread), or the nominal tool point is not.
+    #[error("the error at {at} overflows: its {what} is not finite (axis values beyond what the model can carry)")]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::reliability::overflow)))]
+    Overflow {
+        /// The point, `x = …, y = …`.
+        at: String,
+        /// What overflowed (`mean of px`, `standard deviation of py`, `nominal tool point`).
+        what: String,
+    },
     /// An error of the model has no input distribution.
     #[error("no input distribution for error `{0}`")]
     #[cfg_attr(

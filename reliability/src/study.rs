@@ -604,7 +604,8 @@ impl Study {
         targets: Vec<Target>,
     ) -> Result<Study, ReliabilityError> {
         for block in points.chunks(CASE_BLOCK) {
-            evaluate(&*model, parameters, block)?;
+            let rows = evaluate(&*model, parameters, block)?;
+            check_moments(&inputs, &variables, block, &rows)?;
         }
         let rows = Rows::OnDemand {
             model,
@@ -712,6 +713,10 @@ impl Study {
                 expected: self.inputs.len(),
                 found: bad.len(),
             });
+        }
+        for (p, (inputs, q)) in each.iter().zip(&self.points).enumerate() {
+            let rows = self.sensitivities(p..p + 1);
+            check_moments(inputs, &self.variables, std::slice::from_ref(q), &rows)?;
         }
         self.point_inputs = Some(each);
         Ok(self)
@@ -1391,6 +1396,49 @@ fn evaluate<M: ErrorModel + ?Sized>(
         return Err(ReliabilityError::NonFinite("the model's sensitivities"));
     }
     Ok(flat)
+}
+
+/// Refuses a point whose error moments are not finite: the mean `Σ s·μ` or
+/// the variance `SᵀΣS` of a component (what [`Study::moments`] and every
+/// method compute) at `points` (the `6 × N` matrices `rows`).
+fn check_moments(
+    inputs: &Inputs,
+    variables: &[String],
+    points: &[Arc<[f64]>],
+    rows: &[f64],
+) -> Result<(), ReliabilityError> {
+    let n = inputs.len();
+    let means = inputs.means();
+    for (q, s) in points.iter().zip(rows.chunks_exact((6 * n).max(1))) {
+        for c in Component::ALL {
+            let row = &s[c.index() * n..(c.index() + 1) * n];
+            let mean: f64 = row.iter().zip(means).map(|(s, m)| s * m).sum();
+            let what = if !mean.is_finite() {
+                "mean"
+            } else if !inputs.covariance(row, row).is_finite() {
+                "standard deviation"
+            } else {
+                continue;
+            };
+            return Err(ReliabilityError::Overflow {
+                at: point_text(variables, q),
+                what: format!("{what} of {}", c.name()),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// `x = 1, y = 2.5e300`: a point by its variables (values beyond a million
+/// in exponent form).
+pub(crate) fn point_text(variables: &[String], q: &[f64]) -> String {
+    (variables.iter().zip(q))
+        .map(|(v, x)| match x.abs() < 1e6 {
+            true => format!("{v} = {x}"),
+            false => format!("{v} = {x:e}"),
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The points of a grid in the model's variable order (first grid axis

@@ -159,3 +159,38 @@ fn an_unknown_at_name_blames_at_not_the_machine_file() {
         "no location in the machine file: {err}"
     );
 }
+
+/// Issue 36: an axis value of 1e300 gives finite sensitivities (about
+/// 1e300) whose moments overflow; `path` exited 0 with `inf` in its table.
+/// The study refuses the point, naming it (in exponent form) and what
+/// overflowed; `reliability` over such a grid likewise.
+#[test]
+fn axis_values_whose_moments_overflow_are_refused_naming_the_point() {
+    let axes = scratch("axes_1e300.csv", "x,y,z\n0,-1500,600\n1e300,-1500,600\n");
+    let gantry_file = format!("{ROOT}/examples/machines/gantry_grinder.yaml");
+    for args in [
+        vec!["path", &gantry_file, "--axes", &axes],
+        vec!["reliability", &gantry_file, "--grid", "x=0,1e300"],
+    ] {
+        let out = run(&args);
+        let err = flat(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(out.stdout.is_empty(), "{args:?}");
+        for needle in [
+            "chain::reliability::overflow",
+            "x = 1e300",
+            "y = -1500",
+            "standard deviation of py is not finite",
+        ] {
+            assert!(
+                err.contains(needle),
+                "{args:?}: `{needle}` missing from {err}"
+            );
+        }
+    }
+    // Large but harmless values still run: 1e100 mm gives sensitivities of
+    // 1e100 and variances of 1e200·σ².
+    let axes = scratch("axes_1e100.csv", "x,y,z\n1e100,-1500,600\n");
+    let out = run(&["path", &gantry_file, "--axes", &axes, "--format", "json"]);
+    assert!(out.status.success(), "{}", flat(&out.stderr));
+}
