@@ -44,6 +44,40 @@ pub struct Grid {
 }
 
 impl Grid {
+    /// Checks the grid against the model's variables (names; the model is
+    /// not needed, so callers check before deriving it): every axis a
+    /// variable, none empty or with a non-finite value, every variable an
+    /// axis, at least one axis when there are variables.
+    pub fn check(&self, variables: &[String]) -> Result<(), ReliabilityError> {
+        self.axis_of(variables).map(|_| ())
+    }
+
+    /// Per variable, the index of its axis ([`Grid::check`]'s rules).
+    fn axis_of(&self, variables: &[String]) -> Result<Vec<Option<usize>>, ReliabilityError> {
+        let mut axis_of = vec![None; variables.len()];
+        for (a, (name, values)) in self.axes.iter().enumerate() {
+            let v = variables.iter().position(|x| x == name).ok_or_else(|| {
+                ReliabilityError::unknown("variable", name, variables.iter().map(String::as_str))
+            })?;
+            if values.is_empty() {
+                return Err(ReliabilityError::EmptyGrid(format!(
+                    "axis `{name}` has no value"
+                )));
+            }
+            if values.iter().any(|x| !x.is_finite()) {
+                return Err(ReliabilityError::NonFinite("the grid"));
+            }
+            axis_of[v] = Some(a);
+        }
+        if let Some(v) = axis_of.iter().position(Option::is_none) {
+            return Err(ReliabilityError::MissingCoordinate(variables[v].clone()));
+        }
+        if self.is_empty() && !variables.is_empty() {
+            return Err(ReliabilityError::EmptyGrid("no axis".into()));
+        }
+        Ok(axis_of)
+    }
+
     /// Number of points.
     pub fn len(&self) -> usize {
         if self.axes.is_empty() {
@@ -1444,27 +1478,7 @@ pub(crate) fn point_text(variables: &[String], q: &[f64]) -> String {
 /// The points of a grid in the model's variable order (first grid axis
 /// slowest); a model without variables has the one empty point.
 fn grid_points(grid: &Grid, variables: &[String]) -> Result<Vec<Arc<[f64]>>, ReliabilityError> {
-    let mut axis_of = vec![None; variables.len()];
-    for (a, (name, values)) in grid.axes.iter().enumerate() {
-        let v = variables.iter().position(|x| x == name).ok_or_else(|| {
-            ReliabilityError::unknown("variable", name, variables.iter().map(String::as_str))
-        })?;
-        if values.is_empty() {
-            return Err(ReliabilityError::EmptyGrid(format!(
-                "axis `{name}` has no value"
-            )));
-        }
-        if values.iter().any(|x| !x.is_finite()) {
-            return Err(ReliabilityError::NonFinite("the grid"));
-        }
-        axis_of[v] = Some(a);
-    }
-    if let Some(v) = axis_of.iter().position(Option::is_none) {
-        return Err(ReliabilityError::MissingCoordinate(variables[v].clone()));
-    }
-    if grid.is_empty() && !variables.is_empty() {
-        return Err(ReliabilityError::EmptyGrid("no axis".into()));
-    }
+    let axis_of = grid.axis_of(variables)?;
     let count = grid.len().max(1);
     Ok((0..count)
         .map(|p| {

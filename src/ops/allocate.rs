@@ -234,13 +234,12 @@ pub fn run(
         (AllocationTarget::Requirement, StrategyName::Paper) => GridUse::Paper,
     };
     allocate::check_grid(machine, what)?;
-    let model = chain_core::compile(machine);
     let options = StudyOptions {
         params: request.params,
         sided: request.sided,
         ..StudyOptions::default()
     };
-    let study = study::study(machine, file, &model, &options)?;
+    let (study, model) = study::study(machine, file, &options)?;
     let parameters = reliability::machine::parameters(machine, request.params)?;
     let bounds = allocate::bounds(machine, &study)?;
     let strategy = match request.strategy {

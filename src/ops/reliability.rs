@@ -121,7 +121,6 @@ pub fn prepare(
         Some(path) => Some(study::read_posterior(machine, path, request.approach)?),
         None => None,
     };
-    let model = chain_core::compile(machine);
     let options = StudyOptions {
         params: request.params,
         grid: request.grid,
@@ -129,7 +128,7 @@ pub fn prepare(
         system,
         posterior: posterior.as_ref(),
     };
-    let study = study::study(machine, file, &model, &options)?;
+    let (study, model) = study::study(machine, file, &options)?;
     let wanted = request.acceptance || (machine.reliability.as_ref()).is_some_and(|r| r.acceptance);
     Ok(Prepared {
         machine: machine.name.clone(),

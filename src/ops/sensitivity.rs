@@ -220,7 +220,6 @@ fn reliability_kind(
         }
         _ => None,
     };
-    let model = chain_core::compile(machine);
     let options = StudyOptions {
         params: request.params,
         grid: request.grid,
@@ -228,11 +227,13 @@ fn reliability_kind(
         system: None,
         posterior: posterior.as_ref(),
     };
-    let study = study::study(machine, file, &model, &options)?;
+    let checked = study::check(machine, file, &options)?;
     let point = match request.at {
         Some(coords) => Some(resolve::at_point(machine, file, coords)?),
         None => None,
     };
+    let model = chain_core::compile(machine);
+    let study = study::build(machine, &model, checked, &options)?;
     let values = reliability::machine::parameters(machine, request.params)?;
     let (at, result) = reliability::document::sensitivity(
         &study,

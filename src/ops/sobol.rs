@@ -175,7 +175,6 @@ pub fn run(
         .into());
     }
     resolve::check_parameters(machine, request.params)?;
-    let model = chain_core::compile(machine);
     let study = match request.at {
         None => {
             let options = StudyOptions {
@@ -183,13 +182,14 @@ pub fn run(
                 grid: request.grid,
                 ..StudyOptions::default()
             };
-            study::study(machine, file, &model, &options)?
+            study::study(machine, file, &options)?.0
         }
         Some(coords) => {
             let point = resolve::at_point(machine, file, coords)?;
             let spec = reliability::machine::spec(machine, None)?;
             let inputs = reliability::machine::inputs(machine)?;
             let values = reliability::machine::parameters(machine, request.params)?;
+            let model = chain_core::compile(machine);
             Study::at_points(&model, &values, inputs, spec, vec![point])?
         }
     };

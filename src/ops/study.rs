@@ -10,7 +10,8 @@ use chain_core::model::Sided;
 use chain_core::values::{Approach, ApproachError};
 use chain_core::{CompiledModel, Machine};
 use reliability::{
-    Algorithm, Method, Posterior, PosteriorError, ReliabilityError, Study, StudyResult, System,
+    Algorithm, Inputs, Method, Posterior, PosteriorError, ReliabilityError, Study, StudyResult,
+    StudySpec, System,
 };
 
 use super::resolve::{self, ResolveError};
@@ -82,21 +83,27 @@ impl From<PosteriorError> for StudyError {
     }
 }
 
-/// The study of `machine`'s reliability section (evaluated through
-/// `model`, compiled from it) with `options`; `file` names the machine
-/// file in messages.
-///
-/// The study keeps a copy of the model, not the sensitivities
-/// ([`Study::on_demand`]): every command over it uses each point's a few
-/// times at most, and a million-point grid then holds only its points
-/// (issue 36; the tape's blocks equal its points bit for bit, so the results
-/// are those of a study that keeps them).
-pub fn study(
+/// A study's parts resolved from the machine file and the options alone:
+/// everything [`study`] checks before the model is derived (issue 36,
+/// point 3: a long chain takes a minute to derive; a missing grid axis, an
+/// unknown `--param` or a missing statistic is refused before that).
+#[derive(Debug)]
+pub struct Checked {
+    spec: StudySpec,
+    inputs: Inputs,
+    parameters: Vec<f64>,
+}
+
+/// Checks the options against `machine` (`file` names it) and resolves the
+/// study's specification, inputs and parameter values, with no derivation:
+/// the parameters, the grid overrides, the grid itself (every axis a
+/// variable of the machine, every variable an axis, no empty or non-finite
+/// axis), the statistics (or the posterior's inputs).
+pub fn check(
     machine: &Machine,
     file: &str,
-    model: &CompiledModel,
     options: &StudyOptions<'_>,
-) -> Result<Study, StudyError> {
+) -> Result<Checked, StudyError> {
     resolve::check_parameters(machine, options.params)?;
     let mut spec = reliability::machine::spec(machine, options.system)?;
     if let Some(s) = options.sided {
@@ -109,16 +116,59 @@ pub fn study(
             None => spec.grid.axes.push((name.clone(), values.clone())),
         }
     }
+    let variables: Vec<String> = machine.variables.iter().map(|v| v.name.clone()).collect();
+    spec.grid.check(&variables)?;
     let inputs = match options.posterior {
         None => reliability::machine::inputs(machine)?,
         Some(p) => p.inputs(machine)?,
     };
     let parameters = reliability::machine::parameters(machine, options.params)?;
+    Ok(Checked {
+        spec,
+        inputs,
+        parameters,
+    })
+}
+
+/// The study of a [`check`]ed machine, evaluated through `model` (compiled
+/// from it), with the posterior's inputs per point when `options` has one.
+///
+/// The study keeps a copy of the model, not the sensitivities
+/// ([`Study::on_demand`]): every command over it uses each point's a few
+/// times at most, and a million-point grid then holds only its points
+/// (issue 36; the tape's blocks equal its points bit for bit, so the results
+/// are those of a study that keeps them).
+pub fn build(
+    machine: &Machine,
+    model: &CompiledModel,
+    checked: Checked,
+    options: &StudyOptions<'_>,
+) -> Result<Study, StudyError> {
+    let Checked {
+        spec,
+        inputs,
+        parameters,
+    } = checked;
     let study = Study::on_demand(Arc::new(model.clone()), &parameters, inputs, spec)?;
     Ok(match options.posterior {
         Some(p) => p.apply(machine, study)?,
         None => study,
     })
+}
+
+/// The study of `machine`'s reliability section with `options` (`file`
+/// names the machine file in messages): [`check`], then the derivation
+/// (`chain_core::compile`), then [`build`]; returns the compiled model with
+/// it.
+pub fn study(
+    machine: &Machine,
+    file: &str,
+    options: &StudyOptions<'_>,
+) -> Result<(Study, CompiledModel), StudyError> {
+    let checked = check(machine, file, options)?;
+    let model = chain_core::compile(machine);
+    let study = build(machine, &model, checked, options)?;
+    Ok((study, model))
 }
 
 /// The reliability algorithm of a study command: `--method`, `--samples`,

@@ -617,3 +617,45 @@ fn grid_ranges_are_the_same_grid_as_the_listed_values() {
     let err = fails(&["sobol", gantry().to_str().unwrap(), "--grid", "x=0:1000:1"]);
     assert!(err.contains("N ≥ 2"), "{err}");
 }
+
+/// Issue 36, point 3: what a study needs from the machine file and the
+/// options is checked with no model (`chain::ops::study::check`, which every
+/// study command runs before the derivation): a grid axis missing from the
+/// file, an empty `--grid` axis, an unknown `--param`, an error without
+/// statistics.
+#[test]
+fn study_checks_need_no_derivation() {
+    use chain::ops::study::{check, StudyError, StudyOptions};
+    use reliability::ReliabilityError;
+    let text = std::fs::read_to_string(gantry()).unwrap();
+    let load = |text: &str| chain_core::load_str(text, "gantry.yaml").expect("loads");
+    // The grid without its z axis.
+    let no_z = load(&text.replace("    z: [600, 800, 1000, 1200, 1400]\n", ""));
+    let err = check(&no_z, "gantry.yaml", &StudyOptions::default()).unwrap_err();
+    assert!(
+        matches!(&err, StudyError::Reliability(ReliabilityError::MissingCoordinate(v)) if v == "z"),
+        "{err:?}"
+    );
+    let m = load(&text);
+    let empty = [("x".to_string(), Vec::new())];
+    let options = StudyOptions {
+        grid: &empty,
+        ..StudyOptions::default()
+    };
+    let err = check(&m, "gantry.yaml", &options).unwrap_err();
+    assert!(err.to_string().contains("--grid x: the axis has no value"), "{err}");
+    let params = [("nope".to_string(), 1.0)];
+    let options = StudyOptions {
+        params: &params,
+        ..StudyOptions::default()
+    };
+    assert!(matches!(
+        check(&m, "gantry.yaml", &options),
+        Err(StudyError::Resolve(_) | StudyError::Reliability(_))
+    ));
+    let no_stat = load(&text.replace("  dxx: {dist: normal, mean: 0, std: 0.05/6}\n", ""));
+    let err = check(&no_stat, "gantry.yaml", &StudyOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("dxx"), "{err}");
+    // And the whole file passes.
+    check(&m, "gantry.yaml", &StudyOptions::default()).expect("the example checks");
+}
