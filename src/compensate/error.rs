@@ -4,6 +4,7 @@
 //! with the `cli` feature).
 
 use super::MAX_SUPPORTED_ORDER;
+use chain_core::diagnostic::shortened;
 
 /// Errors of reading, analysing and exporting swing-angle measurements.
 ///
@@ -101,7 +102,7 @@ pub enum CompensateError {
         column: String,
     },
     /// A cell is not a number.
-    #[error("{file}:{line}: column `{column}`: `{value}` is not a number")]
+    #[error("{file}:{line}: column `{column}`: `{}` is not a number", shortened(.value))]
     #[cfg_attr(feature = "cli", diagnostic(code(chain::csv::not_a_number)))]
     NotNumeric {
         /// The file.
@@ -114,7 +115,7 @@ pub enum CompensateError {
         value: String,
     },
     /// A cell is NaN or infinite.
-    #[error("{file}:{line}: column `{column}`: `{value}` is not finite")]
+    #[error("{file}:{line}: column `{column}`: `{}` is not finite", shortened(.value))]
     #[cfg_attr(feature = "cli", diagnostic(code(chain::csv::not_finite)))]
     NotFinite {
         /// The file.

@@ -187,3 +187,58 @@ fn values_tables() {
         check(&err, &format!("{file}{message}"), code);
     }
 }
+
+/// Issue 36, point 4: a refused huge value is quoted shortened (its first
+/// 40 characters and `…`, `chain_core::diagnostic::shortened`), not printed
+/// in full: a 5,000-character cell in a CSV of `path`, `compensate` and a
+/// values table, and a 5,000-character name where a number belongs in a
+/// machine file.
+#[test]
+fn huge_refused_values_are_quoted_shortened() {
+    let dir = scratch("huge");
+    let huge = format!("1{}", "x".repeat(4999));
+    let machine = format!("{ROOT}/examples/machines/gantry_grinder.yaml");
+    std::fs::write(dir.join("axes.csv"), format!("x,y,z\n0,{huge},0\n")).unwrap();
+    std::fs::write(
+        dir.join("comp.csv"),
+        format!("theta_deg,z1,z3\n10,{huge},3\n20,1,3\n"),
+    )
+    .unwrap();
+    let name = "a".repeat(5000);
+    let text = std::fs::read_to_string(&machine).unwrap().replacen(
+        "x: [0, 250, 500, 750, 1000]",
+        &format!("x: [{name}]"),
+        1,
+    );
+    std::fs::write(dir.join("long_name.yaml"), text).unwrap();
+    let shown = format!("{}…", &huge[..40]);
+    let runs: [(&[&str], String); 3] = [
+        (
+            &["path", &machine, "--axes", "axes.csv"],
+            format!("axes.csv:2: column `y`: `{shown}` is not a number"),
+        ),
+        (
+            &["compensate", "comp.csv", "--length", "500"],
+            format!("comp.csv:2: column `z1`: `{shown}` is not a number"),
+        ),
+        (
+            &["reliability", "long_name.yaml"],
+            format!(
+                "`{}…` is a name, but only numbers are allowed here",
+                &name[..40]
+            ),
+        ),
+    ];
+    for (args, message) in runs {
+        let err = refused(&dir, args);
+        assert!(
+            err.contains(&message),
+            "{args:?}: expected `{message}` in {err}"
+        );
+        assert!(
+            !err.contains(&huge[..200]) && !err.contains(&name[..200]),
+            "{args:?} echoes the value in full: {} bytes",
+            err.len()
+        );
+    }
+}

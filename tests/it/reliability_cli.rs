@@ -643,7 +643,10 @@ fn study_checks_need_no_derivation() {
         ..StudyOptions::default()
     };
     let err = check(&m, "gantry.yaml", &options).unwrap_err();
-    assert!(err.to_string().contains("--grid x: the axis has no value"), "{err}");
+    assert!(
+        err.to_string().contains("--grid x: the axis has no value"),
+        "{err}"
+    );
     let params = [("nope".to_string(), 1.0)];
     let options = StudyOptions {
         params: &params,

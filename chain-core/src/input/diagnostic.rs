@@ -751,7 +751,10 @@ impl Problem {
             Problem::NameInNumber { name } => D::new(
                 "chain::name_in_number",
                 "not a number",
-                format!("`{name}` is a name, but only numbers are allowed here"),
+                format!(
+                    "`{}` is a name, but only numbers are allowed here",
+                    shortened(name)
+                ),
             ),
             Problem::NotPositive { what, value } => D::new(
                 "chain::not_positive",
@@ -1070,6 +1073,22 @@ impl fmt::Display for Problem {
             write!(f, " ({note})")?;
         }
         Ok(())
+    }
+}
+
+/// The most characters of an input's text a message quotes
+/// ([`shortened`]).
+pub const QUOTED_CHARS: usize = 40;
+
+/// `text` as a message quotes it: whole when it has at most
+/// [`QUOTED_CHARS`] characters, else its first [`QUOTED_CHARS`] and `…`
+/// (issue 36: a refused 5,000-digit cell is not echoed in full). The one
+/// shortening of every located message (YAML scalars, CSV cells, names in
+/// numbers).
+pub fn shortened(text: &str) -> std::borrow::Cow<'_, str> {
+    match text.char_indices().nth(QUOTED_CHARS) {
+        None => std::borrow::Cow::Borrowed(text),
+        Some((end, _)) => std::borrow::Cow::Owned(format!("{}…", &text[..end])),
     }
 }
 

@@ -7,6 +7,7 @@
 //! code. A cell's message names its column: ``column `y`: `abc` is not a
 //! number``.
 
+use crate::diagnostic::shortened;
 use std::fmt;
 
 /// One refusal of a CSV input.
@@ -87,10 +88,14 @@ impl fmt::Display for CsvProblem {
                 plural(*columns, "column")
             ),
             CsvProblem::NotANumber { column, text } => {
-                write!(f, "column `{column}`: `{text}` is not a number")
+                write!(
+                    f,
+                    "column `{column}`: `{}` is not a number",
+                    shortened(text)
+                )
             }
             CsvProblem::NotFinite { column, text } => {
-                write!(f, "column `{column}`: `{text}` is not finite")
+                write!(f, "column `{column}`: `{}` is not finite", shortened(text))
             }
             CsvProblem::EmptyCell { column } => write!(f, "column `{column}`: the cell is empty"),
         }

@@ -156,13 +156,7 @@ impl Node {
             NodeKind::Mapping(_) => "a mapping".into(),
             NodeKind::Sequence(_) => "a list".into(),
             NodeKind::Scalar(s) if s.is_null() => "nothing (null)".into(),
-            NodeKind::Scalar(s) => {
-                let mut t: String = s.text.chars().take(40).collect();
-                if t.len() < s.text.len() {
-                    t.push('…');
-                }
-                format!("`{t}`")
-            }
+            NodeKind::Scalar(s) => format!("`{}`", crate::diagnostic::shortened(&s.text)),
         }
     }
 
