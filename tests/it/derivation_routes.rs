@@ -5,21 +5,8 @@
 
 use crate::common;
 
-use std::path::PathBuf;
-
 use chain_core::model::{Component, Frame};
-use common::{example_file, example_path};
-
-fn example_machines() -> Vec<PathBuf> {
-    let dir = example_file("machines");
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .expect("examples/machines exists")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
-        .collect();
-    files.sort();
-    files
-}
+use common::{example_machines, example_path};
 
 #[test]
 fn dmm_route_equals_matrix_route_on_every_example() {

@@ -769,6 +769,25 @@ fn the_library_refuses_what_does_not_fit() {
 
 // ---------------------------------------------------------- other machines
 
+/// Asserts a map point's error is `S(q)·v` with the numeric product's
+/// sensitivities `s` (6 × n) and the values `v`, to 1e-9 of the terms'
+/// magnitude; returns the largest `|S·v|` component.
+fn assert_is_s_times_v(got: &[f64; 6], s: &[f64], v: &[f64], q: &[f64]) -> f64 {
+    let n = v.len();
+    let mut largest = 0.0f64;
+    for c in 0..6 {
+        let expect: f64 = (0..n).map(|j| s[c * n + j] * v[j]).sum();
+        let mag: f64 = (0..n).map(|j| (s[c * n + j] * v[j]).abs()).sum();
+        assert!(
+            (got[c] - expect).abs() <= 1e-9 * mag + 1e-13,
+            "{c} at {q:?}: {} vs {expect}",
+            got[c]
+        );
+        largest = largest.max(expect.abs());
+    }
+    largest
+}
+
 #[test]
 fn the_gantry_grinder_maps_like_its_numeric_product() {
     let m = load_example("gantry_grinder.yaml");
@@ -787,7 +806,6 @@ fn the_gantry_grinder_maps_like_its_numeric_product() {
     let points = doc["points"].as_array().unwrap();
     assert_eq!(points.len(), 125);
     let exact = Exact::new(&m);
-    let n = m.errors.len();
     let arcsec = std::f64::consts::PI / 648_000.0;
     let spline = Spline::new(&[0.0, 500.0, 1000.0], &[0.0, 3.1e-3, 5.2e-3]);
     let mut by_name: HashMap<&str, Motion> = HashMap::new();
@@ -812,16 +830,7 @@ fn the_gantry_grinder_maps_like_its_numeric_product() {
             .iter()
             .map(|e| by_name.get(e.name.as_str()).map_or(0.0, |f| f(&q)))
             .collect();
-        let got = components(&p["error"]);
-        for c in 0..6 {
-            let expect: f64 = (0..n).map(|j| s[c * n + j] * v[j]).sum();
-            let mag: f64 = (0..n).map(|j| (s[c * n + j] * v[j]).abs()).sum();
-            assert!(
-                (got[c] - expect).abs() <= 1e-9 * mag + 1e-13,
-                "{c} at {q:?}: {} vs {expect}",
-                got[c]
-            );
-        }
+        assert_is_s_times_v(&components(&p["error"]), &s, &v, &q);
     }
 }
 
@@ -861,7 +870,6 @@ fn the_example_gantry_values_map_like_the_numeric_product() {
     let points = doc["points"].as_array().unwrap();
     assert_eq!(points.len(), 27);
     let exact = Exact::new(&m);
-    let n = m.errors.len();
     // units: {linear: um, angular: urad}; the names starting with `d` are
     // the translations.
     let v: Vec<f64> = (m.errors.iter())
@@ -875,16 +883,7 @@ fn the_example_gantry_values_map_like_the_numeric_product() {
         let q = q_of(&m, &p["point"]);
         let s = exact.fd_sensitivity(&q, &[], 1e-3);
         let got = components(&p["error"]);
-        for c in 0..6 {
-            let expect: f64 = (0..n).map(|j| s[c * n + j] * v[j]).sum();
-            let mag: f64 = (0..n).map(|j| (s[c * n + j] * v[j]).abs()).sum();
-            assert!(
-                (got[c] - expect).abs() <= 1e-9 * mag + 1e-13,
-                "{c} at {q:?}: {} vs {expect}",
-                got[c]
-            );
-            largest = largest.max(expect.abs());
-        }
+        largest = largest.max(assert_is_s_times_v(&got, &s, &v, &q));
     }
     // Some tens of µm at the corners, as one-sigma errors over metres give.
     assert!(largest > 0.01 && largest < 0.1, "{largest}");

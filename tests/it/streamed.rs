@@ -20,13 +20,7 @@ use reliability::sorm::Sorm;
 /// Every example machine with a reliability section and statistics for
 /// all its errors.
 fn machines() -> Vec<(PathBuf, Machine)> {
-    let dir = example_file("machines");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("examples/machines exists")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
-        .collect();
-    files.sort();
+    let files = common::example_machines();
     files
         .into_iter()
         .filter_map(|f| {

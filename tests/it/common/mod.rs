@@ -889,3 +889,15 @@ impl Points {
         out.iter_mut().for_each(|x| *x = self.next(range));
     }
 }
+
+/// Every machine file of examples/machines, sorted.
+pub fn example_machines() -> Vec<std::path::PathBuf> {
+    let dir = example_file("machines");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .expect("examples/machines exists")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "yaml"))
+        .collect();
+    files.sort();
+    files
+}
