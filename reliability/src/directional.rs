@@ -39,8 +39,8 @@ use crate::method::Method;
 use crate::normal;
 use crate::rng::CaseRng;
 use crate::sampler::{
-    case_id, check_cov, check_samples, drive, finish, impl_sampler, Progress, SimulationResult,
-    Stop, Stopping, Sums,
+    check_cov, check_samples, drive, finish, impl_sampler, Progress, SimulationResult, Stop,
+    Stopping, Streams, Sums,
 };
 use crate::simulation::illinois;
 use crate::standard::{Scratch, Standard};
@@ -119,13 +119,24 @@ impl DirectionalSimulation {
         events: &[Event<'_, L>],
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
+        self.run_streams(events, Streams::ALL, progress)
+    }
+
+    /// [`DirectionalSimulation::run_cases`], case `i` on the streams of
+    /// `streams.id(i)`.
+    pub fn run_streams<L: LimitState>(
+        &self,
+        events: &[Event<'_, L>],
+        streams: Streams<'_>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
         check_samples(self.samples)?;
         if let Some(c) = self.cov {
             check_cov(c)?;
         }
         let stds: Vec<Standard<'_, '_, L>> = events.iter().map(Standard::new).collect();
         let block = |case: usize, block: u32, count: u64, _: &mut [f64]| {
-            self.block(&stds[case], case_id(case), block, count)
+            self.block(&stds[case], streams.id(case), block, count)
         };
         let runs = drive(
             events.len(),

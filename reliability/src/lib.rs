@@ -85,16 +85,17 @@ pub use form::{BranchResult, Calls, Form, FormResult, Termination};
 pub use inputs::{Inputs, Marginal};
 pub use limit_state::{Affine, AffineView, Criterion, Event, LimitState, ToleranceLimitState};
 pub use path::{
-    Extreme, InstantResult, PathInstant, PathRecord, PathResult, PathStudy, PathTarget, Quantity,
-    TargetSummary,
+    Extreme, InstantResult, PathBlocks, PathInstant, PathRecord, PathResult, PathStudy,
+    PathSummary, PathTarget, Quantity, TargetSummary,
 };
 pub use posterior::{Posterior, PosteriorError};
+pub use sampler::Streams;
 pub use sensitivity::{sensitivity, InputSensitivity, SensitivityMethod, SensitivityResult};
 pub use simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult, Stop, Stopping};
 pub use sobol::{Sobol, SobolError, SobolResult};
 pub use study::{
-    Algorithm, CaseResult, ErrorMoments, ErrorSensitivity, FormCase, FormLimit, Grid, Method,
-    SormCase, Study, StudyResult, StudySpec, Summary, System, Target, TargetSensitivity,
+    Algorithm, CaseResult, CaseTally, ErrorMoments, ErrorSensitivity, FormCase, FormLimit, Grid,
+    Method, SormCase, Study, StudyResult, StudySpec, Summary, System, Target, TargetSensitivity,
     VolumetricMoments,
 };
 pub use subset::{SubsetLevel, SubsetResult, SubsetSimulation};

@@ -27,8 +27,8 @@ use crate::inputs::Inputs;
 use crate::par::prelude::*;
 use crate::simulation::Progress;
 use crate::study::{
-    Algorithm, CaseResult, Method, SharedModel, Study, StudyResult, StudySpec, System, Target,
-    VolumetricMoments,
+    Algorithm, CaseResult, CaseTally, Method, SharedModel, Study, StudyResult, StudySpec, System,
+    Target, VolumetricMoments,
 };
 
 /// One instant of a path, as given.
@@ -149,6 +149,30 @@ pub struct Extreme {
     pub value: f64,
     /// The index of its record (the first on ties).
     pub record: usize,
+    /// That instant's input row.
+    pub row: usize,
+    /// That instant's `t`.
+    pub t: f64,
+}
+
+impl Extreme {
+    /// `value` at `record` if it beats `best` (larger; the first on ties).
+    fn larger(
+        best: Option<Extreme>,
+        value: f64,
+        record: usize,
+        i: &PathInstant,
+    ) -> Option<Extreme> {
+        match best {
+            Some(b) if b.value >= value => best,
+            _ => Some(Extreme {
+                value,
+                record,
+                row: i.row,
+                t: i.t,
+            }),
+        }
+    }
 }
 
 /// One target's reliability over the path.
@@ -197,35 +221,6 @@ impl PathResult {
         self.study.as_ref().and_then(|s| s.requirement)
     }
 
-    /// Where `value` is largest over the evaluated instants (the first on
-    /// ties); `None` when no instant is evaluated.
-    pub fn arg_max(&self, value: impl Fn(&InstantResult) -> f64) -> Option<Extreme> {
-        self.records
-            .iter()
-            .enumerate()
-            .filter_map(|(k, r)| r.result.as_ref().map(|e| (k, value(e))))
-            .fold(None, |best, (k, v)| match best {
-                Some(Extreme { value: b, .. }) if b >= v => best,
-                _ => Some(Extreme {
-                    value: v,
-                    record: k,
-                }),
-            })
-    }
-
-    /// The largest `|mean|` of a component (the largest mean of `|p|`).
-    pub fn max_mean(&self, q: Quantity) -> Option<Extreme> {
-        match q {
-            Quantity::Volumetric => self.arg_max(|e| e.mean(q)),
-            Quantity::Component(_) => self.arg_max(|e| e.mean(q).abs()),
-        }
-    }
-
-    /// The largest standard deviation of a quantity.
-    pub fn max_std(&self, q: Quantity) -> Option<Extreme> {
-        self.arg_max(|e| e.std(q))
-    }
-
     /// The case of target `t` (its index in [`PathResult::targets`]) at an
     /// evaluated instant.
     pub fn case(&self, e: &InstantResult, t: usize) -> &CaseResult {
@@ -246,35 +241,139 @@ impl PathResult {
         (0..self.targets.len()).map(move |t| self.case(e, t))
     }
 
-    /// The reliability of target `t` (its index in [`PathResult::targets`])
-    /// over the evaluated instants.
-    pub fn summary(&self, t: usize) -> Option<TargetSummary> {
-        let worst = self.arg_max(|e| -self.case(e, t).reliability)?;
-        let values: Vec<f64> = self
-            .records
-            .iter()
-            .filter_map(|r| r.result.as_ref().map(|e| self.case(e, t).reliability))
-            .collect();
-        Some(TargetSummary {
-            min: Extreme {
-                value: -worst.value,
-                record: worst.record,
-            },
-            mean: values.iter().sum::<f64>() / values.len() as f64,
-            met: self
-                .study
-                .as_ref()
-                .and_then(|s| s.summaries.get(t))
-                .and_then(|s| s.met),
-        })
-    }
-
     /// Every case of every evaluated instant (instant by instant).
     pub fn cases(&self) -> impl Iterator<Item = &CaseResult> + Clone {
         self.records
             .iter()
             .filter_map(|r| r.result.as_ref())
             .flat_map(|e| self.cases_of(e))
+    }
+}
+
+/// The summary of a path, added up record by record as the records come
+/// (a path run a block of instants at a time keeps this, not its records;
+/// issue 36): the instants by status, each target's smallest and mean
+/// reliability, the largest mean and standard deviation of every error
+/// quantity, and the [`CaseTally`] of the cases (instant by instant, each
+/// instant's targets in order).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathSummary {
+    /// The instants added.
+    pub instants: usize,
+    /// Those with results.
+    pub evaluated: usize,
+    /// Those the inverse kinematics could not reach.
+    pub unreachable: usize,
+    /// Those at a singular pose.
+    pub singular: usize,
+    /// The cases' account.
+    pub tally: CaseTally,
+    requirement: Option<Requirement>,
+    /// Per target: the smallest reliability (as the largest `−R`) and the
+    /// running sum of `R`.
+    worst: Vec<(Option<Extreme>, f64)>,
+    /// Per [`Quantity::ALL`]: the largest `|mean|` (mean of `|p|`) and std.
+    max_mean: [Option<Extreme>; 7],
+    max_std: [Option<Extreme>; 7],
+}
+
+impl PathSummary {
+    /// An empty summary of `targets` targets under `requirement`.
+    pub fn new(targets: usize, requirement: Option<Requirement>) -> PathSummary {
+        PathSummary {
+            instants: 0,
+            evaluated: 0,
+            unreachable: 0,
+            singular: 0,
+            tally: CaseTally::default(),
+            requirement,
+            worst: vec![(None, 0.0); targets],
+            max_mean: [None; 7],
+            max_std: [None; 7],
+        }
+    }
+
+    /// The summary of a whole result.
+    pub fn of(r: &PathResult) -> PathSummary {
+        let requirement = r.study.as_ref().and_then(|s| s.requirement);
+        let mut out = PathSummary::new(r.targets.len(), requirement);
+        out.add(r);
+        out
+    }
+
+    /// Adds the records of `block`, the path's next records (a block's
+    /// [`PathResult`] from [`PathStudy::blocks`], or a whole result).
+    pub fn add(&mut self, block: &PathResult) {
+        for rec in &block.records {
+            let k = self.instants;
+            let i = &rec.instant;
+            self.instants += 1;
+            match i.status {
+                Status::Unreachable => self.unreachable += 1,
+                Status::Singular => self.singular += 1,
+                _ => {}
+            }
+            let Some(e) = &rec.result else { continue };
+            self.evaluated += 1;
+            for (t, c) in block.cases_of(e).enumerate() {
+                let (worst, sum) = &mut self.worst[t];
+                *worst = Extreme::larger(*worst, -c.reliability, k, i);
+                *sum += c.reliability;
+                self.tally.add(c);
+            }
+            for (n, &q) in Quantity::ALL.iter().enumerate() {
+                let mean = match q {
+                    Quantity::Volumetric => e.mean(q),
+                    Quantity::Component(_) => e.mean(q).abs(),
+                };
+                self.max_mean[n] = Extreme::larger(self.max_mean[n], mean, k, i);
+                self.max_std[n] = Extreme::larger(self.max_std[n], e.std(q), k, i);
+            }
+        }
+    }
+
+    /// The reliability of target `t` (its index in [`PathResult::targets`])
+    /// over the evaluated instants; `None` when none is evaluated.
+    pub fn target(&self, t: usize) -> Option<TargetSummary> {
+        let (worst, sum) = self.worst.get(t)?;
+        let worst = (*worst)?;
+        let min = Extreme {
+            value: -worst.value,
+            ..worst
+        };
+        let mean = sum / self.evaluated as f64;
+        Some(TargetSummary {
+            min,
+            mean,
+            met: self
+                .requirement
+                .map(|r| min.value >= r.min && mean >= r.mean),
+        })
+    }
+
+    /// The largest `|mean|` of a component (the largest mean of `|p|`).
+    pub fn max_mean(&self, q: Quantity) -> Option<Extreme> {
+        self.max_mean[Quantity::ALL.iter().position(|x| *x == q)?]
+    }
+
+    /// The largest standard deviation of a quantity.
+    pub fn max_std(&self, q: Quantity) -> Option<Extreme> {
+        self.max_std[Quantity::ALL.iter().position(|x| *x == q)?]
+    }
+
+    /// The requirement, if the study has one.
+    pub fn requirement(&self) -> Option<Requirement> {
+        self.requirement
+    }
+
+    /// Whether every target meets the requirement (`None` without one, or
+    /// when no instant is evaluated).
+    pub fn requirement_met(&self) -> Option<bool> {
+        self.requirement?;
+        let met: Option<Vec<bool>> = (0..self.worst.len())
+            .map(|t| self.target(t).and_then(|s| s.met))
+            .collect();
+        met.map(|m| m.iter().all(|&x| x))
     }
 }
 
@@ -400,64 +499,166 @@ impl PathStudy {
         &self.targets
     }
 
-    /// Runs `algorithm` at every evaluated instant and assembles the records.
+    /// Runs `algorithm` at every evaluated instant and assembles the records:
+    /// [`PathStudy::blocks`] gathered into one result (the cases, target-major
+    /// over the whole path, and the study's summaries as [`Study::run`]
+    /// gives them).
     pub fn run(
         &self,
         algorithm: &Algorithm,
         progress: &dyn Progress,
     ) -> Result<PathResult, ReliabilityError> {
-        let study_result = match &self.study {
-            Some(study) => Some(study.run(algorithm, progress)?),
-            None => None,
-        };
-        // The moments of the evaluated instants, a block at a time in
-        // parallel (in instant order whatever the threads).
+        let nt = self.targets.len();
         let mut records = Vec::with_capacity(self.instants.len());
-        let mut k = 0;
-        for block in self.instants.chunks(MOMENT_BLOCK) {
-            let from = k;
-            let to = from + block.iter().filter(|i| i.axes.is_some()).count();
-            k = to;
-            let mut results = match (&self.study, &study_result) {
-                (Some(study), Some(_)) => (from..to)
-                    .into_par_iter()
-                    .map(|k| {
-                        let moments = study.moments(k);
-                        InstantResult {
-                            nominal: self.nominal[k],
-                            component_mean: moments.mean,
-                            component_std: Component::ALL.map(|c| moments.std(c)),
-                            volumetric: moments.volumetric(),
-                            evaluated: k,
-                        }
-                    })
-                    .collect(),
-                _ => Vec::new(),
+        let mut per_target: Vec<Vec<CaseResult>> = vec![Vec::new(); nt];
+        let mut evaluated = 0;
+        for block in self.blocks(algorithm, progress) {
+            let block = block?;
+            let here = block.evaluated();
+            if let Some(r) = block.study {
+                let n = r.cases.len() / nt.max(1);
+                let mut cases = r.cases.into_iter();
+                for target in per_target.iter_mut() {
+                    target.extend(cases.by_ref().take(n));
+                }
             }
-            .into_iter();
-            for instant in block {
-                let result = match instant.axes {
-                    Some(_) => results.next(),
-                    None => None,
-                };
-                records.push(PathRecord {
-                    instant: instant.clone(),
-                    result,
-                });
-            }
+            records.extend(block.records.into_iter().map(|mut rec| {
+                if let Some(e) = &mut rec.result {
+                    e.evaluated += evaluated;
+                }
+                rec
+            }));
+            evaluated += here;
         }
+        let study = self
+            .study
+            .as_ref()
+            .map(|s| s.finish(algorithm.method(), per_target.concat()));
         Ok(PathResult {
             method: algorithm.method(),
             sided: self.sided,
             targets: self.targets.clone(),
             records,
-            study: study_result,
+            study,
+        })
+    }
+
+    /// The path's records a block of instants at a time, each block run as
+    /// its instants' part of [`PathStudy::run`] (the same cases bit for bit:
+    /// a sampler's case draws the streams of its index in the whole study),
+    /// computed when the iterator is advanced: what `chain path` writes as
+    /// the blocks come, keeping a [`PathSummary`] instead of the records
+    /// (issue 36, point 1).
+    ///
+    /// A block is a [`PathResult`] of its records: its `study` holds the
+    /// block's cases, target-major within the block, and no summaries;
+    /// [`InstantResult::evaluated`] counts within the block.
+    pub fn blocks<'a>(
+        &'a self,
+        algorithm: &'a Algorithm,
+        progress: &'a dyn Progress,
+    ) -> PathBlocks<'a> {
+        PathBlocks {
+            path: self,
+            algorithm,
+            progress,
+            next: 0,
+            evaluated: 0,
+        }
+    }
+}
+
+/// The iterator of [`PathStudy::blocks`].
+pub struct PathBlocks<'a> {
+    path: &'a PathStudy,
+    algorithm: &'a Algorithm,
+    progress: &'a dyn Progress,
+    /// The first instant of the next block.
+    next: usize,
+    /// The evaluated instants before it.
+    evaluated: usize,
+}
+
+impl PathBlocks<'_> {
+    /// The block of instants `from..to`, whose evaluated instants start at
+    /// `first` among the study's points.
+    fn block(&self, from: usize, to: usize, first: usize) -> Result<PathResult, ReliabilityError> {
+        let path = self.path;
+        let block = &path.instants[from..to];
+        let n = block.iter().filter(|i| i.axes.is_some()).count();
+        let study = match &path.study {
+            Some(study) if n > 0 => {
+                let np = study.points().len();
+                let ids: Vec<usize> = (0..path.targets.len())
+                    .flat_map(|t| t * np + first..t * np + first + n)
+                    .collect();
+                let cases = study.run_cases(self.algorithm, &ids, self.progress)?;
+                Some((study, cases))
+            }
+            _ => None,
+        };
+        // The moments of the evaluated instants, in parallel (in instant
+        // order whatever the threads).
+        let mut results = match &study {
+            Some((study, _)) => (0..n)
+                .into_par_iter()
+                .map(|k| {
+                    let moments = study.moments(first + k);
+                    InstantResult {
+                        nominal: path.nominal[first + k],
+                        component_mean: moments.mean,
+                        component_std: Component::ALL.map(|c| moments.std(c)),
+                        volumetric: moments.volumetric(),
+                        evaluated: k,
+                    }
+                })
+                .collect(),
+            None => Vec::new(),
+        }
+        .into_iter();
+        let records = block
+            .iter()
+            .map(|instant| PathRecord {
+                instant: instant.clone(),
+                result: instant.axes.as_ref().and_then(|_| results.next()),
+            })
+            .collect();
+        Ok(PathResult {
+            method: self.algorithm.method(),
+            sided: path.sided,
+            targets: path.targets.clone(),
+            records,
+            study: study.map(|(study, cases)| StudyResult {
+                method: self.algorithm.method(),
+                variables: study.variables().to_vec(),
+                cases,
+                summaries: Vec::new(),
+                requirement: study.spec().requirement,
+            }),
         })
     }
 }
 
-/// The instants whose moments are computed at a time ([`PathStudy::run`]).
-const MOMENT_BLOCK: usize = 4096;
+impl Iterator for PathBlocks<'_> {
+    type Item = Result<PathResult, ReliabilityError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let total = self.path.instants.len();
+        if self.next >= total {
+            return None;
+        }
+        let (from, to) = (self.next, (self.next + PATH_BLOCK).min(total));
+        let first = self.evaluated;
+        self.next = to;
+        self.evaluated += (self.path.instants[from..to].iter())
+            .filter(|i| i.axes.is_some())
+            .count();
+        Some(self.block(from, to, first))
+    }
+}
+
+/// The instants of a block of [`PathStudy::blocks`].
+const PATH_BLOCK: usize = 4096;
 
 /// The targets a study of this spec would have, with their tolerances.
 fn spec_targets(spec: &StudySpec) -> Vec<PathTarget> {
@@ -582,12 +783,15 @@ mod tests {
             assert_eq!(e.nominal, pose.position.map(|x| x + 0.0));
         }
         // Extremes point at records, not at evaluated indices.
-        let worst = r.summary(0).unwrap();
+        let summary = PathSummary::of(&r);
+        let worst = summary.target(0).unwrap();
         let rel = |k: usize| r.case(r.records[k].result.as_ref().unwrap(), 0).reliability;
         assert_eq!(worst.min.value, rel(0).min(rel(2)));
         assert!(worst.min.record == 0 || worst.min.record == 2);
+        let at = &r.records[worst.min.record].instant;
+        assert_eq!((worst.min.row, worst.min.t), (at.row, at.t));
         assert!((worst.mean - 0.5 * (rel(0) + rel(2))).abs() < 1e-15);
-        let big = r.max_std(Quantity::Volumetric).unwrap();
+        let big = summary.max_std(Quantity::Volumetric).unwrap();
         assert_ne!(big.record, 1);
     }
 
@@ -600,7 +804,9 @@ mod tests {
         assert!(path.study().is_none());
         let r = path.run(&Algorithm::Form(Form::default()), &()).unwrap();
         assert_eq!(r.evaluated(), 0);
-        assert!(r.summary(0).is_none() && r.max_std(Quantity::Volumetric).is_none());
+        let summary = PathSummary::of(&r);
+        assert!(summary.target(0).is_none() && summary.max_std(Quantity::Volumetric).is_none());
+        assert_eq!(summary.requirement_met(), None);
         assert_eq!(r.targets.last().unwrap().target, Target::Series);
         assert_eq!(r.targets.last().unwrap().tolerance, None);
         assert!(r.study.is_none());

@@ -24,18 +24,41 @@ pub trait Sampler: Sync {
     /// The method it is.
     fn method(&self) -> Method;
 
-    /// Runs every event (case `i` on streams `i << 32 | block`) under the
-    /// sampler's stop rule (its sample count, or its target coefficient of
-    /// variation within that budget), telling `progress` of the samples
-    /// drawn.
+    /// Runs every event (case `i` on streams `streams.id(i) << 32 | block`)
+    /// under the sampler's stop rule (its sample count, or its target
+    /// coefficient of variation within that budget), telling `progress` of
+    /// the samples drawn.
     fn run_events(
         &self,
         events: &[Event<'_>],
+        streams: Streams<'_>,
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError>;
 }
 
-/// Implements [`Sampler`] for a sampler type whose `run_cases` runs events
+/// Which random streams the cases of a run sample: case `i` of the run
+/// samples stream `i` ([`Streams::ALL`]) unless the run is a part of a larger
+/// study and carries the study's case numbers ([`Streams::of`]: a path run a
+/// block of instants at a time draws what the whole run would; issue 36).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Streams<'a>(Option<&'a [usize]>);
+
+impl<'a> Streams<'a> {
+    /// Case `i` samples stream `i`.
+    pub const ALL: Streams<'static> = Streams(None);
+
+    /// Case `i` samples stream `ids[i]` (`ids` as long as the run's events).
+    pub fn of(ids: &'a [usize]) -> Streams<'a> {
+        Streams(Some(ids))
+    }
+
+    /// The stream of the run's case `case`.
+    pub(crate) fn id(&self, case: usize) -> u32 {
+        case_id(self.0.map_or(case, |ids| ids[case]))
+    }
+}
+
+/// Implements [`Sampler`] for a sampler type whose `run_streams` runs events
 /// under its own stop rule.
 macro_rules! impl_sampler {
     ($($t:ty => $method:expr),* $(,)?) => {$(
@@ -47,9 +70,10 @@ macro_rules! impl_sampler {
             fn run_events(
                 &self,
                 events: &[$crate::limit_state::Event<'_>],
+                streams: $crate::sampler::Streams<'_>,
                 progress: &dyn $crate::sampler::Progress,
             ) -> Result<Vec<$crate::sampler::SimulationResult>, $crate::error::ReliabilityError> {
-                self.run_cases(events, progress)
+                self.run_streams(events, streams, progress)
             }
         }
     )*};

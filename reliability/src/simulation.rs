@@ -32,8 +32,8 @@ use crate::method::Method;
 use crate::normal;
 use crate::par::prelude::*;
 use crate::rng::CaseRng;
-use crate::sampler::{case_id, check_samples, drive, finish, impl_sampler, Sums};
 pub use crate::sampler::{check_cov, Progress, SimulationResult, Stop, Stopping, MAX_SAMPLES};
+use crate::sampler::{check_samples, drive, finish, impl_sampler, Streams, Sums};
 use crate::util::dot;
 use chain_core::model::Sided;
 
@@ -100,15 +100,26 @@ impl MonteCarlo {
         events: &[Event<'_, L>],
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
+        self.run_streams(events, Streams::ALL, progress)
+    }
+
+    /// [`MonteCarlo::run_cases`], case `i` on the streams of `streams.id(i)`.
+    pub fn run_streams<L: LimitState>(
+        &self,
+        events: &[Event<'_, L>],
+        streams: Streams<'_>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
         if let Some(target) = self.cov {
             check_cov(target)?;
         }
-        self.run_rule(events, self.cov, progress)
+        self.run_rule(events, streams, self.cov, progress)
     }
 
     fn run_rule<L: LimitState>(
         &self,
         events: &[Event<'_, L>],
+        streams: Streams<'_>,
         target: Option<f64>,
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
@@ -121,7 +132,7 @@ impl MonteCarlo {
         let block = |case: usize, block: u32, count: u64, x: &mut [f64]| {
             let event = &events[case];
             let x = &mut x[..event.inputs.len()];
-            let mut rng = CaseRng::new(self.seed, case_id(case), block);
+            let mut rng = CaseRng::new(self.seed, streams.id(case), block);
             let mut fails = 0u64;
             if let Some(a) = &affine[case] {
                 for _ in 0..count {
@@ -195,11 +206,25 @@ impl ImportanceSampling {
         events: &[Event<'_, L>],
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
+        self.run_streams(events, Streams::ALL, progress)
+    }
+
+    /// [`ImportanceSampling::run_cases`], case `i` on the streams of
+    /// `streams.id(i)`.
+    pub fn run_streams<L: LimitState>(
+        &self,
+        events: &[Event<'_, L>],
+        streams: Streams<'_>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
         let forms = events
             .par_iter()
             .map(|e| self.form.run(e))
             .collect::<Result<Vec<_>, _>>()?;
-        self.run_cases_with(events, forms, progress)
+        if let Some(target) = self.cov {
+            check_cov(target)?;
+        }
+        self.run_rule(events, forms, streams, self.cov, progress)
     }
 
     /// Runs several events with their FORM results already computed.
@@ -218,13 +243,14 @@ impl ImportanceSampling {
         if let Some(target) = self.cov {
             check_cov(target)?;
         }
-        self.run_rule(events, forms, self.cov, progress)
+        self.run_rule(events, forms, Streams::ALL, self.cov, progress)
     }
 
     fn run_rule<L: LimitState>(
         &self,
         events: &[Event<'_, L>],
         forms: Vec<FormResult>,
+        streams: Streams<'_>,
         target: Option<f64>,
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
@@ -243,7 +269,7 @@ impl ImportanceSampling {
             .collect();
         let width = kernels.iter().map(Kernel::scratch).max().unwrap_or(0);
         let block = |case: usize, block: u32, count: u64, scratch: &mut [f64]| {
-            let mut rng = CaseRng::new(self.seed, case_id(case), block);
+            let mut rng = CaseRng::new(self.seed, streams.id(case), block);
             kernels[case].block(&events[case], &mut rng, count, scratch)
         };
         let estimate = |k: &Kernel, s: &Sums, samples: u64| {

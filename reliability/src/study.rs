@@ -29,7 +29,7 @@ use crate::limit_state::{Criterion, Event, ToleranceLimitState};
 pub use crate::method::Method;
 use crate::normal;
 use crate::par::prelude::*;
-use crate::sampler::{Progress, Sampler, SimulationResult, Stopping};
+use crate::sampler::{Progress, Sampler, SimulationResult, Stopping, Streams};
 use crate::sensitivity::{sensitivity, SensitivityMethod, SensitivityResult};
 use crate::simulation::{ImportanceSampling, MonteCarlo};
 use crate::sorm::{Sorm, SormResult};
@@ -386,6 +386,83 @@ impl CaseResult {
     /// levels exhausted); true for FORM and plain sample counts.
     pub fn sampler_converged(&self) -> bool {
         self.stopping.is_none_or(|s| s.converged)
+    }
+}
+
+/// What a run's cases add up to, added case by case: the limit-state calls,
+/// how FORM ended, the largest standard error, and the cases that did not
+/// converge (how many, and the first of each kind). The one account of the
+/// cases behind the summaries of a grid study and of a path, which a path
+/// run a block of instants at a time adds up as its blocks finish
+/// (issue 36).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CaseTally {
+    /// The cases added.
+    pub cases: usize,
+    /// Their calls, summed.
+    pub calls: Calls,
+    /// The cases with a FORM account (FORM, SORM, the importance sampling).
+    pub forms: usize,
+    /// How many of those FORM runs ended in each [`Termination::ALL`].
+    pub terminations: [usize; Termination::ALL.len()],
+    /// How many of those converged.
+    pub forms_converged: usize,
+    /// The first case whose FORM did not converge.
+    pub first_form_unconverged: Option<CaseResult>,
+    /// The largest standard error of `p_f` (sampling only).
+    pub max_std_error: Option<f64>,
+    /// The cases whose sampler stopped without meeting its rule.
+    pub sampler_unconverged: usize,
+    /// The first of them.
+    pub first_sampler_unconverged: Option<CaseResult>,
+}
+
+impl CaseTally {
+    /// The tally of `cases`, in their order.
+    pub fn of<'a>(cases: impl IntoIterator<Item = &'a CaseResult>) -> CaseTally {
+        let mut tally = CaseTally::default();
+        cases.into_iter().for_each(|c| tally.add(c));
+        tally
+    }
+
+    /// Adds one case.
+    pub fn add(&mut self, c: &CaseResult) {
+        self.cases += 1;
+        self.calls.values += c.calls.values;
+        self.calls.gradients += c.calls.gradients;
+        if let Some(f) = &c.form {
+            self.forms += 1;
+            if let Some(k) = Termination::ALL.iter().position(|t| *t == f.termination) {
+                self.terminations[k] += 1;
+            }
+            if f.converged {
+                self.forms_converged += 1;
+            } else if self.first_form_unconverged.is_none() {
+                self.first_form_unconverged = Some(c.clone());
+            }
+        }
+        if let Some(se) = c.std_error {
+            self.max_std_error = Some(self.max_std_error.map_or(se, |m| m.max(se)));
+        }
+        if !c.sampler_converged() {
+            self.sampler_unconverged += 1;
+            if self.first_sampler_unconverged.is_none() {
+                self.first_sampler_unconverged = Some(c.clone());
+            }
+        }
+    }
+
+    /// The FORM terminations that occurred and how often, in
+    /// [`Termination::ALL`] order.
+    pub fn terminations(&self) -> impl Iterator<Item = (Termination, usize)> + '_ {
+        (Termination::ALL.iter().copied())
+            .zip(self.terminations)
+            .filter(|(_, n)| *n > 0)
+    }
+
+    /// The cases whose FORM did not converge.
+    pub fn form_unconverged(&self) -> usize {
+        self.forms - self.forms_converged
     }
 }
 
@@ -962,16 +1039,20 @@ impl Study {
 
     /// FORM on every case (exact for one-sided components in normal inputs).
     pub fn form(&self, form: &Form) -> Result<StudyResult, ReliabilityError> {
-        self.form_reporting(form, &())
+        let cases = self.form_cases(form, self.all_cases(), &())?;
+        Ok(self.finish(Method::Form, cases))
     }
 
-    /// [`Study::form`], telling `progress` of each block of cases done.
-    fn form_reporting(
+    /// FORM on the cases of `set`, telling `progress` of each block of
+    /// cases done.
+    fn form_cases(
         &self,
         form: &Form,
+        set: CaseSet<'_>,
         progress: &dyn Progress,
-    ) -> Result<StudyResult, ReliabilityError> {
-        let cases = self.cases_in_blocks(
+    ) -> Result<Vec<CaseResult>, ReliabilityError> {
+        self.cases_in_blocks(
+            set,
             progress,
             |e| form.run(e),
             |i, r| {
@@ -980,35 +1061,35 @@ impl Study {
                 c.calls = r.calls;
                 c
             },
-        )?;
-        Ok(self.finish(Method::Form, cases))
+        )
     }
 
-    /// Runs `run` on every case's event and keeps `keep` of its result, a
-    /// block of [`CASE_BLOCK`] cases at a time (in parallel within the
-    /// block): an event and its full result (design point, direction
-    /// cosines) live only while their block runs, so a study of a million
-    /// points keeps only its cases (issue 36, point 1). The cases come in
-    /// case order whatever the blocks.
+    /// Runs `run` on the event of every case of `set` and keeps `keep` of
+    /// its result (given the case's index in the study), a block of
+    /// [`CASE_BLOCK`] cases at a time (in parallel within the block): an
+    /// event and its full result (design point, direction cosines) live only
+    /// while their block runs, so a study of a million points keeps only its
+    /// cases (issue 36, point 1). The cases come in the set's order whatever
+    /// the blocks.
     fn cases_in_blocks<T: Send>(
         &self,
+        set: CaseSet<'_>,
         progress: &dyn Progress,
         run: impl Fn(&Event<'_>) -> Result<T, ReliabilityError> + Sync + Send,
         keep: impl Fn(usize, T) -> CaseResult,
     ) -> Result<Vec<CaseResult>, ReliabilityError> {
-        let np = self.points.len();
-        let total = self.targets.len() * np;
+        let total = set.len();
         let mut cases = Vec::with_capacity(total);
         let mut start = 0;
         while start < total {
             let end = (start + CASE_BLOCK).min(total);
-            let events = self.events_of(start..end)?;
+            let events = self.events_in(set, start..end)?;
             let results = per_event(&events, &run)?;
             cases.extend(
                 results
                     .into_iter()
                     .enumerate()
-                    .map(|(k, r)| keep(start + k, r)),
+                    .map(|(k, r)| keep(set.id(start + k), r)),
             );
             progress.advance((end - start) as u64);
             start = end;
@@ -1016,19 +1097,47 @@ impl Study {
         Ok(cases)
     }
 
+    /// The events of the cases at `positions` of `set`, each consecutive
+    /// run of case indices through [`Study::events_of`].
+    fn events_in(
+        &self,
+        set: CaseSet<'_>,
+        positions: Range<usize>,
+    ) -> Result<Vec<Event<'_>>, ReliabilityError> {
+        let ids = match set {
+            CaseSet::All(_) => return self.events_of(positions),
+            CaseSet::Ids(ids) => &ids[positions],
+        };
+        let mut out = Vec::with_capacity(ids.len());
+        let mut k = 0;
+        while k < ids.len() {
+            let mut e = k + 1;
+            while e < ids.len() && ids[e] == ids[e - 1] + 1 {
+                e += 1;
+            }
+            out.extend(self.events_of(ids[k]..ids[e - 1] + 1)?);
+            k = e;
+        }
+        Ok(out)
+    }
+
     /// SORM on every case: FORM, then the exact curvatures at its design
     /// point ([`crate::sorm`]); the case's probability is Tvedt's.
     pub fn sorm(&self, sorm: &Sorm) -> Result<StudyResult, ReliabilityError> {
-        self.sorm_reporting(sorm, &())
+        let cases = self.sorm_cases(sorm, self.all_cases(), &())?;
+        Ok(self.finish(Method::Sorm, cases))
     }
 
-    /// [`Study::sorm`], telling `progress` of each block of cases done.
-    fn sorm_reporting(
+    /// SORM on the cases of `set`, telling `progress` of each block of
+    /// cases done.
+    fn sorm_cases(
         &self,
         sorm: &Sorm,
+        set: CaseSet<'_>,
         progress: &dyn Progress,
-    ) -> Result<StudyResult, ReliabilityError> {
-        let cases = self.cases_in_blocks(
+    ) -> Result<Vec<CaseResult>, ReliabilityError> {
+        self.cases_in_blocks(
+            set,
             progress,
             |e| sorm.run(e),
             |i, r: SormResult| {
@@ -1038,8 +1147,7 @@ impl Study {
                 c.sorm = Some(Box::new(SormCase::of(&r)));
                 c
             },
-        )?;
-        Ok(self.finish(Method::Sorm, cases))
+        )
     }
 
     /// The importance sampling on every case.
@@ -1066,9 +1174,22 @@ impl Study {
         sampler: &dyn Sampler,
         progress: &dyn Progress,
     ) -> Result<StudyResult, ReliabilityError> {
-        let events = self.events()?;
-        let results = sampler.run_events(&events, progress)?;
-        Ok(self.finish(sampler.method(), self.sampled(&results)))
+        let set = self.all_cases();
+        let cases = self.sampled_cases(sampler, set, progress)?;
+        Ok(self.finish(sampler.method(), cases))
+    }
+
+    /// `sampler` on the cases of `set`, each on the streams of its index in
+    /// the study.
+    fn sampled_cases(
+        &self,
+        sampler: &dyn Sampler,
+        set: CaseSet<'_>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<CaseResult>, ReliabilityError> {
+        let events = self.events_in(set, 0..set.len())?;
+        let results = sampler.run_events(&events, set.streams(), progress)?;
+        Ok(self.sampled(set, &results))
     }
 
     /// Runs `algorithm` on every case (`progress` hears of the samples
@@ -1078,13 +1199,48 @@ impl Study {
         algorithm: &Algorithm,
         progress: &dyn Progress,
     ) -> Result<StudyResult, ReliabilityError> {
+        let cases = self.run_set(algorithm, self.all_cases(), progress)?;
+        Ok(self.finish(algorithm.method(), cases))
+    }
+
+    /// Runs `algorithm` on the cases `ids` (indices in the study, target-major,
+    /// ascending), each exactly as [`Study::run`] runs it (a sampler's case
+    /// draws the streams of its index in the study): what a path run a
+    /// block of instants at a time runs (issue 36, point 1).
+    pub fn run_cases(
+        &self,
+        algorithm: &Algorithm,
+        ids: &[usize],
+        progress: &dyn Progress,
+    ) -> Result<Vec<CaseResult>, ReliabilityError> {
+        let total = self.targets.len() * self.points.len();
+        if let Some(&bad) = ids.iter().find(|&&i| i >= total) {
+            return Err(ReliabilityError::Dimension {
+                what: "case index",
+                expected: total,
+                found: bad,
+            });
+        }
+        self.run_set(algorithm, CaseSet::Ids(ids), progress)
+    }
+
+    fn all_cases(&self) -> CaseSet<'static> {
+        CaseSet::All(self.targets.len() * self.points.len())
+    }
+
+    fn run_set(
+        &self,
+        algorithm: &Algorithm,
+        set: CaseSet<'_>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<CaseResult>, ReliabilityError> {
         match algorithm {
-            Algorithm::Form(form) => self.form_reporting(form, progress),
-            Algorithm::Sorm(sorm) => self.sorm_reporting(sorm, progress),
-            Algorithm::Subset(ss) => self.subset(ss, progress),
-            Algorithm::ImportanceSampling(is) => self.sampled_by(is, progress),
-            Algorithm::MonteCarlo(mc) => self.sampled_by(mc, progress),
-            Algorithm::Directional(ds) => self.sampled_by(ds, progress),
+            Algorithm::Form(form) => self.form_cases(form, set, progress),
+            Algorithm::Sorm(sorm) => self.sorm_cases(sorm, set, progress),
+            Algorithm::Subset(ss) => self.subset_cases(ss, set, progress),
+            Algorithm::ImportanceSampling(is) => self.sampled_cases(is, set, progress),
+            Algorithm::MonteCarlo(mc) => self.sampled_cases(mc, set, progress),
+            Algorithm::Directional(ds) => self.sampled_cases(ds, set, progress),
         }
     }
 
@@ -1094,13 +1250,23 @@ impl Study {
         ss: &SubsetSimulation,
         progress: &dyn Progress,
     ) -> Result<StudyResult, ReliabilityError> {
-        let events = self.events()?;
-        let results = ss.run_cases(&events, progress)?;
-        let cases = results
+        let cases = self.subset_cases(ss, self.all_cases(), progress)?;
+        Ok(self.finish(Method::Subset, cases))
+    }
+
+    fn subset_cases(
+        &self,
+        ss: &SubsetSimulation,
+        set: CaseSet<'_>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<CaseResult>, ReliabilityError> {
+        let events = self.events_in(set, 0..set.len())?;
+        let results = ss.run_streams(&events, set.streams(), progress)?;
+        Ok(results
             .into_iter()
             .enumerate()
-            .map(|(i, r)| {
-                let mut c = self.case(i, r.reliability, r.pf, r.beta);
+            .map(|(k, r)| {
+                let mut c = self.case(set.id(k), r.reliability, r.pf, r.beta);
                 c.std_error = Some(r.std_error);
                 c.cov = Some(r.cov);
                 c.samples = Some(r.samples);
@@ -1112,16 +1278,15 @@ impl Study {
                 c.levels = Some(r.levels);
                 c
             })
-            .collect();
-        Ok(self.finish(Method::Subset, cases))
+            .collect())
     }
 
-    fn sampled(&self, results: &[SimulationResult]) -> Vec<CaseResult> {
+    fn sampled(&self, set: CaseSet<'_>, results: &[SimulationResult]) -> Vec<CaseResult> {
         results
             .iter()
             .enumerate()
-            .map(|(i, r)| {
-                let mut c = self.case(i, r.reliability, r.pf, r.beta);
+            .map(|(k, r)| {
+                let mut c = self.case(set.id(k), r.reliability, r.pf, r.beta);
                 c.std_error = Some(r.std_error);
                 c.cov = Some(r.cov);
                 c.samples = Some(r.samples);
@@ -1156,7 +1321,8 @@ impl Study {
         }
     }
 
-    fn finish(&self, method: Method, cases: Vec<CaseResult>) -> StudyResult {
+    /// The study's result from its cases, every case in order.
+    pub(crate) fn finish(&self, method: Method, cases: Vec<CaseResult>) -> StudyResult {
         let np = self.points.len();
         let summaries = self
             .targets
@@ -1498,11 +1664,44 @@ pub fn closed_form_reliability(tolerance: f64, sigma_e: f64) -> f64 {
     normal::cdf(tolerance / sigma_e)
 }
 
-/// `f` on every event: in parallel from 64 events on (below that the
-/// threads cost more than they save); results in event order.
+/// The cases a run covers: every case of the study (`All(n)`), or the
+/// listed ones (`Ids`: indices in the study, target-major, ascending).
+#[derive(Debug, Clone, Copy)]
+enum CaseSet<'a> {
+    All(usize),
+    Ids(&'a [usize]),
+}
+
+impl CaseSet<'_> {
+    fn len(&self) -> usize {
+        match self {
+            CaseSet::All(n) => *n,
+            CaseSet::Ids(ids) => ids.len(),
+        }
+    }
+
+    /// The study index of the set's `k`-th case.
+    fn id(&self, k: usize) -> usize {
+        match self {
+            CaseSet::All(_) => k,
+            CaseSet::Ids(ids) => ids[k],
+        }
+    }
+
+    /// The random streams of the set's cases: their study indices.
+    fn streams(&self) -> Streams<'_> {
+        match self {
+            CaseSet::All(_) => Streams::ALL,
+            CaseSet::Ids(ids) => Streams::of(ids),
+        }
+    }
+}
+
 /// The cases [`Study::form`] and [`Study::sorm`] run at a time.
 const CASE_BLOCK: usize = 4096;
 
+/// `f` on every event: in parallel from 64 events on (below that the
+/// threads cost more than they save); results in event order.
 fn per_event<T: Send>(
     events: &[Event<'_>],
     f: impl Fn(&Event<'_>) -> Result<T, ReliabilityError> + Sync + Send,

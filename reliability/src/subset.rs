@@ -64,7 +64,7 @@ use crate::limit_state::{Event, LimitState};
 use crate::normal;
 use crate::par::prelude::*;
 use crate::rng::CaseRng;
-use crate::sampler::{check_cov, Progress, Stop, Stopping};
+use crate::sampler::{check_cov, Progress, Stop, Stopping, Streams};
 use crate::standard::Standard;
 
 /// The target acceptance rate of the aCS adaptation (Papaioannou et al.
@@ -226,10 +226,21 @@ impl SubsetSimulation {
         events: &[Event<'_, L>],
         progress: &dyn Progress,
     ) -> Result<Vec<SubsetResult>, ReliabilityError> {
+        self.run_streams(events, Streams::ALL, progress)
+    }
+
+    /// [`SubsetSimulation::run_cases`], case `i` on the streams of
+    /// `streams.id(i)`.
+    pub fn run_streams<L: LimitState>(
+        &self,
+        events: &[Event<'_, L>],
+        streams: Streams<'_>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<SubsetResult>, ReliabilityError> {
         let (nc, ns) = self.check()?;
         let case = |i: usize| -> SubsetResult {
             let std = Standard::new(&events[i]);
-            let case_id = u32::try_from(i).unwrap_or(u32::MAX);
+            let case_id = streams.id(i);
             match self.cov {
                 None => {
                     let r = self.one_run(&std, case_id, 0, nc, ns, progress);

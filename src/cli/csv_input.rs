@@ -90,8 +90,7 @@ pub(crate) fn numeric_rows(input: &mut CsvInput) -> miette::Result<Vec<(usize, V
     let name = &input.name;
     input
         .table
-        .rows
-        .iter()
+        .rows()
         .map(|row| {
             let line = row.first().map_or(0, |(_, o)| o.line);
             let values = row

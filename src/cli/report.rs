@@ -60,6 +60,12 @@ pub trait Report: Serialize {
     /// The human-readable table (ends with a newline).
     fn table(&self) -> String;
 
+    /// Writes the table into `out`: [`Report::table`], unless the document
+    /// writes its rows as they come (a streamed path).
+    fn write_table(&self, out: &mut dyn Write) -> std::io::Result<()> {
+        out.write_all(self.table().as_bytes())
+    }
+
     /// Writes the CSV form into `out`, a header and then each row as it is
     /// formed (nothing is collected, so a million-row map streams);
     /// `None` when the document has no CSV form (the command does not offer
@@ -157,7 +163,7 @@ fn write_json<T: Serialize + ?Sized>(doc: &T, out: &mut dyn Write) -> std::io::R
 /// rendered. `Ok(false)`: the document has no CSV form.
 fn write_to<R: Report>(doc: &R, format: Format, out: &mut dyn Write) -> std::io::Result<bool> {
     match format {
-        Format::Table => out.write_all(doc.table().as_bytes())?,
+        Format::Table => doc.write_table(out)?,
         Format::Json => write_json(doc, out)?,
         Format::Csv => {
             let mut csv = Csv::new(out);

@@ -5,7 +5,7 @@
 //! requirement's line.
 
 use chain_core::model::Sided;
-use reliability::{FormCase, Method, Posterior, Study, StudyResult, Termination};
+use reliability::{CaseTally, Method, Posterior, Study, StudyResult};
 
 use super::report;
 
@@ -143,17 +143,9 @@ fn flat(idx: &[usize], dims: &[usize]) -> usize {
 }
 
 /// `closed form 45, converged 3` (the terminations that occur).
-pub(crate) fn terminations_text<'a>(forms: impl Iterator<Item = &'a FormCase>) -> String {
-    let mut counts = [0usize; Termination::ALL.len()];
-    for f in forms {
-        if let Some(k) = Termination::ALL.iter().position(|t| *t == f.termination) {
-            counts[k] += 1;
-        }
-    }
-    Termination::ALL
-        .iter()
-        .zip(counts)
-        .filter(|(_, n)| *n > 0)
+fn terminations_text(tally: &CaseTally) -> String {
+    tally
+        .terminations()
         .map(|(t, n)| format!("{} {n}", t.name().replace('_', " ")))
         .collect::<Vec<_>>()
         .join(", ")
@@ -162,27 +154,24 @@ pub(crate) fn terminations_text<'a>(forms: impl Iterator<Item = &'a FormCase>) -
 /// The table line on how FORM ended and what the cases cost: `FORM: 25 of
 /// 25 cases converged (closed form 25); limit-state calls: 0 values, 0
 /// gradients`.
-pub(crate) fn calls_text<'a>(
-    cases: impl Iterator<Item = &'a reliability::CaseResult> + Clone,
-    method: Method,
-) -> String {
-    let values: u64 = cases.clone().map(|c| c.calls.values).sum();
-    let gradients: u64 = cases.clone().map(|c| c.calls.gradients).sum();
-    let calls = format!("limit-state calls: {values} values, {gradients} gradients");
-    let forms: Vec<&FormCase> = cases.filter_map(|c| c.form.as_ref()).collect();
-    if forms.is_empty() {
+pub(crate) fn calls_text(tally: &CaseTally, method: Method) -> String {
+    let calls = format!(
+        "limit-state calls: {} values, {} gradients",
+        tally.calls.values, tally.calls.gradients
+    );
+    if tally.forms == 0 {
         return calls;
     }
-    let converged = forms.iter().filter(|f| f.converged).count();
     let what = match method {
         Method::Form => "FORM",
         Method::Sorm => "FORM (SORM's design points)",
         _ => "FORM (centring)",
     };
     format!(
-        "{what}: {converged} of {} cases converged ({}); {calls}",
-        forms.len(),
-        terminations_text(forms.iter().copied())
+        "{what}: {} of {} cases converged ({}); {calls}",
+        tally.forms_converged,
+        tally.forms,
+        terminations_text(tally)
     )
 }
 

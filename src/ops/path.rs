@@ -9,6 +9,7 @@
 //! Python from arrays; both build a [`PathRequest`] and get the same
 //! [`PathDocument`].
 
+use std::cell::RefCell;
 use std::sync::Arc;
 
 use chain_core::inverse::Status;
@@ -17,8 +18,8 @@ use chain_core::named::NameMap;
 use chain_core::Machine;
 use reliability::document::RequirementDocument;
 use reliability::{
-    machine, Calls, Extreme, FormCase, InstantResult, Method, PathInstant, PathResult, PathStudy,
-    Progress, Quantity, ReliabilityError, Target, Termination,
+    machine, Algorithm, Calls, Extreme, FormCase, InstantResult, Method, PathInstant, PathResult,
+    PathStudy, PathSummary, PathTarget, Progress, Quantity, ReliabilityError, Target, Termination,
 };
 use serde::{Serialize, Serializer};
 
@@ -103,10 +104,10 @@ pub enum PathOpsError {
     Machine(#[from] NoInverse),
 }
 
-/// The document of `chain path`: the library's [`PathResult`] with what the
-/// command knows of its input (JSON: docs/path.md).
+/// What `chain path` knows of its output before it runs: the machine, the
+/// input, the method and the targets (the JSON's head, the table's title).
 #[derive(Debug, Clone)]
-pub struct PathDocument {
+pub struct PathHead {
     /// The machine.
     pub machine: String,
     /// The frame of the errors (`workpiece`, ...).
@@ -119,7 +120,34 @@ pub struct PathDocument {
     pub variables: Vec<String>,
     /// Whether the input gave the instants `t` (otherwise the row numbers).
     pub has_t: bool,
-    /// The records and summaries.
+    /// The instants of the path.
+    pub instants: usize,
+    /// The algorithm.
+    pub method: Method,
+    /// One- or two-sided tolerances.
+    pub sided: Sided,
+    /// The targets, in case order.
+    pub targets: Vec<PathTarget>,
+    /// Whether the cases carry a sampler's standard error (a sampling
+    /// method and at least one instant with axis values).
+    pub sampled: bool,
+}
+
+impl PathHead {
+    /// The targets, in case order.
+    pub fn target_names(&self) -> impl Iterator<Item = Target> + '_ {
+        self.targets.iter().map(|t| t.target)
+    }
+}
+
+/// The document of `chain path` kept in memory (Python, `--plot`): the
+/// library's [`PathResult`] with what the command knows of its input (JSON:
+/// docs/path.md, through [`PathOutput`]).
+#[derive(Debug, Clone)]
+pub struct PathDocument {
+    /// The head.
+    pub head: PathHead,
+    /// The records and the whole study's result.
     pub result: PathResult,
     /// Notes and warnings on the run (FORM's limits, non-normal inputs,
     /// cases that did not converge), each a line `note: …` or `warning: …`;
@@ -127,12 +155,29 @@ pub struct PathDocument {
     pub notes: Vec<String>,
 }
 
-/// Runs `chain path`.
+/// `chain path` checked and its study built, ready to run in memory
+/// ([`PreparedPath::run`]) or a block of instants at a time as its output is
+/// written ([`PreparedPath::output`]).
+pub struct PreparedPath {
+    /// The head of its output.
+    pub head: PathHead,
+    /// The notes known before the run (FORM's limits, non-normal inputs).
+    pub notes: Vec<String>,
+    path: PathStudy,
+    algorithm: Algorithm,
+}
+
+/// Runs `chain path` in memory.
 pub fn run(
     machine: &Machine,
     request: &PathRequest<'_>,
     progress: &dyn Progress,
 ) -> Result<PathDocument, PathOpsError> {
+    prepare(machine, request)?.run(progress)
+}
+
+/// Checks `chain path`'s request and builds its study.
+pub fn prepare(machine: &Machine, request: &PathRequest<'_>) -> Result<PreparedPath, PathOpsError> {
     let m = machine;
     request.algorithm.check()?;
     resolve::check_parameters(m, request.params)?;
@@ -169,7 +214,9 @@ pub fn run(
     // The study keeps the model, not every instant's sensitivities
     // (issue 36): a path of a million instants holds its points only.
     let model = Arc::new(chain_core::compile(m));
+    let sided = spec.sided;
     let path = PathStudy::on_demand(model, &params, inputs, spec, instants)?;
+    let algorithm = request.algorithm.algorithm();
     let mut notes = Vec::new();
     match path.study() {
         None => notes
@@ -186,20 +233,154 @@ pub fn run(
             }
         }
     }
-    let result = path.run(&request.algorithm.algorithm(), progress)?;
-    if let (Some(study), Some(r)) = (path.study(), &result.study) {
-        notes.extend(study::unconverged_warnings(r, study.variables()));
-    }
-    Ok(PathDocument {
+    let method = algorithm.method();
+    let head = PathHead {
         machine: m.name.clone(),
         frame: m.frame.name(),
         input: request.input.kind(),
         source: request.input.source().to_string(),
         variables: m.variables.iter().map(|v| v.name.clone()).collect(),
         has_t,
-        result,
+        instants: path.instants().len(),
+        method,
+        sided,
+        targets: path.targets().to_vec(),
+        sampled: !matches!(method, Method::Form | Method::Sorm) && path.study().is_some(),
+    };
+    Ok(PreparedPath {
+        head,
         notes,
+        path,
+        algorithm,
     })
+}
+
+impl PreparedPath {
+    /// Runs the whole path and keeps every record.
+    pub fn run(self, progress: &dyn Progress) -> Result<PathDocument, PathOpsError> {
+        let result = self.path.run(&self.algorithm, progress)?;
+        let mut notes = self.notes;
+        notes.extend(self.head.run_notes(&PathSummary::of(&result)));
+        Ok(PathDocument {
+            head: self.head,
+            result,
+            notes,
+        })
+    }
+
+    /// The output of the path run a block of instants at a time as it is
+    /// written (each block's records dropped once written; issue 36).
+    pub fn output<'a>(&'a self, progress: &'a dyn Progress) -> PathOutput<'a> {
+        PathOutput {
+            head: &self.head,
+            records: Records::Streamed {
+                path: &self.path,
+                algorithm: &self.algorithm,
+                progress,
+            },
+            summary: RefCell::new(None),
+            failed: RefCell::new(None),
+        }
+    }
+}
+
+impl PathHead {
+    /// The warnings on the cases that did not converge.
+    pub fn run_notes(&self, summary: &PathSummary) -> Vec<String> {
+        study::unconverged_warnings(&summary.tally, self.method, &self.variables)
+    }
+}
+
+impl PathDocument {
+    /// Its output (the records it keeps).
+    pub fn output(&self) -> PathOutput<'_> {
+        PathOutput {
+            head: &self.head,
+            records: Records::Kept(&self.result),
+            summary: RefCell::new(None),
+            failed: RefCell::new(None),
+        }
+    }
+}
+
+/// Where a [`PathOutput`]'s records come from.
+enum Records<'a> {
+    /// A result in memory: one block.
+    Kept(&'a PathResult),
+    /// The study, run a block at a time.
+    Streamed {
+        path: &'a PathStudy,
+        algorithm: &'a Algorithm,
+        progress: &'a dyn Progress,
+    },
+}
+
+/// The output of `chain path`, whatever its format: the head, then the
+/// records a block at a time ([`PathOutput::each_block`]; computed as they
+/// are written when the path is streamed), then the [`PathSummary`] they add
+/// up to. The JSON (its `Serialize`) and the CLI's table and CSV read it.
+pub struct PathOutput<'a> {
+    /// The head.
+    pub head: &'a PathHead,
+    records: Records<'a>,
+    summary: RefCell<Option<PathSummary>>,
+    failed: RefCell<Option<ReliabilityError>>,
+}
+
+impl PathOutput<'_> {
+    /// Hands every block of records to `f`, with the index of its first
+    /// record, and keeps the summary they add up to
+    /// ([`PathOutput::summary`]). A run that fails keeps its error
+    /// ([`PathOutput::take_error`]) and ends the blocks with `stop`'s value
+    /// of it; `f`'s error ends them too.
+    pub fn each_block<E>(
+        &self,
+        mut f: impl FnMut(&PathResult, usize) -> Result<(), E>,
+        stop: impl Fn(&ReliabilityError) -> E,
+    ) -> Result<(), E> {
+        let h = self.head;
+        let requirement = match &self.records {
+            Records::Kept(r) => r.requirement(),
+            Records::Streamed { path, .. } => path.study().and_then(|s| s.spec().requirement),
+        };
+        let mut summary = PathSummary::new(h.targets.len(), requirement);
+        match &self.records {
+            Records::Kept(r) => {
+                f(r, 0)?;
+                summary.add(r);
+            }
+            Records::Streamed {
+                path,
+                algorithm,
+                progress,
+            } => {
+                for block in path.blocks(algorithm, *progress) {
+                    let block = match block {
+                        Ok(b) => b,
+                        Err(e) => {
+                            let out = stop(&e);
+                            *self.failed.borrow_mut() = Some(e);
+                            return Err(out);
+                        }
+                    };
+                    f(&block, summary.instants)?;
+                    summary.add(&block);
+                }
+            }
+        }
+        *self.summary.borrow_mut() = Some(summary);
+        Ok(())
+    }
+
+    /// The summary, once every block is handed out.
+    pub fn summary(&self) -> Option<PathSummary> {
+        self.summary.borrow().clone()
+    }
+
+    /// The error that ended the run, if one did.
+    pub fn take_error(&self) -> Option<ReliabilityError> {
+        self.failed.borrow_mut().take()
+    }
 }
 
 /// The instants of a table of axis values; whether it gave `t`.
@@ -236,20 +417,15 @@ struct AtJson {
     t: f64,
 }
 
-impl PathDocument {
-    /// Where an extreme occurs.
-    fn at(&self, e: &Extreme) -> AtJson {
-        let i = &self.result.records[e.record].instant;
-        AtJson { row: i.row, t: i.t }
+impl AtJson {
+    fn of(e: &Extreme) -> AtJson {
+        AtJson { row: e.row, t: e.t }
     }
+}
 
-    /// The targets, in case order.
-    pub fn targets(&self) -> impl Iterator<Item = Target> + '_ {
-        self.result.targets.iter().map(|t| t.target)
-    }
-
+impl PathHead {
     fn per_target<V>(&self, values: impl Iterator<Item = V>) -> NameMap<Target, V> {
-        NameMap(self.targets().zip(values).collect())
+        NameMap(self.target_names().zip(values).collect())
     }
 }
 
@@ -264,17 +440,27 @@ struct PathJson<'a> {
     tolerances: NameMap<Target, f64>,
     variables: &'a [String],
     instants: InstantsJson<'a>,
-    summary: SummaryJson,
+    summary: SummaryJson<'a>,
 }
 
-/// The instants of [`PathJson`], each object formed as it is written (a
-/// million instants are not a second list in memory; issue 36).
-struct InstantsJson<'a>(&'a PathDocument);
+/// The instants of [`PathJson`], each object formed as it is written, a
+/// block at a time (a million instants are neither a second list in memory
+/// nor, streamed, a first one; issue 36).
+struct InstantsJson<'a>(&'a PathOutput<'a>);
 
 impl Serialize for InstantsJson<'_> {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let doc = self.0;
-        serializer.collect_seq(doc.result.records.iter().map(|rec| doc.instant_json(rec)))
+        use serde::ser::{Error, SerializeSeq};
+        let out = self.0;
+        let mut seq = serializer.serialize_seq(None)?;
+        out.each_block(
+            |block, _| {
+                (block.records.iter())
+                    .try_for_each(|rec| seq.serialize_element(&instant_json(out.head, block, rec)))
+            },
+            |e| S::Error::custom(e),
+        )?;
+        seq.end()
     }
 }
 
@@ -305,8 +491,57 @@ struct CaseJson {
     calls: Calls,
 }
 
+/// The JSON object of one instant of `block`.
+fn instant_json<'a>(
+    head: &'a PathHead,
+    block: &PathResult,
+    rec: &reliability::PathRecord,
+) -> InstantJson<'a> {
+    let i = &rec.instant;
+    let e = rec.result.as_ref();
+    let moments = |pick: fn(&InstantResult, Quantity) -> f64| {
+        e.map(|e| NameMap(Quantity::ALL.iter().map(|&q| (q, pick(e, q))).collect()))
+    };
+    InstantJson {
+        row: i.row,
+        t: i.t,
+        axes: i
+            .axes
+            .as_ref()
+            .map(|q| NameMap::zip(head.variables.iter().map(String::as_str), q.iter().copied())),
+        status: i.status,
+        nominal: e.map(|e| e.nominal),
+        mean: moments(InstantResult::mean),
+        std: moments(InstantResult::std),
+        reliability: e.map(|e| head.per_target(block.cases_of(e).map(|c| c.reliability))),
+        std_error: e.and_then(|e| {
+            let se: Option<Vec<f64>> = block.cases_of(e).map(|c| c.std_error).collect();
+            se.map(|se| head.per_target(se.into_iter()))
+        }),
+        cases: e.map(|e| {
+            head.per_target(block.cases_of(e).map(|c| CaseJson {
+                form: c.form,
+                calls: c.calls,
+            }))
+        }),
+    }
+}
+
+/// The summary of [`PathJson`], read when it is written: after the
+/// instants, whose blocks add it up.
+struct SummaryJson<'a>(&'a PathOutput<'a>);
+
+impl Serialize for SummaryJson<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::Error;
+        let summary = (self.0.summary())
+            .ok_or_else(|| S::Error::custom("the path's summary before its instants"))?;
+        summary_json(self.0.head, &summary).serialize(serializer)
+    }
+}
+
 #[derive(Serialize)]
-struct SummaryJson {
+struct SummaryFields {
     instants: usize,
     evaluated: usize,
     unreachable: usize,
@@ -365,116 +600,83 @@ struct FormSummaryJson {
     terminations: NameMap<Termination, usize>,
 }
 
-impl Serialize for PathDocument {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        self.json().serialize(serializer)
+fn summary_json(head: &PathHead, s: &PathSummary) -> SummaryFields {
+    let reliability = head.per_target((0..head.targets.len()).map(|t| {
+        s.target(t).map(|s| TargetJson {
+            min: s.min.value,
+            mean: s.mean,
+            worst: AtJson::of(&s.min),
+            met: s.met,
+        })
+    }));
+    let error = NameMap(
+        Quantity::ALL
+            .iter()
+            .map(|&q| {
+                let doc = match (s.max_mean(q), s.max_std(q)) {
+                    (Some(m), Some(sd)) => Some(ErrorJson {
+                        volumetric: q == Quantity::Volumetric,
+                        mean: m.value,
+                        mean_at: AtJson::of(&m),
+                        std: sd.value,
+                        std_at: AtJson::of(&sd),
+                    }),
+                    _ => None,
+                };
+                (q, doc)
+            })
+            .collect(),
+    );
+    let tally = &s.tally;
+    let form = (tally.forms > 0).then(|| FormSummaryJson {
+        cases: tally.forms,
+        converged: tally.forms_converged,
+        terminations: NameMap(tally.terminations().collect()),
+    });
+    SummaryFields {
+        instants: s.instants,
+        evaluated: s.evaluated,
+        unreachable: s.unreachable,
+        singular: s.singular,
+        reliability,
+        error,
+        requirement: s.requirement().and_then(|req| {
+            Some(RequirementDocument {
+                min: req.min,
+                mean: req.mean,
+                met: s.requirement_met()?,
+            })
+        }),
+        form,
+        calls: tally.calls,
     }
 }
 
-impl PathDocument {
-    /// The JSON object of one instant.
-    fn instant_json<'a>(&'a self, rec: &'a reliability::PathRecord) -> InstantJson<'a> {
-        let r = &self.result;
-        let i = &rec.instant;
-        let e = rec.result.as_ref();
-        let moments = |pick: fn(&InstantResult, Quantity) -> f64| {
-            e.map(|e| NameMap(Quantity::ALL.iter().map(|&q| (q, pick(e, q))).collect()))
-        };
-        InstantJson {
-            row: i.row,
-            t: i.t,
-            axes: i.axes.as_ref().map(|q| {
-                NameMap::zip(self.variables.iter().map(String::as_str), q.iter().copied())
-            }),
-            status: i.status,
-            nominal: e.map(|e| e.nominal),
-            mean: moments(InstantResult::mean),
-            std: moments(InstantResult::std),
-            reliability: e.map(|e| self.per_target(r.cases_of(e).map(|c| c.reliability))),
-            std_error: e.and_then(|e| {
-                let se: Option<Vec<f64>> = r.cases_of(e).map(|c| c.std_error).collect();
-                se.map(|se| self.per_target(se.into_iter()))
-            }),
-            cases: e.map(|e| {
-                self.per_target(r.cases_of(e).map(|c| CaseJson {
-                    form: c.form,
-                    calls: c.calls,
-                }))
-            }),
-        }
-    }
-
-    fn json(&self) -> PathJson<'_> {
-        let r = &self.result;
-        let instants = InstantsJson(self);
-        let reliability = self.per_target((0..r.targets.len()).map(|t| {
-            r.summary(t).map(|s| TargetJson {
-                min: s.min.value,
-                mean: s.mean,
-                worst: self.at(&s.min),
-                met: s.met,
-            })
-        }));
-        let error = NameMap(
-            Quantity::ALL
-                .iter()
-                .map(|&q| {
-                    let doc = match (r.max_mean(q), r.max_std(q)) {
-                        (Some(m), Some(s)) => Some(ErrorJson {
-                            volumetric: q == Quantity::Volumetric,
-                            mean: m.value,
-                            mean_at: self.at(&m),
-                            std: s.value,
-                            std_at: self.at(&s),
-                        }),
-                        _ => None,
-                    };
-                    (q, doc)
-                })
-                .collect(),
-        );
-        let forms: Vec<&FormCase> = r.cases().filter_map(|c| c.form.as_ref()).collect();
-        let form = (!forms.is_empty()).then(|| FormSummaryJson {
-            cases: forms.len(),
-            converged: forms.iter().filter(|f| f.converged).count(),
-            terminations: NameMap(
-                Termination::ALL
-                    .iter()
-                    .map(|&t| (t, forms.iter().filter(|f| f.termination == t).count()))
-                    .filter(|(_, n)| *n > 0)
-                    .collect(),
-            ),
-        });
-        let calls = r.cases().fold(Calls::default(), |a, c| Calls {
-            values: a.values + c.calls.values,
-            gradients: a.gradients + c.calls.gradients,
-        });
-        let summary = SummaryJson {
-            instants: r.records.len(),
-            evaluated: r.evaluated(),
-            unreachable: r.count(Status::Unreachable),
-            singular: r.count(Status::Singular),
-            reliability,
-            error,
-            requirement: r.study.as_ref().and_then(RequirementDocument::of),
-            form,
-            calls,
-        };
+impl Serialize for PathOutput<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let h = self.head;
         PathJson {
-            machine: &self.machine,
-            method: r.method,
-            input: self.input,
-            frame: self.frame,
-            sided: r.sided,
+            machine: &h.machine,
+            method: h.method,
+            input: h.input,
+            frame: h.frame,
+            sided: h.sided,
             tolerances: NameMap(
-                r.targets
+                h.targets
                     .iter()
                     .filter_map(|t| t.tolerance.map(|v| (t.target, v)))
                     .collect(),
             ),
-            variables: &self.variables,
-            instants,
-            summary,
+            variables: &h.variables,
+            instants: InstantsJson(self),
+            summary: SummaryJson(self),
         }
+        .serialize(serializer)
+    }
+}
+
+impl Serialize for PathDocument {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        self.output().serialize(serializer)
     }
 }

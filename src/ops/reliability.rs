@@ -13,7 +13,7 @@ use chain_core::values::Approach;
 use chain_core::{CompiledModel, Machine};
 use reliability::acceptance::AcceptanceResult;
 use reliability::document::{AcceptanceDocument, ReliabilityDocument};
-use reliability::{Method, Posterior, Progress, ReliabilityError, Study, StudyResult};
+use reliability::{CaseTally, Method, Posterior, Progress, ReliabilityError, Study, StudyResult};
 use serde::{Serialize, Serializer};
 
 use super::study::{self, AlgorithmOptions, OptionError, StudyError, StudyOptions, SystemChoice};
@@ -190,7 +190,11 @@ impl Prepared {
         if self.algorithm.method == Method::Form {
             notes.extend(study::form_limits_note(&self.study));
         }
-        notes.extend(study::unconverged_warnings(&result, self.study.variables()));
+        notes.extend(study::unconverged_warnings(
+            &CaseTally::of(&result.cases),
+            result.method,
+            self.study.variables(),
+        ));
         let acceptance = match self.acceptance {
             Some((tolerance, seed)) => {
                 let a = reliability::document::acceptance(&self.study, tolerance, seed)?;

@@ -10,7 +10,7 @@ use chain_core::model::Sided;
 use chain_core::values::{Approach, ApproachError};
 use chain_core::{CompiledModel, Machine};
 use reliability::{
-    Algorithm, Inputs, Method, Posterior, PosteriorError, ReliabilityError, Study, StudyResult,
+    Algorithm, CaseTally, Inputs, Method, Posterior, PosteriorError, ReliabilityError, Study,
     StudySpec, System,
 };
 
@@ -324,10 +324,15 @@ pub fn form_limits_note(study: &Study) -> Option<String> {
     })
 }
 
-/// The warnings on a study's cases that did not converge: the samplers'
-/// (the `--cov` target not reached within the budget, subset simulation out
-/// of levels), then FORM's (the iteration limit).
-pub fn unconverged_warnings(r: &StudyResult, variables: &[String]) -> Vec<String> {
+/// The warnings on a run's cases that did not converge (their
+/// [`CaseTally`]): the samplers' (the `--cov` target not reached within the
+/// budget, subset simulation out of levels), then FORM's (the iteration
+/// limit).
+pub fn unconverged_warnings(
+    tally: &CaseTally,
+    method: Method,
+    variables: &[String],
+) -> Vec<String> {
     let at = |point: &[f64]| {
         (variables.iter().zip(point))
             .map(|(v, x)| format!("{v} = {x}"))
@@ -335,30 +340,25 @@ pub fn unconverged_warnings(r: &StudyResult, variables: &[String]) -> Vec<String
             .join(", ")
     };
     let mut out = Vec::new();
-    let bad: Vec<&reliability::CaseResult> =
-        r.cases.iter().filter(|c| !c.sampler_converged()).collect();
-    if let Some(first) = bad.first() {
+    if let Some(first) = &tally.first_sampler_unconverged {
         let why = first.stopping.map_or("", |s| match s.stopped_by {
             reliability::Stop::Levels => "subset simulation ran out of levels",
             _ => "the sample budget ran out before the target coefficient of variation",
         });
         out.push(format!(
             "warning: the {} did not converge on {} of {} cases (first: {} at {}: {why}); their values are not converged estimates (listed under the table, `converged: false` in JSON and CSV)",
-            r.method.title(),
-            bad.len(),
-            r.cases.len(),
+            method.title(),
+            tally.sampler_unconverged,
+            tally.cases,
             first.target,
             at(&first.point)
         ));
     }
-    let bad: Vec<&reliability::CaseResult> = (r.cases.iter())
-        .filter(|c| c.form.is_some_and(|f| !f.converged))
-        .collect();
-    if let Some(first) = bad.first() {
+    if let Some(first) = &tally.first_form_unconverged {
         out.push(format!(
             "warning: FORM did not converge on {} of {} cases (first: {} at {}); their reliabilities are the last iterates' (listed under the table, `converged: false` in JSON and CSV)",
-            bad.len(),
-            r.cases.len(),
+            tally.form_unconverged(),
+            tally.cases,
             first.target,
             at(&first.point)
         ));

@@ -130,13 +130,14 @@ fn on_demand_form_equals_kept_across_case_blocks() {
 const GIB: u64 = 1 << 30;
 
 /// The million-point runs of docs/performance.md under 1 GiB each (`map`
-/// and FORM `reliability` over a 100³ grid of the gantry grinder, every
-/// output format). Ignored in the test command (about a minute on two
-/// cores); `cargo test --profile ci --test it -- --ignored million` runs it,
+/// and FORM `reliability` over a 100³ grid of the gantry grinder, and FORM
+/// `path` along 10⁶ instants of a raster through the same box, every output
+/// format). Ignored in the test command (about three minutes on two cores);
+/// `cargo test --profile ci --test it -- --ignored million` runs it,
 /// `scripts/peak_memory.sh` prints the figures.
 #[test]
 #[ignore]
-fn a_million_point_map_and_reliability_stay_under_a_gibibyte() {
+fn a_million_point_map_reliability_and_path_stay_under_a_gibibyte() {
     let grid = [
         "--grid",
         "x=0:1000:100",
@@ -160,6 +161,27 @@ fn a_million_point_map_and_reliability_stay_under_a_gibibyte() {
             eprintln!("{command} --format {format}: {} MB", peak >> 20);
             assert!(peak < GIB, "{args:?}: {} MB", peak >> 20);
         }
+    }
+    // The raster of scripts/peak_memory.sh: x fastest, 100 values per axis.
+    let mut text = String::from("t,x,y,z\n");
+    for k in 0..1_000_000usize {
+        let (i, j, m) = (k / 10_000, (k / 100) % 100, k % 100);
+        let (x, y, z) = (
+            1000.0 * m as f64 / 99.0,
+            -1500.0 + 3000.0 * j as f64 / 99.0,
+            600.0 + 800.0 * i as f64 / 99.0,
+        );
+        text.push_str(&format!("{:.3},{x:?},{y:?},{z:?}\n", k as f64 * 0.001));
+    }
+    let axes = common::cli::scratch_file("gantry_1e6.csv", &text);
+    drop(text);
+    let axes = axes.to_str().expect("UTF-8 path");
+    for format in ["table", "csv", "json"] {
+        let args = ["path", gantry, "--axes", axes, "--format", format];
+        let (code, peak) = common::cli::peak_memory(&args);
+        assert_eq!(code, 0, "{args:?}");
+        eprintln!("path --format {format}: {} MB", peak >> 20);
+        assert!(peak < GIB, "{args:?}: {} MB", peak >> 20);
     }
 }
 
@@ -199,7 +221,7 @@ fn form_and_sorm_report_every_case_to_the_progress_sink() {
 #[test]
 fn on_demand_paths_equal_kept_ones() {
     use chain_core::inverse::Status;
-    use reliability::{PathInstant, PathStudy};
+    use reliability::{PathInstant, PathStudy, PathSummary};
     let file = example_file("machines/gantry_grinder.yaml");
     let m = chain_core::load_file(&file).expect("gantry loads");
     let model = chain_core::compile(&m);
@@ -234,10 +256,63 @@ fn on_demand_paths_equal_kept_ones() {
             seed: 2,
             cov: None,
         }),
+        // A stop rule: each case stops at its own count.
+        Algorithm::MonteCarlo(MonteCarlo {
+            samples: 4000,
+            seed: 4,
+            cov: Some(0.5),
+        }),
+        Algorithm::Directional(DirectionalSimulation {
+            samples: 8,
+            seed: 6,
+            cov: None,
+        }),
     ] {
         let k = kept.run(&algorithm, &()).expect("kept run");
         let l = lazy.run(&algorithm, &()).expect("on-demand run");
         assert_eq!(k.evaluated(), 4999);
         assert_eq!(k, l);
+        // The path runs its study a block of instants at a time (each case
+        // on the streams of its index in the whole study): the cases are
+        // those of the whole study run at once, bit for bit.
+        let whole = lazy
+            .study()
+            .expect("study")
+            .run(&algorithm, &())
+            .expect("whole");
+        assert_eq!(l.study.as_ref(), Some(&whole));
+        // The blocks as `chain path` writes them: the same records, and
+        // the summary added up block by block is the whole result's.
+        let mut summary = PathSummary::new(l.targets.len(), whole.requirement);
+        let mut records = Vec::new();
+        let (mut blocks, mut before) = (0, 0);
+        for block in lazy.blocks(&algorithm, &()) {
+            let block = block.expect("block");
+            summary.add(&block);
+            for rec in &block.records {
+                let cases: Vec<_> = match &rec.result {
+                    Some(e) => block.cases_of(e).cloned().collect(),
+                    None => Vec::new(),
+                };
+                let mut rec = rec.clone();
+                if let Some(e) = &mut rec.result {
+                    e.evaluated += before;
+                }
+                records.push((rec, cases));
+            }
+            before += block.evaluated();
+            blocks += 1;
+        }
+        assert!(blocks >= 2, "5,000 instants make more than one block");
+        assert_eq!(summary, PathSummary::of(&l));
+        assert_eq!(records.len(), l.records.len());
+        for (rec, (streamed, cases)) in l.records.iter().zip(&records) {
+            assert_eq!(rec, streamed);
+            let whole: Vec<_> = match &rec.result {
+                Some(e) => l.cases_of(e).cloned().collect(),
+                None => Vec::new(),
+            };
+            assert_eq!(&whole, cases);
+        }
     }
 }

@@ -2058,9 +2058,9 @@ impl Reader {
             self.report(span, key, missing.into());
             return None;
         };
-        let mut points = Vec::with_capacity(csv.rows.len());
+        let mut points = Vec::with_capacity(csv.len());
         let mut bad = Vec::new();
-        for row in &csv.rows {
+        for row in csv.rows() {
             let (qt, qo) = &row[qc];
             let (vt, vo) = &row[vc];
             let q = cell_number(qt, qo, &mut bad);

@@ -295,9 +295,9 @@ impl Measurements {
         )
         .map_err(fail)?;
         let mut problems = Vec::new();
-        let mut rows = Vec::with_capacity(csv.rows.len());
-        for cells in &csv.rows {
-            match columns.record(cells) {
+        let mut rows = Vec::with_capacity(csv.len());
+        for cells in csv.rows() {
+            match columns.record(&cells) {
                 Ok(row) => rows.push(row),
                 Err(p) => problems.push(*p),
             }

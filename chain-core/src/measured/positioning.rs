@@ -285,9 +285,9 @@ impl Runs {
         let columns = RunColumns::classify(&csv).map_err(fail)?;
         let mut problems: Vec<(Origin, Problem)> = Vec::new();
         // (target, direction, run) → (value, origin of the row's first cell).
-        let mut cells: Vec<Cell> = Vec::with_capacity(csv.rows.len());
-        for row in &csv.rows {
-            match columns.cell(row) {
+        let mut cells: Vec<Cell> = Vec::with_capacity(csv.len());
+        for row in csv.rows() {
+            match columns.cell(&row) {
                 Ok(c) => cells.push(c),
                 Err(p) => problems.push(*p),
             }

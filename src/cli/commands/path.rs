@@ -109,6 +109,16 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
         algorithm: args.algorithm.options(),
         input,
     };
+    let report = |e: PathOpsError| match e {
+        PathOpsError::Reliability(e) => loaded.report(e),
+        PathOpsError::Resolve(e) => miette::Report::new(e),
+        PathOpsError::Option(e) => miette::Report::new(e),
+        PathOpsError::Machine(e) => miette::Report::new(e),
+    };
+    let prepared = path::prepare(&loaded.machine, &request).map_err(report)?;
+    for note in &prepared.notes {
+        eprintln!("{note}");
+    }
     // A counter of the cases (FORM, SORM) or samples done: the instants
     // with axis values are known only once the path is solved.
     let (verb, unit) = match request.algorithm.method {
@@ -116,23 +126,38 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
         _ => ("sampling", "samples"),
     };
     let bar = Progress::new(args.format != PathFormat::Json, None, verb, unit);
-    let doc = path::run(&loaded.machine, &request, &|n| bar.inc(n));
-    bar.finish();
-    let doc = doc.map_err(|e| match e {
-        PathOpsError::Reliability(e) => loaded.report(e),
-        PathOpsError::Resolve(e) => miette::Report::new(e),
-        PathOpsError::Option(e) => miette::Report::new(e),
-        PathOpsError::Machine(e) => miette::Report::new(e),
-    })?;
-    for note in &doc.notes {
-        eprintln!("{note}");
-    }
+    let format = args.format.into();
     if let Some(dir) = &args.plot {
+        // The charts need every record: the path is run in memory.
+        let printed = prepared.notes.len();
+        let doc = prepared.run(&|n| bar.inc(n));
+        bar.finish();
+        let doc = doc.map_err(report)?;
         for f in path_plot::write_all(dir, &doc)? {
             eprintln!("wrote {}", f.display());
         }
+        report::emit(&doc.output(), format)?;
+        for note in &doc.notes[printed..] {
+            eprintln!("{note}");
+        }
+        return Ok(());
     }
-    report::emit(&doc, args.format.into())
+    // Otherwise each block of instants is written as it is done and only
+    // the summary is kept (issue 36).
+    let progress = |n| bar.inc(n);
+    let output = prepared.output(&progress);
+    let written = report::emit(&output, format);
+    bar.finish();
+    if let Some(e) = output.take_error() {
+        return Err(loaded.report(e));
+    }
+    written?;
+    if let Some(summary) = output.summary() {
+        for note in output.head.run_notes(&summary) {
+            eprintln!("{note}");
+        }
+    }
+    Ok(())
 }
 
 report::formats!(PathFormat: Table, Json, Csv);

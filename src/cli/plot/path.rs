@@ -20,12 +20,15 @@ pub(crate) fn write_all(dir: &Path, doc: &PathDocument) -> miette::Result<Vec<Pa
         eprintln!("note: no evaluated instant; no chart written");
         return Ok(Vec::new());
     }
-    let x_label = if doc.has_t { "t" } else { "row" };
+    let x_label = if doc.head.has_t { "t" } else { "row" };
     let method = r.method.title();
     let mut files = Vec::new();
 
     let mut chart = XyChart::new(
-        format!("{}: reliability along the path ({method})", doc.machine),
+        format!(
+            "{}: reliability along the path ({method})",
+            doc.head.machine
+        ),
         x_label,
         "reliability (%)",
     )
@@ -63,7 +66,10 @@ pub(crate) fn write_all(dir: &Path, doc: &PathDocument) -> miette::Result<Vec<Pa
             continue;
         }
         let mut chart = XyChart::new(
-            format!("{}: error standard deviation along the path", doc.machine),
+            format!(
+                "{}: error standard deviation along the path",
+                doc.head.machine
+            ),
             x_label,
             unit,
         )

@@ -1,30 +1,40 @@
-//! The table and CSV of `chain path` ([`PathDocument`]): one row per
-//! instant, the error statistics and the reliabilities, then the summary.
+//! The table and CSV of `chain path` ([`PathOutput`]): one row per instant
+//! (the error statistics and the reliabilities), then the summary. Both are
+//! written a block of records at a time as the path runs (issue 36); the
+//! JSON is the output's own `Serialize` (`chain::ops::path`).
 
-use chain::ops::path::PathDocument;
-use chain_core::inverse::Status;
-use reliability::{FormCase, PathInstant, Quantity};
+use std::io::{self, Write};
+
+use chain::ops::path::{PathHead, PathOutput};
+use reliability::{Extreme, FormCase, PathSummary, Quantity};
 
 use crate::cli::report::{self, Csv, Report};
 use crate::cli::study_text::{calls_text, requirement_text, sided_title};
 
-impl Report for PathDocument {
+impl Report for PathOutput<'_> {
     fn table(&self) -> String {
-        to_table(self)
+        let mut out = Vec::new();
+        // Writing into a vector fails only when the run does (kept in the
+        // output for the command to report).
+        let _ = self.write_table(&mut out);
+        String::from_utf8_lossy(&out).into_owned()
+    }
+
+    fn write_table(&self, out: &mut dyn Write) -> io::Result<()> {
+        write_table(self, out)
     }
 
     fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
-        let r = &self.result;
-        let sampled = r.cases().any(|c| c.std_error.is_some());
-        let names: Vec<&str> = r.targets.iter().map(|t| t.target.name()).collect();
+        let h = self.head;
+        let names: Vec<&str> = h.targets.iter().map(|t| t.target.name()).collect();
         let mut header = vec!["row".to_string(), "t".to_string()];
-        header.extend(self.variables.iter().cloned());
+        header.extend(h.variables.iter().cloned());
         header.push("status".into());
         header.extend(["nominal_x", "nominal_y", "nominal_z"].map(String::from));
         header.extend(Quantity::ALL.iter().map(|q| format!("mean_{q}")));
         header.extend(Quantity::ALL.iter().map(|q| format!("std_{q}")));
         header.extend(names.iter().map(|t| format!("reliability_{t}")));
-        if sampled {
+        if h.sampled {
             header.extend(names.iter().map(|t| format!("std_error_{t}")));
         }
         for key in [
@@ -38,42 +48,49 @@ impl Report for PathDocument {
         }
         let width = header.len();
         out.header(header);
-        for rec in &r.records {
-            let i = &rec.instant;
-            let mut row = vec![i.row.to_string(), format!("{:?}", i.t)];
-            match &i.axes {
-                Some(q) => row.extend(q.iter().map(|x| format!("{x:?}"))),
-                None => row.extend(self.variables.iter().map(|_| String::new())),
-            }
-            row.push(i.status.name().into());
-            if let Some(e) = &rec.result {
-                row.extend(e.nominal.iter().map(|x| format!("{x:?}")));
-                row.extend(Quantity::ALL.iter().map(|&q| format!("{:?}", e.mean(q))));
-                row.extend(Quantity::ALL.iter().map(|&q| format!("{:?}", e.std(q))));
-                row.extend(r.cases_of(e).map(|c| format!("{:?}", c.reliability)));
-                if sampled {
-                    match r
-                        .cases_of(e)
-                        .map(|c| c.std_error)
-                        .collect::<Option<Vec<_>>>()
-                    {
-                        Some(se) => row.extend(se.iter().map(|x| format!("{x:?}"))),
-                        None => row.extend(names.iter().map(|_| String::new())),
+        // The Csv writer keeps its own first write error; a failed run is
+        // kept in the output for the command to report.
+        let _ = self.each_block(
+            |r, _| {
+                for rec in &r.records {
+                    let i = &rec.instant;
+                    let mut row = vec![i.row.to_string(), format!("{:?}", i.t)];
+                    match &i.axes {
+                        Some(q) => row.extend(q.iter().map(|x| format!("{x:?}"))),
+                        None => row.extend(h.variables.iter().map(|_| String::new())),
                     }
+                    row.push(i.status.name().into());
+                    if let Some(e) = &rec.result {
+                        row.extend(e.nominal.iter().map(|x| format!("{x:?}")));
+                        row.extend(Quantity::ALL.iter().map(|&q| format!("{:?}", e.mean(q))));
+                        row.extend(Quantity::ALL.iter().map(|&q| format!("{:?}", e.std(q))));
+                        row.extend(r.cases_of(e).map(|c| format!("{:?}", c.reliability)));
+                        if h.sampled {
+                            match (r.cases_of(e))
+                                .map(|c| c.std_error)
+                                .collect::<Option<Vec<_>>>()
+                            {
+                                Some(se) => row.extend(se.iter().map(|x| format!("{x:?}"))),
+                                None => row.extend(names.iter().map(|_| String::new())),
+                            }
+                        }
+                        let form = |f: fn(&FormCase) -> String| {
+                            r.cases_of(e)
+                                .map(move |c| c.form.as_ref().map(f).unwrap_or_default())
+                        };
+                        row.extend(form(|f| f.termination.to_string()));
+                        row.extend(form(|f| f.converged.to_string()));
+                        row.extend(form(|f| f.iterations.to_string()));
+                        row.extend(r.cases_of(e).map(|c| c.calls.values.to_string()));
+                        row.extend(r.cases_of(e).map(|c| c.calls.gradients.to_string()));
+                    }
+                    row.resize(width, String::new());
+                    out.row(row);
                 }
-                let form = |f: fn(&FormCase) -> String| {
-                    r.cases_of(e)
-                        .map(move |c| c.form.as_ref().map(f).unwrap_or_default())
-                };
-                row.extend(form(|f| f.termination.to_string()));
-                row.extend(form(|f| f.converged.to_string()));
-                row.extend(form(|f| f.iterations.to_string()));
-                row.extend(r.cases_of(e).map(|c| c.calls.values.to_string()));
-                row.extend(r.cases_of(e).map(|c| c.calls.gradients.to_string()));
-            }
-            row.resize(width, String::new());
-            out.row(row);
-        }
+                Ok::<(), ()>(())
+            },
+            |_| (),
+        );
         Some(())
     }
 }
@@ -99,12 +116,17 @@ fn sci(v: f64) -> String {
     }
 }
 
-fn at_text(i: &PathInstant, has_t: bool) -> String {
+/// `row 7 (t = 0.35)`, or `row 7` when the input gave no `t`.
+fn at_text(row: usize, t: f64, has_t: bool) -> String {
     if has_t {
-        format!("row {} (t = {})", i.row, num(i.t))
+        format!("row {row} (t = {})", num(t))
     } else {
-        format!("row {}", i.row)
+        format!("row {row}")
     }
+}
+
+fn extreme_text(e: &Extreme, has_t: bool) -> String {
+    at_text(e.row, e.t, has_t)
 }
 
 /// `|p|` for the volumetric quantity, the component's name otherwise.
@@ -115,144 +137,138 @@ pub(crate) fn label(q: Quantity) -> &'static str {
     }
 }
 
-fn to_table(doc: &PathDocument) -> String {
-    use std::fmt::Write as _;
-    let r = &doc.result;
-    let mut out = String::new();
-    let sided = sided_title(r.sided);
-    let _ = writeln!(
+/// The table: title, tolerances, one row per instant (axis values, status,
+/// mean and std of the toleranced components and `|p|`, the reliability of
+/// every target), the cases FORM left at its iteration limit, the summary.
+fn write_table(output: &PathOutput<'_>, out: &mut dyn Write) -> io::Result<()> {
+    let h: &PathHead = output.head;
+    let sided = sided_title(h.sided);
+    writeln!(
         out,
         "{}: error and reliability along a path ({} instants from {}, {}, {sided}, frame {})",
-        doc.machine,
-        r.records.len(),
-        doc.source,
-        r.method.title(),
-        doc.frame
-    );
-    let tol: Vec<String> = r
-        .targets
-        .iter()
+        h.machine,
+        h.instants,
+        h.source,
+        h.method.title(),
+        h.frame
+    )?;
+    let tol: Vec<String> = (h.targets.iter())
         .filter_map(|t| t.tolerance.map(|v| format!("{} {}", t.target, num(v))))
         .collect();
-    let _ = writeln!(out, "tolerances: {}", tol.join(", "));
+    writeln!(out, "tolerances: {}", tol.join(", "))?;
     // Which error quantities to show: the toleranced components and |p|.
-    let shown: Vec<Quantity> = Quantity::ALL
-        .iter()
-        .copied()
-        .filter(|q| *q == Quantity::Volumetric || doc.targets().any(|t| t.name() == q.name()))
+    let shown: Vec<Quantity> = (Quantity::ALL.iter().copied())
+        .filter(|q| *q == Quantity::Volumetric || h.target_names().any(|t| t.name() == q.name()))
         .collect();
-    let _ = writeln!(
+    writeln!(
         out,
-        "\nmean and standard deviation of the error (lengths in the file's unit, angles in rad)"
-    );
-    let _ = write!(out, "{:>5} {:>10}", "row", if doc.has_t { "t" } else { "" });
-    for v in &doc.variables {
-        let _ = write!(out, " {v:>10}");
+        "\nmean and standard deviation of the error (lengths in the file's unit, angles in rad) and reliability (%)"
+    )?;
+    write!(out, "{:>5} {:>10}", "row", if h.has_t { "t" } else { "" })?;
+    for v in &h.variables {
+        write!(out, " {v:>10}")?;
     }
-    let _ = write!(out, "  {:<11}", "status");
+    write!(out, "  {:<11}", "status")?;
     for &q in &shown {
-        let _ = write!(out, " {:>11} {:>10}", format!("{} mean", label(q)), "std");
+        write!(out, " {:>11} {:>10}", format!("{} mean", label(q)), "std")?;
     }
-    out.push('\n');
-    for rec in &r.records {
-        let i = &rec.instant;
-        let t = if doc.has_t { num(i.t) } else { String::new() };
-        let _ = write!(out, "{:>5} {t:>10}", i.row);
-        match &i.axes {
-            Some(q) => q.iter().for_each(|x| {
-                let _ = write!(out, " {:>10}", num(*x));
-            }),
-            None => doc.variables.iter().for_each(|_| {
-                let _ = write!(out, " {:>10}", "-");
-            }),
-        }
-        let _ = write!(out, "  {:<11}", i.status.name());
-        if let Some(e) = &rec.result {
-            for &q in &shown {
-                let _ = write!(out, " {:>11} {:>10}", sci(e.mean(q)), sci(e.std(q)));
-            }
-        }
-        out.push('\n');
+    for t in h.target_names() {
+        write!(out, " {:>10}", t.name())?;
     }
-    let _ = writeln!(out, "\nreliability (%)");
-    let _ = write!(out, "{:>5} {:>10}", "row", if doc.has_t { "t" } else { "" });
-    for t in doc.targets() {
-        let _ = write!(out, " {:>10}", t.name());
-    }
-    out.push('\n');
+    writeln!(out)?;
     let mut bad = Vec::new();
-    for rec in &r.records {
-        let i = &rec.instant;
-        let t = if doc.has_t { num(i.t) } else { String::new() };
-        let _ = write!(out, "{:>5} {t:>10}", i.row);
-        match &rec.result {
-            Some(e) => r.cases_of(e).for_each(|c| {
-                let _ = write!(out, " {:>10.3}", 100.0 * c.reliability);
-                if !c.converged() {
-                    bad.push(format!("{} at {}", c.target, at_text(i, doc.has_t)));
+    output.each_block(
+        |r, _| {
+            for rec in &r.records {
+                let i = &rec.instant;
+                let t = if h.has_t { num(i.t) } else { String::new() };
+                write!(out, "{:>5} {t:>10}", i.row)?;
+                match &i.axes {
+                    Some(q) => q.iter().try_for_each(|x| write!(out, " {:>10}", num(*x)))?,
+                    None => (h.variables.iter()).try_for_each(|_| write!(out, " {:>10}", "-"))?,
                 }
-            }),
-            None => {
-                let _ = write!(out, " {}", i.status.name());
+                write!(out, "  {:<11}", i.status.name())?;
+                if let Some(e) = &rec.result {
+                    for &q in &shown {
+                        write!(out, " {:>11} {:>10}", sci(e.mean(q)), sci(e.std(q)))?;
+                    }
+                    for c in r.cases_of(e) {
+                        write!(out, " {:>10.3}", 100.0 * c.reliability)?;
+                        if !c.converged() {
+                            bad.push(format!("{} at {}", c.target, at_text(i.row, i.t, h.has_t)));
+                        }
+                    }
+                }
+                writeln!(out)?;
             }
-        }
-        out.push('\n');
-    }
+            Ok(())
+        },
+        |e| io::Error::other(e.to_string()),
+    )?;
     if !bad.is_empty() {
-        let _ = writeln!(
+        writeln!(
             out,
             "* FORM stopped at the iteration limit (the value shown is the last iterate's, not a converged reliability): {}",
             bad.join(", ")
-        );
+        )?;
     }
-    let _ = writeln!(
+    let s = output
+        .summary()
+        .ok_or_else(|| io::Error::other("the path's summary before its records"))?;
+    write_summary(h, &s, &shown, out)
+}
+
+/// The summary lines of the table.
+fn write_summary(
+    h: &PathHead,
+    s: &PathSummary,
+    shown: &[Quantity],
+    out: &mut dyn Write,
+) -> io::Result<()> {
+    writeln!(
         out,
         "\nsummary over {} instants ({} evaluated, {} unreachable, {} singular)",
-        r.records.len(),
-        r.evaluated(),
-        r.count(Status::Unreachable),
-        r.count(Status::Singular)
-    );
-    for (t, target) in doc.targets().enumerate() {
-        if let Some(s) = r.summary(t) {
-            let worst = &r.records[s.min.record].instant;
-            let _ = write!(
+        s.instants, s.evaluated, s.unreachable, s.singular
+    )?;
+    for (t, target) in h.target_names().enumerate() {
+        if let Some(ts) = s.target(t) {
+            write!(
                 out,
                 "  {:<10} reliability min {:.3} % at {}, mean {:.3} %",
                 target.name(),
-                100.0 * s.min.value,
-                at_text(worst, doc.has_t),
-                100.0 * s.mean
-            );
-            if let (Some(req), Some(met)) = (r.requirement(), s.met) {
-                out.push_str(&requirement_text(&req, met));
+                100.0 * ts.min.value,
+                extreme_text(&ts.min, h.has_t),
+                100.0 * ts.mean
+            )?;
+            if let (Some(req), Some(met)) = (s.requirement(), ts.met) {
+                out.write_all(requirement_text(&req, met).as_bytes())?;
             }
-            out.push('\n');
+            writeln!(out)?;
         }
     }
-    for &q in &shown {
-        if let (Some(m), Some(s)) = (r.max_mean(q), r.max_std(q)) {
+    for &q in shown {
+        if let (Some(m), Some(sd)) = (s.max_mean(q), s.max_std(q)) {
             let what = if q == Quantity::Volumetric {
                 "max mean"
             } else {
                 "max |mean|"
             };
-            let _ = writeln!(
+            writeln!(
                 out,
                 "  {:<10} {what} {} at {}, max std {} at {}",
                 label(q),
                 sci(m.value),
-                at_text(&r.records[m.record].instant, doc.has_t),
-                sci(s.value),
-                at_text(&r.records[s.record].instant, doc.has_t)
-            );
+                extreme_text(&m, h.has_t),
+                sci(sd.value),
+                extreme_text(&sd, h.has_t)
+            )?;
         }
     }
-    if let Some(se) = r.cases().filter_map(|c| c.std_error).reduce(f64::max) {
-        let _ = writeln!(out, "  sampling: largest standard error of p_f {se:.2e}");
+    if let Some(se) = s.tally.max_std_error {
+        writeln!(out, "  sampling: largest standard error of p_f {se:.2e}")?;
     }
-    if r.evaluated() > 0 {
-        let _ = writeln!(out, "  {}", calls_text(r.cases(), r.method));
+    if s.evaluated > 0 {
+        writeln!(out, "  {}", calls_text(&s.tally, h.method))?;
     }
-    out
+    Ok(())
 }

@@ -6,7 +6,7 @@
 
 use chain::ops::reliability::ReliabilityRun;
 use reliability::acceptance::AcceptanceResult;
-use reliability::{normal, Stopping, Study, StudyResult, SubsetLevel};
+use reliability::{normal, CaseTally, Stopping, Study, StudyResult, SubsetLevel};
 
 use crate::cli::report::{Csv, Report};
 use crate::cli::study_text::{
@@ -260,7 +260,11 @@ fn to_table(machine: &str, study: &Study, r: &StudyResult) -> String {
             }
             _ => {}
         }
-        let _ = writeln!(out, "  {}", calls_text(cases.iter(), r.method));
+        let _ = writeln!(
+            out,
+            "  {}",
+            calls_text(&CaseTally::of(cases.iter()), r.method)
+        );
     }
     if marked {
         let sampler = r.cases.iter().any(|c| !c.sampler_converged());

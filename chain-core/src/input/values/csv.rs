@@ -20,14 +20,37 @@ pub const MAX_TABLE_BYTES: usize = crate::bounded::TABLE_BYTES;
 /// One CSV file as located cells: the one place the `csv` crate's records
 /// become cells with their origins (values tables, measurement and
 /// candidate files, and the command line's pose and axes CSVs).
+///
+/// The data cells are kept compactly (their texts one after another, and
+/// per cell where it is; a cell's [`Origin`] is formed when its row is read
+/// through [`CsvFile::rows`]): a million-row file costs about its size
+/// again, not a string and an origin per cell (issue 36).
 #[derive(Debug, Clone)]
 pub struct CsvFile {
     /// Its text (for the diagnostics' snippets).
     pub text: String,
     /// Header names with their origins.
     pub header: Vec<(String, Origin)>,
-    /// Data rows: each cell's text and origin (key: its column's name).
-    pub rows: Vec<Vec<(String, Origin)>>,
+    /// The data cells' texts, one after another, row by row.
+    cells: String,
+    /// Per data cell, row by row (each row as wide as the header).
+    spans: Vec<CellSpan>,
+    /// Per data row, its 1-based line.
+    lines: Vec<usize>,
+}
+
+/// Where a data cell of a [`CsvFile`] is.
+#[derive(Debug, Clone, Copy)]
+struct CellSpan {
+    /// The end of its text in [`CsvFile::cells`] (it starts where the
+    /// previous cell's ends).
+    end: usize,
+    /// Its byte offset in the file's text.
+    offset: usize,
+    /// Its length there (quotes included).
+    len: usize,
+    /// Its 1-based column in characters.
+    column: usize,
 }
 
 /// Why a CSV file could not be used at all.
@@ -79,7 +102,10 @@ impl CsvFile {
             Diagnostics::single(name, text, origin, Problem::Message(message))
         };
         let mut header: Vec<(String, Origin)> = Vec::new();
-        let mut rows = Vec::new();
+        // The header's names, for the repeated-name check (a hash, not a
+        // scan per column: 100,000 columns are checked at once).
+        let mut seen: std::collections::HashMap<String, usize> = Default::default();
+        let (mut cells, mut cell_spans, mut lines) = (String::new(), Vec::new(), Vec::new());
         for record in reader.records() {
             let record = record.map_err(|e| {
                 let line = e.position().map_or(1, ::csv::Position::line);
@@ -101,21 +127,44 @@ impl CsvFile {
             };
             let (start, line) = record_start(data, pos);
             let spans = field_spans(data, start);
-            let cell = |k: usize, key: &str| -> Origin {
-                let (offset, len) = spans.get(k).copied().unwrap_or((start, 0));
-                let line_start = data[..offset]
-                    .iter()
-                    .rposition(|&b| b == b'\n')
-                    .map_or(0, |p| p + 1);
-                let column = String::from_utf8_lossy(&data[line_start..offset])
+            // Each field's 1-based column in characters, counted once along
+            // the line (not from the line's start for every field: a line
+            // of 100,000 fields is linear, not quadratic).
+            let line_start = data[..start]
+                .iter()
+                .rposition(|&b| b == b'\n')
+                .map_or(0, |p| p + 1);
+            let mut columns = Vec::with_capacity(spans.len());
+            let (mut at, mut column) = (line_start, 1);
+            for &(offset, _) in &spans {
+                column += String::from_utf8_lossy(&data[at..offset.max(at)])
                     .chars()
-                    .count()
-                    + 1;
-                Origin {
-                    offset: offset + bom,
+                    .count();
+                at = offset.max(at);
+                columns.push(column);
+            }
+            let span = |k: usize| -> CellSpan {
+                let (offset, len) = spans.get(k).copied().unwrap_or((start, 0));
+                let column = columns.get(k).copied().unwrap_or_else(|| {
+                    String::from_utf8_lossy(&data[line_start..offset])
+                        .chars()
+                        .count()
+                        + 1
+                });
+                CellSpan {
+                    end: 0,
+                    offset,
                     len,
-                    line,
                     column,
+                }
+            };
+            let cell = |k: usize, key: &str| -> Origin {
+                let s = span(k);
+                Origin {
+                    offset: s.offset + bom,
+                    len: s.len,
+                    line,
+                    column: s.column,
                     key: key.to_string(),
                 }
             };
@@ -131,7 +180,7 @@ impl CsvFile {
                         .help(header_help);
                         return Err(located(origin, empty));
                     }
-                    if let Some((_, first)) = header.iter().find(|(h, _)| h == field) {
+                    if let Some(first) = seen.get(field).map(|&i| &header[i].1) {
                         let twice = Message::new(
                             format!(
                                 "column `{field}` appears twice in the header (first in column {})",
@@ -142,6 +191,7 @@ impl CsvFile {
                         );
                         return Err(located(origin, twice));
                     }
+                    seen.insert(field.to_string(), header.len());
                     header.push((field.to_string(), origin));
                 }
                 continue;
@@ -154,14 +204,15 @@ impl CsvFile {
                 let width = Message::new(problem.to_string(), problem.label(), problem.code());
                 return Err(located(cell(0, ""), width));
             }
-            rows.push(
-                record
-                    .iter()
-                    .zip(&header)
-                    .enumerate()
-                    .map(|(k, (field, (column, _)))| (field.to_string(), cell(k, column)))
-                    .collect(),
-            );
+            for (k, field) in record.iter().enumerate() {
+                cells.push_str(field);
+                cell_spans.push(CellSpan {
+                    end: cells.len(),
+                    offset: span(k).offset + bom,
+                    ..span(k)
+                });
+            }
+            lines.push(line);
         }
         if header.is_empty() {
             let problem = CsvProblem::Empty;
@@ -169,7 +220,7 @@ impl CsvFile {
                 .help(header_help);
             return Err(located(line_origin(text, 1), empty));
         }
-        if rows.is_empty() {
+        if lines.is_empty() {
             let problem = CsvProblem::NoData;
             let none = Message::new(problem.to_string(), problem.label(), problem.code())
                 .help("each row after the header is one record");
@@ -180,7 +231,43 @@ impl CsvFile {
         Ok(CsvFile {
             text: text.to_string(),
             header,
-            rows,
+            cells,
+            spans: cell_spans,
+            lines,
+        })
+    }
+
+    /// The number of data rows.
+    pub fn len(&self) -> usize {
+        self.lines.len()
+    }
+
+    /// Whether there is no data row (never, for a parsed file).
+    pub fn is_empty(&self) -> bool {
+        self.lines.is_empty()
+    }
+
+    /// The data rows in order, each as its cells' texts and origins (key:
+    /// the cell's column name), formed as the row is read.
+    pub fn rows(&self) -> impl ExactSizeIterator<Item = Vec<(String, Origin)>> + '_ {
+        let width = self.header.len();
+        (0..self.lines.len()).map(move |r| {
+            let line = self.lines[r];
+            (r * width..(r + 1) * width)
+                .zip(&self.header)
+                .map(|(k, (name, _))| {
+                    let s = self.spans[k];
+                    let from = if k == 0 { 0 } else { self.spans[k - 1].end };
+                    let origin = Origin {
+                        offset: s.offset,
+                        len: s.len,
+                        line,
+                        column: s.column,
+                        key: name.clone(),
+                    };
+                    (self.cells[from..s.end].to_string(), origin)
+                })
+                .collect()
         })
     }
 
@@ -305,13 +392,40 @@ mod tests {
         assert_eq!(f.names().collect::<Vec<_>>(), ["x", "EXX", "EYX"]);
         assert_eq!(f.header[1].1.line, 2);
         assert_eq!(f.header[1].1.column, 4);
-        assert_eq!(f.rows.len(), 2);
-        let (text0, o) = &f.rows[1][1];
+        assert_eq!(f.len(), 2);
+        let rows: Vec<_> = f.rows().collect();
+        let (text0, o) = &rows[1][1];
         assert_eq!(text0, "3");
         assert_eq!((o.line, o.column, o.key.as_str()), (6, 5, "EXX"));
         assert_eq!(&text[o.offset..o.offset + o.len], "\"3\"");
-        let (_, o) = &f.rows[0][2];
+        let (_, o) = &rows[0][2];
         assert_eq!((o.line, o.column), (4, 7));
+    }
+
+    /// 100,000 columns: the repeated-name check and the cells' columns are
+    /// linear in the width (they were quadratic: 22 s for this header).
+    #[test]
+    fn a_hundred_thousand_columns_are_read_with_their_columns() {
+        let n = 100_000;
+        let names: Vec<String> = (0..n).map(|k| format!("c{k}")).collect();
+        let cells: Vec<String> = (0..n).map(|k| format!("{}", k % 10)).collect();
+        let text = format!("{}\n{}\n", names.join(","), cells.join(", "));
+        let f = CsvFile::parse(&text, "wide.csv").unwrap();
+        let row = f.rows().next().unwrap();
+        assert_eq!(row.len(), n);
+        // Cell k starts after k cells of one digit, each followed by ", ".
+        for k in [0, 1, 99_999] {
+            let (cell, o) = &row[k];
+            assert_eq!(cell, &format!("{}", k % 10));
+            assert_eq!((o.column, o.key.as_str()), (1 + 3 * k, names[k].as_str()));
+            assert_eq!(&text[o.offset..o.offset + o.len], cell);
+        }
+        let twice = format!("{},c7\n{}\n", names.join(","), vec!["1"; n + 1].join(","));
+        let err = CsvFile::parse(&twice, "wide.csv").unwrap_err();
+        let headline = err.first().problem.headline();
+        assert!(headline.contains("`c7` appears twice"), "{headline}");
+        // `c0,c1,…,` : `c7` starts at character 1 + 3·7.
+        assert!(headline.contains("first in column 22"), "{headline}");
     }
 
     #[test]
