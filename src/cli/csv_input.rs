@@ -52,20 +52,17 @@ fn refusal(name: &str, line: usize, problem: &CsvProblem) -> miette::Report {
 /// Opens a CSV file (`-`: stdin; at most [`bounded::PATH_BYTES`]) and reads
 /// its header and rows through the one CSV reader
 /// (`chain_core::values::csv::CsvFile`): a leading byte-order mark is
-/// dropped, `#` lines and blank lines skipped, a header-only file and a
-/// ragged row refused as `file:line: …`.
+/// dropped, `#` lines and blank lines skipped; text that is not UTF-8 or
+/// holds a NUL byte, a header-only file and a ragged row refused as
+/// `file:line: …`.
 pub(crate) fn open_csv(path: &Path) -> miette::Result<CsvInput> {
     let (name, bytes) = read_input(path, bounded::PATH_BYTES)?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        let line = 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count();
-        miette::MietteDiagnostic::new(format!("{name}:{line}: the line is not valid UTF-8"))
-            .with_code("chain::csv::malformed")
-    })?;
-    let table = CsvFile::parse_with(&text, &name, "the header names the columns, e.g. `t,x,y,z`")
-        .map_err(|d| {
+    let table = CsvFile::parse_bytes(
+        &bytes,
+        &name,
+        "the header names the columns, e.g. `t,x,y,z`",
+    )
+    .map_err(|d| {
         let first = d.first();
         miette::Report::from(
             miette::MietteDiagnostic::new(format!(
@@ -76,6 +73,7 @@ pub(crate) fn open_csv(path: &Path) -> miette::Result<CsvInput> {
             .with_code(first.problem.code()),
         )
     })?;
+    drop(bytes);
     let header = table.header.iter().map(|(h, _)| h.clone()).collect();
     Ok(CsvInput {
         name,

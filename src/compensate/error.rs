@@ -6,6 +6,41 @@
 use super::MAX_SUPPORTED_ORDER;
 use chain_core::diagnostic::shortened;
 
+/// A refusal of the shared CSV reader: `file:line: message`, with the
+/// reader's diagnostic code (`chain::csv::ragged`, ...).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{file}:{line}: {message}")]
+pub struct TableRefusal {
+    /// The file.
+    pub file: String,
+    /// The line (1-based).
+    pub line: usize,
+    /// What is wrong (the reader's headline).
+    pub message: String,
+    /// The reader's code.
+    pub code: &'static str,
+}
+
+impl TableRefusal {
+    /// The first refusal of the reader's diagnostics.
+    pub fn of(file: &str, d: &chain_core::diagnostic::Diagnostics) -> TableRefusal {
+        let first = d.first();
+        TableRefusal {
+            file: file.to_string(),
+            line: first.origin.line,
+            message: first.problem.headline(),
+            code: first.problem.code(),
+        }
+    }
+}
+
+#[cfg(feature = "cli")]
+impl miette::Diagnostic for TableRefusal {
+    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        Some(Box::new(self.code))
+    }
+}
+
 /// Errors of reading, analysing and exporting swing-angle measurements.
 ///
 /// Every error about the input names the file and, where there is one, the
@@ -42,17 +77,13 @@ pub enum CompensateError {
         /// The file.
         file: String,
     },
-    /// A line is not well-formed CSV (bad UTF-8, reported by the reader).
-    #[error("{file}:{line}: {message}")]
-    #[cfg_attr(feature = "cli", diagnostic(code(chain::csv::malformed)))]
-    Malformed {
-        /// The file.
-        file: String,
-        /// The line.
-        line: u64,
-        /// What is wrong.
-        message: String,
-    },
+    /// The file is not a CSV table (not UTF-8 text, malformed, a row of
+    /// another width than the header, a header name missing or repeated):
+    /// a refusal of the reader every CSV input shares
+    /// (`chain_core::values::csv::CsvFile`), in its words and with its code.
+    #[error(transparent)]
+    #[cfg_attr(feature = "cli", diagnostic(transparent))]
+    Table(#[from] TableRefusal),
     /// A row has another number of fields than the header.
     #[error("{file}:{line}: {}", chain_core::tabular::CsvProblem::Ragged { fields: *fields, columns: *columns })]
     #[cfg_attr(feature = "cli", diagnostic(code(chain::csv::ragged)))]

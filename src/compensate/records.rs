@@ -1,139 +1,67 @@
-//! Reading the measurement CSV of `chain compensate` (feature `records`:
-//! the `csv` crate): the records of a file or of its bytes, leniently, with
-//! the lines they start on; [`crate::compensate::Measurements::from_records`]
-//! types and checks them. The CLI and Python read through it.
+//! Reading the measurement CSV of `chain compensate` (feature `records`):
+//! the records of a file or of its bytes through the reader every CSV input
+//! shares (`chain_core::values::csv::CsvFile`), with the lines they start
+//! on; [`crate::compensate::Measurements::from_records`] types and checks
+//! them. The CLI and Python read through it.
 
 use std::path::Path;
 
 use chain_core::bounded;
 
+use chain_core::values::csv::CsvFile;
+
+use super::error::TableRefusal;
 use super::{CompensateError, Measurements, RawRecord};
+
+/// What the header of a swing-angle file names (the help of an empty file
+/// or an unnamed column).
+const HEADER_HELP: &str = "the header names the columns `theta_deg,z1,z3` (optionally `z2`)";
 
 /// The measurements of the CSV file at `path`.
 pub fn read_measurements(path: &Path) -> Result<Measurements, CompensateError> {
     let name = path.display().to_string();
-    Measurements::from_records(&name, read_records(path).map_err(RecordsError::into_error)?)
-}
-
-/// The measurements of CSV bytes named `name`.
-pub fn parse_measurements(name: &str, data: &[u8]) -> Result<Measurements, CompensateError> {
-    Measurements::from_records(
-        name,
-        parse_records(name, data).map_err(RecordsError::into_error)?,
-    )
-}
-
-/// Why [`read_records`] could not read a file.
-#[derive(Debug)]
-enum RecordsError {
-    /// The file could not be read.
-    Io {
-        /// The file as named.
-        name: String,
-        /// The underlying error.
-        source: std::io::Error,
-    },
-    /// The file is larger than its bound (`chain_core::bounded`).
-    TooLarge {
-        /// The file as named.
-        name: String,
-        /// The bound in bytes.
-        limit: usize,
-    },
-    /// A line is not well-formed CSV (bad UTF-8).
-    Malformed {
-        /// The file as named.
-        name: String,
-        /// The line (1-based).
-        line: u64,
-        /// What is wrong.
-        message: String,
-    },
-}
-
-/// Reads every record of a CSV file leniently, the header included: a
-/// leading byte-order mark is dropped, lines starting with `#` and blank lines
-/// are skipped, fields are trimmed and rows may differ in length (the caller
-/// checks them). Each record carries the line it starts on (1-based, after the
-/// comments and blank lines before it). `chain compensate` reads its
-/// measurements with it.
-fn read_records(path: &Path) -> Result<Vec<RawRecord>, RecordsError> {
-    let name = path.display().to_string();
     let data = bounded::read_path(path, bounded::COMPENSATE_BYTES).map_err(|e| match e {
-        bounded::ReadError::Io(source) => RecordsError::Io {
-            name: name.clone(),
+        bounded::ReadError::Io(source) => CompensateError::Io {
+            file: name.clone(),
             source,
         },
-        bounded::ReadError::TooLarge { limit } => RecordsError::TooLarge {
-            name: name.clone(),
+        bounded::ReadError::TooLarge { limit } => CompensateError::TooLarge {
+            file: name.clone(),
             limit,
         },
     })?;
-    parse_records(&name, &data)
+    parse_measurements(&name, &data)
 }
 
-/// [`read_records`] over bytes already read; `name` names the source.
-fn parse_records(name: &str, data: &[u8]) -> Result<Vec<RawRecord>, RecordsError> {
-    let data = data.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(data);
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .from_reader(data);
-    let malformed = |e: csv::Error| RecordsError::Malformed {
-        name: name.to_string(),
-        line: e.position().map_or(1, csv::Position::line),
-        message: csv_error_message(&e),
-    };
-    let mut out = Vec::new();
-    for (i, row) in reader.records().enumerate() {
-        let row = row.map_err(malformed)?;
-        // The header of a file whose reader reports no position is line 1.
-        let fallback = if i == 0 { 1 } else { 0 };
-        let line = row.position().map_or(fallback, |p| record_line(data, p));
-        out.push(RawRecord::new(line, row.iter()));
-    }
-    Ok(out)
-}
-
-/// The line a record starts on (after the comment and blank lines the
-/// reader skipped): the values files' rule, `chain_core::values::csv`.
-fn record_line(data: &[u8], pos: &csv::Position) -> u64 {
-    let (_, line) = chain_core::values::csv::record_start(data, pos);
-    u64::try_from(line).unwrap_or(u64::MAX)
-}
-
-fn csv_error_message(e: &csv::Error) -> String {
-    match e.kind() {
-        csv::ErrorKind::Utf8 { err, .. } => format!("the line is not valid UTF-8 ({err})"),
-        csv::ErrorKind::UnequalLengths {
-            expected_len, len, ..
-        } => format!("expected {expected_len} fields, found {len}"),
-        _ => e.to_string(),
-    }
-}
-
-impl RecordsError {
-    /// The error in the library's words (the analysis errors' messages and
-    /// codes).
-    fn into_error(self) -> CompensateError {
-        match self {
-            RecordsError::Io { name, source } => CompensateError::Io { file: name, source },
-            RecordsError::TooLarge { name, limit } => {
-                CompensateError::TooLarge { file: name, limit }
-            }
-            RecordsError::Malformed {
-                name,
-                line,
-                message,
-            } => CompensateError::Malformed {
-                file: name,
-                line,
-                message,
+/// The measurements of CSV bytes named `name`: read by the reader every CSV
+/// input shares (`CsvFile`: a leading byte-order mark dropped, `#` comment
+/// and blank lines skipped, cells trimmed, every row as wide as the header,
+/// every refusal at its line), then typed and checked by
+/// [`Measurements::from_records`].
+pub fn parse_measurements(name: &str, data: &[u8]) -> Result<Measurements, CompensateError> {
+    let csv = CsvFile::parse_bytes(data, name, HEADER_HELP).map_err(|d| {
+        let refusal = TableRefusal::of(name, &d);
+        match refusal.code {
+            // The swing-angle files' own words for these two.
+            "chain::csv::empty" => CompensateError::Empty {
+                file: name.to_string(),
             },
+            "chain::csv::no_data" => CompensateError::NoData {
+                file: name.to_string(),
+                header_line: refusal.line as u64,
+            },
+            _ => CompensateError::Table(refusal),
         }
-    }
+    })?;
+    let header = RawRecord::new(
+        csv.header.first().map_or(1, |(_, o)| o.line as u64),
+        csv.names(),
+    );
+    let rows = csv.rows().map(|cells| {
+        let line = cells.first().map_or(0, |(_, o)| o.line as u64);
+        RawRecord::new(line, cells.into_iter().map(|(text, _)| text))
+    });
+    Measurements::from_records(name, std::iter::once(header).chain(rows))
 }
 
 #[cfg(test)]
@@ -164,15 +92,32 @@ mod tests {
 
     #[test]
     fn reader_errors_name_the_file_and_line() {
+        // The shared reader's words and codes (`CsvFile`).
         let e = parse("bad.csv", b"theta_deg,z1,z3\n1,0,\xFF\n").unwrap_err();
         assert!(
-            matches!(e, CompensateError::Malformed { line: 2, .. }),
-            "{e}"
+            matches!(&e, CompensateError::Table(t) if t.line == 2 && t.code == "chain::invalid_utf8"),
+            "{e:?}"
         );
+        assert_eq!(
+            e.to_string(),
+            "bad.csv:2: the file is not valid UTF-8 (invalid byte at byte offset 20)"
+        );
+        let e = parse("twice.csv", b"theta_deg,z1,z3,z1\n1,0,-0.1,0\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "twice.csv:1: column `z1` appears twice in the header (first in column 11)",
+            "{e:?}"
+        );
+        // Names differing in case only: the swing-angle columns' own check.
+        let e = parse("case.csv", b"theta_deg,z1,z3,Z1\n1,0,-0.1,0\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "case.csv:1: column `z1` appears twice in the header"
+        );
+        let e = parse("header.csv", b"theta_deg,z1,z3\n").unwrap_err();
         assert!(
-            e.to_string()
-                .starts_with("bad.csv:2: the line is not valid UTF-8"),
-            "{e}"
+            matches!(e, CompensateError::NoData { header_line: 1, .. }),
+            "{e:?}"
         );
         let e = parse("empty.csv", b"# only a comment\n\n").unwrap_err();
         assert_eq!(
@@ -183,6 +128,10 @@ mod tests {
         assert_eq!(
             e.to_string(),
             "short.csv:3: this row has 2 fields but the header has 3 columns"
+        );
+        assert!(
+            matches!(&e, CompensateError::Table(t) if t.code == "chain::csv::ragged"),
+            "{e:?}"
         );
         let e = super::read_measurements(Path::new("/nonexistent/swing.csv")).unwrap_err();
         assert!(matches!(e, CompensateError::Io { .. }), "{e}");

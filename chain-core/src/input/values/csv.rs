@@ -76,6 +76,18 @@ impl CsvFile {
         CsvFile::parse(text, name).map_err(CsvOpenError::Invalid)
     }
 
+    /// Parses CSV bytes: checked as text first (no NUL byte, valid UTF-8,
+    /// the first bad byte located, as every input is), then
+    /// [`CsvFile::parse_with`].
+    pub fn parse_bytes(
+        bytes: &[u8],
+        name: &str,
+        header_help: &'static str,
+    ) -> Result<CsvFile, Diagnostics> {
+        let text = crate::load::decode(bytes, name)?;
+        CsvFile::parse_with(text, name, header_help)
+    }
+
     /// Parses the CSV text of a values table.
     pub(crate) fn parse(text: &str, name: &str) -> Result<CsvFile, Diagnostics> {
         CsvFile::parse_with(text, name, TABLE_HEADER)
@@ -277,7 +289,7 @@ impl CsvFile {
     }
 
     /// The header names.
-    pub(crate) fn names(&self) -> impl Iterator<Item = &str> {
+    pub fn names(&self) -> impl Iterator<Item = &str> {
         self.header.iter().map(|(h, _)| h.as_str())
     }
 
