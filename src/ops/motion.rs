@@ -95,6 +95,14 @@ pub enum MotionOpsError {
     /// The motion cannot be set up or solved.
     #[error(transparent)]
     Motion(#[from] MotionError),
+    /// An instant is unreachable with the variables `--fix` holds.
+    #[error("--fix {fix}: {error}")]
+    HeldUnreachable {
+        /// The `--fix` values, as given.
+        fix: String,
+        /// The conversion's refusal.
+        error: MotionError,
+    },
 }
 
 /// The options' code, else the inner diagnostic's code, help, source and
@@ -106,6 +114,16 @@ impl Worded for MotionOpsError {
             | MotionOpsError::Samples(_)
             | MotionOpsError::Tolerance { .. }
             | MotionOpsError::AngularWithoutTolerance => Some("chain::cli::invalid_option"),
+            MotionOpsError::HeldUnreachable { .. } => Some("chain::motion::unreachable"),
+            _ => None,
+        }
+    }
+
+    fn own_help(&self) -> Option<String> {
+        match self {
+            MotionOpsError::HeldUnreachable { .. } => Some(
+                "hold fewer variables (--fix), or hold them at values from which the generator's pose is reachable".into(),
+            ),
             _ => None,
         }
     }
@@ -123,6 +141,52 @@ impl Worded for MotionOpsError {
 }
 
 diagnostic!(MotionOpsError);
+
+/// A conversion that fails on the path, located where its cause was given:
+/// an instant the CNC machine cannot reach with the variables held by
+/// `--fix` (named) or `cnc.fix`, or else at the generator's settings
+/// (`values`); a roll it cannot follow continuously at `roll.drive`; other
+/// errors as they are.
+fn located(settings: &Settings, fix: &[(String, f64)], e: MotionError) -> MotionOpsError {
+    use chain_core::diagnostic::{Diagnostics, Message, Problem};
+    if matches!(e, MotionError::Unreachable { .. }) && !fix.is_empty() {
+        return MotionOpsError::HeldUnreachable {
+            fix: (fix.iter())
+                .map(|(n, v)| format!("{n}={v}"))
+                .collect::<Vec<_>>()
+                .join(" --fix "),
+            error: e,
+        };
+    }
+    let (origin, label, help) = match (&e, &settings.fix_origin) {
+        (MotionError::Unreachable { .. }, Some(held)) => (
+            held,
+            "the held variables",
+            "hold fewer variables, or hold them at values from which the generator's pose is reachable",
+        ),
+        (MotionError::Unreachable { .. }, None) => (
+            &settings.values_origin,
+            "the generator's settings",
+            "check these settings against the CNC machine's parameters and strokes, or its `start` guess (cnc.start)",
+        ),
+        (MotionError::Discontinuous { .. }, _) => (
+            &settings.drive_origin,
+            "the roll",
+            "shorten the roll interval so that it stays on one side of the singular configuration",
+        ),
+        _ => return MotionOpsError::Motion(e),
+    };
+    let code = match &e {
+        MotionError::Unreachable { .. } => "chain::motion::unreachable",
+        _ => "chain::motion::discontinuous",
+    };
+    MotionOpsError::Settings(Diagnostics::single(
+        settings.file.clone(),
+        settings.source.clone(),
+        origin.clone(),
+        Problem::Message(Message::new(e.to_string(), label, code).help(help)),
+    ))
+}
 
 /// The document of `chain motion`: one conversion run with the settings it
 /// came from (JSON: docs/motion.md).
@@ -201,7 +265,8 @@ pub fn run(
             tolerance: request.tolerance,
             angular_tolerance: request.angular_tolerance,
         },
-    )?;
+    )
+    .map_err(|e| located(&settings, request.fix, e))?;
     Ok(MotionDocument {
         conversion,
         settings,

@@ -279,6 +279,77 @@ fn cli_infeasible_exits_non_zero_naming_component_and_errors() {
     );
 }
 
+/// Every standard deviation pinned at its `min_std`: nothing can be
+/// tightened. The paper's procedure stalls on `px` at round 0 and the
+/// least-cost allocation finds the requirement infeasible; each refusal
+/// names the file, line and column of the statistics entry of the error it
+/// lists first, and shows it (issue 36: it named the machine only).
+#[test]
+fn cli_stalled_and_infeasible_allocations_point_at_the_statistics_entry() {
+    let text = std::fs::read_to_string(gantry_path()).unwrap();
+    let pinned: String = text
+        .lines()
+        .map(
+            |line| match (line.contains("dist: normal"), line.find("std: ")) {
+                (true, Some(i)) => {
+                    let expr = line[i + 5..].trim_end_matches('}').trim();
+                    format!(
+                        "{}\n",
+                        line.replacen('}', &format!(", min_std: {expr}}}"), 1)
+                    )
+                }
+                _ => format!("{line}\n"),
+            },
+        )
+        .collect();
+    let file = scratch("gantry_pinned").join("pinned.yaml");
+    std::fs::write(&file, &pinned).unwrap();
+    let f = file.to_str().unwrap();
+    // Where each error's entry is, counted here from the text.
+    let entry = |name: &str| {
+        let line = 1 + pinned
+            .lines()
+            .position(|l| l.starts_with(&format!("  {name}: {{dist")))
+            .expect("entry");
+        format!("{f}:{line}:3: gantry_grinder: ")
+    };
+    let err = fails(&["allocate", f, "--strategy", "paper"]);
+    mentions(
+        &err,
+        &[
+            "chain::allocate::stalled",
+            "stops after round 0: px misses the requirement",
+            "its statistics entry",
+        ],
+    );
+    // The first of the ranked errors, as the message lists them.
+    let first = err
+        .split("further (")
+        .nth(1)
+        .and_then(|r| r.split(',').next())
+        .expect("ranked errors")
+        .trim()
+        .to_string();
+    let flat = err.split_whitespace().collect::<Vec<_>>().join(" ");
+    let at = entry(&first);
+    assert!(flat.contains(&at), "{at:?} is missing from:\n{err}");
+    let err = fails(&["allocate", f]);
+    mentions(
+        &err,
+        &["chain::allocate::infeasible", "its statistics entry"],
+    );
+    let first = err
+        .split("binding bounds: ")
+        .nth(1)
+        .and_then(|r| r.split(" (").next())
+        .expect("binding errors")
+        .trim()
+        .to_string();
+    let flat = err.split_whitespace().collect::<Vec<_>>().join(" ");
+    let at = entry(&first);
+    assert!(flat.contains(&at), "{at:?} is missing from:\n{err}");
+}
+
 #[test]
 fn cli_allocation_errors_have_their_own_codes() {
     // No requirement: its own code and the hint, no catch-all code.
@@ -430,6 +501,37 @@ fn cli_plot_writes_maps_and_the_tightening_chart() {
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A requirement that already holds: nothing is tightened, so `--plot`
+/// writes the before/after maps, no tightening chart, and says why (it
+/// failed with `chain::plot::no_data`), for both strategies.
+#[test]
+fn cli_plot_with_nothing_tightened_writes_the_maps_and_says_so() {
+    let text = std::fs::read_to_string(gantry_path()).unwrap();
+    let easy = text.replace(
+        "requirement: {min: 0.95, mean: 0.97}",
+        "requirement: {min: 0.5, mean: 0.5}",
+    );
+    assert_ne!(easy, text, "the gantry's requirement line");
+    let file = scratch("easy").join("easy.yaml");
+    std::fs::write(&file, easy).unwrap();
+    for strategy in ["paper", "optimal"] {
+        let dir = scratch(&format!("plot-easy-{strategy}"));
+        let out = ok(&[
+            "allocate",
+            file.to_str().unwrap(),
+            "--strategy",
+            strategy,
+            "--plot",
+            dir.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        mentions(&err, &["no error was tightened", "allocate_px.png"]);
+        assert!(dir.join("allocate_pz.svg").exists(), "{err}");
+        assert!(!dir.join("allocate_tightening.png").exists(), "{err}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }
 
 /// The gantry grinder with an `nx × ny × nz` grid over its strokes and

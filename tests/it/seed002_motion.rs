@@ -1166,6 +1166,58 @@ fn cli_json_document_and_plots() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// An instant the CNC machine cannot reach is refused where its cause was
+/// given (issue 36: the refusal named no file, line or option): with the
+/// rotary axes held by `--fix`, naming the option; held by the settings'
+/// `cnc.fix`, at that key; with nothing held, at the generator's `values`.
+#[test]
+fn unreachable_instants_are_located_where_the_cause_was_given() {
+    let settings = settings_path("seed002_concave").display().to_string();
+    let cnc = cnc_file();
+    let base = [
+        "motion",
+        cnc.as_str(),
+        "--settings",
+        settings.as_str(),
+        "--samples",
+        "5",
+    ];
+    let mut args = base.to_vec();
+    args.extend(["--fix", "B=0", "--fix", "A=0"]);
+    let err = unwrapped(&fails(&args));
+    assert!(
+        err.contains("--fix B=0 --fix A=0: at t = 0: the CNC machine cannot reproduce")
+            && err.contains("chain::motion::unreachable"),
+        "{err}"
+    );
+    // The same held in the settings file.
+    let dir = scratch("held");
+    let good = std::fs::read_to_string(settings_path("seed002_concave")).unwrap();
+    let generator = example_path("cradle_generator.yaml").display().to_string();
+    let held = good
+        .replace("../machines/cradle_generator.yaml", &generator)
+        .replace(
+            "  match: pose ",
+            "  match: point_axis\n  fix: {B: 0, A: 0}\n ",
+        );
+    assert!(
+        held.contains("fix: {B: 0, A: 0}"),
+        "the settings' match line"
+    );
+    let file = dir.join("held.yaml");
+    std::fs::write(&file, &held).unwrap();
+    let mut args = base.to_vec();
+    args[3] = file.to_str().unwrap();
+    let err = unwrapped(&fails(&args));
+    let line = held.lines().position(|l| l.contains("fix: {B")).unwrap() + 1;
+    assert!(
+        err.contains(&format!("held.yaml:{line}:"))
+            && err.contains("the CNC machine cannot reproduce")
+            && err.contains("the held variables"),
+        "{err}"
+    );
+}
+
 #[test]
 fn cli_table_and_errors() {
     let settings = settings_path("seed002_concave").display().to_string();

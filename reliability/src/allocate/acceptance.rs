@@ -290,9 +290,8 @@ pub fn acceptance<M: ErrorModel + ?Sized>(
                         errors: bounds
                             .iter()
                             .filter(|b| b.min_std > 0.0)
-                            .map(|b| b.error.as_str())
-                            .collect::<Vec<_>>()
-                            .join(", "),
+                            .map(|b| b.error.clone())
+                            .collect(),
                     });
                 }
                 let mut tightened = Vec::new();

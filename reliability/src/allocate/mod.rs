@@ -393,7 +393,7 @@ pub enum AllocateError {
         binding: Vec<String>,
     },
     /// The paper's procedure can tighten nothing more.
-    #[error("the paper's procedure stops after round {round}: {component} misses the requirement and none of its errors can be tightened further ({errors} at min_std or zero)")]
+    #[error("the paper's procedure stops after round {round}: {component} misses the requirement and none of its errors can be tightened further ({} at min_std or zero)", errors.join(", "))]
     #[cfg_attr(
         feature = "miette",
         diagnostic(
@@ -407,12 +407,28 @@ pub enum AllocateError {
         /// The component.
         component: String,
         /// Its ranked errors.
-        errors: String,
+        errors: Vec<String>,
     },
     /// The optimiser did not converge.
     #[error("the optimiser did not converge: {0}")]
     #[cfg_attr(feature = "miette", diagnostic(code(chain::allocate::not_converged)))]
     NotConverged(String),
+}
+
+impl AllocateError {
+    /// The error parameter the refusal names first, whose statistics entry
+    /// (its `min_std`) a message can point at: a stalled round's first
+    /// ranked error, an infeasible requirement's first binding error.
+    pub fn statistic(&self) -> Option<&str> {
+        match self {
+            AllocateError::Stalled { errors, .. } => errors.first().map(String::as_str),
+            // Each binding entry is `name (min_std …)`.
+            AllocateError::Infeasible { binding, .. } => {
+                binding.first().and_then(|b| b.split(" (").next())
+            }
+            _ => None,
+        }
+    }
 }
 
 /// The study's inputs with other standard deviations: families, means and

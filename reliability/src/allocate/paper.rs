@@ -80,11 +80,7 @@ pub fn paper<M: ErrorModel + ?Sized>(
                 return Err(AllocateError::Stalled {
                     round: round - 1,
                     component: name.clone(),
-                    errors: ranked
-                        .iter()
-                        .map(|&j| bounds[j].error.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", "),
+                    errors: ranked.iter().map(|&j| bounds[j].error.clone()).collect(),
                 });
             }
             for j in 0..n {

@@ -119,7 +119,7 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
     let run = ops::run(&loaded.machine, loaded.file_name(), &request).map_err(|e| match e {
         AllocateOpsError::Study(e) => loaded.study_error(*e),
         AllocateOpsError::Reliability(e) => loaded.report(e),
-        e => miette::Report::new(e),
+        e => loaded.allocate_error(e),
     })?;
     if let Some(dir) = &args.plot {
         let stds: Vec<f64> = run.result.std.iter().map(|(_, s)| *s).collect();
