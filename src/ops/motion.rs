@@ -169,6 +169,13 @@ fn located(settings: &Settings, fix: &[(String, f64)], e: MotionError) -> Motion
             "the generator's settings",
             "check these settings against the CNC machine's parameters and strokes, or its `start` guess (cnc.start)",
         ),
+        (MotionError::TooFewInstants { variable, .. }, _) => (
+            (settings.drive.iter())
+                .find(|d| d.name == *variable)
+                .map_or(&settings.drive_origin, |d| &d.key),
+            "its roll law",
+            "raise --samples to the instants it needs, or check `ratio` and `roll.omega_c` (a roll ratio is a tooth ratio, a few units to a few tens), or shorten `roll.interval`",
+        ),
         (MotionError::Discontinuous { .. }, _) => (
             &settings.drive_origin,
             "the roll",
@@ -178,6 +185,7 @@ fn located(settings: &Settings, fix: &[(String, f64)], e: MotionError) -> Motion
     };
     let code = match &e {
         MotionError::Unreachable { .. } => "chain::motion::unreachable",
+        MotionError::TooFewInstants { .. } => "chain::motion::too_few_instants",
         _ => "chain::motion::discontinuous",
     };
     MotionOpsError::Settings(Diagnostics::single(

@@ -1166,6 +1166,89 @@ fn cli_json_document_and_plots() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A roll too fast for its instants is refused from the settings alone
+/// (issue 36, point 3): a roll ratio of 1e5 turned the blank through 41,900
+/// rad, 42 rad between the 1,000 instants, and ran 24 s (38 s before) of
+/// continuation; a ratio of 30,000 turns it by 12.58 rad ≈ 4π between
+/// instants, which the continuation took for no turn at all (the axis came
+/// back a whole number of turns off). With the instants it asks for, the
+/// run follows the roll: the work axis turns through the whole roll, at
+/// most a quarter turn between rows.
+#[test]
+fn a_roll_too_fast_for_its_instants_is_refused_from_its_inputs() {
+    let good = std::fs::read_to_string(settings_path("seed002_concave")).unwrap();
+    let generator = example_path("cradle_generator.yaml").display().to_string();
+    let cnc = cnc_file();
+    let dir = scratch("fast-roll");
+    let with_ratio = |ratio: &str| {
+        let text = good
+            .replace("../machines/cradle_generator.yaml", &generator)
+            .replace(
+                "phi_p: {start: 0, ratio: 6.33912}",
+                &format!("phi_p: {{start: 0, ratio: {ratio}}}"),
+            );
+        assert!(text.contains(&format!("ratio: {ratio}}}")), "the phi_p law");
+        let file = dir.join(format!("ratio_{ratio}.yaml"));
+        std::fs::write(&file, &text).unwrap();
+        (file.display().to_string(), text)
+    };
+    // omega_c = 2°/s over [-6, 6] s: phi_p turns ratio · 2° · 12 s.
+    let omega = 2f64.to_radians();
+    for (ratio, r) in [("100000", 1e5), ("30000", 3e4)] {
+        let (file, text) = with_ratio(ratio);
+        let err = unwrapped(&fails(&["motion", &cnc, "--settings", &file]));
+        let total = r * omega * 12.0;
+        let needed = (total / FRAC_PI_2).ceil() as u64 + 1;
+        let line = text
+            .lines()
+            .position(|l| l.contains("phi_p: {start"))
+            .unwrap()
+            + 1;
+        assert!(
+            err.contains(&format!("ratio_{ratio}.yaml:{line}:5"))
+                && err.contains("chain::motion::too_few_instants")
+                && err.contains(&format!(
+                    "the roll turns `phi_p` by {:.4} rad between instants",
+                    total / 999.0
+                ))
+                && err.contains(&format!("it needs at least {needed} instants")),
+            "{err}"
+        );
+    }
+    // Ratio 3000: 1,256.6 rad over the roll, 1,258 instants (801 needed).
+    let (file, _) = with_ratio("3000");
+    let csv = ok_stdout(&[
+        "motion",
+        &cnc,
+        "--settings",
+        &file,
+        "--samples",
+        "1258",
+        "--format",
+        "csv",
+    ]);
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let a = header.iter().position(|h| *h == "A").expect("A column");
+    let values: Vec<f64> = lines
+        .map(|l| l.split(',').nth(a).unwrap().parse().unwrap())
+        .collect();
+    let total = 3000.0 * omega * 12.0;
+    let turned = (values[values.len() - 1] - values[0]).abs();
+    assert!(
+        (turned - total).abs() < 0.01 * total,
+        "A turns {turned} rad, the roll {total}"
+    );
+    let step = values
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(0.0, f64::max);
+    assert!(step <= 1.0 + 1e-9, "largest step of A: {step}");
+    // The paper's roll (2.66 rad) runs on two instants (1.33 rad apart).
+    let settings = settings_path("seed002_concave").display().to_string();
+    ok_stdout(&["motion", &cnc, "--settings", &settings, "--samples", "2"]);
+}
+
 /// An instant the CNC machine cannot reach is refused where its cause was
 /// given (issue 36: the refusal named no file, line or option): with the
 /// rotary axes held by `--fix`, naming the option; held by the settings'

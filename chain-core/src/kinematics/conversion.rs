@@ -68,6 +68,7 @@ impl Conversion {
     /// at every instant, expands it and measures the truncation errors.
     pub fn run(motion: Motion, options: &RunOptions) -> Result<Conversion, MotionError> {
         let times = motion.sample_times(options.samples);
+        motion.check_instants(&times)?;
         let q0 = motion.solve_cold(0.0)?;
         let exact = motion.trajectory_from(&q0, &times)?;
         let mut worst = PoseError {

@@ -184,6 +184,25 @@ pub enum MotionError {
         /// `pose` or `tool point and axis`.
         what: &'static str,
     },
+    /// A rotary generator law turns by more than [`MAX_TURN_PER_INSTANT`]
+    /// between consecutive instants ([`Motion::check_instants`]).
+    #[error("the roll turns `{variable}` by {turn:.4} rad between instants ({total:.4} rad over the roll interval, {instants} instants): more than a quarter turn (π/2 rad), so the CNC axes cannot be followed from one instant to the next (a whole turn between instants would go unseen); it needs at least {needed} instants")]
+    #[cfg_attr(feature = "miette", diagnostic(
+        code(chain::motion::too_few_instants),
+        help("raise --samples, or check the roll: the law's `ratio` and `omega_c` (a roll ratio is a tooth ratio, a few units to a few tens), or a shorter `roll.interval`")
+    ))]
+    TooFewInstants {
+        /// The generator variable.
+        variable: String,
+        /// Its largest turn between consecutive instants (rad).
+        turn: f64,
+        /// Its turn over the interval (rad).
+        total: f64,
+        /// The instants asked for.
+        instants: usize,
+        /// The instants it needs.
+        needed: u64,
+    },
     /// No axis values reproduce the generator's pose at an instant.
     #[error("at t = {t}: the CNC machine cannot reproduce the generator's {what} (best residual: position {position:.3e}, angle {angle:.3e} rad)")]
     #[cfg_attr(feature = "miette", diagnostic(
@@ -279,6 +298,7 @@ pub struct Motion {
     gen_params: Vec<f64>,
     laws: Vec<Law>,
     gen_names: Vec<String>,
+    gen_kinds: Vec<JointKind>,
     cnc: Kinematics,
     cnc_params: Vec<f64>,
     names: Vec<String>,
@@ -292,6 +312,14 @@ pub struct Motion {
 
 /// Newton iterations per solve.
 const MAX_NEWTON: usize = 60;
+/// The largest turn (rad) of a rotary generator law between consecutive
+/// instants (`t = 0` among them) that [`Motion::check_instants`] accepts:
+/// the continuation ([`Motion::trajectory`]) compares consecutive instants
+/// and halves its step when a rotary axis jumps by more than 0.5 rad, so a
+/// turn of about 2π between instants would pass for none (the axes would
+/// be reported a whole turn off); a quarter turn keeps far from that, and
+/// lets the paper's rolls run on as few as two instants.
+pub const MAX_TURN_PER_INSTANT: f64 = std::f64::consts::FRAC_PI_2;
 /// A solution is accepted when the position error is below this times
 /// `max(1, |p|)` and the angle error below this (rad).
 pub const ACCEPT: f64 = 1e-10;
@@ -389,6 +417,7 @@ impl Motion {
             generator_name: generator.name.clone(),
             cnc_name: cnc.name.clone(),
             gen_names: gk.variables().iter().map(|v| v.0.clone()).collect(),
+            gen_kinds: gk.variables().iter().map(|v| v.1).collect(),
             names: ck.variables().iter().map(|v| v.0.clone()).collect(),
             kinds: ck.variables().iter().map(|v| v.1).collect(),
             generator: gk,
@@ -460,6 +489,42 @@ impl Motion {
             _ => (0..k)
                 .map(|i| a + (b - a) * i as f64 / (k - 1) as f64)
                 .collect(),
+        }
+    }
+
+    /// Checks that no rotary generator law turns by more than
+    /// [`MAX_TURN_PER_INSTANT`] between consecutive instants of `times`
+    /// (with `t = 0`, where the continuation starts): from the laws alone,
+    /// before any solve. A roll that turns too fast for its instants (a roll
+    /// ratio of 1e5 turns the blank through 41,900 rad over the paper's
+    /// interval: 42 rad between 1,000 instants) is refused at once, with the
+    /// number of instants it needs, where it took minutes of continuation
+    /// and could alias whole turns.
+    pub fn check_instants(&self, times: &[f64]) -> Result<(), MotionError> {
+        let mut ts: Vec<f64> = times.iter().copied().chain([0.0]).collect();
+        ts.sort_by(f64::total_cmp);
+        let gap = ts.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+        let (a, b) = self.interval;
+        let worst = (0..self.laws.len())
+            .filter(|&k| self.gen_kinds[k] == JointKind::Rotary)
+            .map(|k| (k, self.laws[k].rate.abs()))
+            .max_by(|x, y| x.1.total_cmp(&y.1));
+        match worst {
+            Some((k, rate)) if rate * gap > MAX_TURN_PER_INSTANT => {
+                let needed = (rate * (b - a) / MAX_TURN_PER_INSTANT).ceil() + 1.0;
+                Err(MotionError::TooFewInstants {
+                    variable: self.gen_names[k].clone(),
+                    turn: rate * gap,
+                    total: rate * (b - a),
+                    instants: times.len(),
+                    needed: if needed < 1e15 {
+                        needed as u64
+                    } else {
+                        u64::MAX
+                    },
+                })
+            }
+            _ => Ok(()),
         }
     }
 
