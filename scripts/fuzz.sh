@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The longer fuzz run (docs/robustness.md, "Fuzzing"): the fuzz tests of
-# tests/it/fuzz.rs with CASES cases per input (default 2000; the test
-# command runs a few dozen). A failing case is saved in the temporary
+# tests/it/fuzz.rs (byte-level mutations) and tests/it/fuzz_structured.rs
+# (structural edits, proptest programs) with CASES cases per input
+# (default 2000; the test command runs a few dozen). A failing case is saved in the temporary
 # directory the failure message names.
 #
 #   scripts/fuzz.sh [CASES]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-CHAIN_FUZZ_CASES="${1:-2000}" cargo test --profile ci --test it -- fuzz:: --nocapture
+CHAIN_FUZZ_CASES="${1:-2000}" cargo test --profile ci --test it -- fuzz:: fuzz_structured:: --nocapture

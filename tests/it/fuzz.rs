@@ -36,7 +36,7 @@ use crate::common::Rng;
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// Cases per input, scaled by `CHAIN_FUZZ_CASES` (default `default`).
-fn cases(default: usize) -> usize {
+pub(crate) fn cases(default: usize) -> usize {
     std::env::var("CHAIN_FUZZ_CASES")
         .ok()
         .and_then(|v| v.parse::<usize>().ok())
@@ -157,7 +157,7 @@ fn mutate(rng: &mut Rng, bytes: &[u8]) -> Vec<u8> {
 
 /// Runs `case` on a thread of its own, failing the test (with the input
 /// saved under `name` in `dir`) when it panics or takes more than `bound`.
-fn bounded(
+pub(crate) fn bounded(
     dir: &Path,
     name: &str,
     input: &[u8],

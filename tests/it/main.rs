@@ -31,6 +31,7 @@ mod function_slot_input;
 mod function_slot_reliability;
 mod function_slots;
 mod fuzz;
+mod fuzz_structured;
 mod generated_into;
 mod geometric_sensitivity;
 mod golden_outputs;
