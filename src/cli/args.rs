@@ -2,6 +2,7 @@
 //! their argument structs with `#[command(flatten)]`.
 
 use chain_core::compensation::controllers::Controller;
+use chain_core::diagnostic::shortened;
 use chain_core::model::Sided;
 use reliability::Method;
 
@@ -128,7 +129,7 @@ pub(crate) fn parse_cov(s: &str) -> Result<f64, String> {
     let v: f64 = s
         .trim()
         .parse()
-        .map_err(|_| format!("`{s}` is not a number"))?;
+        .map_err(|_| format!("`{}` is not a number", shortened(s)))?;
     if !v.is_finite() || v <= 0.0 || v > 1.0 {
         return Err(format!(
             "the target coefficient of variation must be in (0, 1] (found `{s}`)"
@@ -184,13 +185,13 @@ impl SystemArgs {
 pub(crate) fn parse_assignment(s: &str) -> Result<(String, f64), String> {
     let (name, value) = s
         .split_once('=')
-        .ok_or_else(|| format!("expected NAME=VALUE, found `{s}`"))?;
+        .ok_or_else(|| format!("expected NAME=VALUE, found `{}`", shortened(s)))?;
     let v: f64 = value
         .trim()
         .parse()
-        .map_err(|_| format!("`{value}` is not a number"))?;
+        .map_err(|_| format!("`{}` is not a number", shortened(value)))?;
     if !v.is_finite() {
-        return Err(format!("`{value}` is not finite"));
+        return Err(format!("`{}` is not finite", shortened(value)));
     }
     Ok((name.trim().to_string(), v))
 }
@@ -199,7 +200,7 @@ pub(crate) fn parse_assignment(s: &str) -> Result<(String, f64), String> {
 pub(crate) fn parse_axis(s: &str) -> Result<(String, Vec<f64>), String> {
     let (name, values) = s
         .split_once('=')
-        .ok_or_else(|| format!("expected VAR=V1,V2,..., found `{s}`"))?;
+        .ok_or_else(|| format!("expected VAR=V1,V2,..., found `{}`", shortened(s)))?;
     let values = values
         .split(',')
         .map(|v| {
@@ -207,11 +208,11 @@ pub(crate) fn parse_axis(s: &str) -> Result<(String, Vec<f64>), String> {
                 .parse::<f64>()
                 .ok()
                 .filter(|x| x.is_finite())
-                .ok_or_else(|| format!("`{v}` is not a finite number"))
+                .ok_or_else(|| format!("`{}` is not a finite number", shortened(v)))
         })
         .collect::<Result<Vec<_>, _>>()?;
     if values.is_empty() {
-        return Err(format!("axis `{name}` has no value"));
+        return Err(format!("axis `{}` has no value", shortened(name)));
     }
     Ok((name.trim().to_string(), values))
 }
@@ -228,18 +229,25 @@ pub(crate) fn parse_grid_axis(s: &str) -> Result<(String, Vec<f64>), String> {
     }
     let parts: Vec<&str> = spec.split(':').map(str::trim).collect();
     let [lo, hi, n] = parts[..] else {
-        return Err(format!("expected LO:HI:N after `{name}=`, found `{spec}`"));
+        return Err(format!(
+            "expected LO:HI:N after `{}=`, found `{}`",
+            shortened(name),
+            shortened(spec)
+        ));
     };
     let number = |t: &str| {
         t.parse::<f64>()
             .ok()
             .filter(|x| x.is_finite())
-            .ok_or_else(|| format!("`{t}` is not a finite number"))
+            .ok_or_else(|| format!("`{}` is not a finite number", shortened(t)))
     };
     let (lo, hi) = (number(lo)?, number(hi)?);
-    let n: usize = n
-        .parse()
-        .map_err(|_| format!("`{n}` is not a count of values (a whole number ≥ 2)"))?;
+    let n: usize = n.parse().map_err(|_| {
+        format!(
+            "`{}` is not a count of values (a whole number ≥ 2)",
+            shortened(n)
+        )
+    })?;
     if n < 2 {
         return Err(format!(
             "LO:HI:N needs N ≥ 2 values, found {n} (one value is `{name}=V`)"
@@ -299,7 +307,7 @@ pub(crate) fn parse_point(s: &str) -> Result<AtPoint, String> {
         .collect::<Result<Vec<_>, _>>()?;
     for (i, (name, _)) in point.iter().enumerate() {
         if point[..i].iter().any(|(n, _)| n == name) {
-            return Err(format!("`{name}` is given twice"));
+            return Err(format!("`{}` is given twice", shortened(name)));
         }
     }
     Ok(AtPoint(point))

@@ -242,3 +242,47 @@ fn huge_refused_values_are_quoted_shortened() {
         );
     }
 }
+
+/// A huge option value, argument or subcommand refused by the command-line
+/// parser is quoted shortened too (issue 36: clap echoed it whole), with
+/// clap's exit status 2.
+#[test]
+fn huge_command_line_values_are_quoted_shortened() {
+    let huge = "9".repeat(5000);
+    let gantry = format!("{ROOT}/examples/machines/gantry_grinder.yaml");
+    let assignment = format!("a=x{huge}");
+    let option = format!("--{huge}");
+    let runs: [(Vec<&str>, String); 4] = [
+        (
+            vec!["path", &gantry, "--axes", "x.csv", "--samples", &huge],
+            format!("invalid value '{}…' for '--samples", &huge[..40]),
+        ),
+        (
+            vec!["path", &gantry, "--axes", "x.csv", "--param", &assignment],
+            format!("`x{}…` is not a number", &huge[..39]),
+        ),
+        (
+            vec![&option],
+            format!("unexpected argument '--{}…'", &huge[..38]),
+        ),
+        (
+            vec![&huge],
+            format!("unrecognized subcommand '{}…'", &huge[..40]),
+        ),
+    ];
+    for (args, message) in runs {
+        let out = Command::new(env!("CARGO_BIN_EXE_chain"))
+            .args(&args)
+            .env("NO_COLOR", "1")
+            .output()
+            .expect("chain runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(&message), "expected `{message}` in {err}");
+        assert!(
+            !err.contains(&huge[..200]),
+            "echoes the value in full: {} bytes",
+            err.len()
+        );
+    }
+}

@@ -536,6 +536,120 @@ fn edited_machine_trees_never_panic_and_are_refused_in_place() {
     );
 }
 
+/// A scalar as the inline syntax writes it: its own tokens when they lex
+/// and hold no top-level comma, else a string literal.
+fn inline_scalar(text: &str, plain: bool) -> String {
+    let lexes = || {
+        text.parse::<proc_macro2::TokenStream>().is_ok_and(|t| {
+            !t.is_empty()
+                && t.into_iter()
+                    .all(|tt| !matches!(&tt, proc_macro2::TokenTree::Punct(p) if p.as_char() == ',' || p.as_char() == ';'))
+        })
+    };
+    if plain && !text.contains(['{', '}', '[', ']', '(', ')', '"', '\'']) && lexes() {
+        text.to_string()
+    } else {
+        format!("{text:?}")
+    }
+}
+
+/// The tree in the `machine!` inline syntax (docs of
+/// `chain_core::inline`): `pub Fuzz { key: value, … }`.
+fn inline(y: &Y) -> String {
+    fn value(y: &Y) -> String {
+        match y {
+            Y::S(t, plain) => inline_scalar(t, *plain),
+            Y::L(items) => format!(
+                "[{}]",
+                items.iter().map(value).collect::<Vec<_>>().join(", ")
+            ),
+            Y::M(entries) => format!("{{ {} }}", entries_of(entries)),
+        }
+    }
+    fn entries_of(entries: &[(String, Y)]) -> String {
+        entries
+            .iter()
+            .map(|(k, v)| format!("{}: {}", inline_scalar(k, true), value(v)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+    match y {
+        Y::M(entries) => format!("pub Fuzz {{ {} }}", entries_of(entries)),
+        other => format!("pub Fuzz {{ machine: {} }}", value(other)),
+    }
+}
+
+/// Whether the macro's expansion of `source` is clean (no
+/// `compile_error!`); `None` when the text does not lex (the compiler would
+/// not hand it to the macro).
+fn expand_clean(source: &str) -> Option<bool> {
+    let tokens = source.parse::<proc_macro2::TokenStream>().ok()?;
+    Some(
+        !chain_core::expand::expand(tokens)
+            .to_string()
+            .contains("compile_error"),
+    )
+}
+
+/// The example machines in the inline syntax: every one expands cleanly as
+/// written, so the edits below reach the macro's rules, not only its
+/// syntax.
+#[test]
+fn unedited_trees_expand_as_inline_machines() {
+    let mut files = yaml_files("machines", "\nbodies:");
+    files.extend(yaml_files("robots", "\nbodies:"));
+    let mut clean = Vec::new();
+    for f in &files {
+        if expand_clean(&inline(&tree(f))) == Some(true) {
+            clean.push(f.file_name().unwrap().to_string_lossy().into_owned());
+        }
+    }
+    eprintln!(
+        "{} of {} example machines expand cleanly inline",
+        clean.len(),
+        files.len()
+    );
+    assert!(
+        clean.iter().any(|f| f == "gantry_grinder.yaml"),
+        "{clean:?}"
+    );
+    assert!(clean.len() == files.len(), "{clean:?} of {}", files.len());
+}
+
+/// Structural edits of the example machines, written in the inline syntax,
+/// through the macro's expansion (`chain_core::expand`, no compiler): a
+/// `compile_error!` for what it refuses, never a panic, within the bound.
+#[test]
+fn edited_machine_trees_expand_inline_without_panic() {
+    let mut files = yaml_files("machines", "\nbodies:");
+    files.extend(yaml_files("robots", "\nbodies:"));
+    let (trees, keys, donors) = corpus(&files);
+    let (mut clean, mut total) = (0, 0);
+    for (name, t) in &trees {
+        let (a, n) = run_programs(
+            &format!("inline-{name}"),
+            t,
+            &keys,
+            &donors,
+            cases(8),
+            Duration::from_secs(20),
+            |text| {
+                // The edited tree again, from its YAML (what the programs
+                // hand over), in the inline syntax.
+                let parsed = chain_core::yaml::parse(&text);
+                let Some(root) = parsed.root.as_ref() else {
+                    return Ok(false);
+                };
+                Ok(expand_clean(&inline(&Y::of(root))) == Some(true))
+            },
+        );
+        clean += a;
+        total += n;
+    }
+    eprintln!("{clean} of {total} edited inline machines expanded cleanly");
+    assert!(clean < total, "{clean} of {total}");
+}
+
 fn check_settings(text: String) -> Result<bool, String> {
     let base = Path::new(ROOT).join("examples/settings");
     match chain_core::settings::load_settings_str(&text, "fuzz.yaml", &base) {
