@@ -407,6 +407,39 @@ fn yaml_files(dir: &str, marker: &str) -> Vec<PathBuf> {
     out
 }
 
+/// The example machines and robots.
+fn machine_files() -> Vec<PathBuf> {
+    let mut files = yaml_files("machines", "\nbodies:");
+    files.extend(yaml_files("robots", "\nbodies:"));
+    files
+}
+
+/// [`run_programs`] on every tree of a corpus, `check_of` giving each
+/// tree's check; the accepted and total cases over all of them.
+fn run_corpus(
+    prefix: &str,
+    (trees, keys, donors): &(Vec<(String, Y)>, Vec<String>, Vec<Y>),
+    programs: usize,
+    bound: Duration,
+    check_of: impl Fn(&str) -> fn(String) -> Result<bool, String>,
+) -> (usize, usize) {
+    let (mut accepted, mut total) = (0, 0);
+    for (name, t) in trees {
+        let (a, n) = run_programs(
+            &format!("{prefix}-{name}"),
+            t,
+            keys,
+            donors,
+            programs,
+            bound,
+            check_of(name),
+        );
+        accepted += a;
+        total += n;
+    }
+    (accepted, total)
+}
+
 fn tree(path: &Path) -> Y {
     let text = std::fs::read_to_string(path).expect("example");
     let parsed = chain_core::yaml::parse(&text);
@@ -469,8 +502,7 @@ fn the_location_check_catches_a_refusal_outside_the_text() {
 /// mutants).
 #[test]
 fn unedited_trees_load_as_their_files() {
-    let mut files = yaml_files("machines", "\nbodies:");
-    files.extend(yaml_files("robots", "\nbodies:"));
+    let files = machine_files();
     for f in &files {
         let original = chain_core::load_file(f).expect("example loads");
         let text = render(&tree(f));
@@ -512,23 +544,13 @@ fn check_machine(text: String) -> Result<bool, String> {
 /// that loads through the derivation, the tape and one evaluation.
 #[test]
 fn edited_machine_trees_never_panic_and_are_refused_in_place() {
-    let mut files = yaml_files("machines", "\nbodies:");
-    files.extend(yaml_files("robots", "\nbodies:"));
-    let (trees, keys, donors) = corpus(&files);
-    let (mut loaded, mut total) = (0, 0);
-    for (name, t) in &trees {
-        let (a, n) = run_programs(
-            &format!("tree-{name}"),
-            t,
-            &keys,
-            &donors,
-            cases(24),
-            Duration::from_secs(20),
-            check_machine,
-        );
-        loaded += a;
-        total += n;
-    }
+    let (loaded, total) = run_corpus(
+        "tree",
+        &corpus(&machine_files()),
+        cases(24),
+        Duration::from_secs(20),
+        |_| check_machine,
+    );
     eprintln!("{loaded} of {total} edited machines loaded");
     assert!(
         loaded > 0 && loaded < total,
@@ -596,8 +618,7 @@ fn expand_clean(source: &str) -> Option<bool> {
 /// syntax.
 #[test]
 fn unedited_trees_expand_as_inline_machines() {
-    let mut files = yaml_files("machines", "\nbodies:");
-    files.extend(yaml_files("robots", "\nbodies:"));
+    let files = machine_files();
     let mut clean = Vec::new();
     for f in &files {
         if expand_clean(&inline(&tree(f))) == Some(true) {
@@ -616,36 +637,28 @@ fn unedited_trees_expand_as_inline_machines() {
     assert!(clean.len() == files.len(), "{clean:?} of {}", files.len());
 }
 
+/// The edited tree again, from its YAML (what the programs hand over), in
+/// the inline syntax through the macro's expansion.
+fn check_inline(text: String) -> Result<bool, String> {
+    let parsed = chain_core::yaml::parse(&text);
+    let Some(root) = parsed.root.as_ref() else {
+        return Ok(false);
+    };
+    Ok(expand_clean(&inline(&Y::of(root))) == Some(true))
+}
+
 /// Structural edits of the example machines, written in the inline syntax,
 /// through the macro's expansion (`chain_core::expand`, no compiler): a
 /// `compile_error!` for what it refuses, never a panic, within the bound.
 #[test]
 fn edited_machine_trees_expand_inline_without_panic() {
-    let mut files = yaml_files("machines", "\nbodies:");
-    files.extend(yaml_files("robots", "\nbodies:"));
-    let (trees, keys, donors) = corpus(&files);
-    let (mut clean, mut total) = (0, 0);
-    for (name, t) in &trees {
-        let (a, n) = run_programs(
-            &format!("inline-{name}"),
-            t,
-            &keys,
-            &donors,
-            cases(8),
-            Duration::from_secs(20),
-            |text| {
-                // The edited tree again, from its YAML (what the programs
-                // hand over), in the inline syntax.
-                let parsed = chain_core::yaml::parse(&text);
-                let Some(root) = parsed.root.as_ref() else {
-                    return Ok(false);
-                };
-                Ok(expand_clean(&inline(&Y::of(root))) == Some(true))
-            },
-        );
-        clean += a;
-        total += n;
-    }
+    let (clean, total) = run_corpus(
+        "inline",
+        &corpus(&machine_files()),
+        cases(8),
+        Duration::from_secs(20),
+        |_| check_inline,
+    );
     eprintln!("{clean} of {total} edited inline machines expanded cleanly");
     assert!(clean < total, "{clean} of {total}");
 }
@@ -672,19 +685,13 @@ fn check_settings(text: String) -> Result<bool, String> {
 /// they load, the binding to their generator and CNC machine.
 #[test]
 fn edited_settings_trees_never_panic_and_are_refused_in_place() {
-    let files = yaml_files("settings", "roll:");
-    let (trees, keys, donors) = corpus(&files);
-    for (name, t) in &trees {
-        run_programs(
-            &format!("tree-{name}"),
-            t,
-            &keys,
-            &donors,
-            cases(60),
-            Duration::from_secs(10),
-            check_settings,
-        );
-    }
+    run_corpus(
+        "tree",
+        &corpus(&yaml_files("settings", "roll:")),
+        cases(60),
+        Duration::from_secs(10),
+        |_| check_settings,
+    );
 }
 
 fn values_machine(values: &str) -> &'static str {
@@ -695,11 +702,24 @@ fn values_machine(values: &str) -> &'static str {
     }
 }
 
+/// An example machine, loaded once for every case that needs it.
+fn example_machine(path: &'static str) -> &'static chain_core::model::Machine {
+    type Loaded = Vec<(&'static str, &'static chain_core::model::Machine)>;
+    static LOADED: std::sync::Mutex<Loaded> = std::sync::Mutex::new(Vec::new());
+    let mut loaded = LOADED.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, m)) = loaded.iter().find(|(p, _)| *p == path) {
+        return m;
+    }
+    let m = chain_core::load_file(&Path::new(ROOT).join(path)).expect("example machine");
+    let m: &'static chain_core::model::Machine = Box::leak(Box::new(m));
+    loaded.push((path, m));
+    m
+}
+
 fn check_values(file: &'static str, text: &str) -> Result<bool, String> {
-    let machine = chain_core::load_file(&Path::new(ROOT).join(values_machine(file)))
-        .map_err(|d| d.to_string())?;
+    let machine = example_machine(values_machine(file));
     let base = Path::new(ROOT).join("examples/values");
-    match chain_core::values::Values::parse(text, "fuzz.yaml", &base, &machine) {
+    match chain_core::values::Values::parse(text, "fuzz.yaml", &base, machine) {
         Ok(_) => Ok(true),
         Err(chain_core::values::ValuesError::File(d)) => {
             let _ = d.to_string();
@@ -717,23 +737,16 @@ fn check_values(file: &'static str, text: &str) -> Result<bool, String> {
 /// with their CSV files beside them) through their reader.
 #[test]
 fn edited_values_trees_never_panic_and_are_refused_in_place() {
-    let files = yaml_files("values", "values");
-    let (trees, keys, donors) = corpus(&files);
-    for (name, t) in &trees {
-        let check: fn(String) -> Result<bool, String> = match name.as_str() {
+    run_corpus(
+        "tree",
+        &corpus(&yaml_files("values", "values")),
+        cases(40),
+        Duration::from_secs(10),
+        |name| match name {
             "gantry_grinder.yaml" => |t| check_values("gantry_grinder.yaml", &t),
             _ => |t| check_values("vmc3.yaml", &t),
-        };
-        run_programs(
-            &format!("tree-{name}"),
-            t,
-            &keys,
-            &donors,
-            cases(40),
-            Duration::from_secs(10),
-            check,
-        );
-    }
+        },
+    );
 }
 
 // ---------------------------------------------------------------------------
@@ -964,9 +977,8 @@ fn example_csv(path: &str) -> Table {
     Table::read(&Path::new(ROOT).join("examples").join(path))
 }
 
-fn probe_machine() -> chain_core::model::Machine {
-    chain_core::load_file(&Path::new(ROOT).join("examples/measurements/vmc3_probe.yaml"))
-        .expect("probe machine")
+fn probe_machine() -> &'static chain_core::model::Machine {
+    example_machine("examples/measurements/vmc3_probe.yaml")
 }
 
 fn check_measurements(
@@ -974,12 +986,12 @@ fn check_measurements(
     layout: chain_core::measured::measurements::Layout,
 ) -> Result<(), String> {
     use chain_core::measured::measurements::Measurements;
-    match Measurements::parse(&text, "fuzz.csv", &probe_machine(), &[], layout) {
+    match Measurements::parse(&text, "fuzz.csv", probe_machine(), &[], layout) {
         Ok(m) => {
             // The design of what was read (the exact sensitivity per row).
-            let model = chain_core::compile(&probe_machine());
+            let model = chain_core::compile(probe_machine());
             let _ =
-                chain_core::measured::measurements::Design::new(&model, &probe_machine(), &m.rows);
+                chain_core::measured::measurements::Design::new(&model, probe_machine(), &m.rows);
             Ok(())
         }
         Err(e) => {
