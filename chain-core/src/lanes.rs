@@ -6,7 +6,9 @@
 //! and `cos` of each rotary variable for the whole group at once with
 //! [`sin_cos`], then the per-point body with those values. The other
 //! helpers load a group's values and check a batch's shape for generated
-//! code.
+//! code. The runtime tape (`symbolic::eval`) takes its `sin`/`cos` from
+//! here too: [`sin_cos`] over a block's lanes, [`sin_cos_one`] for one
+//! point, the same bits either way.
 //!
 //! [`sin_cos`] is written here, branch-free over four lanes so that LLVM
 //! vectorises it, rather than taken from `wide` (whose `f64x4::sin_cos` has
@@ -86,18 +88,14 @@ fn poly(x: f64, c: &[f64; 6]) -> f64 {
 /// of π/2 (three-part Cody–Waite), the minimax polynomials on the reduced
 /// argument, and the quadrant `y mod 4` choosing and signing them, every
 /// lane without branches. Within 2 ulp of the standard library's `sin` and
-/// `cos` (the test `sin_cos_is_within_two_ulp` says where); |x| ≥
-/// [`SIN_COS_LIMIT`], NaN and ±∞ go to the standard library.
+/// `cos` (the test `sin_cos_is_within_two_ulp` says where); a lane with
+/// |x| ≥ [`SIN_COS_LIMIT`], NaN or ±∞ is the standard library's. Each
+/// lane's value depends on that lane's `x` alone, so [`sin_cos_one`] gives
+/// the same bits for one value.
 #[inline(always)]
 pub fn sin_cos(x: [f64; LANES]) -> ([f64; LANES], [f64; LANES]) {
     let mut s = [0.0; LANES];
     let mut c = [0.0; LANES];
-    if x.iter().any(|v| v.is_nan() || v.abs() >= SIN_COS_LIMIT) {
-        for l in 0..LANES {
-            (s[l], c[l]) = x[l].sin_cos();
-        }
-        return (s, c);
-    }
     for l in 0..LANES {
         let xa = x[l].abs();
         let shifted = xa * core::f64::consts::FRAC_2_PI + ROUND;
@@ -119,7 +117,24 @@ pub fn sin_cos(x: [f64; LANES]) -> ([f64; LANES], [f64; LANES]) {
         s[l] = f64::from_bits(sin_bits ^ (sin_sign & SIGN));
         c[l] = f64::from_bits(cos_bits ^ cos_sign);
     }
+    let beyond = |v: f64| v.is_nan() || v.abs() >= SIN_COS_LIMIT;
+    if x.iter().any(|&v| beyond(v)) {
+        for l in 0..LANES {
+            if beyond(x[l]) {
+                (s[l], c[l]) = x[l].sin_cos();
+            }
+        }
+    }
     (s, c)
+}
+
+/// [`sin_cos`] of one value (the same bits as in any lane of a group):
+/// the runtime tape's `sin`/`cos`, so that its batched and per-point
+/// evaluations agree bit for bit.
+#[inline]
+pub fn sin_cos_one(x: f64) -> (f64, f64) {
+    let (s, c) = sin_cos([x; LANES]);
+    (s[0], c[0])
 }
 
 /// The sign bit of an `f64`.
@@ -246,5 +261,38 @@ mod tests {
         let (s, c) = sin_cos([f64::NAN, f64::INFINITY, -f64::INFINITY, 0.0]);
         assert!(s[..3].iter().chain(&c[..3]).all(|v| v.is_nan()));
         assert_eq!((s[3], c[3]), (0.0, 1.0));
+    }
+
+    /// A lane's value depends on its own argument alone: the same bits
+    /// beside NaN, ±∞, an argument beyond [`SIN_COS_LIMIT`] or finite
+    /// neighbours, and from [`sin_cos_one`] (what lets the runtime tape's
+    /// per-point and batched evaluations agree bit for bit). Beyond the
+    /// limit a lane is the standard library's.
+    #[test]
+    fn lanes_are_independent() {
+        let big = 2.0 * SIN_COS_LIMIT;
+        // Arguments where the kernel and the standard library differ in
+        // the last bits, so that a lane wrongly sent to the standard
+        // library is seen.
+        let xs: Vec<f64> = (0..2000)
+            .map(|k| -7.0 + 14.0 * f64::from(k) / 2000.0)
+            .filter(|&x| sin_cos_one(x) != x.sin_cos())
+            .take(20)
+            .collect();
+        assert_eq!(xs.len(), 20);
+        let neighbours = [f64::NAN, f64::INFINITY, big, 0.25];
+        for &x in &xs {
+            let one = sin_cos_one(x);
+            for &n in &neighbours {
+                let (s, c) = sin_cos([n, x, n, n]);
+                assert_eq!(
+                    (s[1].to_bits(), c[1].to_bits()),
+                    (one.0.to_bits(), one.1.to_bits()),
+                    "{x} beside {n}"
+                );
+            }
+        }
+        let (s, c) = sin_cos([0.3, big, 0.3, 0.3]);
+        assert_eq!((s[1], c[1]), big.sin_cos());
     }
 }

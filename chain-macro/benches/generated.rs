@@ -434,8 +434,11 @@ fn every_machine(c: &mut Criterion) {
 /// code, `POINTS` points per iteration (throughput per point); the batch
 /// writes `CHUNK` matrices into one reused buffer at a time, as the per-point
 /// routes write one. `batch_2_thread`: two halves on a pool of two threads.
+/// The `tape_*` routes are the same machine's runtime tape (`$yaml`,
+/// `CompiledModel::sensitivity_points`, blocks of `BATCH_LANES` points) on
+/// the same points, issue 35 §3.
 macro_rules! batched {
-    ($g:expr, $pools:expr, $ty:ident, $name:literal, $p:expr, $sympy:expr) => {{
+    ($g:expr, $pools:expr, $ty:ident, $name:literal, $yaml:literal, $p:expr, $sympy:expr) => {{
         const NV: usize = $ty::VARIABLES.len();
         const NE: usize = $ty::ERRORS.len();
         let p = $p;
@@ -488,8 +491,52 @@ macro_rules! batched {
                 }
             })
         });
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join($yaml);
+        let tape = chain::core::compile(&chain::core::load_file(&path).expect("valid machine"));
+        let tp = &p[..tape.parameters().len()];
+        let mut flat_chunk = vec![0.0; CHUNK * 6 * NE];
+        tape.sensitivity_points(&flat[..CHUNK * NV], tp, &mut flat_chunk)
+            .expect("sizes fit");
+        for (a, b) in chunk.iter().flatten().flatten().zip(&flat_chunk) {
+            assert!(
+                (a - b).abs() <= 1e-13 * a.abs().max(1.0),
+                "{} tape: {a} vs {b}",
+                $name
+            );
+        }
+        $g.bench_function(concat!($name, "/tape_batch"), |b| {
+            b.iter(|| {
+                for qc in flat.chunks_exact(CHUNK * NV) {
+                    tape.sensitivity_points(black_box(qc), black_box(tp), &mut flat_chunk)
+                        .expect("sizes fit");
+                    black_box(&mut flat_chunk);
+                }
+            })
+        });
         // Threads: `REPEAT` passes over the points per iteration, so that
         // waking the pool's threads (tens of µs on this VM) does not count.
+        let mut flat_halves = vec![vec![0.0; CHUNK * 6 * NE]; 2];
+        for (threads, pool) in [(1usize, &$pools[0]), (2, &$pools[1])] {
+            let id = format!("{}/tape_batch_{threads}_thread_x{REPEAT}", $name);
+            $g.bench_function(id, |b| {
+                b.iter(|| {
+                    pool.install(|| {
+                        use rayon::prelude::*;
+                        (flat.par_chunks(flat.len() / threads))
+                            .zip(flat_halves.par_iter_mut())
+                            .for_each(|(part, buf)| {
+                                for _ in 0..REPEAT {
+                                    for qc in part.chunks_exact(CHUNK * NV) {
+                                        tape.sensitivity_points(black_box(qc), black_box(tp), buf)
+                                            .expect("sizes fit");
+                                        black_box(&mut *buf);
+                                    }
+                                }
+                            })
+                    })
+                })
+            });
+        }
         let mut halves = vec![vec![[[0.0; NE]; 6]; CHUNK]; 2];
         for (threads, pool) in [(1usize, &$pools[0]), (2, &$pools[1])] {
             let id = format!("{}/batch_into_{threads}_thread_x{REPEAT}", $name);
@@ -545,6 +592,7 @@ fn batched(c: &mut Criterion) {
         pools,
         GantryGrinder,
         "gantry_grinder",
+        "../examples/machines/gantry_grinder.yaml",
         [0.0f64; 0],
         None::<GantryPerPoint>
     );
@@ -556,6 +604,7 @@ fn batched(c: &mut Criterion) {
         pools,
         BcHeadTable,
         "bc_head_table",
+        "benches/machines/bc_head_table.yaml",
         [150.0f64],
         Some(sympy)
     );
@@ -583,6 +632,20 @@ fn callgrind(spec: &str) {
         [80.0, 1.1, 40.0, 100.0, -1.4],
     ];
     let mut out4 = [[[0.0; 33]; 6]; 4];
+    // The runtime tape of the same machine and of the gantry, eight points
+    // (one block) per count.
+    let tape = |path: &str| {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+        chain::core::compile(&chain::core::load_file(&path).expect("valid machine"))
+    };
+    let (bc_tape, gantry_tape) = (
+        tape("benches/machines/bc_head_table.yaml"),
+        tape("../examples/machines/gantry_grinder.yaml"),
+    );
+    let bc_q8: Vec<f64> = (0..8).flat_map(|k| q4[k % 4]).collect();
+    let gantry_q8: Vec<f64> = (0..24).map(|i| 100.0 + 37.0 * i as f64).collect();
+    let mut bc_out8 = vec![0.0; 8 * 6 * 33];
+    let mut gantry_out8 = vec![0.0; 8 * 6 * 21];
     for _ in 0..count {
         match name {
             "v1_sensitivity" => {
@@ -607,6 +670,19 @@ fn callgrind(spec: &str) {
                 // One group of four points per count.
                 BcHeadTable::sensitivity_batch_into(black_box(&q4), black_box(&p), &mut out4);
                 black_box(&mut out4);
+            }
+            "tape_batch" => {
+                let p = &p[..bc_tape.parameters().len()];
+                bc_tape
+                    .sensitivity_points(black_box(&bc_q8), black_box(p), &mut bc_out8)
+                    .expect("sizes fit");
+                black_box(&mut bc_out8);
+            }
+            "tape_batch_gantry" => {
+                gantry_tape
+                    .sensitivity_points(black_box(&gantry_q8), &[], &mut gantry_out8)
+                    .expect("sizes fit");
+                black_box(&mut gantry_out8);
             }
             "sin_cos" => {
                 let (s, c) = black_box(q[1]).sin_cos();

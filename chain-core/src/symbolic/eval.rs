@@ -56,13 +56,24 @@ pub struct CompiledModel {
     parameters: Vec<&'static str>,
     errors: Vec<&'static str>,
     parameter_values: Vec<Option<f64>>,
-    /// Register index and meaning of each symbol slot.
+    /// Register index and meaning of each symbol slot but `cos`/`sin` of
+    /// the rotary variables.
     loads: Vec<(usize, Symbol)>,
+    /// `(cos register, sin register, variable)` of each rotary variable,
+    /// both by [`crate::lanes::sin_cos`].
+    trig: Vec<(usize, usize, usize)>,
     /// `regs[dst] = regs[a] * regs[b]`, in order.
     products: Vec<(u32, u32, u32)>,
     register_count: usize,
     /// Sensitivity outputs: `(row-major index c*N+j, terms range)`.
     sensitivity: Vec<(u32, u32, u32)>,
+    /// The sensitivity outputs that vary with the point (a term on a
+    /// register other than `1`).
+    varying: Vec<(u32, u32, u32)>,
+    /// One point's sensitivity matrix with every constant entry (zeros and
+    /// the outputs on register `1` alone) in place: each matrix starts as
+    /// a copy of it, then [`CompiledModel::varying`] is written.
+    template: Vec<f64>,
     /// Nominal outputs: `(0..9 rotation row-major, 9..12 position, terms range)`.
     nominal: Vec<(u32, u32, u32)>,
     /// `(coefficient, register)` terms of all outputs.
@@ -82,13 +93,15 @@ impl CompiledModel {
             registers: 1,
             ..TapeBuilder::default()
         };
-        for (i, (_, kind)) in model.variables.iter().enumerate() {
-            let i = crate::algebra::index_u16(i);
+        let mut trig = Vec::new();
+        for (v, (_, kind)) in model.variables.iter().enumerate() {
+            let i = crate::algebra::index_u16(v);
             match kind {
                 JointKind::Prismatic => builder.load(Symbol::Var(i)),
                 JointKind::Rotary => {
                     builder.load(Symbol::Cos(i));
                     builder.load(Symbol::Sin(i));
+                    trig.push((builder.registers - 2, builder.registers - 1, v));
                 }
             }
         }
@@ -120,17 +133,43 @@ impl CompiledModel {
                 nominal.push((to_u32(9 + i), range.0, range.1));
             }
         }
+        let terms = builder.terms;
+        let constant = |&(_, start, end): &(u32, u32, u32)| {
+            terms[start as usize..end as usize].iter().all(|t| t.1 == 0)
+        };
+        let mut template = vec![0.0; 6 * n];
+        for output in sensitivity.iter().filter(|o| constant(o)) {
+            // The same sum as `dot` with register `1` alone.
+            let (idx, start, end) = *output;
+            template[idx as usize] = terms[start as usize..end as usize]
+                .iter()
+                .map(|&(c, _)| c * 1.0)
+                .sum();
+        }
+        let varying = sensitivity
+            .iter()
+            .filter(|o| !constant(o))
+            .copied()
+            .collect();
+        let loads = builder
+            .loads
+            .into_iter()
+            .filter(|(_, s)| !matches!(s, Symbol::Cos(_) | Symbol::Sin(_)))
+            .collect();
         CompiledModel {
             variables: model.variables.iter().map(|v| intern(&v.0)).collect(),
             parameters: model.parameters.iter().map(|p| intern(&p.0)).collect(),
             errors: model.errors.iter().map(|e| intern(e)).collect(),
             parameter_values: model.parameters.iter().map(|p| p.1).collect(),
-            loads: builder.loads,
+            loads,
+            trig,
             products: builder.products,
             register_count: builder.registers,
             sensitivity,
+            varying,
+            template,
             nominal,
-            terms: builder.terms,
+            terms,
         }
     }
 
@@ -156,6 +195,10 @@ impl CompiledModel {
         regs[0] = 1.0;
         for &(r, s) in &self.loads {
             regs[r] = SymbolicModel::symbol_value(s, q, p);
+        }
+        for &(rc, rs, v) in &self.trig {
+            let x = q.get(v).copied().unwrap_or(f64::NAN);
+            (regs[rs], regs[rc]) = crate::lanes::sin_cos_one(x);
         }
         for &(dst, a, b) in &self.products {
             regs[dst as usize] = regs[a as usize] * regs[b as usize];
@@ -249,16 +292,32 @@ impl CompiledModel {
     /// number of real points.
     fn run_block(&self, qs: &[f64], p: &[f64], regs: &mut Vec<Lanes>) -> usize {
         const W: usize = BATCH_LANES;
+        const { assert!(W % crate::lanes::LANES == 0) };
         let nv = self.variables.len();
         let real = qs.len() / nv;
         regs.resize(self.register_count, [0.0; W]);
         regs[0] = [1.0; W];
-        for (lane, q) in (0..W).map(|lane| {
+        let point = |lane: usize| {
             let k = lane.min(real - 1);
-            (lane, &qs[k * nv..(k + 1) * nv])
-        }) {
-            for &(r, s) in &self.loads {
-                regs[r][lane] = SymbolicModel::symbol_value(s, q, p);
+            &qs[k * nv..(k + 1) * nv]
+        };
+        for &(r, s) in &self.loads {
+            regs[r] = match s {
+                Symbol::Var(i) => {
+                    let i = usize::from(i);
+                    std::array::from_fn(|l| point(l).get(i).copied().unwrap_or(f64::NAN))
+                }
+                _ => [SymbolicModel::symbol_value(s, &[], p); BATCH_LANES],
+            };
+        }
+        for &(rc, rs, v) in &self.trig {
+            let x: Lanes = std::array::from_fn(|l| point(l).get(v).copied().unwrap_or(f64::NAN));
+            for (h, x) in x.chunks_exact(crate::lanes::LANES).enumerate() {
+                let x = std::array::from_fn(|l| x[l]);
+                let (sin, cos) = crate::lanes::sin_cos(x);
+                let at = h * crate::lanes::LANES..(h + 1) * crate::lanes::LANES;
+                regs[rs][at.clone()].copy_from_slice(&sin);
+                regs[rc][at].copy_from_slice(&cos);
             }
         }
         for &(dst, a, b) in &self.products {
@@ -284,12 +343,22 @@ impl CompiledModel {
     /// One block's sensitivity matrices.
     fn sensitivity_block(&self, qs: &[f64], p: &[f64], out: &mut [f64], regs: &mut Vec<Lanes>) {
         let width = 6 * self.errors.len();
-        let real = self.run_block(qs, p, regs);
-        out.iter_mut().for_each(|v| *v = 0.0);
-        for &(idx, start, end) in &self.sensitivity {
+        self.run_block(qs, p, regs);
+        // Each point's matrix starts as the template; then each varying
+        // output is written into every real point's matrix.
+        let mut rows = out.chunks_exact_mut(width);
+        let mut rows: [&mut [f64]; BATCH_LANES] =
+            std::array::from_fn(|_| rows.next().unwrap_or_default());
+        // (The rows past a short last block are empty.)
+        for row in rows.iter_mut().filter(|row| !row.is_empty()) {
+            row.copy_from_slice(&self.template);
+        }
+        for &(idx, start, end) in &self.varying {
             let acc = self.dot_lanes(regs, start, end);
-            for (l, v) in acc.iter().enumerate().take(real) {
-                out[l * width + idx as usize] = *v;
+            for (row, v) in rows.iter_mut().zip(acc) {
+                if let Some(o) = row.get_mut(idx as usize) {
+                    *o = v;
+                }
             }
         }
     }
@@ -353,9 +422,14 @@ impl ErrorModel for CompiledModel {
     }
 
     fn sensitivity(&self, q: &[f64], p: &[f64], out: &mut [f64]) {
-        out.iter_mut().for_each(|v| *v = 0.0);
+        for (o, t) in out
+            .iter_mut()
+            .zip(self.template.iter().chain(std::iter::repeat(&0.0)))
+        {
+            *o = *t;
+        }
         self.with_registers(q, p, |regs| {
-            for &(idx, start, end) in &self.sensitivity {
+            for &(idx, start, end) in &self.varying {
                 if let Some(slot) = out.get_mut(idx as usize) {
                     *slot = self.dot(regs, start, end);
                 }
