@@ -459,6 +459,19 @@ macro_rules! batched {
                 );
             }
         }
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join($yaml);
+        let tape = chain::core::compile(&chain::core::load_file(&path).expect("valid machine"));
+        let tp = &p[..tape.parameters().len()];
+        let mut flat_chunk = vec![0.0; CHUNK * 6 * NE];
+        tape.sensitivity_points(&flat[..CHUNK * NV], tp, &mut flat_chunk)
+            .expect("sizes fit");
+        for (a, b) in chunk.iter().flatten().flatten().zip(&flat_chunk) {
+            assert!(
+                (a - b).abs() <= 1e-13 * a.abs().max(1.0),
+                "{} tape: {a} vs {b}",
+                $name
+            );
+        }
         // Every route writes `CHUNK` matrices into one reused buffer, one
         // matrix per point, as a batch consumer does.
         $g.bench_function(concat!($name, "/sensitivity_into"), |b| {
@@ -491,19 +504,6 @@ macro_rules! batched {
                 }
             })
         });
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join($yaml);
-        let tape = chain::core::compile(&chain::core::load_file(&path).expect("valid machine"));
-        let tp = &p[..tape.parameters().len()];
-        let mut flat_chunk = vec![0.0; CHUNK * 6 * NE];
-        tape.sensitivity_points(&flat[..CHUNK * NV], tp, &mut flat_chunk)
-            .expect("sizes fit");
-        for (a, b) in chunk.iter().flatten().flatten().zip(&flat_chunk) {
-            assert!(
-                (a - b).abs() <= 1e-13 * a.abs().max(1.0),
-                "{} tape: {a} vs {b}",
-                $name
-            );
-        }
         $g.bench_function(concat!($name, "/tape_batch"), |b| {
             b.iter(|| {
                 for qc in flat.chunks_exact(CHUNK * NV) {

@@ -422,12 +422,10 @@ impl ErrorModel for CompiledModel {
     }
 
     fn sensitivity(&self, q: &[f64], p: &[f64], out: &mut [f64]) {
-        for (o, t) in out
-            .iter_mut()
-            .zip(self.template.iter().chain(std::iter::repeat(&0.0)))
-        {
-            *o = *t;
-        }
+        // The template, then zeros past it (an `out` longer than 6·N).
+        let k = out.len().min(self.template.len());
+        out[..k].copy_from_slice(&self.template[..k]);
+        out[k..].fill(0.0);
         self.with_registers(q, p, |regs| {
             for &(idx, start, end) in &self.varying {
                 if let Some(slot) = out.get_mut(idx as usize) {
