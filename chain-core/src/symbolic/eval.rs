@@ -68,10 +68,10 @@ pub struct CompiledModel {
     /// Sensitivity outputs: `(row-major index c*N+j, terms range)`.
     sensitivity: Vec<(u32, u32, u32)>,
     /// The sensitivity outputs that vary with the point (a term on a
-    /// register other than `1`).
+    /// register other than register 0, the constant `1`).
     varying: Vec<(u32, u32, u32)>,
     /// One point's sensitivity matrix with every constant entry (zeros and
-    /// the outputs on register `1` alone) in place: each matrix starts as
+    /// the outputs whose terms are all on register 0) in place: each matrix starts as
     /// a copy of it, then [`CompiledModel::varying`] is written.
     template: Vec<f64>,
     /// Nominal outputs: `(0..9 rotation row-major, 9..12 position, terms range)`.
@@ -139,7 +139,7 @@ impl CompiledModel {
         };
         let mut template = vec![0.0; 6 * n];
         for output in sensitivity.iter().filter(|o| constant(o)) {
-            // The same sum as `dot` with register `1` alone.
+            // The same sum as `dot` with register 0 (the constant 1).
             let (idx, start, end) = *output;
             template[idx as usize] = terms[start as usize..end as usize]
                 .iter()
@@ -307,7 +307,9 @@ impl CompiledModel {
                     let i = usize::from(i);
                     std::array::from_fn(|l| point(l).get(i).copied().unwrap_or(f64::NAN))
                 }
-                _ => [SymbolicModel::symbol_value(s, &[], p); BATCH_LANES],
+                Symbol::Param(_) => [SymbolicModel::symbol_value(s, &[], p); BATCH_LANES],
+                // Not among the loads: `trig` below.
+                Symbol::Cos(_) | Symbol::Sin(_) => continue,
             };
         }
         for &(rc, rs, v) in &self.trig {
