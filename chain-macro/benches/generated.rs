@@ -520,20 +520,17 @@ macro_rules! batched {
             let id = format!("{}/tape_batch_{threads}_thread_x{REPEAT}", $name);
             $g.bench_function(id, |b| {
                 b.iter(|| {
-                    pool.install(|| {
-                        use rayon::prelude::*;
-                        (flat.par_chunks(flat.len() / threads))
-                            .zip(flat_halves.par_iter_mut())
-                            .for_each(|(part, buf)| {
-                                for _ in 0..REPEAT {
-                                    for qc in part.chunks_exact(CHUNK * NV) {
-                                        tape.sensitivity_points(black_box(qc), black_box(tp), buf)
-                                            .expect("sizes fit");
-                                        black_box(&mut *buf);
-                                    }
-                                }
-                            })
-                    })
+                    passes(
+                        pool,
+                        threads,
+                        &flat,
+                        CHUNK * NV,
+                        &mut flat_halves,
+                        |qc, buf| {
+                            tape.sensitivity_points(black_box(qc), black_box(tp), buf)
+                                .expect("sizes fit")
+                        },
+                    )
                 })
             });
         }
@@ -542,22 +539,8 @@ macro_rules! batched {
             let id = format!("{}/batch_into_{threads}_thread_x{REPEAT}", $name);
             $g.bench_function(id, |b| {
                 b.iter(|| {
-                    pool.install(|| {
-                        use rayon::prelude::*;
-                        (qs.par_chunks(qs.len() / threads))
-                            .zip(halves.par_iter_mut())
-                            .for_each(|(part, buf)| {
-                                for _ in 0..REPEAT {
-                                    for qc in part.chunks_exact(CHUNK) {
-                                        $ty::sensitivity_batch_into(
-                                            black_box(qc),
-                                            black_box(&p),
-                                            buf,
-                                        );
-                                        black_box(&mut *buf);
-                                    }
-                                }
-                            })
+                    passes(pool, threads, &qs, CHUNK, &mut halves, |qc, buf| {
+                        $ty::sensitivity_batch_into(black_box(qc), black_box(&p), buf)
                     })
                 })
             });
@@ -568,6 +551,33 @@ macro_rules! batched {
 /// Passes over the points per iteration of the thread benchmarks of the
 /// `batched` group (their time is for `REPEAT · POINTS` points).
 const REPEAT: usize = 16;
+
+/// `REPEAT` passes over `points` on `pool`: `threads` equal parts, each
+/// with its own reused buffer of `bufs`, `call(chunk, buf)` for each
+/// `per_call` items of a part.
+fn passes<T: Sync, B: Send>(
+    pool: &rayon::ThreadPool,
+    threads: usize,
+    points: &[T],
+    per_call: usize,
+    bufs: &mut [B],
+    call: impl Fn(&[T], &mut B) + Sync,
+) {
+    use rayon::prelude::*;
+    pool.install(|| {
+        points
+            .par_chunks(points.len() / threads)
+            .zip(bufs.par_iter_mut())
+            .for_each(|(part, buf)| {
+                for _ in 0..REPEAT {
+                    for chunk in part.chunks_exact(per_call) {
+                        call(chunk, buf);
+                        black_box(&mut *buf);
+                    }
+                }
+            })
+    })
+}
 
 /// The `batched` group (see [`batched!`]).
 fn batched(c: &mut Criterion) {
