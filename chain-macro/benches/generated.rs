@@ -82,12 +82,7 @@ fn gantry(c: &mut Criterion) {
     c.bench_function("gantry_sensitivity/hand_written", |b| {
         b.iter(|| black_box(hand_written(black_box(&q))))
     });
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../examples/machines/gantry_grinder.yaml"
-    );
-    let machine = chain::core::load_file(std::path::Path::new(path)).expect("valid machine");
-    let runtime = chain::core::compile(&machine);
+    let runtime = runtime_tape("../examples/machines/gantry_grinder.yaml");
     let mut out = vec![0.0; 6 * 21];
     c.bench_function("gantry_sensitivity/runtime_tape", |b| {
         b.iter(|| {
@@ -107,12 +102,7 @@ fn five_axis(c: &mut Criterion) {
     c.bench_function("cnc5_bevel_sensitivity/generated", |b| {
         b.iter(|| black_box(Cnc5Bevel::sensitivity(black_box(&q), black_box(&p))))
     });
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../examples/machines/cnc5_bevel.yaml"
-    );
-    let machine = chain::core::load_file(std::path::Path::new(path)).expect("valid machine");
-    let runtime = chain::core::compile(&machine);
+    let runtime = runtime_tape("../examples/machines/cnc5_bevel.yaml");
     let mut out = vec![0.0; 6 * runtime.errors().len()];
     c.bench_function("cnc5_bevel_sensitivity/runtime_tape", |b| {
         b.iter(|| {
@@ -210,9 +200,7 @@ macro_rules! every_machine {
         const NV: usize = $ty::VARIABLES.len();
         const NP: usize = $ty::PARAMETERS.len();
         const NE: usize = $ty::ERRORS.len();
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/", $path);
-        let machine = chain::core::load_file(std::path::Path::new(path)).expect("valid machine");
-        let runtime = chain::core::compile(&machine);
+        let runtime = runtime_tape($path);
         let qs = bench_points(NV);
         let p: [f64; NP] = std::array::from_fn(|k| $ty::PARAMETER_VALUES[k].unwrap_or(100.0));
         // The runtime model's orders, by name.
@@ -459,8 +447,7 @@ macro_rules! batched {
                 );
             }
         }
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join($yaml);
-        let tape = chain::core::compile(&chain::core::load_file(&path).expect("valid machine"));
+        let tape = runtime_tape($yaml);
         let tp = &p[..tape.parameters().len()];
         let mut flat_chunk = vec![0.0; CHUNK * 6 * NE];
         tape.sensitivity_points(&flat[..CHUNK * NV], tp, &mut flat_chunk)
@@ -546,6 +533,13 @@ macro_rules! batched {
             });
         }
     }};
+}
+
+/// The runtime tape of the machine file at `path` (relative to this
+/// crate's directory).
+fn runtime_tape(path: &str) -> chain::core::CompiledModel {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+    chain::core::compile(&chain::core::load_file(&path).expect("valid machine"))
 }
 
 /// Passes over the points per iteration of the thread benchmarks of the
@@ -644,13 +638,9 @@ fn callgrind(spec: &str) {
     let mut out4 = [[[0.0; 33]; 6]; 4];
     // The runtime tape of the same machine and of the gantry, eight points
     // (one block) per count.
-    let tape = |path: &str| {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
-        chain::core::compile(&chain::core::load_file(&path).expect("valid machine"))
-    };
     let (bc_tape, gantry_tape) = (
-        tape("benches/machines/bc_head_table.yaml"),
-        tape("../examples/machines/gantry_grinder.yaml"),
+        runtime_tape("benches/machines/bc_head_table.yaml"),
+        runtime_tape("../examples/machines/gantry_grinder.yaml"),
     );
     let bc_q8: Vec<f64> = (0..8).flat_map(|k| q4[k % 4]).collect();
     let gantry_q8: Vec<f64> = (0..24).map(|i| 100.0 + 37.0 * i as f64).collect();

@@ -288,33 +288,31 @@ impl CompiledModel {
     }
 
     /// Loads and runs the tape over one block of at most [`BATCH_LANES`]
-    /// points (`qs`, padded with its last point) into `regs`; returns the
-    /// number of real points.
-    fn run_block(&self, qs: &[f64], p: &[f64], regs: &mut Vec<Lanes>) -> usize {
+    /// points (`qs`, padded with its last point) into `regs`.
+    fn run_block(&self, qs: &[f64], p: &[f64], regs: &mut Vec<Lanes>) {
         const W: usize = BATCH_LANES;
         const { assert!(W % crate::lanes::LANES == 0) };
         let nv = self.variables.len();
         let real = qs.len() / nv;
         regs.resize(self.register_count, [0.0; W]);
         regs[0] = [1.0; W];
-        let point = |lane: usize| {
-            let k = lane.min(real - 1);
-            &qs[k * nv..(k + 1) * nv]
+        // Variable `i` of every lane's point.
+        let variable = |i: usize| -> Lanes {
+            std::array::from_fn(|lane| {
+                let k = lane.min(real - 1);
+                qs[k * nv..(k + 1) * nv].get(i).copied().unwrap_or(f64::NAN)
+            })
         };
         for &(r, s) in &self.loads {
             regs[r] = match s {
-                Symbol::Var(i) => {
-                    let i = usize::from(i);
-                    std::array::from_fn(|l| point(l).get(i).copied().unwrap_or(f64::NAN))
-                }
+                Symbol::Var(i) => variable(usize::from(i)),
                 Symbol::Param(_) => [SymbolicModel::symbol_value(s, &[], p); BATCH_LANES],
                 // Not among the loads: `trig` below.
                 Symbol::Cos(_) | Symbol::Sin(_) => continue,
             };
         }
         for &(rc, rs, v) in &self.trig {
-            let x: Lanes = std::array::from_fn(|l| point(l).get(v).copied().unwrap_or(f64::NAN));
-            for (h, x) in x.chunks_exact(crate::lanes::LANES).enumerate() {
+            for (h, x) in variable(v).chunks_exact(crate::lanes::LANES).enumerate() {
                 let x = std::array::from_fn(|l| x[l]);
                 let (sin, cos) = crate::lanes::sin_cos(x);
                 let at = h * crate::lanes::LANES..(h + 1) * crate::lanes::LANES;
@@ -326,7 +324,6 @@ impl CompiledModel {
             let (x, y) = (regs[a as usize], regs[b as usize]);
             regs[dst as usize] = std::array::from_fn(|l| x[l] * y[l]);
         }
-        real
     }
 
     /// One output's dot product in every lane.
