@@ -1,4 +1,4 @@
-//! Structure-aware fuzzing (issue 36, point 5), beside the byte-level
+//! Structure-aware fuzzing, beside the byte-level
 //! mutations of `fuzz.rs`: proptest programs of *structural* edits of the
 //! example inputs, so that the mutants get past the YAML and CSV syntax into
 //! every rule behind it.
@@ -21,9 +21,14 @@
 //!
 //! The promise, for every case: no panic, within the time bound, and every
 //! refusal located inside the text it refuses (a line from 1 to the last
-//! line, an offset within the text). Proptest shrinks a failing program to
-//! its smallest form; `CHAIN_FUZZ_CASES` scales the number of programs per
-//! input as for `fuzz.rs` (docs/robustness.md, "Fuzzing").
+//! line, an offset within the text). Each run of programs is tallied
+//! ([`Tally`]): some mutants must be accepted and used, and the refusals
+//! must fall on several lines, so that edits which only ever broke a
+//! file's first line, or never got past the reader, fail the test.
+//! Proptest shrinks a failing program to its smallest form; the programs
+//! are seeded (`CHAIN_FUZZ_SEED` picks another sequence) and
+//! `CHAIN_FUZZ_CASES` scales their number per input as for `fuzz.rs`
+//! (docs/robustness.md, "Fuzzing").
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -31,7 +36,7 @@ use std::time::Duration;
 use chain_core::diagnostic::Diagnostics;
 use chain_core::yaml::{Node, NodeKind, ScalarStyle};
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestCaseError, TestRunner};
+use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
 
 use crate::common::cli::scratch;
 use crate::fuzz::{bounded, cases};
@@ -349,6 +354,86 @@ fn located_inside(d: &Diagnostics, text: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// A runner of `programs` programs, seeded: the same programs every run
+/// (`CHAIN_FUZZ_SEED`, a number, picks another sequence for longer runs).
+fn runner(programs: usize) -> TestRunner {
+    let seed: u64 = std::env::var("CHAIN_FUZZ_SEED")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0);
+    let mut bytes = [0u8; 32];
+    bytes[..8].copy_from_slice(&seed.to_le_bytes());
+    let config = Config {
+        cases: programs as u32,
+        failure_persistence: None,
+        rng_algorithm: RngAlgorithm::ChaCha,
+        ..Config::default()
+    };
+    TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &bytes))
+}
+
+/// What one case did with its input.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Outcome {
+    /// Read (and, where the check goes further, used).
+    Accepted,
+    /// Refused; the first refusal's line when the reader locates it in the
+    /// edited text.
+    Refused(Option<usize>),
+}
+
+/// [`located_inside`], then the refusal's outcome.
+fn refusal(d: &Diagnostics, text: &str) -> Result<Outcome, String> {
+    let _ = d.to_string();
+    located_inside(d, text)?;
+    Ok(Outcome::Refused(d.iter().next().map(|e| e.origin.line)))
+}
+
+/// The outcomes of a run of programs.
+#[derive(Debug, Default)]
+struct Tally {
+    accepted: usize,
+    refused: usize,
+    /// The distinct lines refusals were located at.
+    lines: std::collections::BTreeSet<usize>,
+}
+
+impl Tally {
+    fn add(&mut self, outcome: Outcome) {
+        match outcome {
+            Outcome::Accepted => self.accepted += 1,
+            Outcome::Refused(line) => {
+                self.refused += 1;
+                self.lines.extend(line);
+            }
+        }
+    }
+
+    fn merge(&mut self, other: Tally) {
+        self.accepted += other.accepted;
+        self.refused += other.refused;
+        self.lines.extend(other.lines);
+    }
+
+    /// The edits reached past the first refusal a reader makes: some
+    /// inputs were accepted, some refused, and the refusals fell on at
+    /// least `lines` different lines (a mutator that only ever broke the
+    /// top of a file would give one).
+    #[track_caller]
+    fn assert_varied(&self, what: &str, lines: usize) {
+        eprintln!(
+            "{what}: {} accepted, {} refused at {} lines",
+            self.accepted,
+            self.refused,
+            self.lines.len()
+        );
+        assert!(
+            self.accepted > 0 && self.refused > 0 && self.lines.len() >= lines,
+            "{what}: {self:?}"
+        );
+    }
+}
+
 /// Runs `programs` programs of edits on `base` (with `keys` and `donors`
 /// from every example of its kind) through `check`, each bounded in time.
 fn run_programs(
@@ -358,17 +443,11 @@ fn run_programs(
     donors: &[Y],
     programs: usize,
     bound: Duration,
-    check: fn(String) -> Result<bool, String>,
-) -> (usize, usize) {
+    check: fn(String) -> Result<Outcome, String>,
+) -> Tally {
     let dir = scratch(name);
-    let mut runner = TestRunner::new(Config {
-        cases: programs as u32,
-        failure_persistence: None,
-        rng_algorithm: proptest::test_runner::RngAlgorithm::ChaCha,
-        ..Config::default()
-    });
-    let accepted = std::cell::Cell::new(0usize);
-    let total = std::cell::Cell::new(0usize);
+    let mut runner = runner(programs);
+    let tally = std::cell::RefCell::new(Tally::default());
     let result = runner.run(&program(), |edits| {
         let mut doc = base.clone();
         for &e in &edits {
@@ -380,10 +459,9 @@ fn run_programs(
         bounded(&dir, name, text.as_bytes(), bound, move || {
             let _ = tx.send(check(input));
         });
-        total.set(total.get() + 1);
         match rx.recv() {
-            Ok(Ok(loaded)) => {
-                accepted.set(accepted.get() + usize::from(loaded));
+            Ok(Ok(outcome)) => {
+                tally.borrow_mut().add(outcome);
                 Ok(())
             }
             Ok(Err(why)) => Err(TestCaseError::fail(format!("{why}\n--- input ---\n{text}"))),
@@ -393,7 +471,7 @@ fn run_programs(
     if let Err(e) = result {
         panic!("{name}: {e}");
     }
-    (accepted.get(), total.get())
+    tally.into_inner()
 }
 
 fn yaml_files(dir: &str, marker: &str) -> Vec<PathBuf> {
@@ -415,17 +493,17 @@ fn machine_files() -> Vec<PathBuf> {
 }
 
 /// [`run_programs`] on every tree of a corpus, `check_of` giving each
-/// tree's check; the accepted and total cases over all of them.
+/// tree's check; the outcomes over all of them.
 fn run_corpus(
     prefix: &str,
     (trees, keys, donors): &(Vec<(String, Y)>, Vec<String>, Vec<Y>),
     programs: usize,
     bound: Duration,
-    check_of: impl Fn(&str) -> fn(String) -> Result<bool, String>,
-) -> (usize, usize) {
-    let (mut accepted, mut total) = (0, 0);
+    check_of: impl Fn(&str) -> fn(String) -> Result<Outcome, String>,
+) -> Tally {
+    let mut tally = Tally::default();
     for (name, t) in trees {
-        let (a, n) = run_programs(
+        tally.merge(run_programs(
             &format!("{prefix}-{name}"),
             t,
             keys,
@@ -433,11 +511,9 @@ fn run_corpus(
             programs,
             bound,
             check_of(name),
-        );
-        accepted += a;
-        total += n;
+        ));
     }
-    (accepted, total)
+    tally
 }
 
 fn tree(path: &Path) -> Y {
@@ -519,7 +595,7 @@ fn unedited_trees_load_as_their_files() {
     }
 }
 
-fn check_machine(text: String) -> Result<bool, String> {
+fn check_machine(text: String) -> Result<Outcome, String> {
     match chain_core::load_str(&text, "fuzz.yaml") {
         Ok(m) => {
             let model = chain_core::compile(&m);
@@ -531,12 +607,9 @@ fn check_machine(text: String) -> Result<bool, String> {
                 .collect();
             let mut s = vec![0.0; 6 * chain_core::ErrorModel::errors(&model).len()];
             chain_core::ErrorModel::sensitivity(&model, &q, &p, &mut s);
-            Ok(true)
+            Ok(Outcome::Accepted)
         }
-        Err(d) => {
-            let _ = d.to_string();
-            located_inside(&d, &text).map(|()| false)
-        }
+        Err(d) => refusal(&d, &text),
     }
 }
 
@@ -544,18 +617,14 @@ fn check_machine(text: String) -> Result<bool, String> {
 /// that loads through the derivation, the tape and one evaluation.
 #[test]
 fn edited_machine_trees_never_panic_and_are_refused_in_place() {
-    let (loaded, total) = run_corpus(
+    run_corpus(
         "tree",
         &corpus(&machine_files()),
         cases(24),
         Duration::from_secs(20),
         |_| check_machine,
-    );
-    eprintln!("{loaded} of {total} edited machines loaded");
-    assert!(
-        loaded > 0 && loaded < total,
-        "{loaded} of {total} edited machines loaded"
-    );
+    )
+    .assert_varied("edited machines", 20);
 }
 
 /// A scalar as the inline syntax writes it: its own tokens when they lex
@@ -639,12 +708,15 @@ fn unedited_trees_expand_as_inline_machines() {
 
 /// The edited tree again, from its YAML (what the programs hand over), in
 /// the inline syntax through the macro's expansion.
-fn check_inline(text: String) -> Result<bool, String> {
+fn check_inline(text: String) -> Result<Outcome, String> {
     let parsed = chain_core::yaml::parse(&text);
     let Some(root) = parsed.root.as_ref() else {
-        return Ok(false);
+        return Ok(Outcome::Refused(None));
     };
-    Ok(expand_clean(&inline(&Y::of(root))) == Some(true))
+    Ok(match expand_clean(&inline(&Y::of(root))) {
+        Some(true) => Outcome::Accepted,
+        _ => Outcome::Refused(None),
+    })
 }
 
 /// Structural edits of the example machines, written in the inline syntax,
@@ -652,18 +724,19 @@ fn check_inline(text: String) -> Result<bool, String> {
 /// `compile_error!` for what it refuses, never a panic, within the bound.
 #[test]
 fn edited_machine_trees_expand_inline_without_panic() {
-    let (clean, total) = run_corpus(
+    // The expansion's refusals are `compile_error!`s, located by the
+    // compiler, so no lines are counted here.
+    run_corpus(
         "inline",
         &corpus(&machine_files()),
         cases(8),
         Duration::from_secs(20),
         |_| check_inline,
-    );
-    eprintln!("{clean} of {total} edited inline machines expanded cleanly");
-    assert!(clean < total, "{clean} of {total}");
+    )
+    .assert_varied("edited inline machines", 0);
 }
 
-fn check_settings(text: String) -> Result<bool, String> {
+fn check_settings(text: String) -> Result<Outcome, String> {
     let base = Path::new(ROOT).join("examples/settings");
     match chain_core::settings::load_settings_str(&text, "fuzz.yaml", &base) {
         Ok(s) => {
@@ -672,12 +745,9 @@ fn check_settings(text: String) -> Result<bool, String> {
             if let (Ok(g), Some(Ok(c))) = (s.load_generator(), s.load_cnc()) {
                 let _ = s.bind(&g, &c, &[]).map_err(|d| d.to_string());
             }
-            Ok(true)
+            Ok(Outcome::Accepted)
         }
-        Err(d) => {
-            let _ = d.to_string();
-            located_inside(&d, &text).map(|()| false)
-        }
+        Err(d) => refusal(&d, &text),
     }
 }
 
@@ -691,7 +761,8 @@ fn edited_settings_trees_never_panic_and_are_refused_in_place() {
         cases(60),
         Duration::from_secs(10),
         |_| check_settings,
-    );
+    )
+    .assert_varied("edited settings", 10);
 }
 
 fn values_machine(values: &str) -> &'static str {
@@ -716,19 +787,16 @@ fn example_machine(path: &'static str) -> &'static chain_core::model::Machine {
     m
 }
 
-fn check_values(file: &'static str, text: &str) -> Result<bool, String> {
+fn check_values(file: &'static str, text: &str) -> Result<Outcome, String> {
     let machine = example_machine(values_machine(file));
     let base = Path::new(ROOT).join("examples/values");
     match chain_core::values::Values::parse(text, "fuzz.yaml", &base, machine) {
-        Ok(_) => Ok(true),
-        Err(chain_core::values::ValuesError::File(d)) => {
-            let _ = d.to_string();
-            located_inside(&d, text).map(|()| false)
-        }
+        Ok(_) => Ok(Outcome::Accepted),
+        Err(chain_core::values::ValuesError::File(d)) => refusal(&d, text),
         // A table's refusals are located in the table's own file.
         Err(e) => {
             let _ = e.to_string();
-            Ok(false)
+            Ok(Outcome::Refused(None))
         }
     }
 }
@@ -746,7 +814,8 @@ fn edited_values_trees_never_panic_and_are_refused_in_place() {
             "gantry_grinder.yaml" => |t| check_values("gantry_grinder.yaml", &t),
             _ => |t| check_values("vmc3.yaml", &t),
         },
-    );
+    )
+    .assert_varied("edited values files", 10);
 }
 
 // ---------------------------------------------------------------------------
@@ -761,7 +830,8 @@ struct Table {
 }
 
 impl Table {
-    fn read(path: &Path) -> Table {
+    /// The comments, header and the first `rows` rows of a CSV file.
+    fn read(path: &Path, rows: usize) -> Table {
         let text = std::fs::read_to_string(path).expect("example CSV");
         let comments = text
             .lines()
@@ -779,9 +849,8 @@ impl Table {
             .iter()
             .map(String::from)
             .collect();
-        // A few rows are enough to reach every rule.
         let rows = records
-            .take(12)
+            .take(rows)
             .map(|r| r.iter().map(String::from).collect())
             .collect();
         Table {
@@ -936,15 +1005,11 @@ fn run_table_programs(
     name: &str,
     base: &Table,
     programs: usize,
-    check: fn(String) -> Result<(), String>,
-) {
+    check: fn(String) -> Result<Outcome, String>,
+) -> Tally {
     let dir = scratch(name);
-    let mut runner = TestRunner::new(Config {
-        cases: programs as u32,
-        failure_persistence: None,
-        rng_algorithm: proptest::test_runner::RngAlgorithm::ChaCha,
-        ..Config::default()
-    });
+    let mut runner = runner(programs);
+    let tally = std::cell::RefCell::new(Tally::default());
     let result = runner.run(&(program(), any::<bool>()), |(edits, crlf)| {
         let mut t = base.clone();
         for &e in &edits {
@@ -963,7 +1028,10 @@ fn run_table_programs(
             },
         );
         match rx.recv() {
-            Ok(Ok(())) => Ok(()),
+            Ok(Ok(outcome)) => {
+                tally.borrow_mut().add(outcome);
+                Ok(())
+            }
             Ok(Err(why)) => Err(TestCaseError::fail(format!("{why}\n--- input ---\n{text}"))),
             Err(_) => Err(TestCaseError::fail("the case sent nothing")),
         }
@@ -971,10 +1039,20 @@ fn run_table_programs(
     if let Err(e) = result {
         panic!("{name}: {e}");
     }
+    tally.into_inner()
 }
 
+/// An example table's first rows: a few are enough to reach every rule of
+/// a table read row by row.
 fn example_csv(path: &str) -> Table {
-    Table::read(&Path::new(ROOT).join("examples").join(path))
+    Table::read(&Path::new(ROOT).join("examples").join(path), 12)
+}
+
+/// An example positioning run file, whole: the runs are checked as a
+/// whole (every target in every run and direction), so a cut one is never
+/// evaluated.
+fn example_runs(path: &str) -> Table {
+    Table::read(&Path::new(ROOT).join("examples").join(path), usize::MAX)
 }
 
 fn probe_machine() -> &'static chain_core::model::Machine {
@@ -984,7 +1062,7 @@ fn probe_machine() -> &'static chain_core::model::Machine {
 fn check_measurements(
     text: String,
     layout: chain_core::measured::measurements::Layout,
-) -> Result<(), String> {
+) -> Result<Outcome, String> {
     use chain_core::measured::measurements::Measurements;
     match Measurements::parse(&text, "fuzz.csv", probe_machine(), &[], layout) {
         Ok(m) => {
@@ -992,11 +1070,42 @@ fn check_measurements(
             let model = chain_core::compile(probe_machine());
             let _ =
                 chain_core::measured::measurements::Design::new(&model, probe_machine(), &m.rows);
-            Ok(())
+            Ok(Outcome::Accepted)
         }
         Err(e) => {
             let _ = e.to_string();
-            located_inside(e.diagnostics(), &text)
+            refusal(e.diagnostics(), &text)
+        }
+    }
+}
+
+/// The tables' rendering is faithful: every example table, written back
+/// unedited (LF or CRLF), is read as its file is.
+#[test]
+fn unedited_tables_are_read() {
+    use chain_core::measured::measurements::Layout;
+    use chain_core::measured::positioning::{AxisKind, Runs};
+    for crlf in [false, true] {
+        for (file, layout) in [
+            ("measurements/ballplate.csv", Layout::Measurements),
+            ("measurements/interferometer.csv", Layout::Measurements),
+            ("measurements/candidates.csv", Layout::Candidates),
+        ] {
+            let text = example_csv(file).render(crlf);
+            assert_eq!(
+                check_measurements(text, layout),
+                Ok(Outcome::Accepted),
+                "{file}"
+            );
+        }
+        for (file, kind) in [
+            ("positioning/x_axis_runs.csv", AxisKind::Linear),
+            ("positioning/c_axis_runs.csv", AxisKind::Rotary),
+        ] {
+            let text = example_runs(file).render(crlf);
+            if let Err(e) = Runs::parse(&text, "fuzz.csv", kind) {
+                panic!("{file}: {e}\n{text}");
+            }
         }
     }
 }
@@ -1015,14 +1124,16 @@ fn edited_measurement_tables_never_panic_and_are_refused_in_place() {
             &example_csv(file),
             cases(60),
             |t| check_measurements(t, Layout::Measurements),
-        );
+        )
+        .assert_varied(file, 5);
     }
     run_table_programs(
         "table-candidates",
         &example_csv("measurements/candidates.csv"),
         cases(60),
         |t| check_measurements(t, Layout::Candidates),
-    );
+    )
+    .assert_varied("candidates", 5);
 }
 
 /// Structural edits of positioning runs (linear and rotary), swing-angle
@@ -1032,25 +1143,29 @@ fn edited_run_swing_and_values_tables_never_panic_and_are_refused_in_place() {
     use chain_core::measured::positioning::{AxisKind, Runs};
     run_table_programs(
         "table-x-runs",
-        &example_csv("positioning/x_axis_runs.csv"),
-        cases(60),
+        &example_runs("positioning/x_axis_runs.csv"),
+        // Most edits break a run file as a whole (a row missing, a run
+        // repeated): more programs, so that some reach the evaluation.
+        cases(240),
         |t| match Runs::parse(&t, "fuzz.csv", AxisKind::Linear) {
             Ok(runs) => {
                 let _ = chain_core::measured::positioning::evaluate(&runs, Default::default());
-                Ok(())
+                Ok(Outcome::Accepted)
             }
-            Err(e) => located_inside(e.diagnostics(), &t),
+            Err(e) => refusal(e.diagnostics(), &t),
         },
-    );
+    )
+    .assert_varied("linear runs", 5);
     run_table_programs(
         "table-c-runs",
-        &example_csv("positioning/c_axis_runs.csv"),
-        cases(60),
+        &example_runs("positioning/c_axis_runs.csv"),
+        cases(240),
         |t| match Runs::parse(&t, "fuzz.csv", AxisKind::Rotary) {
-            Ok(_) => Ok(()),
-            Err(e) => located_inside(e.diagnostics(), &t),
+            Ok(_) => Ok(Outcome::Accepted),
+            Err(e) => refusal(e.diagnostics(), &t),
         },
-    );
+    )
+    .assert_varied("rotary runs", 5);
     run_table_programs(
         "table-swing",
         &example_csv("data/swing_htm50200.csv"),
@@ -1058,17 +1173,22 @@ fn edited_run_swing_and_values_tables_never_panic_and_are_refused_in_place() {
         |t| {
             // Refusals name `file:line` in their message.
             match chain::compensate::records::parse_measurements("fuzz.csv", t.as_bytes()) {
-                Ok(_) => Ok(()),
+                Ok(_) => Ok(Outcome::Accepted),
                 Err(e) => {
                     let message = e.to_string();
+                    let line = message
+                        .strip_prefix("fuzz.csv:")
+                        .and_then(|rest| rest.split(':').next())
+                        .and_then(|n| n.parse().ok());
                     match message.starts_with("fuzz.csv:") {
-                        true => Ok(()),
+                        true => Ok(Outcome::Refused(line)),
                         false => Err(format!("a refusal without its line: {message}")),
                     }
                 }
             }
         },
-    );
+    )
+    .assert_varied("swing records", 5);
     run_table_programs(
         "table-values",
         &example_csv("values/x_axis.csv"),
@@ -1076,9 +1196,10 @@ fn edited_run_swing_and_values_tables_never_panic_and_are_refused_in_place() {
         |t| match chain_core::values::csv::CsvFile::parse_bytes(t.as_bytes(), "fuzz.csv", "help") {
             Ok(f) => {
                 let _ = f.rows().count();
-                Ok(())
+                Ok(Outcome::Accepted)
             }
-            Err(d) => located_inside(&d, &t),
+            Err(d) => refusal(&d, &t),
         },
-    );
+    )
+    .assert_varied("values table", 5);
 }
