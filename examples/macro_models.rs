@@ -7,7 +7,7 @@
 
 use chain::core::model::Sided;
 use chain::core::ErrorModel;
-use chain::reliability::{Event, Form, Inputs, Marginal, MonteCarlo, ToleranceLimitState};
+use chain::reliability::{Event, Form, Inputs, Marginal, MonteCarlo, Sampler, ToleranceLimitState};
 
 chain::machine! {
     pub GantryGrinder {

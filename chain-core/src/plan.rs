@@ -787,15 +787,10 @@ impl<'b> Search<'b> {
 // ---------------------------------------------------------------------------
 // The document of `chain plan`.
 
-/// What each candidate measures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Kind {
-    /// The tool-point deviation `px, py, pz` (three rows per candidate).
-    Point,
-    /// The deviation along the candidate's `ux, uy, uz` (one row).
-    Direction,
-}
+/// What each candidate measures: the measurement kind of `chain identify`
+/// (`point`, three rows per candidate; `direction`, one row along the
+/// candidate's `ux, uy, uz`).
+pub use crate::measured::MeasurementKind as Kind;
 
 /// A `kind` asked for that the candidate file contradicts.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -826,15 +821,14 @@ impl Kind {
         let Some(first) = candidates.rows.first() else {
             return Ok(None);
         };
-        let kind = match first.observed {
-            crate::measured::Observed::Point => Kind::Point,
-            crate::measured::Observed::Direction { .. } => Kind::Direction,
-        };
+        let kind = first.observed.kind();
         let file = candidates.file.clone();
         match (asked, kind) {
+            (None, _)
+            | (Some(Kind::Point), Kind::Point)
+            | (Some(Kind::Direction), Kind::Direction) => Ok(Some(kind)),
             (Some(Kind::Point), Kind::Direction) => Err(KindError::PointWithDirections { file }),
             (Some(Kind::Direction), Kind::Point) => Err(KindError::DirectionWithout { file }),
-            _ => Ok(Some(kind)),
         }
     }
 }

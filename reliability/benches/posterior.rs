@@ -17,7 +17,8 @@ use std::path::Path;
 use chain_core::model::{Component, Sided};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use reliability::{
-    machine, Event, Form, Inputs, LimitState, MonteCarlo, Posterior, Study, ToleranceLimitState,
+    machine, Event, Form, Inputs, LimitState, MonteCarlo, Posterior, Sampler, Study,
+    ToleranceLimitState,
 };
 
 const POSTERIOR: &str = "machine: gantry_grinder

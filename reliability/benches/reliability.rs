@@ -18,7 +18,7 @@ use std::path::Path;
 use chain_core::model::{Component, Sided};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use reliability::{
-    machine, Event, Form, ImportanceSampling, MonteCarlo, Study, ToleranceLimitState,
+    machine, Event, Form, ImportanceSampling, MonteCarlo, Sampler, Study, ToleranceLimitState,
 };
 
 fn gantry() -> (chain_core::Machine, chain_core::CompiledModel) {

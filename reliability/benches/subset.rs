@@ -18,7 +18,7 @@ use std::path::Path;
 
 use chain_core::model::{Component, Sided};
 use criterion::{criterion_group, criterion_main, Criterion};
-use reliability::{machine, normal, Event, Study, SubsetSimulation, ToleranceLimitState};
+use reliability::{machine, normal, Event, Sampler, Study, SubsetSimulation, ToleranceLimitState};
 
 const BETA: f64 = 4.7534;
 

@@ -10,7 +10,9 @@ use std::path::Path;
 use std::time::Instant;
 
 use chain_core::model::{Component, Sided};
-use reliability::{machine, Event, Form, ImportanceSampling, MonteCarlo, ToleranceLimitState};
+use reliability::{
+    machine, Event, Form, ImportanceSampling, MonteCarlo, Sampler, ToleranceLimitState,
+};
 
 fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
     let samples: u64 = std::env::args()

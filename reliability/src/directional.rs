@@ -39,8 +39,8 @@ use crate::method::Method;
 use crate::normal;
 use crate::rng::CaseRng;
 use crate::sampler::{
-    check_cov, check_samples, drive, finish, impl_sampler, Progress, SimulationResult, Stop,
-    Stopping, Streams, Sums,
+    check_cov, check_samples, drive, finish, Progress, Sampler, SimulationResult, Stop, Stopping,
+    Streams, Sums,
 };
 use crate::simulation::illinois;
 use crate::standard::{Scratch, Standard};
@@ -103,28 +103,15 @@ fn chi2_mass(n: usize, r0: f64, r1: f64) -> f64 {
     }
 }
 
-impl DirectionalSimulation {
-    /// Runs one event (on stream case 0).
-    pub fn run<L: LimitState>(
-        &self,
-        event: &Event<'_, L>,
-    ) -> Result<SimulationResult, ReliabilityError> {
-        let mut out = self.run_cases(std::slice::from_ref(event), &())?;
-        Ok(out.remove(0))
+impl Sampler for DirectionalSimulation {
+    type Output = SimulationResult;
+
+    fn method(&self) -> Method {
+        Method::Directional
     }
 
-    /// Runs several events; case `i` draws from streams `i << 32 | block`.
-    pub fn run_cases<L: LimitState>(
-        &self,
-        events: &[Event<'_, L>],
-        progress: &dyn Progress,
-    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
-        self.run_streams(events, Streams::ALL, progress)
-    }
-
-    /// [`DirectionalSimulation::run_cases`], case `i` on the streams of
-    /// `streams.id(i)`.
-    pub fn run_streams<L: LimitState>(
+    /// Case `i` draws from streams `streams.id(i) << 32 | block`.
+    fn run_streams<L: LimitState>(
         &self,
         events: &[Event<'_, L>],
         streams: Streams<'_>,
@@ -170,7 +157,9 @@ impl DirectionalSimulation {
             })
             .collect())
     }
+}
 
+impl DirectionalSimulation {
     fn block<L: LimitState>(
         &self,
         std: &Standard<'_, '_, L>,
@@ -306,8 +295,6 @@ fn estimate(s: &Sums, count: u64) -> (f64, f64) {
     };
     (mean, (var / n).sqrt())
 }
-
-impl_sampler!(DirectionalSimulation => Method::Directional);
 
 #[cfg(test)]
 mod tests {

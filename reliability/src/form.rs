@@ -418,6 +418,7 @@ mod tests {
     use crate::inputs::{Inputs, Marginal};
     use crate::limit_state::Criterion;
     use crate::limit_state::ToleranceLimitState;
+    use crate::sampler::Sampler;
     use chain_core::model::Sided;
 
     fn inputs(stds: &[f64]) -> Inputs {

@@ -18,7 +18,8 @@
 //! - [`Event`]: a limit state with its inputs;
 //! - algorithms [`Form`], [`ImportanceSampling`], [`MonteCarlo`] and the
 //!   function [`sensitivity()`], returning plain serialisable results
-//!   ([`FormResult`], [`SimulationResult`], [`SensitivityResult`]);
+//!   ([`FormResult`], [`SimulationResult`], [`SensitivityResult`]); the
+//!   samplers run through the [`Sampler`] trait (`run`, `run_cases`);
 //! - [`Study`]: all of it over a workspace grid for any
 //!   [`chain_core::ErrorModel`] (runtime-compiled or `machine!`-generated),
 //!   and [`machine`] to build one from a machine file;
@@ -28,7 +29,7 @@
 //! # Example
 //!
 //! ```
-//! use reliability::{Event, Form, ImportanceSampling, Inputs, Marginal, ToleranceLimitState};
+//! use reliability::{Event, Form, ImportanceSampling, Inputs, Marginal, Sampler, ToleranceLimitState};
 //! use chain_core::model::Sided;
 //! // px at (y, z) = (0, 600) of the gantry grinder, Eq. 34 with Table 1's σ:
 //! // px = −δxx − z·εyx + y·εzx + δxz + δxy + y·Sxy − y·εzz.
@@ -89,7 +90,7 @@ pub use path::{
     PathSummary, PathTarget, Quantity, TargetSummary,
 };
 pub use posterior::{Posterior, PosteriorError};
-pub use sampler::Streams;
+pub use sampler::{Sampler, Streams};
 pub use sensitivity::{sensitivity, InputSensitivity, SensitivityMethod, SensitivityResult};
 pub use simulation::{ImportanceSampling, MonteCarlo, Progress, SimulationResult, Stop, Stopping};
 pub use sobol::{Sobol, SobolError, SobolResult};

@@ -5,35 +5,60 @@
 //! the block sums in block order, counts the calls and applies the stop
 //! rules (a sample count, or a target coefficient of variation within a
 //! budget) for crude Monte Carlo, the importance sampling and directional
-//! simulation alike. A study runs any of them through [`Sampler`] (as
-//! argmin's solvers are generic over a small problem trait, and OpenTURNS
-//! keeps event, algorithm and result apart).
+//! simulation alike. A sampler implements one run of many events on their
+//! streams ([`Sampler::run_streams`]: on the driver, or on subset
+//! simulation's own level loop); the trait provides the rest (one event,
+//! [`Sampler::run`]; many on streams `0, 1, …`, [`Sampler::run_cases`]).
+//! A study runs any of them through [`Sampler`] (as argmin's solvers are
+//! generic over a small problem trait, and OpenTURNS keeps event, algorithm
+//! and result apart).
 
 use serde::Serialize;
 
 use crate::error::ReliabilityError;
 use crate::form::FormResult;
-use crate::limit_state::Event;
+use crate::limit_state::{Event, LimitState};
 use crate::method::Method;
 use crate::normal;
 use crate::par::prelude::*;
 
 /// A sampling algorithm as a study runs it: its method, and a run of every
-/// event under its own stop rule.
+/// event under its own stop rule. A sampler implements [`Sampler::method`]
+/// and [`Sampler::run_streams`]; [`Sampler::run_cases`] and [`Sampler::run`]
+/// are provided.
 pub trait Sampler: Sync {
+    /// What the run of one event reports.
+    type Output;
+
     /// The method it is.
     fn method(&self) -> Method;
 
-    /// Runs every event (case `i` on streams `streams.id(i) << 32 | block`)
+    /// Runs every event (case `i` on the random streams of `streams.id(i)`)
     /// under the sampler's stop rule (its sample count, or its target
-    /// coefficient of variation within that budget), telling `progress` of
-    /// the samples drawn.
-    fn run_events(
+    /// coefficient of variation within a budget), telling `progress` of the
+    /// samples drawn.
+    fn run_streams<L: LimitState>(
         &self,
-        events: &[Event<'_>],
+        events: &[Event<'_, L>],
         streams: Streams<'_>,
         progress: &dyn Progress,
-    ) -> Result<Vec<SimulationResult>, ReliabilityError>;
+    ) -> Result<Vec<Self::Output>, ReliabilityError>;
+
+    /// Runs several events; case `i` draws from the streams of case `i`
+    /// ([`Sampler::run_streams`] on [`Streams::ALL`]).
+    fn run_cases<L: LimitState>(
+        &self,
+        events: &[Event<'_, L>],
+        progress: &dyn Progress,
+    ) -> Result<Vec<Self::Output>, ReliabilityError> {
+        self.run_streams(events, Streams::ALL, progress)
+    }
+
+    /// Runs one event (on the streams of case 0).
+    fn run<L: LimitState>(&self, event: &Event<'_, L>) -> Result<Self::Output, ReliabilityError> {
+        let mut out = self.run_cases(std::slice::from_ref(event), &())?;
+        Ok(out.remove(0))
+    }
 }
 
 /// Which random streams the cases of a run sample: case `i` of the run
@@ -57,28 +82,6 @@ impl<'a> Streams<'a> {
         case_id(self.0.map_or(case, |ids| ids[case]))
     }
 }
-
-/// Implements [`Sampler`] for a sampler type whose `run_streams` runs events
-/// under its own stop rule.
-macro_rules! impl_sampler {
-    ($($t:ty => $method:expr),* $(,)?) => {$(
-        impl $crate::sampler::Sampler for $t {
-            fn method(&self) -> $crate::method::Method {
-                $method
-            }
-
-            fn run_events(
-                &self,
-                events: &[$crate::limit_state::Event<'_>],
-                streams: $crate::sampler::Streams<'_>,
-                progress: &dyn $crate::sampler::Progress,
-            ) -> Result<Vec<$crate::sampler::SimulationResult>, $crate::error::ReliabilityError> {
-                self.run_streams(events, streams, progress)
-            }
-        }
-    )*};
-}
-pub(crate) use impl_sampler;
 
 /// The largest number of samples per case (2³⁶ ≈ 6.9·10¹⁰).
 pub const MAX_SAMPLES: u64 = 1 << 36;

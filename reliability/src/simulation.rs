@@ -33,7 +33,7 @@ use crate::normal;
 use crate::par::prelude::*;
 use crate::rng::CaseRng;
 pub use crate::sampler::{check_cov, Progress, SimulationResult, Stop, Stopping, MAX_SAMPLES};
-use crate::sampler::{check_samples, drive, finish, impl_sampler, Streams, Sums};
+use crate::sampler::{check_samples, drive, finish, Sampler, Streams, Sums};
 use crate::util::dot;
 use chain_core::model::Sided;
 
@@ -41,7 +41,17 @@ use chain_core::model::Sided;
 pub const BLOCK: u64 = 1 << 16;
 
 /// Crude Monte Carlo: `p_f ≈ (1/N)·Σ 1[g(x_i) ≤ 0]` with `x_i` drawn from the
-/// inputs; standard error `√(p_f(1 − p_f)/(N − 1))`.
+/// inputs; standard error `√(p_f(1 − p_f)/(N − 1))`. Run through
+/// [`Sampler`]:
+///
+/// ```
+/// use reliability::{Event, Inputs, Marginal, MonteCarlo, Sampler, ToleranceLimitState};
+/// use chain_core::model::Sided;
+/// let inputs = Inputs::new(vec!["e".into()], vec![Marginal::normal(0.0, 1.0).unwrap()]).unwrap();
+/// let g = ToleranceLimitState::component(vec![1.0], 1.0, Sided::Upper).unwrap();
+/// let r = MonteCarlo { samples: 100_000, seed: 1, cov: None }.run(&Event::new(&inputs, g).unwrap()).unwrap();
+/// assert!((r.pf - 0.158_655).abs() < 4.0 * r.std_error);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MonteCarlo {
     /// Samples per case (with a target CoV: the largest number).
@@ -67,26 +77,14 @@ pub struct ImportanceSampling {
     pub cov: Option<f64>,
 }
 
-impl MonteCarlo {
-    /// Runs one event (on stream case 0).
-    ///
-    /// ```
-    /// use reliability::{Event, Inputs, Marginal, MonteCarlo, ToleranceLimitState};
-    /// use chain_core::model::Sided;
-    /// let inputs = Inputs::new(vec!["e".into()], vec![Marginal::normal(0.0, 1.0).unwrap()]).unwrap();
-    /// let g = ToleranceLimitState::component(vec![1.0], 1.0, Sided::Upper).unwrap();
-    /// let r = MonteCarlo { samples: 100_000, seed: 1, cov: None }.run(&Event::new(&inputs, g).unwrap()).unwrap();
-    /// assert!((r.pf - 0.158_655).abs() < 4.0 * r.std_error);
-    /// ```
-    pub fn run<L: LimitState>(
-        &self,
-        event: &Event<'_, L>,
-    ) -> Result<SimulationResult, ReliabilityError> {
-        let mut out = self.run_cases(std::slice::from_ref(event), &())?;
-        Ok(out.remove(0))
+impl Sampler for MonteCarlo {
+    type Output = SimulationResult;
+
+    fn method(&self) -> Method {
+        Method::MonteCarlo
     }
 
-    /// Runs several events; case `i` draws from streams `i << 32 | block`.
+    /// Case `i` draws from streams `streams.id(i) << 32 | block`.
     ///
     /// With a target coefficient of variation ([`MonteCarlo::cov`]) each
     /// case runs until its estimate's CoV is at most the target (checked
@@ -95,16 +93,7 @@ impl MonteCarlo {
     /// converged ([`Stop::Budget`]). A case with no failure yet has no CoV
     /// and goes on. The estimate is bit-identical to a run of the same seed
     /// with the number of samples it stopped at.
-    pub fn run_cases<L: LimitState>(
-        &self,
-        events: &[Event<'_, L>],
-        progress: &dyn Progress,
-    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
-        self.run_streams(events, Streams::ALL, progress)
-    }
-
-    /// [`MonteCarlo::run_cases`], case `i` on the streams of `streams.id(i)`.
-    pub fn run_streams<L: LimitState>(
+    fn run_streams<L: LimitState>(
         &self,
         events: &[Event<'_, L>],
         streams: Streams<'_>,
@@ -113,16 +102,6 @@ impl MonteCarlo {
         if let Some(target) = self.cov {
             check_cov(target)?;
         }
-        self.run_rule(events, streams, self.cov, progress)
-    }
-
-    fn run_rule<L: LimitState>(
-        &self,
-        events: &[Event<'_, L>],
-        streams: Streams<'_>,
-        target: Option<f64>,
-        progress: &dyn Progress,
-    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
         check_samples(self.samples)?;
         let width = events.iter().map(|e| e.inputs.len()).max().unwrap_or(0);
         // Tolerance limit states in normal inputs are evaluated on the
@@ -171,7 +150,7 @@ impl MonteCarlo {
             width,
             progress,
             block,
-            target.map(|t| {
+            self.cov.map(|t| {
                 (t, move |_: usize, s: &Sums, n: u64| {
                     let (pf, se) = estimate(s, n);
                     s.s1 > 0.0 && se <= t * pf
@@ -191,43 +170,8 @@ impl MonteCarlo {
 }
 
 impl ImportanceSampling {
-    /// Runs one event (on stream case 0).
-    pub fn run<L: LimitState>(
-        &self,
-        event: &Event<'_, L>,
-    ) -> Result<SimulationResult, ReliabilityError> {
-        let mut out = self.run_cases(std::slice::from_ref(event), &())?;
-        Ok(out.remove(0))
-    }
-
-    /// Runs several events; case `i` draws from streams `i << 32 | block`.
-    pub fn run_cases<L: LimitState>(
-        &self,
-        events: &[Event<'_, L>],
-        progress: &dyn Progress,
-    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
-        self.run_streams(events, Streams::ALL, progress)
-    }
-
-    /// [`ImportanceSampling::run_cases`], case `i` on the streams of
-    /// `streams.id(i)`.
-    pub fn run_streams<L: LimitState>(
-        &self,
-        events: &[Event<'_, L>],
-        streams: Streams<'_>,
-        progress: &dyn Progress,
-    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
-        let forms = events
-            .par_iter()
-            .map(|e| self.form.run(e))
-            .collect::<Result<Vec<_>, _>>()?;
-        if let Some(target) = self.cov {
-            check_cov(target)?;
-        }
-        self.run_rule(events, forms, streams, self.cov, progress)
-    }
-
-    /// Runs several events with their FORM results already computed.
+    /// Runs several events with their FORM results already computed; case
+    /// `i` draws from streams `i << 32 | block`.
     ///
     /// With a target coefficient of variation ([`ImportanceSampling::cov`])
     /// each case runs until its CoV is at most the target (checked after
@@ -240,20 +184,21 @@ impl ImportanceSampling {
         forms: Vec<FormResult>,
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
-        if let Some(target) = self.cov {
-            check_cov(target)?;
-        }
-        self.run_rule(events, forms, Streams::ALL, self.cov, progress)
+        self.run_forms(events, forms, Streams::ALL, progress)
     }
 
-    fn run_rule<L: LimitState>(
+    /// [`ImportanceSampling::run_cases_with`], case `i` on the streams of
+    /// `streams.id(i)`.
+    fn run_forms<L: LimitState>(
         &self,
         events: &[Event<'_, L>],
         forms: Vec<FormResult>,
         streams: Streams<'_>,
-        target: Option<f64>,
         progress: &dyn Progress,
     ) -> Result<Vec<SimulationResult>, ReliabilityError> {
+        if let Some(target) = self.cov {
+            check_cov(target)?;
+        }
         check_samples(self.samples)?;
         if forms.len() != events.len() {
             return Err(ReliabilityError::Dimension {
@@ -290,7 +235,7 @@ impl ImportanceSampling {
             width,
             progress,
             block,
-            target.map(|t| {
+            self.cov.map(|t| {
                 let kernels = &kernels;
                 (t, move |case: usize, s: &Sums, n: u64| {
                     let (pf, se) = estimate(&kernels[case], s, n);
@@ -318,6 +263,30 @@ impl ImportanceSampling {
                 r
             })
             .collect())
+    }
+}
+
+impl Sampler for ImportanceSampling {
+    type Output = SimulationResult;
+
+    fn method(&self) -> Method {
+        Method::ImportanceSampling
+    }
+
+    /// FORM on every event first (its design direction centres the
+    /// sampling), then [`ImportanceSampling::run_cases_with`] on the streams
+    /// of `streams`.
+    fn run_streams<L: LimitState>(
+        &self,
+        events: &[Event<'_, L>],
+        streams: Streams<'_>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<SimulationResult>, ReliabilityError> {
+        let forms = events
+            .par_iter()
+            .map(|e| self.form.run(e))
+            .collect::<Result<Vec<_>, _>>()?;
+        self.run_forms(events, forms, streams, progress)
     }
 }
 
@@ -726,11 +695,6 @@ pub(crate) fn illinois(
     }
     0.5 * (a + b)
 }
-
-impl_sampler!(
-    MonteCarlo => Method::MonteCarlo,
-    ImportanceSampling => Method::ImportanceSampling,
-);
 
 #[cfg(test)]
 mod tests {

@@ -1169,9 +1169,9 @@ impl Study {
     }
 
     /// `sampler` on every case, under its own stop rule.
-    pub fn sampled_by(
+    pub fn sampled_by<S: Sampler<Output = SimulationResult>>(
         &self,
-        sampler: &dyn Sampler,
+        sampler: &S,
         progress: &dyn Progress,
     ) -> Result<StudyResult, ReliabilityError> {
         let set = self.all_cases();
@@ -1181,14 +1181,14 @@ impl Study {
 
     /// `sampler` on the cases of `set`, each on the streams of its index in
     /// the study.
-    fn sampled_cases(
+    fn sampled_cases<S: Sampler<Output = SimulationResult>>(
         &self,
-        sampler: &dyn Sampler,
+        sampler: &S,
         set: CaseSet<'_>,
         progress: &dyn Progress,
     ) -> Result<Vec<CaseResult>, ReliabilityError> {
         let events = self.events_in(set, 0..set.len())?;
-        let results = sampler.run_events(&events, set.streams(), progress)?;
+        let results = sampler.run_streams(&events, set.streams(), progress)?;
         Ok(self.sampled(set, &results))
     }
 

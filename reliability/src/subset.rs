@@ -61,10 +61,11 @@ use serde::Serialize;
 
 use crate::error::ReliabilityError;
 use crate::limit_state::{Event, LimitState};
+use crate::method::Method;
 use crate::normal;
 use crate::par::prelude::*;
 use crate::rng::CaseRng;
-use crate::sampler::{check_cov, Progress, Stop, Stopping, Streams};
+use crate::sampler::{check_cov, Progress, Sampler, Stop, Stopping, Streams};
 use crate::standard::Standard;
 
 /// The target acceptance rate of the aCS adaptation (Papaioannou et al.
@@ -208,59 +209,6 @@ impl SubsetSimulation {
             }
         }
         Ok(((self.samples / ns) as usize, ns as usize))
-    }
-
-    /// Runs one event (on stream case 0).
-    pub fn run<L: LimitState>(
-        &self,
-        event: &Event<'_, L>,
-    ) -> Result<SubsetResult, ReliabilityError> {
-        let mut out = self.run_cases(std::slice::from_ref(event), &())?;
-        Ok(out.remove(0))
-    }
-
-    /// Runs several events in parallel; case `i` draws from streams
-    /// `i << 32 | (run·64 + level)`.
-    pub fn run_cases<L: LimitState>(
-        &self,
-        events: &[Event<'_, L>],
-        progress: &dyn Progress,
-    ) -> Result<Vec<SubsetResult>, ReliabilityError> {
-        self.run_streams(events, Streams::ALL, progress)
-    }
-
-    /// [`SubsetSimulation::run_cases`], case `i` on the streams of
-    /// `streams.id(i)`.
-    pub fn run_streams<L: LimitState>(
-        &self,
-        events: &[Event<'_, L>],
-        streams: Streams<'_>,
-        progress: &dyn Progress,
-    ) -> Result<Vec<SubsetResult>, ReliabilityError> {
-        let (nc, ns) = self.check()?;
-        let case = |i: usize| -> SubsetResult {
-            let std = Standard::new(&events[i]);
-            let case_id = streams.id(i);
-            match self.cov {
-                None => {
-                    let r = self.one_run(&std, case_id, 0, nc, ns, progress);
-                    let stop = if r.reached {
-                        Stop::Samples
-                    } else {
-                        Stop::Levels
-                    };
-                    combine(vec![r], stop, None)
-                }
-                Some(target) => self.until_cov(&std, case_id, nc, ns, target, progress),
-            }
-        };
-        Ok(crate::par::in_pool(|| {
-            if events.len() == 1 {
-                vec![case(0)]
-            } else {
-                (0..events.len()).into_par_iter().map(case).collect()
-            }
-        }))
     }
 
     /// Independent runs until the target CoV or the budget; runs go in
@@ -481,6 +429,48 @@ impl SubsetSimulation {
             levels,
             reached: false,
         }
+    }
+}
+
+impl Sampler for SubsetSimulation {
+    type Output = SubsetResult;
+
+    fn method(&self) -> Method {
+        Method::Subset
+    }
+
+    /// Runs the events in parallel; case `i` draws from streams
+    /// `streams.id(i) << 32 | (run·64 + level)`.
+    fn run_streams<L: LimitState>(
+        &self,
+        events: &[Event<'_, L>],
+        streams: Streams<'_>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<SubsetResult>, ReliabilityError> {
+        let (nc, ns) = self.check()?;
+        let case = |i: usize| -> SubsetResult {
+            let std = Standard::new(&events[i]);
+            let case_id = streams.id(i);
+            match self.cov {
+                None => {
+                    let r = self.one_run(&std, case_id, 0, nc, ns, progress);
+                    let stop = if r.reached {
+                        Stop::Samples
+                    } else {
+                        Stop::Levels
+                    };
+                    combine(vec![r], stop, None)
+                }
+                Some(target) => self.until_cov(&std, case_id, nc, ns, target, progress),
+            }
+        };
+        Ok(crate::par::in_pool(|| {
+            if events.len() == 1 {
+                vec![case(0)]
+            } else {
+                (0..events.len()).into_par_iter().map(case).collect()
+            }
+        }))
     }
 }
 

@@ -15,7 +15,7 @@ use reliability::normal;
 use reliability::simulation::BLOCK;
 use reliability::{
     DirectionalSimulation, Event, Form, ImportanceSampling, Inputs, Marginal, MonteCarlo,
-    ReliabilityError, Stop, SubsetSimulation, ToleranceLimitState,
+    ReliabilityError, Sampler, Stop, SubsetSimulation, ToleranceLimitState,
 };
 
 fn normals(n: usize) -> Inputs {

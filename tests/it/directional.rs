@@ -14,8 +14,8 @@
 use chain_core::model::Sided;
 use reliability::normal;
 use reliability::{
-    Criterion, DirectionalSimulation, Event, Inputs, LimitState, Marginal, MonteCarlo, Stop,
-    ToleranceLimitState,
+    Criterion, DirectionalSimulation, Event, Inputs, LimitState, Marginal, MonteCarlo, Sampler,
+    Stop, ToleranceLimitState,
 };
 use statrs::function::gamma::gamma_ur;
 

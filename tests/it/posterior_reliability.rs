@@ -591,8 +591,8 @@ impl reliability::LimitState for Hidden {
 #[test]
 fn the_general_routes_meet_the_closed_form_with_correlated_inputs() {
     use reliability::{
-        sensitivity, Event, Form, ImportanceSampling, MonteCarlo, Posterior, SensitivityMethod,
-        ToleranceLimitState,
+        sensitivity, Event, Form, ImportanceSampling, MonteCarlo, Posterior, Sampler,
+        SensitivityMethod, ToleranceLimitState,
     };
     let m = load_example(MACHINE);
     let law = Law::of(&m);

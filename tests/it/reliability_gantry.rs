@@ -14,7 +14,7 @@ use common::example_path;
 use common::wang_yuan_2021::{TABLE2, TABLE3, TABLE4};
 use reliability::{
     machine, normal, sensitivity, Criterion, Event, Form, ImportanceSampling, Inputs, MonteCarlo,
-    SensitivityMethod, Study, System, Target, ToleranceLimitState,
+    Sampler, SensitivityMethod, Study, System, Target, ToleranceLimitState,
 };
 
 fn gantry() -> (Machine, CompiledModel) {

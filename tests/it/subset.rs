@@ -12,7 +12,7 @@
 use chain_core::model::Sided;
 use reliability::normal;
 use reliability::{
-    Criterion, Event, Inputs, LimitState, Marginal, MonteCarlo, Stop, SubsetSimulation,
+    Criterion, Event, Inputs, LimitState, Marginal, MonteCarlo, Sampler, Stop, SubsetSimulation,
     ToleranceLimitState,
 };
 

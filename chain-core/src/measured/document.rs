@@ -4,12 +4,14 @@
 //! `--values-out` writes. Assembled here, from the library's typed results,
 //! so that every front end gives the same document for the same input.
 
+use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
 use serde::Serialize;
 
 use super::identify::{Estimate, IdentifyOptions, NoiseRule, Prior, Residual};
 use super::iterate::{self, FirstOrderCheck, Iteration, ANGLE_LIMIT};
+use super::measurements::MeasuredComponent;
 use super::predict::{predict, predict_rows, Prediction};
 use super::subset::{ChosenBy, FixedStatus, Subset, TERM_CUTOFF};
 use super::{identify, Design, DesignError, Identification, IdentifyError, Measurements};
@@ -54,7 +56,8 @@ pub struct GroupDoc {
 pub struct ResidualDoc {
     /// The CSV line of its measurement.
     pub line: usize,
-    /// `dpx`, `dpy`, `dpz` or `d`.
+    /// Its component ([`super::measurements::MeasuredComponent::name`]:
+    /// `dpx`, `dpy`, `dpz` or `d`).
     pub component: &'static str,
     /// `b − A x`.
     pub residual: f64,
@@ -573,14 +576,10 @@ fn and_list(names: &[String]) -> String {
     }
 }
 
-/// The measured component's name in words (`dpx` → `px`).
-fn component_name(c: &str) -> &str {
-    c.strip_prefix("d").filter(|s| !s.is_empty()).unwrap_or(c)
-}
-
 /// A group of the null space in words, derived from the design's columns
 /// of its members: when they are all parallel (column rank 1), which
-/// measured components they act on and whether as a constant (an offset);
+/// measured components they act on (named by the quantities they measure,
+/// in the components' order) and whether as a constant (an offset);
 /// otherwise how many independent combinations they act through.
 fn explain(design: &Design, r: &Identification, members: &[usize], vectors: usize) -> String {
     let names: Vec<String> = members.iter().map(|&j| r.errors[j].clone()).collect();
@@ -611,25 +610,23 @@ fn explain(design: &Design, r: &Identification, members: &[usize], vectors: usiz
             .unwrap_or(members[0]);
         let col = a.column(best);
         let scale = col.amax();
-        let mut components: Vec<&'static str> = Vec::new();
+        // The design's components in their order (by kind, then row).
+        let present: BTreeSet<MeasuredComponent> = design.origin.iter().map(|&(_, c)| c).collect();
+        let mut on: Vec<String> = Vec::new();
         let mut constant = true;
-        for comp in ["dpx", "dpy", "dpz", "d"] {
+        for comp in present {
             let values: Vec<f64> = (0..a.nrows())
                 .filter(|&i| design.origin[i].1 == comp)
                 .map(|i| col[i])
                 .collect();
             if values.iter().any(|v| v.abs() > 1e-9 * scale) {
-                components.push(comp);
+                on.push(comp.quantity().to_string());
                 let first = values[0];
                 if values.iter().any(|v| (v - first).abs() > 1e-9 * scale) {
                     constant = false;
                 }
             }
         }
-        let on: Vec<String> = components
-            .iter()
-            .map(|c| component_name(c).to_string())
-            .collect();
         let what = if constant {
             format!("one offset in {}", and_list(&on))
         } else {

@@ -291,7 +291,8 @@ pub struct Residual {
 pub struct Standardised {
     /// The scalar row (0-based) in the design.
     pub row: usize,
-    /// The component (`dpx`, `dpy`, `dpz` or `d`).
+    /// The component ([`super::measurements::MeasuredComponent::name`]:
+    /// `dpx`, `dpy`, `dpz` or `d`).
     pub component: &'static str,
     /// `b − A x`.
     pub residual: f64,
@@ -671,7 +672,7 @@ pub fn identify(
                     let ti = residuals[i] / (sigma * (1.0 - h).sqrt());
                     largest.push(Standardised {
                         row: i,
-                        component: design.origin.get(i).map_or("", |o| o.1),
+                        component: design.origin.get(i).map_or("", |o| o.1.name()),
                         residual: residuals[i],
                         standardised: ti,
                         leverage: h,

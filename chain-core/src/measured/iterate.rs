@@ -34,7 +34,7 @@ use serde::Serialize;
 
 use super::exact::ExactChain;
 use super::identify::{Estimate, Identification};
-use super::measurements::{Design, Measurement, Observed};
+use super::measurements::{Design, Measurement};
 use crate::model::{ErrorKind, Machine};
 
 /// Identified angles beyond this (rad) are outside the first-order range.
@@ -84,7 +84,9 @@ pub struct Iteration {
     pub change: Vec<f64>,
 }
 
-/// The exact rows at `x`: `f(x)` and, with `jacobian`, `∂f/∂x` (`m × n`).
+/// The exact rows at `x`: `f(x)` and, with `jacobian`, `∂f/∂x` (`m × n`),
+/// each record's rows [`super::Observed::row`] of the exact deviation and
+/// of its Jacobian, as the design's rows are of the sensitivity.
 pub fn exact_rows(
     machine: &Machine,
     records: &[Measurement],
@@ -107,26 +109,17 @@ pub fn exact_rows(
         } else {
             (chain.deviation(&rec.q, &rec.p, x), None)
         };
-        match rec.observed {
-            Observed::Point => {
-                for c in 0..3 {
-                    f[i + c] = dev[c];
-                    if let (Some(out), Some(j)) = (jac.as_mut(), &j) {
-                        out.row_mut(i + c).copy_from(&j.row(c));
-                    }
+        let observed = &rec.observed;
+        let rows = observed.rows();
+        for c in 0..rows {
+            f[i + c] = observed.row(c, dev);
+            if let (Some(out), Some(j)) = (jac.as_mut(), &j) {
+                for k in 0..n {
+                    out[(i + c, k)] = observed.row(c, [j[(0, k)], j[(1, k)], j[(2, k)]]);
                 }
-                i += 3;
-            }
-            Observed::Direction { u } => {
-                f[i] = (0..3).map(|c| u[c] * dev[c]).sum();
-                if let (Some(out), Some(j)) = (jac.as_mut(), &j) {
-                    for k in 0..n {
-                        out[(i, k)] = (0..3).map(|c| u[c] * j[(c, k)]).sum();
-                    }
-                }
-                i += 1;
             }
         }
+        i += rows;
     }
     (f, jac)
 }

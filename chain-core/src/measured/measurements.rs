@@ -21,6 +21,11 @@
 //! The design rows of a record are [`design_rows`]: `S_p(q, p)`, the three
 //! position rows of the model's exact sensitivity (tool point), or
 //! `uᵀ S_p(q, p)` (one row along a direction).
+//!
+//! What is particular to a kind of measurement (its columns, the names of
+//! its design rows, how its rows take the position rows) is held by
+//! [`MeasurementKind`] and [`Observed`]; the reader, the design and the
+//! identification's document ask them.
 
 use serde::Serialize;
 
@@ -56,7 +61,125 @@ pub enum Layout {
     Candidates,
 }
 
-/// What one record measures.
+/// A kind of measurement, without a record's data: what it measures, the
+/// CSV columns that give it and the names of its design rows.
+///
+/// Everything a kind names (its given and measured columns, the quantities
+/// its components measure) is one arm of a single match in this type; its
+/// design rows are [`Observed::row`]; how a CSV row gives its data is the
+/// measurement reader's match on the kind. A new kind is a variant here,
+/// in [`MeasurementKind::ALL`] and in [`Observed`]; the compiler then asks
+/// for its arm in each of those matches (none has a wildcard). Kinds order
+/// as declared, which is the order the identification's words list the
+/// measured components in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MeasurementKind {
+    /// The tool-point deviation `(px, py, pz)`: columns `dpx,dpy,dpz`,
+    /// three design rows.
+    Point,
+    /// The deviation along a unit direction: columns `ux,uy,uz` (given,
+    /// candidates have them too) and `d` (measured), one design row.
+    Direction,
+}
+
+/// The names of one kind of measurement (see [`MeasurementKind`]).
+struct KindNames {
+    /// The columns that say how a record measures, besides its pose and
+    /// parameters; a candidate file has them too.
+    given: &'static [&'static str],
+    /// The measured columns, one per design row, in row order.
+    components: &'static [&'static str],
+    /// The quantity each component measures, in the same order.
+    quantities: &'static [&'static str],
+}
+
+impl MeasurementKind {
+    /// Every kind, in declaration order: the kinds a CSV header is read
+    /// for.
+    pub const ALL: [MeasurementKind; 2] = [MeasurementKind::Point, MeasurementKind::Direction];
+
+    /// Every name of the kind.
+    fn names(self) -> KindNames {
+        match self {
+            MeasurementKind::Point => KindNames {
+                given: &[],
+                components: &POINT_COLUMNS,
+                quantities: &["px", "py", "pz"],
+            },
+            MeasurementKind::Direction => KindNames {
+                given: &DIRECTION_COLUMNS,
+                components: &[DISTANCE_COLUMN],
+                quantities: &["d"],
+            },
+        }
+    }
+
+    /// The columns that say how a record of this kind measures, besides
+    /// its pose and parameters (`ux,uy,uz`; none for a tool point). A
+    /// candidate file has them too.
+    pub fn given(self) -> &'static [&'static str] {
+        self.names().given
+    }
+
+    /// The measured columns, one per design row in row order: the names of
+    /// the components (`dpx,dpy,dpz`; `d`).
+    pub fn components(self) -> &'static [&'static str] {
+        self.names().components
+    }
+
+    /// The quantity each component measures, in row order, as the
+    /// identification's words name it (`px, py, pz`; `d`).
+    pub fn quantities(self) -> &'static [&'static str] {
+        self.names().quantities
+    }
+
+    /// Every column of a record of this kind besides its pose, parameters
+    /// and std, as a measurement header has them: the given ones, then the
+    /// measured ones (`dpx,dpy,dpz`; `ux,uy,uz,d`).
+    pub fn columns(self) -> Vec<&'static str> {
+        let names = self.names();
+        (names.given.iter())
+            .chain(names.components)
+            .copied()
+            .collect()
+    }
+
+    /// The number of design rows of one record (one per component: 3 or
+    /// 1).
+    pub fn rows(self) -> usize {
+        self.names().components.len()
+    }
+
+    /// The components of one record, in row order.
+    pub fn measured(self) -> impl Iterator<Item = MeasuredComponent> {
+        (0..self.rows()).map(move |index| MeasuredComponent { kind: self, index })
+    }
+}
+
+/// One design row of a record: which component of its kind's measurement
+/// it is. Components order by kind (declaration order), then row.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct MeasuredComponent {
+    /// The record's kind.
+    pub kind: MeasurementKind,
+    /// The row within the record (below `kind.rows()`).
+    pub index: usize,
+}
+
+impl MeasuredComponent {
+    /// Its measured column (`dpx`, `dpy`, `dpz` or `d`).
+    pub fn name(self) -> &'static str {
+        self.kind.components()[self.index]
+    }
+
+    /// The quantity it measures (`px`, `py`, `pz` or `d`).
+    pub fn quantity(self) -> &'static str {
+        self.kind.quantities()[self.index]
+    }
+}
+
+/// What one record measures: its kind with the record's own data.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Observed {
@@ -70,11 +193,27 @@ pub enum Observed {
 }
 
 impl Observed {
+    /// Its kind.
+    pub fn kind(&self) -> MeasurementKind {
+        match self {
+            Observed::Point => MeasurementKind::Point,
+            Observed::Direction { .. } => MeasurementKind::Direction,
+        }
+    }
+
     /// The number of design rows of one record (3 or 1).
     pub fn rows(&self) -> usize {
+        self.kind().rows()
+    }
+
+    /// Design row `k` (below [`Observed::rows`]) at one column, from that
+    /// column's three position rows `p` (the `px, py, pz` rows of a
+    /// sensitivity, a deviation or its Jacobian): `p[k]` for a tool point,
+    /// `u · p` (summed x, y, z) along a direction.
+    pub fn row(&self, k: usize, p: [f64; 3]) -> f64 {
         match self {
-            Observed::Point => 3,
-            Observed::Direction { .. } => 1,
+            Observed::Point => p[k],
+            Observed::Direction { u } => u[0] * p[0] + u[1] * p[1] + u[2] * p[2],
         }
     }
 }
@@ -90,8 +229,9 @@ pub struct Measurement {
     pub p: Vec<f64>,
     /// What it measures.
     pub observed: Observed,
-    /// The measured values: `[dpx, dpy, dpz]` or `[d]` (empty for a
-    /// candidate).
+    /// The measured values, one per component of its kind
+    /// ([`MeasurementKind::components`]): `[dpx, dpy, dpz]` or `[d]` (empty
+    /// for a candidate).
     pub values: Vec<f64>,
     /// Its standard deviation, if the CSV has a `std` column.
     pub std: Option<f64>,
@@ -272,14 +412,16 @@ impl Measurements {
         layout: Layout,
     ) -> Result<Measurements, MeasurementsError> {
         let header_help = match layout {
-            Layout::Measurements => {
-                "the header names the pose variables, any per-row parameters, then `dpx,dpy,dpz` or `ux,uy,uz,d`, and optionally `std`"
-            }
-            Layout::Candidates => {
-                "the header names the pose variables, any per-row parameters, and optionally `ux,uy,uz` and `std`"
-            }
+            Layout::Measurements => format!(
+                "the header names the pose variables, any per-row parameters, then {}, and optionally `std`",
+                layout.named_columns(" or ")
+            ),
+            Layout::Candidates => format!(
+                "the header names the pose variables, any per-row parameters, and optionally {} and `std`",
+                layout.named_columns(" or ")
+            ),
         };
-        let csv = crate::values::csv::CsvFile::parse_with(text, file, header_help)
+        let csv = crate::values::csv::CsvFile::parse_with(text, file, &header_help)
             .map_err(MeasurementsError)?;
         let fail = |problems: Vec<(Origin, Problem)>| {
             MeasurementsError(
@@ -333,6 +475,37 @@ impl Measurements {
     }
 }
 
+#[cfg(feature = "csv")]
+impl Layout {
+    /// The columns a file of this layout has for a record of `kind`: all
+    /// of them for measurements, the given ones for candidates (not
+    /// measured yet).
+    fn columns(self, kind: MeasurementKind) -> Vec<&'static str> {
+        match self {
+            Layout::Measurements => kind.columns(),
+            Layout::Candidates => kind.given().to_vec(),
+        }
+    }
+
+    /// Each kind's columns in this layout as a header names them, joined
+    /// by `sep` (`` `dpx,dpy,dpz` or `ux,uy,uz,d` ``); kinds without any
+    /// are left out.
+    fn named_columns(self, sep: &str) -> String {
+        (MeasurementKind::ALL.into_iter())
+            .map(|kind| self.columns(kind))
+            .filter(|columns| !columns.is_empty())
+            .map(|columns| quoted(&columns))
+            .collect::<Vec<_>>()
+            .join(sep)
+    }
+}
+
+/// Columns as a header names them: `` `ux,uy,uz,d` ``.
+#[cfg(feature = "csv")]
+fn quoted(columns: &[&str]) -> String {
+    format!("`{}`", columns.join(","))
+}
+
 /// Where each quantity is in a CSV's columns.
 #[cfg(feature = "csv")]
 struct Columns {
@@ -340,10 +513,13 @@ struct Columns {
     q: Vec<usize>,
     /// Per parameter, its column or its fixed value.
     p: Vec<Result<usize, f64>>,
-    /// The measured value columns (3 for `dp*`, 1 for `d`, none).
+    /// What every record measures.
+    kind: MeasurementKind,
+    /// The kind's given columns (`ux,uy,uz`), in its order.
+    given: Vec<usize>,
+    /// The kind's measured value columns, in its order (none for
+    /// candidates).
     values: Vec<usize>,
-    /// The direction columns, if any.
-    u: Option<[usize; 3]>,
     std: Option<usize>,
 }
 
@@ -367,16 +543,16 @@ fn classify(
 ) -> Result<Columns, Vec<(Origin, Problem)>> {
     let mut problems = Vec::new();
     let find = |name: &str| header.iter().position(|(h, _)| h == name);
-    let measured: &[&str] = match layout {
-        Layout::Measurements => &["dpx", "dpy", "dpz", "ux", "uy", "uz", "d", "std"],
-        Layout::Candidates => &["ux", "uy", "uz", "std"],
-    };
+    let measured: Vec<&str> = (MeasurementKind::ALL.into_iter())
+        .flat_map(|kind| layout.columns(kind))
+        .chain([STD_COLUMN])
+        .collect();
     for (name, origin) in header {
         let known = m.variable_index(name).is_some()
             || m.parameter_index(name).is_some()
             || measured.contains(&name.as_str());
         let measured_value = layout == Layout::Candidates
-            && (POINT_COLUMNS.contains(&name.as_str()) || name == DISTANCE_COLUMN);
+            && (MeasurementKind::ALL.iter()).any(|kind| kind.components().contains(&name.as_str()));
         if measured_value {
             let message = Message::new(
                 format!(
@@ -412,8 +588,10 @@ fn classify(
                     .collect::<Vec<_>>()
                     .join(", "),
                 match layout {
-                    Layout::Measurements => "`dpx,dpy,dpz` or `ux,uy,uz,d`, and optionally `std`",
-                    Layout::Candidates => "optionally `ux,uy,uz` and `std`",
+                    Layout::Measurements =>
+                        format!("{}, and optionally `std`", layout.named_columns(" or ")),
+                    Layout::Candidates =>
+                        format!("optionally {} and `std`", layout.named_columns(" or ")),
                 }
             ));
             problems.push((origin.clone(), message.into()));
@@ -466,13 +644,24 @@ fn classify(
             }
         }
     }
-    let dp: Vec<Option<usize>> = POINT_COLUMNS.iter().map(|c| find(c)).collect();
-    let u: Vec<Option<usize>> = DIRECTION_COLUMNS.iter().map(|c| find(c)).collect();
-    let d = find(DISTANCE_COLUMN);
-    let set = |cols: &[Option<usize>]| cols.iter().all(Option::is_some);
-    let any = |cols: &[Option<usize>]| cols.iter().any(Option::is_some);
-    let mut values = Vec::new();
-    let mut direction = None;
+    // The records' kind: the one kind some of whose columns the header has,
+    // else the one kind that has no column in this layout (a candidate
+    // tool point); all of its columns are then needed.
+    let named: Vec<_> = (MeasurementKind::ALL.into_iter())
+        .map(|kind| {
+            let names = layout.columns(kind);
+            let at: Vec<Option<usize>> = names.iter().map(|c| find(c)).collect();
+            (kind, names, at)
+        })
+        .collect();
+    let mut kinds: Vec<_> = (named.iter())
+        .filter(|(_, _, at)| at.iter().any(Option::is_some))
+        .collect();
+    if kinds.is_empty() {
+        kinds = (named.iter())
+            .filter(|(_, names, _)| names.is_empty())
+            .collect();
+    }
     let partial = |names: &str| {
         located(
             header_origin,
@@ -481,60 +670,54 @@ fn classify(
             "chain::measurements::partial_columns",
         )
     };
-    match layout {
-        Layout::Measurements => {
-            let point = any(&dp);
-            let along = any(&u) || d.is_some();
-            if point && along {
+    let mut read = None;
+    match kinds.as_slice() {
+        [] => {
+            if problems.is_empty() {
                 problems.push(*located(
                     header_origin,
-                    "the header has both `dpx,dpy,dpz` and `ux,uy,uz,d`: a file holds one kind of measurement".into(),
-                    "two kinds",
-                    "chain::measurements::two_kinds",
-                ));
-            } else if point {
-                if set(&dp) {
-                    values = dp.iter().flatten().copied().collect();
-                } else {
-                    problems.push(*partial("dpx,dpy,dpz"));
-                }
-            } else if along {
-                if set(&u) && d.is_some() {
-                    values = vec![d.unwrap_or(0)];
-                    direction = Some([u[0].unwrap_or(0), u[1].unwrap_or(0), u[2].unwrap_or(0)]);
-                } else {
-                    problems.push(*partial("ux,uy,uz,d"));
-                }
-            } else if problems.is_empty() {
-                problems.push(*located(
-                    header_origin,
-                    "the header has no measured values: expected `dpx,dpy,dpz` or `ux,uy,uz,d`"
-                        .into(),
+                    format!(
+                        "the header has no measured values: expected {}",
+                        layout.named_columns(" or ")
+                    ),
                     "no measured values",
                     "chain::measurements::no_values",
                 ));
             }
         }
-        Layout::Candidates => {
-            if any(&u) {
-                if set(&u) {
-                    direction = Some([u[0].unwrap_or(0), u[1].unwrap_or(0), u[2].unwrap_or(0)]);
-                } else {
-                    problems.push(*partial("ux,uy,uz"));
-                }
+        [(kind, names, at)] => {
+            if at.iter().all(Option::is_some) {
+                read = Some((*kind, at.iter().flatten().copied().collect::<Vec<usize>>()));
+            } else {
+                problems.push(*partial(&names.join(",")));
             }
         }
+        several => {
+            let both: Vec<String> = several.iter().map(|(_, names, _)| quoted(names)).collect();
+            problems.push(*located(
+                header_origin,
+                format!(
+                    "the header has both {}: a file holds one kind of measurement",
+                    both.join(" and ")
+                ),
+                "two kinds",
+                "chain::measurements::two_kinds",
+            ));
+        }
     }
-    if problems.is_empty() {
-        Ok(Columns {
-            q,
-            p,
-            values,
-            u: direction,
-            std: find(STD_COLUMN),
-        })
-    } else {
-        Err(problems)
+    match read {
+        Some((kind, at)) if problems.is_empty() => {
+            let (given, values) = at.split_at(kind.given().len());
+            Ok(Columns {
+                q,
+                p,
+                kind,
+                given: given.to_vec(),
+                values: values.to_vec(),
+                std: find(STD_COLUMN),
+            })
+        }
+        _ => Err(problems),
     }
 }
 
@@ -565,9 +748,10 @@ impl Columns {
             .iter()
             .map(|&c| number(c))
             .collect::<Result<Vec<_>, _>>()?;
-        let observed = match self.u {
-            None => Observed::Point,
-            Some(cols) => {
+        let observed = match self.kind {
+            MeasurementKind::Point => Observed::Point,
+            MeasurementKind::Direction => {
+                let cols = &self.given;
                 let u = [number(cols[0])?, number(cols[1])?, number(cols[2])?];
                 let norm = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
                 if (norm - 1.0).abs() > UNIT_TOLERANCE {
@@ -609,11 +793,12 @@ impl Columns {
     }
 }
 
-/// The design rows of one record at its pose: the position rows of the
-/// model's exact sensitivity `S(q, p)` (`∂(px, py, pz)/∂e`, 3 rows), or
-/// `uᵀ S_p(q, p)` along a direction (1 row). `out` receives
-/// `observed.rows() × N` values row-major, `N` the model's error count;
-/// `scratch` is `6 × N` long. `q` and `p` are in the model's orders.
+/// The design rows of one record at its pose, [`Observed::row`] of the
+/// position rows of the model's exact sensitivity `S(q, p)`
+/// (`∂(px, py, pz)/∂e`): those 3 rows for a tool point, `uᵀ S_p(q, p)`
+/// along a direction (1 row). `out` receives `observed.rows() × N` values
+/// row-major, `N` the model's error count; `scratch` is `6 × N` long. `q`
+/// and `p` are in the model's orders.
 ///
 /// The model's sensitivity is the design matrix of calibration (spec
 /// section 4): a measured deviation is `S_p · e` plus noise.
@@ -627,12 +812,9 @@ pub fn design_rows<M: ErrorModel + ?Sized>(
 ) {
     let n = model.errors().len();
     model.sensitivity(q, p, scratch);
-    match observed {
-        Observed::Point => out[..3 * n].copy_from_slice(&scratch[..3 * n]),
-        Observed::Direction { u } => {
-            for j in 0..n {
-                out[j] = u[0] * scratch[j] + u[1] * scratch[n + j] + u[2] * scratch[2 * n + j];
-            }
+    for k in 0..observed.rows() {
+        for j in 0..n {
+            out[k * n + j] = observed.row(k, [scratch[j], scratch[n + j], scratch[2 * n + j]]);
         }
     }
 }
@@ -654,8 +836,8 @@ pub struct Design {
     /// Each row's standard deviation, if the records have one.
     pub std: Option<Vec<f64>>,
     /// Each row's record (index into the records) and component
-    /// (`dpx`, `dpy`, `dpz` or `d`).
-    pub origin: Vec<(usize, &'static str)>,
+    /// ([`MeasuredComponent::name`]: `dpx`, `dpy`, `dpz` or `d`).
+    pub origin: Vec<(usize, MeasuredComponent)>,
 }
 
 /// Why a design could not be built from records.
@@ -760,16 +942,12 @@ impl Design {
                     },
                 });
             }
-            let names: &[&'static str] = match r.observed {
-                Observed::Point => &["dpx", "dpy", "dpz"],
-                Observed::Direction { .. } => &["d"],
-            };
-            for (c, name) in names.iter().enumerate() {
-                b.push(r.values.get(c).copied().unwrap_or(0.0));
+            for component in r.observed.kind().measured() {
+                b.push(r.values.get(component.index).copied().unwrap_or(0.0));
                 if let (Some(s), Some(v)) = (std.as_mut(), r.std) {
                     s.push(v);
                 }
-                origin.push((i, *name));
+                origin.push((i, component));
             }
             at += k;
         }

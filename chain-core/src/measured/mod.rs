@@ -21,8 +21,8 @@ pub mod subset;
 
 pub use identify::{identify, Identification, IdentifyError, IdentifyOptions, NoiseRule};
 pub use measurements::{
-    design_rows, Design, DesignError, Holdout, HoldoutError, Layout, Measurement, Measurements,
-    MeasurementsError, Observed,
+    design_rows, Design, DesignError, Holdout, HoldoutError, Layout, MeasuredComponent,
+    Measurement, MeasurementKind, Measurements, MeasurementsError, Observed,
 };
 pub use predict::{predict, ErrorStats, Prediction};
 pub use subset::{ChosenBy, Fixed, FixedStatus, Subset, SubsetChoice};

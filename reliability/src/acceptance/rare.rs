@@ -30,6 +30,7 @@ use serde::Serialize;
 use super::Rectangles;
 use crate::error::ReliabilityError;
 use crate::limit_state::{Event, LimitState};
+use crate::sampler::Sampler;
 use crate::simulation::Stopping;
 use crate::subset::{SubsetLevel, SubsetSimulation};
 use crate::util::dot;

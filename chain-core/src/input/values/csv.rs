@@ -97,11 +97,7 @@ impl CsvFile {
     /// wide as the header; refusals worded by [`CsvProblem`]);
     /// `header_help` says what the header of this kind of
     /// file names (the help of an empty file or an unnamed column).
-    pub fn parse_with(
-        text: &str,
-        name: &str,
-        header_help: &'static str,
-    ) -> Result<CsvFile, Diagnostics> {
+    pub fn parse_with(text: &str, name: &str, header_help: &str) -> Result<CsvFile, Diagnostics> {
         let bom = if text.starts_with('\u{feff}') { 3 } else { 0 };
         let data = &text.as_bytes()[bom..];
         let mut reader = ::csv::ReaderBuilder::new()
