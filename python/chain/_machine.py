@@ -249,8 +249,8 @@ class Machine:
           (the document's ``acceptance``; also computed when the file sets
           ``reliability.acceptance: true``), to ``acceptance_tolerance``.
         """
-        if samples is not None and (not isinstance(samples, int) or isinstance(samples, bool) or samples < 1):
-            raise ValueError(f"samples must be a positive integer, not {samples!r}")
+        if samples is not None and (not isinstance(samples, int) or isinstance(samples, bool) or samples < 0):
+            raise ValueError(f"samples must be a non-negative integer, not {samples!r}")
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
             raise ValueError(f"seed must be a non-negative integer, not {seed!r}")
         if not isinstance(method, str):

@@ -28,15 +28,9 @@ pub(crate) fn compensate_json(
     select: &str,
     order: Option<usize>,
 ) -> PyResult<String> {
-    let rule = select.parse::<SelectionRule>().map_err(|message| {
-        value_error(
-            OptionError {
-                option: "select",
-                message,
-            }
-            .to_string(),
-        )
-    })?;
+    let rule = select
+        .parse::<SelectionRule>()
+        .map_err(|message| value_error(OptionError::new("select", message).to_string()))?;
     let measurements = match (path, text) {
         (Some(path), None) => records::read_measurements(Path::new(path)),
         (None, Some(text)) => records::parse_measurements(name, text.as_bytes()),

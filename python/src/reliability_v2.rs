@@ -37,9 +37,6 @@ pub(crate) fn algorithm_options(
         cov,
     };
     options.check().map_err(|e| value_error(e.to_string()))?;
-    if samples == Some(0) && !matches!(options.method, Method::Form | Method::Sorm) {
-        return Err(value_error("samples must be at least 1"));
-    }
     Ok(options)
 }
 

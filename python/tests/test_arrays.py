@@ -184,7 +184,7 @@ def test_bad_options(ac):
     g = chain.Machine.load(ROOT / "examples/machines/gantry_grinder.yaml")
     with pytest.raises(ValueError, match=r"invalid value \"sorm\?\" for `method`"):
         g.reliability(method="sorm?")
-    with pytest.raises(ValueError, match="samples must be"):
+    with pytest.raises(ValueError, match="the number of samples must be between 1 and"):
         g.reliability(method="mc", samples=0)
     with pytest.raises(chain.MachineError, match="axis variable"):
         g.reliability(grid={"w": [0.0]})

@@ -8,9 +8,8 @@
 //!
 //! The same holds for the whole-machine acceptance object
 //! ([`AcceptanceDocument`], `chain reliability --acceptance`) and the Sobol
-//! indices ([`SobolDocument`], `chain sobol`); [`algorithm`] turns a method
-//! name's options into the [`Algorithm`] both run (the defaults in one
-//! place), [`volumetric`] the `--system volumetric` target.
+//! indices ([`SobolDocument`], `chain sobol`); [`volumetric`] is the
+//! `--system volumetric` target.
 //!
 //! [`sensitivity`] runs `chain sensitivity --kind reliability` (at a point
 //! or the grid mean) and [`SensitivityDocument`] is its JSON.
@@ -33,10 +32,9 @@ use crate::allocate::{
 };
 use crate::sobol::{Estimate, OutputIndices, SobolResult};
 use crate::{
-    Algorithm, Calls, CaseResult, DirectionalSimulation, ErrorModel, Form, FormCase,
-    ImportanceSampling, Method, MonteCarlo, Posterior, ReliabilityError, SensitivityMethod,
-    SormCase, Stopping, Study, StudyResult, SubsetLevel, SubsetSimulation, Summary, System, Target,
-    TargetSensitivity,
+    Calls, CaseResult, ErrorModel, Form, FormCase, Method, Posterior, ReliabilityError,
+    SensitivityMethod, SormCase, Stopping, Study, StudyResult, SubsetLevel, Summary, System,
+    Target, TargetSensitivity,
 };
 
 /// The document of a grid study (the spec's `reliability` JSON contract).
@@ -242,99 +240,6 @@ impl<'a> ReliabilityDocument<'a> {
 
 // ---------------------------------------------------------------------------
 // The algorithm of a method name's options.
-
-/// The samples per case of `method` when `given` is `None` (spec
-/// reliability-v2 §2): is 10⁴, mc 10⁵; with a target coefficient of
-/// variation (`to_cov`) the budget, mc 10⁷, is and directional 10⁶;
-/// subset 10³ per level, directional 10⁴; 0 for FORM and SORM, which draw none.
-pub fn samples(method: Method, given: Option<u64>, to_cov: bool) -> u64 {
-    match (method, to_cov) {
-        (Method::Form | Method::Sorm, _) => 0,
-        (Method::ImportanceSampling, false) => given.unwrap_or(10_000),
-        (Method::MonteCarlo, false) => given.unwrap_or(100_000),
-        (Method::ImportanceSampling, true) => given.unwrap_or(1_000_000),
-        (Method::MonteCarlo, true) => given.unwrap_or(10_000_000),
-        (Method::Subset, _) => given.unwrap_or(1_000),
-        (Method::Directional, false) => given.unwrap_or(10_000),
-        (Method::Directional, true) => given.unwrap_or(1_000_000),
-    }
-}
-
-/// A sampler option that cannot hold for its method, found before any
-/// work is done: `option` is the option's name (`"cov"`, `"samples"`); the
-/// binary spells it `--cov`, the Python package `cov=`.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct OptionProblem {
-    /// The option at fault.
-    pub option: &'static str,
-    /// What is wrong with it.
-    pub message: String,
-}
-
-/// The checks of `method`'s sampler options that need no model, shared by
-/// `chain reliability` and the Python package: a target coefficient of
-/// variation with FORM or SORM (which draw no samples) and subset
-/// simulation's samples per level (a positive multiple of `1/p0`). Zero
-/// samples are the library's own `invalid_samples` error.
-pub fn check_options(
-    method: Method,
-    samples: Option<u64>,
-    cov: Option<f64>,
-) -> Result<(), OptionProblem> {
-    let problem = |option, message: String| Err(OptionProblem { option, message });
-    let draws = !matches!(method, Method::Form | Method::Sorm);
-    if cov.is_some() && !draws {
-        let what = if method == Method::Form {
-            "FORM"
-        } else {
-            "SORM"
-        };
-        return problem(
-            "cov",
-            format!(
-                "{what} draws no samples; a target coefficient of variation needs method mc, is, subset or directional"
-            ),
-        );
-    }
-    if method == Method::Subset {
-        if let Some(n) = samples {
-            if let Err(ReliabilityError::InvalidSampler(m)) = SubsetSimulation::new(n, 0).check() {
-                return problem("samples", m);
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Subset simulation's sample budget with a target coefficient of
-/// variation, in levels of its samples per level.
-pub const SUBSET_BUDGET_LEVELS: u64 = 1000;
-
-/// The algorithm of `method` with `samples` per case (see [`samples`] for
-/// the defaults; FORM and SORM ignore it and `seed`) and an optional target
-/// coefficient of variation `cov` (`samples` is then the budget; for subset
-/// simulation the samples per level, [`SUBSET_BUDGET_LEVELS`] levels' worth
-/// at most). FORM and SORM take no target: callers refuse one before.
-pub fn algorithm(method: Method, samples: u64, seed: u64, cov: Option<f64>) -> Algorithm {
-    match method {
-        Method::MonteCarlo => Algorithm::MonteCarlo(MonteCarlo { samples, seed, cov }),
-        Method::ImportanceSampling => Algorithm::ImportanceSampling(ImportanceSampling {
-            samples,
-            seed,
-            form: Form::default(),
-            cov,
-        }),
-        Method::Subset => {
-            let mut s = SubsetSimulation::new(samples, seed);
-            s.cov = cov;
-            s.budget = samples.saturating_mul(SUBSET_BUDGET_LEVELS);
-            Algorithm::Subset(s)
-        }
-        Method::Directional => Algorithm::Directional(DirectionalSimulation { samples, seed, cov }),
-        Method::Form => Algorithm::Form(Form::default()),
-        Method::Sorm => Algorithm::Sorm(crate::sorm::Sorm::default()),
-    }
-}
 
 /// The `--system volumetric` target: `√(px² + py² + pz²) ≤ tolerance`,
 /// by default the smallest position tolerance of the reliability section.

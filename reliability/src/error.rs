@@ -151,7 +151,7 @@ pub enum ReliabilityError {
         max: u64,
     },
     /// A target coefficient of variation outside `(0, 1]` (or not finite).
-    #[error("the target coefficient of variation must be in (0, 1] (found {0})")]
+    #[error("the target coefficient of variation must be in (0, 1] (found `{0}`)")]
     #[cfg_attr(feature = "miette", diagnostic(code(chain::reliability::invalid_cov)))]
     InvalidTargetCov(f64),
     /// A sampler's settings are inconsistent (e.g. subset simulation's

@@ -184,6 +184,26 @@ pub enum Algorithm {
 }
 
 impl Algorithm {
+    /// Checks its settings without running it: a sampler's sample count
+    /// (1 to [`crate::MAX_SAMPLES`]), its target coefficient of variation
+    /// (in (0, 1]), subset simulation's levels and samples per level. FORM
+    /// and SORM have nothing to check. The same checks run again when a
+    /// sampler runs, so a caller may refuse bad settings before any model
+    /// is built.
+    pub fn check(&self) -> Result<(), ReliabilityError> {
+        let sampler = |samples: u64, cov: Option<f64>| {
+            cov.map_or(Ok(()), crate::sampler::check_cov)?;
+            crate::sampler::check_samples(samples)
+        };
+        match self {
+            Algorithm::Form(_) | Algorithm::Sorm(_) => Ok(()),
+            Algorithm::ImportanceSampling(a) => sampler(a.samples, a.cov),
+            Algorithm::MonteCarlo(a) => sampler(a.samples, a.cov),
+            Algorithm::Directional(a) => sampler(a.samples, a.cov),
+            Algorithm::Subset(a) => a.check().map(|_| ()),
+        }
+    }
+
     /// The method it is.
     pub fn method(&self) -> Method {
         match self {

@@ -197,12 +197,12 @@ impl Serialize for AllocationRun {
 /// no error is ever tightened, and NaN compares false with all).
 pub fn check_threshold(t: f64) -> Result<f64, OptionError> {
     if !(0.0..=1.0).contains(&t) {
-        return Err(OptionError {
-            option: "threshold",
-            message: format!(
+        return Err(OptionError::new(
+            "threshold",
+            format!(
                 "the threshold is a fraction of the largest sensitivity, in [0, 1] (found `{t}`)"
             ),
-        });
+        ));
     }
     Ok(t)
 }

@@ -110,10 +110,10 @@ pub fn prepare(
     request.algorithm.check()?;
     let t = request.acceptance_tolerance;
     if !(t.is_finite() && t > 0.0 && t < 1.0) {
-        return Err(OptionError {
-            option: "acceptance-tolerance",
-            message: format!("{t} (an absolute error in (0, 1))"),
-        }
+        return Err(OptionError::new(
+            "acceptance-tolerance",
+            format!("{t} (an absolute error in (0, 1))"),
+        )
         .into());
     }
     let system = study::system(machine, request.system)?;
@@ -153,9 +153,7 @@ impl Prepared {
         let a = &self.algorithm;
         let fixed =
             !matches!(a.method, Method::Form | Method::Sorm | Method::Subset) && a.cov.is_none();
-        fixed.then(|| {
-            reliability::document::samples(a.method, a.samples, false).saturating_mul(self.cases())
-        })
+        fixed.then(|| study::samples(a.method, a.samples, false).saturating_mul(self.cases()))
     }
 
     /// Whether the algorithm draws samples (all but FORM and SORM).

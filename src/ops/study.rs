@@ -10,8 +10,9 @@ use chain_core::model::Sided;
 use chain_core::values::{Approach, ApproachError};
 use chain_core::{CompiledModel, Machine};
 use reliability::{
-    Algorithm, CaseTally, Inputs, Method, Posterior, PosteriorError, ReliabilityError, Study,
-    StudySpec, System,
+    Algorithm, CaseTally, DirectionalSimulation, Form, ImportanceSampling, Inputs, Method,
+    MonteCarlo, Posterior, PosteriorError, ReliabilityError, Study, StudySpec, SubsetSimulation,
+    System,
 };
 
 use super::resolve::{self, ResolveError};
@@ -171,19 +172,20 @@ pub fn study(
     Ok((study, model))
 }
 
-/// The reliability algorithm of a study command: `--method`, `--samples`,
-/// `--seed`, `--cov`.
+/// The reliability algorithm of a study command: its method, samples,
+/// seed and target coefficient of variation (the CLI's `--method`,
+/// `--samples`, `--seed`, `--cov`; Python's keywords of the same names).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AlgorithmOptions {
-    /// `--method`.
+    /// The method.
     pub method: Method,
-    /// `--samples` per case (for subset simulation per level); `None`: the
-    /// method's default ([`reliability::document::samples`]).
+    /// Samples per case (for subset simulation per level); `None`: the
+    /// method's default ([`samples`]).
     pub samples: Option<u64>,
-    /// `--seed` of the random streams.
+    /// Seed of the random streams.
     pub seed: u64,
-    /// `--cov`: a target coefficient of variation in (0, 1]; `samples` is
-    /// then the budget.
+    /// A target coefficient of variation in (0, 1]; `samples` is then the
+    /// budget.
     pub cov: Option<f64>,
 }
 
@@ -207,44 +209,125 @@ pub struct OptionError {
     pub option: &'static str,
     /// Why.
     pub message: String,
+    /// The library's refusal it words, whose code it keeps (`None`: a
+    /// rule of this layer, `chain::cli::invalid_option`).
+    pub cause: Option<Box<ReliabilityError>>,
+}
+
+impl OptionError {
+    /// A rule of this layer about `option`.
+    pub fn new(option: &'static str, message: impl Into<String>) -> OptionError {
+        OptionError {
+            option,
+            message: message.into(),
+            cause: None,
+        }
+    }
+
+    /// The library's refusal `e` of the value of `option`, in its words
+    /// (a sampler's settings without their `invalid sampler settings: `).
+    pub fn of(option: &'static str, e: ReliabilityError) -> OptionError {
+        let message = match &e {
+            ReliabilityError::InvalidSampler(m) => m.clone(),
+            e => e.to_string(),
+        };
+        OptionError {
+            option,
+            message,
+            cause: Some(Box::new(e)),
+        }
+    }
 }
 
 impl Worded for OptionError {
     fn own_code(&self) -> Option<&'static str> {
-        Some("chain::cli::invalid_option")
+        self.cause.is_none().then_some("chain::cli::invalid_option")
+    }
+
+    #[cfg(feature = "cli")]
+    fn inner(&self) -> Option<&dyn miette::Diagnostic> {
+        self.cause.as_deref().map(|e| e as &dyn miette::Diagnostic)
     }
 }
 
 diagnostic!(OptionError);
 
+/// The samples per case of `method` when `given` is `None` (spec
+/// reliability-v2 §2): is 10⁴, mc 10⁵; with a target coefficient of
+/// variation (`to_cov`) the budget, mc 10⁷, is and directional 10⁶;
+/// subset 10³ per level, directional 10⁴; 0 for FORM and SORM, which draw none.
+pub fn samples(method: Method, given: Option<u64>, to_cov: bool) -> u64 {
+    match (method, to_cov) {
+        (Method::Form | Method::Sorm, _) => 0,
+        (Method::ImportanceSampling, false) => given.unwrap_or(10_000),
+        (Method::MonteCarlo, false) => given.unwrap_or(100_000),
+        (Method::ImportanceSampling, true) => given.unwrap_or(1_000_000),
+        (Method::MonteCarlo, true) => given.unwrap_or(10_000_000),
+        (Method::Subset, _) => given.unwrap_or(1_000),
+        (Method::Directional, false) => given.unwrap_or(10_000),
+        (Method::Directional, true) => given.unwrap_or(1_000_000),
+    }
+}
+
+/// Subset simulation's sample budget with a target coefficient of
+/// variation, in levels of its samples per level.
+pub const SUBSET_BUDGET_LEVELS: u64 = 1000;
+
 impl AlgorithmOptions {
-    /// The checks that need no model: `--cov` in (0, 1] and not with FORM
-    /// or SORM, subset simulation's samples per level
-    /// ([`reliability::document::check_options`]).
+    /// Every check of the options, none needing a model, so that the CLI
+    /// and Python refuse them before any file is read: the target
+    /// coefficient of variation in (0, 1] and only for a method that draws
+    /// samples, then the algorithm's own settings ([`Algorithm::check`]:
+    /// the sample count, subset simulation's samples per level).
     pub fn check(&self) -> Result<(), OptionError> {
         if let Some(c) = self.cov {
-            if !(c.is_finite() && c > 0.0 && c <= 1.0) {
-                return Err(OptionError {
-                    option: "cov",
-                    message: format!(
-                        "the target coefficient of variation must be in (0, 1] (found `{c}`)"
+            reliability::sampler::check_cov(c).map_err(|e| OptionError::of("cov", e))?;
+            if let Method::Form | Method::Sorm = self.method {
+                return Err(OptionError::new(
+                    "cov",
+                    format!(
+                        "{} draws no samples; a target coefficient of variation needs method mc, is, subset or directional",
+                        self.method.name().to_uppercase()
                     ),
-                });
+                ));
             }
         }
-        reliability::document::check_options(self.method, self.samples, self.cov).map_err(|p| {
-            OptionError {
-                option: p.option,
-                message: p.message,
-            }
-        })
+        self.algorithm()
+            .check()
+            .map_err(|e| OptionError::of("samples", e))
     }
 
-    /// The library's algorithm for these options
-    /// ([`reliability::document::algorithm`]).
+    /// The library's algorithm for these options: the method with its
+    /// samples ([`samples`]: given, or the method's default) and seed, the
+    /// target coefficient of variation (the samples then its budget; for
+    /// subset simulation the samples per level, [`SUBSET_BUDGET_LEVELS`]
+    /// levels' worth at most). FORM and SORM take no target ([`check`]
+    /// refuses one).
+    ///
+    /// [`check`]: AlgorithmOptions::check
     pub fn algorithm(&self) -> Algorithm {
-        let samples = reliability::document::samples(self.method, self.samples, self.cov.is_some());
-        reliability::document::algorithm(self.method, samples, self.seed, self.cov)
+        let (seed, cov) = (self.seed, self.cov);
+        let samples = samples(self.method, self.samples, cov.is_some());
+        match self.method {
+            Method::MonteCarlo => Algorithm::MonteCarlo(MonteCarlo { samples, seed, cov }),
+            Method::ImportanceSampling => Algorithm::ImportanceSampling(ImportanceSampling {
+                samples,
+                seed,
+                form: Form::default(),
+                cov,
+            }),
+            Method::Subset => {
+                let mut s = SubsetSimulation::new(samples, seed);
+                s.cov = cov;
+                s.budget = samples.saturating_mul(SUBSET_BUDGET_LEVELS);
+                Algorithm::Subset(s)
+            }
+            Method::Directional => {
+                Algorithm::Directional(DirectionalSimulation { samples, seed, cov })
+            }
+            Method::Form => Algorithm::Form(Form::default()),
+            Method::Sorm => Algorithm::Sorm(reliability::sorm::Sorm::default()),
+        }
     }
 }
 
@@ -275,10 +358,7 @@ impl SystemChoice {
         kind: Option<SystemKind>,
         tolerance: Option<f64>,
     ) -> Result<Option<SystemChoice>, OptionError> {
-        let refuse = |message: String| OptionError {
-            option: "system-tolerance",
-            message,
-        };
+        let refuse = |message: String| OptionError::new("system-tolerance", message);
         match (kind, tolerance) {
             (None, None) => Ok(None),
             (None, Some(_)) => Err(refuse(

@@ -190,4 +190,38 @@ fn sampler_options_are_checked_with_their_name() {
         "0.1",
     ]);
     assert!(err.contains("'--cov'"), "{err}");
+    // The sample count and the target's range too, for every command that
+    // samples (the count was once refused only after the model was built).
+    for (command, args) in [
+        ("reliability", &["--method", "mc", "--samples", "0"][..]),
+        (
+            "reliability",
+            &["--method", "directional", "--samples", "0"],
+        ),
+        (
+            "path",
+            &["--axes", "x.csv", "--method", "is", "--samples", "0"],
+        ),
+        ("reliability", &["--method", "mc", "--cov", "1.5"]),
+        ("path", &["--axes", "x.csv", "--method", "mc", "--cov", "0"]),
+    ] {
+        let err = fails(&[&[command, "no/such.yaml"][..], args].concat());
+        let err = err
+            .split_whitespace()
+            .filter(|w| *w != "│")
+            .collect::<Vec<_>>()
+            .join(" ");
+        let option = if args.contains(&"--cov") {
+            "'--cov'"
+        } else {
+            "'--samples'"
+        };
+        assert!(err.contains(option), "{command} {args:?}: {err}");
+        assert!(!err.contains("no/such.yaml"), "{command} {args:?}: {err}");
+        assert!(
+            err.contains("the number of samples must be between 1 and 68719476736 (found 0)")
+                || err.contains("the target coefficient of variation must be in (0, 1]"),
+            "{command} {args:?}: {err}"
+        );
+    }
 }

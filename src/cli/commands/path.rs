@@ -67,6 +67,7 @@ pub struct PathArgs {
 /// Runs `chain path`.
 pub fn exec(args: PathArgs) -> miette::Result<()> {
     // Refused before the machine file is read.
+    args.algorithm.check()?;
     let system = args.system.choice()?;
     let loaded = Loaded::new(&args.file)?;
     let display = |p: &std::path::Path| match p.as_os_str() == "-" {
