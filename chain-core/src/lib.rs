@@ -19,7 +19,6 @@ pub mod lanes;
 pub mod measured;
 mod model_trait;
 pub mod named;
-pub mod plan;
 pub mod symbolic;
 
 // The stages' modules under their historical flat paths (`chain_core::load`,
@@ -33,7 +32,7 @@ pub use derive::{derive, derive_in, SymbolicModel};
 pub use diagnostic::Diagnostics;
 pub use eval::{compile, CompiledModel, BATCH_LANES};
 pub use load::{load_bytes, load_file, load_file_with_text, load_str};
-pub use measured::{identify, measurements};
+pub use measured::{identify, measurements, plan};
 pub use model::Machine;
 pub use model_trait::{BatchError, ErrorModel, ErrorValues, OutOfRange, Pose};
 pub use values::Values;

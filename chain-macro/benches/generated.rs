@@ -19,7 +19,7 @@ chain::machine!(SpreadAlongAxis = "../examples/machines/spread_along_axis.yaml")
 chain::machine!(Vmc3 = "../examples/machines/vmc3.yaml");
 
 /// The v1 emission of the same machine (`chain derive --format rust`, the
-/// bodies before issue 17), committed for `tests/it/generated_into.rs`.
+/// bodies before issue 17), committed for `tests/it/commands/generated_into.rs`.
 #[allow(dead_code)]
 mod v1 {
     include!("../../tests/generated_v1/bc_head_table.rs");

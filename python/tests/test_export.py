@@ -13,7 +13,8 @@ VALUES = ROOT / "examples/values/vmc3.yaml"
 @pytest.mark.parametrize("controller", ["grid", "beckhoff", "linuxcnc", "siemens-cec", "klipper"])
 def test_export_is_the_cli_s(cli, controller, tmp_path):
     """The summary equals `chain export --format json`; the files equal the committed examples
-    (examples/export/, which tests/it/export_controllers.rs regenerates from the library)."""
+    (examples/export/, which tests/it/commands/export_controllers.rs regenerates from the
+    library)."""
     m = chain.Machine.load(MACHINE)
     got = m.export(VALUES, controller=controller, params={"L": 150}, out=tmp_path / "out")
     want = cli("export", MACHINE, "--values", VALUES, "--controller", controller, "--param", "L=150")

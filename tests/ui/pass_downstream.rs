@@ -1,5 +1,5 @@
 // A crate outside the workspace that depends on `chain` alone: the generated
-// code must name only paths reachable through `chain`. tests/it/downstream.rs
+// code must name only paths reachable through `chain`. tests/it/commands/downstream.rs
 // builds this same file as a crate of its own on `chain` without default
 // features (the library without the CLI).
 use chain::core::ErrorModel;

@@ -1,19 +1,23 @@
-//! A machine as it is measured: measurement records, their design matrix
-//! and the identification of the error parameters from them
-//! (measured-machines spec, section 4; `docs/identify.md`).
+//! A machine as it is measured: measurement records, their design matrix,
+//! the identification of the error parameters from them and the planning of
+//! where to measure (measured-machines spec, sections 4-5;
+//! `docs/identify.md`, `docs/plan.md`).
 //!
 //! [`measurements`] reads a measurement (or `chain plan` candidate) CSV
 //! against a [`crate::Machine`] and gives each record's design rows from a
 //! model's exact sensitivity; [`identify`] solves the weighted least-squares
-//! problem (or its Gaussian-prior posterior) through an SVD; [`positioning`]
+//! problem (or its Gaussian-prior posterior) through an SVD; [`plan`] chooses
+//! where to measure (a D-optimal subset of the candidates); [`positioning`]
 //! reads an axis's ISO 230-2 positioning runs and evaluates them, and
 //! [`positioning_values`] writes them into a values file.
 
 pub mod document;
+mod estimate;
 pub mod exact;
 pub mod identify;
 pub mod iterate;
 pub mod measurements;
+pub mod plan;
 pub mod positioning;
 pub mod positioning_values;
 pub mod predict;

@@ -42,7 +42,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
-use super::identify::{Estimate, IdentifyError};
+use super::estimate::{Estimate, IdentifyError};
 
 /// Relation weights (in equilibrated units: the share of the fixed
 /// unknown's unit-norm effect carried by an estimated one) below this are

@@ -9,7 +9,7 @@ script) and writes `bc_head_table_sympy.rs`: one function writing the whole
 `chain-macro/benches/generated.rs` includes that file.
 
 Regenerate (after a change of the machine or of the derivation, which
-`tests/it/generated_into.rs::sympy_bench_input_is_current` detects):
+`tests/it/commands/generated_into.rs::sympy_bench_input_is_current` detects):
 
     cargo build --release
     target/release/chain derive chain-macro/benches/machines/bc_head_table.yaml \

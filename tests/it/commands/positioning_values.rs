@@ -15,9 +15,9 @@ use chain::core::values::{
 };
 use chain::core::ErrorValues;
 
+use crate::commands::positioning::{read_runs, welford};
 use crate::common::cli::{fails, ok, ok_json, scratch, unwrapped, write};
 use crate::common::example_file;
-use crate::positioning::{read_runs, welford};
 
 /// A one-axis machine: the tool on an x slide along `axis`, the positioning
 /// error `EXX` in `dx`, a straightness `EYX`, a squareness `S`, and a rotary

@@ -136,7 +136,7 @@ fn system_targets_and_overrides() {
     let vol = &results[3];
     assert_eq!(vol["component"], "volumetric");
     // Inside 4 standard errors of the 10⁷-sample Monte Carlo value 0.2069
-    // (tests/it/reliability_gantry.rs) at the corner (1000, 1500, 1400).
+    // (tests/it/papers/reliability_gantry.rs) at the corner (1000, 1500, 1400).
     let pf = vol["pf"].as_f64().unwrap();
     let se = vol["std_error"].as_f64().unwrap();
     assert!((pf - 0.2069).abs() < 4.0 * se + 2e-4, "{pf} ± {se}");

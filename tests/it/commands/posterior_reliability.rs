@@ -509,7 +509,7 @@ fn bad_posteriors_are_located_refusals() {
         "{e}"
     );
     // std 0 is not a spread (a table beside it is read: its input varies
-    // along the axis, tests/it/positioning_values.rs).
+    // along the axis, tests/it/commands/positioning_values.rs).
     let e = run(
         "table",
         "machine: gantry_grinder\nvalues:\n  dxx: {points: [[0, 0], [1000, 0.005]]}\n  dxz: {value: 0.001, std: 0}\n",

@@ -18,22 +18,22 @@ use chain::core::ErrorModel;
 mod v1 {
     #![allow(dead_code, clippy::all)]
     pub mod gantry {
-        include!("../generated_v1/gantry_grinder.rs");
+        include!("../../generated_v1/gantry_grinder.rs");
     }
     pub mod internal {
-        include!("../generated_v1/internal_grinder.rs");
+        include!("../../generated_v1/internal_grinder.rs");
     }
     pub mod cnc5 {
-        include!("../generated_v1/cnc5_bevel.rs");
+        include!("../../generated_v1/cnc5_bevel.rs");
     }
     pub mod ac {
-        include!("../generated_v1/ac_trunnion.rs");
+        include!("../../generated_v1/ac_trunnion.rs");
     }
     pub mod hh {
-        include!("../generated_v1/head_head_bc.rs");
+        include!("../../generated_v1/head_head_bc.rs");
     }
     pub mod bc {
-        include!("../generated_v1/bc_head_table.rs");
+        include!("../../generated_v1/bc_head_table.rs");
     }
 }
 

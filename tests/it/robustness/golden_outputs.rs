@@ -27,8 +27,8 @@
 //!
 //! The sampling methods are not recorded in that list: their results moved
 //! with the random streams in issue 11, within their standard errors (their
-//! checks are in `reliability_gantry.rs`, `reliability_cli.rs` and
-//! `path.rs`).
+//! checks are in `papers/reliability_gantry.rs`, `commands/reliability_cli.rs`
+//! and `commands/path.rs`).
 //!
 //! `tests/golden/ops/commands.txt` (issue 31: one application layer,
 //! `chain::ops`, under the CLI and Python; the samplers behind one trait and

@@ -39,7 +39,7 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
 
 use crate::common::cli::scratch;
-use crate::fuzz::{bounded, cases};
+use crate::robustness::fuzz::{bounded, cases};
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 

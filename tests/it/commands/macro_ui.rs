@@ -10,9 +10,9 @@
 //! `downstream` compiles `pass_downstream.rs` again as a crate of its own on
 //! `chain` without default features.
 
-#[path = "../ui/pass_downstream.rs"]
+#[path = "../../ui/pass_downstream.rs"]
 mod pass_downstream;
-#[path = "../ui/pass_function_slots.rs"]
+#[path = "../../ui/pass_function_slots.rs"]
 mod pass_function_slots;
 
 /// `tests/ui/pass_downstream.rs`: `machine!` inline and from a file, FORM on

@@ -87,7 +87,7 @@ fn truth(name: &str) -> f64 {
 /// squares the recovery tests below check. At these noise levels the
 /// weakest combination of the cubic and quadratic coefficients is within
 /// the noise, and the noise rule would leave it out
-/// (`tests/it/identify_subset.rs` tests the rule).
+/// (`tests/it/commands/identify_subset.rs` tests the rule).
 fn full_rank() -> IdentifyOptions {
     IdentifyOptions {
         rank_tol: Some(chain::core::measured::identify::RANK_TOLERANCE),
