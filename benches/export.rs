@@ -1,5 +1,5 @@
 //! `chain export --controller grid` benchmarks (docs/performance.md,
-//! "chain export --controller grid (issue 14)"), on the example five-axis
+//! "chain export --controller grid"), on the example five-axis
 //! ac_trunnion (examples/machines/ac_trunnion.yaml: y, A, C, x, z; 41 error
 //! parameters) with a values file of its 41 errors (40 constants of
 //! 10 µm / 10 µrad class and the X positioning error as a 3-point table)

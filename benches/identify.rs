@@ -1,5 +1,5 @@
-//! `chain identify` benchmarks (docs/performance.md, "chain identify (issue
-//! 13)"), on the cubic-Legendre five-axis machine
+//! `chain identify` benchmarks (docs/performance.md, "chain identify"), on
+//! the cubic-Legendre five-axis machine
 //! (examples/machines/legendre5.yaml, 131 error parameters) with 10⁴
 //! tool-point measurements (3·10⁴ design rows) over its travel, simulated
 //! through the compiled model with known errors. Run with
@@ -13,7 +13,7 @@
 //!   identification alone;
 //! - the same three with the suffix `_173`: the machine with degree-5
 //!   Legendre series on the linear axes and degree 4 on C (18·6 + 6·4 +
-//!   6·5 + 11 = 173 unknowns, above the issue's 170), the same 10⁴
+//!   6·5 + 11 = 173 unknowns, above the 170-unknown target), the same 10⁴
 //!   measurements.
 
 use std::hint::black_box;

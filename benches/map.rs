@@ -1,4 +1,4 @@
-//! `chain map` benchmarks (docs/performance.md, "chain map (issue 12)"), on
+//! `chain map` benchmarks (docs/performance.md, "chain map"), on
 //! the example vmc3 (examples/machines/vmc3.yaml: 3 axes, 24 error
 //! parameters) with its values (examples/values/vmc3.yaml: 18 tabulated
 //! error motions, 21 positions each, and 3 squareness constants) over a

@@ -1,4 +1,4 @@
-//! `chain plan`'s library: K = 50 of 10⁴ candidate poses (issue 13: under
+//! `chain plan`'s library: K = 50 of 10⁴ candidate poses (the target: under
 //! 1 s), on the gantry grinder (21 errors) and the cubic-Legendre 5-axis
 //! machine (131 errors): the design rows (`measured::Design`, the exact
 //! sensitivity at every candidate) and the D-optimal search, separately and

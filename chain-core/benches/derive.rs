@@ -1,4 +1,4 @@
-//! Derivation and runtime-evaluator benchmarks (issue targets in
+//! Derivation and runtime-evaluator benchmarks (targets and figures in
 //! docs/performance.md). Run with `cargo bench -p chain-core --bench derive`.
 
 use std::hint::black_box;

@@ -1,9 +1,9 @@
-//! Function slots (issue 12): deriving a five-axis machine whose 30 error
+//! Function slots: deriving a five-axis machine whose 30 error
 //! motions are cubic Legendre series (`examples/machines/legendre5.yaml`, 131
 //! error parameters) and evaluating its 6×131 sensitivity, with the runtime
 //! tape and with the code `machine!` generates for it
 //! (`benches/generated/legendre5.rs`, kept current by a unit test of
-//! `emit.rs`). Figures in docs/performance.md, "Function slots (issue 12)".
+//! `emit.rs`). Figures in docs/performance.md, "Function slots".
 //! Run with `cargo bench -p chain-core --bench function_slots`.
 
 use std::hint::black_box;

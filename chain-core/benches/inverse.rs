@@ -1,5 +1,5 @@
-//! Inverse-kinematics throughput (issue 8: at least 10^6 poses per second per
-//! core for closed-form chains; figures in docs/performance.md). Run with
+//! Inverse-kinematics throughput (the target: at least 10^6 poses per second
+//! per core for closed-form chains; figures in docs/performance.md). Run with
 //! `cargo bench -p chain-core --bench inverse`.
 
 use std::hint::black_box;

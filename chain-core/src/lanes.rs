@@ -1,5 +1,5 @@
 //! Lanes of points for the batched kernels of the `machine!` types
-//! (`sensitivity_batch_into` and its siblings, issue 35; docs/macro.md,
+//! (`sensitivity_batch_into` and its siblings; docs/macro.md,
 //! "The generated type").
 //!
 //! A generated batch function takes points in groups of [`LANES`]: `sin`

@@ -21,7 +21,7 @@ mod model_trait;
 pub mod named;
 pub mod symbolic;
 
-// The stages' modules under their historical flat paths (`chain_core::load`,
+// The stages' modules also at flat paths (`chain_core::load`,
 // `chain_core::inverse`, ...), which downstream code and the docs use.
 pub use input::{bounded, diagnostic, expr, inline, load, model, settings, tabular, values, yaml};
 pub use kinematics::{conversion, geometry, inverse, jet, motion};

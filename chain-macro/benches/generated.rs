@@ -1,4 +1,4 @@
-//! Generated code vs hand-written Rust vs the runtime tape (issue 7 targets;
+//! Generated code vs hand-written Rust vs the runtime tape (targets and
 //! figures in docs/performance.md). Run with
 //! `cargo bench -p chain-macro --bench generated`.
 
@@ -18,8 +18,9 @@ chain::machine!(Legendre5 = "../examples/machines/legendre5.yaml");
 chain::machine!(SpreadAlongAxis = "../examples/machines/spread_along_axis.yaml");
 chain::machine!(Vmc3 = "../examples/machines/vmc3.yaml");
 
-/// The v1 emission of the same machine (`chain derive --format rust`, the
-/// bodies before issue 17), committed for `tests/it/commands/generated_into.rs`.
+/// The v1 emission of the same machine (`chain derive --format rust`: the
+/// plain bodies, without the shared sums of what `machine!` emits),
+/// committed for `tests/it/commands/generated_into.rs`.
 #[allow(dead_code)]
 mod v1 {
     include!("../../tests/generated_v1/bc_head_table.rs");
@@ -112,7 +113,7 @@ fn five_axis(c: &mut Criterion) {
     });
 }
 
-/// The "two rotary axes, 40+ errors" machine of the issue: an A/C trunnion
+/// The "two rotary axes, 40+ errors" target machine: an A/C trunnion
 /// with 41 errors (`examples/machines/ac_trunnion.yaml`).
 fn two_rotary_axes(c: &mut Criterion) {
     let p = [150.0, 200.0];
@@ -122,9 +123,9 @@ fn two_rotary_axes(c: &mut Criterion) {
     });
 }
 
-/// Issue 17: the B-head/C-table machine with 33 errors
-/// (`benches/machines/bc_head_table.yaml`): the v1 body, the new functions
-/// and SymPy's output of the same Jacobian, in one binary.
+/// The B-head/C-table machine with 33 errors
+/// (`benches/machines/bc_head_table.yaml`): the v1 body, the functions
+/// `machine!` emits and SymPy's output of the same Jacobian, in one binary.
 fn bc_head_table(c: &mut Criterion) {
     let p = [150.0];
     let q = [120.0, 0.7, -40.0, 250.0, -0.4];
@@ -190,7 +191,7 @@ fn bench_points(nv: usize) -> Vec<f64> {
         .collect()
 }
 
-/// Issue 17 §4: one group for every example machine and the B-head/C-table
+/// One group for every example machine and the B-head/C-table
 /// five-axis machine, `POINTS` points per iteration: generated
 /// `sensitivity_into`, the runtime tape point by point, the batched tape on
 /// the calling thread (`sensitivity_points`) and `sensitivity_batch` in a
@@ -416,7 +417,7 @@ fn every_machine(c: &mut Criterion) {
     g.finish();
 }
 
-/// Issue 35 §1: the batched generated kernel (`sensitivity_batch_into`,
+/// The batched generated kernel (`sensitivity_batch_into`,
 /// four points per lane group) against the same type's per-point
 /// `sensitivity_into` and, on the B-head/C-table machine, SymPy's per-point
 /// code, `POINTS` points per iteration (throughput per point); the batch
@@ -424,7 +425,7 @@ fn every_machine(c: &mut Criterion) {
 /// routes write one. `batch_2_thread`: two halves on a pool of two threads.
 /// The `tape_*` routes are the same machine's runtime tape (`$yaml`,
 /// `CompiledModel::sensitivity_points`, blocks of `BATCH_LANES` points) on
-/// the same points, issue 35 §3.
+/// the same points.
 macro_rules! batched {
     ($g:expr, $pools:expr, $ty:ident, $name:literal, $yaml:literal, $p:expr, $sympy:expr) => {{
         const NV: usize = $ty::VARIABLES.len();

@@ -116,7 +116,7 @@ def allocate_json(
 ) -> str: ...
 
 
-# -- group B: the measured machine (python/src/group_b.rs) --------------------
+# -- group B: the measured machine (python/src/measured.rs) --------------------
 
 def identify_json(
     model: Model,

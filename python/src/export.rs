@@ -7,7 +7,7 @@ use chain::ops::Worded;
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 
-use crate::group_b::read_values;
+use crate::measured::read_values;
 use crate::{named, resolve_error, study_error, to_json, value_error, Model};
 
 /// The compensation of the built machine `values` (a file `values_path`,

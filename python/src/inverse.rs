@@ -7,14 +7,13 @@ use pyo3::prelude::*;
 
 use crate::{check_finite, resolve_error, study_error, to_json, value_error, Model};
 
-/// The poses of a checked `(N, width)` array (`width` 6 or 12), each
-/// refused as `poses row K: ...` (0-based).
+/// The poses of an `(N, width)` array (`width` 6 or 12), a row refused as
+/// `poses row K: ...` (0-based), the width as `poses: ...`.
 pub(crate) fn pose_rows(flat: &[f64], width: usize) -> PyResult<Vec<PoseRow>> {
-    (flat.chunks_exact(width).enumerate())
-        .map(|(k, v)| {
-            PoseRow::from_values(None, v).map_err(|e| value_error(format!("poses row {k}: {e}")))
-        })
-        .collect()
+    inverse::pose_rows(flat, width).map_err(|(row, e)| match row {
+        Some(k) => value_error(format!("poses row {k}: {e}")),
+        None => value_error(format!("poses: {e}")),
+    })
 }
 
 /// The inverse kinematics of `poses` (`(N, 6)`: `px, py, pz, i, j, k`, or
@@ -30,11 +29,6 @@ pub(crate) fn inverse_json(
     params: Vec<(String, f64)>,
 ) -> PyResult<String> {
     let width = poses.shape()[1];
-    if width != 6 && width != 12 {
-        return Err(value_error(format!(
-            "poses must have 6 columns (px, py, pz, i, j, k) or 12 (px, py, pz, r11 … r33), found {width}"
-        )));
-    }
     let flat = poses.as_slice()?;
     check_finite(flat, width, "poses")?;
     let rows = pose_rows(flat, width)?;

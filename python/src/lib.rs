@@ -18,8 +18,8 @@
 
 mod compensate;
 mod export;
-mod group_b;
 mod inverse;
+mod measured;
 mod motion;
 mod path;
 mod positioning;
@@ -37,8 +37,8 @@ use reliability::document::describe;
 use reliability::ReliabilityError;
 
 mod allocate;
-mod reliability_v2;
 mod sensitivity;
+mod study;
 
 create_exception!(
     _chain,
@@ -571,11 +571,11 @@ pub(crate) fn sided_named(sided: Option<&str>) -> PyResult<Option<chain_core::mo
 fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Model>()?;
     m.add("MachineError", m.py().get_type::<MachineError>())?;
-    m.add_function(wrap_pyfunction!(group_b::identify_json, m)?)?;
-    m.add_function(wrap_pyfunction!(group_b::plan_json, m)?)?;
-    m.add_function(wrap_pyfunction!(group_b::map_json, m)?)?;
-    m.add_function(wrap_pyfunction!(reliability_v2::reliability_json, m)?)?;
-    m.add_function(wrap_pyfunction!(reliability_v2::sobol_json, m)?)?;
+    m.add_function(wrap_pyfunction!(measured::identify_json, m)?)?;
+    m.add_function(wrap_pyfunction!(measured::plan_json, m)?)?;
+    m.add_function(wrap_pyfunction!(measured::map_json, m)?)?;
+    m.add_function(wrap_pyfunction!(study::reliability_json, m)?)?;
+    m.add_function(wrap_pyfunction!(study::sobol_json, m)?)?;
     m.add_function(wrap_pyfunction!(
         sensitivity::sensitivity_reliability_json,
         m

@@ -7,7 +7,7 @@ use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
 use crate::inverse::pose_rows;
-use crate::reliability_v2::{algorithm_options, system_choice};
+use crate::study::{algorithm_options, system_choice};
 use crate::{check_finite, resolve_error, sided_named, study_error, to_json, value_error, Model};
 
 /// Error and reliability along a path. Exactly one of `axes` (an `(N, C)`
@@ -61,11 +61,6 @@ pub(crate) fn path_json(
         }
         (None, Some(p)) => {
             let width = p.shape()[1];
-            if width != 6 && width != 12 {
-                return Err(value_error(format!(
-                    "poses must have 6 columns (px, py, pz, i, j, k) or 12 (px, py, pz, r11 … r33), found {width}"
-                )));
-            }
             let flat = p.as_slice()?;
             check_finite(flat, width, "poses")?;
             let mut read = pose_rows(flat, width)?;

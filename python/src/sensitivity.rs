@@ -11,7 +11,7 @@ use chain::ops::Worded;
 use chain_core::geometric::NominalSizes;
 use pyo3::prelude::*;
 
-use crate::reliability_v2::parse_approach;
+use crate::study::parse_approach;
 use crate::{resolve_error, sided_named, study_error, study_failure, to_json, value_error, Model};
 
 /// Runs the request and returns its document's JSON.

@@ -1,5 +1,5 @@
 """Every command of the CLI, one parametrised test: the Python binding's ``to_dict()`` equals
-``chain <command> ... --format json`` on the same example input (issue 31: one application layer,
+``chain <command> ... --format json`` on the same example input (one application layer,
 ``chain::ops``, under both)."""
 
 import numpy as np

@@ -9,7 +9,7 @@ import pytest
 
 import chain
 from conftest import MACHINES, ROOT, flat
-from test_reliability_v2 import POSTERIOR
+from test_reliability import POSTERIOR
 
 WITH_RELIABILITY = [p for p in MACHINES if "\nreliability:" in p.read_text() and "\nstatistics:" in p.read_text()]
 IDS = [p.stem for p in WITH_RELIABILITY]

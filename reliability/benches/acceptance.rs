@@ -4,7 +4,7 @@
 //! (three standard errors), with and without the sensitivities.
 //!
 //! Run with `cargo bench -p reliability --bench acceptance`; the figures are
-//! in `docs/performance.md` (issue 15, part C).
+//! in `docs/performance.md` ("Whole-machine acceptance probability").
 
 use std::hint::black_box;
 use std::path::Path;

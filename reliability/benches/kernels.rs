@@ -1,5 +1,5 @@
 //! Criterion benchmarks of the numerical kernels against the crates that
-//! could replace them, in one run (issue 11: a hand-written kernel stays only
+//! could replace them, in one run (the rule: a hand-written kernel stays only
 //! where it is at least 1.3× faster or measurably more accurate).
 //!
 //! Run with `cargo bench -p reliability --bench kernels`; the figures and the
@@ -11,13 +11,13 @@
 //!   `Normal::pdf`;
 //! - `normal/quantile/*`: `Φ⁻¹(p)` over 1024 points log-spaced in
 //!   `[10⁻¹⁶, ½]` and mirrored into `[½, 1 − 10⁻¹⁶]`, with `statrs`' `erfc_inv`
-//!   (the library's) and with the former hand-written Acklam + Halley kernel
-//!   (kept below as [`former::inverse_cdf`] for this comparison only);
+//!   (the library's) and with a hand-written Acklam + Halley kernel (below
+//!   as [`former::inverse_cdf`], for this comparison only);
 //! - `variates/normal/*`: 1024 standard normal variates from one ChaCha8
 //!   stream, with the library's 32-bit ziggurat (`CaseRng::fill_normal`) and
 //!   with `rand_distr::StandardNormal`;
 //! - `variates/words/*`: 1024 raw 64-bit words, straight from `rand_chacha`
-//!   (the library's) and through the former 64-word buffer.
+//!   (the library's) and through a 64-word buffer ([`former::Buffered`]).
 
 use std::hint::black_box;
 
@@ -31,10 +31,10 @@ use statrs::distribution::{Continuous, Normal};
 
 const N: usize = 1024;
 
-/// The former kernels, kept here only to be measured against their
-/// replacements.
+/// Hand-written kernels the library does not use, kept here only to be
+/// measured against the library's.
 mod former {
-    /// The former `Φ⁻¹`: Acklam's rational approximation refined by two
+    /// A hand-written `Φ⁻¹`: Acklam's rational approximation refined by two
     /// Halley steps on `Φ(x) − p` (with `libm`'s `erfc`).
     pub fn inverse_cdf(p: f64) -> f64 {
         if p.is_nan() || !(0.0..=1.0).contains(&p) {
@@ -105,7 +105,7 @@ mod former {
         x
     }
 
-    /// The former stream: ChaCha8 output copied into a 64-word buffer.
+    /// A buffered stream: ChaCha8 output copied into a 64-word buffer.
     pub struct Buffered {
         inner: rand_chacha::ChaCha8Rng,
         buffer: [u64; 64],

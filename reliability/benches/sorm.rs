@@ -4,7 +4,8 @@
 //! truncated normal on [−0.01, 0.012], and `dxx`–`dyx` correlated 0.5 (Nataf).
 //!
 //! Run with `cargo bench -p reliability --bench sorm`; the figure is recorded
-//! in `docs/performance.md` (part A of issue 15).
+//! in `docs/performance.md` ("FORM + SORM with non-normal, correlated
+//! inputs").
 //!
 //! With `CHAIN_SORM_CASES=path.json` set, the benchmark first writes the 375
 //! cases (inputs, each case's sensitivity row, tolerance and chain's FORM and

@@ -106,7 +106,7 @@ pub struct CaseDocument<'a> {
 
 /// The cases of a [`ReliabilityDocument`]: serialised as the list of their
 /// [`CaseDocument`]s, each formed when it is written, so that a document of
-/// a million cases is not a second copy of them (issue 36, point 1).
+/// a million cases is not a second copy of them.
 #[derive(Debug)]
 pub struct CaseDocuments<'a> {
     /// The grid's axes in file order, with their index in the model's

@@ -251,8 +251,9 @@ impl Inputs {
             adjusted[i * k + j] = r0;
             adjusted[j * k + i] = r0;
         }
-        // nalgebra's factor (the v1 one, to the last bit); the hand-written
-        // one only to name the pair where a failing factorisation stops.
+        // nalgebra's factor (the reference results hold its rounding to the
+        // last bit); the hand-written one only to name the pair where a
+        // failing factorisation stops.
         let factor = match nalgebra::Cholesky::new(nalgebra::DMatrix::from_row_slice(
             k, k, &adjusted,
         ))

@@ -18,11 +18,17 @@ pub(crate) const SQRT_3: f64 = 1.732_050_807_568_877_2;
 
 /// The marginal distribution of one input.
 ///
-/// Built only through the validating constructors [`Marginal::normal`] and
-/// [`Marginal::uniform`] (the law is private), so every `Marginal` has a
-/// finite mean and a positive spread; [`Marginal::family`] and the accessors
-/// read it back. It serialises as `{"dist": "normal", "mean": …, "std": …}` or
-/// `{"dist": "uniform", "min": …, "max": …}`.
+/// Built only through the validating constructors ([`Marginal::normal`],
+/// [`Marginal::uniform`], [`Marginal::lognormal`],
+/// [`Marginal::truncated_normal`], [`Marginal::weibull`],
+/// [`Marginal::gumbel`], [`Marginal::triangular`], [`Marginal::rayleigh`]
+/// and [`Marginal::with_moments`]; the law is private), so every `Marginal`
+/// has a finite mean and a positive spread; [`Marginal::family`] and the
+/// accessors read it back. It serialises as its family's name under `dist`
+/// and that family's parameters: `{"dist": "normal", "mean": …, "std": …}`,
+/// `{"dist": "uniform", "min": …, "max": …}`,
+/// `{"dist": "lognormal", "mean": …, "std": …, "shift": …}`, and so on
+/// (a truncated normal's absent bound is left out).
 ///
 /// ```
 /// use reliability::inputs::{Family, Marginal};
@@ -66,7 +72,8 @@ enum Law {
     Normal { mean: f64, std: f64 },
     /// Uniform on `[min, max]`, `min < max`.
     Uniform { min: f64, max: f64 },
-    /// `reliability-v2.md` §1 (`crate::families`).
+    /// Lognormal (the variable's mean and std, a shift; `reliability-v2.md`
+    /// §1, `crate::families`).
     Lognormal(Lognormal),
     /// Truncated normal (parent mean and std, bounds).
     TruncatedNormal(TruncatedNormal),
@@ -81,7 +88,7 @@ enum Law {
 }
 
 impl Marginal {
-    /// A validated normal marginal.
+    /// A validated normal marginal: a finite `mean` and `std > 0`.
     pub fn normal(mean: f64, std: f64) -> Result<Marginal, ReliabilityError> {
         if !mean.is_finite() || !std.is_finite() || std <= 0.0 {
             return Err(ReliabilityError::InvalidDistribution(format!(
@@ -91,7 +98,7 @@ impl Marginal {
         Ok(Marginal(Law::Normal { mean, std }))
     }
 
-    /// A validated uniform marginal.
+    /// A validated uniform marginal: finite bounds, `min < max`.
     pub fn uniform(min: f64, max: f64) -> Result<Marginal, ReliabilityError> {
         if !min.is_finite() || !max.is_finite() || min >= max {
             return Err(ReliabilityError::InvalidDistribution(format!(
@@ -130,7 +137,8 @@ impl Marginal {
         Ok(Marginal(Law::Gumbel(Gumbel::new(mode, scale)?)))
     }
 
-    /// A validated triangular on `[min, max]` with its mode in between.
+    /// A validated triangular on `[min, max]` (`min < max`) with its mode in
+    /// between (`min ≤ mode ≤ max`).
     pub fn triangular(min: f64, mode: f64, max: f64) -> Result<Marginal, ReliabilityError> {
         Ok(Marginal(Law::Triangular(Triangular::new(min, mode, max)?)))
     }
@@ -350,7 +358,8 @@ impl Marginal {
 
     /// `∂x/∂σ` at fixed `u` (the marginal parametrised by mean and std, the
     /// mean held): `u` for a normal, `√3·(2Φ(u) − 1)` for a uniform,
-    /// `(x − μ)/σ` for the other location-scale families.
+    /// `(x − μ)/σ` for the other location-scale families, `crate::families`
+    /// for the lognormal, Weibull and truncated normal.
     pub fn dx_dstd(&self, u: f64) -> f64 {
         match &self.0 {
             Law::Normal { .. } => u,
@@ -367,8 +376,9 @@ impl Marginal {
         }
     }
 
-    /// One physical sample (`T(u)` of a standard normal draw for the v2
-    /// families).
+    /// One physical sample: `μ + σ·z` for a normal and `min + (max − min)·U`
+    /// for a uniform (a standard normal `z`, a uniform `U` on `[0, 1)`), `T(u)`
+    /// of a standard normal draw for the other families.
     #[inline]
     pub fn sample(&self, rng: &mut CaseRng) -> f64 {
         match self.0 {

@@ -6,7 +6,7 @@
 //! so a failure probability of `Φ(−8) ≈ 6.2·10⁻¹⁶` keeps all its digits. This
 //! is the `R = Φ(β)` of the paper's Eq. 31.
 //!
-//! Which crate computes what was measured (issue 11: `statrs` unless a kernel
+//! Which crate computes what was measured (the rule: `statrs` unless a kernel
 //! is at least 1.3× faster or measurably more accurate in the tails, β up to
 //! 8). Accuracy against mpmath (80 digits) at 2,321 points `x ∈ [−8, 8]` and
 //! 7,940 points `p ∈ [10⁻¹⁶, 1 − 10⁻¹⁶]`; speed from `benches/kernels.rs`,
@@ -16,7 +16,7 @@
 //! |---|---|---|---|
 //! | `cdf`, `sf` | `libm::erfc` | 75 / 5.2 (libm) vs 886,252 / 155,082 (statrs 0.19.1 `erfc`: ~5·10⁻¹¹ relative on `|x| ∈ [0.7, 1.8]`) | statrs 1.9× faster |
 //! | `pdf` | the formula | 15 / 2.66 vs 16 / 2.69 (statrs `Normal::pdf`) | formula 1.19× faster |
-//! | `inverse_cdf` | `statrs` `erfc_inv` | 3 / 0.64 (statrs) vs 204 / 0.75 (former Acklam + Halley) | statrs 7.0× faster |
+//! | `inverse_cdf` | `statrs` `erfc_inv` | 3 / 0.64 (statrs) vs 204 / 0.75 (hand-written Acklam + Halley) | statrs 7.0× faster |
 //!
 //! The `cdf`/`sf` error of both is dominated by the rounding of `x/√2`
 //! (`erfc` amplifies a relative argument error by `2y²`, ≈ 60 at `x = 8`);
@@ -80,8 +80,9 @@ pub fn interval(a: f64, b: f64) -> f64 {
 ///
 /// `statrs::function::erf::erfc_inv` (Boost's rational approximations):
 /// against mpmath at 7,940 points `p ∈ [10⁻¹⁶, 1 − 10⁻¹⁶]` its largest error is
-/// 3 ulp (mean 0.64), where the former hand-written Acklam + two Halley steps
-/// reached 204 ulp near `p = ½` (mean 0.75); see `docs/performance.md`.
+/// 3 ulp (mean 0.64), where a hand-written Acklam + two Halley steps
+/// (`benches/kernels.rs`) reach 204 ulp near `p = ½` (mean 0.75); see
+/// `docs/performance.md`.
 ///
 /// ```
 /// use reliability::normal::{cdf, inverse_cdf};

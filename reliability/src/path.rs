@@ -251,8 +251,8 @@ impl PathResult {
 }
 
 /// The summary of a path, added up record by record as the records come
-/// (a path run a block of instants at a time keeps this, not its records;
-/// issue 36): the instants by status, each target's smallest and mean
+/// (a path run a block of instants at a time keeps this, not its records):
+/// the instants by status, each target's smallest and mean
 /// reliability, the largest mean and standard deviation of every error
 /// quantity, and the [`CaseTally`] of the cases (instant by instant, each
 /// instant's targets in order).
@@ -547,8 +547,7 @@ impl PathStudy {
     /// its instants' part of [`PathStudy::run`] (the same cases bit for bit:
     /// a sampler's case draws the streams of its index in the whole study),
     /// computed when the iterator is advanced: what `chain path` writes as
-    /// the blocks come, keeping a [`PathSummary`] instead of the records
-    /// (issue 36, point 1).
+    /// the blocks come, keeping a [`PathSummary`] instead of the records.
     ///
     /// A block is a [`PathResult`] of its records: its `study` holds the
     /// block's cases, target-major within the block, and no summaries;

@@ -1,5 +1,4 @@
-//! The posterior of a calibration as reliability inputs (`docs/posterior.md`;
-//! issue 13, point 2).
+//! The posterior of a calibration as reliability inputs (`docs/posterior.md`).
 //!
 //! A values file (measured-machines spec, section 2) read by
 //! [`chain_core::values::Values`], plus the two extras the spec lets

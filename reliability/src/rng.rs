@@ -11,13 +11,13 @@
 //! runs a block therefore never changes what it draws, so results are
 //! bit-identical for a given seed whatever the number of threads.
 //!
-//! Until December 2026 the streams were ChaCha8 with the 64-bit stream
-//! identifier `case << 32 | block`: about 28 instructions per 64-bit word
-//! against about 10 for xoshiro256++, the larger part of a subset-simulation
-//! step (docs/performance.md, "Subset simulation"). Seeded results changed
-//! with the switch; the statistical tests (Monte Carlo, importance sampling,
+//! The streams are xoshiro256++ rather than ChaCha8 (with the 64-bit stream
+//! identifier `case << 32 | block`): ChaCha8 takes about 28 instructions per
+//! 64-bit word against about 10 for xoshiro256++, and drawing is the larger
+//! part of a subset-simulation step (docs/performance.md, "Subset
+//! simulation"). The statistical tests (Monte Carlo, importance sampling,
 //! subset and directional simulation against exact answers within their
-//! standard errors) hold on the new streams.
+//! standard errors) hold on these streams.
 //!
 //! [`CaseRng`] is itself a [`rand::Rng`], so any `rand`/`rand_distr`
 //! distribution samples from it; uniforms are `rand`'s [`StandardUniform`]
@@ -31,7 +31,7 @@
 //! 64-bit word per variate) on one ChaCha8 stream, in one run:
 //! 1024 variates in 5.3 µs (193 M/s) against 11.3 µs (91 M/s), 2.1× — above
 //! the 1.3× bar, so the kernel stays (Monte Carlo draws 21 normals per
-//! sample). The former 64-word buffer in front of ChaCha8 is gone: it was
+//! sample). A 64-word buffer in front of ChaCha8 is not worth keeping: it is
 //! only 1.14× faster than `rand_chacha`'s own block buffer (1024 words in
 //! 4.8 µs against 5.4 µs). Figures: `docs/performance.md`.
 

@@ -64,7 +64,7 @@ pub trait Sampler: Sync {
 /// Which random streams the cases of a run sample: case `i` of the run
 /// samples stream `i` ([`Streams::ALL`]) unless the run is a part of a larger
 /// study and carries the study's case numbers ([`Streams::of`]: a path run a
-/// block of instants at a time draws what the whole run would; issue 36).
+/// block of instants at a time draws what the whole run would).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Streams<'a>(Option<&'a [usize]>);
 

@@ -299,8 +299,8 @@ enum Rows {
     /// `(p·6 + c)·n + j` (one allocation; `n` = the number of errors).
     Stored(Vec<f64>),
     /// Evaluated a block of points at a time when cases, moments or rows
-    /// ask for them, and dropped with the block (issue 36, point 1: a
-    /// million-point grid keeps no `6 × N` matrix per point).
+    /// ask for them, and dropped with the block (so a million-point grid
+    /// keeps no `6 × N` matrix per point).
     OnDemand {
         model: SharedModel,
         parameters: Vec<f64>,
@@ -413,8 +413,7 @@ impl CaseResult {
 /// how FORM ended, the largest standard error, and the cases that did not
 /// converge (how many, and the first of each kind). The one account of the
 /// cases behind the summaries of a grid study and of a path, which a path
-/// run a block of instants at a time adds up as its blocks finish
-/// (issue 36).
+/// run a block of instants at a time adds up as its blocks finish.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct CaseTally {
     /// The cases added.
@@ -1089,7 +1088,7 @@ impl Study {
     /// [`CASE_BLOCK`] cases at a time (in parallel within the block): an
     /// event and its full result (design point, direction cosines) live only
     /// while their block runs, so a study of a million points keeps only its
-    /// cases (issue 36, point 1). The cases come in the set's order whatever
+    /// cases. The cases come in the set's order whatever
     /// the blocks.
     fn cases_in_blocks<T: Send>(
         &self,
@@ -1226,7 +1225,7 @@ impl Study {
     /// Runs `algorithm` on the cases `ids` (indices in the study, target-major,
     /// ascending), each exactly as [`Study::run`] runs it (a sampler's case
     /// draws the streams of its index in the study): what a path run a
-    /// block of instants at a time runs (issue 36, point 1).
+    /// block of instants at a time runs.
     pub fn run_cases(
         &self,
         algorithm: &Algorithm,

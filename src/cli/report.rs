@@ -12,7 +12,7 @@
 //! - tables: [`Report::table`], the human-readable text of each document.
 //!
 //! [`emit`] renders a document in the chosen format straight into a buffered
-//! stdout (JSON and CSV are never held as one string: issue 36, point 1)
+//! stdout (JSON and CSV are never held as one string)
 //! with one error rule ([`write_stdout`]): a closed pipe ends the output
 //! quietly, any other write error is reported and the exit is non-zero.
 

@@ -1,8 +1,9 @@
 //! How a study's results read in words, shared by the commands that run
-//! studies (`reliability`, `sensitivity`, `path`, `allocate`, ...): point
-//! coordinates as JSON objects, the posterior's listing, FORM's and the
-//! samplers' warnings, the per-target maps the plots draw, the
-//! requirement's line.
+//! studies (`reliability`, `sensitivity`, `path`): the posterior's
+//! listing, the per-target maps the plots draw, the line on how FORM ended
+//! and what the cases cost, the sides' names and the requirement's line.
+//! The warnings on cases that did not converge are
+//! `chain::ops::study::unconverged_warnings`.
 
 use chain_core::model::Sided;
 use reliability::{CaseTally, Method, Posterior, Study, StudyResult};

@@ -227,7 +227,8 @@ pub fn run(
     request: &AllocateRequest<'_>,
 ) -> Result<AllocationRun, AllocateOpsError> {
     check(request)?;
-    // Refused from the file before the derivation (issue 36, point 2).
+    // Refused from the file before the derivation: a grid larger than the
+    // target and strategy take.
     let what = match (request.target, request.strategy) {
         (AllocationTarget::Acceptance, _) => GridUse::Acceptance,
         (AllocationTarget::Requirement, StrategyName::Optimal) => GridUse::Optimal,

@@ -27,6 +27,14 @@ pub enum PoseError {
     /// A tool axis of length 0.
     #[error("the tool axis (i, j, k) is zero")]
     ZeroAxis,
+    /// A pose with neither 6 nor 12 values.
+    #[error(
+        "a pose has 6 values (px, py, pz, i, j, k) or 12 (px, py, pz, r11 … r33), found {found}"
+    )]
+    Width {
+        /// The number of values given.
+        found: usize,
+    },
     /// A matrix that is not a rotation (to 1e-6, det +1).
     #[error("r11..r33 is not a rotation (|RᵀR − I| = {worst:.1e}, det = {det:.6})")]
     NotRotation {
@@ -97,19 +105,15 @@ pub const ROTATION_COLUMNS: [&str; 12] = [
 
 impl PoseRow {
     /// A pose from its values: 6 (`px, py, pz, i, j, k`) or 12 (`px, py,
-    /// pz, r11 … r33`); the orientation is checked by [`Orientation::axis`]
-    /// or [`Orientation::rotation`].
-    ///
-    /// # Panics
-    /// When `values` has neither 6 nor 12 entries (the callers check the
-    /// header or the array's shape first).
+    /// pz, r11 … r33`, [`PoseError::Width`] otherwise); the orientation is
+    /// checked by [`Orientation::axis`] or [`Orientation::rotation`].
     pub fn from_values(t: Option<f64>, values: &[f64]) -> Result<PoseRow, PoseError> {
         let orientation = match values.len() {
             6 => Orientation::axis([values[3], values[4], values[5]])?,
             12 => Orientation::rotation(std::array::from_fn(|i| {
                 std::array::from_fn(|j| values[3 + 3 * i + j])
             }))?,
-            n => panic!("a pose has 6 or 12 values, not {n}"),
+            found => return Err(PoseError::Width { found }),
         };
         Ok(PoseRow {
             t,
@@ -117,6 +121,18 @@ impl PoseRow {
             orientation,
         })
     }
+}
+
+/// The poses of `flat`, rows of `width` values each (6 or 12; the width
+/// is refused before any row otherwise); a row's refusal comes with its
+/// 0-based index.
+pub fn pose_rows(flat: &[f64], width: usize) -> Result<Vec<PoseRow>, (Option<usize>, PoseError)> {
+    if width != 6 && width != 12 {
+        return Err((None, PoseError::Width { found: width }));
+    }
+    (flat.chunks_exact(width).enumerate())
+        .map(|(k, v)| PoseRow::from_values(None, v).map_err(|e| (Some(k), e)))
+        .collect()
 }
 
 /// The request of `chain inverse`.

@@ -3,7 +3,7 @@
 //! the points (the grid over `reliability.grid`, or rows) and the built
 //! machine that maps them ([`prepare`]); then the map, or its summary alone,
 //! and with `--compensated` the map after a controller's compensation
-//! ([`PreparedMap::run`], issue 14 point 4; docs/export.md). The CLI and
+//! ([`PreparedMap::run`]; docs/export.md). The CLI and
 //! `Machine.map` run it.
 
 use chain_core::built::{BuiltMachine, MapError, MapSummary, Points};

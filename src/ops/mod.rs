@@ -1,5 +1,5 @@
-//! The application layer under the command line and Python (issue 31, in
-//! slices): what a command resolves from its options before the libraries
+//! The application layer under the command line and Python: what a
+//! command resolves from its options before the libraries
 //! run, written once. The `chain` binary and the Python package both call
 //! these functions, so an option is checked by one rule and refused in one
 //! wording.

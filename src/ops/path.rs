@@ -211,8 +211,8 @@ pub fn prepare(machine: &Machine, request: &PathRequest<'_>) -> Result<PreparedP
             (has_t, instants)
         }
     };
-    // The study keeps the model, not every instant's sensitivities
-    // (issue 36): a path of a million instants holds its points only.
+    // The study keeps the model, not every instant's sensitivities: a
+    // path of a million instants holds its points only.
     let model = Arc::new(chain_core::compile(m));
     let sided = spec.sided;
     let path = PathStudy::on_demand(model, &params, inputs, spec, instants)?;
@@ -269,7 +269,7 @@ impl PreparedPath {
     }
 
     /// The output of the path run a block of instants at a time as it is
-    /// written (each block's records dropped once written; issue 36).
+    /// written (each block's records dropped once written).
     pub fn output<'a>(&'a self, progress: &'a dyn Progress) -> PathOutput<'a> {
         PathOutput {
             head: &self.head,
@@ -445,7 +445,7 @@ struct PathJson<'a> {
 
 /// The instants of [`PathJson`], each object formed as it is written, a
 /// block at a time (a million instants are neither a second list in memory
-/// nor, streamed, a first one; issue 36).
+/// nor, streamed, a first one).
 struct InstantsJson<'a>(&'a PathOutput<'a>);
 
 impl Serialize for InstantsJson<'_> {

@@ -393,7 +393,7 @@ pub fn fixed(m: &Machine, fix: &[(String, f64)]) -> Result<Vec<(usize, f64)>, Re
 }
 
 /// Where each axis variable's values come from in a table of axis values
-/// (`chain path --axes`, `chain map --points`, `chain export --points`,
+/// (`chain path --axes`, `chain map --axes`, `chain export --axes`,
 /// Python's arrays with named columns): its column, or a `--fix` value.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AxesColumns {

@@ -85,9 +85,9 @@ impl From<PosteriorError> for StudyError {
 }
 
 /// A study's parts resolved from the machine file and the options alone:
-/// everything [`study`] checks before the model is derived (issue 36,
-/// point 3: a long chain takes a minute to derive; a missing grid axis, an
-/// unknown `--param` or a missing statistic is refused before that).
+/// everything [`study`] checks before the model is derived (a long chain
+/// takes a minute to derive; a missing grid axis, an unknown `--param` or a
+/// missing statistic is refused before that).
 #[derive(Debug)]
 pub struct Checked {
     spec: StudySpec,
@@ -137,8 +137,8 @@ pub fn check(
 /// The study keeps a copy of the model, not the sensitivities
 /// ([`Study::on_demand`]): every command over it uses each point's a few
 /// times at most, and a million-point grid then holds only its points
-/// (issue 36; the tape's blocks equal its points bit for bit, so the results
-/// are those of a study that keeps them).
+/// (the tape's blocks equal its points bit for bit, so the results are
+/// those of a study that keeps them).
 pub fn build(
     machine: &Machine,
     model: &CompiledModel,

@@ -1082,7 +1082,7 @@ pub const QUOTED_CHARS: usize = 40;
 
 /// `text` as a message quotes it: whole when it has at most
 /// [`QUOTED_CHARS`] characters, else its first [`QUOTED_CHARS`] and `…`
-/// (issue 36: a refused 5,000-digit cell is not echoed in full). The one
+/// (so a refused 5,000-digit cell is not echoed in full). The one
 /// shortening of every located message (YAML scalars, CSV cells, names in
 /// numbers).
 pub fn shortened(text: &str) -> std::borrow::Cow<'_, str> {

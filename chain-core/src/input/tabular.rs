@@ -1,4 +1,4 @@
-//! The one wording of the CSV readers' refusals (issue 18): every CSV input
+//! The one wording of the CSV readers' refusals: every CSV input
 //! of the toolkit — values tables, measurement and candidate files (located
 //! diagnostics, `file:line:column: …` with a snippet), and the command
 //! line's `chain inverse --pose`, `chain path --axes` and `chain compensate

@@ -1,6 +1,6 @@
 //! The exact (not linearised) tool-point deviation of a machine with finite
-//! error values, and its exact derivatives in the errors (issue 33,
-//! point 2): what `chain identify` checks its first-order fit against and
+//! error values, and its exact derivatives in the errors: what
+//! `chain identify` checks its first-order fit against and
 //! what `--iterate` solves.
 //!
 //! # Formulas

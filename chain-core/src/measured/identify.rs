@@ -276,7 +276,7 @@ impl Identification {
 /// ([`noise_rule`]).
 pub const SIGNIFICANT: f64 = 5.0;
 
-/// The noise rule (issue 33, point 1): which of the structural directions
+/// The noise rule: which of the structural directions
 /// of the equilibrated weighted design (singular values `s`, largest first;
 /// `c_i = u_iᵀ y` the data's coordinate along each) the data do not
 /// determine beyond their noise.

@@ -1,5 +1,5 @@
 //! The first-order fit checked against the exact kinematics, and the
-//! exact fit (`chain identify --iterate`, issue 33, point 2;
+//! exact fit (`chain identify --iterate`;
 //! `docs/identify.md`, "When first order is not enough").
 //!
 //! # Formulas

@@ -1,6 +1,7 @@
 //! How an identification predicts measurements it was not fitted to
-//! (issue 33, point 3): the error a machine shows at held-out poses before
-//! correction (the measured values `b`) and after it (`b − A x̂`, the
+//! (`chain identify --validate` or `--holdout`): the error a machine shows
+//! at held-out poses before correction (the measured values `b`) and after
+//! it (`b − A x̂`, the
 //! measured values less what the estimates predict through the same exact
 //! sensitivity rows the fit used), the numbers a calibration engineer
 //! reports for a calibration (`docs/identify.md`, "Prediction at held-out

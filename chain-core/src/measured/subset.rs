@@ -1,4 +1,4 @@
-//! Which unknowns to estimate (issue 34): an identifiable subset chosen by a
+//! Which unknowns to estimate: an identifiable subset chosen by a
 //! rank-revealing elimination, the ordinary least-squares estimates of that
 //! subset with the others fixed at their nominal value (0), and each fixed
 //! unknown's relation to the estimated ones (`docs/identify.md`, "What is

@@ -145,7 +145,7 @@ pub fn expand(input: TokenStream) -> TokenStream {
         type_name: name.to_string(),
         visibility: quote!(#vis),
         crate_path: quote!(::chain),
-        emission: crate::emit::Emission::Direct,
+        emission: crate::emit::Emission::Macro,
     };
     let generated = emit(&model, &options);
     quote!(#generated #tracking)

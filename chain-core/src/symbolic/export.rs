@@ -9,8 +9,9 @@
 //! their definitions: a top-level `functions` list in JSON, a `functions`
 //! block after the error list in text, one `align*` line each in LaTeX; the
 //! coefficients appear in `errors` and `components` as ordinary errors.
-//! Without function slots every output is what it was before
-//! (`docs/function-slots-derivation.md`).
+//! A machine without function slots gets none of these additions (its
+//! outputs are pinned byte for byte by the golden tests;
+//! `docs/function-slots-derivation.md`).
 
 use serde::Serialize;
 #[cfg(feature = "json")]

@@ -133,7 +133,7 @@ impl NominalSizes {
                     ));
                 }
                 // A size is a small error: bounded so that `S·e` and its sum
-                // stay finite (issue 18).
+                // stay finite.
                 let (max, unit) = if angle {
                     (MAX_NOMINAL_ANGLE, "π rad (180°)")
                 } else {

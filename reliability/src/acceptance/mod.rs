@@ -276,7 +276,7 @@ pub enum AcceptanceMethod {
 
 /// How the acceptance probability of non-normal inputs is sampled.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Sampler {
+pub enum AcceptanceSampling {
     /// Crude Monte Carlo, or subset simulation when the pilot's small side
     /// has fewer than [`RARE_EVENTS`] samples.
     Auto,
@@ -382,8 +382,8 @@ pub struct Acceptance {
     /// differences with fixed QMC points).
     pub pivots: Option<Vec<usize>>,
     /// Crude Monte Carlo or subset simulation for non-normal inputs
-    /// ([`Sampler::Auto`]).
-    pub sampler: Sampler,
+    /// ([`AcceptanceSampling::Auto`]).
+    pub sampling: AcceptanceSampling,
     /// Subset simulation: samples per level (2,000).
     pub subset_samples: u64,
     /// Subset simulation: the target coefficient of variation of the small
@@ -402,7 +402,7 @@ impl Default for Acceptance {
             seed: 1,
             sensitivity: true,
             pivots: None,
-            sampler: Sampler::Auto,
+            sampling: AcceptanceSampling::Auto,
             subset_samples: 2000,
             rare_cov: 0.1,
         }
@@ -414,7 +414,7 @@ const BLOCK: u64 = 8192;
 /// Blocks of the crude Monte Carlo pilot (16 · 8,192 = 131,072 samples).
 pub const PILOT_BLOCKS: u64 = 16;
 /// Fewer pilot samples than this on the small side (rejected, or accepted
-/// when `P < 1/2`) select subset simulation under [`Sampler::Auto`]: the
+/// when `P < 1/2`) select subset simulation under [`AcceptanceSampling::Auto`]: the
 /// pilot's coefficient of variation of that side is then above 10 %
 /// (`√((1 − q)/m)`), the small side below `100/131,072 ≈ 7.6·10⁻⁴`, and crude
 /// Monte Carlo would need `100/q` samples for 10 % (10⁷ at `q = 10⁻⁵`), while
@@ -604,7 +604,7 @@ impl Acceptance {
         let inputs = &system.inputs;
         let n = inputs.len();
         let k = system.distinct();
-        if self.sampler != Sampler::MonteCarlo
+        if self.sampling != AcceptanceSampling::MonteCarlo
             && !(self.rare_cov.is_finite() && self.rare_cov > 0.0 && self.rare_cov < 1.0)
         {
             return Err(ReliabilityError::InvalidOption {
@@ -708,7 +708,7 @@ impl Acceptance {
             let total = (blocks * BLOCK) as f64;
             let p = acc[0] / total;
             let se = (p * (1.0 - p) / total).sqrt();
-            if first && self.samples.is_none() && self.sampler != Sampler::MonteCarlo {
+            if first && self.samples.is_none() && self.sampling != AcceptanceSampling::MonteCarlo {
                 let accepted = acc[0] as u64;
                 let drawn = blocks * BLOCK;
                 let (side, events) = if 2 * accepted < drawn {
@@ -716,7 +716,7 @@ impl Acceptance {
                 } else {
                     (RareSide::Rejection, drawn - accepted)
                 };
-                if self.sampler == Sampler::Subset || events < RARE_EVENTS {
+                if self.sampling == AcceptanceSampling::Subset || events < RARE_EVENTS {
                     let budget = self
                         .max_samples
                         .saturating_sub(drawn)

@@ -34,7 +34,7 @@ use serde::Serialize;
 
 use super::{component_summaries, evaluate, step_std};
 use super::{AllocateError, Allocation, ErrorBounds, Paper, Step};
-use crate::acceptance::{Acceptance, AcceptanceResult, Rectangles, Sampler};
+use crate::acceptance::{Acceptance, AcceptanceResult, AcceptanceSampling, Rectangles};
 use crate::error::ReliabilityError;
 use crate::study::Study;
 
@@ -109,7 +109,7 @@ pub fn acceptance<M: ErrorModel + ?Sized>(
         // covers the re-evaluation with another seed.
         Acceptance {
             samples: Some(MC_SAMPLES),
-            sampler: Sampler::MonteCarlo,
+            sampling: AcceptanceSampling::MonteCarlo,
             ..Acceptance::default()
         }
     };

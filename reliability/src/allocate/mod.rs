@@ -103,7 +103,7 @@ impl GridUse {
 /// Refuses a machine whose reliability grid is larger than `what` takes
 /// ([`GridUse::limit`]), from the machine file alone: before the model is
 /// derived, with the advice to allocate on a coarser grid and check the
-/// result on the fine one (issue 36, point 2). A machine without a
+/// result on the fine one. A machine without a
 /// reliability section passes (the study refuses it).
 pub fn check_grid(machine: &Machine, what: GridUse) -> Result<(), ReliabilityError> {
     let Some(r) = &machine.reliability else {

@@ -2,8 +2,8 @@
 //! Tvedt) on three non-normal cases; the numbers come from
 //! `reliability/benches/openturns_sorm.py` (run by hand; CI has no
 //! OpenTURNS). Tolerance: 1e-6 relative in each generalised index (the
-//! issue's; OpenTURNS' Abdo–Rackwitz stops at 1e-12 and its Hessian is its
-//! symbolic one, ours exact).
+//! required agreement; OpenTURNS' Abdo–Rackwitz stops at 1e-12 and its
+//! Hessian is its symbolic one, ours exact).
 
 use chain_core::model::Sided;
 use reliability::sorm::Sorm;

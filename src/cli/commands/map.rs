@@ -8,8 +8,8 @@
 //! at every row of `--axes`, with the error values `v_j` of a values file
 //! (section 2), through [`chain_core::BuiltMachine::map`]. See `docs/map.md`.
 //!
-//! `--compensated CONTROLLER` adds the map after compensation (issue 14,
-//! point 4; `docs/export.md`): the controller's correction
+//! `--compensated CONTROLLER` adds the map after compensation
+//! (`docs/export.md`): the controller's correction
 //! ([`chain_core::compensation::Correction`]) added to every commanded point,
 //! the residual through [`chain_core::BuiltMachine::compensated_map`], shown
 //! next to the uncompensated map (table, JSON `compensated`, CSV columns

@@ -144,7 +144,7 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
         return Ok(());
     }
     // Otherwise each block of instants is written as it is done and only
-    // the summary is kept (issue 36).
+    // the summary is kept.
     let progress = |n| bar.inc(n);
     let output = prepared.output(&progress);
     let written = report::emit(&output, format);

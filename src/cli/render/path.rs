@@ -1,6 +1,6 @@
 //! The table and CSV of `chain path` ([`PathOutput`]): one row per instant
 //! (the error statistics and the reliabilities), then the summary. Both are
-//! written a block of records at a time as the path runs (issue 36); the
+//! written a block of records at a time as the path runs; the
 //! JSON is the output's own `Serialize` (`chain::ops::path`).
 
 use std::io::{self, Write};

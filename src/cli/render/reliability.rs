@@ -66,7 +66,9 @@ impl Report for ReliabilityRun {
             ]
             .map(String::from),
         );
-        // The sampler's stopping rule, when it reports one (v1 runs do not).
+        // The sampler's stopping rule, when it reports one (subset and
+        // directional simulation, and any sampler run to a target CoV; not
+        // FORM, SORM or a plain sample count).
         let stopped = r.cases.iter().any(|c| c.stopping.is_some());
         let leveled = r.cases.iter().any(|c| c.levels.is_some());
         if stopped {

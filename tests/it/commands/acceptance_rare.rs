@@ -4,7 +4,9 @@
 //! of Nataf-correlated non-normal inputs against finite differences of `P`
 //! with common random numbers (the test's own generator and counting).
 
-use reliability::acceptance::{Acceptance, AcceptanceMethod, RareSide, Rectangles, Sampler};
+use reliability::acceptance::{
+    Acceptance, AcceptanceMethod, AcceptanceSampling, RareSide, Rectangles,
+};
 use reliability::inputs::Correlation;
 use reliability::{normal, Inputs, Marginal};
 
@@ -62,7 +64,7 @@ fn small_rejection_by_subset_simulation_equals_the_closed_form() {
     // Crude Monte Carlo over the same pilot cannot see it: the binomial
     // standard error of ~1 event is of the size of the answer itself.
     let mc = Acceptance {
-        sampler: Sampler::MonteCarlo,
+        sampling: AcceptanceSampling::MonteCarlo,
         max_samples: 131_072,
         sensitivity: false,
         ..Acceptance::default()
@@ -119,7 +121,7 @@ fn small_acceptance_by_subset_simulation_equals_the_closed_form() {
 /// The selection itself: a rejection of 2·10⁻³ (~260 pilot events, above
 /// the threshold of 100) stays crude Monte Carlo and equals its closed
 /// form; one of 3·10⁻⁴ (~40 events) goes to subset simulation;
-/// `Sampler::MonteCarlo` and `Sampler::Subset` force either; a bad target
+/// `AcceptanceSampling::MonteCarlo` and `AcceptanceSampling::Subset` force either; a bad target
 /// CoV is refused naming it.
 #[test]
 fn the_pilot_selects_subset_simulation_below_one_hundred_events() {
@@ -140,7 +142,7 @@ fn the_pilot_selects_subset_simulation_below_one_hundred_events() {
     assert!(s.pilot_events < 100 && s.pilot_events > 10, "{s:?}");
     assert!(((1.0 - r.probability) - 3e-4).abs() <= 3.0 * r.std_error);
     let forced = Acceptance {
-        sampler: Sampler::MonteCarlo,
+        sampling: AcceptanceSampling::MonteCarlo,
         ..plain.clone()
     }
     .run(&system(3e-4))
@@ -148,7 +150,7 @@ fn the_pilot_selects_subset_simulation_below_one_hundred_events() {
     assert_eq!(forced.method, AcceptanceMethod::MonteCarlo);
     assert!(forced.subset.is_none());
     let forced = Acceptance {
-        sampler: Sampler::Subset,
+        sampling: AcceptanceSampling::Subset,
         ..plain.clone()
     }
     .run(&system(0.2))

@@ -283,7 +283,7 @@ fn cli_infeasible_exits_non_zero_naming_component_and_errors() {
 /// tightened. The paper's procedure stalls on `px` at round 0 and the
 /// least-cost allocation finds the requirement infeasible; each refusal
 /// names the file, line and column of the statistics entry of the error it
-/// lists first, and shows it (issue 36: it named the machine only).
+/// lists first, and shows it (not the machine alone).
 #[test]
 fn cli_stalled_and_infeasible_allocations_point_at_the_statistics_entry() {
     let text = std::fs::read_to_string(gantry_path()).unwrap();
@@ -557,7 +557,7 @@ fn gantry_grid(name: &str, n: [usize; 3], parameters: &str) -> PathBuf {
     common::cli::scratch_file(name, &text)
 }
 
-/// Issue 36, point 2: each allocation refuses a grid larger than it runs on
+/// Each allocation refuses a grid larger than it runs on
 /// within about a minute, from the machine file before the derivation (a
 /// symbolic parameter, which the study would refuse, is not reached),
 /// naming the reliability section, the counts and what to do instead.

@@ -1,4 +1,4 @@
-//! The batched kernels of the `machine!` types (issue 35, point 1):
+//! The batched kernels of the `machine!` types:
 //! `sensitivity_batch_into`, `sensitivity_nonzeros_batch_into`,
 //! `error_batch_into`, `error_batch_each_into` and the `ErrorModel` batch
 //! methods over them, on every example machine (a test below fails when a

@@ -1,4 +1,4 @@
-//! Denavit–Hartenberg bodies (issue 33, point 4): a `dh` / `mdh` row derives
+//! Denavit–Hartenberg bodies: a `dh` / `mdh` row derives
 //! to the model of the Denavit–Hartenberg product itself.
 //!
 //! The DH tables are written out here, not read from the files, and each

@@ -12,7 +12,7 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The bound of issue 11 on what a library user compiles (the crate itself
+/// The bound on what a library user compiles (the crate itself
 /// not counted).
 const MAX_DOWNSTREAM_CRATES: usize = 40;
 

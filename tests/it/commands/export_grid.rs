@@ -1,5 +1,5 @@
-//! `chain export --controller grid` (measured-machines spec, section 6;
-//! issue 14 points 1 and 3) against an independent computation: the exported
+//! `chain export --controller grid` (measured-machines spec, section 6)
+//! against an independent computation: the exported
 //! corrections applied back through the exact numeric 4×4 product of
 //! `tests/it/common` (not chain's model), on a 3-axis machine (vmc3) and a
 //! 5-axis machine (ac_trunnion), with values files of errors of about

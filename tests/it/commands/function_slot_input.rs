@@ -2,8 +2,8 @@
 //! iso` in machine files (measured-machines spec, section 1): the valid
 //! forms give exactly the named coefficients, kinds and function records;
 //! every refusal is one located diagnostic naming the file, line and key, and
-//! `chain derive` exits non-zero on it. The v1 example machines load exactly
-//! as they did before function slots existed.
+//! `chain derive` exits non-zero on it. The v1 example machines (without
+//! function slots) load exactly to their recorded machines.
 
 use crate::common;
 
@@ -377,13 +377,13 @@ fn iso_names_the_six_component_errors_after_the_variable() {
 
 // ------------------------------------------------------------- v1 unchanged
 
-/// The serialised machine of every v1 example, recorded before function
-/// slots and `iso` existed (`tests/data/function_slots/v1/`): the loader
+/// The serialised machine of every v1 example, recorded by a loader without
+/// function slots and `iso` (`tests/data/function_slots/v1/`): the loader
 /// builds exactly the same machines.
 #[test]
 fn v1_example_machines_load_exactly_as_before() {
-    // The six v1 example machines recorded before function slots existed
-    // (examples added since are not v1 files).
+    // The six v1 example machines, those recorded under
+    // `tests/data/function_slots/v1/` (the other examples are not v1 files).
     let v1 = [
         "ac_trunnion",
         "cnc5_bevel",

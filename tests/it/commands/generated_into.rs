@@ -1,16 +1,17 @@
-//! The `machine!` functions that write into the caller's storage (issue 17):
+//! The `machine!` functions that write into the caller's storage:
 //! `sensitivity_into`, `sensitivity_flat_into`, `sensitivity_nonzeros` with
 //! `NONZEROS`, `error_into` and the `ErrorModel` impl over them, on every
-//! example machine the macro declares and on the issue's B-head/C-table
-//! benchmark machine.
+//! example machine the macro declares and on the B-head/C-table benchmark
+//! machine (`chain-macro/benches/machines/bc_head_table.yaml`).
 //!
 //! The reference is the v1 emission of the same machines (`chain derive
-//! --format rust`, `chain_core::emit::Emission::V1`, the bodies before issue
-//! 17) committed under `tests/generated_v1/` and compiled here:
-//! `v1_files_are_current` checks that they are the emitter's v1 output, so
-//! this test compares the new bodies against the old ones. Values are equal
-//! as `f64` (`==`) and bit for bit when non-zero: the new bodies share a
-//! sum and its negation, exact in IEEE 754 but for the sign of a zero.
+//! --format rust`, `chain_core::emit::Emission::Derive`: each function a
+//! self-contained body) committed under `tests/generated_v1/` and compiled
+//! here: `v1_files_are_current` checks that they are the emitter's v1
+//! output, so this test compares the `machine!` bodies (`Emission::Macro`)
+//! against the v1 ones. Values are equal as `f64` (`==`) and bit for bit
+//! when non-zero: the `machine!` bodies share a sum and its negation, exact
+//! in IEEE 754 but for the sign of a zero.
 
 use crate::common::Points;
 use chain::core::ErrorModel;
@@ -69,7 +70,7 @@ fn v1_files_are_current() {
         let machine = chain::core::load_file(&root().join(file)).unwrap_or_else(|d| panic!("{d}"));
         let model = chain::core::derive(&machine);
         let options = chain::core::emit::EmitOptions::for_model(&model);
-        assert_eq!(options.emission, chain::core::emit::Emission::V1);
+        assert_eq!(options.emission, chain::core::emit::Emission::Derive);
         let code = chain::core::emit::emit_pretty(&model, &options);
         let recorded =
             std::fs::read_to_string(root().join(format!("tests/generated_v1/{name}.rs"))).unwrap();
@@ -98,7 +99,8 @@ fn runtime_model_has_no_sparsity() {
     assert_eq!(out, [5.0; 32]);
 }
 
-/// The whole comparison for one machine: new type `$new`, v1 type `$old`.
+/// The whole comparison for one machine: `machine!` type `$new`, v1 type
+/// `$old`.
 macro_rules! compare {
     ($new:ty, $old:ty, $file:expr) => {{
         const V: usize = <$new>::VARIABLES.len();

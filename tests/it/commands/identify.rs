@@ -466,7 +466,7 @@ fn values_out_reads_back_and_maps_like_the_estimates() {
         &Default::default(),
     )
     .unwrap();
-    // The file holds the least-squares subset's values (issue 34).
+    // The file holds the least-squares subset's values.
     let (solution, _) = lib.solution();
     let mut b = ValuesBuilder::new(&m);
     for (j, (name, est)) in lib.estimates.0.iter().enumerate() {
@@ -855,7 +855,7 @@ fn reliability_after_calibration_reads_the_identified_posterior() {
     // The whole workflow on the gantry grinder: measure tool-point
     // deviations (tool point 0, position only: rank deficient), identify,
     // write the values, run `chain reliability --values`. Without a prior
-    // the values are the least-squares subset's (issue 34);
+    // the values are the least-squares subset's;
     // with `--prior` it is full rank; both run through the reliability.
     let m = load_example("gantry_grinder.yaml");
     let means: Vec<f64> = m
@@ -976,7 +976,7 @@ fn reliability_after_calibration_reads_the_identified_posterior() {
     check(&post);
 }
 
-/// `--validate` (issue 33, point 3): the estimates' prediction at poses held
+/// `--validate`: the estimates' prediction at poses held
 /// out of the fit, against an independent computation: the error before is
 /// the measured deviations themselves, the error after is the measured
 /// deviations less the exact numeric product of `tests/it/common` with the

@@ -1,4 +1,4 @@
-//! The exact kinematics of `chain identify` (issue 33, point 2) against the
+//! The exact kinematics of `chain identify` against the
 //! independent numeric 4×4 product of `tests/it/common`: the deviation with
 //! finite errors and its derivatives (central differences of that
 //! product); the first-order check; `--iterate` on errors large enough that

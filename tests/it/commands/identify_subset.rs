@@ -1,4 +1,4 @@
-//! What `chain identify` estimates and what it fixes (issues 33 and 34),
+//! What `chain identify` estimates and what it fixes,
 //! against independent computations: measurements simulated through the
 //! exact numeric 4×4 product of `tests/it/common` (not chain's derivation),
 //! the known redundancies of serial chains (consecutive parallel joint axes,
@@ -519,7 +519,7 @@ fn the_cli_chooses_the_subset_as_the_library_does() {
             "{name}: {got} vs {want}"
         );
     }
-    // TX now carries DX6: the fixed DX6 acts as TX.
+    // With DX6 fixed in TX's place, TX carries DX6: the fixed DX6 acts as TX.
     let words: Vec<&str> = json["subset"]["fixed"]
         .as_array()
         .unwrap()

@@ -1,4 +1,4 @@
-//! Inverse kinematics (issue 8 point 2): round trips forward(inverse(pose)) =
+//! Inverse kinematics: round trips forward(inverse(pose)) =
 //! pose on random reachable poses, a singular and an unreachable pose, and the
 //! `chain inverse` CLI (JSON shape, bad CSV).
 

@@ -229,3 +229,34 @@ fn an_idle_spin_is_held_whatever_else_is_fixed() {
         .iter()
         .any(|sol| (sol[index("A")] - 0.5).abs() < 1e-9));
 }
+
+/// A pose of neither 6 nor 12 values is a refusal, not a panic, before any
+/// row is read; a bad row is named by its index.
+#[test]
+fn pose_widths_other_than_6_and_12_are_refused() {
+    use chain::ops::inverse::{pose_rows, PoseError, PoseRow};
+    for width in [0, 5, 7, 11, 13] {
+        let flat = vec![1.0; 2 * width];
+        let (row, e) = pose_rows(&flat, width).unwrap_err();
+        assert_eq!((row, e.clone()), (None, PoseError::Width { found: width }));
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "a pose has 6 values (px, py, pz, i, j, k) or 12 (px, py, pz, r11 … r33), found {width}"
+            )
+        );
+        assert!(matches!(
+            PoseRow::from_values(None, &flat[..width]),
+            Err(PoseError::Width { found }) if found == width
+        ));
+    }
+    let rows = pose_rows(
+        &[0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 2.0, 3.0, 0.0, 0.0, 0.0],
+        6,
+    );
+    assert!(matches!(rows, Err((Some(1), PoseError::ZeroAxis))));
+    assert_eq!(
+        pose_rows(&[0.0, 0.0, 0.0, 0.0, 0.0, 1.0], 6).unwrap().len(),
+        1
+    );
+}

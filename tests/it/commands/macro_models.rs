@@ -271,7 +271,8 @@ fn wrong_slice_lengths_give_nan_not_panic() {
 
 /// `chain derive --format rust` prints the v1 emission (pinned byte for byte
 /// by `tests/golden/derive_gantry.rs.txt`); the macro emits the same type with
-/// the issue-17 functions (`Emission::Direct`). Both are the one emitter's
+/// the functions that write into the caller's storage
+/// (`Emission::Macro`). Both are the one emitter's
 /// output for the same model.
 #[test]
 fn derive_format_rust_prints_what_the_macro_emits() {
@@ -293,7 +294,7 @@ fn derive_format_rust_prints_what_the_macro_emits() {
     // The formatter may break the call over several lines when the absolute
     // path is long, so cut the whole statement, not one line.
     let without_tracking = remove_tracking_statement(&expanded);
-    let direct = options.with_emission(chain::core::emit::Emission::Direct);
+    let direct = options.with_emission(chain::core::emit::Emission::Macro);
     assert_eq!(
         chain::core::emit::emit_pretty(&model, &direct),
         without_tracking

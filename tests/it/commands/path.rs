@@ -714,8 +714,9 @@ fn moments_follow_the_sensitivity_rows() {
 
 #[test]
 fn chain_motion_csv_feeds_chain_path_directly() {
-    // The bridge of issue 8: the converted bevel-gear motion (`chain motion
-    // --format csv`, header `t,<variables>`) read by `chain path --axes -`.
+    // The bridge from motion to path: the converted bevel-gear motion
+    // (`chain motion --format csv`, header `t,<variables>`) read by
+    // `chain path --axes -`.
     let text = ok_stdout(&[
         "motion",
         s(&example_path("cnc5_bevel.yaml")),

@@ -540,7 +540,7 @@ fn cli_bad_input_is_located() {
     let bad = |name: &str, text: &str, count: &str, wants: &[&str]| {
         refused(GANTRY, name, text, &["--count", count], wants)
     };
-    // The spec's and the bad inputs of a candidate file.
+    // Bad inputs of a candidate file, the spec's among them.
     bad(
         "unknown.csv",
         "x,y,z,w\n0,0,600,1\n",

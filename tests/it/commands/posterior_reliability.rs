@@ -1,4 +1,4 @@
-//! Post-measurement reliability (issue 13, point 2; `docs/posterior.md`):
+//! Post-measurement reliability (`docs/posterior.md`):
 //! `chain reliability --values` and `chain sensitivity --values` with the
 //! posterior of a calibration, on the gantry grinder of seed 000.
 //!

@@ -618,7 +618,7 @@ fn grid_ranges_are_the_same_grid_as_the_listed_values() {
     assert!(err.contains("N ≥ 2"), "{err}");
 }
 
-/// Issue 36, point 3: what a study needs from the machine file and the
+/// What a study needs from the machine file and the
 /// options is checked with no model (`chain::ops::study::check`, which every
 /// study command runs before the derivation): a grid axis missing from the
 /// file, an empty `--grid` axis, an unknown `--param`, an error without

@@ -191,7 +191,7 @@ fn sampler_options_are_checked_with_their_name() {
     ]);
     assert!(err.contains("'--cov'"), "{err}");
     // The sample count and the target's range too, for every command that
-    // samples (the count was once refused only after the model was built).
+    // samples, before the model is built.
     for (command, args) in [
         ("reliability", &["--method", "mc", "--samples", "0"][..]),
         (

@@ -1,4 +1,4 @@
-//! `chain reliability --method sorm` (issue 15 point 3; reliability-v2 §3)
+//! `chain reliability --method sorm` (reliability-v2 §3)
 //! end to end. The library's formulas are checked against OpenTURNS in
 //! `reliability/tests/it/sorm.rs`; here the command: on the gantry with normal
 //! inputs every limit state is linear in u, so the curvatures vanish and

@@ -1,4 +1,4 @@
-//! Issue 36, point 1: a study that keeps the model instead of every point's
+//! A study that keeps the model instead of every point's
 //! sensitivities (`Study::on_demand`, what every study command builds) gives
 //! the results of one that keeps them (`Study::new`) bit for bit, on every
 //! example machine with a reliability section and on a grid larger than one
@@ -126,7 +126,7 @@ fn on_demand_form_equals_kept_across_case_blocks() {
     assert_eq!(k, l);
 }
 
-/// A gibibyte, the bound of issue 36, point 1.
+/// A gibibyte, the peak memory a million-point command must stay under.
 const GIB: u64 = 1 << 30;
 
 /// The million-point runs of docs/performance.md under 1 GiB each (`map`

@@ -727,7 +727,7 @@ pub fn subset_estimates(m: &Machine, json: &serde_json::Value) -> (Vec<f64>, Vec
         .unzip()
 }
 
-/// Each estimated error's combination of the truth (issue 34): `e_k + Σ_j
+/// Each estimated error's combination of the truth: `e_k + Σ_j
 /// c_jk e_j` over the fixed errors' relations of the JSON; a fixed error's
 /// entry is its nominal 0.
 pub fn subset_combinations(m: &Machine, json: &serde_json::Value, e: &[f64]) -> Vec<f64> {

@@ -7,8 +7,8 @@
 //! - the generator's derived pose is the printed Eq. 3-4 with three typos
 //!   corrected (docs/errata.md 002-3..002-5), exactly up to rounding (1e-12),
 //!   and the independent 4×4 product of `tests/it/common` agrees (1e-12);
-//! - the two chains give the same pose to 1e-9 (mm, rad: the issue's
-//!   figure; Newton stops at ~1e-13) at 1,000 instants for both settings,
+//! - the two chains give the same pose to 1e-9 (mm, rad: the required
+//!   agreement; Newton stops at ~1e-13) at 1,000 instants for both settings,
 //!   checked with the symbolic engine and with the independent product;
 //! - the paper's closed forms (i = j = 0; the tilted case) agree with the
 //!   general solution to 1e-9 once corrected (A = −φ_p; A by atan2);
@@ -1166,14 +1166,14 @@ fn cli_json_document_and_plots() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A roll too fast for its instants is refused from the settings alone
-/// (issue 36, point 3): a roll ratio of 1e5 turned the blank through 41,900
-/// rad, 42 rad between the 1,000 instants, and ran 24 s (38 s before) of
-/// continuation; a ratio of 30,000 turns it by 12.58 rad ≈ 4π between
-/// instants, which the continuation took for no turn at all (the axis came
-/// back a whole number of turns off). With the instants it asks for, the
-/// run follows the roll: the work axis turns through the whole roll, at
-/// most a quarter turn between rows.
+/// A roll too fast for its instants is refused from the settings alone: a
+/// roll ratio of 1e5 turns the blank through 41,900 rad, 42 rad between the
+/// 1,000 instants (a run of it measured 24 s of continuation); a ratio
+/// of 30,000 turns it by 12.58 rad ≈ 4π between instants, which the
+/// continuation takes for no turn at all (the axis comes back a whole
+/// number of turns off). With the instants it asks for, the run follows the
+/// roll: the work axis turns through the whole roll, at most a quarter turn
+/// between rows.
 #[test]
 fn a_roll_too_fast_for_its_instants_is_refused_from_its_inputs() {
     let good = std::fs::read_to_string(settings_path("seed002_concave")).unwrap();
@@ -1250,7 +1250,7 @@ fn a_roll_too_fast_for_its_instants_is_refused_from_its_inputs() {
 }
 
 /// An instant the CNC machine cannot reach is refused where its cause was
-/// given (issue 36: the refusal named no file, line or option): with the
+/// given: with the
 /// rotary axes held by `--fix`, naming the option; held by the settings'
 /// `cnc.fix`, at that key; with nothing held, at the generator's `values`.
 #[test]

@@ -1,4 +1,4 @@
-//! Atomic file writes (issue 18, point 1): every file is written to a
+//! Atomic file writes: every file is written to a
 //! temporary file beside it and renamed into place, so a failed write leaves
 //! no partial file (`src/cli/atomic.rs`).
 

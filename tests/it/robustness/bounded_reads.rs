@@ -1,4 +1,4 @@
-//! Bounded reads (issue 18, point 2): a device or a FIFO given as an input
+//! Bounded reads: a device or a FIFO given as an input
 //! file is refused, with the file's name and its bound, after at
 //! most the bound's bytes were read (`chain_core::bounded`).
 

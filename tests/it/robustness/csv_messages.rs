@@ -1,4 +1,4 @@
-//! One message shape for every CSV reader (issue 18, point 5): a header-only
+//! One message shape for every CSV reader: a header-only
 //! file, a ragged row and a non-numeric cell are worded the same by `chain
 //! inverse --pose`, `chain path --axes`, `chain compensate`, measurement
 //! CSVs (`chain identify`) and values tables (`chain map --values`), under
@@ -188,7 +188,7 @@ fn values_tables() {
     }
 }
 
-/// Issue 36, point 4: a refused huge value is quoted shortened (its first
+/// A refused huge value is quoted shortened (its first
 /// 40 characters and `…`, `chain_core::diagnostic::shortened`), not printed
 /// in full: a 5,000-character cell in a CSV of `path`, `compensate` and a
 /// values table, and a 5,000-character name where a number belongs in a
@@ -244,7 +244,7 @@ fn huge_refused_values_are_quoted_shortened() {
 }
 
 /// A huge option value, argument or subcommand refused by the command-line
-/// parser is quoted shortened too (issue 36: clap echoed it whole), with
+/// parser is quoted shortened too (clap's own message echoes it whole), with
 /// clap's exit status 2.
 #[test]
 fn huge_command_line_values_are_quoted_shortened() {

@@ -1,4 +1,4 @@
-//! Numbers that stay numbers (issue 18, point 4): extreme values are refused
+//! Numbers that stay numbers: extreme values are refused
 //! with their key or option, or written in a finite form, never as `inf` or
 //! `NaN` in a successful output.
 
@@ -160,9 +160,9 @@ fn an_unknown_at_name_blames_at_not_the_machine_file() {
     );
 }
 
-/// Issue 36: an axis value of 1e300 gives finite sensitivities (about
-/// 1e300) whose moments overflow; `path` exited 0 with `inf` in its table.
-/// The study refuses the point, naming it (in exponent form) and what
+/// An axis value of 1e300 gives finite sensitivities (about 1e300) whose
+/// moments overflow (unchecked, `path` would exit 0 with `inf` in its
+/// table). The study refuses the point, naming it (in exponent form) and what
 /// overflowed; `reliability` over such a grid likewise.
 #[test]
 fn axis_values_whose_moments_overflow_are_refused_naming_the_point() {

@@ -1,4 +1,4 @@
-//! Fuzzing in the test command (issue 36, point 5): mutated example inputs
+//! Fuzzing in the test command: mutated example inputs
 //! through every parser and entry point, with zero panics, zero hangs (a
 //! time bound per case) and zero aborts allowed.
 //!

@@ -1,40 +1,40 @@
-//! The CLI's outputs before and after the architecture change.
+//! The CLI's outputs against recorded reference outputs.
 //!
-//! `tests/golden/commands.txt` lists commands whose outputs were recorded with
-//! the binary built from the commit before the change (`tests/golden/NAME`).
-//! Each is run again and compared byte for byte, in every format.
+//! `tests/golden/commands.txt` lists commands whose outputs are recorded in
+//! `tests/golden/NAME` from an earlier build of the binary (see that file's
+//! header). Each is run again and compared byte for byte, in every format.
 //!
-//! The `reliability` and `path` (FORM) outputs have since gained content
-//! (FORM's termination and call counts, the cases that did not converge,
-//! the path's volumetric columns): they were re-recorded on 6 Dec 2026, after
-//! a check that every recorded line, JSON key and CSV column of the earlier
-//! recording was contained, unchanged, in the new output. They too must now
-//! come out byte for byte.
+//! The `reliability` and `path` (FORM) recordings, of 6 Dec 2026, include
+//! FORM's termination and call counts, the cases that did not converge and
+//! the path's volumetric columns; every line, JSON key and CSV column of the
+//! recording they replace was checked to be contained, unchanged, in them.
+//! They too must come out byte for byte.
 //!
 //! One exception to byte identity: the least-cost allocation
 //! (`allocate_optimal.*`). Its linear solves are nalgebra's LU and Cholesky
-//! since issue 11 (item 5: no hand-written linear algebra), and the optimum
-//! moves by round-off (the stds by 1-3 ulp, the KKT residuals between
+//! (no hand-written linear algebra), and the optimum differs from the
+//! recording by round-off (the stds by 1-3 ulp, the KKT residuals between
 //! 6.7e-16 and 8.9e-16). Those files are compared number by number: equal to
 //! 1e-14 relative, or both below 1e-14 in magnitude (round-off residuals);
 //! every other byte identical.
 //!
 //! A second exception: the path on the five-axis machine (`path_cnc5.*`)
-//! is compared to the same round-off where its numbers are JSON. Since
-//! issue 35 the runtime tape takes `sin`/`cos` of the rotary axes from the
-//! vectorised kernel of `chain_core::lanes` (≤ 2 ulp from the standard
-//! library's, docs/macro.md), and its means move by an ulp.
+//! is compared to the same round-off where its numbers are JSON. The
+//! runtime tape takes `sin`/`cos` of the rotary axes from the vectorised
+//! kernel of `chain_core::lanes` (≤ 2 ulp from the standard library's,
+//! docs/macro.md), and its means differ from the recording by an ulp.
 //!
-//! The sampling methods are not recorded in that list: their results moved
-//! with the random streams in issue 11, within their standard errors (their
-//! checks are in `papers/reliability_gantry.rs`, `commands/reliability_cli.rs`
-//! and `commands/path.rs`).
+//! The sampling methods are not in that list: the recording's binary drew
+//! other random streams, and their results differ within their standard
+//! errors (their checks are in `papers/reliability_gantry.rs`,
+//! `commands/reliability_cli.rs` and `commands/path.rs`).
 //!
-//! `tests/golden/ops/commands.txt` (issue 31: one application layer,
-//! `chain::ops`, under the CLI and Python; the samplers behind one trait and
-//! one driver) lists every command on the example inputs, the seeded samplers
-//! with and without a target CoV included, recorded with the binary of the
-//! commit before issue 31 (aa98b10); each must come out byte for byte.
+//! `tests/golden/ops/commands.txt` lists every command on the example
+//! inputs, the seeded samplers with and without a target CoV included,
+//! recorded with the binary of commit aa98b10 (the exceptions are noted in
+//! that file): the one application layer `chain::ops` under the CLI and
+//! Python, and the samplers behind one trait and one driver, must reproduce
+//! each output byte for byte.
 
 use crate::common;
 

@@ -1,5 +1,5 @@
 //! Options checked by the parser, with their name in the message, before any
-//! file is read (issue 18, point 4).
+//! file is read.
 
 use std::process::Command;
 

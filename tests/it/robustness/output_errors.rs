@@ -1,4 +1,4 @@
-//! Output errors (issue 18, point 1): a closed pipe ends every command
+//! Output errors: a closed pipe ends every command
 //! quietly (no panic, no message), a full device is a clear message and
 //! exit 1. Every subcommand that writes a result to stdout: derive,
 //! reliability, sensitivity, allocate, inverse, path, map, compensate,

@@ -1,7 +1,7 @@
 //! A machine file written as one line of JSON (which YAML accepts) whose
-//! located error sits past column 65,535: the diagnostic renderer used to
-//! panic there ("Formatting argument out of range", exit 101). The snippet is
-//! now cut to a window around the located key (issue 18, point 5).
+//! located error sits past column 65,535: the diagnostic renderer cuts the
+//! snippet to a window around the located key, because rendering a line
+//! that wide whole panics ("Formatting argument out of range", exit 101).
 
 use std::process::Command;
 

@@ -202,7 +202,7 @@ impl Loader {
             self.finite(node, &path, key)
         };
         // Moments square these numbers and sum them over the errors: a
-        // magnitude above `MAX_STATISTIC` would overflow to `inf` (issue 18).
+        // magnitude above `MAX_STATISTIC` would overflow to `inf`.
         Some(match v {
             Some(x) if x.abs() > MAX_STATISTIC => {
                 self.report(

@@ -24,7 +24,7 @@ pub const MAX_TABLE_BYTES: usize = crate::bounded::TABLE_BYTES;
 /// The data cells are kept compactly (their texts one after another, and
 /// per cell where it is; a cell's [`Origin`] is formed when its row is read
 /// through [`CsvFile::rows`]): a million-row file costs about its size
-/// again, not a string and an origin per cell (issue 36).
+/// again, not a string and an origin per cell.
 #[derive(Debug, Clone)]
 pub struct CsvFile {
     /// Its text (for the diagnostics' snippets).

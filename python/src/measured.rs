@@ -1,7 +1,7 @@
-//! Bindings group B, the measured machine (measured-machines spec):
-//! `chain map`, `chain identify`, `chain plan` and `chain compensate`, each
-//! returning the document the CLI prints with `--format json` for the same
-//! input, built by the same library function.
+//! The measured machine (measured-machines spec): `chain map`, `chain
+//! identify` and `chain plan`, each returning the document the CLI prints
+//! with `--format json` for the same input, built by the same library
+//! function.
 //!
 //! Inputs the CLI reads from files come as a path or as their text (the
 //! Python side writes numpy arrays as the CSV the CLI would read, so that

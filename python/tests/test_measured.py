@@ -92,7 +92,7 @@ def test_identify_is_the_cli_json(name, cli, tmp_path):
 
 
 def test_identify_validate_is_the_cli_json(cli):
-    """Machine.identify(validate=...) equals `chain identify --validate` (issue 33, point 3): the
+    """Machine.identify(validate=...) equals `chain identify --validate`: the
     held-out measurements as a path or as columns give the same prediction."""
     m = chain.Machine.load(PROBE)
     ball, inter = MEAS / "ballplate.csv", MEAS / "interferometer.csv"
@@ -206,7 +206,7 @@ def test_inverse_is_the_cli_json(cli, cli_error, tmp_path):
     # One pose as a 1-D row; fix and params by name.
     one = m.inverse(poses[0])
     assert one.rows[0] == got.rows[0]
-    with pytest.raises(ValueError, match="poses must have 6 columns"):
+    with pytest.raises(ValueError, match="poses: a pose has 6 values \\(px, py, pz, i, j, k\\) or 12"):
         m.inverse(np.zeros((2, 5)))
     with pytest.raises(ValueError, match="poses row 1: the tool axis \\(i, j, k\\) is zero"):
         m.inverse(np.array([poses[0], [0, 0, 0, 0, 0, 0]]))
@@ -221,8 +221,8 @@ def test_inverse_is_the_cli_json(cli, cli_error, tmp_path):
 
 
 def test_identify_subset_options_are_the_cli_json(cli):
-    """Machine.identify(fix=, estimate=, rank_tol=) equals `chain identify --fix/--estimate/--rank-tol`
-    (issue 34): the same subset document; a bad name raises the CLI's message."""
+    """Machine.identify(fix=, estimate=, rank_tol=) equals `chain identify --fix/--estimate/--rank-tol`:
+    the same subset document; a bad name raises the CLI's message."""
     m = chain.Machine.load(PROBE)
     ball = MEAS / "ballplate.csv"
     r = m.identify(ball)
@@ -245,7 +245,7 @@ def test_identify_subset_options_are_the_cli_json(cli):
 
 
 def test_identify_iterate_is_the_cli_json(cli):
-    """Machine.identify(iterate=True) equals `chain identify --iterate` (issue 33, point 2)."""
+    """Machine.identify(iterate=True) equals `chain identify --iterate`."""
     m = chain.Machine.load(PROBE)
     ball = MEAS / "ballplate.csv"
     r = m.identify(ball, iterate=True)
@@ -256,7 +256,7 @@ def test_identify_iterate_is_the_cli_json(cli):
 
 
 def test_identify_holdout_is_the_cli_json(cli):
-    """Machine.identify(holdout=, seed=) equals `chain identify --holdout --seed` (issue 33, point 3)."""
+    """Machine.identify(holdout=, seed=) equals `chain identify --holdout --seed`."""
     m = chain.Machine.load(PROBE)
     ball = MEAS / "ballplate.csv"
     r = m.identify(ball, holdout=0.25, seed=7)

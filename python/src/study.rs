@@ -1,6 +1,8 @@
-//! The reliability bindings (issue 16): `chain reliability` with every
-//! option of the command line (methods form, is, mc, sorm, subset,
-//! directional; `cov`; `system`; `values`; `acceptance`) and `chain sobol`.
+//! The study commands' bindings: `chain reliability` with every option of
+//! the command line (methods form, is, mc, sorm, subset, directional;
+//! `cov`; `system`; `values`; `acceptance`) and `chain sobol`, and the
+//! study options `chain path` and `chain sensitivity` share with them
+//! (method, samples, seed and target; system; approach).
 //!
 //! Each returns the document the CLI prints with `--format json` for the
 //! same input: `chain reliability`'s through `chain::ops::reliability` (the
