@@ -164,9 +164,10 @@ def positioning_json(
 
 def inverse_json(
     model: Model,
-    poses: npt.NDArray[np.float64],
+    poses: Optional[npt.NDArray[np.float64]],
     fix: Sequence[Tuple[str, float]],
     params: Sequence[Tuple[str, float]],
+    poses_file: Optional[str] = None,
 ) -> str: ...
 
 
@@ -187,6 +188,8 @@ def path_json(
     sided: Optional[str],
     system: Optional[str],
     system_tolerance: Optional[float],
+    axes_file: Optional[str] = None,
+    poses_file: Optional[str] = None,
 ) -> str: ...
 
 

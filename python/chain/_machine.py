@@ -282,11 +282,14 @@ class Machine:
         ``poses``: an ``(N, 6)`` array of ``px, py, pz, i, j, k`` (tool point
         and tool axis in the workpiece frame) or ``(N, 12)`` of ``px, py, pz,
         r11 … r33`` (the whole tool frame, row-major); one pose may be a 1-D
-        row. ``fix``: values of the variables the pose does not determine
+        row; or the path of a pose CSV, read as ``--pose`` reads it. ``fix``: values of the variables the pose does not determine
         (``--fix``). Built and checked by ``chain::ops::inverse`` as the CLI's.
         """
         from ._results import InverseResult
 
+        if isinstance(poses, (str, os.PathLike)):
+            text = _chain.inverse_json(self._model, None, _params(fix), _params(params), os.fspath(poses))
+            return InverseResult._from_json(text)
         a = _float_array(poses, "poses")
         if a.ndim == 1:
             a = a.reshape(1, -1)
@@ -319,7 +322,9 @@ class Machine:
           works) naming axis variables in any order, as the columns of
           ``--axes`` (an optional first ``"t"`` is the instant);
         - ``poses``: an ``(N, 6)`` or ``(N, 12)`` array of tool poses as for
-          :meth:`inverse`, solved by the inverse kinematics.
+          :meth:`inverse`, solved by the inverse kinematics;
+        - either as the path of a CSV file, read as ``--axes`` or ``--pose``
+          reads it.
 
         ``t``: the instants (``N`` values; the row numbers when omitted).
         ``fix``: variables held at a value (``--fix``). ``method``,
@@ -331,6 +336,18 @@ class Machine:
 
         if (axes is None) == (poses is None):
             raise ValueError("give the path as axes=... or poses=... (one of them)")
+        if isinstance(axes, (str, os.PathLike)) or isinstance(poses, (str, os.PathLike)):
+            if t is not None:
+                raise ValueError("t=... is given with a file; give the instants as its column t")
+            if not isinstance(method, str):
+                raise ValueError(f"method must be a str, not {type(method).__name__}")
+            axes_file = None if axes is None else os.fspath(axes)
+            poses_file = None if poses is None else os.fspath(poses)
+            text = _chain.path_json(
+                self._model, [], None, None, None, _params(fix), _params(params),
+                method, samples, seed, cov, sided, system, system_tolerance, axes_file, poses_file,
+            )
+            return PathResult._from_json(text)
         header: List[str] = []
         axes_array = poses_array = t_array = None
         if t is not None:

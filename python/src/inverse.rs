@@ -1,11 +1,14 @@
 //! `chain inverse --format json` over an array of poses, through
 //! `chain::ops::inverse` (the CLI's request, checks and document).
 
+use std::path::Path;
+
 use chain::ops::inverse::{self, InverseOpsError, InverseRequest, PoseRow};
+use chain::ops::tables::{self, Source};
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
-use crate::{check_finite, resolve_error, study_error, to_json, value_error, Model};
+use crate::{check_finite, resolve_error, study_error, table_error, to_json, value_error, Model};
 
 /// The poses of an `(N, width)` array (`width` 6 or 12), a row refused as
 /// `poses row K: ...` (0-based), the width as `poses: ...`.
@@ -17,21 +20,36 @@ pub(crate) fn pose_rows(flat: &[f64], width: usize) -> PyResult<Vec<PoseRow>> {
 }
 
 /// The inverse kinematics of `poses` (`(N, 6)`: `px, py, pz, i, j, k`, or
-/// `(N, 12)`: `px, py, pz, r11 … r33`), `fix` and `params` as `--fix` and
-/// `--param`.
+/// `(N, 12)`: `px, py, pz, r11 … r33`) or of the pose CSV at `poses_file`
+/// (read as `chain inverse --pose` reads it), `fix` and `params` as `--fix`
+/// and `--param`.
 #[pyfunction]
-#[pyo3(signature = (model, poses, fix, params))]
+#[pyo3(signature = (model, poses, fix, params, poses_file=None))]
 pub(crate) fn inverse_json(
     py: Python<'_>,
     model: &Model,
-    poses: PyReadonlyArray2<'_, f64>,
+    poses: Option<PyReadonlyArray2<'_, f64>>,
     fix: Vec<(String, f64)>,
     params: Vec<(String, f64)>,
+    poses_file: Option<&str>,
 ) -> PyResult<String> {
-    let width = poses.shape()[1];
-    let flat = poses.as_slice()?;
-    check_finite(flat, width, "poses")?;
-    let rows = pose_rows(flat, width)?;
+    let rows = match (poses, poses_file) {
+        (Some(poses), None) => {
+            let width = poses.shape()[1];
+            let flat = poses.as_slice()?;
+            check_finite(flat, width, "poses")?;
+            pose_rows(flat, width)?
+        }
+        (None, Some(file)) => {
+            let read = py.allow_threads(|| tables::read_poses(Source::Path(Path::new(file))));
+            read.map_err(|e| table_error(py, model, e))?.1
+        }
+        _ => {
+            return Err(value_error(
+                "give the poses as an array or a file, one of them",
+            ))
+        }
+    };
     let request = InverseRequest {
         params: &params,
         fix: &fix,

@@ -150,6 +150,20 @@ pub(crate) fn study_error(py: Python<'_>, err: &ReliabilityError, file: &str) ->
 /// An option refused by `chain::ops::resolve`, with the CLI's message: an
 /// unknown name as `MachineError` naming the machine file, a bad value as
 /// `ValueError`.
+/// A table's refusal ([`chain::ops::tables`]) as the CLI words it: a
+/// `MachineError` where its columns name what the machine lacks, a
+/// `ValueError` otherwise.
+pub(crate) fn table_error(
+    py: Python<'_>,
+    model: &Model,
+    e: chain::ops::tables::TableError,
+) -> PyErr {
+    match e {
+        chain::ops::tables::TableError::Resolve(e) => resolve_error(py, model, e),
+        e => value_error(e.to_string()),
+    }
+}
+
 pub(crate) fn resolve_error(
     py: Python<'_>,
     model: &Model,

@@ -2,20 +2,25 @@
 //! CLI's request, checks and document): axis values with named columns, or
 //! tool poses solved by the inverse kinematics.
 
+use std::path::Path;
+
 use chain::ops::path::{self, PathInput, PathOpsError, PathRequest};
+use chain::ops::tables::{self, Source, Table, TableError};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
 use crate::inverse::pose_rows;
 use crate::study::{algorithm_options, system_choice};
-use crate::{check_finite, resolve_error, sided_named, study_error, to_json, value_error, Model};
+use crate::{
+    check_finite, resolve_error, sided_named, study_error, table_error, to_json, value_error, Model,
+};
 
 /// Error and reliability along a path. Exactly one of `axes` (an `(N, C)`
 /// array whose columns `header` names: axis variables in any order, an
 /// optional first `t`) and `poses` (`(N, 6)` or `(N, 12)`, as `inverse`;
 /// `t` their instants) is given; the other keywords are the CLI's options.
 #[pyfunction]
-#[pyo3(signature = (model, header, axes, poses, t, fix, params, method, samples, seed, cov, sided, system, system_tolerance))]
+#[pyo3(signature = (model, header, axes, poses, t, fix, params, method, samples, seed, cov, sided, system, system_tolerance, axes_file=None, poses_file=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn path_json(
     py: Python<'_>,
@@ -33,12 +38,50 @@ pub(crate) fn path_json(
     sided: Option<&str>,
     system: Option<&str>,
     system_tolerance: Option<f64>,
+    axes_file: Option<&str>,
+    poses_file: Option<&str>,
 ) -> PyResult<String> {
     let algorithm = algorithm_options(method, samples, seed, cov)?;
     let sided = sided_named(sided)?;
     let system = system_choice(system, system_tolerance)?;
-    let (rows, poses_read);
+    let (rows, poses_read, file_header, file_name);
     let input = match (&axes, &poses) {
+        (None, None) if axes_file.is_some() || poses_file.is_some() => {
+            match (axes_file, poses_file) {
+                (Some(file), None) => {
+                    let read = py.allow_threads(|| {
+                        let table = Table::read(Source::Path(Path::new(file)))?;
+                        let rows = table.numeric_rows()?;
+                        Ok::<_, TableError>((table.name, table.header, rows))
+                    });
+                    let (name, header, read) = read.map_err(|e| table_error(py, model, e))?;
+                    (file_name, file_header) = (name, header);
+                    rows = read.into_iter().map(|(_, r)| r).collect::<Vec<_>>();
+                    PathInput::Axes {
+                        source: &file_name,
+                        header: &file_header,
+                        rows: &rows,
+                    }
+                }
+                (None, Some(file)) => {
+                    let read =
+                        py.allow_threads(|| tables::read_poses(Source::Path(Path::new(file))));
+                    let (has_t, read) = read.map_err(|e| table_error(py, model, e))?;
+                    poses_read = read;
+                    file_name = file.to_string();
+                    PathInput::Poses {
+                        source: &file_name,
+                        has_t,
+                        rows: &poses_read,
+                    }
+                }
+                _ => {
+                    return Err(value_error(
+                        "give the path as axes=... or poses=... (one of them)",
+                    ))
+                }
+            }
+        }
         (Some(a), None) => {
             let width = a.shape()[1];
             if width != header.len() {

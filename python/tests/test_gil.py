@@ -62,3 +62,31 @@ def test_python_runs_during_a_batch():
     gaps = _largest_gaps(calls, _run_beside_ticks([batch]))
     assert np.median(gaps) < 0.5, f"the main thread stood still for {gaps} of each call"
 
+
+
+def test_a_file_read_releases_the_gil(tmp_path):
+    """Deterministic, whatever the scheduler: `inverse` on a FIFO blocks in the Rust reader until
+    this thread writes the poses. Were the GIL held while it reads, this thread could not run the
+    write and the two would wait on each other (the join's timeout only ends such a deadlock)."""
+    import os
+
+    fifo = tmp_path / "poses.csv"
+    os.mkfifo(fifo)
+    m = chain.Machine.load(ROOT / "examples/paths/cnc5_bevel_stats.yaml")
+    result = {}
+
+    def read():
+        try:
+            result["doc"] = m.inverse(fifo, fix={"mu": 0.0}).to_dict()
+        except Exception as e:  # pragma: no cover - reported below
+            result["error"] = e
+
+    worker = threading.Thread(target=read)
+    worker.start()
+    with open(fifo, "w") as f:  # blocks until the reader opens the FIFO
+        f.write("px,py,pz,i,j,k\n")
+        f.write((ROOT / "examples/paths/cnc5_bevel_pose.csv").read_text().splitlines()[-1].split(",", 1)[1] + "\n")
+    worker.join(timeout=120)
+    assert not worker.is_alive(), "the reader still holds the GIL"
+    assert "error" not in result, result.get("error")
+    assert len(result["doc"]["rows"]) >= 1

@@ -83,3 +83,46 @@ def test_path_refusals_are_the_cli_s(cli_error, tmp_path):
     assert str(info.value) == "--param nope: machine `cnc5_bevel_stats` has no parameter `nope`"
     assert str(info.value) in flat(cli_error("path", machine, "--axes", ROOT / "examples/paths/cnc5_bevel_axes.csv",
                                              "--param", "nope=1"))
+
+
+def test_path_and_inverse_read_the_files_the_cli_reads(cli, cli_error, tmp_path):
+    """A CSV path where the CLI reads a file: the same document, and the same words when refused
+    (the reader is `chain::ops::tables` for both)."""
+    machine = ROOT / "examples/paths/cnc5_bevel_stats.yaml"
+    axes_file = ROOT / "examples/paths/cnc5_bevel_axes.csv"
+    pose_file = ROOT / "examples/paths/cnc5_bevel_pose.csv"
+    m = chain.Machine.load(machine)
+    assert m.path(axes=axes_file).to_dict() == cli("path", machine, "--axes", axes_file)
+    assert m.path(axes=str(axes_file), method="mc", samples=500, seed=2).to_dict() == cli(
+        "path", machine, "--axes", axes_file, "--method", "mc", "--samples", 500, "--seed", 2)
+    got = m.path(poses=pose_file, fix={"mu": 0.0})
+    assert got.to_dict() == cli("path", machine, "--pose", pose_file, "--fix", "mu=0")
+    assert got.input == "pose"
+    assert m.inverse(pose_file, fix={"mu": 0.0}).to_dict() == cli("inverse", machine, "--pose", pose_file,
+                                                                  "--fix", "mu=0")
+    # Refusals: a cell that is not a number, a pose header, a pose that is not one, a missing file,
+    # a column that names no axis variable.
+    bad_cell = tmp_path / "cell.csv"
+    bad_cell.write_text("t,x,y,z\n0,0,0,0\n1,0,zz,0\n")
+    bad_header = tmp_path / "header.csv"
+    bad_header.write_text("px,py,pz,i,j\n0,0,0,0,1\n")
+    bad_pose = tmp_path / "pose.csv"
+    bad_pose.write_text("px,py,pz,i,j,k\n0,0,0,0,0,0\n")
+    bad_column = tmp_path / "column.csv"
+    bad_column.write_text("t,x,y,zz\n0,0,0,0\n")
+    missing = tmp_path / "missing.csv"
+    for call, args in [
+        (lambda: m.path(axes=bad_cell), ["path", machine, "--axes", bad_cell]),
+        (lambda: m.path(poses=bad_header), ["path", machine, "--pose", bad_header]),
+        (lambda: m.inverse(bad_header), ["inverse", machine, "--pose", bad_header]),
+        (lambda: m.inverse(bad_pose), ["inverse", machine, "--pose", bad_pose]),
+        (lambda: m.inverse(missing), ["inverse", machine, "--pose", missing]),
+        (lambda: m.path(axes=bad_column), ["path", machine, "--axes", bad_column]),
+    ]:
+        with pytest.raises(ValueError) as info:
+            call()
+        # Compared without white space: miette wraps long paths mid-name.
+        bare = "".join(flat(str(info.value)).split())
+        assert bare in "".join(flat(cli_error(*args)).split()), args
+    with pytest.raises(ValueError, match="t=... is given with a file"):
+        m.path(axes=axes_file, t=[0.0])

@@ -26,7 +26,9 @@
 //! - [`reliability`]: `chain reliability`'s request, the prepared study and the run's document;
 //! - [`sensitivity`]: `chain sensitivity`'s request (either kind) and document;
 //! - [`sobol`]: `chain sobol`'s request and document;
-//! - [`path`]: `chain path`'s request (axis values or poses) and document.
+//! - [`path`]: `chain path`'s request (axis values or poses) and document;
+//! - [`tables`] (feature `records`): the numeric CSV tables of poses and
+//!   axis values those commands read, from a path or from bytes.
 
 pub mod allocate;
 pub mod compensate;
@@ -45,6 +47,8 @@ pub mod resolve;
 pub mod sensitivity;
 pub mod sobol;
 pub mod study;
+#[cfg(feature = "records")]
+pub mod tables;
 pub mod worded;
 
 pub use worded::Worded;

@@ -13,7 +13,7 @@ use reliability::Method;
 
 use crate::cli::args::parse_assignment;
 use crate::cli::args::{AlgorithmArgs, ModelArgs, SystemArgs};
-use crate::cli::csv_input::{numeric_rows, open_csv, read_poses};
+use crate::cli::csv_input::{numeric_table, read_poses};
 use crate::cli::loaded::Loaded;
 use crate::cli::progress::Progress;
 use crate::cli::report;
@@ -70,20 +70,10 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
     args.algorithm.check()?;
     let system = args.system.choice()?;
     let loaded = Loaded::new(&args.file)?;
-    let display = |p: &std::path::Path| match p.as_os_str() == "-" {
-        true => "<stdin>".to_string(),
-        false => p.display().to_string(),
-    };
     let (source, header, rows, poses);
     let input = match (&args.axes, &args.pose) {
         (Some(file), _) => {
-            let mut csv = open_csv(file)?;
-            rows = numeric_rows(&mut csv)?
-                .into_iter()
-                .map(|(_, values)| values)
-                .collect::<Vec<_>>();
-            header = csv.header;
-            source = display(file);
+            (source, header, rows) = numeric_table(file)?;
             PathInput::Axes {
                 source: &source,
                 header: &header,
@@ -93,7 +83,10 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
         (None, Some(file)) => {
             let (has_t, read) = read_poses(file)?;
             poses = read;
-            source = display(file);
+            source = match file.as_os_str() == "-" {
+                true => "<stdin>".to_string(),
+                false => file.display().to_string(),
+            };
             PathInput::Poses {
                 source: &source,
                 has_t,
