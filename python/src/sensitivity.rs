@@ -46,9 +46,6 @@ pub(crate) fn sensitivity_reliability_json(
     values: Option<&str>,
     approach: Option<&str>,
 ) -> PyResult<String> {
-    if values.is_none() && approach.is_some() {
-        return Err(value_error("approach needs values"));
-    }
     let approach = parse_approach(approach)?;
     let request = SensitivityRequest {
         kind: SensitivityKind::Reliability,

@@ -99,9 +99,6 @@ pub(crate) fn reliability_json(
     let algorithm = algorithm_options(method, samples, seed, cov)?;
     let system = system_choice(system, system_tolerance)?;
     let sided = sided_named(sided)?;
-    if values.is_none() && approach.is_some() {
-        return Err(value_error("approach needs values"));
-    }
     let approach = parse_approach(approach)?;
     let request = ReliabilityRequest {
         params: &params,

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import chain
-from conftest import ROOT, squeezed
+from conftest import ROOT, flat, squeezed
 
 RUNS = ROOT / "examples/positioning"
 
@@ -89,7 +89,7 @@ def test_map_with_an_approach_is_the_cli_json(cli, tmp_path):
         m.map(values, grid=grid, approach="sideways")
 
 
-def test_values_out_and_reliability_with_the_repeatability(cli, tmp_path):
+def test_values_out_and_reliability_with_the_repeatability(cli, cli_error, tmp_path):
     """positioning(machine=, slot=) writes what --values-out writes; reliability(values=, approach=) is the CLI's."""
     vmc3 = ROOT / "examples/machines/vmc3.yaml"
     m = chain.Machine.load(vmc3)
@@ -122,8 +122,13 @@ def test_values_out_and_reliability_with_the_repeatability(cli, tmp_path):
         assert got == cli("reliability", one, "--values", values, *flag)
     s = m1.sensitivity_reliability(values=values, approach="up").to_dict()
     assert s == cli("sensitivity", one, "--values", values, "--approach", "up")
-    with pytest.raises(ValueError, match="approach needs values"):
-        m1.reliability(approach="up")
+    # Without values there are no tables to choose a direction of: the same words as the CLI's.
+    wording = "invalid value for '--approach': the direction of a values file's tables: give --values VALUES.yaml too"
+    for call, command in [(m1.reliability, "reliability"), (m1.sensitivity_reliability, "sensitivity")]:
+        with pytest.raises(ValueError) as info:
+            call(approach="up")
+        assert str(info.value) == wording
+        assert flat(wording) in flat(cli_error(command, one, "--approach", "up"))
 
 
 def test_compensate_is_the_cli_json(cli, cli_error):

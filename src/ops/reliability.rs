@@ -108,6 +108,7 @@ pub fn prepare(
     request: &ReliabilityRequest<'_>,
 ) -> Result<Prepared, ReliabilityOpsError> {
     request.algorithm.check()?;
+    study::check_approach(request.values, request.approach)?;
     let t = request.acceptance_tolerance;
     if !(t.is_finite() && t > 0.0 && t < 1.0) {
         return Err(OptionError::new(

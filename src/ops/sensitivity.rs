@@ -17,7 +17,7 @@ use reliability::{Form, Posterior, ReliabilityError, TargetSensitivity};
 use serde::{Serialize, Serializer};
 
 use super::resolve::{self, ResolveError};
-use super::study::{self, StudyError, StudyOptions};
+use super::study::{self, OptionError, StudyError, StudyOptions};
 use super::worded::{diagnostic, Worded};
 
 /// What `chain sensitivity` computes (`--kind`).
@@ -72,6 +72,9 @@ pub enum SensitivityOpsError {
     /// An option does not match the machine.
     #[error(transparent)]
     Resolve(#[from] ResolveError),
+    /// An option refused before anything is read.
+    #[error(transparent)]
+    Option(#[from] OptionError),
     /// The study (the machine's sections, the options, the posterior).
     #[error(transparent)]
     Study(Box<StudyError>),
@@ -104,6 +107,7 @@ impl Worded for SensitivityOpsError {
     fn inner(&self) -> Option<&dyn miette::Diagnostic> {
         match self {
             SensitivityOpsError::Resolve(e) => Some(e),
+            SensitivityOpsError::Option(e) => Some(e),
             _ => None,
         }
     }
@@ -204,6 +208,9 @@ pub fn check(request: &SensitivityRequest<'_>) -> Result<(), SensitivityOpsError
                 grid_for: "the mean",
             }
             .into())
+        }
+        (SensitivityKind::Reliability, None) => {
+            Ok(study::check_approach(None, request.approach)?)
         }
         _ => Ok(()),
     }

@@ -75,6 +75,21 @@ pub fn read_posterior(
     Ok(posterior)
 }
 
+/// `--approach` chooses the direction of a values file's tables: without
+/// `--values` there are none, and the choice is refused, not dropped.
+pub fn check_approach(
+    values: Option<&Path>,
+    approach: &[(Option<String>, Approach)],
+) -> Result<(), OptionError> {
+    match (values, approach) {
+        (None, [_, ..]) => Err(OptionError::new(
+            "approach",
+            "the direction of a values file's tables: give --values VALUES.yaml too",
+        )),
+        _ => Ok(()),
+    }
+}
+
 impl From<PosteriorError> for StudyError {
     fn from(e: PosteriorError) -> StudyError {
         match e {

@@ -63,7 +63,7 @@ pub struct ReliabilityArgs {
     /// Which approach direction of the values' bidirectional tables to
     /// read: `up`, `down` or `mean` (the default), or per axis
     /// `x=up,y=down` (docs/values.md, "Direction").
-    #[arg(long, value_name = "DIR|VAR=DIR,...", value_parser = chain_core::values::parse_approaches, requires = "values")]
+    #[arg(long, value_name = "DIR|VAR=DIR,...", value_parser = chain_core::values::parse_approaches)]
     pub approach: Vec<Vec<(Option<String>, chain_core::values::Approach)>>,
     /// Also the whole-machine acceptance probability: every toleranced
     /// component within tolerance at every grid point at once, with its
@@ -80,8 +80,9 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     args.algorithm.check()?;
     // Refused before the machine file is read.
     let system = args.system.choice()?;
-    let loaded = Loaded::new(&args.file)?;
     let approach: Vec<_> = args.approach.iter().flatten().cloned().collect();
+    chain::ops::study::check_approach(args.values.as_deref(), &approach)?;
+    let loaded = Loaded::new(&args.file)?;
     let request = ReliabilityRequest {
         params: &args.model.param.params,
         grid: &args.grid,

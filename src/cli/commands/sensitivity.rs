@@ -76,7 +76,7 @@ pub struct SensitivityArgs {
     /// `--kind reliability` with a values file: which approach direction of
     /// its bidirectional tables to read, `up`, `down`, `mean` (the default)
     /// or per axis `x=up,y=down` (docs/values.md, "Direction").
-    #[arg(long, value_name = "DIR|VAR=DIR,...", value_parser = chain_core::values::parse_approaches, requires = "values")]
+    #[arg(long, value_name = "DIR|VAR=DIR,...", value_parser = chain_core::values::parse_approaches)]
     pub approach: Vec<Vec<(Option<String>, chain_core::values::Approach)>>,
     /// Replace the grid values of one axis for the grid mean, `VAR=V1,V2,...`, or `VAR=LO:HI:N` for N evenly spaced values from LO to HI (repeatable).
     #[arg(long = "grid", value_name = "VAR=V1,V2,...|VAR=LO:HI:N", value_parser = parse_grid_axis)]

@@ -662,3 +662,19 @@ fn study_checks_need_no_derivation() {
     // And the whole file passes.
     check(&m, "gantry.yaml", &StudyOptions::default()).expect("the example checks");
 }
+
+/// `--approach` without `--values` is refused by the application layer's
+/// one rule (the words Python uses), never dropped, for both commands that
+/// take it, before the machine file is read.
+#[test]
+fn an_approach_without_values_is_refused_by_one_rule() {
+    for command in ["reliability", "sensitivity"] {
+        for file in [gantry().to_str().unwrap(), "no/such.yaml"] {
+            let err = unwrapped(&fails(&[command, file, "--approach", "up"]));
+            assert!(
+                err.contains("invalid value for '--approach': the direction of a values file's tables: give --values VALUES.yaml too"),
+                "{command} {file}: {err}"
+            );
+        }
+    }
+}
