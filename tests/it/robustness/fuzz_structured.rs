@@ -434,6 +434,32 @@ impl Tally {
     }
 }
 
+/// One case: `check` on `text` within `bound` (a panic or a hang saved
+/// under `dir`), its outcome added to `tally`, a failed check the case's
+/// failure with its input.
+fn run_case(
+    dir: &Path,
+    name: &str,
+    text: String,
+    bound: Duration,
+    check: fn(String) -> Result<Outcome, String>,
+    tally: &std::cell::RefCell<Tally>,
+) -> Result<(), TestCaseError> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let input = text.clone();
+    bounded(dir, name, text.as_bytes(), bound, move || {
+        let _ = tx.send(check(input));
+    });
+    match rx.recv() {
+        Ok(Ok(outcome)) => {
+            tally.borrow_mut().add(outcome);
+            Ok(())
+        }
+        Ok(Err(why)) => Err(TestCaseError::fail(format!("{why}\n--- input ---\n{text}"))),
+        Err(_) => Err(TestCaseError::fail("the case sent nothing")),
+    }
+}
+
 /// Runs `programs` programs of edits on `base` (with `keys` and `donors`
 /// from every example of its kind) through `check`, each bounded in time.
 fn run_programs(
@@ -453,20 +479,7 @@ fn run_programs(
         for &e in &edits {
             apply(&mut doc, e, keys, donors);
         }
-        let text = render(&doc);
-        let (tx, rx) = std::sync::mpsc::channel();
-        let input = text.clone();
-        bounded(&dir, name, text.as_bytes(), bound, move || {
-            let _ = tx.send(check(input));
-        });
-        match rx.recv() {
-            Ok(Ok(outcome)) => {
-                tally.borrow_mut().add(outcome);
-                Ok(())
-            }
-            Ok(Err(why)) => Err(TestCaseError::fail(format!("{why}\n--- input ---\n{text}"))),
-            Err(_) => Err(TestCaseError::fail("the case sent nothing")),
-        }
+        run_case(&dir, name, render(&doc), bound, check, &tally)
     });
     if let Err(e) = result {
         panic!("{name}: {e}");
@@ -1015,26 +1028,14 @@ fn run_table_programs(
         for &e in &edits {
             edit_table(&mut t, e);
         }
-        let text = t.render(crlf);
-        let (tx, rx) = std::sync::mpsc::channel();
-        let input = text.clone();
-        bounded(
+        run_case(
             &dir,
             name,
-            text.as_bytes(),
+            t.render(crlf),
             Duration::from_secs(20),
-            move || {
-                let _ = tx.send(check(input));
-            },
-        );
-        match rx.recv() {
-            Ok(Ok(outcome)) => {
-                tally.borrow_mut().add(outcome);
-                Ok(())
-            }
-            Ok(Err(why)) => Err(TestCaseError::fail(format!("{why}\n--- input ---\n{text}"))),
-            Err(_) => Err(TestCaseError::fail("the case sent nothing")),
-        }
+            check,
+            &tally,
+        )
     });
     if let Err(e) = result {
         panic!("{name}: {e}");
