@@ -336,25 +336,20 @@ class Machine:
 
         if (axes is None) == (poses is None):
             raise ValueError("give the path as axes=... or poses=... (one of them)")
-        if isinstance(axes, (str, os.PathLike)) or isinstance(poses, (str, os.PathLike)):
-            if t is not None:
-                raise ValueError("t=... is given with a file; give the instants as its column t")
-            if not isinstance(method, str):
-                raise ValueError(f"method must be a str, not {type(method).__name__}")
-            axes_file = None if axes is None else os.fspath(axes)
-            poses_file = None if poses is None else os.fspath(poses)
-            text = _chain.path_json(
-                self._model, [], None, None, None, _params(fix), _params(params),
-                method, samples, seed, cov, sided, system, system_tolerance, axes_file, poses_file,
-            )
-            return PathResult._from_json(text)
+        # A file is read by the CLI's reader (its column t gives the instants).
+        axes_file = os.fspath(axes) if isinstance(axes, (str, os.PathLike)) else None
+        poses_file = os.fspath(poses) if isinstance(poses, (str, os.PathLike)) else None
+        if (axes_file or poses_file) and t is not None:
+            raise ValueError("t=... is given with a file; give the instants as its column t")
         header: List[str] = []
         axes_array = poses_array = t_array = None
         if t is not None:
             t_array = np.ascontiguousarray(_float_array(t, "t"))
             if t_array.ndim != 1:
                 raise ValueError(f"t of shape {t_array.shape}: expected (N,)")
-        if axes is not None:
+        if axes_file or poses_file:
+            pass  # no arrays: Rust reads the file
+        elif axes is not None:
             if isinstance(axes, Mapping) or hasattr(axes, "columns"):
                 names = [str(k) for k in (axes.columns if hasattr(axes, "columns") else axes.keys())]
                 columns = [_float_array(axes[k], f"axes[{k!r}]") for k in (axes.columns if hasattr(axes, "columns") else axes.keys())]
@@ -396,7 +391,7 @@ class Machine:
             raise ValueError(f"method must be a str, not {type(method).__name__}")
         text = _chain.path_json(
             self._model, header, axes_array, poses_array, t_array, _params(fix), _params(params),
-            method, samples, seed, cov, sided, system, system_tolerance,
+            method, samples, seed, cov, sided, system, system_tolerance, axes_file, poses_file,
         )
         return PathResult._from_json(text)
 

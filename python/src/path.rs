@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use chain::ops::path::{self, PathInput, PathOpsError, PathRequest};
-use chain::ops::tables::{self, Source, Table, TableError};
+use chain::ops::tables::{self, Source};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
@@ -44,45 +44,29 @@ pub(crate) fn path_json(
     let algorithm = algorithm_options(method, samples, seed, cov)?;
     let sided = sided_named(sided)?;
     let system = system_choice(system, system_tolerance)?;
-    let (rows, poses_read, file_header, file_name);
-    let input = match (&axes, &poses) {
-        (None, None) if axes_file.is_some() || poses_file.is_some() => {
-            match (axes_file, poses_file) {
-                (Some(file), None) => {
-                    let read = py.allow_threads(|| {
-                        let table = Table::read(Source::Path(Path::new(file)))?;
-                        let rows = table.numeric_rows()?;
-                        Ok::<_, TableError>((table.name, table.header, rows))
-                    });
-                    let (name, header, read) = read.map_err(|e| table_error(py, model, e))?;
-                    (file_name, file_header) = (name, header);
-                    rows = read.into_iter().map(|(_, r)| r).collect::<Vec<_>>();
-                    PathInput::Axes {
-                        source: &file_name,
-                        header: &file_header,
-                        rows: &rows,
-                    }
-                }
-                (None, Some(file)) => {
-                    let read =
-                        py.allow_threads(|| tables::read_poses(Source::Path(Path::new(file))));
-                    let (has_t, read) = read.map_err(|e| table_error(py, model, e))?;
-                    poses_read = read;
-                    file_name = file.to_string();
-                    PathInput::Poses {
-                        source: &file_name,
-                        has_t,
-                        rows: &poses_read,
-                    }
-                }
-                _ => {
-                    return Err(value_error(
-                        "give the path as axes=... or poses=... (one of them)",
-                    ))
-                }
+    let (rows, poses_read, table, file_name);
+    let input = match (&axes, &poses, axes_file, poses_file) {
+        (None, None, Some(file), None) => {
+            let read = py.allow_threads(|| tables::read_numbers(Source::Path(Path::new(file))));
+            table = read.map_err(|e| table_error(py, model, e))?;
+            PathInput::Axes {
+                source: &table.name,
+                header: &table.header,
+                rows: &table.rows,
             }
         }
-        (Some(a), None) => {
+        (None, None, None, Some(file)) => {
+            let read = py.allow_threads(|| tables::read_poses(Source::Path(Path::new(file))));
+            let (has_t, read) = read.map_err(|e| table_error(py, model, e))?;
+            poses_read = read;
+            file_name = file.to_string();
+            PathInput::Poses {
+                source: &file_name,
+                has_t,
+                rows: &poses_read,
+            }
+        }
+        (Some(a), None, None, None) => {
             let width = a.shape()[1];
             if width != header.len() {
                 return Err(value_error(format!(
@@ -102,7 +86,7 @@ pub(crate) fn path_json(
                 rows: &rows,
             }
         }
-        (None, Some(p)) => {
+        (None, Some(p), None, None) => {
             let width = p.shape()[1];
             let flat = p.as_slice()?;
             check_finite(flat, width, "poses")?;

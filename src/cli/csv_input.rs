@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use chain::ops::inverse::PoseRow;
-use chain::ops::tables::{self, Source, Table, TableError};
+use chain::ops::tables::{self, NumericTable, Source, TableError};
 use chain_core::bounded;
 
 /// The bytes of an input file (`-`: stdin) and its display name, at most
@@ -45,18 +45,9 @@ pub(crate) fn with_table<T>(
     })?)
 }
 
-/// The header and numeric rows of the table at `path` (`-`: stdin), with
-/// its name.
-pub(crate) fn numeric_table(path: &Path) -> miette::Result<(String, Vec<String>, Vec<Vec<f64>>)> {
-    with_table(path, |source| {
-        let table = Table::read(source)?;
-        let rows = table.numeric_rows()?;
-        Ok((
-            table.name,
-            table.header,
-            rows.into_iter().map(|(_, r)| r).collect(),
-        ))
-    })
+/// The numbers of the table at `path` (`-`: stdin; [`tables::read_numbers`]).
+pub(crate) fn numeric_table(path: &Path) -> miette::Result<NumericTable> {
+    with_table(path, tables::read_numbers)
 }
 
 /// The poses of `path` (`-`: stdin; [`tables::read_poses`]).

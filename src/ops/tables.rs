@@ -189,6 +189,29 @@ impl Table {
     }
 }
 
+/// A table of numbers as a command takes it: its name, header and rows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NumericTable {
+    /// The name messages give it.
+    pub name: String,
+    /// The header's names, trimmed.
+    pub header: Vec<String>,
+    /// The data rows, every cell a finite number.
+    pub rows: Vec<Vec<f64>>,
+}
+
+/// A table whose every cell is a finite number ([`Table::numeric_rows`]):
+/// the axis values of `chain path --axes` by named column.
+pub fn read_numbers(source: Source<'_>) -> Result<NumericTable, TableError> {
+    let table = Table::read(source)?;
+    let rows = table.numeric_rows()?;
+    Ok(NumericTable {
+        name: table.name,
+        header: table.header,
+        rows: rows.into_iter().map(|(_, r)| r).collect(),
+    })
+}
+
 /// A pose table: header `px,py,pz,i,j,k` (tool point and tool axis) or
 /// `px,py,pz,r11,…,r33` (tool point and the tool frame's rotation,
 /// row-major; refused unless orthonormal to 1e-6 with det +1), optionally

@@ -70,14 +70,14 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
     args.algorithm.check()?;
     let system = args.system.choice()?;
     let loaded = Loaded::new(&args.file)?;
-    let (source, header, rows, poses);
+    let (source, table, poses);
     let input = match (&args.axes, &args.pose) {
         (Some(file), _) => {
-            (source, header, rows) = numeric_table(file)?;
+            table = numeric_table(file)?;
             PathInput::Axes {
-                source: &source,
-                header: &header,
-                rows: &rows,
+                source: &table.name,
+                header: &table.header,
+                rows: &table.rows,
             }
         }
         (None, Some(file)) => {
