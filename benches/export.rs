@@ -91,7 +91,7 @@ fn benches(c: &mut Criterion) {
         bench.iter(|| pool.install(|| black_box(grid::export(&b, &kin, grid(&m, 10)).unwrap())))
     });
     let small = grid::export(&b, &kin, grid(&m, 10)).unwrap();
-    g.bench_function("csv_1e5", |bench| bench.iter(|| black_box(small.csv())));
+    g.bench_function("csv_1e5", |bench| bench.iter(|| black_box(small.csv(""))));
     g.finish();
     let mut g = c.benchmark_group("node");
     let q = [100.0, 0.3, 1.2, 400.0, -100.0];

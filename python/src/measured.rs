@@ -11,12 +11,11 @@
 
 use std::path::Path;
 
-use chain::ops::identify::{self, IdentifyRequest};
+use chain::ops::identify::{IdentifyOpsError, IdentifyRequest};
 use chain::ops::plan::{self, PlanRequest};
+use chain::ops::tables::Source;
 use chain::ops::Worded;
-use chain_core::measured::{
-    Holdout, IdentifyOptions, Layout, Measurements, MeasurementsError, SubsetChoice,
-};
+use chain_core::measured::{Layout, Measurements, MeasurementsError};
 use chain_core::model::Machine;
 use chain_core::plan::Kind;
 use chain_core::values::{Values, ValuesError};
@@ -96,37 +95,46 @@ pub(crate) fn identify_json(
     holdout: Option<f64>,
     seed: Option<u64>,
 ) -> PyResult<(String, String)> {
-    let m = &model.machine;
-    let subset =
-        SubsetChoice::from_options(fix, estimate).map_err(|e| value_error(e.to_string()))?;
-    let holdout = Holdout::from_options(holdout, seed).map_err(|e| value_error(e.to_string()))?;
-    let options = IdentifyOptions { rank_tol, subset };
-    identify::check_options(prior, &options, iterate, holdout, validate.is_some())
-        .map_err(|e| value_error(e.to_string()))?;
-    chain::ops::resolve::check_parameters(m, &params).map_err(|e| resolve_error(py, model, e))?;
-    let measurements = read_measurements(py, m, path, text, file, &params, Layout::Measurements)?;
-    let validation = match &validate {
-        Some((path, text, file)) => Some(read_measurements(
-            py,
-            m,
-            path.as_deref(),
-            text.as_deref(),
-            file,
-            &params,
-            Layout::Measurements,
-        )?),
+    /// A CSV as a path, or as its text named `file`.
+    fn source<'s>(
+        path: Option<&'s str>,
+        text: Option<&'s str>,
+        file: &'s str,
+    ) -> PyResult<Source<'s>> {
+        match (path, text) {
+            (Some(path), None) => Ok(Source::Path(Path::new(path))),
+            (None, Some(text)) => Ok(Source::Bytes {
+                name: file,
+                bytes: text.as_bytes(),
+            }),
+            _ => Err(value_error(
+                "give the CSV as a path or as its text, not both",
+            )),
+        }
+    }
+    let validate = match &validate {
+        Some((path, text, file)) => Some(source(path.as_deref(), text.as_deref(), file)?),
         None => None,
     };
     let request = IdentifyRequest {
+        measurements: source(path, text, file)?,
+        validate,
+        params: &params,
         prior,
-        options,
-        iterate,
+        rank_tol,
+        fix,
+        estimate,
         holdout,
-        validation: validation.as_ref(),
+        seed,
+        iterate,
     };
-    let run = py
-        .allow_threads(|| identify::run(m, &measurements, &request))
-        .map_err(|e| value_error(e.to_string()))?;
+    let checked = request.check().map_err(|e| value_error(e.with_help()))?;
+    let m = &model.machine;
+    let run = py.allow_threads(|| checked.run(m)).map_err(|e| match e {
+        IdentifyOpsError::Resolve(e) => resolve_error(py, model, e),
+        IdentifyOpsError::Measurements(e) => load_error(py, e.diagnostics()),
+        e => value_error(e.with_help()),
+    })?;
     Ok((to_json(&run)?, run.values_text))
 }
 

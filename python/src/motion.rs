@@ -6,6 +6,7 @@
 use std::path::Path;
 
 use chain::ops::motion::{self, MotionOpsError, MotionRequest};
+use chain::ops::Worded;
 use chain_core::settings::{self, ReferenceError};
 use pyo3::prelude::*;
 
@@ -48,7 +49,7 @@ pub(crate) fn motion_json(
             load_error(py, &d)
         }
         MotionOpsError::Resolve(e) => resolve_error(py, model, e),
-        e => value_error(e.to_string()),
+        e => value_error(e.with_help()),
     };
     motion::check(&request).map_err(refused)?;
     let settings = match (path, text) {

@@ -17,7 +17,7 @@ use std::path::Path;
 use chain_core::model::{Component, Sided};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use reliability::{
-    machine, Event, Form, Inputs, LimitState, MonteCarlo, Posterior, Sampler, Study,
+    machine, Algorithm, Event, Form, Inputs, LimitState, MonteCarlo, Posterior, Sampler, Study,
     ToleranceLimitState,
 };
 
@@ -70,7 +70,9 @@ fn benches(c: &mut Criterion) {
     g.throughput(Throughput::Elements(375));
     for (name, s) in &studies {
         g.bench_function(*name, |b| {
-            pool.install(|| b.iter(|| black_box(s.form(&Form::default()).expect("form"))))
+            pool.install(|| {
+                b.iter(|| black_box(s.run(&Algorithm::Form(Form::default()), &()).expect("form")))
+            })
         });
     }
     g.finish();

@@ -5,7 +5,7 @@
 //! the targets and with OpenTURNS are in `docs/performance.md`.
 //!
 //! - `form/375_cases`: FORM on every (point, component) case of the 5×5×5
-//!   grid, sensitivities already evaluated (`Study::form`);
+//!   grid, sensitivities already evaluated (`Study::run` with FORM);
 //! - `study/new`: evaluating the model's sensitivities at the 125 points;
 //! - `is/px/{1,2}_threads`: the importance sampling on px at the worst corner
 //!   (7 active errors, 6 sampled coordinates per sample), 2²⁰ samples;
@@ -18,7 +18,8 @@ use std::path::Path;
 use chain_core::model::{Component, Sided};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use reliability::{
-    machine, Event, Form, ImportanceSampling, MonteCarlo, Sampler, Study, ToleranceLimitState,
+    machine, Algorithm, Event, Form, ImportanceSampling, MonteCarlo, Sampler, Study,
+    ToleranceLimitState,
 };
 
 fn gantry() -> (chain_core::Machine, chain_core::CompiledModel) {
@@ -60,7 +61,15 @@ fn benches(c: &mut Criterion) {
     g.throughput(Throughput::Elements(375));
     let one = pool(1);
     g.bench_function("375_cases", |b| {
-        one.install(|| b.iter(|| black_box(study.form(&Form::default()).expect("form"))))
+        one.install(|| {
+            b.iter(|| {
+                black_box(
+                    study
+                        .run(&Algorithm::Form(Form::default()), &())
+                        .expect("form"),
+                )
+            })
+        })
     });
     g.finish();
 

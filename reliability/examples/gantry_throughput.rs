@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use chain_core::model::{Component, Sided};
 use reliability::{
-    machine, Event, Form, ImportanceSampling, MonteCarlo, Sampler, ToleranceLimitState,
+    machine, Algorithm, Event, Form, ImportanceSampling, MonteCarlo, Sampler, ToleranceLimitState,
 };
 
 fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
@@ -50,7 +50,7 @@ fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
             Ok::<_, Box<dyn std::error::Error + Send + Sync>>((t, last))
         };
         let (t_form, r_form) = best(&mut || {
-            let r = study.form(&Form::default())?;
+            let r = study.run(&Algorithm::Form(Form::default()), &())?;
             Ok(r.summaries[0].min)
         })?;
         let (t_form1, pf_form) = best(&mut || Ok(Form::default().run(&event)?.pf))?;

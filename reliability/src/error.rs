@@ -162,6 +162,15 @@ pub enum ReliabilityError {
         diagnostic(code(chain::reliability::invalid_sampler))
     )]
     InvalidSampler(String),
+    /// The study's inputs differ from point to point (tables in a values
+    /// file), so it has none at an arbitrary point
+    /// ([`crate::Study::sensitivity_point`]): a one-point grid has them.
+    #[error("the inputs differ from point to point (tables in the values): there are none at an arbitrary point; take the point as a one-point grid instead")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(code(chain::reliability::inputs_vary_at_point))
+    )]
+    InputsVaryAtPoint,
     /// A setting of an algorithm is out of range.
     #[error("{option}: {message}")]
     #[cfg_attr(

@@ -733,7 +733,7 @@ mod tests {
 
         // The same points as a plain point study: identical cases.
         let at = Study::at_points(&model, &[], inputs.clone(), spec, points.to_vec()).unwrap();
-        let direct = at.form(&Form::default()).unwrap();
+        let direct = at.run(&Algorithm::Form(Form::default()), &()).unwrap();
         let n = model.errors().len();
         let (means, stds) = (inputs.means().to_vec(), inputs.stds().to_vec());
         for (k, rec) in [&r.records[0], &r.records[2]].into_iter().enumerate() {

@@ -351,7 +351,7 @@ pub struct CaseResult {
     /// Subset simulation's levels (of its first run).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub levels: Option<Vec<SubsetLevel>>,
-    /// SORM's account of the case (`--method sorm`; boxed: a FORM case
+    /// SORM's account of the case ([`Algorithm::Sorm`]; boxed: a FORM case
     /// carries no room for it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sorm: Option<Box<SormCase>>,
@@ -826,7 +826,7 @@ impl Study {
     /// The study with inputs of its own at every point (in
     /// [`Study::points`] order, the same errors in the same order): a built
     /// machine whose measured error motions have a mean and a repeatability
-    /// that vary along the axes (`chain reliability --values` with
+    /// that vary along the axes (a posterior of a values file with
     /// tables, docs/posterior.md). Every case's event and moments use its
     /// point's inputs.
     pub fn with_point_inputs(mut self, each: Vec<Inputs>) -> Result<Study, ReliabilityError> {
@@ -1056,12 +1056,6 @@ impl Study {
         Ok(out)
     }
 
-    /// FORM on every case (exact for one-sided components in normal inputs).
-    pub fn form(&self, form: &Form) -> Result<StudyResult, ReliabilityError> {
-        let cases = self.form_cases(form, self.all_cases(), &())?;
-        Ok(self.finish(Method::Form, cases))
-    }
-
     /// FORM on the cases of `set`, telling `progress` of each block of
     /// cases done.
     fn form_cases(
@@ -1140,13 +1134,6 @@ impl Study {
         Ok(out)
     }
 
-    /// SORM on every case: FORM, then the exact curvatures at its design
-    /// point ([`crate::sorm`]); the case's probability is Tvedt's.
-    pub fn sorm(&self, sorm: &Sorm) -> Result<StudyResult, ReliabilityError> {
-        let cases = self.sorm_cases(sorm, self.all_cases(), &())?;
-        Ok(self.finish(Method::Sorm, cases))
-    }
-
     /// SORM on the cases of `set`, telling `progress` of each block of
     /// cases done.
     fn sorm_cases(
@@ -1169,35 +1156,6 @@ impl Study {
         )
     }
 
-    /// The importance sampling on every case.
-    pub fn importance_sampling(
-        &self,
-        is: &ImportanceSampling,
-        progress: &dyn Progress,
-    ) -> Result<StudyResult, ReliabilityError> {
-        self.sampled_by(is, progress)
-    }
-
-    /// Crude Monte Carlo on every case.
-    pub fn monte_carlo(
-        &self,
-        mc: &MonteCarlo,
-        progress: &dyn Progress,
-    ) -> Result<StudyResult, ReliabilityError> {
-        self.sampled_by(mc, progress)
-    }
-
-    /// `sampler` on every case, under its own stop rule.
-    pub fn sampled_by<S: Sampler<Output = SimulationResult>>(
-        &self,
-        sampler: &S,
-        progress: &dyn Progress,
-    ) -> Result<StudyResult, ReliabilityError> {
-        let set = self.all_cases();
-        let cases = self.sampled_cases(sampler, set, progress)?;
-        Ok(self.finish(sampler.method(), cases))
-    }
-
     /// `sampler` on the cases of `set`, each on the streams of its index in
     /// the study.
     fn sampled_cases<S: Sampler<Output = SimulationResult>>(
@@ -1211,8 +1169,13 @@ impl Study {
         Ok(self.sampled(set, &results))
     }
 
-    /// Runs `algorithm` on every case (`progress` hears of the samples
-    /// drawn, or for FORM and SORM, which draw none, of the cases done).
+    /// Runs `algorithm` on every case: FORM (exact for one-sided components
+    /// in normal inputs) and SORM (FORM, then the exact curvatures at its
+    /// design point, [`crate::sorm`]; the case's probability is Tvedt's) a
+    /// block of cases at a time, a sampler under its own stop rule with each
+    /// case on the random streams of its index. `progress` hears of the
+    /// samples drawn, or for FORM and SORM, which draw none, of the cases
+    /// done.
     pub fn run(
         &self,
         algorithm: &Algorithm,
@@ -1261,16 +1224,6 @@ impl Study {
             Algorithm::MonteCarlo(mc) => self.sampled_cases(mc, set, progress),
             Algorithm::Directional(ds) => self.sampled_cases(ds, set, progress),
         }
-    }
-
-    /// Subset simulation on every case.
-    pub fn subset(
-        &self,
-        ss: &SubsetSimulation,
-        progress: &dyn Progress,
-    ) -> Result<StudyResult, ReliabilityError> {
-        let cases = self.subset_cases(ss, self.all_cases(), progress)?;
-        Ok(self.finish(Method::Subset, cases))
     }
 
     fn subset_cases(
@@ -1407,6 +1360,9 @@ impl Study {
 
     /// The sensitivities of every target at an arbitrary point (axis values in
     /// the model's variable order), sorted like [`Study::sensitivity_mean`].
+    /// A study whose inputs differ from point to point has no inputs at an
+    /// arbitrary point ([`ReliabilityError::InputsVaryAtPoint`]); a study
+    /// on a one-point grid has them.
     pub fn sensitivity_point<M: ErrorModel + ?Sized>(
         &self,
         model: &M,
@@ -1422,10 +1378,7 @@ impl Study {
             });
         }
         if self.varies() {
-            return Err(ReliabilityError::InvalidOption {
-                option: "--at",
-                message: "the inputs differ from point to point (tables in the values); give the point as a one-point grid (--grid VAR=VALUE for every axis) instead".into(),
-            });
+            return Err(ReliabilityError::InputsVaryAtPoint);
         }
         let single = Study::at_points(
             model,
@@ -1716,7 +1669,7 @@ impl CaseSet<'_> {
     }
 }
 
-/// The cases [`Study::form`] and [`Study::sorm`] run at a time.
+/// The cases [`Study::run`] runs at a time with FORM or SORM.
 const CASE_BLOCK: usize = 4096;
 
 /// `f` on every event: in parallel from 64 events on (below that the
@@ -1759,7 +1712,7 @@ mod tests {
         let total = study.targets().len() * study.points().len();
         assert!(total > CASE_BLOCK, "{total} cases");
         let form = Form::default();
-        let r = study.form(&form).unwrap();
+        let r = study.run(&Algorithm::Form(form), &()).unwrap();
         let events = study.events().unwrap();
         assert_eq!(r.cases.len(), events.len());
         for (c, e) in r.cases.iter().zip(&events) {
@@ -1775,7 +1728,7 @@ mod tests {
             assert_eq!(c.point, study.points()[i % np]);
         }
         let sorm = Sorm::default();
-        let s = study.sorm(&sorm).unwrap();
+        let s = study.run(&Algorithm::Sorm(sorm), &()).unwrap();
         for i in [0, CASE_BLOCK - 1, CASE_BLOCK, total - 1] {
             let alone = sorm.run(&events[i]).unwrap();
             assert_eq!(s.cases[i].pf.to_bits(), alone.pf.to_bits(), "case {i}");
@@ -1796,7 +1749,10 @@ mod tests {
         assert!(at.spec().grid.axes.is_empty());
         assert_eq!(at.targets(), grid.targets());
         let form = Form::default();
-        let (rg, ra) = (grid.form(&form).unwrap(), at.form(&form).unwrap());
+        let (rg, ra) = (
+            grid.run(&Algorithm::Form(form), &()).unwrap(),
+            at.run(&Algorithm::Form(form), &()).unwrap(),
+        );
         let (ng, na) = (grid.points().len(), at.points().len());
         for t in 0..grid.targets().len() {
             for (k, &p) in picked.iter().enumerate() {

@@ -148,11 +148,6 @@ pub struct Analysis {
 }
 
 impl Analysis {
-    /// The fit of the selected order.
-    pub fn selected_fit(&self) -> &PolyFit {
-        &self.compensation.fit
-    }
-
     /// The fit of `order`, if it was fitted.
     pub fn fit(&self, order: usize) -> Option<&PolyFit> {
         self.fits.iter().find(|f| f.order == order)

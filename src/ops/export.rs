@@ -48,6 +48,13 @@ impl ExportController {
             ExportController::Tables(c) => c.name(),
         }
     }
+
+    /// The words that open the first comment line of the files written
+    /// for it: the command that wrote them, `chain export --controller
+    /// NAME` ([`ExportOptions::provenance`]).
+    pub fn provenance(self) -> String {
+        format!("chain export --controller {}", self.name())
+    }
 }
 
 /// The request of `chain export`.
@@ -165,9 +172,13 @@ fn compensation_message(e: &CompensationError) -> String {
 }
 
 /// A [`ControllerError`]'s message: a table that does not cover the
-/// travel names the table, its range and the value needed.
+/// travel names the table, its range and the value needed; an axis without
+/// a travel is told how to give one.
 fn controller_message(e: &ControllerError) -> String {
     match e {
+        ControllerError::NoTravel { variable } => format!(
+            "no travel for axis `{variable}`: give it (e.g. `--grid {variable}=0:800:81`) or add the axis to the machine file's `reliability.grid`"
+        ),
         ControllerError::OutOfTable {
             variable,
             lo,
@@ -371,7 +382,7 @@ pub fn run(
                     error: Box::new(error),
                 }
             })?;
-            let file = result.file();
+            let file = result.file(&request.controller.provenance());
             Ok(ExportDocument::Grid(GridExport {
                 values_file: values_file.to_string(),
                 files: vec![file.name.clone()],
@@ -387,6 +398,7 @@ pub fn run(
                 cec_max_points: request.cec_max_points.unwrap_or(CEC_DEFAULT_MAX_POINTS),
                 beckhoff_max_records: (request.beckhoff_max_records)
                     .unwrap_or(BECKHOFF_DEFAULT_MAX_RECORDS),
+                provenance: request.controller.provenance(),
             };
             let export = table_export(c, &built, m, &options, request.grid, values_file)?;
             Ok(ExportDocument::Tables(TablesExport {

@@ -2,33 +2,79 @@
 //! §4; docs/identify.md): the error parameters of a built machine from
 //! measurements, by weighted least squares through an SVD or the posterior
 //! of the `statistics` prior, with the values file `--values-out` writes.
-//! The measurements are read by the adapter (a file for the CLI, a path or
-//! columns for Python) through `chain_core::measured::Measurements`.
+//!
+//! One entry for the CLI and Python: an [`IdentifyRequest`] holds the
+//! options as given and where the measurement files come from (a path, or
+//! bytes the caller holds: Python's CSV text); [`IdentifyRequest::check`]
+//! assembles and checks the options with no file read and no machine, so
+//! that both refuse a bad option first; [`CheckedIdentify::run`] checks
+//! the parameters against the machine, reads the measurement files and
+//! runs. Every refusal is worded here in the options' names
+//! ([`IdentifyOpsError`]), the library's error kept for its code. The
+//! document and the values file are [`document`]'s.
 
-use chain_core::measured::document::{
-    identify_document, values_file, DocumentError, IdentifyDocument,
+pub mod document;
+
+use chain_core::measured::{
+    DesignError, HoldoutError, Identification, IdentifyError, IdentifyOptions, MeasurementsError,
+    SubsetSide,
 };
-use chain_core::measured::{Holdout, HoldoutError, Identification, IdentifyOptions, Measurements};
+#[cfg(feature = "records")]
+use chain_core::measured::{Holdout, Layout, Measurements, SubsetChoice};
+#[cfg(feature = "records")]
 use chain_core::Machine;
 use serde::{Serialize, Serializer};
 
-/// The request of `chain identify`.
-#[derive(Debug, Clone, Default)]
+pub use document::{identify_document, values_file, Identified, IdentifyDocument};
+
+use super::resolve::ResolveError;
+#[cfg(feature = "records")]
+use super::tables::Source;
+use super::worded::{diagnostic, Worded};
+
+/// The request of `chain identify`: the options as the CLI and Python take
+/// them, and the measurement files.
+#[cfg(feature = "records")]
+#[derive(Debug, Clone)]
 pub struct IdentifyRequest<'a> {
+    /// `--measurements`: the measurement CSV.
+    pub measurements: Source<'a>,
+    /// `--validate`: measurements held out of the fit (the same columns),
+    /// where the estimates' prediction is reported.
+    pub validate: Option<Source<'a>>,
+    /// `--param NAME=VALUE`: the parameters the CSVs have no column for.
+    pub params: &'a [(String, f64)],
     /// `--prior`: the machine file's `statistics` as a Gaussian prior.
     pub prior: bool,
-    /// `--rank-tol`, `--fix`, `--estimate`: the rank rule and the
-    /// estimated subset.
-    pub options: IdentifyOptions,
+    /// `--rank-tol`: a fixed relative tolerance on the singular values
+    /// instead of the noise rule.
+    pub rank_tol: Option<f64>,
+    /// `--fix`: the error parameters fixed at 0, every other one estimated.
+    pub fix: Option<Vec<String>>,
+    /// `--estimate`: the only error parameters estimated.
+    pub estimate: Option<Vec<String>>,
+    /// `--holdout`: the fraction of the records held out of the fit, where
+    /// the estimates' prediction is reported (not with `validate`).
+    pub holdout: Option<f64>,
+    /// `--seed`: the seed of the holdout's split (only with `holdout`;
+    /// default [`Holdout::DEFAULT_SEED`]).
+    pub seed: Option<u64>,
     /// `--iterate`: fit the exact kinematics from the linear estimate.
     pub iterate: bool,
-    /// `--holdout FRACTION --seed S`: records of the measurements held out
-    /// of the fit, where the estimates' prediction is reported (not with
-    /// `validation`).
-    pub holdout: Option<Holdout>,
-    /// `--validate`: measurements held out of the fit, where the estimates'
-    /// prediction is reported.
-    pub validation: Option<&'a Measurements>,
+}
+
+/// An [`IdentifyRequest`] whose options are checked: what
+/// [`CheckedIdentify::run`] reads and runs.
+#[cfg(feature = "records")]
+#[derive(Debug, Clone)]
+pub struct CheckedIdentify<'a> {
+    measurements: Source<'a>,
+    validate: Option<Source<'a>>,
+    params: &'a [(String, f64)],
+    prior: bool,
+    options: IdentifyOptions,
+    iterate: bool,
+    holdout: Option<Holdout>,
 }
 
 /// The document of `chain identify` (JSON: [`IdentifyDocument`]) with the
@@ -49,68 +95,262 @@ impl Serialize for IdentifyRun {
     }
 }
 
-/// The checks of `chain identify`'s options that need no file (the CLI
-/// and Python run them before reading the machine and the measurements):
-/// `--rank-tol`, `--fix`/`--estimate` with `--prior`, `--iterate` with
-/// `--prior`, `--holdout` with `--validate` (the fraction is checked where
-/// the [`Holdout`] is made).
-pub fn check_options(
+/// Why `chain identify` cannot run, in the options' words.
+#[derive(Debug, thiserror::Error)]
+pub enum IdentifyOpsError {
+    /// `--fix` with `--estimate`.
+    #[error("--fix: cannot be given with --estimate (one names the fixed parameters, the other the estimated ones)")]
+    FixWithEstimate,
+    /// `--seed` without `--holdout`: it would choose nothing.
+    #[error(
+        "--holdout: --seed chooses the records --holdout holds out; give --holdout FRACTION too"
+    )]
+    SeedWithoutHoldout,
+    /// `--holdout` with `--validate`.
+    #[error("--holdout: cannot be given with --validate (one holds records of the measurements out, the other reads them from a file)")]
+    HoldoutWithValidate,
+    /// The held-out fraction, or the split it makes of the records.
+    #[error("--holdout: {}", holdout_words(.0))]
+    Holdout(HoldoutError),
+    /// The options against each other or the data, the prior, the solve.
+    #[error("{}", identify_words(.0))]
+    Identify(IdentifyError),
+    /// A `--param` that is not the machine's.
+    #[error(transparent)]
+    Resolve(#[from] ResolveError),
+    /// A measurement file refused (located).
+    #[error(transparent)]
+    Measurements(#[from] MeasurementsError),
+    /// The records do not give a design (named by their file).
+    #[error("{file}: {reason}")]
+    Design {
+        /// The measurement file.
+        file: String,
+        /// The design's refusal.
+        reason: DesignError,
+    },
+}
+
+/// The option that chooses a subset's list.
+fn subset_option(side: SubsetSide) -> &'static str {
+    match side {
+        SubsetSide::Fixed => "--fix",
+        SubsetSide::Estimated => "--estimate",
+    }
+}
+
+/// A holdout's refusal after `--holdout: `.
+fn holdout_words(e: &HoldoutError) -> String {
+    match e {
+        HoldoutError::Fraction(f) => format!("{f} is not a fraction in (0, 1)"),
+        e => e.to_string(),
+    }
+}
+
+/// The library's refusal in the options' words.
+fn identify_words(e: &IdentifyError) -> String {
+    match e {
+        IdentifyError::NoPrior { machine, missing } => format!(
+            "--prior needs a statistics entry for every error parameter; machine `{machine}` has none for {}",
+            missing.join(", ")
+        ),
+        IdentifyError::NoNoiseScale { rows, rank } => format!(
+            "--prior without a `std` column estimates the measurement noise from the least-squares residual, but there are {rows} rows for rank {rank}"
+        ),
+        IdentifyError::Subset { side, problem } => {
+            format!("{}: {problem}", subset_option(*side))
+        }
+        IdentifyError::SubsetWithPrior { side } => format!(
+            "{} chooses the parameters of a least-squares fit; with --prior every parameter is estimated from the data and its statistics",
+            subset_option(*side)
+        ),
+        IdentifyError::IterateWithPrior => {
+            "--iterate fits the exact kinematics by least squares; it does not take --prior".into()
+        }
+        IdentifyError::RankTolerance(t) => {
+            format!("--rank-tol: {t} is not a relative tolerance in (0, 1)")
+        }
+        e => e.to_string(),
+    }
+}
+
+/// What to do about a subset option's refusal.
+const SUBSET_HELP: &str = "--fix and --estimate take error parameter names separated by commas; `chain identify` without them shows which parameters the measurements can separate";
+
+/// What to do about a holdout's refusal.
+const HOLDOUT_HELP: &str = "--holdout takes the fraction of the records to hold out of the fit, e.g. --holdout 0.2 (with --seed S to choose another split)";
+
+impl Worded for IdentifyOpsError {
+    fn own_code(&self) -> Option<&'static str> {
+        match self {
+            IdentifyOpsError::FixWithEstimate => Some("chain::identify::subset"),
+            IdentifyOpsError::SeedWithoutHoldout | IdentifyOpsError::HoldoutWithValidate => {
+                Some("chain::identify::holdout")
+            }
+            _ => None,
+        }
+    }
+
+    fn own_help(&self) -> Option<String> {
+        let help = match self {
+            IdentifyOpsError::FixWithEstimate => SUBSET_HELP,
+            IdentifyOpsError::SeedWithoutHoldout
+            | IdentifyOpsError::HoldoutWithValidate
+            | IdentifyOpsError::Holdout(_) => HOLDOUT_HELP,
+            IdentifyOpsError::Identify(e) => match e {
+                IdentifyError::NoPrior { .. } => {
+                    "add them to the machine file's `statistics`, or identify without --prior"
+                }
+                IdentifyError::NoNoiseScale { .. } => {
+                    "give each measurement its standard deviation (a `std` column), or more measurements"
+                }
+                IdentifyError::Subset { .. } => SUBSET_HELP,
+                IdentifyError::SubsetWithPrior { .. } => "leave out --prior, or the subset option",
+                IdentifyError::IterateWithPrior => {
+                    "identify with --iterate alone, or with --prior alone"
+                }
+                IdentifyError::RankTolerance(_) => {
+                    "e.g. --rank-tol 1e-6 (singular values of the equilibrated design below 1e-6 × the largest count as zero)"
+                }
+                _ => return None,
+            },
+            IdentifyOpsError::Resolve(e) => return e.own_help(),
+            IdentifyOpsError::Measurements(_) | IdentifyOpsError::Design { .. } => return None,
+        };
+        Some(help.to_string())
+    }
+
+    #[cfg(feature = "cli")]
+    fn inner(&self) -> Option<&dyn miette::Diagnostic> {
+        match self {
+            IdentifyOpsError::Holdout(e) => Some(e),
+            IdentifyOpsError::Identify(e) => Some(e),
+            IdentifyOpsError::Resolve(e) => Some(e),
+            IdentifyOpsError::Measurements(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+diagnostic!(IdentifyOpsError);
+
+/// The identification's options against each other, one rule each: the
+/// library's ([`IdentifyOptions::check`]: a subset list naming some error,
+/// the rank tolerance, no subset with the prior), then `--iterate` without
+/// `--prior`.
+fn check_fit(
     prior: bool,
     options: &IdentifyOptions,
     iterate: bool,
-    holdout: Option<Holdout>,
-    validate: bool,
-) -> Result<(), DocumentError> {
-    options.check(prior)?;
+) -> Result<(), IdentifyOpsError> {
+    options.check(prior).map_err(IdentifyOpsError::Identify)?;
     if iterate && prior {
-        return Err(chain_core::measured::IdentifyError::IterateWithPrior.into());
-    }
-    if holdout.is_some() && validate {
-        return Err(HoldoutError {
-            message: "cannot be given with --validate (one holds records of the measurements out, the other reads them from a file)".into(),
-        }
-        .into());
+        return Err(IdentifyOpsError::Identify(IdentifyError::IterateWithPrior));
     }
     Ok(())
 }
 
-/// Runs `chain identify` of `machine` over `measurements`.
-pub fn run(
-    machine: &Machine,
-    measurements: &Measurements,
-    request: &IdentifyRequest<'_>,
-) -> Result<IdentifyRun, DocumentError> {
-    check_options(
-        request.prior,
-        &request.options,
-        request.iterate,
-        request.holdout,
-        request.validation.is_some(),
-    )?;
-    let split = match request.holdout {
-        Some(h) => Some(measurements.holdout(h.fraction, h.seed)?),
-        None => None,
-    };
-    let (fitted, validation) = match &split {
-        Some((fit, held)) => (fit, Some(held)),
-        None => (measurements, request.validation),
-    };
-    let mut identified = identify_document(
-        machine,
-        fitted,
-        request.prior,
-        &request.options,
-        request.iterate,
-        validation,
-    )?;
-    if let (Some(v), Some((_, held))) = (identified.document.validation.as_mut(), &split) {
-        v.holdout = request.holdout;
-        v.lines = Some(held.rows.iter().map(|r| r.line).collect());
+#[cfg(feature = "records")]
+impl<'a> IdentifyRequest<'a> {
+    /// Every check of the options that needs no file and no machine (the
+    /// CLI and Python run it before reading the machine file): `--fix` or
+    /// `--estimate`, `--seed` only with `--holdout` and the fraction in
+    /// (0, 1), the identification's options ([`IdentifyOptions::check`],
+    /// `--iterate` without `--prior`), `--holdout` without `--validate`.
+    pub fn check(self) -> Result<CheckedIdentify<'a>, IdentifyOpsError> {
+        let subset = match (self.fix, self.estimate) {
+            (Some(_), Some(_)) => return Err(IdentifyOpsError::FixWithEstimate),
+            (Some(names), None) => SubsetChoice::Fix(names),
+            (None, Some(names)) => SubsetChoice::Estimate(names),
+            (None, None) => SubsetChoice::Elimination,
+        };
+        let holdout = match (self.holdout, self.seed) {
+            (None, Some(_)) => return Err(IdentifyOpsError::SeedWithoutHoldout),
+            (None, None) => None,
+            (Some(fraction), seed) => {
+                let h = Holdout {
+                    fraction,
+                    seed: seed.unwrap_or(Holdout::DEFAULT_SEED),
+                };
+                h.check().map_err(IdentifyOpsError::Holdout)?;
+                Some(h)
+            }
+        };
+        let options = IdentifyOptions {
+            rank_tol: self.rank_tol,
+            subset,
+        };
+        check_fit(self.prior, &options, self.iterate)?;
+        if holdout.is_some() && self.validate.is_some() {
+            return Err(IdentifyOpsError::HoldoutWithValidate);
+        }
+        Ok(CheckedIdentify {
+            measurements: self.measurements,
+            validate: self.validate,
+            params: self.params,
+            prior: self.prior,
+            options,
+            iterate: self.iterate,
+            holdout,
+        })
     }
-    let values_text = values_file(machine, &measurements.file, &identified);
-    Ok(IdentifyRun {
-        document: identified.document,
-        result: identified.result,
-        values_text,
-    })
+}
+
+#[cfg(feature = "records")]
+impl CheckedIdentify<'_> {
+    /// Runs `chain identify` of `machine`: the `--param` names and values
+    /// checked, the measurements (and those of `--validate`) read, the
+    /// holdout's split, the identification, its document and values file.
+    pub fn run(&self, machine: &Machine) -> Result<IdentifyRun, IdentifyOpsError> {
+        super::resolve::check_parameters(machine, self.params)?;
+        let measurements = read(self.measurements, machine, self.params)?;
+        let validation = (self.validate)
+            .map(|v| read(v, machine, self.params))
+            .transpose()?;
+        let split = match self.holdout {
+            Some(h) => Some(
+                (measurements.holdout(h.fraction, h.seed)).map_err(IdentifyOpsError::Holdout)?,
+            ),
+            None => None,
+        };
+        let (fitted, validation) = match &split {
+            Some((fit, held)) => (fit, Some(held)),
+            None => (&measurements, validation.as_ref()),
+        };
+        let mut identified = identify_document(
+            machine,
+            fitted,
+            self.prior,
+            &self.options,
+            self.iterate,
+            validation,
+        )?;
+        if let (Some(v), Some((_, held))) = (identified.document.validation.as_mut(), &split) {
+            v.holdout = self.holdout;
+            v.lines = Some(held.rows.iter().map(|r| r.line).collect());
+        }
+        let values_text = values_file(machine, &measurements.file, &identified);
+        Ok(IdentifyRun {
+            document: identified.document,
+            result: identified.result,
+            values_text,
+        })
+    }
+}
+
+/// A measurement CSV for `machine` from a file or from the caller's bytes.
+#[cfg(feature = "records")]
+fn read(
+    source: Source<'_>,
+    machine: &Machine,
+    params: &[(String, f64)],
+) -> Result<Measurements, IdentifyOpsError> {
+    let layout = Layout::Measurements;
+    let read = match source {
+        Source::Path(path) => Measurements::read(path, machine, params, layout),
+        Source::Bytes { name, bytes } => {
+            Measurements::from_bytes(bytes, name, machine, params, layout)
+        }
+    };
+    Ok(read?)
 }

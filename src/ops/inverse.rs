@@ -171,8 +171,21 @@ pub struct NoInverse {
     pub error: InverseError,
 }
 
-/// Worded by the [`InverseError`]: its code and help.
+/// Worded by the [`InverseError`] (its code), with the help naming
+/// `--fix` where holding variables is the remedy.
 impl Worded for NoInverse {
+    fn own_help(&self) -> Option<String> {
+        match self.error {
+            InverseError::Shape { .. } => {
+                Some("hold the extra variables with --fix NAME=VALUE (e.g. mu=0)".into())
+            }
+            InverseError::NoFreeVariable => Some(
+                "hold fewer variables (--fix), or check that the axes move the tool relative to the workpiece".into(),
+            ),
+            _ => None,
+        }
+    }
+
     #[cfg(feature = "cli")]
     fn inner(&self) -> Option<&dyn miette::Diagnostic> {
         Some(&self.error)

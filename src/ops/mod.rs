@@ -17,7 +17,9 @@
 //! - [`allocate`]: `chain allocate`'s request and document;
 //! - [`compensate`]: `chain compensate`'s request (the fit's options, the table) and document;
 //! - [`export`]: `chain export`'s request, document and the per-axis tables `map --compensated` shares;
-//! - [`identify`]: `chain identify`'s request and document (with the values file);
+//! - [`identify`]: `chain identify`'s request (options checked before any
+//!   file is read, the measurement files read from a path or bytes), its
+//!   refusals and document (with the values file);
 //! - [`plan`]: `chain plan`'s request, refusals and document;
 //! - [`inverse`]: `chain inverse`'s request, poses and document;
 //! - [`positioning`]: `chain positioning`'s request, document and values file;

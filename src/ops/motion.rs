@@ -124,6 +124,9 @@ impl Worded for MotionOpsError {
             MotionOpsError::HeldUnreachable { .. } => Some(
                 "hold fewer variables (--fix), or hold them at values from which the generator's pose is reachable".into(),
             ),
+            MotionOpsError::Motion(MotionError::Underdetermined { .. }) => Some(
+                "hold the others (cnc.fix / --fix, e.g. mu=0) or match the full pose".into(),
+            ),
             _ => None,
         }
     }

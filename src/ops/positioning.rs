@@ -43,7 +43,7 @@ pub struct Positioned {
 
 /// Why `chain positioning` cannot write its values file.
 #[derive(Debug, thiserror::Error)]
-#[error("--slot {slot} (machine {file}): {error}")]
+#[error("--slot {slot} (machine {file}): {error}{}", rotary_hint(error))]
 #[cfg_attr(
     feature = "cli",
     derive(miette::Diagnostic),
@@ -56,6 +56,18 @@ pub struct PositioningError {
     pub file: String,
     /// Why the slot cannot take the run.
     pub error: Box<SlotError>,
+}
+
+/// What a slot of a rotary axis refused for linear runs adds: the option
+/// that reads the runs as a rotary axis's.
+fn rotary_hint(error: &SlotError) -> &'static str {
+    match error {
+        SlotError::KindMismatch {
+            runs: AxisKind::Linear,
+            ..
+        } => " (give --rotary for a rotary axis's runs)",
+        _ => "",
+    }
 }
 
 /// The axis kind of `--rotary`.

@@ -108,6 +108,10 @@ pub enum ResolveError {
         /// Every axis variable.
         variables: Vec<String>,
     },
+    /// `--at` with inputs that differ from point to point (a values file
+    /// with tables): they are known at the grid's points only.
+    #[error("--at: the inputs differ from point to point (tables in the values)")]
+    AtVaryingInputs,
     /// `--at` (one point) and `--grid` (the grid of a mean) given together.
     #[error("--grid cannot be combined with --at")]
     AtWithGrid {
@@ -193,6 +197,7 @@ impl Worded for ResolveError {
             ResolveError::NonFiniteAt { .. } => "chain::cli::at_not_finite",
             ResolveError::UnknownFixed { .. } => "chain::cli::fix_unknown_variable",
             ResolveError::MissingAt { .. } => "chain::cli::at_missing_variable",
+            ResolveError::AtVaryingInputs => "chain::cli::at_varying_inputs",
             ResolveError::AtWithGrid { .. } => "chain::cli::at_with_grid",
             ResolveError::UnknownAxisColumn { .. } => "chain::csv::unknown_column",
             ResolveError::ColumnAndFix { .. } => "chain::cli::fix_and_column",
@@ -211,6 +216,9 @@ impl Worded for ResolveError {
             ResolveError::UnknownAtVariable {
                 file, variables, ..
             } => format!("the axis variables of {file} are {}", variables.join(", ")),
+            ResolveError::AtVaryingInputs => {
+                "give the point as a one-point grid (--grid VAR=VALUE for every axis) instead".into()
+            }
             ResolveError::AtWithGrid { grid_for } => format!(
                 "--at evaluates at one point, --grid sets the grid of {grid_for}; give one"
             ),

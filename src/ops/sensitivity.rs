@@ -248,7 +248,11 @@ fn reliability_kind(
         &values,
         point.as_deref(),
         &Form::default(),
-    )?;
+    )
+    .map_err(|e| match e {
+        ReliabilityError::InputsVaryAtPoint => ResolveError::AtVaryingInputs.into(),
+        e => SensitivityOpsError::from(e),
+    })?;
     Ok(SensitivityReport::Reliability(Box::new(
         ReliabilitySensitivity {
             machine: machine.name.clone(),

@@ -33,7 +33,7 @@
 
 use serde::Serialize;
 
-use super::{CompensationError, Correction, ExportedFile, Residual, ResidualScratch};
+use super::{opening_line, CompensationError, Correction, ExportedFile, Residual, ResidualScratch};
 use crate::built::{BuiltMachine, Points, MAP_BLOCK};
 use crate::kinematics::forward::{Kinematics, Scalar};
 use crate::model::{Frame, JointKind};
@@ -616,17 +616,23 @@ impl GridCompensation {
         h
     }
 
-    /// The comment lines of the file (each starting with `# `): what the
+    /// The comment lines of the file (each starting with `# `): what wrote
+    /// it (`provenance`, see [`ExportOptions::provenance`]), what the
     /// columns are, their units and the sign convention.
-    pub fn comments(&self) -> Vec<String> {
+    ///
+    /// [`ExportOptions::provenance`]: crate::compensation::controllers::ExportOptions::provenance
+    pub fn comments(&self, provenance: &str) -> Vec<String> {
         let units: Vec<String> = (self.variables.iter().zip(&self.rotary))
             .map(|(v, r)| format!("{v} {}", if *r { "rad" } else { "mm" }))
             .collect();
         vec![
-            format!(
-                "chain export --controller grid: machine {}, {} nodes (docs/export.md)",
-                self.machine,
-                self.len()
+            opening_line(
+                provenance,
+                &format!(
+                    "machine {}, {} nodes (docs/export.md)",
+                    self.machine,
+                    self.len()
+                ),
             ),
             format!("units: {}; residual mm", units.join(", ")),
             "sign: command q + delta_q instead of q; delta_q cancels the predicted error (actual - nominal) to first order".to_string(),
@@ -638,13 +644,14 @@ impl GridCompensation {
         ]
     }
 
-    /// The whole grid CSV: the comment lines, the header, one row per node
-    /// (numbers in Rust's shortest round-trip form).
-    pub fn csv(&self) -> String {
+    /// The whole grid CSV: the comment lines (the first opening with
+    /// `provenance`), the header, one row per node (numbers in Rust's
+    /// shortest round-trip form).
+    pub fn csv(&self, provenance: &str) -> String {
         use std::fmt::Write;
         let nv = self.variables.len();
         let mut s = String::with_capacity(64 + self.len() * nv * 2 * 22);
-        for c in self.comments() {
+        for c in self.comments(provenance) {
             let _ = writeln!(s, "# {c}");
         }
         let _ = writeln!(s, "{}", self.header().join(","));
@@ -662,19 +669,19 @@ impl GridCompensation {
         s
     }
 
-    /// The file `--out DIR` writes: `<machine>_grid.csv` with
+    /// The file to write: `<machine>_grid.csv` with
     /// [`GridCompensation::csv`].
-    pub fn file(&self) -> ExportedFile {
+    pub fn file(&self, provenance: &str) -> ExportedFile {
         ExportedFile {
             name: format!("{}_grid.csv", self.machine),
-            text: self.csv(),
+            text: self.csv(provenance),
         }
     }
 
     /// The correction a controller reading this grid applies: multilinear
     /// interpolation of the nodes' `δq` inside the grid
-    /// ([`GridCorrection`]). An export at a list of poses (`--axes`) has
-    /// no grid to interpolate.
+    /// ([`GridCorrection`]). An export at a list of points
+    /// (not a [`Points::Grid`]) has no grid to interpolate.
     pub fn correction(&self) -> Result<GridCorrection, GridError> {
         let Points::Grid(axes) = &self.points else {
             return Err(GridError::NotAGrid);
@@ -689,7 +696,9 @@ impl GridCompensation {
 #[non_exhaustive]
 pub enum GridError {
     /// The nodes are a list of poses, not a grid.
-    #[error("the nodes are a list of poses (--axes), not a grid: there is nothing to interpolate between them")]
+    #[error(
+        "the nodes are a list of points, not a grid: there is nothing to interpolate between them"
+    )]
     #[cfg_attr(feature = "miette", diagnostic(code(chain::export::not_a_grid)))]
     NotAGrid,
     /// An axis lists a value twice.

@@ -3,14 +3,14 @@
 //! commanded axes so that the tool point lands where the command aimed, and
 //! the files each controller reads.
 //!
-//! One interface joins the exporters, the round trips and `chain map
-//! --compensated`: a [`Correction`] gives, at commanded axis values `q`,
-//! the corrections `δq` the controller adds to them (the machine's
-//! variables, in their order and units: mm, rad). The grid export
-//! (`grid.rs`) and each controller format (`controllers/`) produce one;
-//! the residual after compensation is the built machine's error at
-//! `q + δq` plus the nominal motion `δq` causes, against the tool point the
-//! uncorrected command aimed at.
+//! One interface joins the exporters, the round trips and the compensated
+//! error map ([`BuiltMachine::compensated_map`]): a [`Correction`] gives,
+//! at commanded axis values `q`, the corrections `δq` the controller adds
+//! to them (the machine's variables, in their order and units: mm, rad).
+//! The grid export (`grid.rs`) and each controller format (`controllers/`)
+//! produce one; the residual after compensation is the built machine's
+//! error at `q + δq` plus the nominal motion `δq` causes, against the tool
+//! point the uncorrected command aimed at.
 
 use crate::model_trait::OutOfRange;
 use serde::Serialize;
@@ -250,6 +250,17 @@ impl<'b, M: ErrorModel> Residual<'b, M> {
     }
 }
 
+/// The first comment line of a written file: `provenance` (the words
+/// naming what wrote it), a colon, then `rest`; `rest` alone when
+/// `provenance` is empty.
+pub(crate) fn opening_line(provenance: &str, rest: &str) -> String {
+    if provenance.is_empty() {
+        rest.to_string()
+    } else {
+        format!("{provenance}: {rest}")
+    }
+}
+
 /// `r · v`.
 pub(crate) fn apply(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
     std::array::from_fn(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2])
@@ -263,8 +274,8 @@ pub(crate) fn apply_transposed(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
 impl<M: ErrorModel + Sync> BuiltMachine<M> {
     /// The error map after compensation: at every point `q` the residual of
     /// [`Residual::at`] with `δq` from `correction`, as a [`MapResult`] (the
-    /// same document and summary as [`BuiltMachine::map`]'s, so `chain map
-    /// --compensated` shows and plots it the same way). Blocks of
+    /// same document and summary as [`BuiltMachine::map`]'s, so it is shown
+    /// and plotted the same way). Blocks of
     /// [`MAP_BLOCK`] points run in parallel under the `parallel` feature.
     pub fn compensated_map(
         &self,

@@ -104,11 +104,6 @@ impl Jet {
         Jet { c }
     }
 
-    /// `1 / self` (a non-finite series when `a_0 = 0`).
-    pub fn recip(&self) -> Jet {
-        Jet::constant(1.0, self.order()).div(self)
-    }
-
     /// `self / other`.
     pub fn div(&self, other: &Jet) -> Jet {
         let n = self.order().min(other.order());

@@ -172,8 +172,14 @@ pub enum MotionError {
         t: f64,
     },
     /// More free CNC variables than conditions.
-    #[error("the CNC machine `{machine}` has {free} free variables but matching the {what} gives {rows} conditions; hold the others (cnc.fix / --fix, e.g. mu=0) or match the full pose")]
-    #[cfg_attr(feature = "miette", diagnostic(code(chain::motion::underdetermined)))]
+    #[error("the CNC machine `{machine}` has {free} free variables but matching the {what} gives {rows} conditions")]
+    #[cfg_attr(
+        feature = "miette",
+        diagnostic(
+            code(chain::motion::underdetermined),
+            help("hold the others at fixed values (e.g. mu = 0) or match the full pose")
+        )
+    )]
     Underdetermined {
         /// The CNC machine.
         machine: String,
@@ -189,7 +195,7 @@ pub enum MotionError {
     #[error("the roll turns `{variable}` by {turn:.4} rad between instants ({total:.4} rad over the roll interval, {instants} instants): more than a quarter turn (π/2 rad), so the CNC axes cannot be followed from one instant to the next (a whole turn between instants would go unseen); it needs at least {needed} instants")]
     #[cfg_attr(feature = "miette", diagnostic(
         code(chain::motion::too_few_instants),
-        help("raise --samples, or check the roll: the law's `ratio` and `omega_c` (a roll ratio is a tooth ratio, a few units to a few tens), or a shorter `roll.interval`")
+        help("raise the number of instants, or check the roll: the law's `ratio` and `omega_c` (a roll ratio is a tooth ratio, a few units to a few tens), or a shorter `roll.interval`")
     ))]
     TooFewInstants {
         /// The generator variable.

@@ -1,9 +1,57 @@
 //! What `identify` and `subset` both give: the estimate of one unknown
 //! ([`Estimate`]) and why an identification could not be computed
 //! ([`IdentifyError`]), in a module of their own so that `subset` need not
-//! import `identify`, which runs it. `identify` re-exports both.
+//! import `identify`, which runs it. `identify` re-exports them.
 
 use serde::Serialize;
+
+/// Which list of a chosen subset a refusal is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SubsetSide {
+    /// The errors fixed at 0 (every other one estimated).
+    Fixed,
+    /// The errors estimated (every other one fixed at 0).
+    Estimated,
+}
+
+impl std::fmt::Display for SubsetSide {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            SubsetSide::Fixed => "the fixed errors",
+            SubsetSide::Estimated => "the estimated errors",
+        })
+    }
+}
+
+/// What is wrong with a chosen subset's list of errors.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SubsetProblem {
+    /// The list names no error (every name blank).
+    #[error("names no error parameter")]
+    NoName,
+    /// A name that is not an unknown of the design.
+    #[error("`{name}` is not an error parameter of these measurements{}", suggestion.as_ref().map_or(String::new(), |c| format!(" (did you mean `{c}`?)")))]
+    Unknown {
+        /// The name given.
+        name: String,
+        /// The closest unknown, if any is close.
+        suggestion: Option<String>,
+    },
+    /// A name given twice.
+    #[error("`{name}` is named twice")]
+    Twice {
+        /// The name.
+        name: String,
+    },
+    /// Chosen unknowns the measurements cannot separate from the other
+    /// estimated ones (sorted).
+    #[error("the measurements cannot separate {} from the other estimated parameters; fix {} too", names.join(", "), if names.len() == 1 { "it" } else { "some of them" })]
+    Inseparable {
+        /// The unknowns.
+        names: Vec<String>,
+    },
+}
 
 /// Why an identification could not be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -14,13 +62,14 @@ pub enum IdentifyError {
     #[error("there is no measurement to identify from")]
     #[cfg_attr(feature = "miette", diagnostic(code(chain::identify::no_rows)))]
     NoRows,
-    /// `--prior` on a machine whose `statistics` miss some errors.
-    #[error("--prior needs a statistics entry for every error parameter; machine `{machine}` has none for {}", missing.join(", "))]
+    /// The statistics prior on a machine whose `statistics` miss some
+    /// errors.
+    #[error("the statistics prior needs an entry for every error parameter; machine `{machine}` has none for {}", missing.join(", "))]
     #[cfg_attr(
         feature = "miette",
         diagnostic(
             code(chain::identify::no_prior),
-            help("add them to the machine file's `statistics`, or identify without --prior")
+            help("add them to the machine file's `statistics`, or identify without the prior")
         )
     )]
     NoPrior {
@@ -29,9 +78,9 @@ pub enum IdentifyError {
         /// The errors without a statistics entry.
         missing: Vec<String>,
     },
-    /// `--prior` without a `std` column and no residual degree of freedom
+    /// The prior without a `std` column and no residual degree of freedom
     /// to estimate the noise from.
-    #[error("--prior without a `std` column estimates the measurement noise from the least-squares residual, but there are {rows} rows for rank {rank}")]
+    #[error("the prior without a `std` column estimates the measurement noise from the least-squares residual, but there are {rows} rows for rank {rank}")]
     #[cfg_attr(
         feature = "miette",
         diagnostic(
@@ -45,52 +94,52 @@ pub enum IdentifyError {
         /// The rank.
         rank: usize,
     },
-    /// `--fix`/`--estimate` name an unknown that is not one, twice, or a
-    /// set the measurements cannot separate.
-    #[error("{option}: {message}")]
+    /// A chosen subset's list names an unknown that is not one, names
+    /// none, or chooses unknowns the measurements cannot separate.
+    #[error("{side}: {problem}")]
     #[cfg_attr(
         feature = "miette",
         diagnostic(
             code(chain::identify::subset),
-            help("--fix and --estimate take error parameter names separated by commas; `chain identify` without them shows which parameters the measurements can separate")
+            help("a chosen subset names error parameters of the design; the identification without one shows which parameters the measurements can separate")
         )
     )]
     Subset {
-        /// The option.
-        option: &'static str,
-        /// What is wrong.
-        message: String,
+        /// The list.
+        side: SubsetSide,
+        /// What is wrong with it.
+        problem: SubsetProblem,
     },
-    /// `--fix`/`--estimate` with `--prior`.
-    #[error("{option} chooses the parameters of a least-squares fit; with --prior every parameter is estimated from the data and its statistics")]
+    /// A chosen subset with the prior.
+    #[error("{side} choose the parameters of a least-squares fit; with the prior every parameter is estimated from the data and its statistics")]
     #[cfg_attr(
         feature = "miette",
         diagnostic(
             code(chain::identify::subset_with_prior),
-            help("leave out --prior, or the subset option")
+            help("identify without the prior, or without the chosen subset")
         )
     )]
     SubsetWithPrior {
-        /// The option.
-        option: &'static str,
+        /// The list chosen.
+        side: SubsetSide,
     },
-    /// `--iterate` with `--prior`.
-    #[error("--iterate fits the exact kinematics by least squares; it does not take --prior")]
+    /// The exact-kinematics iteration with the prior.
+    #[error("the exact-kinematics iteration fits by least squares; it does not take the prior")]
     #[cfg_attr(
         feature = "miette",
         diagnostic(
             code(chain::identify::iterate_with_prior),
-            help("identify with --iterate alone, or with --prior alone")
+            help("iterate on the exact kinematics without the prior, or use the prior without iterating")
         )
     )]
     IterateWithPrior,
-    /// `--rank-tol` outside `(0, 1)`.
-    #[error("--rank-tol: {0} is not a relative tolerance in (0, 1)")]
+    /// A rank tolerance outside `(0, 1)`.
+    #[error("the rank tolerance {0} is not a relative tolerance in (0, 1)")]
     #[cfg_attr(
         feature = "miette",
         diagnostic(
             code(chain::identify::rank_tol),
-            help("e.g. --rank-tol 1e-6 (singular values of the equilibrated design below 1e-6 × the largest count as zero)")
+            help("e.g. 1e-6 (singular values of the equilibrated design below 1e-6 × the largest count as zero)")
         )
     )]
     RankTolerance(f64),

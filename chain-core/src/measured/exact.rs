@@ -1,7 +1,7 @@
 //! The exact (not linearised) tool-point deviation of a machine with finite
 //! error values, and its exact derivatives in the errors: what
 //! `chain identify` checks its first-order fit against and
-//! what `--iterate` solves.
+//! what its exact-kinematics iteration solves.
 //!
 //! # Formulas
 //!

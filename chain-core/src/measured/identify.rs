@@ -45,7 +45,7 @@ use super::subset::{self, Problem, Subset, SubsetChoice};
 use crate::model::Machine;
 use crate::named::NameMap;
 
-pub use super::estimate::{Estimate, IdentifyError};
+pub use super::estimate::{Estimate, IdentifyError, SubsetProblem, SubsetSide};
 
 /// Singular values of the equilibrated weighted design below this fraction
 /// of the largest count as zero. The singular values come from the
@@ -66,30 +66,36 @@ pub const LARGEST_RESIDUALS: usize = 10;
 /// Options of [`identify`].
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct IdentifyOptions {
-    /// `--rank-tol`: count the singular values above this fraction of the
-    /// largest as determined (a manual override of the noise rule; in
-    /// `(0, 1)`). `None`: [`RANK_TOLERANCE`] for the structural rank, then
-    /// the noise rule ([`noise_rank`]).
+    /// A fixed rank tolerance: count the singular values above this
+    /// fraction of the largest as determined (a manual override of the
+    /// noise rule; in `(0, 1)`). `None`: [`RANK_TOLERANCE`] for the
+    /// structural rank, then the noise rule ([`noise_rank`]).
     pub rank_tol: Option<f64>,
-    /// Which unknowns are estimated (`--fix`, `--estimate`).
+    /// Which unknowns are estimated.
     pub subset: SubsetChoice,
 }
 
 impl IdentifyOptions {
-    /// The checks that need no data: `--rank-tol` in `(0, 1)`, no subset
-    /// choice with a prior. [`identify`] runs them; front ends run them
-    /// before reading any file.
+    /// The checks that need no data: a chosen subset naming some error,
+    /// the rank tolerance in `(0, 1)`, no chosen subset with a prior.
+    /// [`identify`] runs them; front ends run them before reading any file.
     pub fn check(&self, prior: bool) -> Result<(), IdentifyError> {
+        let chosen = self.subset.chosen();
+        if let Some((side, names)) = chosen {
+            if names.iter().all(|n| n.trim().is_empty()) {
+                return Err(IdentifyError::Subset {
+                    side,
+                    problem: SubsetProblem::NoName,
+                });
+            }
+        }
         if let Some(t) = self.rank_tol {
             if !(t > 0.0 && t < 1.0) {
                 return Err(IdentifyError::RankTolerance(t));
             }
         }
-        match (&self.subset, prior) {
-            (SubsetChoice::Fix(_), true) => Err(IdentifyError::SubsetWithPrior { option: "--fix" }),
-            (SubsetChoice::Estimate(_), true) => Err(IdentifyError::SubsetWithPrior {
-                option: "--estimate",
-            }),
+        match chosen {
+            Some((side, _)) if prior => Err(IdentifyError::SubsetWithPrior { side }),
             _ => Ok(()),
         }
     }
@@ -99,7 +105,7 @@ impl IdentifyOptions {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct NoiseRule {
     /// `deviation` (the noise rule) or `rank-tol` (a fixed tolerance:
-    /// `--rank-tol`, or with `--prior`, or without a residual degree of
+    /// [`IdentifyOptions::rank_tol`], or with a prior, or without a residual degree of
     /// freedom to measure the noise with).
     pub rule: &'static str,
     /// The relative tolerance on the singular values that gave the

@@ -1,5 +1,5 @@
 //! The first-order fit checked against the exact kinematics, and the
-//! exact fit (`chain identify --iterate`;
+//! exact fit by Levenberg–Marquardt (`chain identify`'s iteration;
 //! `docs/identify.md`, "When first order is not enough").
 //!
 //! # Formulas

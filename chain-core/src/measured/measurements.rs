@@ -6,7 +6,7 @@
 //! - the machine's axis variables (every one of them: the pose; rotary in
 //!   radians);
 //! - any of the machine's parameters (that parameter's value for the row; a
-//!   parameter not given as a column takes `--param`'s value, then the
+//!   parameter not given as a column takes the caller's override, then the
 //!   machine file's, and is refused if it has neither);
 //! - either `dpx,dpy,dpz` (a measured tool-point deviation in the machine
 //!   file's frame, as `derive` reports `px, py, pz`) or `ux,uy,uz,d` (a
@@ -265,25 +265,36 @@ impl MeasurementsError {
     }
 }
 
-/// `--holdout FRACTION` outside `(0, 1)`, or a split that leaves no record
+/// A held-out fraction outside `(0, 1)`, or a split that leaves no record
 /// on one side.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
-#[error("--holdout: {message}")]
 #[cfg_attr(
     feature = "miette",
     diagnostic(
         code(chain::identify::holdout),
-        help("--holdout takes the fraction of the records to hold out of the fit, e.g. --holdout 0.2 (with --seed S to choose another split)")
+        help("the held-out fraction is that of the records held out of the fit, e.g. 0.2 (another seed chooses another split)")
     )
 )]
-pub struct HoldoutError {
-    /// What is wrong.
-    pub message: String,
+#[non_exhaustive]
+pub enum HoldoutError {
+    /// The fraction is not in `(0, 1)`.
+    #[error("the held-out fraction {0} is not a fraction in (0, 1)")]
+    Fraction(f64),
+    /// The fraction of these records holds out none or all of them.
+    #[error("{fraction} of {records} records holds out {held}, leaving {} to fit: both sides need a record", records - held)]
+    OneSided {
+        /// The fraction.
+        fraction: f64,
+        /// The records.
+        records: usize,
+        /// How many it holds out.
+        held: usize,
+    },
 }
 
-/// `--holdout FRACTION [--seed S]`: the fraction of the records held out
-/// of the fit and the seed of the split.
+/// The fraction of the records held out of the fit and the seed of the
+/// split.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Holdout {
     /// The fraction held out.
@@ -293,48 +304,22 @@ pub struct Holdout {
 }
 
 impl Holdout {
-    /// The seed when `--seed` is not given.
+    /// The seed when none is given.
     pub const DEFAULT_SEED: u64 = 1;
-
-    /// The choice of `--holdout` and `--seed` (a seed alone is refused: it
-    /// would choose nothing).
-    pub fn from_options(
-        fraction: Option<f64>,
-        seed: Option<u64>,
-    ) -> Result<Option<Holdout>, HoldoutError> {
-        match (fraction, seed) {
-            (None, Some(_)) => Err(HoldoutError {
-                message:
-                    "--seed chooses the records --holdout holds out; give --holdout FRACTION too"
-                        .into(),
-            }),
-            (None, None) => Ok(None),
-            (Some(fraction), seed) => {
-                let h = Holdout {
-                    fraction,
-                    seed: seed.unwrap_or(Holdout::DEFAULT_SEED),
-                };
-                h.check()?;
-                Ok(Some(h))
-            }
-        }
-    }
 
     /// The fraction in `(0, 1)`.
     pub fn check(&self) -> Result<(), HoldoutError> {
         if self.fraction > 0.0 && self.fraction < 1.0 {
             Ok(())
         } else {
-            Err(HoldoutError {
-                message: format!("{} is not a fraction in (0, 1)", self.fraction),
-            })
+            Err(HoldoutError::Fraction(self.fraction))
         }
     }
 }
 
 impl Measurements {
-    /// Splits the records into those fitted and those held out
-    /// (`chain identify --holdout FRACTION --seed S`): `round(FRACTION × n)`
+    /// Splits the records into those fitted and those held out:
+    /// `round(fraction × n)`
     /// records chosen by a seeded shuffle (`rand`'s `SliceRandom::shuffle`,
     /// Fisher–Yates, over xoshiro256++ seeded from `seed` through
     /// SplitMix64, which `rand` documents as portable: the same split on
@@ -351,11 +336,10 @@ impl Measurements {
         let n = self.rows.len();
         let held = (fraction * n as f64).round() as usize;
         if held == 0 || held == n {
-            return Err(HoldoutError {
-                message: format!(
-                    "{fraction} of {n} records holds out {held}, leaving {} to fit: both sides need a record",
-                    n - held
-                ),
+            return Err(HoldoutError::OneSided {
+                fraction,
+                records: n,
+                held,
             });
         }
         let mut order: Vec<usize> = (0..n).collect();
@@ -380,14 +364,9 @@ impl Measurements {
         ))
     }
 
-    /// The number of scalar design rows (3 per point, 1 per direction).
-    pub fn row_count(&self) -> usize {
-        self.rows.iter().map(|r| r.observed.rows()).sum()
-    }
-
-    /// Reads a measurement or candidate CSV for `machine`; `overrides` are
-    /// `--param NAME=VALUE` (later ones win), used for parameters the CSV has
-    /// no column for.
+    /// Reads a measurement or candidate CSV for `machine` (at most
+    /// [`MAX_MEASUREMENT_BYTES`]); `overrides` are parameter values (later
+    /// ones win), used for parameters the CSV has no column for.
     #[cfg(feature = "csv")]
     pub fn read(
         path: &std::path::Path,
@@ -398,8 +377,21 @@ impl Measurements {
         let file = path.display().to_string();
         let bytes = crate::load::read_file(path, &file, MAX_MEASUREMENT_BYTES)
             .map_err(MeasurementsError)?;
-        let text = crate::load::decode(&bytes, &file).map_err(MeasurementsError)?;
-        Measurements::parse(text, &file, machine, overrides, layout)
+        Measurements::from_bytes(&bytes, &file, machine, overrides, layout)
+    }
+
+    /// [`Measurements::read`] over bytes named `file` the caller read: text
+    /// that is not UTF-8 or holds a NUL byte is refused, located.
+    #[cfg(feature = "csv")]
+    pub fn from_bytes(
+        bytes: &[u8],
+        file: &str,
+        machine: &Machine,
+        overrides: &[(String, f64)],
+        layout: Layout,
+    ) -> Result<Measurements, MeasurementsError> {
+        let text = crate::load::decode(bytes, file).map_err(MeasurementsError)?;
+        Measurements::parse(text, file, machine, overrides, layout)
     }
 
     /// [`Measurements::read`] over CSV text named `file`.

@@ -11,7 +11,6 @@
 //! reads an axis's ISO 230-2 positioning runs and evaluates them, and
 //! [`positioning_values`] writes them into a values file.
 
-pub mod document;
 mod estimate;
 pub mod exact;
 pub mod identify;
@@ -23,7 +22,9 @@ pub mod positioning_values;
 pub mod predict;
 pub mod subset;
 
-pub use identify::{identify, Identification, IdentifyError, IdentifyOptions, NoiseRule};
+pub use identify::{
+    identify, Identification, IdentifyError, IdentifyOptions, NoiseRule, SubsetProblem, SubsetSide,
+};
 pub use measurements::{
     design_rows, Design, DesignError, Holdout, HoldoutError, Layout, MeasuredComponent,
     Measurement, MeasurementKind, Measurements, MeasurementsError, Observed,

@@ -97,7 +97,7 @@ pub enum PlanError {
     #[error("there is no candidate")]
     NoCandidates,
     /// `K` is zero or above the candidate count.
-    #[error("--count {count} is not a count of candidates: choose 1 to {candidates}")]
+    #[error("{count} is not a count of the {candidates} candidates: choose 1 to {candidates}")]
     Count {
         /// The count asked for.
         count: usize,
@@ -105,7 +105,7 @@ pub enum PlanError {
         candidates: usize,
     },
     /// `K` candidates cannot inform the identifiable subspace.
-    #[error("{count} candidates give {rows} design rows, fewer than the {rank} dimensions the candidates can identify; choose --count {minimum} or more")]
+    #[error("{count} candidates give {rows} design rows, fewer than the {rank} dimensions the candidates can identify; choose {minimum} candidates or more")]
     TooFew {
         /// The count asked for.
         count: usize,
@@ -785,25 +785,27 @@ impl<'b> Search<'b> {
 }
 
 // ---------------------------------------------------------------------------
-// The document of `chain plan`.
+// What the candidates measure.
 
 /// What each candidate measures: the measurement kind of `chain identify`
 /// (`point`, three rows per candidate; `direction`, one row along the
 /// candidate's `ux, uy, uz`).
 pub use crate::measured::MeasurementKind as Kind;
 
-/// A `kind` asked for that the candidate file contradicts.
+/// A measurement kind asked for that the candidate file contradicts.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
 pub enum KindError {
     /// Point asked for, the file has directions.
-    #[error("{file}:1: columns `ux,uy,uz` give directions, but --kind point measures px, py, pz; pass --kind direction or remove them")]
+    #[error(
+        "{file}:1: columns `ux,uy,uz` give directions, but point measurements measure px, py, pz"
+    )]
     PointWithDirections {
         /// The candidate file.
         file: String,
     },
     /// Direction asked for, the file has none.
-    #[error("{file}:1: --kind direction needs the columns `ux,uy,uz` (the unit direction of each measurement)")]
+    #[error("{file}:1: direction measurements need the columns `ux,uy,uz` (the unit direction of each measurement)")]
     DirectionWithout {
         /// The candidate file.
         file: String,
@@ -812,7 +814,7 @@ pub enum KindError {
 
 impl Kind {
     /// What the candidates of `file` measure (`ux,uy,uz` present: every row
-    /// a direction), checked against `asked` (`--kind`). `None` when there
+    /// a direction), checked against the kind `asked` for. `None` when there
     /// is no candidate.
     pub fn of(
         candidates: &crate::measured::Measurements,
@@ -831,56 +833,4 @@ impl Kind {
             (Some(Kind::Direction), Kind::Point) => Err(KindError::DirectionWithout { file }),
         }
     }
-}
-
-/// The document of `chain plan` (`--format json`, and what the Python
-/// package returns): the library's [`Plan`] with what the command knows of
-/// its input; `lines` and `poses` are for the table only.
-#[derive(Debug, Clone, Serialize)]
-pub struct PlanDocument {
-    /// The machine's name.
-    pub machine: String,
-    /// The candidate file as named in messages.
-    pub candidates_file: String,
-    /// What each candidate measures.
-    pub kind: Kind,
-    /// The axis variables, in model order.
-    pub variables: Vec<String>,
-    /// Each candidate's CSV line.
-    #[serde(skip)]
-    pub lines: Vec<usize>,
-    /// Each candidate's pose.
-    #[serde(skip)]
-    pub poses: Vec<Vec<f64>>,
-    /// The plan.
-    #[serde(flatten)]
-    pub plan: Plan,
-}
-
-/// `chain plan`: `count` of `candidates` (read for `machine` with
-/// [`crate::measured::Layout::Candidates`]) by [`plan`], as its document.
-pub fn plan_document(
-    machine: &Machine,
-    candidates: &crate::measured::Measurements,
-    count: usize,
-    kind: Kind,
-) -> Result<PlanDocument, PlanError> {
-    if count == 0 || count > candidates.rows.len() {
-        return Err(PlanError::Count {
-            count,
-            candidates: candidates.rows.len(),
-        });
-    }
-    let model = crate::compile(machine);
-    let rows = Rows::of(&model, machine, &candidates.rows)?;
-    let result = plan(&rows, count)?;
-    Ok(PlanDocument {
-        machine: machine.name.clone(),
-        candidates_file: candidates.file.clone(),
-        kind,
-        variables: model.variables().iter().map(|v| v.to_string()).collect(),
-        lines: candidates.rows.iter().map(|c| c.line).collect(),
-        poses: candidates.rows.iter().map(|c| c.q.clone()).collect(),
-        plan: result,
-    })
 }

@@ -88,7 +88,7 @@ pub enum AxisKind {
     #[default]
     Linear,
     /// Targets and deviations in degrees in the run file; statistics in
-    /// arcseconds (`--rotary`).
+    /// arcseconds.
     Rotary,
 }
 
@@ -98,6 +98,14 @@ impl AxisKind {
         match self {
             AxisKind::Linear => Unit::Mm,
             AxisKind::Rotary => Unit::Arcsec,
+        }
+    }
+
+    /// `linear` or `rotary`.
+    pub fn name(self) -> &'static str {
+        match self {
+            AxisKind::Linear => "linear",
+            AxisKind::Rotary => "rotary",
         }
     }
 

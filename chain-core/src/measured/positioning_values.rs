@@ -1,5 +1,5 @@
 //! A positioning run as the error values of a built machine
-//! (`chain positioning --values-out`; docs/positioning.md, "Into a values
+//! (what `chain positioning` writes; docs/positioning.md, "Into a values
 //! file"; docs/values.md, "Direction").
 //!
 //! The run measures one error motion: the positioning error of the axis, the
@@ -107,7 +107,7 @@ pub enum SlotError {
         alternatives: Vec<String>,
     },
     /// A linear run for a rotary axis or the other way round.
-    #[error("`{name}` is an error of the {joint} axis `{variable}`, but the runs are of a {runs} axis{}", if *runs == "rotary" { "" } else { " (give --rotary for a rotary axis's runs)" })]
+    #[error("`{name}` is an error of the {joint} axis `{variable}`, but the runs are of a {} axis", runs.name())]
     #[cfg_attr(feature = "miette", diagnostic(code(chain::positioning::axis_kind)))]
     KindMismatch {
         /// The name.
@@ -116,8 +116,8 @@ pub enum SlotError {
         variable: String,
         /// `prismatic` or `rotary`.
         joint: &'static str,
-        /// `linear` or `rotary`.
-        runs: &'static str,
+        /// The kind of axis the runs were read as.
+        runs: AxisKind,
     },
 }
 
@@ -184,10 +184,7 @@ pub fn slot(
                 JointKind::Prismatic => "prismatic",
                 JointKind::Rotary => "rotary",
             },
-            runs: match k {
-                AxisKind::Linear => "linear",
-                AxisKind::Rotary => "rotary",
-            },
+            runs: k,
         }));
     }
     let offset = if joint.kind == JointKind::Prismatic {

@@ -1,5 +1,5 @@
 //! How an identification predicts measurements it was not fitted to
-//! (`chain identify --validate` or `--holdout`): the error a machine shows
+//! (held-out measurements, from a file or split off the fitted ones): the error a machine shows
 //! at held-out poses before correction (the measured values `b`) and after
 //! it (`b − A x̂`, the
 //! measured values less what the estimates predict through the same exact
@@ -76,7 +76,7 @@ pub fn predict(design: &Design, r: &Identification) -> Prediction {
 
 /// The prediction at the rows of `design` when the model predicts
 /// `predicted` there (one value per scalar row): the exact kinematics of
-/// `--iterate`'s values, say.
+/// the exact-kinematics iteration's values, say.
 pub fn predict_rows(design: &Design, predicted: &[f64]) -> Prediction {
     let after: Vec<f64> = (design.b.iter().zip(predicted))
         .map(|(b, p)| b - p)

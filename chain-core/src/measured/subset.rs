@@ -36,13 +36,13 @@
 //!   `s_max` is **redundant** (structurally: the measurements cannot tell
 //!   it from the combination), otherwise **weak** (chosen by the noise
 //!   rule: the data do not determine it beyond their noise) or **fixed**
-//!   (by `--fix`/`--estimate`: fixing it biases the estimates by its true
+//!   (by the caller's choice: fixing it biases the estimates by its true
 //!   value times the part `ρ_j` the others do not carry).
 
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
-use super::estimate::{Estimate, IdentifyError};
+use super::estimate::{Estimate, IdentifyError, SubsetProblem, SubsetSide};
 
 /// Relation weights (in equilibrated units: the share of the fixed
 /// unknown's unit-norm effect carried by an estimated one) below this are
@@ -55,13 +55,14 @@ pub const TERM_CUTOFF: f64 = 1e-3;
 pub enum ChosenBy {
     /// The column-pivoted QR of the truncated equilibrated design.
     Elimination,
-    /// `--fix NAME,...`: every other unknown is estimated.
+    /// The fixed unknowns named: every other one is estimated.
     Fix,
-    /// `--estimate NAME,...`: every other unknown is fixed.
+    /// The estimated unknowns named: every other one is fixed.
     Estimate,
 }
 
-/// Which unknowns are estimated (`--fix`, `--estimate`).
+/// Which unknowns are estimated: the elimination's choice, or a list
+/// chosen by the caller.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub enum SubsetChoice {
     /// The elimination's choice.
@@ -74,40 +75,12 @@ pub enum SubsetChoice {
 }
 
 impl SubsetChoice {
-    /// The choice of `--fix` and `--estimate` (at most one of them).
-    pub fn from_options(
-        fix: Option<Vec<String>>,
-        estimate: Option<Vec<String>>,
-    ) -> Result<SubsetChoice, IdentifyError> {
-        match (fix, estimate) {
-            (Some(_), Some(_)) => Err(IdentifyError::Subset {
-                option: "--fix",
-                message: "cannot be given with --estimate (one names the fixed parameters, the other the estimated ones)".into(),
-            }),
-            (Some(names), None) if names.iter().all(|n| n.trim().is_empty()) => {
-                Err(IdentifyError::Subset {
-                    option: "--fix",
-                    message: "names no error parameter".into(),
-                })
-            }
-            (None, Some(names)) if names.iter().all(|n| n.trim().is_empty()) => {
-                Err(IdentifyError::Subset {
-                    option: "--estimate",
-                    message: "names no error parameter".into(),
-                })
-            }
-            (Some(names), None) => Ok(SubsetChoice::Fix(names)),
-            (None, Some(names)) => Ok(SubsetChoice::Estimate(names)),
-            (None, None) => Ok(SubsetChoice::Elimination),
-        }
-    }
-
-    /// The option's name, for messages.
-    fn option(&self) -> &'static str {
+    /// The list chosen and its names (`None`: the elimination's choice).
+    pub fn chosen(&self) -> Option<(SubsetSide, &[String])> {
         match self {
-            SubsetChoice::Elimination => "",
-            SubsetChoice::Fix(_) => "--fix",
-            SubsetChoice::Estimate(_) => "--estimate",
+            SubsetChoice::Elimination => None,
+            SubsetChoice::Fix(names) => Some((SubsetSide::Fixed, names)),
+            SubsetChoice::Estimate(names) => Some((SubsetSide::Estimated, names)),
         }
     }
 }
@@ -123,7 +96,7 @@ pub enum FixedStatus {
     /// Left out by the noise rule: the data determine it only within their
     /// noise.
     Weak,
-    /// Fixed by `--fix`/`--estimate` although the estimated ones do not
+    /// Fixed by the caller's choice although the estimated ones do not
     /// carry all its effect.
     Fixed,
 }
@@ -281,32 +254,25 @@ fn pivots(
     (chosen, remaining)
 }
 
-/// The index of each name in `names`, or the refusal naming the option and
-/// the closest unknown.
+/// The index of each name in `names`, or the refusal naming the list
+/// (`side`) and the closest unknown.
 fn indices(
-    option: &'static str,
+    side: SubsetSide,
     given: &[String],
     names: &[String],
 ) -> Result<Vec<usize>, IdentifyError> {
+    let refuse = |problem| IdentifyError::Subset { side, problem };
     let mut out = Vec::with_capacity(given.len());
     for g in given {
         match names.iter().position(|n| n == g) {
             Some(j) if !out.contains(&j) => out.push(j),
-            Some(_) => {
-                return Err(IdentifyError::Subset {
-                    option,
-                    message: format!("`{g}` is named twice"),
-                })
-            }
+            Some(_) => return Err(refuse(SubsetProblem::Twice { name: g.clone() })),
             None => {
                 let close = crate::input::diagnostic::closest(g, names.iter().map(String::as_str));
-                return Err(IdentifyError::Subset {
-                    option,
-                    message: format!(
-                        "`{g}` is not an error parameter of these measurements{}",
-                        close.map_or(String::new(), |c| format!(" (did you mean `{c}`?)"))
-                    ),
-                });
+                return Err(refuse(SubsetProblem::Unknown {
+                    name: g.clone(),
+                    suggestion: close.map(str::to_string),
+                }));
             }
         }
     }
@@ -330,14 +296,15 @@ pub(crate) fn choose(
             (ChosenBy::Elimination, chosen)
         }
         SubsetChoice::Fix(names) => {
-            let fixed = indices("--fix", names, p.names)?;
+            let fixed = indices(SubsetSide::Fixed, names, p.names)?;
             (
                 ChosenBy::Fix,
                 all.iter().copied().filter(|j| !fixed.contains(j)).collect(),
             )
         }
         SubsetChoice::Estimate(names) => {
-            (ChosenBy::Estimate, indices("--estimate", names, p.names)?)
+            let estimated = indices(SubsetSide::Estimated, names, p.names)?;
+            (ChosenBy::Estimate, estimated)
         }
     };
     kept.sort_unstable();
@@ -348,20 +315,18 @@ pub(crate) fn choose(
         let c = p.truncated(structural);
         let (chosen, remaining) = pivots(&c, &kept, kept.len(), floor);
         if chosen.len() < kept.len() {
-            let mut tied: Vec<&str> = kept
+            let mut names: Vec<String> = kept
                 .iter()
                 .zip(&remaining)
                 .filter(|(_, &rest)| rest <= floor)
-                .map(|(&j, _)| p.names[j].as_str())
+                .map(|(&j, _)| p.names[j].clone())
                 .collect();
-            tied.sort_unstable();
+            names.sort_unstable();
             return Err(IdentifyError::Subset {
-                option: choice.option(),
-                message: format!(
-                    "the measurements cannot separate {} from the other estimated parameters; fix {} too",
-                    tied.join(", "),
-                    if tied.len() == 1 { "it" } else { "some of them" }
-                ),
+                side: choice
+                    .chosen()
+                    .map_or(SubsetSide::Estimated, |(side, _)| side),
+                problem: SubsetProblem::Inseparable { names },
             });
         }
     }

@@ -1,7 +1,7 @@
 //! Rust code emission: a [`SymbolicModel`] → straight-line Rust.
 //!
-//! One emitter serves both the `machine!` macro and `chain derive --format
-//! rust`. The generated type has the name lists, named index constants,
+//! One emitter serves both the `machine!` macro and `chain derive`'s Rust
+//! output. The generated type has the name lists, named index constants,
 //! `error`, `sensitivity` and `nominal` as inherent functions over fixed-size
 //! arrays (no heap, no panics), and an implementation of
 //! `chain::core::ErrorModel` so it is interchangeable with a runtime model.
@@ -34,7 +34,7 @@ pub struct EmitOptions {
 /// Which form of the generated API to emit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Emission {
-    /// What `chain derive --format rust` prints: the functions `error`,
+    /// What `chain derive` prints as Rust: the functions `error`,
     /// `sensitivity` and `nominal`, each a self-contained body (the output
     /// is pinned byte for byte by `tests/golden/`).
     Derive,
@@ -105,364 +105,35 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
     let ty = Ident::new(&options.type_name, Span::call_site());
     let krate = &options.crate_path;
     let vis = &options.visibility;
-    let v = lit(model.variables.len());
-    let p = lit(model.parameters.len());
-    let n = lit(model.errors.len());
+    let sizes = Sizes::of(model);
+    let Sizes { v, p, n } = &sizes;
     let var_names: Vec<&str> = model.variables.iter().map(|x| x.0.as_str()).collect();
     let param_names: Vec<&str> = model.parameters.iter().map(|x| x.0.as_str()).collect();
     let error_names: Vec<&str> = model.errors.iter().map(String::as_str).collect();
-    let param_values: Vec<TokenStream> = model
-        .parameters
-        .iter()
-        .map(|(_, value)| match value {
-            Some(x) if x.is_finite() => {
-                let lit = Literal::f64_unsuffixed(*x);
-                quote!(::core::option::Option::Some(#lit))
-            }
-            _ => quote!(::core::option::Option::None),
-        })
-        .collect();
-
+    let param_values = parameter_values(model);
     let index_consts = index_constants(model);
     let direct = options.emission == Emission::Macro;
 
-    // Sensitivity: every non-zero coefficient.
-    let sens_polys: Vec<(usize, usize, &Poly)> = model
-        .components
-        .iter()
-        .enumerate()
-        .flat_map(|(c, entries)| entries.iter().map(move |(j, poly)| (c, *j, poly)))
-        .collect();
-    let mut sens = Body::new(model, direct);
-    let sens_entries: Vec<(usize, usize, bool, TokenStream)> = sens_polys
-        .iter()
-        .filter(|(_, _, poly)| !(direct && poly.is_zero()))
-        .map(|(c, j, poly)| {
-            let (negative, e) = sens.signed(poly);
-            (*c, *j, negative, e)
-        })
-        .collect();
-    let signed_value = |negative: bool, e: &TokenStream| {
-        if negative {
-            quote!(-#e)
-        } else {
-            quote!(#e)
-        }
-    };
-    let sens_assign: Vec<TokenStream> = sens_entries
-        .iter()
-        .map(|(c, j, negative, e)| {
-            let value = signed_value(*negative, e);
-            let (c, j) = (lit(*c), lit(*j));
-            quote!(s[#c][#j] = #value;)
-        })
-        .collect();
-    let sens_prelude = sens.prelude();
-
-    let mut err = Body::new(model, direct);
-    let err_rows: Vec<TokenStream> = Component::ALL
-        .iter()
-        .map(|c| {
-            let mut row = TokenStream::new();
-            for (k, (j, poly)) in model.components[c.index()].iter().enumerate() {
-                let (negative, ex) = err.signed(poly);
-                let j = lit(*j);
-                let factor = if ex.to_string() == "1.0" {
-                    quote!(e[#j])
-                } else {
-                    quote!(#ex * e[#j])
-                };
-                row.extend(match (k, negative) {
-                    (0, false) => quote!(#factor),
-                    (0, true) => quote!(-#factor),
-                    (_, false) => quote!(+ #factor),
-                    (_, true) => quote!(- #factor),
-                });
-            }
-            if row.is_empty() {
-                quote!(0.0)
-            } else {
-                row
-            }
-        })
-        .collect();
-    let err_prelude = err.prelude();
-
-    let mut nom = Body::new(model, false);
-    let rot: Vec<TokenStream> = model
-        .nominal_rotation
-        .iter()
-        .map(|row| {
-            let cells: Vec<TokenStream> = row.iter().map(|x| nom.expr(x)).collect();
-            quote!([#(#cells),*])
-        })
-        .collect();
-    let pos: Vec<TokenStream> = model.nominal_position.iter().map(|x| nom.expr(x)).collect();
-    let nom_prelude = nom.prelude();
+    let sens = SensitivityBody::new(model, direct);
+    let err = ErrorBody::new(model, direct);
+    let nominal = NominalBody::new(model);
+    let nom_prelude = &nominal.prelude;
+    let (rot, pos) = (&nominal.rotation, &nominal.position);
 
     let (error_fns, sensitivity_fns, model_fns) = if direct {
-        let total = 6 * model.errors.len();
-        let mut flat: Vec<TokenStream> = vec![quote!(0.0); total];
-        for (c, j, negative, e) in &sens_entries {
-            flat[c * model.errors.len() + j] = signed_value(*negative, e);
-        }
-        let flat_stores = flat.iter().enumerate().map(|(k, value)| {
-            let k = lit(k);
-            quote!(out[#k] = #value;)
-        });
-        let nonzero_stores = sens_entries
-            .iter()
-            .enumerate()
-            .map(|(k, (_, _, negative, e))| {
-                let value = signed_value(*negative, e);
-                let k = lit(k);
-                quote!(out[#k] = #value;)
-            });
-        let nonzeros = sens_entries.iter().map(|(c, j, _, _)| {
-            let (c, j) = (lit(*c), lit(*j));
-            quote!((#c, #j))
-        });
-        let k = lit(sens_entries.len());
-        let total = lit(total);
-        let error_stores = err_rows.iter().enumerate().map(|(c, row)| {
-            let c = lit(c);
-            quote!(out[#c] = #row;)
-        });
-        let error_fns = quote! {
-            #[inline]
-            #[must_use]
-            pub fn error(q: &[f64; #v], p: &[f64; #p], e: &[f64; #n]) -> [f64; 6] {
-                let mut out = [0.0f64; 6];
-                Self::error_into(q, p, e, &mut out);
-                out
-            }
-
-            /// [`Self::error`] written into `out` (every component).
-            #[inline]
-            pub fn error_into(q: &[f64; #v], p: &[f64; #p], e: &[f64; #n], out: &mut [f64; 6]) {
-                #err_prelude
-                #(#error_stores)*
-            }
-        };
-        let sensitivity_fns = quote! {
-            #[inline]
-            #[must_use]
-            pub fn sensitivity(q: &[f64; #v], p: &[f64; #p]) -> [[f64; #n]; 6] {
-                // Its own body: zero-filling a returned array and then calling
-                // `sensitivity_into` over it measured 1.5× slower.
-                #sens_prelude
-                let mut s = [[0.0f64; #n]; 6];
-                #(#sens_assign)*
-                s
-            }
-
-            /// [`Self::sensitivity`] written into `out`: every entry, the
-            /// structural zeros included (no zero-filling needed, no copy).
-            #[inline]
-            pub fn sensitivity_into(q: &[f64; #v], p: &[f64; #p], out: &mut [[f64; #n]; 6]) {
-                // `6 × N` elements: the conversion cannot fail.
-                if let ::core::result::Result::Ok(flat) =
-                    <&mut [f64; #total]>::try_from(out.as_flattened_mut())
-                {
-                    Self::sensitivity_flat_into(q, p, flat);
-                }
-            }
-
-            /// [`Self::sensitivity`] written row-major into `out`
-            /// (`out[c * N + j] = ∂E_c/∂e_j`), every entry in index order.
-            #[inline]
-            pub fn sensitivity_flat_into(q: &[f64; #v], p: &[f64; #p], out: &mut [f64; #total]) {
-                #sens_prelude
-                #(#flat_stores)*
-            }
-
-            /// The entries of the sensitivity matrix that are not identically
-            /// zero, `(row, error index)`, row-major: the order of
-            /// [`Self::sensitivity_nonzeros`]. Every other entry is exactly 0.
-            pub const NONZEROS: [(usize, usize); #k] = [#(#nonzeros),*];
-
-            /// The entries [`Self::NONZEROS`] of the sensitivity matrix, in
-            /// that order: `out[k] = s[NONZEROS[k].0][NONZEROS[k].1]`.
-            #[inline]
-            pub fn sensitivity_nonzeros(q: &[f64; #v], p: &[f64; #p], out: &mut [f64; #k]) {
-                #sens_prelude
-                #(#nonzero_stores)*
-            }
-        };
-        let batch_fns = batch_functions(model, krate, (&sens, &sens_entries), (&err, &err_rows));
-        let model_fns = quote! {
-            fn error(&self, q: &[f64], p: &[f64], e: &[f64], out: &mut [f64; 6]) {
-                match (
-                    <&[f64; #v]>::try_from(q),
-                    <&[f64; #p]>::try_from(p),
-                    <&[f64; #n]>::try_from(e),
-                ) {
-                    (Ok(q), Ok(p), Ok(e)) => Self::error_into(q, p, e, out),
-                    _ => *out = [f64::NAN; 6],
-                }
-            }
-            fn sensitivity(&self, q: &[f64], p: &[f64], out: &mut [f64]) {
-                match (<&[f64; #v]>::try_from(q), <&[f64; #p]>::try_from(p)) {
-                    (Ok(q), Ok(p)) => match <&mut [f64; #total]>::try_from(&mut *out) {
-                        Ok(flat) => Self::sensitivity_flat_into(q, p, flat),
-                        // A slice of another length (the trait asks for 6 × N):
-                        // the entries that fit.
-                        Err(_) => {
-                            let s = Self::sensitivity(q, p);
-                            for (slot, value) in out.iter_mut().zip(s.iter().flatten()) {
-                                *slot = *value;
-                            }
-                        }
-                    },
-                    _ => out.iter_mut().for_each(|slot| *slot = f64::NAN),
-                }
-            }
-            fn sparsity(&self) -> ::core::option::Option<&[(usize, usize)]> {
-                ::core::option::Option::Some(&Self::NONZEROS)
-            }
-            fn sensitivity_nonzeros(&self, q: &[f64], p: &[f64], out: &mut [f64]) -> bool {
-                match (
-                    <&[f64; #v]>::try_from(q),
-                    <&[f64; #p]>::try_from(p),
-                    <&mut [f64; #k]>::try_from(out),
-                ) {
-                    (Ok(q), Ok(p), Ok(out)) => {
-                        Self::sensitivity_nonzeros(q, p, out);
-                        true
-                    }
-                    _ => false,
-                }
-            }
-        };
-        let (batch_fns, batch_model_fns) = batch_fns;
-        let sensitivity_fns = quote!(#sensitivity_fns #batch_fns);
-        let model_fns = quote!(#model_fns #batch_model_fns);
-        (error_fns, sensitivity_fns, model_fns)
+        macro_functions(model, krate, &sizes, &sens, &err)
     } else {
-        let error_fns = quote! {
-            #[inline]
-            #[must_use]
-            pub fn error(q: &[f64; #v], p: &[f64; #p], e: &[f64; #n]) -> [f64; 6] {
-                #err_prelude
-                [#(#err_rows),*]
-            }
-        };
-        let sensitivity_fns = quote! {
-            #[inline]
-            #[must_use]
-            pub fn sensitivity(q: &[f64; #v], p: &[f64; #p]) -> [[f64; #n]; 6] {
-                #sens_prelude
-                let mut s = [[0.0f64; #n]; 6];
-                #(#sens_assign)*
-                s
-            }
-        };
-        let model_fns = quote! {
-            fn error(&self, q: &[f64], p: &[f64], e: &[f64], out: &mut [f64; 6]) {
-                *out = match (
-                    <&[f64; #v]>::try_from(q),
-                    <&[f64; #p]>::try_from(p),
-                    <&[f64; #n]>::try_from(e),
-                ) {
-                    (Ok(q), Ok(p), Ok(e)) => Self::error(q, p, e),
-                    _ => [f64::NAN; 6],
-                };
-            }
-            fn sensitivity(&self, q: &[f64], p: &[f64], out: &mut [f64]) {
-                match (<&[f64; #v]>::try_from(q), <&[f64; #p]>::try_from(p)) {
-                    (Ok(q), Ok(p)) => {
-                        let s = Self::sensitivity(q, p);
-                        for (slot, value) in out.iter_mut().zip(s.iter().flatten()) {
-                            *slot = *value;
-                        }
-                    }
-                    _ => out.iter_mut().for_each(|slot| *slot = f64::NAN),
-                }
-            }
-        };
-        (error_fns, sensitivity_fns, model_fns)
+        derive_functions(&sizes, &sens, &err)
     };
 
-    let text = |poly: &Poly| poly.to_text(&|s| model.symbol_name(s));
-    let component_docs: Vec<String> = Component::ALL
-        .iter()
-        .map(|c| {
-            let terms: Vec<(bool, String)> = model.components[c.index()]
-                .iter()
-                .map(|(j, poly)| crate::export::term(&text(poly), &model.errors[*j]))
-                .collect();
-            let rhs = crate::export::join_terms(&terms, (" + ", " - "));
-            format!(" - `{} = {}`", c.name(), rhs)
-        })
-        .collect();
-    let nominal_doc: Vec<String> = model
-        .nominal_rotation
-        .iter()
-        .map(|row| {
-            let cells: Vec<String> = row.iter().map(&text).collect();
-            format!(" - `R` row: `[{}]`", cells.join(", "))
-        })
-        .chain(std::iter::once(format!(
-            " - position: `[{}]`",
-            model
-                .nominal_position
-                .iter()
-                .map(&text)
-                .collect::<Vec<_>>()
-                .join(", ")
-        )))
-        .collect();
-    let type_doc = format!(
-        " First-order error model of machine `{}` (frame: {}), generated by `chain`.",
-        model.machine,
-        model.frame.name()
-    );
+    let Docs {
+        components: component_docs,
+        nominal: nominal_doc,
+        type_doc,
+        functions: function_docs,
+    } = Docs::new(model);
     let vars_doc = format!(" Axis variables, in `q` order: {}.", var_names.join(", "));
-    // Function slots: their definitions in the type's docs and `error_at`, a
-    // built machine's error from error values that vary along the axes.
-    // Machines without function slots generate exactly what they did before.
-    let function_docs: Vec<String> = if model.functions.is_empty() {
-        Vec::new()
-    } else {
-        std::iter::once(String::new())
-            .chain(std::iter::once(
-                " Error motions that vary along their axis (their coefficients are errors):"
-                    .to_string(),
-            ))
-            .chain(
-                model
-                    .functions
-                    .iter()
-                    .map(|f| format!(" - `{}`", crate::export::function_text(model, f))),
-            )
-            .collect()
-    };
-    let error_at = if model.functions.is_empty() {
-        TokenStream::new()
-    } else {
-        quote! {
-            /// The error `[px, py, pz, ox, oy, oz]` of a built machine at `q`:
-            /// `E(q) = Σ_j c_j(q)·v_j(q)`, with the error values `v(q)` from
-            /// `values` (a closure `|q: &[f64], e: &mut [f64]| …` or any
-            /// `ErrorValues`, e.g. a values file) in `ERRORS` order; the
-            /// scratch is a stack array.
-            ///
-            /// # Errors
-            ///
-            /// `OutOfRange` when `values` has no value at `q` (a measured
-            /// table that does not cover it).
-            #[inline]
-            pub fn error_at(
-                q: &[f64; #v],
-                p: &[f64; #p],
-                values: &(impl #krate::core::ErrorValues + ?Sized),
-            ) -> ::core::result::Result<[f64; 6], #krate::core::OutOfRange> {
-                let mut e = [0.0f64; #n];
-                #krate::core::ErrorValues::values_at(values, q, &mut e)?;
-                ::core::result::Result::Ok(Self::error(q, p, &e))
-            }
-        }
-    };
+    let error_at = error_at(model, krate, &sizes);
 
     quote! {
         #[doc = #type_doc]
@@ -532,6 +203,498 @@ pub fn emit(model: &SymbolicModel, options: &EmitOptions) -> TokenStream {
     }
 }
 
+/// The array lengths of the generated signatures: `q` (variables), `p`
+/// (parameters) and `e` (errors), as literals.
+struct Sizes {
+    v: Literal,
+    p: Literal,
+    n: Literal,
+}
+
+impl Sizes {
+    fn of(model: &SymbolicModel) -> Sizes {
+        Sizes {
+            v: lit(model.variables.len()),
+            p: lit(model.parameters.len()),
+            n: lit(model.errors.len()),
+        }
+    }
+}
+
+/// `PARAMETER_VALUES`: each parameter's value given with the machine
+/// (`Some`), or `None` for one supplied at run time (or not finite).
+fn parameter_values(model: &SymbolicModel) -> Vec<TokenStream> {
+    model
+        .parameters
+        .iter()
+        .map(|(_, value)| match value {
+            Some(x) if x.is_finite() => {
+                let lit = Literal::f64_unsuffixed(*x);
+                quote!(::core::option::Option::Some(#lit))
+            }
+            _ => quote!(::core::option::Option::None),
+        })
+        .collect()
+}
+
+/// `value` or `-value`.
+fn signed(negative: bool, e: &TokenStream) -> TokenStream {
+    if negative {
+        quote!(-#e)
+    } else {
+        quote!(#e)
+    }
+}
+
+/// The sensitivity matrix's body: every non-zero coefficient (under
+/// [`Emission::Macro`] the identically zero ones left out) as a signed
+/// expression over the body's locals.
+struct SensitivityBody<'a> {
+    body: Body<'a>,
+    /// `(row, error index, negated, expression)` per emitted entry, row-major.
+    entries: Vec<(usize, usize, bool, TokenStream)>,
+    /// `s[c][j] = value;` per entry.
+    assign: Vec<TokenStream>,
+    /// The body's `let` statements.
+    prelude: TokenStream,
+}
+
+impl<'a> SensitivityBody<'a> {
+    fn new(model: &'a SymbolicModel, direct: bool) -> SensitivityBody<'a> {
+        let polys: Vec<(usize, usize, &Poly)> = model
+            .components
+            .iter()
+            .enumerate()
+            .flat_map(|(c, entries)| entries.iter().map(move |(j, poly)| (c, *j, poly)))
+            .collect();
+        let mut body = Body::new(model, direct);
+        let entries: Vec<(usize, usize, bool, TokenStream)> = polys
+            .iter()
+            .filter(|(_, _, poly)| !(direct && poly.is_zero()))
+            .map(|(c, j, poly)| {
+                let (negative, e) = body.signed(poly);
+                (*c, *j, negative, e)
+            })
+            .collect();
+        let assign: Vec<TokenStream> = entries
+            .iter()
+            .map(|(c, j, negative, e)| {
+                let value = signed(*negative, e);
+                let (c, j) = (lit(*c), lit(*j));
+                quote!(s[#c][#j] = #value;)
+            })
+            .collect();
+        let prelude = body.prelude();
+        SensitivityBody {
+            body,
+            entries,
+            assign,
+            prelude,
+        }
+    }
+}
+
+/// The error vector's body: one row expression `Σ_j coefficient · e[j]`
+/// per component (`0.0` for a component without errors).
+struct ErrorBody<'a> {
+    body: Body<'a>,
+    /// The expression of each component, in [`Component::ALL`] order.
+    rows: Vec<TokenStream>,
+    /// The body's `let` statements.
+    prelude: TokenStream,
+}
+
+impl<'a> ErrorBody<'a> {
+    fn new(model: &'a SymbolicModel, direct: bool) -> ErrorBody<'a> {
+        let mut body = Body::new(model, direct);
+        let rows: Vec<TokenStream> = Component::ALL
+            .iter()
+            .map(|c| {
+                let mut row = TokenStream::new();
+                for (k, (j, poly)) in model.components[c.index()].iter().enumerate() {
+                    let (negative, ex) = body.signed(poly);
+                    let j = lit(*j);
+                    let factor = if ex.to_string() == "1.0" {
+                        quote!(e[#j])
+                    } else {
+                        quote!(#ex * e[#j])
+                    };
+                    row.extend(match (k, negative) {
+                        (0, false) => quote!(#factor),
+                        (0, true) => quote!(-#factor),
+                        (_, false) => quote!(+ #factor),
+                        (_, true) => quote!(- #factor),
+                    });
+                }
+                if row.is_empty() {
+                    quote!(0.0)
+                } else {
+                    row
+                }
+            })
+            .collect();
+        let prelude = body.prelude();
+        ErrorBody {
+            body,
+            rows,
+            prelude,
+        }
+    }
+}
+
+/// The nominal pose's body: the rotation's rows and the position.
+struct NominalBody {
+    /// `[r0, r1, r2]` per row.
+    rotation: Vec<TokenStream>,
+    /// The tool point's coordinates.
+    position: Vec<TokenStream>,
+    /// The body's `let` statements.
+    prelude: TokenStream,
+}
+
+impl NominalBody {
+    fn new(model: &SymbolicModel) -> NominalBody {
+        let mut nom = Body::new(model, false);
+        let rotation: Vec<TokenStream> = model
+            .nominal_rotation
+            .iter()
+            .map(|row| {
+                let cells: Vec<TokenStream> = row.iter().map(|x| nom.expr(x)).collect();
+                quote!([#(#cells),*])
+            })
+            .collect();
+        let position: Vec<TokenStream> =
+            model.nominal_position.iter().map(|x| nom.expr(x)).collect();
+        let prelude = nom.prelude();
+        NominalBody {
+            rotation,
+            position,
+            prelude,
+        }
+    }
+}
+
+/// The functions of [`Emission::Macro`]: the inherent `error` and
+/// `error_into`; `sensitivity`, the `*_into` writers, `NONZEROS` and
+/// `sensitivity_nonzeros`, with the batched kernels ([`batch_functions`]);
+/// and the `ErrorModel` methods that write through them.
+fn macro_functions(
+    model: &SymbolicModel,
+    krate: &TokenStream,
+    sizes: &Sizes,
+    sens: &SensitivityBody<'_>,
+    err: &ErrorBody<'_>,
+) -> (TokenStream, TokenStream, TokenStream) {
+    let Sizes { v, p, n } = sizes;
+    let (err_prelude, sens_prelude) = (&err.prelude, &sens.prelude);
+    let sens_assign = &sens.assign;
+    let sens_entries = &sens.entries;
+    let total = 6 * model.errors.len();
+    let mut flat: Vec<TokenStream> = vec![quote!(0.0); total];
+    for (c, j, negative, e) in sens_entries {
+        flat[c * model.errors.len() + j] = signed(*negative, e);
+    }
+    let flat_stores = flat.iter().enumerate().map(|(k, value)| {
+        let k = lit(k);
+        quote!(out[#k] = #value;)
+    });
+    let nonzero_stores = sens_entries
+        .iter()
+        .enumerate()
+        .map(|(k, (_, _, negative, e))| {
+            let value = signed(*negative, e);
+            let k = lit(k);
+            quote!(out[#k] = #value;)
+        });
+    let nonzeros = sens_entries.iter().map(|(c, j, _, _)| {
+        let (c, j) = (lit(*c), lit(*j));
+        quote!((#c, #j))
+    });
+    let k = lit(sens_entries.len());
+    let total = lit(total);
+    let error_stores = err.rows.iter().enumerate().map(|(c, row)| {
+        let c = lit(c);
+        quote!(out[#c] = #row;)
+    });
+    let error_fns = quote! {
+        #[inline]
+        #[must_use]
+        pub fn error(q: &[f64; #v], p: &[f64; #p], e: &[f64; #n]) -> [f64; 6] {
+            let mut out = [0.0f64; 6];
+            Self::error_into(q, p, e, &mut out);
+            out
+        }
+
+        /// [`Self::error`] written into `out` (every component).
+        #[inline]
+        pub fn error_into(q: &[f64; #v], p: &[f64; #p], e: &[f64; #n], out: &mut [f64; 6]) {
+            #err_prelude
+            #(#error_stores)*
+        }
+    };
+    let sensitivity_fns = quote! {
+        #[inline]
+        #[must_use]
+        pub fn sensitivity(q: &[f64; #v], p: &[f64; #p]) -> [[f64; #n]; 6] {
+            // Its own body: zero-filling a returned array and then calling
+            // `sensitivity_into` over it measured 1.5× slower.
+            #sens_prelude
+            let mut s = [[0.0f64; #n]; 6];
+            #(#sens_assign)*
+            s
+        }
+
+        /// [`Self::sensitivity`] written into `out`: every entry, the
+        /// structural zeros included (no zero-filling needed, no copy).
+        #[inline]
+        pub fn sensitivity_into(q: &[f64; #v], p: &[f64; #p], out: &mut [[f64; #n]; 6]) {
+            // `6 × N` elements: the conversion cannot fail.
+            if let ::core::result::Result::Ok(flat) =
+                <&mut [f64; #total]>::try_from(out.as_flattened_mut())
+            {
+                Self::sensitivity_flat_into(q, p, flat);
+            }
+        }
+
+        /// [`Self::sensitivity`] written row-major into `out`
+        /// (`out[c * N + j] = ∂E_c/∂e_j`), every entry in index order.
+        #[inline]
+        pub fn sensitivity_flat_into(q: &[f64; #v], p: &[f64; #p], out: &mut [f64; #total]) {
+            #sens_prelude
+            #(#flat_stores)*
+        }
+
+        /// The entries of the sensitivity matrix that are not identically
+        /// zero, `(row, error index)`, row-major: the order of
+        /// [`Self::sensitivity_nonzeros`]. Every other entry is exactly 0.
+        pub const NONZEROS: [(usize, usize); #k] = [#(#nonzeros),*];
+
+        /// The entries [`Self::NONZEROS`] of the sensitivity matrix, in
+        /// that order: `out[k] = s[NONZEROS[k].0][NONZEROS[k].1]`.
+        #[inline]
+        pub fn sensitivity_nonzeros(q: &[f64; #v], p: &[f64; #p], out: &mut [f64; #k]) {
+            #sens_prelude
+            #(#nonzero_stores)*
+        }
+    };
+    let batch_fns = batch_functions(
+        model,
+        krate,
+        (&sens.body, sens_entries),
+        (&err.body, &err.rows),
+    );
+    let model_fns = quote! {
+        fn error(&self, q: &[f64], p: &[f64], e: &[f64], out: &mut [f64; 6]) {
+            match (
+                <&[f64; #v]>::try_from(q),
+                <&[f64; #p]>::try_from(p),
+                <&[f64; #n]>::try_from(e),
+            ) {
+                (Ok(q), Ok(p), Ok(e)) => Self::error_into(q, p, e, out),
+                _ => *out = [f64::NAN; 6],
+            }
+        }
+        fn sensitivity(&self, q: &[f64], p: &[f64], out: &mut [f64]) {
+            match (<&[f64; #v]>::try_from(q), <&[f64; #p]>::try_from(p)) {
+                (Ok(q), Ok(p)) => match <&mut [f64; #total]>::try_from(&mut *out) {
+                    Ok(flat) => Self::sensitivity_flat_into(q, p, flat),
+                    // A slice of another length (the trait asks for 6 × N):
+                    // the entries that fit.
+                    Err(_) => {
+                        let s = Self::sensitivity(q, p);
+                        for (slot, value) in out.iter_mut().zip(s.iter().flatten()) {
+                            *slot = *value;
+                        }
+                    }
+                },
+                _ => out.iter_mut().for_each(|slot| *slot = f64::NAN),
+            }
+        }
+        fn sparsity(&self) -> ::core::option::Option<&[(usize, usize)]> {
+            ::core::option::Option::Some(&Self::NONZEROS)
+        }
+        fn sensitivity_nonzeros(&self, q: &[f64], p: &[f64], out: &mut [f64]) -> bool {
+            match (
+                <&[f64; #v]>::try_from(q),
+                <&[f64; #p]>::try_from(p),
+                <&mut [f64; #k]>::try_from(out),
+            ) {
+                (Ok(q), Ok(p), Ok(out)) => {
+                    Self::sensitivity_nonzeros(q, p, out);
+                    true
+                }
+                _ => false,
+            }
+        }
+    };
+    let (batch_fns, batch_model_fns) = batch_fns;
+    let sensitivity_fns = quote!(#sensitivity_fns #batch_fns);
+    let model_fns = quote!(#model_fns #batch_model_fns);
+    (error_fns, sensitivity_fns, model_fns)
+}
+
+/// The functions of [`Emission::Derive`]: the inherent `error` and
+/// `sensitivity`, each a self-contained body, and the `ErrorModel` methods
+/// that call them.
+fn derive_functions(
+    sizes: &Sizes,
+    sens: &SensitivityBody<'_>,
+    err: &ErrorBody<'_>,
+) -> (TokenStream, TokenStream, TokenStream) {
+    let Sizes { v, p, n } = sizes;
+    let (err_prelude, sens_prelude) = (&err.prelude, &sens.prelude);
+    let (err_rows, sens_assign) = (&err.rows, &sens.assign);
+    let error_fns = quote! {
+        #[inline]
+        #[must_use]
+        pub fn error(q: &[f64; #v], p: &[f64; #p], e: &[f64; #n]) -> [f64; 6] {
+            #err_prelude
+            [#(#err_rows),*]
+        }
+    };
+    let sensitivity_fns = quote! {
+        #[inline]
+        #[must_use]
+        pub fn sensitivity(q: &[f64; #v], p: &[f64; #p]) -> [[f64; #n]; 6] {
+            #sens_prelude
+            let mut s = [[0.0f64; #n]; 6];
+            #(#sens_assign)*
+            s
+        }
+    };
+    let model_fns = quote! {
+        fn error(&self, q: &[f64], p: &[f64], e: &[f64], out: &mut [f64; 6]) {
+            *out = match (
+                <&[f64; #v]>::try_from(q),
+                <&[f64; #p]>::try_from(p),
+                <&[f64; #n]>::try_from(e),
+            ) {
+                (Ok(q), Ok(p), Ok(e)) => Self::error(q, p, e),
+                _ => [f64::NAN; 6],
+            };
+        }
+        fn sensitivity(&self, q: &[f64], p: &[f64], out: &mut [f64]) {
+            match (<&[f64; #v]>::try_from(q), <&[f64; #p]>::try_from(p)) {
+                (Ok(q), Ok(p)) => {
+                    let s = Self::sensitivity(q, p);
+                    for (slot, value) in out.iter_mut().zip(s.iter().flatten()) {
+                        *slot = *value;
+                    }
+                }
+                _ => out.iter_mut().for_each(|slot| *slot = f64::NAN),
+            }
+        }
+    };
+    (error_fns, sensitivity_fns, model_fns)
+}
+
+/// The doc lines of the generated type and its functions.
+struct Docs {
+    /// ` - `px = …`` per component: the error and sensitivity functions'.
+    components: Vec<String>,
+    /// The nominal rotation's rows and the position: `nominal`'s.
+    nominal: Vec<String>,
+    /// The type's first line.
+    type_doc: String,
+    /// The function slots' definitions (none without function slots).
+    functions: Vec<String>,
+}
+
+impl Docs {
+    fn new(model: &SymbolicModel) -> Docs {
+        let text = |poly: &Poly| poly.to_text(&|s| model.symbol_name(s));
+        let components: Vec<String> = Component::ALL
+            .iter()
+            .map(|c| {
+                let terms: Vec<(bool, String)> = model.components[c.index()]
+                    .iter()
+                    .map(|(j, poly)| crate::export::term(&text(poly), &model.errors[*j]))
+                    .collect();
+                let rhs = crate::export::join_terms(&terms, (" + ", " - "));
+                format!(" - `{} = {}`", c.name(), rhs)
+            })
+            .collect();
+        let nominal: Vec<String> = model
+            .nominal_rotation
+            .iter()
+            .map(|row| {
+                let cells: Vec<String> = row.iter().map(&text).collect();
+                format!(" - `R` row: `[{}]`", cells.join(", "))
+            })
+            .chain(std::iter::once(format!(
+                " - position: `[{}]`",
+                model
+                    .nominal_position
+                    .iter()
+                    .map(&text)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )))
+            .collect();
+        let type_doc = format!(
+            " First-order error model of machine `{}` (frame: {}), generated by `chain`.",
+            model.machine,
+            model.frame.name()
+        );
+        // Function slots: their definitions in the type's docs. Machines
+        // without function slots have none.
+        let functions: Vec<String> = if model.functions.is_empty() {
+            Vec::new()
+        } else {
+            std::iter::once(String::new())
+                .chain(std::iter::once(
+                    " Error motions that vary along their axis (their coefficients are errors):"
+                        .to_string(),
+                ))
+                .chain(
+                    model
+                        .functions
+                        .iter()
+                        .map(|f| format!(" - `{}`", crate::export::function_text(model, f))),
+                )
+                .collect()
+        };
+        Docs {
+            components,
+            nominal,
+            type_doc,
+            functions,
+        }
+    }
+}
+
+/// `error_at` of a model with function slots: a built machine's error from
+/// error values that vary along the axes (nothing for a model without
+/// function slots).
+fn error_at(model: &SymbolicModel, krate: &TokenStream, sizes: &Sizes) -> TokenStream {
+    if model.functions.is_empty() {
+        return TokenStream::new();
+    }
+    let Sizes { v, p, n } = sizes;
+    quote! {
+        /// The error `[px, py, pz, ox, oy, oz]` of a built machine at `q`:
+        /// `E(q) = Σ_j c_j(q)·v_j(q)`, with the error values `v(q)` from
+        /// `values` (a closure `|q: &[f64], e: &mut [f64]| …` or any
+        /// `ErrorValues`, e.g. a values file) in `ERRORS` order; the
+        /// scratch is a stack array.
+        ///
+        /// # Errors
+        ///
+        /// `OutOfRange` when `values` has no value at `q` (a measured
+        /// table that does not cover it).
+        #[inline]
+        pub fn error_at(
+            q: &[f64; #v],
+            p: &[f64; #p],
+            values: &(impl #krate::core::ErrorValues + ?Sized),
+        ) -> ::core::result::Result<[f64; 6], #krate::core::OutOfRange> {
+            let mut e = [0.0f64; #n];
+            #krate::core::ErrorValues::values_at(values, q, &mut e)?;
+            ::core::result::Result::Ok(Self::error(q, p, &e))
+        }
+    }
+}
+
 /// Emits the generated type as formatted Rust source (prettyplease).
 #[cfg(feature = "pretty")]
 pub fn emit_pretty(model: &SymbolicModel, options: &EmitOptions) -> String {
@@ -572,13 +735,6 @@ fn batch_functions(
     let (v, p_len, n_len) = (lit(nv), lit(np), lit(n));
     let width = 6 * n;
     let k = sens_entries.len();
-    let signed = |negative: bool, e: &TokenStream| {
-        if negative {
-            quote!(-#e)
-        } else {
-            quote!(#e)
-        }
-    };
     let mut flat: Vec<TokenStream> = vec![quote!(0.0); width];
     for (c, j, negative, e) in sens_entries {
         flat[c * n + j] = signed(*negative, e);

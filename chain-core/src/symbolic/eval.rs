@@ -178,11 +178,6 @@ impl CompiledModel {
         &self.parameter_values
     }
 
-    /// Number of tape instructions (products) and output terms.
-    pub fn tape_size(&self) -> (usize, usize) {
-        (self.products.len(), self.terms.len())
-    }
-
     fn with_registers<R>(&self, q: &[f64], p: &[f64], f: impl FnOnce(&[f64]) -> R) -> R {
         let mut stack = [0.0f64; STACK_REGISTERS];
         let mut heap = Vec::new();

@@ -41,7 +41,7 @@ use serde::Serialize;
 use crate::error::ReliabilityError;
 use crate::form::Form;
 use crate::inputs::Inputs;
-use crate::study::{Study, StudyResult, Summary, Target};
+use crate::study::{Algorithm, Study, StudyResult, Summary, Target};
 
 mod acceptance;
 mod optimal;
@@ -450,7 +450,7 @@ pub fn evaluate<M: ErrorModel + ?Sized>(
         with_stds(study, stds)?,
         study.spec().clone(),
     )?;
-    let r = s.form(&Form::default())?;
+    let r = s.run(&Algorithm::Form(Form::default()), &())?;
     Ok((s, r))
 }
 
@@ -509,9 +509,13 @@ mod tests {
         let correlated =
             Inputs::correlated(names.to_vec(), inputs.marginals().to_vec(), &pair).unwrap();
         let study = Study::new(&model, &[], correlated, independent.spec().clone()).unwrap();
-        let own = study.form(&crate::Form::default()).unwrap();
+        let own = study
+            .run(&crate::Algorithm::Form(crate::Form::default()), &())
+            .unwrap();
         let (_, again) = super::evaluate(&model, &[], &study, study.inputs().stds()).unwrap();
-        let plain = independent.form(&crate::Form::default()).unwrap();
+        let plain = independent
+            .run(&crate::Algorithm::Form(crate::Form::default()), &())
+            .unwrap();
         let mut moved = 0.0f64;
         for ((a, b), c) in own.cases.iter().zip(&again.cases).zip(&plain.cases) {
             assert!((a.beta - b.beta).abs() <= 1e-12 * a.beta.abs().max(1.0));

@@ -124,7 +124,10 @@ pub fn exec(args: AllocateArgs) -> miette::Result<()> {
     if let Some(dir) = &args.plot {
         let stds: Vec<f64> = run.result.std.iter().map(|(_, s)| *s).collect();
         let before = (run.study)
-            .form(&reliability::Form::default())
+            .run(
+                &reliability::Algorithm::Form(reliability::Form::default()),
+                &(),
+            )
             .map_err(|e| loaded.report(e))?;
         let (_, after) = allocate::evaluate(&run.model, &run.parameters, &run.study, &stds)
             .map_err(|e| loaded.report(e))?;

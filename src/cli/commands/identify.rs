@@ -5,15 +5,15 @@
 //!
 //! The error parameters of a built machine from measurements
 //! (measured-machines spec, section 4) through
-//! [`chain_core::measured::identify`]: the measurement CSV read against the
+//! [`chain::ops::identify`]: the measurement CSV read against the
 //! machine ([`chain_core::measured::Measurements`]), the exact sensitivity
 //! rows as the design matrix, weighted least squares through an SVD (or the
 //! posterior of the `statistics` prior). See `docs/identify.md`.
 
 use std::path::PathBuf;
 
-use chain::ops::identify::{self, IdentifyRequest};
-use chain_core::measured::{Holdout, IdentifyOptions, Layout, Measurements, SubsetChoice};
+use chain::ops::identify::IdentifyRequest;
+use chain::ops::tables::Source;
 
 use crate::cli::args::ParamArgs;
 use crate::cli::loaded::Loaded;
@@ -84,47 +84,24 @@ pub struct IdentifyArgs {
     pub values_out: Option<PathBuf>,
 }
 
-/// Runs `chain identify` ([`chain::ops::identify`]).
+/// Runs `chain identify` ([`chain::ops::identify`]): the options checked
+/// before the machine file is read.
 pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
-    let subset = SubsetChoice::from_options(args.fix, args.estimate)?;
-    let holdout = Holdout::from_options(args.holdout, args.seed)?;
-    let options = IdentifyOptions {
-        rank_tol: args.rank_tol,
-        subset,
-    };
-    identify::check_options(
-        args.prior,
-        &options,
-        args.iterate,
-        holdout,
-        args.validate.is_some(),
-    )?;
-    let loaded = Loaded::new(&args.file)?;
-    let m = &loaded.machine;
-    args.param.check_names(m)?;
-    let measurements = Measurements::read(
-        &args.measurements,
-        m,
-        &args.param.params,
-        Layout::Measurements,
-    )?;
-    let validation = match &args.validate {
-        Some(path) => Some(Measurements::read(
-            path,
-            m,
-            &args.param.params,
-            Layout::Measurements,
-        )?),
-        None => None,
-    };
     let request = IdentifyRequest {
+        measurements: Source::Path(&args.measurements),
+        validate: args.validate.as_deref().map(Source::Path),
+        params: &args.param.params,
         prior: args.prior,
-        options,
+        rank_tol: args.rank_tol,
+        fix: args.fix,
+        estimate: args.estimate,
+        holdout: args.holdout,
+        seed: args.seed,
         iterate: args.iterate,
-        holdout,
-        validation: validation.as_ref(),
     };
-    let run = identify::run(m, &measurements, &request)?;
+    let checked = request.check()?;
+    let loaded = Loaded::new(&args.file)?;
+    let run = checked.run(&loaded.machine)?;
     if let Some(path) = &args.values_out {
         crate::cli::atomic::write(path, run.values_text.as_bytes())
             .map_err(|e| miette::miette!("cannot write {}: {e}", path.display()))?;

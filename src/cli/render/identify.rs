@@ -4,8 +4,7 @@
 
 use std::fmt::Write as _;
 
-use chain::ops::identify::IdentifyRun;
-use chain_core::measured::document::IdentifyDocument;
+use chain::ops::identify::{IdentifyDocument, IdentifyRun};
 
 use crate::cli::report::Report;
 

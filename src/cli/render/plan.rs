@@ -1,7 +1,8 @@
 //! The table of `chain plan` ([`PlanDocument`]): the chosen candidates
 //! and the std per parameter, optimal against even.
 
-use chain_core::plan::{Kind, PlanDocument};
+use chain::ops::plan::PlanDocument;
+use chain_core::plan::Kind;
 
 use crate::cli::report::{self, Report};
 

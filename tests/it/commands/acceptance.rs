@@ -140,7 +140,12 @@ fn gantry_acceptance_equals_a_ten_million_sample_monte_carlo() {
     );
     // Not the product of the per-point reliabilities: the events are
     // strongly correlated (the product is far smaller).
-    let form = study.form(&reliability::Form::default()).unwrap();
+    let form = study
+        .run(
+            &reliability::Algorithm::Form(reliability::Form::default()),
+            &(),
+        )
+        .unwrap();
     let product: f64 = form.cases.iter().map(|c| c.reliability).product();
     assert!(
         product < 0.5 * r.probability,
@@ -236,7 +241,12 @@ fn one_component_at_one_point_is_the_closed_form() {
         assert!((r.probability - want).abs() < 1e-12, "{r:?} vs {want}");
         if sided == Sided::Upper {
             // The per-point FORM result of the study (exact here).
-            let form = study.form(&reliability::Form::default()).unwrap();
+            let form = study
+                .run(
+                    &reliability::Algorithm::Form(reliability::Form::default()),
+                    &(),
+                )
+                .unwrap();
             let case = form
                 .cases
                 .iter()

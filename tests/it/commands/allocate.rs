@@ -13,7 +13,7 @@ use chain_core::CompiledModel;
 use common::cli::{chain, fails, ok, ok_json, scratch};
 use common::example_path;
 use reliability::allocate::{self, AllocateError, ErrorBounds, Optimal, Paper};
-use reliability::{machine, normal, Form, Study, Summary};
+use reliability::{machine, normal, Algorithm, Form, Study, Summary};
 
 fn gantry_path() -> PathBuf {
     example_path("gantry_grinder.yaml")
@@ -121,7 +121,7 @@ fn optimal_meets_the_requirement_at_far_less_cost_with_kkt() {
     let stds: Vec<f64> = r.std.iter().map(|(_, s)| *s).collect();
     let inputs = allocate::with_stds(&study, &stds).unwrap();
     let check = Study::new(&model, &[], inputs, study.spec().clone()).unwrap();
-    let res = check.form(&Form::default()).unwrap();
+    let res = check.run(&Algorithm::Form(Form::default()), &()).unwrap();
     for c in ["px", "py", "pz"] {
         let s = summary(&res.summaries, c);
         assert!(s.min >= 0.95 && s.mean >= 0.97, "{c}: {s:?}");

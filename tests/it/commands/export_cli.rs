@@ -15,6 +15,7 @@ use std::path::Path;
 use chain::core::built::BuiltMachine;
 use chain::core::compensation::controllers::{export, Controller, ExportOptions};
 use chain::core::values::Values;
+use chain::ops::export::ExportController;
 use common::cli::{fails, ok, ok_json, scratch, unwrapped, write};
 use common::{example_file, load_example, Exact};
 
@@ -35,12 +36,17 @@ fn export_args<'a>(controller: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     a
 }
 
-/// The library's export of vmc3 (tool length 150) with `options`.
+/// The library's export of vmc3 (tool length 150) with `options`, its
+/// files opening with the words `chain export` writes.
 fn library(controller: Controller, options: &ExportOptions) -> Vec<(String, String)> {
     let machine = load_example("vmc3.yaml");
     let values = Values::read(&example_file("values/vmc3.yaml"), &machine).unwrap();
     let built = BuiltMachine::compile(&machine, values, vec![150.0]).unwrap();
-    let e = export(controller, &built, &machine, options).unwrap();
+    let options = ExportOptions {
+        provenance: ExportController::Tables(controller).provenance(),
+        ..options.clone()
+    };
+    let e = export(controller, &built, &machine, &options).unwrap();
     e.files.into_iter().map(|f| (f.name, f.text)).collect()
 }
 

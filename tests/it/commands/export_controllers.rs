@@ -21,6 +21,7 @@ use chain::core::compensation::controllers::{
 };
 use chain::core::values::Values;
 use chain::core::{ErrorValues, Machine};
+use chain::ops::export::ExportController;
 use common::{example_file, load_example, Exact};
 
 /// vmc3 and its example values.
@@ -35,9 +36,15 @@ fn var(machine: &Machine, name: &str) -> usize {
     machine.variable_index(name).unwrap()
 }
 
+/// The export of `controller` with the default options, its files opening
+/// with the words `chain export` writes.
 fn run(controller: Controller, machine: &Machine, values: Values) -> Export {
     let built = BuiltMachine::compile(machine, values, vec![150.0]).unwrap();
-    export(controller, &built, machine, &ExportOptions::default()).unwrap()
+    let options = ExportOptions {
+        provenance: ExportController::Tables(controller).provenance(),
+        ..ExportOptions::default()
+    };
+    export(controller, &built, machine, &options).unwrap()
 }
 
 fn file<'e>(export: &'e Export, name: &str) -> &'e str {

@@ -18,7 +18,7 @@ use crate::common;
 use chain_core::model::Component;
 use common::cli::ok_json;
 use common::{example_path, load_example, normal_cdf};
-use reliability::{machine, Form, Target};
+use reliability::{machine, Algorithm, Form, Target};
 use serde_json::Value;
 
 const FILE: &str = "spread_along_axis.yaml";
@@ -69,7 +69,9 @@ fn px_spread_and_reliability_along_x_are_the_closed_forms() {
     let model = chain_core::compile(&m);
     let study = machine::study(&m, &model, &[], None).expect("study");
     let ix = study.variables().iter().position(|v| v == "x").unwrap();
-    let r = study.form(&Form::default()).expect("form");
+    let r = study
+        .run(&Algorithm::Form(Form::default()), &())
+        .expect("form");
     let np = study.points().len();
     assert_eq!(np, 20);
     let t = study
@@ -110,7 +112,9 @@ fn px_spread_and_reliability_along_x_are_the_closed_forms() {
     assert!(by_x[0].1 > 1.0 - 3e-7);
     // The study of the generated type for the same file is the same study.
     let generated = machine::study(&m, &SpreadAlongAxis, &[], None).expect("study");
-    let g = generated.form(&Form::default()).expect("form");
+    let g = generated
+        .run(&Algorithm::Form(Form::default()), &())
+        .expect("form");
     for (a, b) in g.cases.iter().zip(&r.cases) {
         assert!(close(a.reliability, b.reliability, 1e-15));
     }

@@ -105,8 +105,8 @@ fn the_exact_deviation_and_its_derivatives_are_the_products() {
     }
 }
 
-use chain::core::measured::document::identify_document;
 use chain::core::measured::{IdentifyOptions, Measurement, Measurements, Observed, SubsetChoice};
+use chain::ops::identify::identify_document;
 
 /// The example arm.
 fn arm() -> Machine {
@@ -236,7 +236,7 @@ fn iterate_reaches_the_truth_where_first_order_does_not() {
         "{}",
         doc.first_order.words
     );
-    let values = chain::core::measured::document::values_file(&m, "arm.csv", &done);
+    let values = chain::ops::identify::values_file(&m, "arm.csv", &done);
     assert!(
         values.contains("# --iterate: Levenberg-Marquardt"),
         "{values}"

@@ -176,8 +176,7 @@ fn parallel_axes_act_through_their_sum() {
         assert!((terms[0].1 - 1.0).abs() < 1e-9, "{fixed}: {terms:?}");
     }
     // In words, as the table and the values file print them.
-    let doc =
-        chain::core::measured::document::SubsetDoc::new(r.subset.as_ref().unwrap(), &r.errors);
+    let doc = chain::ops::identify::document::SubsetDoc::new(r.subset.as_ref().unwrap(), &r.errors);
     assert_eq!(
         doc.combination_words("DY2").as_deref(),
         Some("DY2 + DY3 + DY4")

@@ -12,7 +12,7 @@ use chain_core::{CompiledModel, ErrorModel, Machine};
 use common::cli::{chain_stdin, fails, ok_json, ok_stdout, scratch, success_json, write};
 use common::{example_file, example_path};
 use reliability::rng::CaseRng;
-use reliability::{machine, Form, System};
+use reliability::{machine, Algorithm, Form, System};
 use serde_json::Value;
 
 fn gantry() -> PathBuf {
@@ -96,7 +96,7 @@ fn gantry_path_reliability_equals_the_grid_study_at_grid_points() {
         }
         let study =
             reliability::Study::new(&model, &[], machine::inputs(&m).unwrap(), spec).unwrap();
-        let grid = study.form(&Form::default()).unwrap();
+        let grid = study.run(&Algorithm::Form(Form::default()), &()).unwrap();
         let np = study.points().len();
         let vars: Vec<&str> = model.variables().to_vec();
         let mut matched = 0;

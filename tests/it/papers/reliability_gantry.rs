@@ -13,8 +13,8 @@ use chain_core::CompiledModel;
 use common::example_path;
 use common::wang_yuan_2021::{TABLE2, TABLE3, TABLE4};
 use reliability::{
-    machine, normal, sensitivity, Criterion, Event, Form, ImportanceSampling, Inputs, MonteCarlo,
-    Sampler, SensitivityMethod, Study, System, Target, ToleranceLimitState,
+    machine, normal, sensitivity, Algorithm, Criterion, Event, Form, ImportanceSampling, Inputs,
+    MonteCarlo, Sampler, SensitivityMethod, Study, System, Target, ToleranceLimitState,
 };
 
 fn gantry() -> (Machine, CompiledModel) {
@@ -112,7 +112,9 @@ fn percent(
 fn form_reproduces_tables_2_to_4() {
     let (_, _, study) = study(None);
     assert_eq!(study.points().len(), 125);
-    let r = study.form(&Form::default()).expect("form");
+    let r = study
+        .run(&Algorithm::Form(Form::default()), &())
+        .expect("form");
     assert_eq!(r.cases.len(), 375);
     let (study, r) = (&study, &r);
     let value = |c: Component| move |x: f64, y: f64, z: f64| percent(study, r, c, x, y, z);
@@ -158,7 +160,9 @@ fn form_reproduces_tables_2_to_4() {
 #[test]
 fn summaries_match_the_text_of_section_3_3() {
     let (_, _, study) = study(None);
-    let r = study.form(&Form::default()).expect("form");
+    let r = study
+        .run(&Algorithm::Form(Form::default()), &())
+        .expect("form");
     // Section 3.3: "minimum ... 86.07 %, average ... 92.16 %" (x), 93.45/96.75
     // (y), 91.21/95.08 (z); each within 0.35 percentage points.
     let paper = [
@@ -232,15 +236,17 @@ fn sigma_e(c: usize, x: f64, y: f64, z: f64) -> f64 {
 #[test]
 fn form_equals_the_closed_form_and_is_has_zero_variance() {
     let (_, _, study) = study(None);
-    let form = study.form(&Form::default()).expect("form");
+    let form = study
+        .run(&Algorithm::Form(Form::default()), &())
+        .expect("form");
     let is = study
-        .importance_sampling(
-            &ImportanceSampling {
+        .run(
+            &Algorithm::ImportanceSampling(ImportanceSampling {
                 samples: 2_000,
                 seed: 2021,
                 form: Form::default(),
                 cov: None,
-            },
+            }),
             &(),
         )
         .expect("is");
@@ -266,14 +272,16 @@ fn form_equals_the_closed_form_and_is_has_zero_variance() {
 #[test]
 fn monte_carlo_agrees_within_four_standard_errors() {
     let (_, _, study) = study(None);
-    let form = study.form(&Form::default()).expect("form");
+    let form = study
+        .run(&Algorithm::Form(Form::default()), &())
+        .expect("form");
     let mc = study
-        .monte_carlo(
-            &MonteCarlo {
+        .run(
+            &Algorithm::MonteCarlo(MonteCarlo {
                 samples: 40_000,
                 seed: 7,
                 cov: None,
-            },
+            }),
             &(),
         )
         .expect("mc");
@@ -544,23 +552,23 @@ fn results_are_reproducible_whatever_the_thread_count() {
             .expect("pool")
             .install(|| {
                 let mc = study
-                    .monte_carlo(
-                        &MonteCarlo {
+                    .run(
+                        &Algorithm::MonteCarlo(MonteCarlo {
                             samples: 3_000,
                             seed: 3,
                             cov: None,
-                        },
+                        }),
                         &(),
                     )
                     .expect("mc");
                 let is = study
-                    .importance_sampling(
-                        &ImportanceSampling {
+                    .run(
+                        &Algorithm::ImportanceSampling(ImportanceSampling {
                             samples: 3_000,
                             seed: 3,
                             form: Form::default(),
                             cov: None,
-                        },
+                        }),
                         &(),
                     )
                     .expect("is");

@@ -20,7 +20,7 @@
 
 use super::{num, Context, ControllerError, Export, AXIS, SLOT_LETTER};
 use crate::built::BuiltMachine;
-use crate::compensation::{Correction, ExportedFile};
+use crate::compensation::{opening_line, Correction, ExportedFile};
 use crate::eval::CompiledModel;
 use crate::model::JointKind;
 use crate::model_trait::{ErrorModel, OutOfRange};
@@ -130,8 +130,14 @@ pub(super) fn export<M: ErrorModel + Sync>(
     };
     let mut csv = String::new();
     csv.push_str(&format!(
-        "// chain export --controller beckhoff: machine `{}`, ISG_CSV volumetric compensation parameters\n",
-        m.name
+        "// {}\n",
+        opening_line(
+            &ctx.options.provenance,
+            &format!(
+                "machine `{}`, ISG_CSV volumetric compensation parameters",
+                m.name
+            )
+        )
     ));
     csv.push_str("// ISO 230-1 error parameters, error = actual - nominal (not corrections): the controller derives the corrections\n");
     csv.push_str("// (sign convention of ISG's model UNCONFIRMED: if the compensation doubles the error, set `negate XYZ` in the list file)\n");
@@ -245,8 +251,14 @@ pub(super) fn export<M: ErrorModel + Sync>(
     }
     let mut lis = String::new();
     lis.push_str(&format!(
-        "# chain export --controller beckhoff: machine `{}`; list file of volumetric compensation 0\n",
-        m.name
+        "# {}\n",
+        opening_line(
+            &ctx.options.provenance,
+            &format!(
+                "machine `{}`; list file of volumetric compensation 0",
+                m.name
+            )
+        )
     ));
     lis.push_str(&format!(
         "# start-up list (hochlauf.lis): vol_comp[0].file_name <folder>\\vol_comp_0.lis and vol_comp[0].max_records >= {records}\n"

@@ -20,7 +20,7 @@
 //! entries, the orientation) stays.
 
 use super::{num, Context, ControllerError, Export};
-use crate::compensation::{Correction, ExportedFile};
+use crate::compensation::{opening_line, Correction, ExportedFile};
 use crate::model::{ErrorKind, Machine};
 use crate::model_trait::{ErrorModel, OutOfRange};
 use serde::Serialize;
@@ -198,8 +198,14 @@ pub(super) fn export<M: ErrorModel + Sync>(
     let var = |k: usize| &ctx.machine.variables[axes[k].0].name;
     let mut text = String::from("[skew_correction]\n\n[skew_correction chain]\n");
     text.push_str(&format!(
-        "# chain export --controller klipper: machine `{}`; load with SKEW_PROFILE LOAD=chain (after homing)\n",
-        ctx.machine.name
+        "# {}\n",
+        opening_line(
+            &ctx.options.provenance,
+            &format!(
+                "machine `{}`; load with SKEW_PROFILE LOAD=chain (after homing)",
+                ctx.machine.name
+            )
+        )
     ));
     text.push_str(&format!(
         "# Klipper X, Y, Z = the machine's axes `{}`, `{}`, `{}` (tool motion along the workpiece frame's X, Y, Z)\n",

@@ -19,7 +19,7 @@
 use super::{
     interpolate_held, num, Context, ControllerError, DirectionReport, Export, LinearAxis, AXIS,
 };
-use crate::compensation::{Correction, ExportedFile};
+use crate::compensation::{opening_line, Correction, ExportedFile};
 use crate::model_trait::{ErrorModel, OutOfRange};
 use crate::values::{Approach, Given, Values};
 
@@ -158,12 +158,16 @@ pub(super) fn export<M: ErrorModel + Sync>(
         for ((x, f), r) in axis.nodes.iter().zip(&forward).zip(&reverse) {
             text.push_str(&format!("{} {} {}\n", num(*x), num(*f), num(*r)));
         }
-        text.push_str(&format!(
-            "# chain export --controller linuxcnc: machine `{}`, joint {joint} (axis variable `{}`, the tool moves along {}{} as it increases)\n",
+        let opening = format!(
+            "machine `{}`, joint {joint} (axis variable `{}`, the tool moves along {}{} as it increases)",
             ctx.machine.name,
             axis.name,
             if axis.sign > 0.0 { "+" } else { "-" },
             AXIS[axis.frame_axis]
+        );
+        text.push_str(&format!(
+            "# {}\n",
+            opening_line(&ctx.options.provenance, &opening)
         ));
         text.push_str("# [JOINT_n] COMP_FILE_TYPE = 1: columns nominal (commanded joint position) | trim moving + | trim moving -\n");
         text.push_str(&format!(
@@ -225,8 +229,11 @@ pub(super) fn export<M: ErrorModel + Sync>(
         });
     }
     let mut readme = format!(
-        "chain export --controller linuxcnc: machine `{}`\n\nOne COMP_FILE per joint that has a positioning error. In the INI file:\n\n",
-        ctx.machine.name
+        "{}\n\nOne COMP_FILE per joint that has a positioning error. In the INI file:\n\n",
+        opening_line(
+            &ctx.options.provenance,
+            &format!("machine `{}`", ctx.machine.name)
+        )
     );
     for t in &tables {
         let name = &ctx.machine.variables[t.joint].name;

@@ -37,8 +37,7 @@
 //!
 //! # Sampling
 //!
-//! Each axis is sampled on its travel (the `--grid`-like
-//! [`ExportOptions::travel`], else the smallest and largest node of the
+//! Each axis is sampled on its travel ([`ExportOptions::travel`], else the smallest and largest node of the
 //! machine file's `reliability.grid`) at equal steps: the largest step not
 //! above [`ExportOptions::step`] that divides the travel into whole
 //! intervals. A function slot is evaluated exactly at the nodes; a measured
@@ -101,7 +100,8 @@ impl Controller {
         Controller::Klipper,
     ];
 
-    /// The name `--controller` takes.
+    /// The format's name (`beckhoff`, `linuxcnc`, `siemens-cec`,
+    /// `klipper`): what reports and error messages call it.
     pub fn name(self) -> &'static str {
         match self {
             Controller::Beckhoff => "beckhoff",
@@ -111,7 +111,7 @@ impl Controller {
         }
     }
 
-    /// The controller of a `--controller` name.
+    /// The controller of a [`Controller::name`].
     pub fn from_name(name: &str) -> Option<Controller> {
         Controller::ALL.into_iter().find(|c| c.name() == name)
     }
@@ -130,6 +130,10 @@ pub struct ExportOptions {
     pub cec_max_points: usize,
     /// The Beckhoff `vol_comp[i].max_records` the records must fit in.
     pub beckhoff_max_records: usize,
+    /// The words that open the first comment line of every file written,
+    /// naming what wrote it (a command line, say); empty (the default),
+    /// that line opens with the machine.
+    pub provenance: String,
 }
 
 impl Default for ExportOptions {
@@ -139,6 +143,7 @@ impl Default for ExportOptions {
             travel: Vec::new(),
             cec_max_points: CEC_DEFAULT_MAX_POINTS,
             beckhoff_max_records: BECKHOFF_DEFAULT_MAX_RECORDS,
+            provenance: String::new(),
         }
     }
 }
@@ -196,7 +201,7 @@ pub enum ControllerError {
         machine: String,
     },
     /// No travel for an axis.
-    #[error("no travel for axis `{variable}`: give it (e.g. `--grid {variable}=0:800:81`) or add the axis to the machine file's `reliability.grid`")]
+    #[error("no travel for axis `{variable}`: the export options give none and the machine file's `reliability.grid` has no values for it")]
     #[cfg_attr(feature = "miette", diagnostic(code(chain::export::no_travel)))]
     NoTravel {
         /// The variable.
@@ -258,7 +263,7 @@ pub enum ControllerError {
         feature = "miette",
         diagnostic(
             code(chain::export::out_of_table),
-            help("give a travel inside the table (e.g. `--grid`), or measure the table over the whole travel; nothing is extrapolated")
+            help("give a travel inside the table, or measure the table over the whole travel; nothing is extrapolated")
         )
     )]
     OutOfTable {

@@ -15,7 +15,7 @@
 //! UNCONFIRMED and the file says so.
 
 use super::{interpolate_held, num, Context, ControllerError, Export, AXIS};
-use crate::compensation::{Correction, ExportedFile};
+use crate::compensation::{opening_line, Correction, ExportedFile};
 use crate::model_trait::{ErrorModel, OutOfRange};
 
 /// One CEC table as the control reads it.
@@ -112,9 +112,15 @@ pub(super) fn export<M: ErrorModel + Sync>(
     let var = |v: usize| &ctx.machine.variables[v].name;
     let mut text = String::from("%_N_NC_CEC_INI\nCHANDATA(1)\n");
     text.push_str(&format!(
-        "; chain export --controller siemens-cec: machine `{}`, {} tables (one per straightness error)\n",
-        ctx.machine.name,
-        tables.len()
+        "; {}\n",
+        opening_line(
+            &ctx.options.provenance,
+            &format!(
+                "machine `{}`, {} tables (one per straightness error)",
+                ctx.machine.name,
+                tables.len()
+            )
+        )
     ));
     text.push_str(
         "; units: positions (_STEP, _MIN, _MAX) and values in mm (metric measuring system)\n",

@@ -57,7 +57,7 @@ pub enum InverseError {
         feature = "miette",
         diagnostic(
             code(chain::inverse::shape),
-            help("hold the extra variables with --fix NAME=VALUE (e.g. mu=0)")
+            help("hold the extra variables at fixed values (e.g. mu = 0)")
         )
     )]
     Shape {
@@ -84,7 +84,7 @@ pub enum InverseError {
     #[error("no free axis variable moves the tool point or the tool axis")]
     #[cfg_attr(feature = "miette", diagnostic(
         code(chain::inverse::no_free_variable),
-        help("hold fewer variables (--fix), or check that the axes move the tool relative to the workpiece")
+        help("hold fewer variables, or check that the axes move the tool relative to the workpiece")
     ))]
     NoFreeVariable,
     /// The linear axes cannot move the tool point in three independent directions.
@@ -377,12 +377,6 @@ impl Solver {
         Err(InverseError::NotClosedForm)
     }
 
-    /// Indices of the outer (workpiece-frame side, axis `u`) and inner
-    /// (tool-frame side, axis `v`) rotary variables.
-    pub fn rotary_variables(&self) -> (usize, usize) {
-        (self.outer, self.inner)
-    }
-
     fn q(&self, a: f64, b: f64, l: V3) -> Vec<f64> {
         let mut q = self.base.clone();
         q[self.outer] = a;
@@ -585,7 +579,7 @@ impl Solver {
 
 /// The variables a pose leaves alone: the `fixed` ones at their values, and
 /// every other variable that moves neither the tool point nor the tool axis
-/// (a spindle's spin), held at 0 (the spec's default for `--fix`).
+/// (a spindle's spin), held at 0 (the spec's default for a held variable).
 struct Held {
     /// Values of the held variables (0 for the free ones).
     base: Vec<f64>,

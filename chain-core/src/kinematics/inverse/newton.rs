@@ -65,11 +65,6 @@ impl NewtonSolver {
         })
     }
 
-    /// The variables the solver moves (model order).
-    pub fn free_variables(&self) -> &[usize] {
-        &self.free
-    }
-
     /// All solutions found for tool point `point` and tool axis `axis`
     /// (normalised here); `prev` are the previous row's values.
     pub fn solve(&self, point: V3, axis: V3, prev: &[f64]) -> Solution {

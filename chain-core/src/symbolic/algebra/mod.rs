@@ -8,7 +8,7 @@ mod poly;
 pub use dual::{Dual, Transform};
 pub use poly::{format_number, Monomial, Poly, Symbol};
 
-use crate::model::{Axis, BasisFn, Expr, FixedRotation, Machine};
+use crate::model::{BasisFn, Expr, FixedRotation, Machine};
 
 /// Converts a model expression to a polynomial in the parameters.
 ///
@@ -152,11 +152,4 @@ pub fn symbol_name(machine: &Machine, s: Symbol) -> String {
         Symbol::Cos(i) => format!("cos({})", var(i)),
         Symbol::Sin(i) => format!("sin({})", var(i)),
     }
-}
-
-/// Unit vector of an axis.
-pub fn axis_unit(axis: Axis) -> [f64; 3] {
-    let mut u = [0.0; 3];
-    u[axis.index()] = 1.0;
-    u
 }

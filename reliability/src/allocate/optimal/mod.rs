@@ -7,7 +7,7 @@ use chain_core::ErrorModel;
 use super::{component_summaries, evaluate};
 use super::{AllocateError, Allocation, ErrorBounds, Kkt, Optimal};
 use crate::form::Form;
-use crate::study::{Study, Summary};
+use crate::study::{Algorithm, Study, Summary};
 
 mod barrier;
 mod kkt;
@@ -24,7 +24,7 @@ pub fn optimal<M: ErrorModel + ?Sized>(
     options: &Optimal,
 ) -> Result<Allocation, AllocateError> {
     let mut problem = build(study, bounds)?;
-    let initial = component_summaries(&study.form(&Form::default())?);
+    let initial = component_summaries(&study.run(&Algorithm::Form(Form::default()), &())?);
     let n = problem.n();
     let stds0: Vec<f64> = bounds.iter().map(|b| b.std0).collect();
     // Impose the requirement with a small margin.

@@ -7,38 +7,18 @@
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
+use chain_core::measured::identify::{Estimate, IdentifyOptions, NoiseRule, Prior, Residual};
+use chain_core::measured::iterate::{self, FirstOrderCheck, Iteration, ANGLE_LIMIT};
+use chain_core::measured::predict::{predict, predict_rows, Prediction};
+use chain_core::measured::subset::{ChosenBy, FixedStatus, Subset, TERM_CUTOFF};
+use chain_core::measured::{
+    identify, Design, Holdout, Identification, MeasuredComponent, Measurements,
+};
+use chain_core::named::NameMap;
+use chain_core::Machine;
 use serde::Serialize;
 
-use super::identify::{Estimate, IdentifyOptions, NoiseRule, Prior, Residual};
-use super::iterate::{self, FirstOrderCheck, Iteration, ANGLE_LIMIT};
-use super::measurements::MeasuredComponent;
-use super::predict::{predict, predict_rows, Prediction};
-use super::subset::{ChosenBy, FixedStatus, Subset, TERM_CUTOFF};
-use super::{identify, Design, DesignError, Identification, IdentifyError, Measurements};
-use crate::model::Machine;
-use crate::named::NameMap;
-
-/// Why the identification document could not be made.
-#[derive(Debug, thiserror::Error)]
-#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
-pub enum DocumentError {
-    /// The records do not give a design (named by their file).
-    #[error("{file}: {reason}")]
-    Design {
-        /// The measurement file.
-        file: String,
-        /// The design's refusal.
-        reason: DesignError,
-    },
-    /// The prior or the solve refused.
-    #[error(transparent)]
-    #[cfg_attr(feature = "miette", diagnostic(transparent))]
-    Identify(#[from] IdentifyError),
-    /// `--holdout` refused.
-    #[error(transparent)]
-    #[cfg_attr(feature = "miette", diagnostic(transparent))]
-    Holdout(#[from] super::HoldoutError),
-}
+use super::{check_fit, IdentifyOpsError};
 
 /// One group of unknowns the data cannot separate.
 #[derive(Debug, Clone, Serialize)]
@@ -56,7 +36,7 @@ pub struct GroupDoc {
 pub struct ResidualDoc {
     /// The CSV line of its measurement.
     pub line: usize,
-    /// Its component ([`super::measurements::MeasuredComponent::name`]:
+    /// Its component ([`MeasuredComponent::name`]:
     /// `dpx`, `dpy`, `dpz` or `d`).
     pub component: &'static str,
     /// `b − A x`.
@@ -65,7 +45,7 @@ pub struct ResidualDoc {
     pub standardised: f64,
     /// The row's leverage `h`.
     pub leverage: f64,
-    /// `|t|` above [`super::identify::OUTLIER_LIMIT`].
+    /// `|t|` above [`chain_core::measured::identify::OUTLIER_LIMIT`].
     pub outlier: bool,
 }
 
@@ -409,7 +389,7 @@ pub struct Validation {
     /// `--holdout`: the fraction and seed that chose the held-out records
     /// from the measurements (absent with `--validate`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub holdout: Option<super::Holdout>,
+    pub holdout: Option<Holdout>,
     /// `--holdout`: the CSV lines of the held-out records.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lines: Option<Vec<usize>>,
@@ -444,13 +424,11 @@ pub fn identify_document(
     options: &IdentifyOptions,
     iterate: bool,
     validation: Option<&Measurements>,
-) -> Result<Identified, DocumentError> {
-    if iterate && prior {
-        return Err(IdentifyError::IterateWithPrior.into());
-    }
-    let model = crate::compile(machine);
+) -> Result<Identified, IdentifyOpsError> {
+    check_fit(prior, options, iterate)?;
+    let model = chain_core::compile(machine);
     let design_of = |m: &Measurements| {
-        Design::new(&model, machine, &m.rows).map_err(|reason| DocumentError::Design {
+        Design::new(&model, machine, &m.rows).map_err(|reason| IdentifyOpsError::Design {
             file: m.file.clone(),
             reason,
         })
@@ -460,11 +438,11 @@ pub fn identify_document(
         .map(|v| design_of(v).map(|d| (v, d)))
         .transpose()?;
     let prior = if prior {
-        Some(Prior::from_machine(machine, &design.errors)?)
+        Some(Prior::from_machine(machine, &design.errors).map_err(IdentifyOpsError::Identify)?)
     } else {
         None
     };
-    let result = identify(&design, prior.as_ref(), options)?;
+    let result = identify(&design, prior.as_ref(), options).map_err(IdentifyOpsError::Identify)?;
     let (linear, _) = result.solution();
     let check = iterate::check(machine, &measurements.rows, &design, &result, &linear);
     let iteration = match (&result.subset, iterate) {
@@ -588,7 +566,7 @@ fn explain(design: &Design, r: &Identification, members: &[usize], vectors: usiz
         return format!(
             "the measurements leave {} of {list} at the prior (posterior std above {} × the prior std along {})",
             if vectors == 1 { "one combination".to_string() } else { format!("{vectors} combinations") },
-            super::identify::UNINFORMED,
+            chain_core::measured::identify::UNINFORMED,
             if vectors == 1 { "it" } else { "them" }
         );
     }
