@@ -14,6 +14,9 @@
 //! feature `cli` builds the `chain` binary (argument parsing, progress bars,
 //! the diagnostic renderer, CSV input, plots, JSON output); `parallel` runs
 //! sampling on all cores (see `docs/packaging.md`).
+//!
+//! The feature `plot` (on with `cli`) adds `plot`: every command's charts,
+//! computed from its `ops` document and drawn to PNG files or SVG text.
 
 pub use chain_core as core;
 pub use reliability;
@@ -23,3 +26,5 @@ pub use chain_macro::machine;
 
 pub mod compensate;
 pub mod ops;
+#[cfg(feature = "plot")]
+pub mod plot;

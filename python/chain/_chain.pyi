@@ -167,7 +167,7 @@ def inverse_json(
     poses: Optional[npt.NDArray[np.float64]],
     fix: Sequence[Tuple[str, float]],
     params: Sequence[Tuple[str, float]],
-    poses_file: Optional[str] = None,
+    poses_file: Optional[Tuple[Optional[str], Optional[str], str]] = None,
 ) -> str: ...
 
 
@@ -188,8 +188,8 @@ def path_json(
     sided: Optional[str],
     system: Optional[str],
     system_tolerance: Optional[float],
-    axes_file: Optional[str] = None,
-    poses_file: Optional[str] = None,
+    axes_file: Optional[Tuple[Optional[str], Optional[str], str]] = None,
+    poses_file: Optional[Tuple[Optional[str], Optional[str], str]] = None,
 ) -> str: ...
 
 

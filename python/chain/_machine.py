@@ -288,7 +288,7 @@ class Machine:
         from ._results import InverseResult
 
         if isinstance(poses, (str, os.PathLike)):
-            text = _chain.inverse_json(self._model, None, _params(fix), _params(params), os.fspath(poses))
+            text = _chain.inverse_json(self._model, None, _params(fix), _params(params), _file(poses))
             return InverseResult._from_json(text)
         a = _float_array(poses, "poses")
         if a.ndim == 1:
@@ -337,8 +337,8 @@ class Machine:
         if (axes is None) == (poses is None):
             raise ValueError("give the path as axes=... or poses=... (one of them)")
         # A file is read by the CLI's reader (its column t gives the instants).
-        axes_file = os.fspath(axes) if isinstance(axes, (str, os.PathLike)) else None
-        poses_file = os.fspath(poses) if isinstance(poses, (str, os.PathLike)) else None
+        axes_file = _file(axes) if isinstance(axes, (str, os.PathLike)) else None
+        poses_file = _file(poses) if isinstance(poses, (str, os.PathLike)) else None
         if (axes_file or poses_file) and t is not None:
             raise ValueError("t=... is given with a file; give the instants as its column t")
         header: List[str] = []
@@ -734,6 +734,11 @@ class Machine:
 
 
 # -- group B helpers ----------------------------------------------------------
+
+
+def _file(path: Union[str, "os.PathLike[str]"]) -> Tuple[Optional[str], Optional[str], str]:
+    """A file argument of the compiled core, ``(path, text, name)``: here its path, named so."""
+    return os.fspath(path), None, os.fspath(path)
 
 
 def _grid_axes(grid: Optional[Mapping[str, Sequence[float]]]) -> List[Tuple[str, List[float]]]:

@@ -2,12 +2,14 @@
 //! `chain::ops::allocate` (the CLI's request, checks and document).
 
 use chain::ops::allocate::{self, AllocateOpsError, AllocateRequest, AllocationTarget};
+use chain::ops::choice::Rank;
 use chain::ops::Worded;
 use pyo3::prelude::*;
 use reliability::allocate::StrategyName;
 
 use crate::{
-    named, resolve_error, sided_named, study_error, study_failure, to_json, value_error, Model,
+    choice, machine_error, resolve_error, sided_named, study_error, study_failure, to_json,
+    value_error, Model,
 };
 
 /// `chain allocate --format json`: `strategy` `optimal` (least cost, with
@@ -17,7 +19,8 @@ use crate::{
 /// reliability section's) or `acceptance` (the whole-machine acceptance
 /// probability reaching `level`). An allocation that does not meet its
 /// target is returned (its `final.met` is false; the CLI exits non-zero
-/// after printing it).
+/// after printing it); one that cannot go on raises the CLI's message, a
+/// `MachineError` at the statistics entry it names when there is one.
 #[pyfunction]
 #[pyo3(signature = (model, strategy, step, threshold, rank, target, level, params, sided))]
 #[allow(clippy::too_many_arguments)]
@@ -34,25 +37,11 @@ pub(crate) fn allocate_json(
     sided: Option<&str>,
 ) -> PyResult<String> {
     let request = AllocateRequest {
-        strategy: named(
-            "strategy",
-            strategy,
-            &[
-                ("optimal", StrategyName::Optimal),
-                ("paper", StrategyName::Paper),
-            ],
-        )?,
+        strategy: choice::<StrategyName>(strategy)?,
         step,
         threshold,
-        pooled: named("rank", rank, &[("component", false), ("pooled", true)])?,
-        target: named(
-            "target",
-            target,
-            &[
-                ("requirement", AllocationTarget::Requirement),
-                ("acceptance", AllocationTarget::Acceptance),
-            ],
-        )?,
+        pooled: choice::<Rank>(rank)?.pooled(),
+        target: choice::<AllocationTarget>(target)?,
         level,
         params: &params,
         sided: sided_named(sided)?,
@@ -63,7 +52,16 @@ pub(crate) fn allocate_json(
             AllocateOpsError::Study(e) => study_failure(py, model, *e),
             AllocateOpsError::Reliability(e) => study_error(py, &e, &model.file),
             AllocateOpsError::Resolve(e) => resolve_error(py, model, e),
-            e => value_error(e.with_help()),
+            e => match e.location() {
+                Some((origin, _)) => machine_error(
+                    py,
+                    e.with_help(),
+                    &model.file,
+                    Some(origin),
+                    vec![e.to_string()],
+                ),
+                None => value_error(e.with_help()),
+            },
         })?;
     to_json(&run)
 }

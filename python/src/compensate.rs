@@ -1,16 +1,14 @@
 //! `chain compensate --format json` (seed 003's swing-angle workflow): the
-//! measurements from a path or as CSV text, read by the library reader the
-//! CLI uses (`chain::compensate::records`), run by `chain::ops::compensate`
-//! with the CLI's request.
+//! measurements from a path or as CSV text, read by the reader the CLI uses
+//! (`chain::ops::source::read_swing`), run by `chain::ops::compensate` with
+//! the CLI's request.
 
-use std::path::Path;
-
-use chain::compensate::{records, Options, SelectionRule};
+use chain::compensate::{Options, SelectionRule};
 use chain::ops::compensate::{self, CompensateRequest};
-use chain::ops::study::OptionError;
+use chain::ops::source as ops_source;
 use pyo3::prelude::*;
 
-use crate::{to_json, value_error};
+use crate::{choice, source, to_json, value_error};
 
 /// The analysis of the measurements at `path`, or of CSV `text` named
 /// `name`, as `chain compensate FILE --length L ... --format json`.
@@ -28,19 +26,11 @@ pub(crate) fn compensate_json(
     select: &str,
     order: Option<usize>,
 ) -> PyResult<String> {
-    let rule = select
-        .parse::<SelectionRule>()
-        .map_err(|message| value_error(OptionError::new("select", message).to_string()))?;
-    let measurements = match (path, text) {
-        (Some(path), None) => records::read_measurements(Path::new(path)),
-        (None, Some(text)) => records::parse_measurements(name, text.as_bytes()),
-        _ => {
-            return Err(value_error(
-                "give the measurements as a path or as their columns, not both",
-            ))
-        }
-    }
-    .map_err(|e| value_error(e.to_string()))?;
+    let rule = choice::<SelectionRule>(select)?;
+    let source = source(path, text, name)?;
+    let measurements = py
+        .allow_threads(|| ops_source::read_swing(source))
+        .map_err(|e| value_error(e.to_string()))?;
     let request = CompensateRequest {
         options: Options {
             length,

@@ -3,12 +3,13 @@
 //! text and the files the controller reads, by name.
 
 use chain::ops::export::{self, ExportController, ExportOpsError, ExportRequest};
+use chain::ops::resolve::AxisPoints;
 use chain::ops::Worded;
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 
 use crate::measured::read_values;
-use crate::{named, resolve_error, study_error, to_json, value_error, Model};
+use crate::{choice, resolve_error, study_error, to_json, value_error, Model};
 
 /// The compensation of the built machine `values` (a file `values_path`,
 /// or the text `values_text` named `values_file`) for `controller`; `grid`,
@@ -32,23 +33,16 @@ pub(crate) fn export_json(
     beckhoff_max_records: Option<usize>,
     params: Vec<(String, f64)>,
 ) -> PyResult<(String, Vec<(String, String)>)> {
-    let controllers = ExportController::ALL.map(|c| (c.name(), c));
-    let controller = named("controller", controller, &controllers)?;
+    let controller = choice::<ExportController>(controller)?;
     let rows = match &points {
-        Some(q) => {
-            if !grid.is_empty() {
-                return Err(value_error("give grid or points, not both"));
-            }
-            let (flat, _) = model.points(q)?;
-            Some(("points", flat.to_vec()))
-        }
+        Some(q) => Some(("points".to_string(), model.points(q)?.0.to_vec())),
         None => None,
     };
+    let points = AxisPoints::new(&grid, rows).map_err(|e| resolve_error(py, model, e))?;
     let request = ExportRequest {
         controller,
         params: &params,
-        grid: &grid,
-        rows,
+        points,
         step,
         cec_max_points,
         beckhoff_max_records,

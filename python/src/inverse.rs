@@ -1,14 +1,14 @@
 //! `chain inverse --format json` over an array of poses, through
 //! `chain::ops::inverse` (the CLI's request, checks and document).
 
-use std::path::Path;
-
 use chain::ops::inverse::{self, InverseOpsError, InverseRequest, PoseRow};
-use chain::ops::tables::{self, Source};
+use chain::ops::tables;
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
-use crate::{check_finite, resolve_error, study_error, table_error, to_json, value_error, Model};
+use crate::{
+    check_finite, resolve_error, study_error, table_error, to_json, value_error, FileInput, Model,
+};
 
 /// The poses of an `(N, width)` array (`width` 6 or 12), a row refused as
 /// `poses row K: ...` (0-based), the width as `poses: ...`.
@@ -20,9 +20,9 @@ pub(crate) fn pose_rows(flat: &[f64], width: usize) -> PyResult<Vec<PoseRow>> {
 }
 
 /// The inverse kinematics of `poses` (`(N, 6)`: `px, py, pz, i, j, k`, or
-/// `(N, 12)`: `px, py, pz, r11 … r33`) or of the pose CSV at `poses_file`
-/// (read as `chain inverse --pose` reads it), `fix` and `params` as `--fix`
-/// and `--param`.
+/// `(N, 12)`: `px, py, pz, r11 … r33`) or of the pose CSV `poses_file`
+/// (`(path, text, name)`: read as `chain inverse --pose` reads it), `fix`
+/// and `params` as `--fix` and `--param`.
 #[pyfunction]
 #[pyo3(signature = (model, poses, fix, params, poses_file=None))]
 pub(crate) fn inverse_json(
@@ -31,7 +31,7 @@ pub(crate) fn inverse_json(
     poses: Option<PyReadonlyArray2<'_, f64>>,
     fix: Vec<(String, f64)>,
     params: Vec<(String, f64)>,
-    poses_file: Option<&str>,
+    poses_file: Option<FileInput>,
 ) -> PyResult<String> {
     let rows = match (poses, poses_file) {
         (Some(poses), None) => {
@@ -41,7 +41,8 @@ pub(crate) fn inverse_json(
             pose_rows(flat, width)?
         }
         (None, Some(file)) => {
-            let read = py.allow_threads(|| tables::read_poses(Source::Path(Path::new(file))));
+            let source = file.source()?;
+            let read = py.allow_threads(|| tables::read_poses(source));
             read.map_err(|e| table_error(py, model, e))?.1
         }
         _ => {

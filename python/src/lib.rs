@@ -25,15 +25,17 @@ mod path;
 mod positioning;
 use std::mem::MaybeUninit;
 
+use chain::ops::choice::Choice;
+use chain::ops::source::Source;
+use chain::ops::study::describe;
 use chain::ops::Worded;
-use chain_core::model::{Machine, Origin};
+use chain_core::model::{Frame, Machine, Origin};
 use chain_core::{CompiledModel, Diagnostics, ErrorModel};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
-use reliability::document::describe;
 use reliability::ReliabilityError;
 
 mod allocate;
@@ -147,9 +149,6 @@ pub(crate) fn study_error(py: Python<'_>, err: &ReliabilityError, file: &str) ->
     machine_error(py, message, file, origin, vec![d.message])
 }
 
-/// An option refused by `chain::ops::resolve`, with the CLI's message: an
-/// unknown name as `MachineError` naming the machine file, a bad value as
-/// `ValueError`.
 /// A table's refusal ([`chain::ops::tables`]) as the CLI words it: a
 /// `MachineError` where its columns name what the machine lacks, a
 /// `ValueError` otherwise.
@@ -164,6 +163,9 @@ pub(crate) fn table_error(
     }
 }
 
+/// An option refused by `chain::ops::resolve`, with the CLI's message: an
+/// unknown name as `MachineError` naming the machine file, a bad value as
+/// `ValueError`.
 pub(crate) fn resolve_error(
     py: Python<'_>,
     model: &Model,
@@ -177,6 +179,7 @@ pub(crate) fn resolve_error(
     }
 }
 
+/// A `ValueError` with `message`.
 pub(crate) fn value_error(message: impl Into<String>) -> PyErr {
     PyValueError::new_err(message.into())
 }
@@ -223,22 +226,17 @@ impl Model {
         }
     }
 
-    /// The parameter values: the file's, overridden by `overrides`; every
+    /// The parameter values: the file's, overridden by `overrides`, checked
+    /// by `--param`'s rule ([`chain::ops::resolve::Parameters`]); every
     /// symbolic parameter needs one.
     pub(crate) fn parameter_vector(
         &self,
         py: Python<'_>,
         overrides: &[(String, f64)],
     ) -> PyResult<Vec<f64>> {
-        for (name, v) in overrides {
-            if !v.is_finite() {
-                return Err(value_error(format!(
-                    "parameter `{name}` = {v} is not finite"
-                )));
-            }
-        }
-        reliability::machine::parameters(&self.machine, overrides)
-            .map_err(|e| study_error(py, &e, &self.file))
+        let given = chain::ops::resolve::Parameters::new(&self.machine, overrides)
+            .map_err(|e| resolve_error(py, self, e))?;
+        given.values().map_err(|e| study_error(py, &e, &self.file))
     }
 
     /// The points of `q` (rows of `V` values) as a flat slice and their count.
@@ -325,17 +323,7 @@ impl Model {
     #[pyo3(signature = (frame=None))]
     fn derive_json(&self, frame: Option<&str>) -> PyResult<String> {
         use chain::ops::derive::{self, DeriveRequest};
-        use chain_core::model::Frame;
-        let frame = match frame {
-            None => None,
-            Some("tool") => Some(Frame::Tool),
-            Some("workpiece") => Some(Frame::Workpiece),
-            Some(other) => {
-                return Err(value_error(format!(
-                    "frame must be \"tool\" or \"workpiece\", not {other:?}"
-                )))
-            }
-        };
+        let frame = frame.map(choice::<Frame>).transpose()?;
         to_json(&derive::run(&self.machine, &DeriveRequest { frame }))
     }
 
@@ -547,36 +535,40 @@ pub(crate) fn study_failure(
         StudyError::Posterior(PosteriorError::Values(v)) => load_error(py, v.diagnostics()),
         StudyError::Posterior(PosteriorError::File(d)) => load_error(py, &d),
         StudyError::Posterior(PosteriorError::Reliability(e)) => study_error(py, &e, &model.file),
-        e @ (StudyError::Posterior(_) | StudyError::Approach { .. }) => value_error(e.to_string()),
+        e @ (StudyError::Posterior(_) | StudyError::Approach { .. }) => value_error(e.with_help()),
     }
 }
 
-/// `sided` as the CLI's `--sided` (`upper` or `two`).
-/// `given` as one of `choices` (the CLI's spelling of each value), or the
-/// refusal in clap's words: `invalid value "x" for `what` [possible values:
-/// a, b]`.
-pub(crate) fn named<T: Copy>(what: &str, given: &str, choices: &[(&str, T)]) -> PyResult<T> {
-    (choices.iter())
-        .find(|(name, _)| *name == given)
-        .map(|(_, value)| *value)
-        .ok_or_else(|| {
-            let names: Vec<&str> = choices.iter().map(|(name, _)| *name).collect();
-            value_error(format!(
-                "invalid value {given:?} for `{what}` [possible values: {}]",
-                names.join(", ")
-            ))
-        })
+/// `given` as one of `T`'s values, spelt as the CLI spells them, or the
+/// CLI's refusal ([`chain::ops::choice::Choice::parse`]).
+pub(crate) fn choice<T: Choice>(given: &str) -> PyResult<T> {
+    T::parse(given).map_err(|e| value_error(e.to_string()))
 }
 
+/// `sided` as the CLI's `--sided` (`upper` or `two`).
 pub(crate) fn sided_named(sided: Option<&str>) -> PyResult<Option<chain_core::model::Sided>> {
-    use chain_core::model::Sided;
-    match sided {
-        None => Ok(None),
-        Some("upper") => Ok(Some(Sided::Upper)),
-        Some("two") => Ok(Some(Sided::Two)),
-        Some(other) => Err(value_error(format!(
-            "sided must be \"upper\" or \"two\", not {other:?}"
-        ))),
+    sided.map(choice).transpose()
+}
+
+/// A file Python gives as a `path` or as its `text` named `name`
+/// ([`Source::given`]).
+pub(crate) fn source<'a>(
+    path: Option<&'a str>,
+    text: Option<&'a str>,
+    name: &'a str,
+) -> PyResult<Source<'a>> {
+    Source::given(path, text, name).map_err(|e| value_error(e.to_string()))
+}
+
+/// A file argument given as one tuple `(path, text, name)`: a path, or its
+/// text named `name` (`poses_file`, `axes_file`).
+#[derive(FromPyObject)]
+pub(crate) struct FileInput(Option<String>, Option<String>, String);
+
+impl FileInput {
+    /// The file as ops reads it.
+    pub(crate) fn source(&self) -> PyResult<Source<'_>> {
+        source(self.0.as_deref(), self.1.as_deref(), &self.2)
     }
 }
 

@@ -9,11 +9,8 @@
 //! (`MachineError` with file, line, column, key) where the library locates
 //! it, a `ValueError` otherwise.
 
-use std::path::Path;
-
 use chain::ops::identify::{IdentifyOpsError, IdentifyRequest};
 use chain::ops::plan::{self, PlanRequest};
-use chain::ops::tables::Source;
 use chain::ops::Worded;
 use chain_core::measured::{Layout, Measurements, MeasurementsError};
 use chain_core::model::Machine;
@@ -22,12 +19,15 @@ use chain_core::values::{Values, ValuesError};
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 
-use chain::ops::map::{MapOpsError, MapPoints, MapRequest};
+use chain::ops::map::{MapOpsError, MapRequest};
+use chain::ops::resolve::AxisPoints;
+use chain::ops::source as ops_source;
 
-use crate::{load_error, resolve_error, study_error, to_json, value_error, Model};
+use crate::{choice, load_error, resolve_error, source, study_error, to_json, value_error, Model};
 
 /// A measurement or candidate CSV: read from `path`, or parsed from `text`
-/// named `file`.
+/// named `file` ([`chain::ops::source::read_measurements`], the GIL
+/// released).
 fn read_measurements(
     py: Python<'_>,
     m: &Machine,
@@ -37,20 +37,14 @@ fn read_measurements(
     params: &[(String, f64)],
     layout: Layout,
 ) -> PyResult<Measurements> {
-    let read = match (path, text) {
-        (Some(path), None) => Measurements::read(Path::new(path), m, params, layout),
-        (None, Some(text)) => Measurements::parse(text, file, m, params, layout),
-        _ => {
-            return Err(value_error(
-                "give the CSV as a path or as its text, not both",
-            ))
-        }
-    };
+    let source = source(path, text, file)?;
+    let read = py.allow_threads(|| ops_source::read_measurements(source, m, params, layout));
     read.map_err(|e: MeasurementsError| load_error(py, e.diagnostics()))
 }
 
-/// A values file: read from `path` (tables relative to it), or parsed from
-/// `text` named `file` (tables relative to the working directory).
+/// A values file and its name: read from `path` (tables relative to it),
+/// or parsed from `text` named `file` (tables relative to the working
+/// directory) ([`chain::ops::source::read_values`], the GIL released).
 pub(crate) fn read_values(
     py: Python<'_>,
     m: &Machine,
@@ -58,18 +52,10 @@ pub(crate) fn read_values(
     text: Option<&str>,
     file: &str,
 ) -> PyResult<(Values, String)> {
-    let read = match (path, text) {
-        (Some(path), None) => Values::read(Path::new(path), m).map(|v| (v, path.to_string())),
-        (None, Some(text)) => {
-            Values::parse(text, file, Path::new("."), m).map(|v| (v, file.to_string()))
-        }
-        _ => {
-            return Err(value_error(
-                "give the values as a path or as their text, not both",
-            ))
-        }
-    };
-    read.map_err(|e: ValuesError| load_error(py, e.diagnostics()))
+    let source = source(path, text, file)?;
+    let read = py.allow_threads(|| ops_source::read_values(source, m));
+    let values = read.map_err(|e: ValuesError| load_error(py, e.diagnostics()))?;
+    Ok((values, source.name()))
 }
 
 /// `chain identify --format json` (and the values file `--values-out`
@@ -95,23 +81,6 @@ pub(crate) fn identify_json(
     holdout: Option<f64>,
     seed: Option<u64>,
 ) -> PyResult<(String, String)> {
-    /// A CSV as a path, or as its text named `file`.
-    fn source<'s>(
-        path: Option<&'s str>,
-        text: Option<&'s str>,
-        file: &'s str,
-    ) -> PyResult<Source<'s>> {
-        match (path, text) {
-            (Some(path), None) => Ok(Source::Path(Path::new(path))),
-            (None, Some(text)) => Ok(Source::Bytes {
-                name: file,
-                bytes: text.as_bytes(),
-            }),
-            _ => Err(value_error(
-                "give the CSV as a path or as its text, not both",
-            )),
-        }
-    }
     let validate = match &validate {
         Some((path, text, file)) => Some(source(path.as_deref(), text.as_deref(), file)?),
         None => None,
@@ -154,16 +123,7 @@ pub(crate) fn plan_json(
     params: Vec<(String, f64)>,
 ) -> PyResult<String> {
     let m = &model.machine;
-    let kind = match kind {
-        None => None,
-        Some("point") => Some(Kind::Point),
-        Some("direction") => Some(Kind::Direction),
-        Some(other) => {
-            return Err(value_error(format!(
-                "kind must be \"point\" or \"direction\", not {other:?}"
-            )))
-        }
-    };
+    let kind = kind.map(choice::<Kind>).transpose()?;
     chain::ops::resolve::check_parameters(m, &params).map_err(|e| resolve_error(py, model, e))?;
     let candidates = read_measurements(py, m, path, text, file, &params, Layout::Candidates)?;
     let request = PlanRequest { count, kind };
@@ -192,21 +152,12 @@ pub(crate) fn map_json(
 ) -> PyResult<String> {
     let m = &model.machine;
     let (values, name) = read_values(py, m, values_path, values_text, values_file)?;
-    let choices = match approach {
-        Some(text) => chain_core::values::parse_approaches(text)
-            .map_err(|e| value_error(format!("approach: {e}")))?,
-        None => Vec::new(),
+    let choices = crate::study::parse_approach(approach)?;
+    let rows = match &points {
+        Some(q) => Some(("points".to_string(), model.points(q)?.0.to_vec())),
+        None => None,
     };
-    let points = match &points {
-        Some(q) => {
-            if !grid.is_empty() {
-                return Err(value_error("give grid or points, not both"));
-            }
-            let (flat, _) = model.points(q)?;
-            MapPoints::Rows(flat.to_vec())
-        }
-        None => MapPoints::Grid(&grid),
-    };
+    let points = AxisPoints::new(&grid, rows).map_err(|e| resolve_error(py, model, e))?;
     let request = MapRequest {
         params: &params,
         approach: &choices,
@@ -219,8 +170,8 @@ pub(crate) fn map_json(
         MapOpsError::Resolve(e) => resolve_error(py, model, e),
         other => value_error(other.with_help()),
     };
-    let prepared = chain::ops::map::prepare(m, &model.file, values, &name, "points", &request)
-        .map_err(ops_error)?;
+    let prepared =
+        chain::ops::map::prepare(m, &model.file, values, &name, &request).map_err(ops_error)?;
     let doc = py
         .allow_threads(|| prepared.run(m, &request, &|_| {}).map_err(Box::new))
         .map_err(|e| ops_error(*e))?;

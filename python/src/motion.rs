@@ -3,14 +3,13 @@
 //! the exact motion (the instants and the CNC axes at each, the CLI's
 //! `--format csv`).
 
-use std::path::Path;
-
 use chain::ops::motion::{self, MotionOpsError, MotionRequest};
+use chain::ops::source as ops_source;
 use chain::ops::Worded;
-use chain_core::settings::{self, ReferenceError};
+use chain_core::settings::ReferenceError;
 use pyo3::prelude::*;
 
-use crate::{load_error, resolve_error, to_json, value_error, Model};
+use crate::{load_error, resolve_error, source, to_json, value_error, Model};
 
 /// The motion conversion of the settings (a file `path`, or the text
 /// `text` named `file`, whose relative paths are resolved against the
@@ -52,16 +51,10 @@ pub(crate) fn motion_json(
         e => value_error(e.with_help()),
     };
     motion::check(&request).map_err(refused)?;
-    let settings = match (path, text) {
-        (Some(path), None) => settings::load_settings_file(Path::new(path)),
-        (None, Some(text)) => settings::load_settings_str(text, file, Path::new(".")),
-        _ => {
-            return Err(value_error(
-                "give the settings as a path or as their text, not both",
-            ))
-        }
-    }
-    .map_err(|d| load_error(py, &d))?;
+    let source = source(path, text, file)?;
+    let settings = py
+        .allow_threads(|| ops_source::read_settings(source))
+        .map_err(|d| load_error(py, &d))?;
     let doc = py
         .allow_threads(|| motion::run(&model.machine, settings, &request))
         .map_err(refused)?;

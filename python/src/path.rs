@@ -2,23 +2,24 @@
 //! CLI's request, checks and document): axis values with named columns, or
 //! tool poses solved by the inverse kinematics.
 
-use std::path::Path;
-
 use chain::ops::path::{self, PathInput, PathOpsError, PathRequest};
-use chain::ops::tables::{self, Source};
+use chain::ops::tables;
 use numpy::{PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
 use crate::inverse::pose_rows;
 use crate::study::{algorithm_options, system_choice};
 use crate::{
-    check_finite, resolve_error, sided_named, study_error, table_error, to_json, value_error, Model,
+    check_finite, resolve_error, sided_named, study_error, table_error, to_json, value_error,
+    FileInput, Model,
 };
 
 /// Error and reliability along a path. Exactly one of `axes` (an `(N, C)`
 /// array whose columns `header` names: axis variables in any order, an
-/// optional first `t`) and `poses` (`(N, 6)` or `(N, 12)`, as `inverse`;
-/// `t` their instants) is given; the other keywords are the CLI's options.
+/// optional first `t`), `poses` (`(N, 6)` or `(N, 12)`, as `inverse`; `t`
+/// their instants), `axes_file` and `poses_file` (`(path, text, name)`: the
+/// CSV `--axes` or `--pose` reads) is given; the other keywords are the
+/// CLI's options.
 #[pyfunction]
 #[pyo3(signature = (model, header, axes, poses, t, fix, params, method, samples, seed, cov, sided, system, system_tolerance, axes_file=None, poses_file=None))]
 #[allow(clippy::too_many_arguments)]
@@ -38,16 +39,17 @@ pub(crate) fn path_json(
     sided: Option<&str>,
     system: Option<&str>,
     system_tolerance: Option<f64>,
-    axes_file: Option<&str>,
-    poses_file: Option<&str>,
+    axes_file: Option<FileInput>,
+    poses_file: Option<FileInput>,
 ) -> PyResult<String> {
     let algorithm = algorithm_options(method, samples, seed, cov)?;
     let sided = sided_named(sided)?;
     let system = system_choice(system, system_tolerance)?;
     let (rows, poses_read, table, file_name);
-    let input = match (&axes, &poses, axes_file, poses_file) {
+    let input = match (&axes, &poses, &axes_file, &poses_file) {
         (None, None, Some(file), None) => {
-            let read = py.allow_threads(|| tables::read_numbers(Source::Path(Path::new(file))));
+            let source = file.source()?;
+            let read = py.allow_threads(|| tables::read_numbers(source));
             table = read.map_err(|e| table_error(py, model, e))?;
             PathInput::Axes {
                 source: &table.name,
@@ -56,10 +58,11 @@ pub(crate) fn path_json(
             }
         }
         (None, None, None, Some(file)) => {
-            let read = py.allow_threads(|| tables::read_poses(Source::Path(Path::new(file))));
+            let source = file.source()?;
+            let read = py.allow_threads(|| tables::read_poses(source));
             let (has_t, read) = read.map_err(|e| table_error(py, model, e))?;
             poses_read = read;
-            file_name = file.to_string();
+            file_name = source.name();
             PathInput::Poses {
                 source: &file_name,
                 has_t,

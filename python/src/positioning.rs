@@ -2,13 +2,12 @@
 //! from a path or as its text, read and evaluated by the library the CLI
 //! uses; refusals are the CLI's messages (`MachineError`, located).
 
-use std::path::Path;
-
 use chain::ops::positioning as ops;
-use chain_core::measured::positioning::{Coverage, Runs};
+use chain::ops::source as ops_source;
+use chain_core::measured::positioning::Coverage;
 use pyo3::prelude::*;
 
-use crate::{load_error, to_json, value_error, Model};
+use crate::{load_error, source, to_json, value_error, Model};
 
 /// The positioning document of the runs at `path`, or of `text` named
 /// `file`; `k` the coverage factor, `rotary` as `--rotary`. With `model`
@@ -29,23 +28,17 @@ pub(crate) fn positioning_json(
 ) -> PyResult<(String, Option<String>)> {
     let k = Coverage::new(k).map_err(|e| value_error(e.to_string()))?;
     let kind = ops::axis_kind(rotary);
-    let runs = match (path, text) {
-        (Some(path), None) => Runs::read(Path::new(path), kind),
-        (None, Some(text)) => Runs::parse(text, file, kind),
-        _ => {
-            return Err(value_error(
-                "give the runs as a path or as their text, not both",
-            ))
-        }
-    }
-    .map_err(|e| load_error(py, e.diagnostics()))?;
-    let runs_file = path.unwrap_or(file);
+    let source = source(path, text, file)?;
+    let runs = py
+        .allow_threads(|| ops_source::read_runs(source, kind))
+        .map_err(|e| load_error(py, e.diagnostics()))?;
+    let runs_file = source.name();
     let values_out = match (model, slot) {
         (Some(model), Some(slot)) => Some(ops::ValuesOut {
             machine: &model.machine,
             machine_file: &model.file,
             slot,
-            runs_file,
+            runs_file: &runs_file,
         }),
         (None, None) => None,
         _ => return Err(value_error("give machine and slot together")),

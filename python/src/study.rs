@@ -20,7 +20,7 @@ use pyo3::prelude::*;
 use reliability::Method;
 
 use crate::{
-    named, resolve_error, sided_named, study_error, study_failure, to_json, value_error, Model,
+    choice, resolve_error, sided_named, study_error, study_failure, to_json, value_error, Model,
 };
 
 /// `method`, `samples`, `seed` and `cov` as the CLI's `--method`,
@@ -33,7 +33,7 @@ pub(crate) fn algorithm_options(
     cov: Option<f64>,
 ) -> PyResult<AlgorithmOptions> {
     let options = AlgorithmOptions {
-        method: named("method", method, &Method::ALL.map(|m| (m.name(), m)))?,
+        method: choice::<Method>(method)?,
         samples,
         seed,
         cov,
@@ -49,11 +49,7 @@ pub(crate) fn system_choice(
     system: Option<&str>,
     tolerance: Option<f64>,
 ) -> PyResult<Option<SystemChoice>> {
-    let kinds = [
-        ("series", SystemKind::Series),
-        ("volumetric", SystemKind::Volumetric),
-    ];
-    let kind = system.map(|s| named("system", s, &kinds)).transpose()?;
+    let kind = system.map(choice::<SystemKind>).transpose()?;
     SystemChoice::new(kind, tolerance).map_err(|e| value_error(e.to_string()))
 }
 

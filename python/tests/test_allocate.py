@@ -1,12 +1,14 @@
 """`Machine.allocate` (`chain allocate`): each document equal to the CLI's `--format json` for the
 same input on the example machines with a requirement; the allocated standard deviations
 re-evaluated independently (a posterior values file through `Machine.reliability`); bad options
-refused naming the keyword."""
+refused naming the keyword; a refused allocation located as the CLI locates it."""
+
+import re
 
 import pytest
 
 import chain
-from conftest import MACHINES, ROOT, flat
+from conftest import MACHINES, ROOT, flat, squeezed
 
 WITH_REQUIREMENT = [p for p in MACHINES if "requirement:" in p.read_text() and "\nstatistics:" in p.read_text()]
 IDS = [p.stem for p in WITH_REQUIREMENT]
@@ -63,11 +65,12 @@ def test_allocated_stds_meet_the_requirement_when_reevaluated(tmp_path):
 
 def test_bad_options_are_refused_naming_the_keyword(cli_error):
     m = chain.Machine.load(GANTRY)
-    with pytest.raises(ValueError, match="for `strategy`"):
+    # A choice is refused in the words of ops::choice, the CLI's.
+    with pytest.raises(ValueError, match="^`best` is not a strategy: choose one of optimal, paper$"):
         m.allocate(strategy="best")
-    with pytest.raises(ValueError, match="for `rank`"):
+    with pytest.raises(ValueError, match="^`all` is not a ranking: choose one of component, pooled$"):
         m.allocate(strategy="paper", rank="all")
-    with pytest.raises(ValueError, match="for `target`"):
+    with pytest.raises(ValueError, match="^`everything` is not an allocation target: choose one of requirement, acceptance$"):
         m.allocate(target="everything")
     # The CLI's messages, word for word (chain::ops::allocate).
     for kw, opts, wording in [
@@ -94,3 +97,39 @@ def test_bad_options_are_refused_naming_the_keyword(cli_error):
         no_req.allocate()
 
 
+def _pinned(tmp_path):
+    """The gantry with every standard deviation pinned at its `min_std`: nothing can be tightened.
+    Returns the file and its lines."""
+    lines = []
+    for line in GANTRY.read_text().splitlines():
+        if "dist: normal" in line and "std: " in line:
+            expr = line[line.index("std: ") + 5:].rstrip("}").strip()
+            line = line.replace("}", f", min_std: {expr}}}", 1)
+        lines.append(line)
+    path = tmp_path / "pinned.yaml"
+    path.write_text("\n".join(lines) + "\n")
+    return path, lines
+
+
+@pytest.mark.parametrize("strategy,code,names_first", [
+    ("paper", "chain::allocate::stalled", "further ("),
+    ("optimal", "chain::allocate::infeasible", "binding bounds: "),
+])
+def test_refused_allocation_is_located_at_its_statistics_entry_as_the_cli_says(strategy, code, names_first,
+                                                                                 tmp_path, cli_error):
+    """The paper's rounds stall and the least-cost allocation finds the requirement infeasible; each
+    refusal names an error first, and Python raises the CLI's message (at that error's statistics
+    entry, file:line:column) and help, word for word."""
+    path, lines = _pinned(tmp_path)
+    with pytest.raises(chain.MachineError) as info:
+        chain.Machine.load(path).allocate(strategy=strategy)
+    e = info.value
+    message, _, help_text = str(e).partition("\nhelp: ")
+    first = re.match(r"\w+", message.split(names_first, 1)[1]).group()
+    line = 1 + next(i for i, text in enumerate(lines) if text.startswith(f"  {first}: {{dist"))
+    assert (e.line, e.column) == (line, 3)
+    assert message.startswith(f"{e.file}:{line}:3: gantry_grinder: ")
+    err = cli_error("allocate", path, "--strategy", strategy)
+    assert code in err and "its statistics entry" in err
+    assert help_text
+    assert squeezed(message) in squeezed(err) and squeezed(help_text) in squeezed(err)

@@ -44,8 +44,14 @@ def test_export_points_and_refusals(cli_error, tmp_path):
     assert flat(message) in cli
     with pytest.raises(ValueError, match="--controller linuxcnc does not take --axes"):
         m.export(VALUES, controller="linuxcnc", points=q, params={"L": 150})
-    with pytest.raises(ValueError, match=r"invalid value \"fanuc\" for `controller` \[possible values: grid, beckhoff"):
+    with pytest.raises(ValueError) as info:
         m.export(VALUES, controller="fanuc")
+    wording = "`fanuc` is not a controller: choose one of grid, beckhoff, linuxcnc, siemens-cec, klipper"
+    assert str(info.value) == wording
+    assert wording in flat(cli_error("export", MACHINE, "--values", VALUES, "--controller", "fanuc"))
+    with pytest.raises(ValueError) as info:
+        m.export(VALUES, grid={"x": [0.0]}, points=q, params={"L": 150})
+    assert str(info.value).startswith("--grid cannot be combined with --axes\nhelp: --axes gives the points")
     with pytest.raises(ValueError) as info:
         m.export(VALUES, controller="linuxcnc", grid={"x": [0, 900]}, params={"L": 150})
     message = str(info.value)

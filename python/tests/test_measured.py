@@ -138,7 +138,7 @@ def test_plan_bad_input():
     m = chain.Machine.load(PROBE)
     with pytest.raises(ValueError, match="--kind direction needs the columns"):
         m.plan(MEAS / "candidates.csv", 40, kind="direction")
-    with pytest.raises(ValueError, match="kind must be"):
+    with pytest.raises(ValueError, match="`line` is not a measurement kind: choose one of point, direction"):
         m.plan(MEAS / "candidates.csv", 40, kind="line")
     with pytest.raises(ValueError, match="--count 451 is not a count"):
         m.plan(MEAS / "candidates.csv", 451)

@@ -148,8 +148,11 @@ def test_compensate_is_the_cli_json(cli, cli_error):
     r = chain.compensate(path, length=577.11, select="bic", max_order=5)
     assert r.to_dict() == cli("compensate", path, "--length", "577.11", "--select", "bic", "--max-order", "5")
     assert len(r.to_dataframe()) == len(r.points)
-    with pytest.raises(ValueError, match="invalid value for '--select': unknown selection rule `best`"):
+    with pytest.raises(ValueError) as info:
         chain.compensate(path, length=577.11, select="best")
+    wording = "`best` is not a selection rule: choose one of loocv, adjusted-r2, aicc, bic"
+    assert str(info.value) == wording
+    assert wording in cli_error("compensate", path, "--length", "577.11", "--select", "best")
     bad = {k: v for k, v in cols.items() if k != "z3"}
     with pytest.raises(ValueError) as info:
         chain.compensate(bad, length=577.11, name="bad.csv")

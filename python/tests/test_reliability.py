@@ -161,7 +161,8 @@ def test_sobol_with_a_grid_is_the_cli_json(cli):
 
 
 @pytest.mark.parametrize("kw,opts,wording", [
-    ({"method": "bogus"}, ["--method", "bogus"], "possible values: form, is, mc, subset, directional, sorm"),
+    ({"method": "bogus"}, ["--method", "bogus"],
+     "`bogus` is not a method: choose one of form, is, mc, subset, directional, sorm"),
     ({"method": "mc", "cov": 0}, ["--method", "mc", "--cov", "0"],
      "the target coefficient of variation must be in (0, 1] (found `0`)"),
     ({"method": "mc", "cov": -0.5}, ["--method", "mc", "--cov", "-0.5"],
@@ -178,7 +179,8 @@ def test_sobol_with_a_grid_is_the_cli_json(cli):
      "FORM draws no samples; a target coefficient of variation needs"),
     ({"acceptance": True, "acceptance_tolerance": 0.0}, ["--acceptance", "--acceptance-tolerance", "0"],
      "(an absolute error in (0, 1))"),
-    ({"system": "parallel"}, ["--system", "parallel"], "possible values: series, volumetric"),
+    ({"system": "parallel"}, ["--system", "parallel"],
+     "`parallel` is not a system target: choose one of series, volumetric"),
 ])
 def test_bad_options_are_refused_with_the_cli_wording(kw, opts, wording, cli_error):
     with pytest.raises(ValueError) as info:
@@ -202,7 +204,7 @@ def test_other_bad_options_raise_value_error():
          "invalid value for '--system-tolerance': `-1` (a positive allowable volumetric error, mm)"),
         ({"acceptance": "yes"}, "acceptance must be True or False"),
         ({"acceptance": True, "acceptance_tolerance": 1.0}, "invalid value for '--acceptance-tolerance': 1 (an absolute error in (0, 1))"),
-        ({"sided": "three"}, "sided must be \"upper\" or \"two\""),
+        ({"sided": "three"}, "`three` is not a side: choose one of upper, two"),
     ]
     for kw, wording in bad:
         with pytest.raises(ValueError) as info:

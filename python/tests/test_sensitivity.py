@@ -139,7 +139,7 @@ def test_bad_options_are_refused_naming_the_keyword(cli_error):
     with pytest.raises(chain.MachineError, match="unknown axis variable `q`"):
         m.geometric_sensitivity(grid={"q": [0]})
     assert "unknown axis variable" in flat(cli_error("sensitivity", GANTRY, "--kind", "geometric", "--grid", "q=0"))
-    with pytest.raises(ValueError, match="sided must be"):
+    with pytest.raises(ValueError, match="`three` is not a side: choose one of upper, two"):
         m.sensitivity_reliability(sided="three")
     with pytest.raises(ValueError, match="--grid x: NaN is not finite"):
         m.geometric_sensitivity(grid={"x": [0, float("nan")]})

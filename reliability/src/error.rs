@@ -92,7 +92,7 @@ pub enum ReliabilityError {
     /// The reliability grid has more points than an allocation strategy can
     /// run on within minutes ([`crate::allocate::check_grid`]); refused
     /// before anything is derived.
-    #[error("the reliability grid has {points} points; {strategy} runs on at most {limit}")]
+    #[error("the reliability grid has {points} points; {allocation} runs on at most {limit}")]
     #[cfg_attr(
         feature = "miette",
         diagnostic(code(chain::reliability::grid_too_large))
@@ -100,12 +100,10 @@ pub enum ReliabilityError {
     GridTooLarge {
         /// The grid's points.
         points: usize,
-        /// The strategy's limit.
+        /// The allocation's limit.
         limit: usize,
-        /// The strategy (`the least-cost allocation`, ...).
-        strategy: &'static str,
-        /// Why it has a limit.
-        why: &'static str,
+        /// The allocation refused (its name and why it has a limit).
+        allocation: crate::allocate::GridUse,
         /// The reliability section.
         origin: Origin,
     },

@@ -50,7 +50,6 @@
 pub mod acceptance;
 pub mod allocate;
 pub mod directional;
-pub mod document;
 pub mod error;
 mod families;
 pub mod form;

@@ -1,8 +1,8 @@
 //! The posterior of a calibration as reliability inputs (`docs/posterior.md`).
 //!
 //! A values file (measured-machines spec, section 2) read by
-//! [`chain_core::values::Values`], plus the two extras the spec lets
-//! `chain identify --values-out` write and other readers ignore: a `std` per
+//! [`chain_core::values::Values`], plus the two extras the spec lets an
+//! identification's values file carry and other readers ignore: a `std` per
 //! constant, and a `correlation` list of triples
 //!
 //! ```yaml
@@ -39,7 +39,7 @@
 
 use std::path::Path;
 
-use chain_core::diagnostic::{closest, Message, Problem};
+use chain_core::diagnostic::{closest, Describe, Description, Problem};
 use chain_core::model::{Machine, Origin};
 use chain_core::values::{EntryKind, Given, Values, ValuesError};
 use chain_core::yaml::{self, Node};
@@ -73,7 +73,7 @@ pub enum PosteriorError {
         feature = "miette",
         diagnostic(
             code(chain::posterior::table_point),
-            help("study the points inside the tables (--grid), extend them, or add `extrapolate: hold` to the entry")
+            help("study the points inside the tables, extend them, or add `extrapolate: hold` to the entry")
         )
     )]
     Point {
@@ -145,15 +145,105 @@ pub struct Posterior {
     built: Option<Values>,
 }
 
-/// Codes of the posterior's refusals.
-const CODE_STD: &str = "chain::posterior::zero_std";
-const CODE_SHAPE: &str = "chain::posterior::correlation_entry";
-const CODE_UNKNOWN: &str = "chain::posterior::unknown_name";
-const CODE_NO_STD: &str = "chain::posterior::no_std";
-const CODE_SELF: &str = "chain::posterior::self_correlation";
-const CODE_TWICE: &str = "chain::posterior::duplicate_pair";
-const CODE_RHO: &str = "chain::posterior::correlation_range";
-const CODE_PD: &str = "chain::posterior::not_positive_definite";
+/// One thing wrong with a values file read as a posterior (codes
+/// `chain::posterior::*`), worded by its [`Describe`] implementation.
+#[derive(Debug, Clone, PartialEq)]
+enum PosteriorProblem {
+    /// The file cannot be read again for its `correlation`.
+    Read { file: String, reason: String },
+    /// A standard deviation of 0.
+    ZeroStd { name: String },
+    /// `correlation` is not a list.
+    CorrelationNotList { found: String },
+    /// An entry of `correlation` that is not `[NAME, NAME, rho]`.
+    CorrelationEntry { path: String, found: String },
+    /// A name of `correlation` that is not an error of the machine.
+    UnknownName {
+        name: String,
+        suggestion: Option<String>,
+    },
+    /// A name of `correlation` without a `std`.
+    NoStd { name: String },
+    /// A correlation outside (-1, 1).
+    Range { rho: f64 },
+    /// An error correlated with itself.
+    SelfCorrelation { name: String },
+    /// A pair given twice.
+    DuplicatePair { a: String, b: String },
+    /// A correlation matrix that is not positive definite.
+    NotPositiveDefinite { detail: String },
+}
+
+impl Describe for PosteriorProblem {
+    fn describe(&self) -> Description {
+        use Description as D;
+        match self {
+            PosteriorProblem::Read { file, reason } => D::new(
+                "chain::posterior::read",
+                "unreadable",
+                format!("cannot read `{file}`: {reason}"),
+            ),
+            PosteriorProblem::ZeroStd { name } => D::new(
+                "chain::posterior::zero_std",
+                "std 0",
+                format!("`{name}` has std 0: a posterior standard deviation must be positive"),
+            )
+            .help("leave `std` out to keep the statistics spread around the value, or give the identified std".to_string()),
+            PosteriorProblem::CorrelationNotList { found } => D::new(
+                "chain::posterior::correlation_entry",
+                "not a list",
+                format!("`correlation` is {found}: expected a list of `[NAME, NAME, rho]`"),
+            ),
+            PosteriorProblem::CorrelationEntry { path, found } => D::new(
+                "chain::posterior::correlation_entry",
+                "not [NAME, NAME, rho]",
+                format!("`{path}` is {found}: expected `[NAME, NAME, rho]`"),
+            )
+            .help("e.g. `correlation: [[dxx, dxz, -0.45]]`".to_string()),
+            PosteriorProblem::UnknownName { name, suggestion } => D::new(
+                "chain::posterior::unknown_name",
+                "unknown name",
+                D::suggesting(format!("unknown name `{name}`"), suggestion),
+            )
+            .help("correlation names the error parameters and coefficients given in `values` with a `std`".to_string()),
+            PosteriorProblem::NoStd { name } => D::new(
+                "chain::posterior::no_std",
+                "no std",
+                format!("`{name}` has no `std` in this values file: a correlation needs the standard deviations of both errors"),
+            )
+            .help(format!("give it as `{name}: {{value: V, std: S}}` under `values`")),
+            PosteriorProblem::Range { rho } => D::new(
+                "chain::posterior::correlation_range",
+                "out of range",
+                format!("correlation {rho} is out of range: it must be strictly between -1 and 1"),
+            )
+            .help("ρ = ±1 makes one error a copy of the other: drop one of them, or give its std alone; from a rank-deficient identification (errors that only act together), identify with the statistics as a prior".to_string()),
+            PosteriorProblem::SelfCorrelation { name } => D::new(
+                "chain::posterior::self_correlation",
+                "the same name twice",
+                format!("`{name}` is correlated with itself"),
+            )
+            .help("a correlation pairs two different errors (an error's own is 1)".to_string()),
+            PosteriorProblem::DuplicatePair { a, b } => D::new(
+                "chain::posterior::duplicate_pair",
+                "given before",
+                format!("the correlation of `{a}` and `{b}` is given twice"),
+            ),
+            PosteriorProblem::NotPositiveDefinite { detail } => D::new(
+                "chain::posterior::not_positive_definite",
+                "not positive definite",
+                detail.clone(),
+            )
+            .help("a correlation matrix must be positive definite: a rank-deficient identification (see `unidentifiable`) needs the statistics as a prior, or correlations that are consistent with each other".to_string()),
+        }
+    }
+}
+
+impl From<PosteriorProblem> for Problem {
+    fn from(problem: PosteriorProblem) -> Problem {
+        Problem::foreign(problem)
+    }
+}
 
 impl Posterior {
     /// Reads a values file for `machine` as a posterior.
@@ -165,11 +255,10 @@ impl Posterior {
             .map_err(|e| e.to_string())
             .and_then(|b| String::from_utf8(b).map_err(|e| e.to_string()))
             .map_err(|e| {
-                let m = Message::new(
-                    format!("cannot read `{file}`: {e}"),
-                    "unreadable",
-                    "chain::posterior::read",
-                );
+                let m = PosteriorProblem::Read {
+                    file: file.clone(),
+                    reason: e,
+                };
                 PosteriorError::File(Diagnostics::single(
                     file.clone(),
                     "",
@@ -208,13 +297,8 @@ impl Posterior {
             match (&e.given, e.kind) {
                 (Given::Constant { value, std }, EntryKind::Error | EntryKind::Coefficient) => {
                     if *std == Some(0.0) {
-                        let m = Message::new(
-                            format!("`{}` has std 0: a posterior standard deviation must be positive", e.name),
-                            "std 0",
-                            CODE_STD,
-                        )
-                        .help("leave `std` out to keep the statistics spread around the value, or give the identified std");
-                        problems.push((origin, m.into()));
+                        let name = e.name.clone();
+                        problems.push((origin, PosteriorProblem::ZeroStd { name }.into()));
                     }
                     given.push(PosteriorValue {
                         name: e.name.clone(),
@@ -307,7 +391,7 @@ impl Posterior {
     }
 
     /// Reads every bidirectional table for these approach directions
-    /// (`chain reliability --approach`; [`Values::choose_approach`]).
+    /// ([`Values::choose_approach`]).
     pub fn choose_approach(
         &mut self,
         choices: &[(Option<String>, chain_core::values::Approach)],
@@ -475,30 +559,18 @@ fn read_correlation(
         return out;
     }
     let Some(items) = list.as_sequence() else {
-        let m = Message::new(
-            format!(
-                "`correlation` is {}: expected a list of `[NAME, NAME, rho]`",
-                list.describe()
-            ),
-            "not a list",
-            CODE_SHAPE,
-        );
+        let m = PosteriorProblem::CorrelationNotList {
+            found: list.describe(),
+        };
         problems.push((key.span.origin("correlation"), m.into()));
         return out;
     };
     let names = || machine.errors.iter().map(|e| e.name.as_str());
     for (i, item) in items.iter().enumerate() {
         let path = format!("correlation[{i}]");
-        let shape = || {
-            Message::new(
-                format!(
-                    "`{path}` is {}: expected `[NAME, NAME, rho]`",
-                    item.describe()
-                ),
-                "not [NAME, NAME, rho]",
-                CODE_SHAPE,
-            )
-            .help("e.g. `correlation: [[dxx, dxz, -0.45]]`")
+        let shape = || PosteriorProblem::CorrelationEntry {
+            path: path.clone(),
+            found: item.describe(),
         };
         let Some([a, b, r]) = item
             .as_sequence()
@@ -515,19 +587,17 @@ fn read_correlation(
                 return None;
             };
             if !names().any(|x| x == n) {
-                let m = Message::new(format!("unknown name `{n}`"), "unknown name", CODE_UNKNOWN)
-                    .suggest(closest(n, names()))
-                    .help("correlation names the error parameters and coefficients given in `values` with a `std`");
+                let m = PosteriorProblem::UnknownName {
+                    name: n.to_string(),
+                    suggestion: closest(n, names()).map(str::to_string),
+                };
                 problems.push((node.span.origin(p), m.into()));
                 return None;
             }
             if !given.iter().any(|v| v.name == n && v.std.is_some()) {
-                let m = Message::new(
-                    format!("`{n}` has no `std` in this values file: a correlation needs the standard deviations of both errors"),
-                    "no std",
-                    CODE_NO_STD,
-                )
-                .help(format!("give it as `{n}: {{value: V, std: S}}` under `values`"));
+                let m = PosteriorProblem::NoStd {
+                    name: n.to_string(),
+                };
                 problems.push((node.span.origin(p), m.into()));
                 return None;
             }
@@ -546,12 +616,7 @@ fn read_correlation(
                 ok = false;
             }
             Some(v) if !v.is_finite() || v.abs() >= 1.0 => {
-                let m = Message::new(
-                    format!("correlation {v} is out of range: it must be strictly between -1 and 1"),
-                    "out of range",
-                    CODE_RHO,
-                )
-                .help("ρ = ±1 makes one error a copy of the other: drop one of them, or give its std alone; from a rank-deficient `chain identify` (errors that only act together), identify with `--prior`");
+                let m = PosteriorProblem::Range { rho: v };
                 problems.push((r.span.origin(rpath), m.into()));
                 ok = false;
             }
@@ -561,12 +626,7 @@ fn read_correlation(
             continue;
         };
         if na == nb {
-            let m = Message::new(
-                format!("`{na}` is correlated with itself"),
-                "the same name twice",
-                CODE_SELF,
-            )
-            .help("a correlation pairs two different errors (an error's own is 1)");
+            let m = PosteriorProblem::SelfCorrelation { name: na };
             problems.push((item.span.origin(path), m.into()));
             continue;
         }
@@ -574,11 +634,7 @@ fn read_correlation(
             .iter()
             .any(|c| (c.a == na && c.b == nb) || (c.a == nb && c.b == na))
         {
-            let m = Message::new(
-                format!("the correlation of `{na}` and `{nb}` is given twice"),
-                "given before",
-                CODE_TWICE,
-            );
+            let m = PosteriorProblem::DuplicatePair { a: na, b: nb };
             problems.push((item.span.origin(path), m.into()));
             continue;
         }
@@ -592,7 +648,7 @@ fn read_correlation(
 fn positive_definite(
     given: &[PosteriorValue],
     correlations: &[PosteriorCorrelation],
-) -> Result<(), Message> {
+) -> Result<(), PosteriorProblem> {
     let names: Vec<String> = given.iter().map(|v| v.name.clone()).collect();
     let marginals = vec![Marginal::normal(0.0, 1.0).expect("unit normal"); names.len()];
     let index = |n: &str| names.iter().position(|x| x == n).unwrap_or_default();
@@ -606,14 +662,11 @@ fn positive_definite(
         .collect();
     match Inputs::correlated(names, marginals, &pairs) {
         Ok(_) => Ok(()),
-        Err(e) => Err(Message::new(
-            match e {
+        Err(e) => Err(PosteriorProblem::NotPositiveDefinite {
+            detail: match e {
                 ReliabilityError::InvalidDistribution(msg) => msg,
                 other => other.to_string(),
             },
-            "not positive definite",
-            CODE_PD,
-        )
-        .help("a correlation matrix must be positive definite: a rank-deficient identification (see `unidentifiable`) needs `chain identify --prior`, or correlations that are consistent with each other")),
+        }),
     }
 }

@@ -1,7 +1,8 @@
 //! Command-line arguments shared by several subcommands, flattened into
 //! their argument structs with `#[command(flatten)]`.
 
-use chain_core::compensation::controllers::Controller;
+use chain::ops::choice::parser;
+use chain::ops::study::SystemKind;
 use chain_core::diagnostic::shortened;
 use chain_core::model::Sided;
 use reliability::Method;
@@ -10,14 +11,15 @@ use reliability::Method;
 #[derive(Debug, clap::Args)]
 pub struct ParamArgs {
     /// Value of a parameter, `NAME=VALUE` (repeatable; required for symbolic ones).
-    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_assignment)]
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
     pub params: Vec<(String, f64)>,
 }
 
 impl ParamArgs {
     /// Refuses a `--param` naming no parameter of `m` (with the closest
-    /// name), for the commands whose parameters may also come per CSV row
-    /// (`identify`, `plan`): their values are checked where they are used.
+    /// name), or not finite, for the commands whose parameters may also
+    /// come per CSV row (`identify`, `plan`): their values are placed where
+    /// they are used.
     pub fn check_names(&self, m: &chain_core::Machine) -> miette::Result<()> {
         Ok(chain::ops::resolve::check_parameters(m, &self.params)?)
     }
@@ -29,16 +31,16 @@ pub struct ModelArgs {
     #[command(flatten)]
     pub param: ParamArgs,
     /// Override the file's `sided`.
-    #[arg(long, value_enum)]
-    pub sided: Option<SidedArg>,
+    #[arg(long, value_parser = parser::<Sided>())]
+    pub sided: Option<Sided>,
 }
 
 /// `--method`, `--samples`, `--seed`: the reliability algorithm of a study.
 #[derive(Debug, clap::Args)]
 pub struct AlgorithmArgs {
     /// Reliability algorithm.
-    #[arg(long, value_enum, default_value = "form")]
-    pub method: MethodArg,
+    #[arg(long, value_parser = parser::<Method>(), default_value = "form")]
+    pub method: Method,
     /// Samples per case, one case per target and point or instant (is: 10000,
     /// mc: 100000 by default).
     #[arg(long)]
@@ -59,7 +61,7 @@ impl AlgorithmArgs {
     /// The options as the application layer takes them.
     pub fn options(&self) -> chain::ops::study::AlgorithmOptions {
         chain::ops::study::AlgorithmOptions {
-            method: self.method.method(),
+            method: self.method,
             samples: self.samples,
             seed: self.seed,
             cov: self.cov,
@@ -77,8 +79,8 @@ impl AlgorithmArgs {
 #[derive(Debug, clap::Args)]
 pub struct SystemArgs {
     /// Also assess a system limit state.
-    #[arg(long, value_enum)]
-    pub system: Option<SystemArg>,
+    #[arg(long, value_parser = parser::<SystemKind>())]
+    pub system: Option<SystemKind>,
     /// Allowable volumetric error for `--system volumetric` (default: the
     /// smallest position tolerance).
     #[arg(
@@ -90,40 +92,6 @@ pub struct SystemArgs {
     pub tolerance: Option<f64>,
 }
 
-/// Algorithms of `--method`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum MethodArg {
-    /// FORM / improved first-order second-moment (Eq. 19-22, 31).
-    Form,
-    /// The advanced importance sampling (Eq. 23-28), centred by FORM.
-    Is,
-    /// Crude Monte Carlo.
-    Mc,
-    /// Subset simulation (Au & Beck 2001) with adaptive conditional
-    /// sampling, p0 = 0.1; `--samples` per level.
-    Subset,
-    /// Directional simulation (Bjerager 1988).
-    Directional,
-    /// SORM: FORM, then the exact curvatures at its design point;
-    /// Breitung, Hohenbichler–Rackwitz and Tvedt reported, Tvedt's the
-    /// answer.
-    Sorm,
-}
-
-impl MethodArg {
-    /// The library's method.
-    pub(crate) fn method(self) -> Method {
-        match self {
-            MethodArg::Form => Method::Form,
-            MethodArg::Is => Method::ImportanceSampling,
-            MethodArg::Mc => Method::MonteCarlo,
-            MethodArg::Subset => Method::Subset,
-            MethodArg::Directional => Method::Directional,
-            MethodArg::Sorm => Method::Sorm,
-        }
-    }
-}
-
 /// Parses `--cov` as a number; its range is the application layer's rule
 /// ([`chain::ops::study::AlgorithmOptions::check`]).
 pub(crate) fn parse_cov(s: &str) -> Result<f64, String> {
@@ -132,51 +100,20 @@ pub(crate) fn parse_cov(s: &str) -> Result<f64, String> {
         .map_err(|_| format!("`{}` is not a number", shortened(s)))
 }
 
-/// `--sided` override.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum SidedArg {
-    /// `g = I − E`.
-    Upper,
-    /// `|E| ≤ I`.
-    Two,
-}
-
-impl From<SidedArg> for Sided {
-    fn from(s: SidedArg) -> Sided {
-        match s {
-            SidedArg::Upper => Sided::Upper,
-            SidedArg::Two => Sided::Two,
-        }
-    }
-}
-
-/// `--system`: an extra system target.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum SystemArg {
-    /// All listed components within tolerance at once.
-    Series,
-    /// `√(px² + py² + pz²) ≤ I` (`--system-tolerance`, default the smallest
-    /// position tolerance).
-    Volumetric,
-}
-
 impl SystemArgs {
     /// The choice as the application layer takes it
     /// ([`chain::ops::study::SystemChoice::new`]).
     pub fn choice(
         &self,
     ) -> Result<Option<chain::ops::study::SystemChoice>, chain::ops::study::OptionError> {
-        use chain::ops::study::{SystemChoice, SystemKind};
-        let kind = self.system.map(|s| match s {
-            SystemArg::Series => SystemKind::Series,
-            SystemArg::Volumetric => SystemKind::Volumetric,
-        });
-        SystemChoice::new(kind, self.tolerance)
+        chain::ops::study::SystemChoice::new(self.system, self.tolerance)
     }
 }
 
-/// Parses `NAME=VALUE`.
-pub(crate) fn parse_assignment(s: &str) -> Result<(String, f64), String> {
+/// Parses `--param NAME=VALUE` as a name and a number; whether the name is
+/// a parameter and the value finite is the application layer's rule
+/// ([`chain::ops::resolve::check_parameters`]).
+pub(crate) fn parse_param(s: &str) -> Result<(String, f64), String> {
     let (name, value) = s
         .split_once('=')
         .ok_or_else(|| format!("expected NAME=VALUE, found `{}`", shortened(s)))?;
@@ -184,10 +121,17 @@ pub(crate) fn parse_assignment(s: &str) -> Result<(String, f64), String> {
         .trim()
         .parse()
         .map_err(|_| format!("`{}` is not a number", shortened(value)))?;
+    Ok((name.trim().to_string(), v))
+}
+
+/// Parses `NAME=VALUE` with a finite value (`--fix`, `--at`).
+pub(crate) fn parse_assignment(s: &str) -> Result<(String, f64), String> {
+    let (name, v) = parse_param(s)?;
     if !v.is_finite() {
+        let value = s.split_once('=').map_or(s, |(_, v)| v);
         return Err(format!("`{}` is not finite", shortened(value)));
     }
-    Ok((name.trim().to_string(), v))
+    Ok((name, v))
 }
 
 /// Parses `VAR=v1,v2,...` (a grid axis on the command line).
@@ -255,36 +199,6 @@ pub(crate) fn parse_grid_axis(s: &str) -> Result<(String, Vec<f64>), String> {
         .map(|k| if k == n - 1 { hi } else { lo + step * k as f64 })
         .collect();
     Ok((name.trim().to_string(), values))
-}
-
-/// The controllers `chain export` writes for (spec section 6's table).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum ControllerName {
-    /// The universal grid CSV: `δq` at every node and the residual.
-    Grid,
-    /// Beckhoff TwinCAT / ISG volumetric compensation (`ISG_CSV`).
-    Beckhoff,
-    /// LinuxCNC `COMP_FILE` per joint.
-    Linuxcnc,
-    /// Sinumerik CEC sag / cross-axis tables.
-    SiemensCec,
-    /// Klipper `SET_SKEW`.
-    Klipper,
-}
-
-/// The application layer's controller (its name, `--controller`'s, is
-/// [`chain::ops::export::ExportController::name`]).
-impl From<ControllerName> for chain::ops::export::ExportController {
-    fn from(c: ControllerName) -> Self {
-        use chain::ops::export::ExportController::{Grid, Tables};
-        match c {
-            ControllerName::Grid => Grid,
-            ControllerName::Beckhoff => Tables(Controller::Beckhoff),
-            ControllerName::Linuxcnc => Tables(Controller::Linuxcnc),
-            ControllerName::SiemensCec => Tables(Controller::SiemensCec),
-            ControllerName::Klipper => Tables(Controller::Klipper),
-        }
-    }
 }
 
 /// The coordinates of `--at`, `(variable, value)` in the order given.

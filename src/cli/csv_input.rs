@@ -6,7 +6,8 @@
 use std::path::Path;
 
 use chain::ops::inverse::PoseRow;
-use chain::ops::tables::{self, NumericTable, Source, TableError};
+use chain::ops::source::Source;
+use chain::ops::tables::{self, NumericTable, TableError};
 use chain_core::bounded;
 
 /// The bytes of an input file (`-`: stdin) and its display name, at most

@@ -1,13 +1,13 @@
 //! The machine file a command works on, loaded once with its text (for
 //! messages' snippets), and the rendering of the errors located in it:
-//! reliability errors (worded by `reliability::document::describe`) and a
-//! study's refusals ([`chain::ops::study::StudyError`]).
+//! reliability errors (worded by [`chain::ops::study::describe`]), a
+//! study's refusals ([`chain::ops::study::StudyError`]) and an `ops` error
+//! at the place it names ([`Loaded::located`]).
 
 use std::path::Path;
 
-use chain::ops::allocate::AllocateOpsError;
 use chain::ops::study::StudyError;
-use chain_core::model::Machine;
+use chain_core::model::{Machine, Origin};
 use miette::{LabeledSpan, MietteDiagnostic};
 use reliability::ReliabilityError;
 
@@ -40,7 +40,7 @@ impl Loaded {
         match e {
             StudyError::Reliability(e) => self.report(e),
             StudyError::Resolve(e) => miette::Report::new(e),
-            StudyError::Posterior(e) => e.into(),
+            e @ StudyError::Posterior(_) => miette::Report::new(e),
             e @ StudyError::Approach { .. } => miette::miette!("{e}"),
         }
     }
@@ -51,9 +51,9 @@ impl Loaded {
     }
 
     /// A located, rendered diagnostic for a reliability error (worded by
-    /// [`reliability::document::describe`]).
+    /// [`chain::ops::study::describe`]).
     pub(crate) fn report(&self, err: ReliabilityError) -> miette::Report {
-        let d = reliability::document::describe(&err, &self.file);
+        let d = chain::ops::study::describe(&err, &self.file);
         let mut diag = MietteDiagnostic::new(d.message);
         if let Some(code) = miette::Diagnostic::code(&err) {
             diag = diag.with_code(code.to_string());
@@ -64,31 +64,23 @@ impl Loaded {
         self.with_snippet(diag, d.origin, d.label)
     }
 
-    /// An allocation that cannot go on, located at the statistics entry of
-    /// the error it names first (a stalled round's or an infeasible
-    /// requirement's binding error: where its `min_std` is set), as
-    /// `file:line:column: machine: …`.
-    pub(crate) fn allocate_error(&self, e: AllocateOpsError) -> miette::Report {
-        let AllocateOpsError::Allocate { error, .. } = &e else {
-            return miette::Report::new(e);
-        };
-        let stat = error.statistic().and_then(|name| {
-            let m = &self.machine;
-            let j = m.errors.iter().position(|x| x.name == name)?;
-            m.statistics.iter().find(|s| s.error == j)
-        });
-        let Some(stat) = stat else {
-            return miette::Report::new(e);
-        };
-        let o = &stat.origin;
-        let mut diag = MietteDiagnostic::new(format!("{}:{}:{}: {e}", self.file, o.line, o.column));
-        if let Some(code) = miette::Diagnostic::code(&**error) {
+    /// `e` (its message, code and help) shown at `origin` in the machine
+    /// file with the snippet there labelled `label`: an `ops` error that
+    /// carries its place in the file.
+    pub(crate) fn located(
+        &self,
+        e: &dyn miette::Diagnostic,
+        origin: &Origin,
+        label: &str,
+    ) -> miette::Report {
+        let mut diag = MietteDiagnostic::new(e.to_string());
+        if let Some(code) = e.code() {
             diag = diag.with_code(code.to_string());
         }
-        if let Some(help) = miette::Diagnostic::help(&**error) {
+        if let Some(help) = e.help() {
             diag = diag.with_help(help.to_string());
         }
-        self.with_snippet(diag, Some(o), "its statistics entry")
+        self.with_snippet(diag, Some(origin), label)
     }
 
     /// `diag` with the machine file's text around `origin` (when it has a
@@ -96,7 +88,7 @@ impl Loaded {
     fn with_snippet(
         &self,
         mut diag: MietteDiagnostic,
-        origin: Option<&chain_core::model::Origin>,
+        origin: Option<&Origin>,
         label: &str,
     ) -> miette::Report {
         if let Some(o) = origin.filter(|o| o.line > 0 && o.offset <= self.source.len()) {

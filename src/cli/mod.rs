@@ -2,7 +2,7 @@
 //! `commands/` (one file each, clap arguments → a request → `ops` → the
 //! document to `report::emit`; no command imports another), the shared
 //! argument groups in `args.rs`, the table and CSV forms of the documents in
-//! `render/`, the charts in `plot/`.
+//! `render/`, the charts of `chain::plot` written by `plot.rs`.
 
 mod args;
 mod atomic;

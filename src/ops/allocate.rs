@@ -3,15 +3,19 @@
 //! paper's fixed-step tightening of the most sensitive errors or the
 //! least-cost standard deviations that meet the requirement (with a KKT
 //! check), for the reliability section's requirement or the whole-machine
-//! acceptance probability. Run by the CLI and `Machine.allocate`.
+//! acceptance probability. Run by the CLI and `Machine.allocate`, whose
+//! JSON is the [`AllocationDocument`]; a refusal that names an error is
+//! located at its statistics entry ([`AllocateOpsError::location`]) for
+//! both.
 
-use chain_core::model::Sided;
+use chain_core::model::{Origin, Requirement, Sided};
+use chain_core::named::NameMap;
 use chain_core::{CompiledModel, Machine};
 use reliability::allocate::{
-    self, AcceptanceStrategy, AllocateError, Allocation, ErrorBounds, GridUse, Paper, StrategyName,
+    self, AcceptanceAllocation, AcceptanceStrategy, AllocateError, Allocation, ErrorBounds,
+    GridUse, Optimal, Paper, StrategyName,
 };
-use reliability::document::AllocationDocument;
-use reliability::{ReliabilityError, Study};
+use reliability::{ReliabilityError, Study, Summary};
 use serde::{Serialize, Serializer};
 
 use super::resolve::ResolveError;
@@ -91,17 +95,42 @@ pub enum AllocateOpsError {
     /// The study.
     #[error(transparent)]
     Study(Box<StudyError>),
-    /// The machine's sections (located by `reliability::document::describe`).
+    /// The machine's sections (located by [`study::describe`]).
     #[error(transparent)]
     Reliability(#[from] ReliabilityError),
-    /// The allocation itself (an infeasible requirement, a stalled round).
-    #[error("{machine}: {error}")]
+    /// The allocation itself (an infeasible requirement, a stalled round),
+    /// as `file:line:column: machine: …` when it names an error whose
+    /// statistics entry is known.
+    #[error(
+        "{}{machine}: {error}{}",
+        origin.as_ref().map(|o| format!("{file}:{}:{}: ", o.line, o.column)).unwrap_or_default(),
+        if matches!(**error, AllocateError::NotNormal { .. }) { " (use --strategy paper)" } else { "" }
+    )]
     Allocate {
         /// The machine.
         machine: String,
+        /// The machine file.
+        file: String,
+        /// The statistics entry of the error the refusal names first (a
+        /// stalled round's first ranked error, an infeasible requirement's
+        /// first binding error: where its `min_std` is set).
+        origin: Option<Origin>,
         /// What went wrong.
         error: Box<AllocateError>,
     },
+}
+
+impl AllocateOpsError {
+    /// Where in the machine file the refusal is, with the label of that
+    /// place: the statistics entry an allocation's refusal names.
+    pub fn location(&self) -> Option<(&Origin, &'static str)> {
+        match self {
+            AllocateOpsError::Allocate {
+                origin: Some(o), ..
+            } => Some((o, "its statistics entry")),
+            _ => None,
+        }
+    }
 }
 
 impl From<StudyError> for AllocateOpsError {
@@ -125,6 +154,12 @@ impl Worded for AllocateOpsError {
         match self {
             AllocateOpsError::MissingLevel => Some("e.g. --target acceptance --level 0.9".into()),
             AllocateOpsError::Resolve(e) => e.own_help(),
+            AllocateOpsError::Allocate { error, .. } => match **error {
+                AllocateError::Stalled { .. } => Some(
+                    "lower (remove) `min_std` of its errors, or use `--strategy optimal`".into(),
+                ),
+                ref e => e.help().map(String::from),
+            },
             _ => None,
         }
     }
@@ -142,8 +177,7 @@ impl Worded for AllocateOpsError {
 
 diagnostic!(AllocateOpsError);
 
-/// The document of `chain allocate` (JSON: the library's
-/// [`AllocationDocument`]).
+/// The run of `chain allocate` (JSON: its [`AllocationDocument`]).
 #[derive(Debug)]
 pub struct AllocationRun {
     /// The machine.
@@ -161,7 +195,7 @@ pub struct AllocationRun {
 }
 
 impl AllocationRun {
-    /// The library's document of the run.
+    /// The document of the run.
     pub fn document(&self) -> AllocationDocument<'_> {
         AllocationDocument::new(
             &self.machine,
@@ -252,20 +286,20 @@ pub fn run(
             ..Paper::default()
         }),
     };
-    let result = reliability::document::allocation(
-        &model,
-        &parameters,
-        &study,
-        &bounds,
-        strategy,
-        request.level,
-    )
+    let result = match (request.level, strategy) {
+        (Some(level), strategy) => {
+            allocate::acceptance(&model, &parameters, &study, &bounds, level, strategy)
+        }
+        (None, AcceptanceStrategy::Optimal) => {
+            allocate::optimal(&model, &parameters, &study, &bounds, &Optimal::default())
+        }
+        (None, AcceptanceStrategy::Paper(paper)) => {
+            allocate::paper(&model, &parameters, &study, &bounds, &paper)
+        }
+    }
     .map_err(|error| match error {
         AllocateError::Reliability(e) => AllocateOpsError::Reliability(e),
-        error => AllocateOpsError::Allocate {
-            machine: machine.name.clone(),
-            error: Box::new(error),
-        },
+        error => located(machine, file, error),
     })?;
     Ok(AllocationRun {
         machine: machine.name.clone(),
@@ -275,4 +309,221 @@ pub fn run(
         bounds,
         result,
     })
+}
+
+/// An allocation's refusal, at the statistics entry of the error it names
+/// first when the machine file has one.
+fn located(machine: &Machine, file: &str, error: AllocateError) -> AllocateOpsError {
+    let origin = error.statistic().and_then(|name| {
+        let j = machine.error_index(name)?;
+        let stat = machine.statistic(j)?;
+        (stat.origin.line > 0).then(|| stat.origin.clone())
+    });
+    AllocateOpsError::Allocate {
+        machine: machine.name.clone(),
+        file: file.to_string(),
+        origin,
+        error: Box::new(error),
+    }
+}
+
+/// The document of `chain allocate` (docs/allocation.md; field order = key order).
+#[derive(Debug, Serialize)]
+pub struct AllocationDocument<'a> {
+    /// The machine's name.
+    pub machine: &'a str,
+    /// `optimal` or `paper`.
+    pub strategy: StrategyName,
+    /// The reliability section's requirement.
+    pub requirement: Option<Requirement>,
+    /// The standard deviations and summaries before allocation.
+    pub initial: InitialDocument<'a>,
+    /// The paper's rounds (empty for the optimal strategy).
+    pub steps: Vec<StepDocument<'a>>,
+    /// The allocated standard deviations, cost and summaries.
+    #[serde(rename = "final")]
+    pub last: FinalDocument<'a>,
+    /// The KKT check (optimal strategy).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kkt: Option<KktDocument<'a>>,
+    /// `--target acceptance`: level, initial and allocated probability.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub acceptance: Option<&'a AcceptanceAllocation>,
+}
+
+/// One component's reliability over the grid in an [`AllocationDocument`].
+#[derive(Debug, Serialize)]
+pub struct AllocationSummaryDocument {
+    /// Mean reliability over the grid.
+    pub mean: f64,
+    /// Smallest reliability.
+    pub min: f64,
+    /// Largest reliability.
+    pub max: f64,
+    /// Whether the requirement is met (`null` without one).
+    pub met: Option<bool>,
+}
+
+/// The starting point of an [`AllocationDocument`].
+#[derive(Debug, Serialize)]
+pub struct InitialDocument<'a> {
+    /// The initial standard deviation of every error.
+    pub std: NameMap<&'a str, f64>,
+    /// Each component's reliability over the grid.
+    pub summary: NameMap<String, AllocationSummaryDocument>,
+}
+
+/// One round of the paper's procedure in an [`AllocationDocument`].
+#[derive(Debug, Serialize)]
+pub struct StepDocument<'a> {
+    /// 1, 2, …
+    pub round: usize,
+    /// The errors tightened this round.
+    pub tightened: &'a [String],
+    /// Their new standard deviations.
+    pub std: NameMap<&'a str, f64>,
+    /// Each component's reliability after the round.
+    pub summary: NameMap<String, AllocationSummaryDocument>,
+}
+
+/// The outcome of an [`AllocationDocument`].
+#[derive(Debug, Serialize)]
+pub struct FinalDocument<'a> {
+    /// The allocated standard deviations.
+    pub std: NameMap<&'a str, f64>,
+    /// `Σ w (σ0/σ − 1)`.
+    pub cost: f64,
+    /// Whether the requirement (or the acceptance level) is met.
+    pub met: bool,
+    /// Each component's reliability (FORM re-evaluation).
+    pub summary: NameMap<String, AllocationSummaryDocument>,
+}
+
+/// The KKT check of an [`AllocationDocument`].
+#[derive(Debug, Serialize)]
+pub struct KktDocument<'a> {
+    /// `‖∇f − Σ λₖ∇gₖ − z‖∞`.
+    pub stationarity: f64,
+    /// `max |λₖ gₖ|` and the bounds'.
+    pub complementarity: f64,
+    /// Constraint and bound violations.
+    pub feasibility: f64,
+    /// Wrong-signed multipliers.
+    pub dual_feasibility: f64,
+    /// The largest of the four.
+    pub residual: f64,
+    /// Whether the active-set Newton polish converged.
+    pub polished: bool,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// The active constraints.
+    pub active: Vec<ActiveDocument<'a>>,
+    /// The errors at a bound.
+    pub at_bound: Vec<AtBoundDocument<'a>>,
+}
+
+/// An active constraint of a [`KktDocument`].
+#[derive(Debug, Serialize)]
+pub struct ActiveDocument<'a> {
+    /// The constraint.
+    pub constraint: &'a str,
+    /// Its multiplier.
+    pub multiplier: f64,
+}
+
+/// An error at a bound in a [`KktDocument`].
+#[derive(Debug, Serialize)]
+pub struct AtBoundDocument<'a> {
+    /// The error.
+    pub error: &'a str,
+    /// `unchanged` or `min_std`.
+    pub bound: &'a str,
+    /// The bound's multiplier.
+    pub multiplier: f64,
+}
+
+/// `{target: {mean, min, max, met}}` of a list of summaries.
+fn allocation_summaries(s: &[Summary]) -> NameMap<String, AllocationSummaryDocument> {
+    s.iter()
+        .map(|s| {
+            (
+                s.target.to_string(),
+                AllocationSummaryDocument {
+                    mean: s.mean,
+                    min: s.min,
+                    max: s.max,
+                    met: s.met,
+                },
+            )
+        })
+        .collect()
+}
+
+/// `{error: std}` of a list of named standard deviations.
+fn named_stds(s: &[(String, f64)]) -> NameMap<&str, f64> {
+    s.iter().map(|(n, v)| (n.as_str(), *v)).collect()
+}
+
+impl<'a> AllocationDocument<'a> {
+    /// The document of the allocation `r` of the machine `machine`, started
+    /// from `bounds`, for the requirement `requirement`.
+    pub fn new(
+        machine: &'a str,
+        requirement: Option<Requirement>,
+        bounds: &'a [ErrorBounds],
+        r: &'a Allocation,
+    ) -> AllocationDocument<'a> {
+        AllocationDocument {
+            machine,
+            strategy: r.strategy,
+            requirement,
+            initial: InitialDocument {
+                std: bounds.iter().map(|b| (b.error.as_str(), b.std0)).collect(),
+                summary: allocation_summaries(&r.initial),
+            },
+            steps: r
+                .steps
+                .iter()
+                .map(|s| StepDocument {
+                    round: s.round,
+                    tightened: &s.tightened,
+                    std: named_stds(&s.std),
+                    summary: allocation_summaries(&s.summaries),
+                })
+                .collect(),
+            last: FinalDocument {
+                std: named_stds(&r.std),
+                cost: r.cost,
+                met: r.met,
+                summary: allocation_summaries(&r.summaries),
+            },
+            kkt: r.kkt.as_ref().map(|k| KktDocument {
+                stationarity: k.stationarity,
+                complementarity: k.complementarity,
+                feasibility: k.feasibility,
+                dual_feasibility: k.dual_feasibility,
+                residual: k.residual(),
+                polished: k.polished,
+                iterations: k.iterations,
+                active: k
+                    .active
+                    .iter()
+                    .map(|(n, l)| ActiveDocument {
+                        constraint: n,
+                        multiplier: *l,
+                    })
+                    .collect(),
+                at_bound: k
+                    .at_bound
+                    .iter()
+                    .map(|(n, b, z)| AtBoundDocument {
+                        error: n,
+                        bound: b,
+                        multiplier: *z,
+                    })
+                    .collect(),
+            }),
+            acceptance: r.acceptance.as_ref(),
+        }
+    }
 }

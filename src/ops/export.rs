@@ -6,7 +6,7 @@
 //! Python returns both. `chain map --compensated` shares
 //! [`table_export`] and [`travel_of`].
 
-use chain_core::built::{BuiltMachine, MapError, Points};
+use chain_core::built::BuiltMachine;
 use chain_core::compensation::controllers::{
     self, Controller, ControllerError, Export, ExportOptions, FormatReport,
     BECKHOFF_DEFAULT_MAX_RECORDS, CEC_DEFAULT_MAX_POINTS, DEFAULT_STEP,
@@ -19,7 +19,7 @@ use chain_core::Machine;
 use reliability::ReliabilityError;
 use serde::Serialize;
 
-use super::resolve::{self, ResolveError};
+use super::resolve::{AxisPoints, Parameters, ResolveError};
 use super::worded::{diagnostic, Worded};
 
 /// What `chain export` writes for (`--controller`).
@@ -64,12 +64,10 @@ pub struct ExportRequest<'a> {
     pub controller: ExportController,
     /// `--param NAME=VALUE`.
     pub params: &'a [(String, f64)],
-    /// `--grid VAR=...`: the grid's nodes over `reliability.grid` (grid),
-    /// or each axis's travel (the per-axis tables).
-    pub grid: &'a [(String, Vec<f64>)],
-    /// `--axes`: the grid export's nodes as rows of axis values in the
-    /// machine's variable order, flat, with the rows' name in messages.
-    pub rows: Option<(&'a str, Vec<f64>)>,
+    /// The grid export's nodes: `--grid VAR=...` over `reliability.grid`,
+    /// or rows of axis values (`--axes`); for the per-axis tables, the
+    /// grid's values give each axis's travel and rows are refused.
+    pub points: AxisPoints<'a>,
     /// `--step`: the largest table step (mm) of the per-axis tables.
     pub step: Option<f64>,
     /// `--cec-max-points`.
@@ -97,14 +95,6 @@ pub enum ExportOpsError {
     /// The parameters (located in the machine file).
     #[error(transparent)]
     Reliability(#[from] ReliabilityError),
-    /// Rows that are not points of the machine.
-    #[error("{rows}: {error}")]
-    Points {
-        /// The rows' name.
-        rows: String,
-        /// What is wrong.
-        error: MapError,
-    },
     /// The values and the machine do not go together.
     #[error("{values}: {message}")]
     Built {
@@ -324,7 +314,7 @@ pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
             }
         }
         ExportController::Tables(c) => {
-            if request.rows.is_some() {
+            if let AxisPoints::Rows { .. } = request.points {
                 return refuse(
                     "--axes",
                     "a per-axis table samples each axis over its travel: give the travel with --grid VAR=LO,HI and the table step with --step; --axes gives the nodes of --controller grid",
@@ -352,28 +342,14 @@ pub fn run(
 ) -> Result<ExportDocument, ExportOpsError> {
     check(request)?;
     let m = machine;
-    resolve::check_parameters(m, request.params)?;
-    let params = reliability::machine::parameters(m, request.params)?;
+    let params = Parameters::new(m, request.params)?.values()?;
     let built_error = |e: chain_core::built::BuiltError| ExportOpsError::Built {
         values: values_file.to_string(),
         message: e.to_string(),
     };
     match request.controller {
         ExportController::Grid => {
-            let points = match &request.rows {
-                Some((rows, flat)) => {
-                    Points::list(m.variables.len(), flat.clone()).map_err(|error| {
-                        ExportOpsError::Points {
-                            rows: rows.to_string(),
-                            error,
-                        }
-                    })?
-                }
-                None => {
-                    let axes = resolve::grid_axes(m, file, request.grid)?;
-                    Points::Grid(axes.into_iter().map(|(_, v)| v).collect())
-                }
-            };
+            let (points, _) = request.points.resolve(m, file)?;
             let built = BuiltMachine::compile(m, values, params).map_err(built_error)?;
             let kin = Kinematics::from_machine(m);
             let result = grid::export(&built, &kin, points).map_err(|error| {
@@ -394,13 +370,14 @@ pub fn run(
             let built = BuiltMachine::compile(m, values, params).map_err(built_error)?;
             let options = ExportOptions {
                 step: request.step.unwrap_or(DEFAULT_STEP),
-                travel: travel_of(request.grid),
+                travel: travel_of(request.points.grid()),
                 cec_max_points: request.cec_max_points.unwrap_or(CEC_DEFAULT_MAX_POINTS),
                 beckhoff_max_records: (request.beckhoff_max_records)
                     .unwrap_or(BECKHOFF_DEFAULT_MAX_RECORDS),
                 provenance: request.controller.provenance(),
             };
-            let export = table_export(c, &built, m, &options, request.grid, values_file)?;
+            let grid = request.points.grid();
+            let export = table_export(c, &built, m, &options, grid, values_file)?;
             Ok(ExportDocument::Tables(TablesExport {
                 values_file: values_file.to_string(),
                 report: export.report,

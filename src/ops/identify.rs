@@ -29,7 +29,7 @@ pub use document::{identify_document, values_file, Identified, IdentifyDocument}
 
 use super::resolve::ResolveError;
 #[cfg(feature = "records")]
-use super::tables::Source;
+use super::source::Source;
 use super::worded::{diagnostic, Worded};
 
 /// The request of `chain identify`: the options as the CLI and Python take
@@ -345,12 +345,10 @@ fn read(
     machine: &Machine,
     params: &[(String, f64)],
 ) -> Result<Measurements, IdentifyOpsError> {
-    let layout = Layout::Measurements;
-    let read = match source {
-        Source::Path(path) => Measurements::read(path, machine, params, layout),
-        Source::Bytes { name, bytes } => {
-            Measurements::from_bytes(bytes, name, machine, params, layout)
-        }
-    };
-    Ok(read?)
+    Ok(super::source::read_measurements(
+        source,
+        machine,
+        params,
+        Layout::Measurements,
+    )?)
 }

@@ -18,18 +18,8 @@ use reliability::ReliabilityError;
 use serde::Serialize;
 
 use super::export::{self, ExportController, ExportOpsError};
-use super::resolve::{self, ResolveError};
+use super::resolve::{self, AxisPoints, Parameters, ResolveError};
 use super::worded::{diagnostic, Worded};
-
-/// The points of a map.
-#[derive(Debug, Clone)]
-pub enum MapPoints<'a> {
-    /// `--grid` overrides of `reliability.grid`.
-    Grid(&'a [(String, Vec<f64>)]),
-    /// Rows of axis values in the machine's variable order, flat (`--axes`,
-    /// an array).
-    Rows(Vec<f64>),
-}
 
 /// `--compensated CONTROLLER`: the map after the controller's
 /// compensation, exported from the same values.
@@ -51,8 +41,8 @@ pub struct MapRequest<'a> {
     pub params: &'a [(String, f64)],
     /// `--approach`.
     pub approach: &'a [(Option<String>, Approach)],
-    /// The points.
-    pub points: MapPoints<'a>,
+    /// The points: the grid, or rows (`--axes`, an array).
+    pub points: AxisPoints<'a>,
     /// `--compensated`.
     pub compensated: Option<CompensationRequest<'a>>,
     /// Keep every point's error (`false`: the summary alone, for a large
@@ -61,13 +51,7 @@ pub struct MapRequest<'a> {
 }
 
 /// Where the points of a map came from.
-#[derive(Debug, Clone, PartialEq)]
-pub enum MapInput {
-    /// The full-factorial grid of these axes (machine variable order).
-    Grid(Vec<(String, Vec<f64>)>),
-    /// Rows, named so (`--axes` file, `points`).
-    Rows(String),
-}
+pub use super::resolve::PointsInput as MapInput;
 
 /// A map ready to run.
 #[derive(Debug, Clone)]
@@ -100,14 +84,6 @@ pub enum MapOpsError {
         values: String,
         /// What is wrong.
         error: ApproachError,
-    },
-    /// Rows that are not points of the machine.
-    #[error("{source_name}: {error}")]
-    Points {
-        /// The rows' source.
-        source_name: String,
-        /// What is wrong.
-        error: MapError,
     },
     /// The values and the machine do not go together.
     #[error("{values}: {message}")]
@@ -208,14 +184,12 @@ impl Worded for MapOpsError {
 diagnostic!(MapOpsError);
 
 /// Prepares `chain map` of `machine` (`file` names it) with `values` (read
-/// from `values_file`); `rows_name` names the rows of [`MapPoints::Rows`]
-/// in messages.
+/// from `values_file`).
 pub fn prepare(
     machine: &Machine,
     file: &str,
     mut values: Values,
     values_file: &str,
-    rows_name: &str,
     request: &MapRequest<'_>,
 ) -> Result<PreparedMap, MapOpsError> {
     let m = machine;
@@ -227,24 +201,8 @@ pub fn prepare(
                 error,
             })?;
     }
-    resolve::check_parameters(m, request.params)?;
-    let params = reliability::machine::parameters(m, request.params)?;
-    let (points, input) = match &request.points {
-        MapPoints::Rows(flat) => {
-            let points = Points::list(m.variables.len(), flat.clone()).map_err(|error| {
-                MapOpsError::Points {
-                    source_name: rows_name.to_string(),
-                    error,
-                }
-            })?;
-            (points, MapInput::Rows(rows_name.to_string()))
-        }
-        MapPoints::Grid(overrides) => {
-            let axes = resolve::grid_axes(m, file, overrides)?;
-            let values = axes.iter().map(|(_, v)| v.clone()).collect();
-            (Points::Grid(values), MapInput::Grid(axes))
-        }
-    };
+    let params = Parameters::new(m, request.params)?.values()?;
+    let (points, input) = request.points.resolve(m, file)?;
     let built = BuiltMachine::compile(m, values, params).map_err(|e| MapOpsError::Built {
         values: values_file.to_string(),
         message: e.to_string(),
@@ -441,10 +399,7 @@ impl PreparedMap {
         c: &CompensationRequest<'_>,
     ) -> Result<Compensated, MapOpsError> {
         let built = &self.built;
-        let map_grid: &[(String, Vec<f64>)] = match &request.points {
-            MapPoints::Grid(g) => g,
-            MapPoints::Rows(_) => &[],
-        };
+        let map_grid = request.points.grid();
         let compensation_error = |error: CompensationError| {
             MapOpsError::from(ExportOpsError::Compensation {
                 values: self.values_file.clone(),

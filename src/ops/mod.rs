@@ -5,7 +5,12 @@
 //! wording.
 //!
 //! - [`resolve`]: parameter names, grid axes (the machine file's
-//!   `reliability.grid` with overrides), one point given by name (`--at`).
+//!   `reliability.grid` with overrides), one point given by name (`--at`),
+//!   the points of a map or an export (a grid or rows).
+//! - [`choice`]: the options with a closed set of values, each value's
+//!   spelling and help written once, parsed by the CLI and Python alike.
+//! - [`source`] (feature `records`): a file given as a path or as the
+//!   caller's bytes, and the readers of every kind of input file.
 
 //! - [`worded`]: how an `ops` error reads ([`Worded`]: its code and help,
 //!   the error it wraps), for the CLI's diagnostics and Python's text.
@@ -30,9 +35,12 @@
 //! - [`sobol`]: `chain sobol`'s request and document;
 //! - [`path`]: `chain path`'s request (axis values or poses) and document;
 //! - [`tables`] (feature `records`): the numeric CSV tables of poses and
-//!   axis values those commands read, from a path or from bytes.
+//!   axis values those commands read, from a path or from bytes;
+//! - [`views`]: what the CLI's tables and the charts both show of a
+//!   document (a target's reliability maps, where sensitivities hold).
 
 pub mod allocate;
+pub mod choice;
 pub mod compensate;
 #[cfg(feature = "json")]
 pub mod derive;
@@ -48,9 +56,12 @@ pub mod reliability;
 pub mod resolve;
 pub mod sensitivity;
 pub mod sobol;
+#[cfg(feature = "records")]
+pub mod source;
 pub mod study;
 #[cfg(feature = "records")]
 pub mod tables;
+pub mod views;
 pub mod worded;
 
 pub use worded::Worded;

@@ -89,7 +89,7 @@ pub enum MotionOpsError {
     /// The settings do not fit the two machines (located in the settings).
     #[error(transparent)]
     Settings(SettingsError),
-    /// `--fix` names no CNC variable.
+    /// `--param` names no CNC parameter, or `--fix` no CNC variable.
     #[error(transparent)]
     Resolve(#[from] ResolveError),
     /// The motion cannot be set up or solved.
@@ -151,7 +151,7 @@ diagnostic!(MotionOpsError);
 /// (`values`); a roll it cannot follow continuously at `roll.drive`; other
 /// errors as they are.
 fn located(settings: &Settings, fix: &[(String, f64)], e: MotionError) -> MotionOpsError {
-    use chain_core::diagnostic::{Diagnostics, Message, Problem};
+    use chain_core::diagnostic::{Diagnostics, Problem};
     if matches!(e, MotionError::Unreachable { .. }) && !fix.is_empty() {
         return MotionOpsError::HeldUnreachable {
             fix: (fix.iter())
@@ -161,42 +161,85 @@ fn located(settings: &Settings, fix: &[(String, f64)], e: MotionError) -> Motion
             error: e,
         };
     }
-    let (origin, label, help) = match (&e, &settings.fix_origin) {
+    let message = e.to_string();
+    let (origin, problem) = match (&e, &settings.fix_origin) {
         (MotionError::Unreachable { .. }, Some(held)) => (
             held,
-            "the held variables",
-            "hold fewer variables, or hold them at values from which the generator's pose is reachable",
+            MotionProblem::Unreachable {
+                message,
+                held: true,
+            },
         ),
         (MotionError::Unreachable { .. }, None) => (
             &settings.values_origin,
-            "the generator's settings",
-            "check these settings against the CNC machine's parameters and strokes, or its `start` guess (cnc.start)",
+            MotionProblem::Unreachable {
+                message,
+                held: false,
+            },
         ),
         (MotionError::TooFewInstants { variable, .. }, _) => (
             (settings.drive.iter())
                 .find(|d| d.name == *variable)
                 .map_or(&settings.drive_origin, |d| &d.key),
-            "its roll law",
-            "raise --samples to the instants it needs, or check `ratio` and `roll.omega_c` (a roll ratio is a tooth ratio, a few units to a few tens), or shorten `roll.interval`",
+            MotionProblem::TooFewInstants { message },
         ),
         (MotionError::Discontinuous { .. }, _) => (
             &settings.drive_origin,
-            "the roll",
-            "shorten the roll interval so that it stays on one side of the singular configuration",
+            MotionProblem::Discontinuous { message },
         ),
         _ => return MotionOpsError::Motion(e),
-    };
-    let code = match &e {
-        MotionError::Unreachable { .. } => "chain::motion::unreachable",
-        MotionError::TooFewInstants { .. } => "chain::motion::too_few_instants",
-        _ => "chain::motion::discontinuous",
     };
     MotionOpsError::Settings(Diagnostics::single(
         settings.file.clone(),
         settings.source.clone(),
         origin.clone(),
-        Problem::Message(Message::new(e.to_string(), label, code).help(help)),
+        Problem::foreign(problem),
     ))
+}
+
+/// A conversion that fails on the path, as a problem of the settings file
+/// (codes `chain::motion::*`): the error's own message, located where its
+/// cause was given.
+#[derive(Debug)]
+enum MotionProblem {
+    /// The generator's pose is out of the CNC machine's reach; `held`: with
+    /// the variables `cnc.fix` holds (located there), else at the generator's
+    /// settings.
+    Unreachable { message: String, held: bool },
+    /// A roll law needs more instants than the run has.
+    TooFewInstants { message: String },
+    /// The roll cannot be followed continuously.
+    Discontinuous { message: String },
+}
+
+impl chain_core::diagnostic::Describe for MotionProblem {
+    fn describe(&self) -> chain_core::diagnostic::Description {
+        use chain_core::diagnostic::Description as D;
+        match self {
+            MotionProblem::Unreachable {
+                message,
+                held: true,
+            } => D::new("chain::motion::unreachable", "the held variables", message.clone())
+                .help("hold fewer variables, or hold them at values from which the generator's pose is reachable".to_string()),
+            MotionProblem::Unreachable {
+                message,
+                held: false,
+            } => D::new("chain::motion::unreachable", "the generator's settings", message.clone())
+                .help("check these settings against the CNC machine's parameters and strokes, or its `start` guess (cnc.start)".to_string()),
+            MotionProblem::TooFewInstants { message } => D::new(
+                "chain::motion::too_few_instants",
+                "its roll law",
+                message.clone(),
+            )
+            .help("raise --samples to the instants it needs, or check `ratio` and `roll.omega_c` (a roll ratio is a tooth ratio, a few units to a few tens), or shorten `roll.interval`".to_string()),
+            MotionProblem::Discontinuous { message } => D::new(
+                "chain::motion::discontinuous",
+                "the roll",
+                message.clone(),
+            )
+            .help("shorten the roll interval so that it stays on one side of the singular configuration".to_string()),
+        }
+    }
 }
 
 /// The document of `chain motion`: one conversion run with the settings it
@@ -248,6 +291,7 @@ pub fn run(
     request: &MotionRequest<'_>,
 ) -> Result<MotionDocument, MotionOpsError> {
     check(request)?;
+    resolve::check_parameters(cnc, request.params)?;
     let generator = settings
         .load_generator()
         .map_err(MotionOpsError::Generator)?;

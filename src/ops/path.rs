@@ -16,7 +16,6 @@ use chain_core::inverse::Status;
 use chain_core::model::Sided;
 use chain_core::named::NameMap;
 use chain_core::Machine;
-use reliability::document::RequirementDocument;
 use reliability::{
     machine, Algorithm, Calls, Extreme, FormCase, InstantResult, Method, PathInstant, PathResult,
     PathStudy, PathSummary, PathTarget, Progress, Quantity, ReliabilityError, Target, Termination,
@@ -24,6 +23,7 @@ use reliability::{
 use serde::{Serialize, Serializer};
 
 use super::inverse::{solve_rows, NoInverse, PoseRow};
+use super::reliability::RequirementDocument;
 use super::resolve::{self, AxesColumns, ResolveError};
 use super::study::{self, AlgorithmOptions, OptionError, SystemChoice};
 
@@ -93,7 +93,7 @@ pub enum PathOpsError {
     #[error(transparent)]
     Resolve(#[from] ResolveError),
     /// The machine's statistics or reliability section, or the study
-    /// (located in the machine file by `reliability::document::describe`).
+    /// (located in the machine file by [`study::describe`]).
     #[error(transparent)]
     Reliability(#[from] ReliabilityError),
     /// A sampler option.

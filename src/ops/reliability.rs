@@ -4,16 +4,20 @@
 //! machine's statistics or a calibration's posterior, with the
 //! whole-machine acceptance probability when asked. The CLI and
 //! `Machine.reliability` both [`prepare`] the study, [`Prepared::run`] it
-//! and print or return the same [`ReliabilityRun`].
+//! and print or return the same [`ReliabilityRun`], whose JSON is the
+//! [`ReliabilityDocument`] (with its [`AcceptanceDocument`]).
 
 use std::path::Path;
 
 use chain_core::model::Sided;
+use chain_core::named::NameMap;
 use chain_core::values::Approach;
 use chain_core::{CompiledModel, Machine};
-use reliability::acceptance::AcceptanceResult;
-use reliability::document::{AcceptanceDocument, ReliabilityDocument};
-use reliability::{CaseTally, Method, Posterior, Progress, ReliabilityError, Study, StudyResult};
+use reliability::acceptance::{AcceptanceResult, AcceptanceSubset};
+use reliability::{
+    Acceptance, Calls, CaseResult, CaseTally, FormCase, Method, Posterior, Progress, Rectangles,
+    ReliabilityError, SormCase, Stopping, Study, StudyResult, SubsetLevel, Target,
+};
 use serde::{Serialize, Serializer};
 
 use super::study::{self, AlgorithmOptions, OptionError, StudyError, StudyOptions, SystemChoice};
@@ -73,8 +77,7 @@ pub enum ReliabilityOpsError {
     /// posterior).
     #[error(transparent)]
     Study(Box<StudyError>),
-    /// The run (located in the machine file by
-    /// `reliability::document::describe`).
+    /// The run (located in the machine file by [`study::describe`]).
     #[error(transparent)]
     Reliability(#[from] ReliabilityError),
 }
@@ -196,7 +199,7 @@ impl Prepared {
         ));
         let acceptance = match self.acceptance {
             Some((tolerance, seed)) => {
-                let a = reliability::document::acceptance(&self.study, tolerance, seed)?;
+                let a = acceptance(&self.study, tolerance, seed)?;
                 if !a.converged {
                     notes.push(format!(
                         "warning: the acceptance probability did not converge: 3 standard errors = {:.2e} > {tolerance:.2e} after {} samples",
@@ -278,4 +281,294 @@ pub fn run(
     progress: &dyn Progress,
 ) -> Result<ReliabilityRun, ReliabilityOpsError> {
     Ok(prepare(machine, file, request)?.run(progress)?)
+}
+
+/// The acceptance probability of every point × toleranced component of
+/// `study` at once, to an absolute error `tolerance` (three standard
+/// errors), with its sensitivities ([`Acceptance`] over
+/// [`Rectangles::from_study`]).
+fn acceptance(
+    study: &Study,
+    tolerance: f64,
+    seed: u64,
+) -> Result<AcceptanceResult, ReliabilityError> {
+    let system = Rectangles::from_study(study)?;
+    Acceptance {
+        tolerance,
+        seed,
+        ..Acceptance::default()
+    }
+    .run(&system)
+}
+
+/// The document of a grid study (the spec's `reliability` JSON contract).
+#[derive(Debug, Serialize)]
+pub struct ReliabilityDocument<'a> {
+    /// The machine's name.
+    pub machine: &'a str,
+    /// The algorithm.
+    pub method: Method,
+    /// One- or two-sided tolerances.
+    pub sided: Sided,
+    /// Every case, target-major (each case's document formed as it is
+    /// written).
+    pub results: CaseDocuments<'a>,
+    /// Each target's summary over the grid.
+    pub summary: NameMap<Target, SummaryDocument>,
+    /// The requirement and whether every target meets it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub requirement: Option<RequirementDocument>,
+    /// The posterior the inputs came from (a calibration's values file), when given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub posterior: Option<&'a Posterior>,
+    /// The whole-machine acceptance probability (`--acceptance`), when run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub acceptance: Option<AcceptanceDocument<'a>>,
+}
+
+/// One case (target at a grid point) of a [`ReliabilityDocument`].
+#[derive(Debug, Serialize)]
+pub struct CaseDocument<'a> {
+    /// The target.
+    pub component: Target,
+    /// The grid point: the grid's axes in file order.
+    pub point: NameMap<&'a str, f64>,
+    /// The reliability `1 − pf`.
+    pub reliability: f64,
+    /// The failure probability.
+    pub pf: f64,
+    /// The reliability index (infinite for a component the errors do not reach: JSON `null`).
+    pub beta: f64,
+    /// The standard error of a sampled `pf`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub std_error: Option<f64>,
+    /// The samples drawn.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub samples: Option<u64>,
+    /// The coefficient of variation of a sampled `pf`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cov: Option<f64>,
+    /// FORM's account (termination, iterations, exactness), when FORM ran.
+    #[serde(flatten)]
+    pub form: Option<FormCase>,
+    /// The sampler's convergence where FORM's does not occupy the key
+    /// (subset, directional, mc with `--cov`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub converged: Option<bool>,
+    /// Limit-state calls.
+    pub calls: Calls,
+    /// How the sampler stopped (subset, directional, or `--cov`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sampling: Option<Stopping>,
+    /// Subset simulation's levels.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub levels: Option<&'a [SubsetLevel]>,
+    /// SORM's three formulas and curvatures (`--method sorm`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sorm: Option<&'a SormCase>,
+}
+
+/// The cases of a [`ReliabilityDocument`]: serialised as the list of their
+/// [`CaseDocument`]s, each formed when it is written, so that a document of
+/// a million cases is not a second copy of them.
+#[derive(Debug)]
+pub struct CaseDocuments<'a> {
+    /// The grid's axes in file order, with their index in the model's
+    /// variables.
+    axes: Vec<(&'a str, usize)>,
+    /// The cases, target-major.
+    cases: &'a [CaseResult],
+}
+
+impl<'a> CaseDocuments<'a> {
+    /// The number of cases.
+    pub fn len(&self) -> usize {
+        self.cases.len()
+    }
+
+    /// True when there is no case.
+    pub fn is_empty(&self) -> bool {
+        self.cases.is_empty()
+    }
+
+    /// Each case's document, target-major.
+    pub fn iter(&self) -> impl Iterator<Item = CaseDocument<'a>> + '_ {
+        self.cases.iter().map(|c| CaseDocument {
+            component: c.target,
+            point: NameMap(self.axes.iter().map(|&(n, i)| (n, c.point[i])).collect()),
+            reliability: c.reliability,
+            pf: c.pf,
+            beta: c.beta,
+            std_error: c.std_error,
+            samples: c.samples,
+            cov: c.cov,
+            form: c.form,
+            converged: match (&c.form, &c.stopping) {
+                (None, Some(st)) => Some(st.converged),
+                _ => None,
+            },
+            calls: c.calls,
+            sampling: c.stopping,
+            levels: c.levels.as_deref(),
+            sorm: c.sorm.as_deref(),
+        })
+    }
+}
+
+impl Serialize for CaseDocuments<'_> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_seq(self.iter())
+    }
+}
+
+/// One target's summary of a [`ReliabilityDocument`].
+#[derive(Debug, Serialize)]
+pub struct SummaryDocument {
+    /// Mean reliability over the grid.
+    pub mean: f64,
+    /// Smallest reliability over the grid.
+    pub min: f64,
+    /// Largest reliability over the grid.
+    pub max: f64,
+    /// Whether the target meets the requirement (when there is one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub met: Option<bool>,
+}
+
+/// The requirement of a study and whether every target meets it.
+#[derive(Debug, Serialize)]
+pub struct RequirementDocument {
+    /// The smallest reliability required at any point.
+    pub min: f64,
+    /// The mean reliability required over the grid.
+    pub mean: f64,
+    /// Whether every target meets both.
+    pub met: bool,
+}
+
+impl RequirementDocument {
+    /// The requirement of a study result, if it has one.
+    pub fn of(r: &StudyResult) -> Option<RequirementDocument> {
+        r.requirement.map(|req| RequirementDocument {
+            min: req.min,
+            mean: req.mean,
+            met: r.requirement_met(),
+        })
+    }
+}
+
+impl<'a> ReliabilityDocument<'a> {
+    /// The document of a study's result (no posterior: set
+    /// [`ReliabilityDocument::posterior`] when the inputs came from one).
+    pub fn new(machine: &'a str, study: &'a Study, r: &'a StudyResult) -> Self {
+        let ax: Vec<(&'a str, usize)> = study
+            .spec()
+            .grid
+            .axes
+            .iter()
+            .filter_map(|(n, _)| {
+                let i = study.variables().iter().position(|v| v == n)?;
+                Some((n.as_str(), i))
+            })
+            .collect();
+        let results = CaseDocuments {
+            axes: ax,
+            cases: &r.cases,
+        };
+        let summary = NameMap(
+            r.summaries
+                .iter()
+                .map(|s| {
+                    let doc = SummaryDocument {
+                        mean: s.mean,
+                        min: s.min,
+                        max: s.max,
+                        met: s.met,
+                    };
+                    (s.target, doc)
+                })
+                .collect(),
+        );
+        ReliabilityDocument {
+            machine,
+            method: r.method,
+            sided: study.spec().sided,
+            results,
+            summary,
+            requirement: RequirementDocument::of(r),
+            posterior: None,
+            acceptance: None,
+        }
+    }
+}
+
+/// The `acceptance` object of a [`ReliabilityDocument`] (spec §4:
+/// probability, std_error, method, sensitivity; then samples, converged,
+/// tolerance, constraints, rank).
+#[derive(Debug, Serialize)]
+pub struct AcceptanceDocument<'a> {
+    /// P(every toleranced component within tolerance at every point).
+    pub probability: f64,
+    /// Its standard error.
+    pub std_error: f64,
+    /// `genz-bretz-qmc` or `monte-carlo`.
+    pub method: &'static str,
+    /// ∂P/∂σ and ∂P/∂μ of every error parameter.
+    pub sensitivity: Vec<AcceptanceSensitivityDocument<'a>>,
+    /// Integrand evaluations.
+    pub samples: u64,
+    /// Whether three standard errors are below the tolerance.
+    pub converged: bool,
+    /// The absolute error asked for.
+    pub tolerance: Option<f64>,
+    /// Constraints (points × toleranced components).
+    pub constraints: usize,
+    /// The rank of the constraints' rows.
+    pub rank: usize,
+    /// Levels, CoV and pilot of subset simulation (method `subset` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subset: Option<&'a AcceptanceSubset>,
+}
+
+/// One error parameter of [`AcceptanceDocument::sensitivity`].
+#[derive(Debug, Serialize)]
+pub struct AcceptanceSensitivityDocument<'a> {
+    /// The error parameter.
+    pub error: &'a str,
+    /// ∂P/∂σ.
+    pub dr_dstd: f64,
+    /// ∂P/∂μ.
+    pub dr_dmean: f64,
+    /// The standard error of ∂P/∂σ.
+    pub dr_dstd_std_error: f64,
+    /// The standard error of ∂P/∂μ.
+    pub dr_dmean_std_error: f64,
+}
+
+impl<'a> AcceptanceDocument<'a> {
+    /// The document of an acceptance result.
+    pub fn of(a: &'a AcceptanceResult) -> AcceptanceDocument<'a> {
+        AcceptanceDocument {
+            probability: a.probability,
+            std_error: a.std_error,
+            method: a.method.name(),
+            sensitivity: a
+                .sensitivity
+                .iter()
+                .map(|s| AcceptanceSensitivityDocument {
+                    error: &s.error,
+                    dr_dstd: s.dr_dstd,
+                    dr_dmean: s.dr_dmean,
+                    dr_dstd_std_error: s.dr_dstd_std_error,
+                    dr_dmean_std_error: s.dr_dmean_std_error,
+                })
+                .collect(),
+            samples: a.samples,
+            converged: a.converged,
+            tolerance: a.tolerance,
+            constraints: a.constraints,
+            rank: a.rank,
+            subset: a.subset.as_ref(),
+        }
+    }
 }

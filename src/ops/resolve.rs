@@ -1,11 +1,15 @@
 //! Options resolved against a machine, one rule each (docs/python.md and
-//! the commands' docs name the options): `--param` names, the grid of a
-//! study or map (`--grid` over `reliability.grid`), and a point given by
-//! axis name (`--at`). [`ResolveError`] words every refusal once; the CLI
-//! prints it and Python raises it.
+//! the commands' docs name the options): `--param` names and values
+//! ([`Parameters`]), the grid of a study or map (`--grid` over
+//! `reliability.grid`), a point given by axis name (`--at`), and the points
+//! of a map or a grid export ([`AxisPoints`]: the grid or rows, not both).
+//! [`ResolveError`] words every refusal once; the CLI prints it and Python
+//! raises it.
 
+use chain_core::built::{MapError, Points};
 use chain_core::diagnostic::closest;
 use chain_core::Machine;
+use reliability::ReliabilityError;
 
 use super::worded::{diagnostic, Worded};
 
@@ -167,16 +171,29 @@ pub enum ResolveError {
         /// Whether the command takes `--fix`.
         fixable: bool,
     },
+    /// `--grid` (the grid's axes) and `--axes` (rows of points) given
+    /// together.
+    #[error("--grid cannot be combined with --axes")]
+    GridWithRows,
+    /// Rows that do not make points of the machine.
+    #[error("{name}: {error}")]
+    Rows {
+        /// The rows' name (the `--axes` file, Python's `points`).
+        name: String,
+        /// What is wrong.
+        error: MapError,
+    },
 }
 
 impl ResolveError {
     /// True when the machine file is what the option does not match (an
-    /// unknown name): Python raises these as `MachineError` naming the file,
-    /// the others as `ValueError`.
+    /// unknown name): Python raises these as `MachineError` naming the file
+    /// (a `ValueError`), the others as `ValueError`.
     pub fn names_the_machine(&self) -> bool {
         matches!(
             self,
-            ResolveError::UnknownGridAxis { .. }
+            ResolveError::UnknownParameter { .. }
+                | ResolveError::UnknownGridAxis { .. }
                 | ResolveError::UnknownAtVariable { .. }
                 | ResolveError::UnknownFixed { .. }
                 | ResolveError::MissingGrid { .. }
@@ -202,6 +219,8 @@ impl Worded for ResolveError {
             ResolveError::UnknownAxisColumn { .. } => "chain::csv::unknown_column",
             ResolveError::ColumnAndFix { .. } => "chain::cli::fix_and_column",
             ResolveError::MissingAxisColumns { .. } => "chain::csv::missing_column",
+            ResolveError::GridWithRows => "chain::cli::grid_with_axes",
+            ResolveError::Rows { .. } => "chain::map::points",
         })
     }
 
@@ -222,6 +241,9 @@ impl Worded for ResolveError {
             ResolveError::AtWithGrid { grid_for } => format!(
                 "--at evaluates at one point, --grid sets the grid of {grid_for}; give one"
             ),
+            ResolveError::GridWithRows => {
+                "--axes gives the points, --grid the grid over `reliability.grid`; give one".into()
+            }
             ResolveError::MissingAt { variables, .. } => format!(
                 "give every axis variable: --at {}",
                 (variables.iter())
@@ -261,9 +283,10 @@ fn closest_variable(m: &Machine, name: &str) -> Option<String> {
 }
 
 /// Checks `--param NAME=VALUE` against the machine: every name one of its
-/// parameters, every value finite. (The values are placed by
-/// `reliability::machine::parameters`; the commands whose parameters may
-/// also come per CSV row check the names alone here.)
+/// parameters, every value finite. The one rule of `--param`, for every
+/// command and Python's `params`; [`Parameters`] places the values, and the
+/// commands whose parameters may also come per CSV row check the names
+/// alone here.
 pub fn check_parameters(m: &Machine, params: &[(String, f64)]) -> Result<(), ResolveError> {
     for (name, value) in params {
         if m.parameter_index(name).is_none() {
@@ -282,6 +305,38 @@ pub fn check_parameters(m: &Machine, params: &[(String, f64)]) -> Result<(), Res
         }
     }
     Ok(())
+}
+
+/// `--param NAME=VALUE` checked against a machine ([`check_parameters`]):
+/// a set of parameter values that holds no unknown name and no value that
+/// is not finite.
+#[derive(Debug, Clone, Copy)]
+pub struct Parameters<'a> {
+    machine: &'a Machine,
+    given: &'a [(String, f64)],
+}
+
+impl<'a> Parameters<'a> {
+    /// The values `given` for `machine`'s parameters, checked.
+    pub fn new(
+        machine: &'a Machine,
+        given: &'a [(String, f64)],
+    ) -> Result<Parameters<'a>, ResolveError> {
+        check_parameters(machine, given)?;
+        Ok(Parameters { machine, given })
+    }
+
+    /// The values as given (later ones win).
+    pub fn given(&self) -> &'a [(String, f64)] {
+        self.given
+    }
+
+    /// Every parameter's value in the machine's order: the one given, else
+    /// the file's; a symbolic parameter with neither is refused, located in
+    /// the machine file ([`ReliabilityError::SymbolicParameter`]).
+    pub fn values(&self) -> Result<Vec<f64>, ReliabilityError> {
+        reliability::machine::parameters(self.machine, self.given)
+    }
 }
 
 /// The grid axes in the machine's variable order: each axis of
@@ -398,6 +453,76 @@ pub fn fixed(m: &Machine, fix: &[(String, f64)]) -> Result<Vec<(usize, f64)>, Re
         }
     }
     Ok(out)
+}
+
+/// The points a map or a grid export is evaluated at: the full-factorial
+/// grid of `reliability.grid` with `--grid` overrides, or rows of axis
+/// values (`--axes`, Python's `points`), one or the other.
+#[derive(Debug, Clone)]
+pub enum AxisPoints<'a> {
+    /// `--grid` overrides of `reliability.grid`.
+    Grid(&'a [(String, Vec<f64>)]),
+    /// Rows of axis values in the machine's variable order, flat.
+    Rows {
+        /// The rows' name in messages (the `--axes` file, `points`).
+        name: String,
+        /// The values, one row after another.
+        values: Vec<f64>,
+    },
+}
+
+/// Where the points of a map or an export came from, resolved.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PointsInput {
+    /// The full-factorial grid of these axes (machine variable order).
+    Grid(Vec<(String, Vec<f64>)>),
+    /// Rows, named so (`--axes` file, `points`).
+    Rows(String),
+}
+
+impl<'a> AxisPoints<'a> {
+    /// `--grid` overrides or `--axes` rows (`(name, values)`): refused when
+    /// both are given.
+    pub fn new(
+        grid: &'a [(String, Vec<f64>)],
+        rows: Option<(String, Vec<f64>)>,
+    ) -> Result<AxisPoints<'a>, ResolveError> {
+        match rows {
+            Some(_) if !grid.is_empty() => Err(ResolveError::GridWithRows),
+            Some((name, values)) => Ok(AxisPoints::Rows { name, values }),
+            None => Ok(AxisPoints::Grid(grid)),
+        }
+    }
+
+    /// The `--grid` overrides (none for rows).
+    pub fn grid(&self) -> &'a [(String, Vec<f64>)] {
+        match self {
+            AxisPoints::Grid(g) => g,
+            AxisPoints::Rows { .. } => &[],
+        }
+    }
+
+    /// The library's points and where they came from: the grid's axes
+    /// resolved ([`grid_axes`]; `file` names the machine file), or the rows
+    /// as whole points of the machine.
+    pub fn resolve(&self, m: &Machine, file: &str) -> Result<(Points, PointsInput), ResolveError> {
+        match self {
+            AxisPoints::Rows { name, values } => {
+                let points = Points::list(m.variables.len(), values.clone()).map_err(|error| {
+                    ResolveError::Rows {
+                        name: name.clone(),
+                        error,
+                    }
+                })?;
+                Ok((points, PointsInput::Rows(name.clone())))
+            }
+            AxisPoints::Grid(overrides) => {
+                let axes = grid_axes(m, file, overrides)?;
+                let values = axes.iter().map(|(_, v)| v.clone()).collect();
+                Ok((Points::Grid(values), PointsInput::Grid(axes)))
+            }
+        }
+    }
 }
 
 /// Where each axis variable's values come from in a table of axis values
@@ -594,5 +719,37 @@ mod tests {
         );
         let e = check_parameters(&m, &[("L".into(), f64::NAN)]).unwrap_err();
         assert_eq!(e.to_string(), "--param L: NaN is not finite");
+        let given = [("L".to_string(), 5.0)];
+        let p = Parameters::new(&m, &given).unwrap();
+        assert_eq!(p.values().unwrap(), vec![5.0]);
+        assert!(Parameters::new(&m, &[("l".into(), 5.0)])
+            .unwrap_err()
+            .names_the_machine());
+    }
+
+    #[test]
+    fn points_are_a_grid_or_rows() {
+        let m = machine();
+        let grid = [("z".to_string(), vec![1.0])];
+        let e = AxisPoints::new(&grid, Some(("a.csv".into(), vec![]))).unwrap_err();
+        assert_eq!(
+            e.with_help(),
+            "--grid cannot be combined with --axes\nhelp: --axes gives the points, --grid the grid over `reliability.grid`; give one"
+        );
+        let (points, input) = (AxisPoints::new(&grid, None).unwrap())
+            .resolve(&m, "m.yaml")
+            .unwrap();
+        assert_eq!(points.len(), 2);
+        assert_eq!(
+            input,
+            PointsInput::Grid(vec![("x".into(), vec![0.0, 10.0]), ("z".into(), vec![1.0])])
+        );
+        let rows = AxisPoints::new(&[], Some(("a.csv".into(), vec![1.0, 2.0, 3.0]))).unwrap();
+        assert!(rows.grid().is_empty());
+        let e = rows.resolve(&m, "m.yaml").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "a.csv: 3 axis values do not make whole points of 2 variables"
+        );
     }
 }

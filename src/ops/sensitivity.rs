@@ -10,10 +10,12 @@ use std::path::Path;
 
 use chain_core::geometric::{self, GeometricDocument, GeometricSensitivity, NominalSizes, Where};
 use chain_core::model::Sided;
+use chain_core::named::NameMap;
 use chain_core::values::Approach;
 use chain_core::Machine;
-use reliability::document::SensitivityDocument;
-use reliability::{Form, Posterior, ReliabilityError, TargetSensitivity};
+use reliability::{
+    Form, Posterior, ReliabilityError, SensitivityMethod, Target, TargetSensitivity,
+};
 use serde::{Serialize, Serializer};
 
 use super::resolve::{self, ResolveError};
@@ -78,8 +80,7 @@ pub enum SensitivityOpsError {
     /// The study (the machine's sections, the options, the posterior).
     #[error(transparent)]
     Study(Box<StudyError>),
-    /// The evaluation (located in the machine file by
-    /// `reliability::document::describe`).
+    /// The evaluation (located in the machine file by [`study::describe`]).
     #[error(transparent)]
     Reliability(#[from] ReliabilityError),
 }
@@ -124,8 +125,7 @@ pub enum SensitivityReport {
     Geometric(GeometricReport),
 }
 
-/// The reliability sensitivities (JSON: the library's
-/// [`SensitivityDocument`]).
+/// The reliability sensitivities (JSON: their [`SensitivityDocument`]).
 #[derive(Debug, Clone)]
 pub struct ReliabilitySensitivity {
     /// The machine.
@@ -242,17 +242,24 @@ fn reliability_kind(
     let model = chain_core::compile(machine);
     let study = study::build(machine, &model, checked, &options)?;
     let values = reliability::machine::parameters(machine, request.params)?;
-    let (at, result) = reliability::document::sensitivity(
-        &study,
-        &model,
-        &values,
-        point.as_deref(),
-        &Form::default(),
-    )
-    .map_err(|e| match e {
-        ReliabilityError::InputsVaryAtPoint => ResolveError::AtVaryingInputs.into(),
-        e => SensitivityOpsError::from(e),
-    })?;
+    let form = Form::default();
+    let (at, result) = match point {
+        None => (None, study.sensitivity_mean(&form)?),
+        Some(point) => {
+            let result =
+                (study.sensitivity_point(&model, &values, &point, &form)).map_err(|e| match e {
+                    ReliabilityError::InputsVaryAtPoint => ResolveError::AtVaryingInputs.into(),
+                    e => SensitivityOpsError::from(e),
+                })?;
+            // The point as the document lists it: the grid's axes in file
+            // order, then any other variable.
+            let vars = study.variables();
+            let at = (study.display_order().iter())
+                .map(|&i| (vars[i].clone(), point[i]))
+                .collect();
+            (Some(at), result)
+        }
+    };
     Ok(SensitivityReport::Reliability(Box::new(
         ReliabilitySensitivity {
             machine: machine.name.clone(),
@@ -294,4 +301,78 @@ fn geometric_kind(
         nominal,
         result,
     }))
+}
+
+/// The document of `chain sensitivity --kind reliability` (its JSON).
+#[derive(Debug, Serialize)]
+pub struct SensitivityDocument<'a> {
+    /// The machine's name.
+    pub machine: &'a str,
+    /// The point, or `null` for the grid mean.
+    pub at: Option<NameMap<String, f64>>,
+    /// Each target's route (exact or FORM).
+    pub methods: NameMap<Target, SensitivityMethod>,
+    /// Each target's errors, sorted by `|∂R/∂σ|`, largest first.
+    pub components: NameMap<Target, Vec<SensitivityErrorDocument<'a>>>,
+    /// The posterior the inputs came from (`--values`), when given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub posterior: Option<&'a Posterior>,
+    /// The sensitivities the document was built from (for tables).
+    #[serde(skip)]
+    pub result: &'a [TargetSensitivity],
+}
+
+/// One error of a [`SensitivityDocument`]; the grid mean also has the mean
+/// absolute values.
+#[derive(Debug, Serialize)]
+pub struct SensitivityErrorDocument<'a> {
+    /// The error parameter.
+    pub error: &'a str,
+    /// `∂R/∂σ` (Eq. 33).
+    pub dr_dstd: f64,
+    /// `∂R/∂μ` (Eq. 32).
+    pub dr_dmean: f64,
+    /// The FORM importance factor.
+    pub importance: f64,
+    /// The grid mean of `|∂R/∂σ|` (grid mean only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean_abs_dr_dstd: Option<f64>,
+    /// The grid mean of `|∂R/∂μ|` (grid mean only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean_abs_dr_dmean: Option<f64>,
+}
+
+impl<'a> SensitivityDocument<'a> {
+    /// The document of the sensitivities `result`, at the point `at` (or
+    /// the grid mean, which adds the mean absolute values), with the
+    /// posterior `posterior` when the inputs came from one.
+    pub fn new(
+        machine: &'a str,
+        at: Option<Vec<(String, f64)>>,
+        result: &'a [TargetSensitivity],
+        posterior: Option<&'a Posterior>,
+    ) -> SensitivityDocument<'a> {
+        let mean = at.is_none();
+        let errors = |t: &'a TargetSensitivity| -> Vec<SensitivityErrorDocument<'a>> {
+            t.errors
+                .iter()
+                .map(|e| SensitivityErrorDocument {
+                    error: &e.error,
+                    dr_dstd: e.dr_dstd,
+                    dr_dmean: e.dr_dmean,
+                    importance: e.importance,
+                    mean_abs_dr_dstd: mean.then_some(e.mean_abs_dr_dstd),
+                    mean_abs_dr_dmean: mean.then_some(e.mean_abs_dr_dmean),
+                })
+                .collect()
+        };
+        SensitivityDocument {
+            machine,
+            at: at.map(NameMap),
+            methods: result.iter().map(|t| (t.target, t.method)).collect(),
+            components: result.iter().map(|t| (t.target, errors(t))).collect(),
+            posterior,
+            result,
+        }
+    }
 }

@@ -4,9 +4,9 @@
 //! parameter, with bootstrap percentile intervals, at one point (`--at`) or
 //! pooled over the reliability grid. Run by the CLI and `Machine.sobol`.
 
+use chain_core::named::NameMap;
 use chain_core::Machine;
-use reliability::document::SobolDocument;
-use reliability::sobol::{Sobol, SobolError, SobolResult};
+use reliability::sobol::{Estimate, OutputIndices, Sobol, SobolError, SobolResult};
 use reliability::{ReliabilityError, Study};
 use serde::{Serialize, Serializer};
 
@@ -68,7 +68,7 @@ pub enum SobolOpsError {
     /// The study.
     #[error(transparent)]
     Study(Box<StudyError>),
-    /// The machine's sections (located by `reliability::document::describe`).
+    /// The machine's sections (located by [`study::describe`]).
     #[error(transparent)]
     Reliability(#[from] ReliabilityError),
     /// The analysis (correlated inputs, an output that does not vary).
@@ -114,7 +114,7 @@ impl Worded for SobolOpsError {
 
 diagnostic!(SobolOpsError);
 
-/// The document of `chain sobol` (JSON: the library's [`SobolDocument`]).
+/// The run of `chain sobol` (JSON: its [`SobolDocument`]).
 #[derive(Debug)]
 pub struct SobolRun {
     /// The machine.
@@ -128,7 +128,7 @@ pub struct SobolRun {
 }
 
 impl SobolRun {
-    /// The library's document of the run.
+    /// The document of the run.
     pub fn document(&self) -> SobolDocument<'_> {
         SobolDocument::new(&self.machine, &self.study, self.at_point, &self.result)
     }
@@ -205,4 +205,128 @@ pub fn run(
         at_point: request.at.is_some(),
         result,
     })
+}
+
+/// The document of `chain sobol` (docs/sobol.md): the settings, then per
+/// output its variance, the sums of the indices and every error's first
+/// and total index with its interval.
+#[derive(Debug, Serialize)]
+pub struct SobolDocument<'a> {
+    /// The machine's name.
+    pub machine: &'a str,
+    /// `saltelli-jansen`: Saltelli 2010 Table 2 (b) and (f).
+    pub method: &'static str,
+    /// The point, or `null` when the indices pool the grid.
+    pub at: Option<NameMap<String, f64>>,
+    /// The grid pooled (absent at a point).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grid: Option<NameMap<String, Vec<f64>>>,
+    /// Points evaluated.
+    pub points: usize,
+    /// Base samples `N`.
+    pub samples: usize,
+    /// The seed.
+    pub seed: u64,
+    /// Bootstrap replicates.
+    pub bootstrap: usize,
+    /// Confidence level of the intervals.
+    pub confidence: f64,
+    /// Bootstrap blocks.
+    pub blocks: usize,
+    /// Model evaluations per point, `N·(k + 2)`.
+    pub evaluations_per_point: u64,
+    /// Each output's indices, by name.
+    pub outputs: NameMap<&'static str, SobolOutputDocument<'a>>,
+    /// The result the document shows (for the table and CSV forms).
+    #[serde(skip)]
+    pub result: &'a SobolResult,
+}
+
+/// One output of a [`SobolDocument`].
+#[derive(Debug, Serialize)]
+pub struct SobolOutputDocument<'a> {
+    /// The output's variance (summed over the grid when pooled).
+    pub variance: f64,
+    /// Σ of the first-order indices.
+    pub sum_first: &'a Estimate,
+    /// Σ of the total indices.
+    pub sum_total: &'a Estimate,
+    /// Every error's indices.
+    pub errors: Vec<SobolErrorDocument<'a>>,
+}
+
+/// One error of a [`SobolOutputDocument`].
+#[derive(Debug, Serialize)]
+pub struct SobolErrorDocument<'a> {
+    /// The error parameter.
+    pub error: &'a str,
+    /// Its first-order index.
+    pub first: &'a Estimate,
+    /// Its total index.
+    pub total: &'a Estimate,
+}
+
+impl<'a> SobolOutputDocument<'a> {
+    fn of(o: &'a OutputIndices) -> SobolOutputDocument<'a> {
+        SobolOutputDocument {
+            variance: o.variance,
+            sum_first: &o.sum_first,
+            sum_total: &o.sum_total,
+            errors: o
+                .errors
+                .iter()
+                .map(|e| SobolErrorDocument {
+                    error: &e.error,
+                    first: &e.first,
+                    total: &e.total,
+                })
+                .collect(),
+        }
+    }
+}
+
+impl<'a> SobolDocument<'a> {
+    /// The document of `result`, the indices of `study`: at its one point
+    /// when `at_point` (a [`Study::at_points`] study), otherwise pooled
+    /// over its grid.
+    pub fn new(
+        machine: &'a str,
+        study: &Study,
+        at_point: bool,
+        result: &'a SobolResult,
+    ) -> SobolDocument<'a> {
+        let at = at_point.then(|| {
+            NameMap::zip(
+                study.variables().iter().cloned(),
+                study
+                    .points()
+                    .first()
+                    .into_iter()
+                    .flat_map(|q| q.iter())
+                    .copied(),
+            )
+        });
+        let grid = (!at_point).then(|| NameMap(study.spec().grid.axes.clone()));
+        SobolDocument {
+            machine,
+            method: "saltelli-jansen",
+            at,
+            grid,
+            points: result.points,
+            samples: result.settings.samples,
+            seed: result.settings.seed,
+            bootstrap: result.settings.bootstrap,
+            confidence: result.settings.confidence,
+            blocks: result.blocks,
+            evaluations_per_point: result.evaluations_per_point,
+            outputs: NameMap(
+                result
+                    .outputs
+                    .iter()
+                    .map(|o| (o.output.name(), SobolOutputDocument::of(o)))
+                    .collect(),
+            ),
+            result,
+        }
+    }
 }

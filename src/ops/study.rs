@@ -1,14 +1,17 @@
 //! A reliability study from a machine and the options every study command
 //! takes (`--param`, `--grid`, `--sided`, `--system`, `--values`): built by
 //! one function for the CLI's `reliability`, `sensitivity`, `sobol`,
-//! `allocate`, `acceptance`, `path` and Python's methods over them.
+//! `allocate`, `acceptance`, `path` and Python's methods over them; and
+//! [`describe`], the one wording of a study's reliability errors against
+//! the machine file.
 
 use std::path::Path;
 use std::sync::Arc;
 
-use chain_core::model::Sided;
+use chain_core::model::{Origin, Sided};
 use chain_core::values::{Approach, ApproachError};
 use chain_core::{CompiledModel, Machine};
+use reliability::allocate::GridUse;
 use reliability::{
     Algorithm, CaseTally, DirectionalSimulation, Form, ImportanceSampling, Inputs, Method,
     MonteCarlo, Posterior, PosteriorError, ReliabilityError, Study, StudySpec, SubsetSimulation,
@@ -40,7 +43,7 @@ pub enum StudyError {
     #[error(transparent)]
     Resolve(#[from] ResolveError),
     /// The machine's reliability section or the study (located in the
-    /// machine file by `reliability::document::describe`).
+    /// machine file by [`describe`]).
     #[error(transparent)]
     Reliability(#[from] ReliabilityError),
     /// The posterior's inputs (located in the values file).
@@ -98,6 +101,33 @@ impl From<PosteriorError> for StudyError {
         }
     }
 }
+
+impl Worded for StudyError {
+    /// A point outside a posterior's tables names `--grid`, the option that
+    /// chooses the points.
+    fn own_help(&self) -> Option<String> {
+        match self {
+            StudyError::Posterior(PosteriorError::Point { .. }) => Some(
+                "study the points inside the tables (--grid), extend them, or add `extrapolate: hold` to the entry"
+                    .into(),
+            ),
+            StudyError::Resolve(e) => e.own_help(),
+            _ => None,
+        }
+    }
+
+    #[cfg(feature = "cli")]
+    fn inner(&self) -> Option<&dyn miette::Diagnostic> {
+        match self {
+            StudyError::Resolve(e) => Some(e),
+            StudyError::Reliability(e) => Some(e),
+            StudyError::Posterior(e) => Some(e),
+            StudyError::Approach { .. } => None,
+        }
+    }
+}
+
+diagnostic!(StudyError);
 
 /// A study's parts resolved from the machine file and the options alone:
 /// everything [`study`] checks before the model is derived (a long chain
@@ -391,8 +421,9 @@ impl SystemChoice {
     }
 }
 
-/// The library's system target of `choice` on `machine`
-/// ([`reliability::document::volumetric`]).
+/// The library's system target of `choice` on `machine` (a volumetric
+/// target without its tolerance takes the smallest position tolerance of
+/// the reliability section).
 pub fn system(
     machine: &Machine,
     choice: Option<SystemChoice>,
@@ -400,10 +431,26 @@ pub fn system(
     Ok(match choice {
         None => None,
         Some(SystemChoice::Series) => Some(System::Series),
-        Some(SystemChoice::Volumetric(tolerance)) => {
-            Some(reliability::document::volumetric(machine, tolerance)?)
-        }
+        Some(SystemChoice::Volumetric(tolerance)) => Some(volumetric(machine, tolerance)?),
     })
+}
+
+/// The volumetric target `√(px² + py² + pz²) ≤ tolerance`, by default the
+/// smallest position tolerance of the reliability section.
+fn volumetric(machine: &Machine, tolerance: Option<f64>) -> Result<System, ReliabilityError> {
+    let tolerance = match tolerance {
+        Some(t) => t,
+        None => machine
+            .reliability
+            .as_ref()
+            .ok_or(ReliabilityError::NoReliabilitySection)?
+            .tolerance
+            .iter()
+            .filter(|(c, _)| c.index() < 3)
+            .map(|(_, t)| *t)
+            .fold(f64::INFINITY, f64::min),
+    };
+    Ok(System::Volumetric { tolerance })
 }
 
 /// `note: FORM is a first-order approximation here (...)` when FORM is
@@ -459,4 +506,97 @@ pub fn unconverged_warnings(
         ));
     }
     out
+}
+
+/// A [`ReliabilityError`] worded against the machine file it concerns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Described<'e> {
+    /// The message, starting with the file (and `:line:column` when located).
+    pub message: String,
+    /// Where in the file, when the error is located.
+    pub origin: Option<&'e Origin>,
+    /// The label of the location (empty when not located).
+    pub label: &'static str,
+    /// How to fix it (empty when there is nothing to add).
+    pub help: String,
+}
+
+/// The one wording of a reliability error against `file` (the machine file's
+/// name), shared by the CLI's diagnostics and Python's exceptions: the
+/// options that supply what the file lacks (`--param`, `--grid`) and the
+/// allocation a grid is too large for (`--strategy`, `--target`) named as the
+/// CLI spells them.
+pub fn describe<'e>(err: &'e ReliabilityError, file: &str) -> Described<'e> {
+    let (message, origin, label, help): (String, Option<&Origin>, &str, String) = match err {
+        ReliabilityError::MissingStatistic { name, origin } => (
+            format!(
+                "{file}{}: missing key `statistics.{name}`: error parameter `{name}` has no statistics entry",
+                at(origin)
+            ),
+            Some(origin),
+            "used here",
+            format!(
+                "every error needs a distribution for reliability, e.g.\nstatistics:\n  {name}: {{dist: normal, mean: 0, std: 0.01}}"
+            ),
+        ),
+        ReliabilityError::NoReliabilitySection => (
+            format!("{file}: missing key `reliability`: the machine has no reliability section"),
+            None,
+            "",
+            "add, e.g.\nreliability:\n  tolerance: {px: 0.03, py: 0.03, pz: 0.03}\n  sided: upper\n  grid: {x: [0, 500, 1000]}"
+                .to_string(),
+        ),
+        ReliabilityError::SymbolicParameter { name, origin } => (
+            format!(
+                "{file}{}: parameter `{name}` is symbolic (null) and has no value",
+                at(origin)
+            ),
+            Some(origin),
+            "declared without a value",
+            format!("give it one on the command line: --param {name}=VALUE"),
+        ),
+        ReliabilityError::MissingCoordinate(v) => (
+            format!("{file}: the reliability grid has no values for axis variable `{v}` (key `reliability.grid.{v}`)"),
+            None,
+            "",
+            format!("add `{v}: [...]` to reliability.grid, or pass --grid {v}=VALUE"),
+        ),
+        ReliabilityError::GridTooLarge {
+            points,
+            limit,
+            allocation,
+            origin,
+        } => (
+            format!(
+                "{file}{}: key `reliability.grid`: the grid has {points} points; {allocation} ({}) runs on at most {limit} ({})",
+                at(origin),
+                match allocation {
+                    GridUse::Optimal => "--strategy optimal",
+                    GridUse::Paper => "--strategy paper",
+                    GridUse::Acceptance => "--target acceptance",
+                },
+                allocation.why()
+            ),
+            Some(origin),
+            "the grid of this section",
+            format!(
+                "allocate on a coarser grid (a copy of the file with at most {limit} grid points), then check the allocated standard deviations on this grid: put them in `statistics` and run `chain reliability`"
+            ),
+        ),
+        other => (format!("{file}: {other}"), None, "", String::new()),
+    };
+    Described {
+        message,
+        origin,
+        label,
+        help,
+    }
+}
+
+fn at(origin: &Origin) -> String {
+    if origin.line > 0 {
+        format!(":{}:{}", origin.line, origin.column)
+    } else {
+        String::new()
+    }
 }

@@ -11,8 +11,6 @@
 //! holds a NUL byte, a header-only file and a ragged row are refused as
 //! `file:line: …`.
 
-use std::path::Path;
-
 use chain_core::bounded::{self, ReadError};
 use chain_core::tabular;
 use chain_core::values::csv::CsvFile;
@@ -20,21 +18,8 @@ use chain_core::Machine;
 
 use super::inverse::{PoseError, PoseRow, AXIS_COLUMNS, ROTATION_COLUMNS};
 use super::resolve::{AxesColumns, ResolveError};
+use super::source::Source;
 use super::worded::{diagnostic, Worded};
-
-/// Where a table comes from.
-#[derive(Debug, Clone, Copy)]
-pub enum Source<'a> {
-    /// A file, read up to [`bounded::PATH_BYTES`].
-    Path(&'a Path),
-    /// Bytes the caller read, named `name` in messages.
-    Bytes {
-        /// The name messages give the table (`<stdin>`, a Python caller's).
-        name: &'a str,
-        /// The table's bytes.
-        bytes: &'a [u8],
-    },
-}
 
 /// Why a table cannot be read.
 #[derive(Debug, thiserror::Error)]

@@ -33,7 +33,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::diagnostic::{closest, Diagnostics, Message, Problem};
+use crate::diagnostic::{closest, Diagnostics, Problem, SettingsProblem};
 use crate::load::{
     self,
     reader::{index, join, start_origin, TreeReader},
@@ -71,10 +71,6 @@ pub const BUILTIN_GENERATOR_NAME: &str = "cradle_generator.yaml (built-in)";
 /// Settings files larger than this are refused.
 pub const MAX_SETTINGS_BYTES: usize = crate::bounded::SETTINGS_BYTES;
 
-/// How to write an angle, for an angle that cannot be read.
-const DMS_HELP: &str =
-    "write degrees-minutes-seconds as \"-115°39′\" or \"12°30'15\\\"\", or degrees as -115.65deg";
-
 // ---------------------------------------------------------------------------
 // Diagnostics
 
@@ -85,7 +81,7 @@ const DMS_HELP: &str =
 /// text with a label at the span and the other problems as related
 /// diagnostics. The shared rules (unknown key, wrong type, ...) keep their
 /// machine-file wording and codes; the settings' own rules are
-/// [`Problem::Message`]s with codes `chain::settings::*`.
+/// [`SettingsProblem`]s with codes `chain::settings::*`.
 pub type SettingsError = Diagnostics;
 
 /// Why a machine named by a settings file could not be loaded.
@@ -210,13 +206,8 @@ pub fn load_settings_str(text: &str, file: &str, base: &Path) -> Result<Settings
         Some(_) => None,
         None => {
             if r.problems.is_empty() {
-                let empty = Message::new(
-                    "the settings file is empty",
-                    "empty",
-                    "chain::settings::empty",
-                )
-                .help("expected a mapping with `settings`, `values` and `roll`");
-                r.problems.push((start_origin(""), empty.into()));
+                let empty = SettingsProblem::Empty.into();
+                r.problems.push((start_origin(""), empty));
             }
             None
         }
@@ -225,13 +216,8 @@ pub fn load_settings_str(text: &str, file: &str, base: &Path) -> Result<Settings
         (_, Some(e)) => Err(e),
         (Some(s), None) => Ok(s),
         (None, None) => {
-            let invalid = Message::new("invalid settings file", "here", "chain::settings::invalid");
-            Err(Diagnostics::single(
-                file,
-                text,
-                start_origin(""),
-                invalid.into(),
-            ))
+            let invalid = SettingsProblem::Invalid.into();
+            Err(Diagnostics::single(file, text, start_origin(""), invalid))
         }
     }
 }
@@ -270,8 +256,8 @@ impl Reader {
             match parse_dms(t) {
                 Ok(deg) => (deg.to_radians(), true),
                 Err(message) => {
-                    let text = format!("cannot read the angle `{t}`: {message}");
-                    let bad = Message::new(text, "angle", "chain::settings::angle").help(DMS_HELP);
+                    let (text, reason) = (t.to_string(), message);
+                    let bad = SettingsProblem::Angle { text, reason };
                     self.report(node.span, path, bad.into());
                     return None;
                 }
@@ -386,13 +372,8 @@ impl Reader {
         }
         if let (Some(Matching::Pose), Some(origin)) = (matching, &fix_origin) {
             if !fix.is_empty() {
-                let pose = Message::new(
-                    "`cnc.fix` holds variables, which only `match: point_axis` allows (a full pose determines every axis)",
-                    "fix",
-                    "chain::settings::fix_needs_point_axis",
-                )
-                .help("add `match: point_axis` under `cnc`, or remove `fix`");
-                self.problems.push((origin.clone(), pose.into()));
+                let pose = SettingsProblem::FixNeedsPointAxis.into();
+                self.problems.push((origin.clone(), pose));
             }
         }
         Some(Settings {
@@ -438,11 +419,7 @@ impl Reader {
         if t0 < t1 {
             return Some((t0, t1));
         }
-        let empty = Message::new(
-            format!("the roll interval needs t0 < t1, got [{t0}, {t1}]"),
-            "empty interval",
-            "chain::settings::interval",
-        );
+        let empty = SettingsProblem::Interval { t0, t1 };
         self.report(node.span, path, empty.into());
         None
     }
@@ -571,12 +548,14 @@ impl Settings {
         &self,
         path: &Path,
         origin: &Origin,
-        what: &str,
+        what: &'static str,
     ) -> Result<Machine, ReferenceError> {
         if let Err(e) = std::fs::File::open(path) {
-            let text = format!("cannot read the {what} file `{}`: {e}", path.display());
-            let unread = Message::new(text, "file", "chain::settings::machine_file")
-                .help("paths are relative to the settings file's directory");
+            let unread = SettingsProblem::MachineFile {
+                what,
+                path: path.display().to_string(),
+                reason: e.to_string(),
+            };
             let (file, source) = (&self.file, &self.source);
             let error = Diagnostics::single(file, source, origin.clone(), unread.into());
             return Err(ReferenceError::Path(error));
@@ -585,8 +564,8 @@ impl Settings {
     }
 
     /// Checks every name against the generator and the CNC machine and
-    /// builds the motion specification. `cnc_overrides` (e.g. `--param`)
-    /// replace `cnc.parameters` entries.
+    /// builds the motion specification. `cnc_overrides` (the run's
+    /// parameter values, `NAME=VALUE`) replace `cnc.parameters` entries.
     pub fn bind(
         &self,
         generator: &Machine,
@@ -614,17 +593,15 @@ impl Settings {
             .filter(|n| !all_names.contains(n))
             .filter_map(|n| closest(n, all_names.iter().copied()))
             .collect();
-        let unknown = |name: &str, key: &Origin, what: &str| -> Issue {
-            let text =
-                format!("`{name}` is not a parameter or variable of the generator `{gname}`");
-            let help = format!(
-                "{what} names the generator's parameters and variables: {}",
-                all_names.join(", ")
-            );
-            let message = Message::new(text, "unknown name", "chain::settings::unknown_name")
-                .suggest(closest(name, all_names.iter().copied()))
-                .help(help);
-            (key.clone(), message.into())
+        let unknown = |name: &str, key: &Origin, within: &'static str| -> Issue {
+            let problem = SettingsProblem::UnknownName {
+                name: name.to_string(),
+                generator: gname.clone(),
+                within,
+                names: all_names.iter().map(|n| n.to_string()).collect(),
+                suggestion: closest(name, all_names.iter().copied()).map(str::to_string),
+            };
+            (key.clone(), problem.into())
         };
         for n in &self.values {
             if let Some(i) = duplicate(&seen, &n.name, &n.key) {
@@ -661,11 +638,11 @@ impl Settings {
             }
             let Some(k) = generator.variables.iter().position(|v| v.name == d.name) else {
                 if generator.parameters.iter().any(|p| p.name == d.name) {
-                    let text = format!("`{}` is a parameter of the generator `{gname}`; only its variables can be driven", d.name);
-                    let message =
-                        Message::new(text, "not a variable", "chain::settings::drive_parameter")
-                            .help("give it under `values`");
-                    issues.push((d.key.clone(), message.into()));
+                    let problem = SettingsProblem::DriveParameter {
+                        name: d.name.clone(),
+                        generator: gname.clone(),
+                    };
+                    issues.push((d.key.clone(), problem.into()));
                 } else {
                     issues.push(unknown(&d.name, &d.key, "`roll.drive`"));
                 }
@@ -684,36 +661,35 @@ impl Settings {
         }
         for (k, p) in generator.parameters.iter().enumerate() {
             if gparams[k].is_none() && !suggested.contains(&p.name.as_str()) {
-                let text = format!("generator parameter `{}` has no value", p.name);
-                let help = format!("add `{}: <value>` under `values`", p.name);
-                issues.push((self.values_origin.clone(), missing_value(text, help)));
+                let name = p.name.clone();
+                let missing = SettingsProblem::GeneratorParameterMissing { name };
+                issues.push((self.values_origin.clone(), missing.into()));
             }
         }
         for (k, v) in generator.variables.iter().enumerate() {
             if laws[k].is_none() && !suggested.contains(&v.name.as_str()) {
-                let text = format!("generator variable `{}` has no value", v.name);
-                let help = format!(
-                    "hold it with `{}: <value>` under `values`, or move it with `{}: {{start: .., ratio: ..}}` under `roll.drive`",
-                    v.name, v.name
-                );
-                issues.push((self.values_origin.clone(), missing_value(text, help)));
+                let name = v.name.clone();
+                let missing = SettingsProblem::GeneratorVariableMissing { name };
+                issues.push((self.values_origin.clone(), missing.into()));
             }
         }
         if !laws.iter().flatten().any(|l| l.rate != 0.0) && !self.drive.is_empty() {
-            let text = "no generator variable moves: every `ratio` is 0";
-            let message = Message::new(text, "no motion", "chain::settings::no_motion");
-            issues.push((self.drive_origin.clone(), message.into()));
+            let problem = SettingsProblem::NoMotion.into();
+            issues.push((self.drive_origin.clone(), problem));
         }
 
         // CNC side.
         let cname = &cnc.name;
         let mut cparams: Vec<Option<f64>> = cnc.parameters.iter().map(|p| p.value).collect();
-        let not_a_parameter = |name: &str, via: &str, key: &Origin| -> Issue {
-            let text = format!("{via}`{name}` is not a parameter of the CNC machine `{cname}`");
+        let not_a_parameter = |name: &str, command_line: bool, key: &Origin| -> Issue {
             let close = closest(name, cnc.parameters.iter().map(|p| p.name.as_str()));
-            let message = Message::new(text, "unknown parameter", "chain::settings::unknown_name")
-                .suggest(close);
-            (key.clone(), message.into())
+            let problem = SettingsProblem::UnknownParameter {
+                name: name.to_string(),
+                machine: cname.clone(),
+                command_line,
+                suggestion: close.map(str::to_string),
+            };
+            (key.clone(), problem.into())
         };
         for n in &self.cnc_parameters {
             match cnc.parameters.iter().position(|p| p.name == n.name) {
@@ -724,53 +700,46 @@ impl Settings {
                     }
                     cparams[k] = Some(n.value.value);
                 }
-                None => issues.push(not_a_parameter(&n.name, "", &n.key)),
+                None => issues.push(not_a_parameter(&n.name, false, &n.key)),
             }
         }
         for (name, v) in cnc_overrides {
             match cnc.parameters.iter().position(|p| p.name == *name) {
                 Some(k) => cparams[k] = Some(*v),
-                None => issues.push(not_a_parameter(name, "--param: ", &Origin::default())),
+                None => issues.push(not_a_parameter(name, true, &Origin::default())),
             }
         }
         for (k, p) in cnc.parameters.iter().enumerate() {
             if cparams[k].is_none() {
-                let text = format!(
-                    "parameter `{}` of the CNC machine `{cname}` has no value",
-                    p.name
-                );
-                let help = format!(
-                    "add `cnc: {{parameters: {{{}: <value>}}}}` or pass --param {}=VALUE",
-                    p.name, p.name
-                );
-                issues.push((start_origin("cnc.parameters"), missing_value(text, help)));
+                let missing = SettingsProblem::CncParameterMissing {
+                    name: p.name.clone(),
+                    machine: cname.clone(),
+                };
+                issues.push((start_origin("cnc.parameters"), missing.into()));
             }
         }
-        let cnc_variable = |n: &Named, what: &str, issues: &mut Vec<Issue>| -> Option<usize> {
-            match cnc.variables.iter().position(|v| v.name == n.name) {
-                Some(k) => {
-                    if let Some(i) = angle_on_prismatic(cnc, k, &n.name, &n.value) {
-                        issues.push(i);
+        let cnc_variable =
+            |n: &Named, within: &'static str, issues: &mut Vec<Issue>| -> Option<usize> {
+                match cnc.variables.iter().position(|v| v.name == n.name) {
+                    Some(k) => {
+                        if let Some(i) = angle_on_prismatic(cnc, k, &n.name, &n.value) {
+                            issues.push(i);
+                        }
+                        Some(k)
                     }
-                    Some(k)
+                    None => {
+                        let close = closest(&n.name, cnc.variables.iter().map(|v| v.name.as_str()));
+                        let problem = SettingsProblem::UnknownVariable {
+                            name: n.name.clone(),
+                            within,
+                            machine: cname.clone(),
+                            suggestion: close.map(str::to_string),
+                        };
+                        issues.push((n.key.clone(), problem.into()));
+                        None
+                    }
                 }
-                None => {
-                    let text = format!(
-                        "`{}` in {what} is not a variable of the CNC machine `{cname}`",
-                        n.name
-                    );
-                    let close = closest(&n.name, cnc.variables.iter().map(|v| v.name.as_str()));
-                    let message = Message::new(
-                        text,
-                        "unknown variable",
-                        "chain::settings::unknown_variable",
-                    )
-                    .suggest(close);
-                    issues.push((n.key.clone(), message.into()));
-                    None
-                }
-            }
-        };
+            };
         let mut fixed = Vec::new();
         for n in &self.fix {
             if let Some(k) = cnc_variable(n, "`cnc.fix`", &mut issues) {
@@ -815,31 +784,20 @@ type Issue = (Origin, Problem);
 /// The issue of a name given twice (`values` and `roll.drive`).
 fn duplicate(seen: &[(&str, &Origin)], name: &str, key: &Origin) -> Option<Issue> {
     let (_, first) = seen.iter().find(|(n, _)| *n == name)?;
-    let text = format!(
-        "`{name}` is given twice (first on line {}): in `values` and in `roll.drive`",
-        first.line
-    );
-    let message = Message::new(text, "given twice", "chain::settings::duplicate")
-        .help("a held setting goes in `values`, a moving one in `roll.drive`");
-    Some((key.clone(), message.into()))
-}
-
-/// A setting without a value.
-fn missing_value(text: String, help: String) -> Problem {
-    Message::new(text, "missing value", "chain::settings::missing_value")
-        .help(help)
-        .into()
+    let problem = SettingsProblem::Duplicate {
+        name: name.to_string(),
+        first_line: first.line,
+    };
+    Some((key.clone(), problem.into()))
 }
 
 /// The issue of angle units on `name`, which is `what` (a length).
 fn angle_on_length(name: &str, what: &str, value: &Value) -> Issue {
-    let text = format!("`{name}` is {what}; angle units are not allowed");
-    let message = Message::new(
-        text,
-        "angle on a length",
-        "chain::settings::angle_on_length",
-    );
-    (value.origin.clone(), message.into())
+    let problem = SettingsProblem::AngleOnLength {
+        name: name.to_string(),
+        what: what.to_string(),
+    };
+    (value.origin.clone(), problem.into())
 }
 
 fn angle_on_prismatic(machine: &Machine, k: usize, name: &str, value: &Value) -> Option<Issue> {

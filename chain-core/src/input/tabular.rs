@@ -2,19 +2,43 @@
 //! of the toolkit — values tables, measurement and candidate files (located
 //! diagnostics, `file:line:column: …` with a snippet), and the command
 //! line's `chain inverse --pose`, `chain path --axes` and `chain compensate
-//! FILE` (`file:line: …`) — words a header-only file, a ragged row and a
-//! bad cell with the same [`CsvProblem`], under the same `chain::csv::*`
-//! code. A cell's message names its column: ``column `y`: `abc` is not a
-//! number``.
+//! FILE` (`file:line: …`) — words a malformed or header-only file, a bad
+//! header, a ragged row and a bad cell with the same [`CsvProblem`]
+//! ([`CsvProblem::describe`], also [`crate::diagnostic::Problem::Csv`]'s
+//! wording), under the same code. A cell's message names its column:
+//! ``column `y`: `abc` is not a number``.
 
-use crate::diagnostic::shortened;
+use crate::diagnostic::{shortened, Description};
 use std::fmt;
 
-/// One refusal of a CSV input.
+/// One refusal of a CSV input, worded by [`CsvProblem::describe`].
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum CsvProblem {
+    /// Not CSV: a record the CSV reader refuses (a line that is not valid
+    /// UTF-8, ...).
+    Malformed {
+        /// The reader's message.
+        message: String,
+    },
     /// No header line (the file is empty, or only comments and blank lines).
-    Empty,
+    Empty {
+        /// What the header of this kind of file names (the help).
+        header: String,
+    },
+    /// A header column without a name.
+    UnnamedColumn {
+        /// Its 1-based position.
+        column: usize,
+        /// What the header of this kind of file names (the help).
+        header: String,
+    },
+    /// A name given twice in the header.
+    RepeatedColumn {
+        /// The name.
+        name: String,
+        /// The 1-based column of its first occurrence.
+        first: usize,
+    },
     /// A header and no data row.
     NoData,
     /// A row with another number of fields than the header.
@@ -46,28 +70,69 @@ pub enum CsvProblem {
 }
 
 impl CsvProblem {
-    /// The diagnostic code: `chain::csv::…`.
-    pub fn code(&self) -> &'static str {
+    /// Every part of the message of this refusal (headline, help, span
+    /// label, code): one match arm per variant.
+    pub fn describe(&self) -> Description {
+        use Description as D;
         match self {
-            CsvProblem::Empty => "chain::csv::empty",
-            CsvProblem::NoData => "chain::csv::no_data",
-            CsvProblem::Ragged { .. } => "chain::csv::ragged",
-            CsvProblem::NotANumber { .. } => "chain::csv::not_a_number",
-            CsvProblem::NotFinite { .. } => "chain::csv::not_finite",
-            CsvProblem::EmptyCell { .. } => "chain::csv::empty_cell",
+            CsvProblem::Malformed { message } => D::new(
+                "chain::values::csv_malformed",
+                "malformed",
+                format!("malformed CSV: {message}"),
+            ),
+            CsvProblem::Empty { header } => D::new(
+                "chain::csv::empty",
+                "empty",
+                "the file is empty; expected a header line",
+            )
+            .help(header.clone()),
+            CsvProblem::UnnamedColumn { column, header } => D::new(
+                "chain::values::csv_header",
+                "no name",
+                format!("column {column} of the header has no name"),
+            )
+            .help(header.clone()),
+            CsvProblem::RepeatedColumn { name, first } => D::new(
+                "chain::values::csv_header",
+                "repeated",
+                format!("column `{name}` appears twice in the header (first in column {first})"),
+            ),
+            CsvProblem::NoData => D::new(
+                "chain::csv::no_data",
+                "no data row",
+                "the header is followed by no data row",
+            )
+            .help("each row after the header is one record".to_string()),
+            CsvProblem::Ragged { fields, columns } => D::new(
+                "chain::csv::ragged",
+                "row",
+                format!(
+                    "this row has {} but the header has {}",
+                    plural(*fields, "field"),
+                    plural(*columns, "column")
+                ),
+            ),
+            CsvProblem::NotANumber { column, text } => D::new(
+                "chain::csv::not_a_number",
+                "not a number",
+                format!("column `{column}`: `{}` is not a number", shortened(text)),
+            ),
+            CsvProblem::NotFinite { column, text } => D::new(
+                "chain::csv::not_finite",
+                "not finite",
+                format!("column `{column}`: `{}` is not finite", shortened(text)),
+            ),
+            CsvProblem::EmptyCell { column } => D::new(
+                "chain::csv::empty_cell",
+                "empty",
+                format!("column `{column}`: the cell is empty"),
+            ),
         }
     }
 
-    /// The short label of a snippet.
-    pub fn label(&self) -> &'static str {
-        match self {
-            CsvProblem::Empty => "empty",
-            CsvProblem::NoData => "no data row",
-            CsvProblem::Ragged { .. } => "row",
-            CsvProblem::NotANumber { .. } => "not a number",
-            CsvProblem::NotFinite { .. } => "not finite",
-            CsvProblem::EmptyCell { .. } => "empty",
-        }
+    /// The diagnostic code: `chain::csv::…` ([`Description::code`]).
+    pub fn code(&self) -> &'static str {
+        self.describe().code
     }
 
     /// The message located at `file:line`: `file:line: column `y`: …`.
@@ -78,27 +143,7 @@ impl CsvProblem {
 
 impl fmt::Display for CsvProblem {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            CsvProblem::Empty => write!(f, "the file is empty; expected a header line"),
-            CsvProblem::NoData => write!(f, "the header is followed by no data row"),
-            CsvProblem::Ragged { fields, columns } => write!(
-                f,
-                "this row has {} but the header has {}",
-                plural(*fields, "field"),
-                plural(*columns, "column")
-            ),
-            CsvProblem::NotANumber { column, text } => {
-                write!(
-                    f,
-                    "column `{column}`: `{}` is not a number",
-                    shortened(text)
-                )
-            }
-            CsvProblem::NotFinite { column, text } => {
-                write!(f, "column `{column}`: `{}` is not finite", shortened(text))
-            }
-            CsvProblem::EmptyCell { column } => write!(f, "column `{column}`: the cell is empty"),
-        }
+        f.write_str(&self.describe().headline)
     }
 }
 

@@ -31,7 +31,7 @@ use serde::Serialize;
 
 use crate::diagnostic::Diagnostics;
 #[cfg(feature = "csv")]
-use crate::diagnostic::{closest, Message, Problem};
+use crate::diagnostic::{closest, MeasurementsProblem as P, Problem};
 use crate::model::Machine;
 #[cfg(feature = "csv")]
 use crate::model::Origin;
@@ -443,20 +443,8 @@ impl Measurements {
             return Err(fail(problems));
         }
         if rows.is_empty() {
-            let what = match layout {
-                Layout::Measurements => "measurement",
-                Layout::Candidates => "candidate pose",
-            };
-            let empty = Message::new(
-                format!("the file has a header but no {what} row"),
-                "no rows",
-                "chain::measurements::no_rows",
-            )
-            .help(match layout {
-                Layout::Measurements => "each row after the header is one measurement",
-                Layout::Candidates => "each row after the header is one candidate pose",
-            });
-            return Err(fail(vec![(csv.header_origin(), empty.into())]));
+            let empty = P::NoRows { layout }.into();
+            return Err(fail(vec![(csv.header_origin(), empty)]));
         }
         Ok(Measurements {
             file: file.to_string(),
@@ -516,8 +504,8 @@ struct Columns {
 }
 
 #[cfg(feature = "csv")]
-fn located(origin: &Origin, text: String, label: &'static str, code: &'static str) -> Located {
-    Box::new((origin.clone(), Message::new(text, label, code).into()))
+fn located(origin: &Origin, problem: impl Into<Problem>) -> Located {
+    Box::new((origin.clone(), problem.into()))
 }
 
 /// A located problem of a CSV cell or header.
@@ -546,47 +534,22 @@ fn classify(
         let measured_value = layout == Layout::Candidates
             && (MeasurementKind::ALL.iter()).any(|kind| kind.components().contains(&name.as_str()));
         if measured_value {
-            let message = Message::new(
-                format!(
-                    "column `{name}` is a measured value: a candidate file gives only where to measure"
-                ),
-                "measured value",
-                "chain::measurements::measured_in_candidates",
-            )
-            .help(
-                "the candidate columns are the axis variables, parameters per row, `ux,uy,uz` for measurements along a direction, and optionally `std`",
-            );
-            problems.push((origin.clone(), message.into()));
+            let column = name.clone();
+            problems.push((origin.clone(), P::MeasuredInCandidates { column }.into()));
         } else if !known {
             let names: Vec<&str> = (m.variables.iter().map(|v| v.name.as_str()))
                 .chain(m.parameters.iter().map(|p| p.name.as_str()))
                 .chain(measured.iter().copied())
                 .collect();
-            let text = format!(
-                "column `{name}` is neither an axis variable, a parameter of machine `{}`, nor a measurement column",
-                m.name
-            );
-            let message = Message::new(
-                text,
-                "unknown column",
-                "chain::measurements::unknown_column",
-            )
-            .suggest(closest(name, names.iter().copied()))
-            .help(format!(
-                "the columns are the axis variables ({}), parameters, {}",
-                m.variables
-                    .iter()
-                    .map(|v| v.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-                match layout {
-                    Layout::Measurements =>
-                        format!("{}, and optionally `std`", layout.named_columns(" or ")),
-                    Layout::Candidates =>
-                        format!("optionally {} and `std`", layout.named_columns(" or ")),
-                }
-            ));
-            problems.push((origin.clone(), message.into()));
+            let problem = P::UnknownColumn {
+                column: name.clone(),
+                machine: m.name.clone(),
+                variables: m.variables.iter().map(|v| v.name.clone()).collect(),
+                measured: layout.named_columns(" or "),
+                layout,
+                suggestion: closest(name, names.iter().copied()).map(str::to_string),
+            };
+            problems.push((origin.clone(), problem.into()));
         }
     }
     let mut q = Vec::new();
@@ -599,16 +562,8 @@ fn classify(
     if missing.is_empty() {
         q = m.variables.iter().filter_map(|v| find(&v.name)).collect();
     } else {
-        problems.push(*located(
-            header_origin,
-            format!(
-                "the header has no column for the axis variable{} {}: every row needs the whole pose",
-                if missing.len() == 1 { "" } else { "s" },
-                missing.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
-            ),
-            "missing pose column",
-            "chain::measurements::missing_pose",
-        ));
+        let variables = missing.iter().map(|n| n.to_string()).collect();
+        problems.push(*located(header_origin, P::MissingPose { variables }));
     }
     let mut p = Vec::new();
     for param in &m.parameters {
@@ -623,15 +578,10 @@ fn classify(
                     .or(param.value);
                 match value {
                     Some(v) => p.push(Err(v)),
-                    None => problems.push(*located(
-                        header_origin,
-                        format!(
-                            "parameter `{}` is symbolic in the machine file and the header has no column for it",
-                            param.name
-                        ),
-                        "missing parameter",
-                        "chain::measurements::missing_parameter",
-                    )),
+                    None => {
+                        let name = param.name.clone();
+                        problems.push(*located(header_origin, P::MissingParameter { name }));
+                    }
                 }
             }
         }
@@ -654,47 +604,25 @@ fn classify(
             .filter(|(_, names, _)| names.is_empty())
             .collect();
     }
-    let partial = |names: &str| {
-        located(
-            header_origin,
-            format!("the header has only some of `{names}`: give all of them"),
-            "partial columns",
-            "chain::measurements::partial_columns",
-        )
-    };
+    let partial = |names: String| located(header_origin, P::PartialColumns { names });
     let mut read = None;
     match kinds.as_slice() {
         [] => {
             if problems.is_empty() {
-                problems.push(*located(
-                    header_origin,
-                    format!(
-                        "the header has no measured values: expected {}",
-                        layout.named_columns(" or ")
-                    ),
-                    "no measured values",
-                    "chain::measurements::no_values",
-                ));
+                let expected = layout.named_columns(" or ");
+                problems.push(*located(header_origin, P::NoValues { expected }));
             }
         }
         [(kind, names, at)] => {
             if at.iter().all(Option::is_some) {
                 read = Some((*kind, at.iter().flatten().copied().collect::<Vec<usize>>()));
             } else {
-                problems.push(*partial(&names.join(",")));
+                problems.push(*partial(names.join(",")));
             }
         }
         several => {
-            let both: Vec<String> = several.iter().map(|(_, names, _)| quoted(names)).collect();
-            problems.push(*located(
-                header_origin,
-                format!(
-                    "the header has both {}: a file holds one kind of measurement",
-                    both.join(" and ")
-                ),
-                "two kinds",
-                "chain::measurements::two_kinds",
-            ));
+            let kinds = several.iter().map(|(_, names, _)| quoted(names)).collect();
+            problems.push(*located(header_origin, P::TwoKinds { kinds }));
         }
     }
     match read {
@@ -719,9 +647,7 @@ impl Columns {
     fn record(&self, cells: &[(String, Origin)]) -> Result<Measurement, Located> {
         let number = |c: usize| -> Result<f64, Located> {
             let (text, origin) = &cells[c];
-            crate::tabular::number(text, &origin.key).map_err(|problem| {
-                located(origin, problem.to_string(), problem.label(), problem.code())
-            })
+            crate::tabular::number(text, &origin.key).map_err(|problem| located(origin, problem))
         };
         let line = cells.first().map_or(0, |(_, o)| o.line);
         let q = self
@@ -747,12 +673,7 @@ impl Columns {
                 let u = [number(cols[0])?, number(cols[1])?, number(cols[2])?];
                 let norm = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
                 if (norm - 1.0).abs() > UNIT_TOLERANCE {
-                    return Err(located(
-                        &cells[cols[0]].1,
-                        format!("the direction (ux, uy, uz) has length {norm}, not 1"),
-                        "not a unit vector",
-                        "chain::measurements::not_unit",
-                    ));
+                    return Err(located(&cells[cols[0]].1, P::NotUnit { norm }));
                 }
                 Observed::Direction {
                     u: [u[0] / norm, u[1] / norm, u[2] / norm],
@@ -764,12 +685,7 @@ impl Columns {
             Some(c) => {
                 let s = number(c)?;
                 if s <= 0.0 {
-                    return Err(located(
-                        &cells[c].1,
-                        format!("the standard deviation must be positive, got {s}"),
-                        "not positive",
-                        "chain::measurements::std_not_positive",
-                    ));
+                    return Err(located(&cells[c].1, P::StdNotPositive { value: s }));
                 }
                 Some(s)
             }

@@ -31,7 +31,7 @@ use serde::{Serialize, Serializer};
 
 use crate::diagnostic::Diagnostics;
 #[cfg(feature = "csv")]
-use crate::diagnostic::{closest, Message, Problem};
+use crate::diagnostic::{closest, PositioningProblem as P, Problem};
 #[cfg(feature = "csv")]
 use crate::model::Origin;
 
@@ -268,11 +268,6 @@ impl RunsFileError {
     }
 }
 
-/// What a run file's header names (the help of an empty file).
-#[cfg(feature = "csv")]
-const HEADER_HELP: &str =
-    "the header names `target`, `direction`, `run`, and `measured` or `deviation`";
-
 #[cfg(feature = "csv")]
 impl Runs {
     /// Reads a run file (CSV; spec `positioning.md`).
@@ -285,8 +280,9 @@ impl Runs {
 
     /// [`Runs::read`] over CSV text named `file`.
     pub fn parse(text: &str, file: &str, kind: AxisKind) -> Result<Runs, RunsFileError> {
-        let csv = crate::values::csv::CsvFile::parse_with(text, file, HEADER_HELP)
-            .map_err(RunsFileError)?;
+        let csv =
+            crate::values::csv::CsvFile::parse_with(text, file, crate::diagnostic::RUN_FILE_HEADER)
+                .map_err(RunsFileError)?;
         let fail = |problems: Vec<(Origin, Problem)>| {
             RunsFileError(Diagnostics::located(file, text, problems).expect("a problem"))
         };
@@ -339,8 +335,8 @@ struct RunColumns {
 type Located = Box<(Origin, Problem)>;
 
 #[cfg(feature = "csv")]
-fn located(origin: &Origin, text: String, label: &'static str, code: &'static str) -> Located {
-    Box::new((origin.clone(), Message::new(text, label, code).into()))
+fn located(origin: &Origin, problem: impl Into<Problem>) -> Located {
+    Box::new((origin.clone(), problem.into()))
 }
 
 #[cfg(feature = "csv")]
@@ -349,14 +345,11 @@ impl RunColumns {
         let mut problems = Vec::new();
         for (name, origin) in &csv.header {
             if !COLUMNS.contains(&name.as_str()) {
-                let message = Message::new(
-                    format!("column `{name}` is not a column of a positioning run file"),
-                    "unknown column",
-                    "chain::positioning::unknown_column",
-                )
-                .suggest(closest(name, COLUMNS.iter().copied()))
-                .help(HEADER_HELP);
-                problems.push((origin.clone(), message.into()));
+                let problem = P::UnknownColumn {
+                    column: name.clone(),
+                    suggestion: closest(name, COLUMNS.iter().copied()).map(str::to_string),
+                };
+                problems.push((origin.clone(), problem.into()));
             }
         }
         let header = csv.header_origin();
@@ -367,37 +360,25 @@ impl RunColumns {
                 missing.push(name);
             }
         }
+        let mut no_value = false;
         let value = match (find("measured"), find("deviation")) {
             (Some(m), None) => Some((m, true)),
             (None, Some(d)) => Some((d, false)),
             (Some(m), Some(d)) => {
-                problems.push(*located(
-                    &csv.header[m.max(d)].1,
-                    "the header has both `measured` and `deviation`: give exactly one".into(),
-                    "both",
-                    "chain::positioning::value_columns",
-                ));
+                problems.push(*located(&csv.header[m.max(d)].1, P::BothValueColumns));
                 None
             }
             (None, None) => {
-                missing.push("measured` or `deviation");
+                no_value = true;
                 None
             }
         };
-        if !missing.is_empty() {
-            problems.push(*located(
-                &header,
-                format!(
-                    "the header has no column {}",
-                    missing
-                        .iter()
-                        .map(|n| format!("`{n}`"))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
-                "missing column",
-                "chain::positioning::missing_column",
-            ));
+        if !missing.is_empty() || no_value {
+            let problem = P::MissingColumns {
+                columns: missing,
+                value: no_value,
+            };
+            problems.push(*located(&header, problem));
         }
         match (find("target"), find("direction"), find("run"), value) {
             (Some(target), Some(direction), Some(run), Some(value)) if problems.is_empty() => {
@@ -415,51 +396,29 @@ impl RunColumns {
     fn cell(&self, row: &[(String, Origin)]) -> Result<Cell, Located> {
         let number = |c: usize| -> Result<f64, Located> {
             let (text, origin) = &row[c];
-            crate::tabular::number(text, &origin.key).map_err(|problem| {
-                located(origin, problem.to_string(), problem.label(), problem.code())
-            })
+            crate::tabular::number(text, &origin.key).map_err(|problem| located(origin, problem))
         };
         let target = number(self.target)?;
         let (dtext, dorigin) = &row[self.direction];
         let direction = Direction::parse(dtext).ok_or_else(|| {
-            let text = if dtext.is_empty() {
-                "column `direction`: the cell is empty".to_string()
-            } else {
-                format!("column `direction`: `{dtext}` is not a direction")
-            };
-            Box::new((
-                dorigin.clone(),
-                Message::new(text, "direction", "chain::positioning::direction")
-                    .help("a direction is `up` (or `+`, approached moving in the positive direction) or `down` (or `-`)")
-                    .into(),
-            ))
+            let text = dtext.clone();
+            located(dorigin, P::Direction { text })
         })?;
         let (rtext, rorigin) = &row[self.run];
         // A whole number ≥ 1, also as a spreadsheet writes it (`2.0`).
         let run = match rtext.parse::<f64>() {
             Ok(j) if (1.0..=MAX_RUN).contains(&j) && j == j.trunc() => j as usize,
             _ => {
-                let text = if rtext.is_empty() {
-                    "column `run`: the cell is empty".to_string()
-                } else {
-                    format!("column `run`: `{rtext}` is not a run number 1, 2, …")
-                };
-                return Err(located(rorigin, text, "run", "chain::positioning::run"));
+                let text = rtext.clone();
+                return Err(located(rorigin, P::Run { text }));
             }
         };
         let (column, measured) = self.value;
         let value = number(column)?;
         let deviation = if measured { value - target } else { value };
         if !deviation.is_finite() {
-            return Err(located(
-                &row[column].1,
-                format!(
-                    "column `measured`: `{}` minus the target is not finite",
-                    row[column].0
-                ),
-                "not finite",
-                "chain::csv::not_finite",
-            ));
+            let cell = row[column].0.clone();
+            return Err(located(&row[column].1, P::DeviationNotFinite { cell }));
         }
         Ok(Cell {
             target,
@@ -488,18 +447,13 @@ fn group(mut cells: Vec<Cell>, kind: AxisKind, file: &str) -> Result<Runs, Locat
             } else {
                 (&w[1], &w[0])
             };
-            return Err(located(
-                &second.run_origin,
-                format!(
-                    "target {}, direction {}, run {} is given twice (first on line {})",
-                    first.target,
-                    first.direction.name(),
-                    first.run,
-                    first.run_origin.line
-                ),
-                "repeated",
-                "chain::positioning::repeated",
-            ));
+            let problem = P::Repeated {
+                target: first.target,
+                direction: first.direction,
+                run: first.run,
+                first_line: first.run_origin.line,
+            };
+            return Err(located(&second.run_origin, problem));
         }
     }
     // One chunk per target, its up rows first (sorted above).
@@ -515,16 +469,11 @@ fn group(mut cells: Vec<Cell>, kind: AxisKind, file: &str) -> Result<Runs, Locat
     }
     if targets.len() < 2 {
         let only = first_of(&targets[0]);
-        return Err(located(
-            &only.target_origin,
-            format!(
-                "the file has {} target ({}): an ISO 230-2 run needs at least 2",
-                targets.len(),
-                only.target
-            ),
-            "one target",
-            "chain::positioning::too_few_targets",
-        ));
+        let problem = P::TooFewTargets {
+            count: targets.len(),
+            target: only.target,
+        };
+        return Err(located(&only.target_origin, problem));
     }
     // n: the most runs any (target, direction) has; each must have 1..=n.
     let runs = targets
@@ -537,31 +486,21 @@ fn group(mut cells: Vec<Cell>, kind: AxisKind, file: &str) -> Result<Runs, Locat
             let missing = (1..=runs).find(|j| !list.iter().any(|c| c.run == *j));
             if let Some(j) = missing {
                 let first = first_of(t);
-                return Err(located(
-                    &first.target_origin,
-                    format!(
-                        "target {} has {} run(s) {} and {} {}, no run {j} {}: every target needs the same runs 1..{runs} in both directions",
-                        first.target,
-                        t.0.len(),
-                        Direction::Up.name(),
-                        t.1.len(),
-                        Direction::Down.name(),
-                        dir.name(),
-                    ),
-                    "unequal runs",
-                    "chain::positioning::unequal_runs",
-                ));
+                let problem = P::UnequalRuns {
+                    target: first.target,
+                    up: t.0.len(),
+                    down: t.1.len(),
+                    missing: j,
+                    direction: *dir,
+                    runs,
+                };
+                return Err(located(&first.target_origin, problem));
             }
         }
     }
     if runs < 2 {
         let first = first_of(&targets[0]);
-        return Err(located(
-            &first.run_origin,
-            format!("the file has {runs} run per direction: the standard uncertainty s needs at least 2 (ISO 230-2 asks for 5)"),
-            "one run",
-            "chain::positioning::too_few_runs",
-        ));
+        return Err(located(&first.run_origin, P::TooFewRuns { runs }));
     }
     let targets = targets
         .iter()

@@ -1,5 +1,5 @@
-//! Allocation against the whole-machine acceptance probability
-//! (`chain allocate --target acceptance --level L`, spec reliability-v2 §4):
+//! Allocation against the whole-machine acceptance probability reaching a
+//! level `L` (spec reliability-v2 §4):
 //! the same two strategies as the requirement target, with the acceptance
 //! probability `P(σ)` of [`crate::acceptance`] and its sensitivities
 //! `∂P/∂σ` in place of the per-case FORM reliabilities.

@@ -76,16 +76,16 @@ impl GridUse {
     }
 
     /// The allocation, as a message names it.
-    fn name(self) -> &'static str {
+    pub fn name(self) -> &'static str {
         match self {
-            GridUse::Optimal => "the least-cost allocation (--strategy optimal)",
-            GridUse::Paper => "the paper's tightening (--strategy paper)",
-            GridUse::Acceptance => "the allocation for the acceptance (--target acceptance)",
+            GridUse::Optimal => "the least-cost allocation",
+            GridUse::Paper => "the paper's tightening",
+            GridUse::Acceptance => "the allocation for the acceptance",
         }
     }
 
     /// Why it has a limit.
-    fn why(self) -> &'static str {
+    pub fn why(self) -> &'static str {
         match self {
             GridUse::Optimal => {
                 "its interior-point method carries a constraint per point and component: 40 s at 43,000 points, growing faster than the grid"
@@ -100,11 +100,16 @@ impl GridUse {
     }
 }
 
+impl std::fmt::Display for GridUse {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// Refuses a machine whose reliability grid is larger than `what` takes
 /// ([`GridUse::limit`]), from the machine file alone: before the model is
-/// derived, with the advice to allocate on a coarser grid and check the
-/// result on the fine one. A machine without a
-/// reliability section passes (the study refuses it).
+/// derived. A machine without a reliability section passes (the study
+/// refuses it).
 pub fn check_grid(machine: &Machine, what: GridUse) -> Result<(), ReliabilityError> {
     let Some(r) = &machine.reliability else {
         return Ok(());
@@ -114,8 +119,7 @@ pub fn check_grid(machine: &Machine, what: GridUse) -> Result<(), ReliabilityErr
         return Err(ReliabilityError::GridTooLarge {
             points,
             limit: what.limit(),
-            strategy: what.name(),
-            why: what.why(),
+            allocation: what,
             origin: r.origin.clone(),
         });
     }
@@ -304,8 +308,8 @@ pub struct Allocation {
     pub summaries: Vec<Summary>,
     /// The KKT check (optimal strategy).
     pub kkt: Option<Kkt>,
-    /// The acceptance target's outcome (`--target acceptance`; then `met`
-    /// is whether the level is reached).
+    /// The acceptance target's outcome ([`acceptance()`]; then `met` is
+    /// whether the level is reached).
     pub acceptance: Option<AcceptanceAllocation>,
 }
 
@@ -342,25 +346,21 @@ impl Allocation {
 
 /// Why an allocation failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[cfg_attr(feature = "miette", derive(miette::Diagnostic))]
 pub enum AllocateError {
     /// From the reliability engine.
     #[error(transparent)]
-    #[cfg_attr(feature = "miette", diagnostic(code(chain::allocate::reliability)))]
     Reliability(#[from] ReliabilityError),
     /// The machine has no `requirement`.
     #[error("the reliability section has no `requirement` (min and mean) to allocate for")]
-    #[cfg_attr(
-        feature = "miette",
-        diagnostic(
-            code(chain::allocate::no_requirement),
-            help("add, e.g., `requirement: {{min: 0.95, mean: 0.97}}` to the reliability section")
-        )
-    )]
     NoRequirement,
+    /// The least-cost allocation takes normal inputs only.
+    #[error("the optimal allocation needs normal inputs; `{error}` is not normal")]
+    NotNormal {
+        /// The first error parameter whose input is not normal.
+        error: String,
+    },
     /// A setting the strategy does not handle.
     #[error("{0}")]
-    #[cfg_attr(feature = "miette", diagnostic(code(chain::allocate::unsupported)))]
     Unsupported(String),
     /// The requirement cannot be met within the bounds.
     #[error(
@@ -369,13 +369,6 @@ pub enum AllocateError {
         best * 100.0,
         required * 100.0,
         binding.join(", ")
-    )]
-    #[cfg_attr(
-        feature = "miette",
-        diagnostic(
-            code(chain::allocate::infeasible),
-            help("lower the requirement, or lower (remove) `min_std` of the binding errors")
-        )
     )]
     Infeasible {
         /// The component.
@@ -394,13 +387,6 @@ pub enum AllocateError {
     },
     /// The paper's procedure can tighten nothing more.
     #[error("the paper's procedure stops after round {round}: {component} misses the requirement and none of its errors can be tightened further ({} at min_std or zero)", errors.join(", "))]
-    #[cfg_attr(
-        feature = "miette",
-        diagnostic(
-            code(chain::allocate::stalled),
-            help("lower (remove) `min_std` of its errors, or use `--strategy optimal`")
-        )
-    )]
     Stalled {
         /// The last round.
         round: usize,
@@ -411,7 +397,6 @@ pub enum AllocateError {
     },
     /// The optimiser did not converge.
     #[error("the optimiser did not converge: {0}")]
-    #[cfg_attr(feature = "miette", diagnostic(code(chain::allocate::not_converged)))]
     NotConverged(String),
 }
 
@@ -428,6 +413,48 @@ impl AllocateError {
             }
             _ => None,
         }
+    }
+
+    /// The code of the refusal (`chain::allocate::…`).
+    pub fn code(&self) -> &'static str {
+        match self {
+            AllocateError::Reliability(_) => "chain::allocate::reliability",
+            AllocateError::NoRequirement => "chain::allocate::no_requirement",
+            AllocateError::NotNormal { .. } | AllocateError::Unsupported(_) => {
+                "chain::allocate::unsupported"
+            }
+            AllocateError::Infeasible { .. } => "chain::allocate::infeasible",
+            AllocateError::Stalled { .. } => "chain::allocate::stalled",
+            AllocateError::NotConverged(_) => "chain::allocate::not_converged",
+        }
+    }
+
+    /// What to do about it, in the terms of this crate, where there is
+    /// something to say.
+    pub fn help(&self) -> Option<&'static str> {
+        match self {
+            AllocateError::NoRequirement => {
+                Some("add, e.g., `requirement: {min: 0.95, mean: 0.97}` to the reliability section")
+            }
+            AllocateError::Infeasible { .. } => {
+                Some("lower the requirement, or lower (remove) `min_std` of the binding errors")
+            }
+            AllocateError::Stalled { .. } => {
+                Some("lower (remove) `min_std` of its errors, or use the least-cost allocation")
+            }
+            _ => None,
+        }
+    }
+}
+
+#[cfg(feature = "miette")]
+impl miette::Diagnostic for AllocateError {
+    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        Some(Box::new(AllocateError::code(self)))
+    }
+
+    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        AllocateError::help(self).map(|h| Box::new(h) as Box<dyn std::fmt::Display>)
     }
 }
 

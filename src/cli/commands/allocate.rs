@@ -9,40 +9,13 @@
 use std::path::PathBuf;
 
 use chain::ops::allocate::{self as ops, AllocateOpsError, AllocateRequest, AllocationTarget};
+use chain::ops::choice::{parser, Rank};
 use miette::MietteDiagnostic;
-use reliability::allocate::{self, StrategyName};
+use reliability::allocate::StrategyName;
 
 use crate::cli::args::ModelArgs;
 use crate::cli::loaded::Loaded;
-use crate::cli::plot::allocate as allocate_plot;
-use crate::cli::report;
-
-/// `--strategy`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum StrategyArg {
-    /// Least cost `Σ w (σ0/σ − 1)` subject to the requirement (interior point + KKT check).
-    Optimal,
-    /// Wang & Yuan 2021's procedure: tighten the errors within 10 % of the largest sensitivity by one step a round.
-    Paper,
-}
-
-/// `--rank` of the paper's procedure.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum RankArg {
-    /// Rank each unmet component's errors separately (Wang & Yuan 2021, Tables 5-7).
-    Component,
-    /// Rank the summed sensitivities of all unmet components.
-    Pooled,
-}
-
-/// `--target`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum TargetArg {
-    /// The reliability section's `requirement` (minimum and mean over the grid, per component).
-    Requirement,
-    /// The whole-machine acceptance probability reaches `--level` (docs/acceptance.md).
-    Acceptance,
-}
+use crate::cli::{plot, report};
 
 /// Output formats of `chain allocate`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -67,8 +40,8 @@ pub struct AllocateArgs {
     /// Machine file (YAML) with `statistics` and a `reliability` section with a `requirement`.
     pub file: PathBuf,
     /// Allocation strategy.
-    #[arg(long, value_enum, default_value = "optimal")]
-    pub strategy: StrategyArg,
+    #[arg(long, value_parser = parser::<StrategyName>(), default_value = "optimal")]
+    pub strategy: StrategyName,
     /// Step of `--strategy paper` in the tolerance units of Wang & Yuan 2021's Table 1 (σ decreases by
     /// step/6 mm, step/6000 rad for angular and step/3000 rad for squareness errors).
     #[arg(long, value_name = "TOL", default_value_t = 0.005)]
@@ -77,11 +50,11 @@ pub struct AllocateArgs {
     #[arg(long, default_value_t = 0.1, value_parser = threshold, allow_negative_numbers = true)]
     pub threshold: f64,
     /// Ranking of `--strategy paper`.
-    #[arg(long, value_enum, default_value = "component")]
-    pub rank: RankArg,
+    #[arg(long, value_parser = parser::<Rank>(), default_value = "component")]
+    pub rank: Rank,
     /// What to allocate for.
-    #[arg(long, value_enum, default_value = "requirement")]
-    pub target: TargetArg,
+    #[arg(long, value_parser = parser::<AllocationTarget>(), default_value = "requirement")]
+    pub target: AllocationTarget,
     /// The acceptance probability to reach with `--target acceptance`, in (0, 1).
     #[arg(long, value_name = "L")]
     pub level: Option<f64>,
@@ -99,48 +72,28 @@ pub struct AllocateArgs {
 /// Runs `chain allocate` ([`chain::ops::allocate`]).
 pub fn exec(args: AllocateArgs) -> miette::Result<()> {
     let request = AllocateRequest {
-        strategy: match args.strategy {
-            StrategyArg::Optimal => StrategyName::Optimal,
-            StrategyArg::Paper => StrategyName::Paper,
-        },
+        strategy: args.strategy,
         step: args.step,
         threshold: args.threshold,
-        pooled: args.rank == RankArg::Pooled,
-        target: match args.target {
-            TargetArg::Requirement => AllocationTarget::Requirement,
-            TargetArg::Acceptance => AllocationTarget::Acceptance,
-        },
+        pooled: args.rank.pooled(),
+        target: args.target,
         level: args.level,
         params: &args.model.param.params,
-        sided: args.model.sided.map(Into::into),
+        sided: args.model.sided,
     };
     ops::check(&request)?;
     let loaded = Loaded::new(&args.file)?;
     let run = ops::run(&loaded.machine, loaded.file_name(), &request).map_err(|e| match e {
         AllocateOpsError::Study(e) => loaded.study_error(*e),
         AllocateOpsError::Reliability(e) => loaded.report(e),
-        e => loaded.allocate_error(e),
+        e => match e.location() {
+            Some((origin, label)) => loaded.located(&e, origin, label),
+            None => miette::Report::new(e),
+        },
     })?;
     if let Some(dir) = &args.plot {
-        let stds: Vec<f64> = run.result.std.iter().map(|(_, s)| *s).collect();
-        let before = (run.study)
-            .run(
-                &reliability::Algorithm::Form(reliability::Form::default()),
-                &(),
-            )
-            .map_err(|e| loaded.report(e))?;
-        let (_, after) = allocate::evaluate(&run.model, &run.parameters, &run.study, &stds)
-            .map_err(|e| loaded.report(e))?;
-        let files = allocate_plot::write_all(
-            dir,
-            &run.machine,
-            &run.study,
-            &run.bounds,
-            &run.result,
-            &before,
-            &after,
-        )?;
-        for f in files {
+        let charts = chain::plot::allocate::charts(&run).map_err(|e| loaded.report(e))?;
+        for f in plot::write(dir, &charts)? {
             eprintln!("wrote {}", f.display());
         }
     }

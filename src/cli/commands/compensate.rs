@@ -6,9 +6,7 @@ use std::path::PathBuf;
 use chain::compensate::{self, CompensateError, Grid, Options, SelectionRule};
 use chain::ops::{self, compensate::CompensateRequest, compensate::TableRequest};
 
-use crate::cli::report;
-
-use crate::cli::plot::compensate as compensate_plot;
+use crate::cli::{plot, report};
 
 /// Output format of `chain compensate`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -17,30 +15,6 @@ pub enum Format {
     Table,
     /// The JSON document of the spec (section 3), on stdout only.
     Json,
-}
-
-/// Order-selection rule (see docs/compensation.md).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Select {
-    /// Smallest leave-one-out cross-validation error (default).
-    Loocv,
-    /// Largest adjusted R².
-    AdjustedR2,
-    /// Smallest small-sample AIC.
-    Aicc,
-    /// Smallest BIC.
-    Bic,
-}
-
-impl From<Select> for SelectionRule {
-    fn from(s: Select) -> Self {
-        match s {
-            Select::Loocv => SelectionRule::Loocv,
-            Select::AdjustedR2 => SelectionRule::AdjustedR2,
-            Select::Aicc => SelectionRule::Aicc,
-            Select::Bic => SelectionRule::Bic,
-        }
-    }
 }
 
 /// Identify a swing-angle error from tool-tip heights measured at commanded
@@ -65,8 +39,8 @@ pub struct CompensateArgs {
     #[arg(long, default_value_t = 2, value_name = "N")]
     pub min_order: usize,
     /// Rule that selects the order of the compensation law.
-    #[arg(long, value_enum, default_value_t = Select::Loocv)]
-    pub select: Select,
+    #[arg(long, value_parser = chain::ops::choice::parser::<SelectionRule>(), default_value = "loocv")]
+    pub select: SelectionRule,
     /// Use this order for the law instead of the rule's choice.
     #[arg(long, value_name = "N")]
     pub order: Option<usize>,
@@ -95,13 +69,13 @@ pub fn exec(args: CompensateArgs) -> miette::Result<()> {
     if args.grid.is_some() && args.table_out.is_none() {
         return Err(miette::miette!("--grid needs --table-out FILE.csv"));
     }
-    let measurements = compensate::records::read_measurements(&args.file)?;
+    let measurements = ops::source::read_swing(ops::source::Source::Path(&args.file))?;
     let request = CompensateRequest {
         options: Options {
             length: args.length,
             min_order: args.min_order,
             max_order: args.max_order,
-            rule: args.select.into(),
+            rule: args.select,
             fixed_order: args.order,
         },
         table: args.table_out.as_ref().map(|_| TableRequest {
@@ -122,7 +96,7 @@ pub fn exec(args: CompensateArgs) -> miette::Result<()> {
         run.written.push(out.display().to_string());
     }
     if let Some(dir) = &args.plot {
-        let plots = compensate_plot::write_plots(&run.analysis, dir)?;
+        let plots = plot::write(dir, &chain::plot::compensate::charts(&run.analysis))?;
         run.written
             .extend(plots.iter().map(|p| p.display().to_string()));
     }

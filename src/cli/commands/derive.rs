@@ -23,23 +23,14 @@ pub enum DeriveFormat {
     Rust,
 }
 
-/// The frame override of `--frame`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum FrameArg {
-    /// The tool frame.
-    Tool,
-    /// The workpiece frame.
-    Workpiece,
-}
-
 /// Arguments of `chain derive`.
 #[derive(Debug, clap::Args)]
 pub struct DeriveArgs {
     /// Machine file (YAML).
     pub file: PathBuf,
     /// Frame of `p` and `o` (default: the file's `frame`).
-    #[arg(long, value_enum)]
-    pub frame: Option<FrameArg>,
+    #[arg(long, value_parser = chain::ops::choice::parser::<Frame>())]
+    pub frame: Option<Frame>,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: DeriveFormat,
@@ -48,12 +39,7 @@ pub struct DeriveArgs {
 /// Runs `chain derive` ([`chain::ops::derive`]).
 pub fn exec(args: DeriveArgs) -> miette::Result<()> {
     let machine = chain_core::load_file(&args.file)?;
-    let request = DeriveRequest {
-        frame: args.frame.map(|f| match f {
-            FrameArg::Tool => Frame::Tool,
-            FrameArg::Workpiece => Frame::Workpiece,
-        }),
-    };
+    let request = DeriveRequest { frame: args.frame };
     let derivation = derive::run(&machine, &request);
     let model = &derivation.model;
     let out = match args.format {

@@ -22,12 +22,13 @@
 use std::path::PathBuf;
 
 use chain::ops::export::{self, ExportController, ExportOpsError, ExportRequest};
+use chain::ops::resolve::AxisPoints;
+use chain::ops::source::{self, Source};
 use chain_core::compensation::ExportedFile;
-use chain_core::values::Values;
 use miette::MietteDiagnostic;
 
+use crate::cli::args::parse_grid_axis;
 use crate::cli::args::ParamArgs;
-use crate::cli::args::{parse_grid_axis, ControllerName};
 use crate::cli::csv_input::axes_points;
 use crate::cli::loaded::Loaded;
 use crate::cli::report;
@@ -54,8 +55,8 @@ pub struct ExportArgs {
     #[arg(long, value_name = "VALUES.yaml")]
     pub values: PathBuf,
     /// The controller to write for.
-    #[arg(long, value_enum)]
-    pub controller: ControllerName,
+    #[arg(long, value_parser = chain::ops::choice::parser::<ExportController>())]
+    pub controller: ExportController,
     /// Replace (or add) the grid values of one axis: `VAR=V1,V2,...`, or
     /// `VAR=LO:HI:N` (repeatable). For the per-axis table formats it gives
     /// the axis's travel (its smallest and largest value; any further
@@ -65,7 +66,7 @@ pub struct ExportArgs {
     /// Nodes from a CSV of commanded poses instead of the grid: a header
     /// naming every axis variable (rotary in radians), an optional leading
     /// `t`; `-` reads stdin.
-    #[arg(long, value_name = "AXES.csv", conflicts_with = "grid")]
+    #[arg(long, value_name = "AXES.csv")]
     pub axes: Option<PathBuf>,
     /// The largest table step (mm) of the per-axis table formats: each
     /// axis is sampled at the largest step not above it that divides its
@@ -94,21 +95,18 @@ pub struct ExportArgs {
 
 /// Runs `chain export` ([`chain::ops::export`]).
 pub fn exec(args: ExportArgs) -> miette::Result<()> {
-    let controller = ExportController::from(args.controller);
+    let controller = args.controller;
+    // The rows are read once the machine is: the options refuse `--axes`
+    // with `--grid` or a per-axis format before anything is read.
+    let rows = (args.axes.as_ref()).map(|p| (p.display().to_string(), Vec::new()));
     let mut request = ExportRequest {
         controller,
         params: &args.param.params,
-        grid: &args.grid,
-        rows: None,
+        points: AxisPoints::new(&args.grid, rows)?,
         step: args.step,
         cec_max_points: args.cec_max_points,
         beckhoff_max_records: args.beckhoff_max_records,
     };
-    let rows_name = args.axes.as_ref().map(|p| p.display().to_string());
-    if let Some(name) = &rows_name {
-        // Refused by `export::check` before the file is read.
-        request.rows = Some((name, Vec::new()));
-    }
     export::check(&request)?;
     if controller != ExportController::Grid && args.format == Some(ExportFormat::Csv) {
         let d = MietteDiagnostic::new(format!(
@@ -121,9 +119,9 @@ pub fn exec(args: ExportArgs) -> miette::Result<()> {
     }
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
-    let values = Values::read(&args.values, m)?;
-    if let (Some(path), Some(name)) = (&args.axes, &rows_name) {
-        request.rows = Some((name, axes_points(path, m)?));
+    let values = source::read_values(Source::Path(&args.values), m)?;
+    if let (Some(path), AxisPoints::Rows { values: rows, .. }) = (&args.axes, &mut request.points) {
+        *rows = axes_points(path, m)?;
     }
     let file = args.file.display().to_string();
     let values_file = args.values.display().to_string();

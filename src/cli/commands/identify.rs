@@ -13,7 +13,7 @@
 use std::path::PathBuf;
 
 use chain::ops::identify::IdentifyRequest;
-use chain::ops::tables::Source;
+use chain::ops::source::Source;
 
 use crate::cli::args::ParamArgs;
 use crate::cli::loaded::Loaded;

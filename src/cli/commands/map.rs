@@ -15,16 +15,16 @@
 //! next to the uncompensated map (table, JSON `compensated`, CSV columns
 //! `*_after`, plots in `DIR/compensated/`).
 
-use crate::cli::plot::map as map_plot;
-
 use std::path::PathBuf;
 
 use chain::ops::export::ExportController;
-use chain::ops::map::{CompensationRequest, MapOpsError, MapPoints, MapRequest};
-use chain_core::values::{parse_approaches, Approach, Values};
+use chain::ops::map::{CompensationRequest, MapOpsError, MapRequest};
+use chain::ops::resolve::AxisPoints;
+use chain::ops::source::{self, Source};
+use chain_core::values::{parse_approaches, Approach};
 
+use crate::cli::args::parse_grid_axis;
 use crate::cli::args::ParamArgs;
-use crate::cli::args::{parse_grid_axis, ControllerName};
 use crate::cli::csv_input::axes_points;
 use crate::cli::loaded::Loaded;
 use crate::cli::progress::Progress;
@@ -68,7 +68,7 @@ pub struct MapArgs {
     /// Points from a CSV instead of the grid: a header naming every axis
     /// variable (any order; rotary ones in radians), an optional leading
     /// column `t`; `-` reads stdin.
-    #[arg(long, value_name = "AXES.csv", conflicts_with = "grid")]
+    #[arg(long, value_name = "AXES.csv")]
     pub axes: Option<PathBuf>,
     #[command(flatten)]
     pub param: ParamArgs,
@@ -81,8 +81,8 @@ pub struct MapArgs {
     pub plot: Option<PathBuf>,
     /// Also map the error left after this controller's compensation
     /// (exported from the same values; see docs/export.md).
-    #[arg(long, value_enum, value_name = "CONTROLLER")]
-    pub compensated: Option<ControllerName>,
+    #[arg(long, value_parser = chain::ops::choice::parser::<ExportController>(), value_name = "CONTROLLER")]
+    pub compensated: Option<ExportController>,
     /// The grid the `grid` correction is exported on, per axis (default:
     /// the map's grid, or the machine file's with --axes; repeatable). For
     /// the per-axis table formats: the travel of the axis's table (its
@@ -102,23 +102,23 @@ pub struct MapArgs {
 
 /// Runs `chain map` ([`chain::ops::map`]).
 pub fn exec(args: MapArgs) -> miette::Result<()> {
+    // The rows are read once the machine is: `AxisPoints::new` refuses
+    // `--axes` with `--grid` before anything is read.
+    let rows = (args.axes.as_ref()).map(|p| (p.display().to_string(), Vec::new()));
+    let mut points = AxisPoints::new(&args.grid, rows)?;
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
-    let values = Values::read(&args.values, m)?;
+    let values = source::read_values(Source::Path(&args.values), m)?;
     let choices: Vec<_> = args.approach.iter().flatten().cloned().collect();
-    let (points, input_name) = match &args.axes {
-        Some(path) => (
-            MapPoints::Rows(axes_points(path, m)?),
-            path.display().to_string(),
-        ),
-        None => (MapPoints::Grid(&args.grid), String::new()),
-    };
+    if let (Some(path), AxisPoints::Rows { values: rows, .. }) = (&args.axes, &mut points) {
+        *rows = axes_points(path, m)?;
+    }
     let mut request = MapRequest {
         params: &args.param.params,
         approach: &choices,
         points,
-        compensated: args.compensated.map(|c| CompensationRequest {
-            controller: ExportController::from(c),
+        compensated: args.compensated.map(|controller| CompensationRequest {
+            controller,
             grid: &args.compensation_grid,
             step: args.compensation_step,
         }),
@@ -130,8 +130,8 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
     };
     let file = args.file.display().to_string();
     let values_file = args.values.display().to_string();
-    let prepared = chain::ops::map::prepare(m, &file, values, &values_file, &input_name, &request)
-        .map_err(report)?;
+    let prepared =
+        chain::ops::map::prepare(m, &file, values, &values_file, &request).map_err(report)?;
     let count = prepared.points.len();
     // The table of a large map shows the summary only: it needs no point's
     // error kept (the plots and the other formats do).
@@ -142,17 +142,10 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
     let doc = prepared.run(m, &request, &|n| bar.inc(n as u64));
     bar.finish();
     let doc = doc.map_err(report)?;
-    if let (Some(dir), Some(r)) = (&args.plot, doc.full()) {
-        let built = &prepared.built;
-        for f in map_plot::write_all(dir, r, &doc.input, built)? {
+    if let Some(dir) = &args.plot {
+        let charts = chain::plot::map::charts(&doc, &prepared.built);
+        for f in crate::cli::plot::write(dir, &charts)? {
             eprintln!("wrote {}", f.display());
-        }
-        if let Some(c) = &doc.compensated {
-            let mut r = c.result.clone();
-            r.machine = format!("{} compensated ({})", doc.machine, c.controller);
-            for f in map_plot::write_all(&dir.join("compensated"), &r, &doc.input, built)? {
-                eprintln!("wrote {}", f.display());
-            }
         }
     }
     report::emit(&doc, args.format.into())

@@ -8,15 +8,13 @@
 //! instant, and their Maclaurin expansion at `t = 0` with its truncation error
 //! over the roll and the order a tolerance needs.
 
-use crate::cli::plot::motion as motion_plot;
-
 use std::path::PathBuf;
 
-use chain::ops::motion::{self, MotionDocument, MotionRequest};
-use chain_core::settings;
+use chain::ops::motion::{self, MotionRequest};
+use chain::ops::source::{self, Source};
 
-use crate::cli::args::parse_assignment;
-use crate::cli::report;
+use crate::cli::args::{parse_assignment, parse_param};
+use crate::cli::{plot, report};
 
 /// Output formats of `chain motion`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -70,7 +68,7 @@ pub struct MotionArgs {
     pub plot: Option<PathBuf>,
     /// Value of a CNC machine parameter, `NAME=VALUE` (repeatable; overrides
     /// the settings file's `cnc.parameters`).
-    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_assignment)]
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
     pub params: Vec<(String, f64)>,
     /// Hold a CNC variable, `NAME=VALUE` (repeatable): matches the tool point
     /// and axis only (`match: point_axis`), as in face milling with `mu=0`.
@@ -90,11 +88,11 @@ pub fn exec(args: MotionArgs) -> miette::Result<()> {
         fix: &args.fix,
     };
     motion::check(&request)?;
-    let settings = settings::load_settings_file(&args.settings)?;
+    let settings = source::read_settings(Source::Path(&args.settings))?;
     let cnc = chain_core::load_file(&args.file)?;
     let mut doc = motion::run(&cnc, settings, &request)?;
     if let Some(dir) = &args.plot {
-        doc.written = motion_plot::write_all(dir, &view(&doc))?
+        doc.written = plot::write(dir, &chain::plot::motion::charts(&doc))?
             .iter()
             .map(|p| p.display().to_string())
             .collect();
@@ -109,24 +107,3 @@ pub fn exec(args: MotionArgs) -> miette::Result<()> {
 }
 
 report::formats!(MotionFormat: Table, Json, Csv);
-
-/// What the plots draw of a run.
-fn view(doc: &MotionDocument) -> motion_plot::View<'_> {
-    let run = &doc.conversion;
-    motion_plot::View {
-        title: format!(
-            "{} → {} ({})",
-            run.motion.generator_name(),
-            run.motion.cnc_name(),
-            doc.settings.name
-        ),
-        variables: run.motion.variables(),
-        kinds: run.motion.kinds(),
-        times: &run.times,
-        exact: &run.exact,
-        series: &run.series,
-        order: run.order,
-        errors: &run.errors,
-        tolerance: run.required.as_ref().map(|r| r.tolerance.as_slice()),
-    }
-}

@@ -4,8 +4,6 @@
 //! [--format table|json|csv] [--plot DIR]`: error and reliability along a
 //! path ([`chain::ops::path`], docs/path.md).
 
-use crate::cli::plot::path as path_plot;
-
 use std::path::PathBuf;
 
 use chain::ops::path::{self, PathInput, PathOpsError, PathRequest};
@@ -16,7 +14,7 @@ use crate::cli::args::{AlgorithmArgs, ModelArgs, SystemArgs};
 use crate::cli::csv_input::{numeric_table, read_poses};
 use crate::cli::loaded::Loaded;
 use crate::cli::progress::Progress;
-use crate::cli::report;
+use crate::cli::{plot, report};
 
 /// Output formats of `chain path`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -98,7 +96,7 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
     let request = PathRequest {
         params: &args.model.param.params,
         fix: &args.fix,
-        sided: args.model.sided.map(Into::into),
+        sided: args.model.sided,
         system,
         algorithm: args.algorithm.options(),
         input,
@@ -127,7 +125,7 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
         let doc = prepared.run(&|n| bar.inc(n));
         bar.finish();
         let doc = doc.map_err(report)?;
-        for f in path_plot::write_all(dir, &doc)? {
+        for f in plot::write(dir, &chain::plot::path::charts(&doc))? {
             eprintln!("wrote {}", f.display());
         }
         report::emit(&doc.output(), format)?;

@@ -29,17 +29,6 @@ pub enum PlanFormat {
 
 report::formats!(PlanFormat: Table, Json);
 
-/// What each candidate measures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum KindArg {
-    /// The tool-point deviation `px, py, pz` (three rows per candidate); the
-    /// file must not have `ux,uy,uz`.
-    Point,
-    /// The deviation along the candidate's `ux, uy, uz` (one row); the file
-    /// must have them.
-    Direction,
-}
-
 /// Arguments of `chain plan`.
 #[derive(Debug, clap::Args)]
 pub struct PlanArgs {
@@ -57,8 +46,8 @@ pub struct PlanArgs {
     /// What each candidate measures (default: `direction` when the file has
     /// `ux,uy,uz`, else `point`; a `--kind` that contradicts the file is
     /// refused).
-    #[arg(long, value_enum)]
-    pub kind: Option<KindArg>,
+    #[arg(long, value_parser = chain::ops::choice::parser::<Kind>())]
+    pub kind: Option<Kind>,
     #[command(flatten)]
     pub param: ParamArgs,
     /// Output format.
@@ -85,10 +74,7 @@ pub fn exec(args: PlanArgs) -> miette::Result<()> {
     };
     let request = PlanRequest {
         count: args.count,
-        kind: args.kind.map(|k| match k {
-            KindArg::Point => Kind::Point,
-            KindArg::Direction => Kind::Direction,
-        }),
+        kind: args.kind,
     };
     let doc = plan::run(m, &candidates, &request)?;
     report::emit(&doc, args.format.into())

@@ -8,9 +8,7 @@ use std::path::PathBuf;
 use chain::ops::positioning as ops;
 use chain_core::measured::positioning::{Coverage, Runs};
 
-use crate::cli::report;
-
-use crate::cli::plot::positioning as positioning_plot;
+use crate::cli::{plot, report};
 
 /// Output formats of `chain positioning`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -100,7 +98,7 @@ pub fn exec(args: PositioningArgs) -> miette::Result<()> {
         eprintln!("wrote {} ({slot})", out.display());
     }
     if let Some(dir) = &args.plot {
-        for f in positioning_plot::write(dir, &doc)? {
+        for f in plot::write(dir, &chain::plot::positioning::charts(&doc))? {
             eprintln!("wrote {}", f.display());
         }
     }

@@ -13,12 +13,10 @@
 
 use std::path::PathBuf;
 
-use ::reliability::Form;
 use chain::ops::reliability::{self, ReliabilityOpsError, ReliabilityRequest};
 
 use crate::cli::args::{parse_grid_axis, AlgorithmArgs, ModelArgs, SystemArgs};
 use crate::cli::loaded::Loaded;
-use crate::cli::plot::reliability as reliability_plot;
 use crate::cli::progress::Progress;
 use crate::cli::report;
 
@@ -86,7 +84,7 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
     let request = ReliabilityRequest {
         params: &args.model.param.params,
         grid: &args.grid,
-        sided: args.model.sided.map(Into::into),
+        sided: args.model.sided,
         system,
         algorithm: args.algorithm.options(),
         values: args.values.as_deref(),
@@ -119,12 +117,8 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
         eprintln!("{note}");
     }
     if let Some(dir) = &args.plot {
-        let sens = (run.study)
-            .sensitivity_mean(&Form::default())
-            .map_err(|e| loaded.report(e))?;
-        let files =
-            reliability_plot::write_all(dir, &loaded.machine.name, &run.study, &run.result, &sens)?;
-        for f in files {
+        let charts = chain::plot::reliability::charts(&run).map_err(|e| loaded.report(e))?;
+        for f in crate::cli::plot::write(dir, &charts)? {
             eprintln!("wrote {}", f.display());
         }
     }

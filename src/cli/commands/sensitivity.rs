@@ -14,20 +14,15 @@
 //! `--values` giving the nominal error sizes and `--plot DIR` bar charts like
 //! the paper's Figures 3-5 (see `docs/geometric_sensitivity.md`).
 
-use crate::cli::plot::geometric as geometric_plot;
-
 use std::path::PathBuf;
 
 use chain::ops::sensitivity::{
-    self, SensitivityKind as Kind, SensitivityOpsError, SensitivityReport, SensitivityRequest,
-    SensitivityValues,
+    self, SensitivityKind as Kind, SensitivityOpsError, SensitivityRequest, SensitivityValues,
 };
 use chain_core::geometric::NominalSizes;
 
 use crate::cli::args::{parse_grid_axis, parse_point, AtPoint, ModelArgs};
 use crate::cli::loaded::Loaded;
-use crate::cli::plot::reliability as reliability_plot;
-use crate::cli::render::sensitivity::{at_text, where_text};
 use crate::cli::report;
 
 /// What `chain sensitivity` computes.
@@ -116,7 +111,7 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
         },
         at: args.at.as_ref().map(|AtPoint(c)| c.as_slice()),
         params: &args.model.param.params,
-        sided: args.model.sided.map(Into::into),
+        sided: args.model.sided,
         grid: &args.grid,
         values: args.values.as_ref().map(|v| match v {
             ValuesArg::File(f) => SensitivityValues::File(f),
@@ -133,17 +128,8 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
             e => miette::Report::new(e),
         })?;
     if let Some(dir) = &args.plot {
-        let m = &loaded.machine.name;
-        let files = match &doc {
-            SensitivityReport::Reliability(r) => {
-                let where_ = r.at.as_deref().map_or("grid mean".to_string(), at_text);
-                reliability_plot::write_sensitivity(dir, m, &r.inputs, &r.result, &where_)?
-            }
-            SensitivityReport::Geometric(g) => {
-                geometric_plot::write_all(dir, m, &where_text(&g.where_), &g.result)?
-            }
-        };
-        for f in files {
+        let charts = chain::plot::sensitivity::charts(&doc);
+        for f in crate::cli::plot::write(dir, &charts)? {
             eprintln!("wrote {}", f.display());
         }
     }

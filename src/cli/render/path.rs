@@ -6,6 +6,7 @@
 use std::io::{self, Write};
 
 use chain::ops::path::{PathHead, PathOutput};
+use chain::ops::views::quantity_label;
 use reliability::{Extreme, FormCase, PathSummary, Quantity};
 
 use crate::cli::report::{self, Csv, Report};
@@ -129,14 +130,6 @@ fn extreme_text(e: &Extreme, has_t: bool) -> String {
     at_text(e.row, e.t, has_t)
 }
 
-/// `|p|` for the volumetric quantity, the component's name otherwise.
-pub(crate) fn label(q: Quantity) -> &'static str {
-    match q {
-        Quantity::Volumetric => "|p|",
-        Quantity::Component(c) => c.name(),
-    }
-}
-
 /// The table: title, tolerances, one row per instant (axis values, status,
 /// mean and std of the toleranced components and `|p|`, the reliability of
 /// every target), the cases FORM left at its iteration limit, the summary.
@@ -170,7 +163,12 @@ fn write_table(output: &PathOutput<'_>, out: &mut dyn Write) -> io::Result<()> {
     }
     write!(out, "  {:<11}", "status")?;
     for &q in &shown {
-        write!(out, " {:>11} {:>10}", format!("{} mean", label(q)), "std")?;
+        write!(
+            out,
+            " {:>11} {:>10}",
+            format!("{} mean", quantity_label(q)),
+            "std"
+        )?;
     }
     for t in h.target_names() {
         write!(out, " {:>10}", t.name())?;
@@ -256,7 +254,7 @@ fn write_summary(
             writeln!(
                 out,
                 "  {:<10} {what} {} at {}, max std {} at {}",
-                label(q),
+                quantity_label(q),
                 sci(m.value),
                 extreme_text(&m, h.has_t),
                 sci(sd.value),

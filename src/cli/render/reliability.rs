@@ -5,13 +5,12 @@
 //! per (target, point), then the acceptance row.
 
 use chain::ops::reliability::ReliabilityRun;
+use chain::ops::views::target_map;
 use reliability::acceptance::AcceptanceResult;
 use reliability::{normal, CaseTally, Stopping, Study, StudyResult, SubsetLevel};
 
 use crate::cli::report::{Csv, Report};
-use crate::cli::study_text::{
-    calls_text, fmt_num, posterior_lines, requirement_text, sided_title, target_map,
-};
+use crate::cli::study_text::{calls_text, fmt_num, posterior_lines, requirement_text, sided_title};
 
 /// The grid axes in file order, as (name, index in the model's variables).
 fn axes(study: &Study) -> Vec<(String, usize)> {

@@ -2,9 +2,9 @@
 //! list per component, of the reliability sensitivities or the geometric
 //! coefficients.
 
-use chain::ops::sensitivity::{ReliabilitySensitivity, SensitivityReport};
+use chain::ops::sensitivity::{ReliabilitySensitivity, SensitivityDocument, SensitivityReport};
+use chain::ops::views::{at_text, where_text};
 use chain_core::geometric::{GeometricSensitivity, NominalSizes, Where};
-use reliability::document::SensitivityDocument;
 
 use crate::cli::report::Report;
 use crate::cli::study_text::posterior_lines;
@@ -18,17 +18,6 @@ impl Report for SensitivityReport {
             }
         }
     }
-}
-
-/// `at x = 0, y = 1500, z = 600`.
-pub(crate) fn at_text(a: &[(String, f64)]) -> String {
-    format!(
-        "at {}",
-        a.iter()
-            .map(|(n, v)| format!("{n} = {v}"))
-            .collect::<Vec<_>>()
-            .join(", ")
-    )
 }
 
 fn reliability_table(r: &ReliabilitySensitivity) -> String {
@@ -75,22 +64,6 @@ fn reliability_table(r: &ReliabilitySensitivity) -> String {
             }
         }
         out
-    }
-}
-
-pub(crate) fn where_text(w: &Where) -> String {
-    match w {
-        Where::At(a) => format!(
-            "at {}",
-            a.iter()
-                .map(|(n, v)| format!("{n} = {v}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-        Where::Grid(g) => format!(
-            "mean over {} grid points",
-            g.iter().map(|(_, v)| v.len()).product::<usize>()
-        ),
     }
 }
 

@@ -1,8 +1,7 @@
 //! The table and CSV of `chain sobol` ([`SobolRun`]): one table per output
 //! sorted by the total index; one CSV row per output and error.
 
-use chain::ops::sobol::SobolRun;
-use reliability::document::SobolDocument;
+use chain::ops::sobol::{SobolDocument, SobolRun};
 use reliability::sobol::Estimate;
 
 use crate::cli::report::{Csv, Report};

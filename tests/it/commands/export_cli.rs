@@ -332,7 +332,9 @@ fn bad_input_is_refused_clearly() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("[possible values: grid, beckhoff, linuxcnc, siemens-cec, klipper]"),
+        err.contains(
+            "`fanuc` is not a controller: choose one of grid, beckhoff, linuxcnc, siemens-cec, klipper"
+        ),
         "{err}"
     );
     // A machine without the axes or errors a format needs.

@@ -450,7 +450,10 @@ fn points_from_an_axes_file_are_the_grid_points() {
         "--grid",
         "x=1",
     ]);
-    assert!(err.contains("cannot be used with"), "{err}");
+    assert!(
+        err.contains("--grid cannot be combined with --axes"),
+        "{err}"
+    );
 }
 
 /// A values file of one table from the example's x_axis.csv, written in a

@@ -146,7 +146,7 @@ pub(crate) fn read_file(path: &Path, file: &str, limit: usize) -> Result<Vec<u8>
 
 /// The text of a file's bytes: a NUL byte (binary file) or invalid UTF-8 is
 /// a located diagnostic.
-pub(crate) fn decode<'b>(bytes: &'b [u8], file: &str) -> Result<&'b str, Diagnostics> {
+pub fn decode<'b>(bytes: &'b [u8], file: &str) -> Result<&'b str, Diagnostics> {
     if let Some(offset) = bytes.iter().position(|&b| b == 0) {
         return Err(binary(bytes, offset, file));
     }

@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use crate::diagnostic::{Diagnostics, Message, Problem};
+use crate::diagnostic::Diagnostics;
 use crate::model::Origin;
 use crate::tabular::CsvProblem;
 
@@ -106,8 +106,8 @@ impl CsvFile {
             .trim(::csv::Trim::All)
             .comment(Some(b'#'))
             .from_reader(data);
-        let located = |origin: Origin, message: Message| {
-            Diagnostics::single(name, text, origin, Problem::Message(message))
+        let located = |origin: Origin, problem: CsvProblem| {
+            Diagnostics::single(name, text, origin, problem.into())
         };
         let mut header: Vec<(String, Origin)> = Vec::new();
         // The header's names, for the repeated-name check (a hash, not a
@@ -123,12 +123,7 @@ impl CsvFile {
                     }
                     _ => e.to_string(),
                 };
-                let bad = Message::new(
-                    format!("malformed CSV: {message}"),
-                    "malformed",
-                    "chain::values::csv_malformed",
-                );
-                located(line_origin(text, line), bad)
+                located(line_origin(text, line), CsvProblem::Malformed { message })
             })?;
             let Some(pos) = record.position() else {
                 continue;
@@ -180,23 +175,17 @@ impl CsvFile {
                 for (k, field) in record.iter().enumerate() {
                     let origin = cell(k, field);
                     if field.is_empty() {
-                        let empty = Message::new(
-                            format!("column {} of the header has no name", k + 1),
-                            "no name",
-                            "chain::values::csv_header",
-                        )
-                        .help(header_help);
+                        let empty = CsvProblem::UnnamedColumn {
+                            column: k + 1,
+                            header: header_help.to_string(),
+                        };
                         return Err(located(origin, empty));
                     }
                     if let Some(first) = seen.get(field).map(|&i| &header[i].1) {
-                        let twice = Message::new(
-                            format!(
-                                "column `{field}` appears twice in the header (first in column {})",
-                                first.column
-                            ),
-                            "repeated",
-                            "chain::values::csv_header",
-                        );
+                        let twice = CsvProblem::RepeatedColumn {
+                            name: field.to_string(),
+                            first: first.column,
+                        };
                         return Err(located(origin, twice));
                     }
                     seen.insert(field.to_string(), header.len());
@@ -209,8 +198,7 @@ impl CsvFile {
                     fields: record.len(),
                     columns: header.len(),
                 };
-                let width = Message::new(problem.to_string(), problem.label(), problem.code());
-                return Err(located(cell(0, ""), width));
+                return Err(located(cell(0, ""), problem));
             }
             for (k, field) in record.iter().enumerate() {
                 cells.push_str(field);
@@ -223,18 +211,15 @@ impl CsvFile {
             lines.push(line);
         }
         if header.is_empty() {
-            let problem = CsvProblem::Empty;
-            let empty = Message::new(problem.to_string(), problem.label(), problem.code())
-                .help(header_help);
+            let empty = CsvProblem::Empty {
+                header: header_help.to_string(),
+            };
             return Err(located(line_origin(text, 1), empty));
         }
         if lines.is_empty() {
-            let problem = CsvProblem::NoData;
-            let none = Message::new(problem.to_string(), problem.label(), problem.code())
-                .help("each row after the header is one record");
             let first = &header[0].1;
             let origin = line_origin(text, first.line as u64);
-            return Err(located(origin, none));
+            return Err(located(origin, CsvProblem::NoData));
         }
         Ok(CsvFile {
             text: text.to_string(),

@@ -184,10 +184,9 @@ pub(super) fn build(study: &Study, bounds: &[ErrorBounds]) -> Result<Problem, Al
     let req = spec.requirement.ok_or(AllocateError::NoRequirement)?;
     let inputs = study.inputs();
     if let Some(j) = inputs.marginals().iter().position(|m| !m.is_normal()) {
-        return Err(AllocateError::Unsupported(format!(
-            "the optimal allocation needs normal inputs; `{}` is not normal (use --strategy paper)",
-            inputs.names()[j]
-        )));
+        return Err(AllocateError::NotNormal {
+            error: inputs.names()[j].clone(),
+        });
     }
     let np = study.points().len();
     let ne = inputs.len();

@@ -3,42 +3,44 @@
 //! the grid-mean reliability sensitivities `|∂R/∂σ|` (like Figures 6-8), each
 //! as PNG and SVG.
 
-use std::path::{Path, PathBuf};
-
 use plotters::coord::ranged1d::SegmentValue;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use reliability::{Study, StudyResult, TargetSensitivity};
+use reliability::{Form, ReliabilityError, TargetSensitivity};
 
-use super::{viridis, write_both, Area};
-use crate::cli::study_text::target_map;
+use super::{viridis, BarChart, Figures};
+use crate::ops::reliability::ReliabilityRun;
+use crate::ops::sensitivity::ReliabilitySensitivity;
+use crate::ops::views::{at_text, target_map};
 
 const HEAT_SIZE: (u32, u32) = (900, 700);
 const BAR_SIZE: (u32, u32) = (1100, 600);
 
-/// A heat map to draw.
-struct Heat {
-    title: String,
-    rows: (String, Vec<String>),
-    cols: (String, Vec<String>),
+/// A map of labelled cells, each coloured by its value (viridis over the
+/// map's range) and printed with it in %, like the paper's tables.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellMap {
+    /// Caption above the map.
+    pub title: String,
+    /// The vertical axis: its name and one label per row.
+    pub rows: (String, Vec<String>),
+    /// The horizontal axis: its name and one label per column.
+    pub cols: (String, Vec<String>),
     /// Reliability in [0, 1], `values[row][col]`.
-    values: Vec<Vec<f64>>,
+    pub values: Vec<Vec<f64>>,
+    /// Image size in pixels (SVG user units).
+    pub size: (u32, u32),
 }
 
-/// Writes every chart into `dir`; returns the files written.
-pub(crate) fn write_all(
-    dir: &Path,
-    machine: &str,
-    study: &Study,
-    result: &StudyResult,
-    sens: &[TargetSensitivity],
-) -> miette::Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| miette::miette!("{}: cannot create the plot directory: {e}", dir.display()))?;
-    super::ensure_fonts();
+/// The charts of a reliability run: each target's reliability map over the
+/// grid (one per value of a third varying axis) and the grid-mean
+/// reliability sensitivities `|∂R/∂σ|` per target, computed here by FORM.
+pub fn charts(run: &ReliabilityRun) -> Result<Figures, ReliabilityError> {
+    let sens = run.study.sensitivity_mean(&Form::default())?;
+    let (machine, study, result) = (&run.machine, &run.study, &run.result);
     let method = result.method.title();
-    let mut files = Vec::new();
+    let mut figures = Figures::default();
     for (t, target) in study.targets().iter().enumerate() {
         let map = target_map(study, result, t);
         let labels = |axis: &Option<(String, Vec<f64>)>| match axis {
@@ -47,7 +49,7 @@ pub(crate) fn write_all(
         };
         let several = map.maps.len() > 1;
         for (k, (label, values)) in map.maps.iter().enumerate() {
-            let heat = Heat {
+            let heat = CellMap {
                 title: format!(
                     "{machine}: {} reliability (%), {method}{}",
                     target.name(),
@@ -60,42 +62,41 @@ pub(crate) fn write_all(
                 rows: labels(&map.rows),
                 cols: labels(&map.cols),
                 values: values.clone(),
+                size: HEAT_SIZE,
             };
             let stem = if several {
                 format!("reliability_{}_{}", target.name(), k + 1)
             } else {
                 format!("reliability_{}", target.name())
             };
-            files.extend(write_both(dir, &stem, HEAT_SIZE, |root| {
-                draw_heat(root, &heat)
-            })?);
+            figures.push(stem, super::Chart::Cells(heat));
         }
     }
-    files.extend(write_sensitivity(
-        dir,
-        machine,
-        study.inputs().names(),
-        sens,
-        "grid mean",
-    )?);
-    Ok(files)
+    figures
+        .figures
+        .extend(sensitivity_bars(machine, study.inputs().names(), &sens, "grid mean").figures);
+    Ok(figures)
 }
 
-/// Writes one bar chart of `|∂R/∂σ|` per target (`sensitivity_<target>`,
-/// PNG and SVG, like Figures 6-8) into `dir`, the errors in `order` (the
-/// model's error order, as in Table 1); `where_` says where the values hold
-/// (`grid mean`, `at x = 0, …`). Returns the files written.
-pub(crate) fn write_sensitivity(
-    dir: &Path,
+/// The charts of `chain sensitivity --kind reliability`: the bars of
+/// [`sensitivity_bars`] at the document's point or over its grid (`grid
+/// mean`).
+pub fn sensitivity_charts(doc: &ReliabilitySensitivity) -> Figures {
+    let where_ = doc.at.as_deref().map_or("grid mean".to_string(), at_text);
+    sensitivity_bars(&doc.machine, &doc.inputs, &doc.result, &where_)
+}
+
+/// One bar chart of `|∂R/∂σ|` per target (`sensitivity_<target>`, like
+/// Figures 6-8), the errors in `order` (the model's error order, as in
+/// Table 1); `where_` says where the values hold (`grid mean`, `at x = 0,
+/// …`).
+pub fn sensitivity_bars(
     machine: &str,
     order: &[String],
     sens: &[TargetSensitivity],
     where_: &str,
-) -> miette::Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| miette::miette!("{}: cannot create the plot directory: {e}", dir.display()))?;
-    super::ensure_fonts();
-    let mut files = Vec::new();
+) -> Figures {
+    let mut figures = Figures::default();
     for s in sens {
         let values: Vec<f64> = order
             .iter()
@@ -106,9 +107,9 @@ pub(crate) fn write_sensitivity(
                     .map_or(0.0, |e| e.mean_abs_dr_dstd)
             })
             .collect();
-        let chart = super::BarChart {
+        let chart = BarChart {
             size: BAR_SIZE,
-            ..super::BarChart::new(
+            ..BarChart::new(
                 format!(
                     "{machine}: {} reliability sensitivity |∂R/∂σ| ({where_})",
                     s.target
@@ -118,15 +119,20 @@ pub(crate) fn write_sensitivity(
                 values,
             )
         };
-        files.extend(chart.write(dir, &format!("sensitivity_{}", s.target))?);
+        figures.push(format!("sensitivity_{}", s.target), chart);
     }
-    Ok(files)
+    figures
 }
 
-fn draw_heat(area: Area<'_>, heat: &Heat) -> Result<(), String> {
-    match area {
-        Area::Bitmap(a) => heat_on(a, heat),
-        Area::Svg(a) => heat_on(a, heat),
+impl CellMap {
+    pub(super) fn draw<DB: DrawingBackend>(
+        &self,
+        root: DrawingArea<DB, Shift>,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        heat_on(root, self)
     }
 }
 
@@ -134,7 +140,7 @@ fn err<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 
-fn heat_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, heat: &Heat) -> Result<(), String>
+fn heat_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, heat: &CellMap) -> Result<(), String>
 where
     DB::ErrorType: 'static,
 {

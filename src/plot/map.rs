@@ -21,15 +21,13 @@
 //! With one varying axis, or points from `--axes`, `map_position` and
 //! `map_orientation` chart the components along that axis (or the row).
 
-use std::path::{Path, PathBuf};
-
 use chain_core::model::Frame;
 use chain_core::{BuiltMachine, CompiledModel, ErrorModel, MapResult};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{ensure_fonts, ramp, viridis, write_both, Area, Legend, Series, XyChart, GREY};
-use chain::ops::map::MapInput;
+use super::{ramp, viridis, Figures, Legend, Series, XyChart, GREY};
+use crate::ops::map::{MapDocument, MapInput};
 
 const HEAT_SIZE: (u32, u32) = (1000, 760);
 const COMPONENTS: [&str; 6] = chain_core::model::Component::NAMES;
@@ -37,38 +35,53 @@ const COMPONENTS: [&str; 6] = chain_core::model::Component::NAMES;
 const MICRO: [f64; 6] = [1e3, 1e3, 1e3, 1e6, 1e6, 1e6];
 const UNITS: [&str; 6] = ["µm", "µm", "µm", "µrad", "µrad", "µrad"];
 
-/// Writes every chart into `dir`; returns the files written.
-pub(crate) fn write_all(
-    dir: &Path,
+/// The charts of a map document: those of its map, and with
+/// `--compensated` those of the map after compensation under
+/// `compensated/`; none when the document kept no point's error. `built`
+/// is the machine that mapped it (the distorted grid's nominal tool points).
+pub fn charts(doc: &MapDocument, built: &BuiltMachine<CompiledModel>) -> Figures {
+    let Some(r) = doc.full() else {
+        return Figures::default();
+    };
+    let mut figures = result_charts(r, &doc.input, built);
+    if let Some(c) = &doc.compensated {
+        let mut r = c.result.clone();
+        r.machine = format!("{} compensated ({})", doc.machine, c.controller);
+        figures.nest("compensated", result_charts(&r, &doc.input, built));
+    }
+    figures
+}
+
+/// The charts of one map over `input`'s points.
+pub fn result_charts(
     r: &MapResult,
     input: &MapInput,
     built: &BuiltMachine<CompiledModel>,
-) -> miette::Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| miette::miette!("{}: cannot create the plot directory: {e}", dir.display()))?;
-    ensure_fonts();
+) -> Figures {
+    let mut figures = Figures::default();
     match input {
         MapInput::Grid(axes) => {
             let mut by_count: Vec<usize> =
                 (0..axes.len()).filter(|&k| axes[k].1.len() > 1).collect();
             by_count.sort_by_key(|&k| std::cmp::Reverse(axes[k].1.len()));
             match by_count.as_slice() {
-                [a, b, ..] => plane(dir, r, built, axes, *a, *b),
+                [a, b, ..] => plane(&mut figures, r, built, axes, *a, *b),
                 [a] => {
                     let lines = along_axis(axes, *a);
-                    lines_charts(dir, r, &axes[*a].0, &lines, &slice_text(axes, &[*a]))
+                    let slice = slice_text(axes, &[*a]);
+                    lines_charts(&mut figures, r, &axes[*a].0, &lines, &slice);
                 }
-                [] => {
-                    eprintln!("note: the map has one point; no chart written");
-                    Ok(Vec::new())
-                }
+                [] => figures
+                    .notes
+                    .push("note: the map has one point; no chart written".to_string()),
             }
         }
         MapInput::Rows(_) => {
             let lines: Vec<(f64, usize)> = (0..r.len()).map(|i| ((i + 1) as f64, i)).collect();
-            lines_charts(dir, r, "row", &lines, "")
+            lines_charts(&mut figures, r, "row", &lines, "");
         }
     }
+    figures
 }
 
 /// The flat index of a grid node (last axis fastest).
@@ -110,12 +123,12 @@ fn along_axis(axes: &[(String, Vec<f64>)], a: usize) -> Vec<(f64, usize)> {
 
 /// Position and orientation components along one axis (or the row).
 fn lines_charts(
-    dir: &Path,
+    figures: &mut Figures,
     r: &MapResult,
     x_label: &str,
     points: &[(f64, usize)],
     slice: &str,
-) -> miette::Result<Vec<PathBuf>> {
+) {
     let at = if slice.is_empty() {
         String::new()
     } else {
@@ -142,21 +155,20 @@ fn lines_charts(
         .map(|&(x, i)| (x, r.volumetric(i) * 1e3))
         .collect();
     let position = chart("position", "µm", 0..3).series(Series::line("|p|", vol).width(3));
-    let mut files = position.write(dir, "map_position")?;
-    files.extend(chart("orientation", "µrad", 3..6).write(dir, "map_orientation")?);
-    Ok(files)
+    figures.push("map_position", position);
+    figures.push("map_orientation", chart("orientation", "µrad", 3..6));
 }
 
 /// The heat maps and the distorted grid over axes `a` (columns) and `b`
 /// (rows).
 fn plane(
-    dir: &Path,
+    figures: &mut Figures,
     r: &MapResult,
     built: &BuiltMachine<CompiledModel>,
     axes: &[(String, Vec<f64>)],
     a: usize,
     b: usize,
-) -> miette::Result<Vec<PathBuf>> {
+) {
     let slice = slice_text(axes, &[a, b]);
     let at = if slice.is_empty() {
         String::new()
@@ -171,7 +183,6 @@ fn plane(
         flat(&idx, axes)
     };
     let (na, nb) = (axes[a].1.len(), axes[b].1.len());
-    let mut files = Vec::new();
     for c in 0..7 {
         let values: Vec<Vec<f64>> = (0..nb)
             .map(|j| {
@@ -192,39 +203,34 @@ fn plane(
         } else {
             ("|p|", "µm")
         };
-        let heat = Heat {
+        let heat = HeatMap {
             title: format!("{}: {name} ({unit}){at}", r.machine),
             cols: axes[a].clone(),
             rows: axes[b].clone(),
             values,
             diverging: c < 6,
-            unit,
+            unit: unit.to_string(),
+            size: HEAT_SIZE,
         };
         let stem = if c < 6 {
             format!("map_{}", COMPONENTS[c])
         } else {
             "map_volumetric".to_string()
         };
-        files.extend(write_both(dir, &stem, HEAT_SIZE, |area| match area {
-            Area::Bitmap(root) => heat_on(root, &heat),
-            Area::Svg(root) => heat_on(root, &heat),
-        })?);
+        figures.push(stem, super::Chart::Heat(heat));
     }
-    files.extend(distortion(dir, r, built, axes, a, b, &at)?);
-    Ok(files)
+    figures.push("map_distortion", distortion(r, built, axes, a, b, &at));
 }
 
 /// The nominal and the magnified displaced grid.
-#[allow(clippy::too_many_arguments)]
 fn distortion(
-    dir: &Path,
     r: &MapResult,
     built: &BuiltMachine<CompiledModel>,
     axes: &[(String, Vec<f64>)],
     a: usize,
     b: usize,
     at: &str,
-) -> miette::Result<Vec<PathBuf>> {
+) -> XyChart {
     let mid = middle(axes);
     let (na, nb) = (axes[a].1.len(), axes[b].1.len());
     // Nominal tool point and position error in the workpiece frame, per node.
@@ -342,8 +348,7 @@ fn distortion(
     let (su, sw) = (spread(u).max(1e-9), spread(w).max(1e-9));
     let height = (1000.0 * sw / su + 120.0).clamp(500.0, 1300.0) as u32;
     chart.size = (1000, height);
-    chart = chart.legend(Legend::UpperRight);
-    Ok(chart.write(dir, "map_distortion")?)
+    chart.legend(Legend::UpperRight)
 }
 
 /// At most this many grid lines per direction in the distorted grid.
@@ -397,19 +402,26 @@ fn tick(v: f64) -> String {
     }
 }
 
-/// A heat map to draw.
-struct Heat {
-    title: String,
+/// A heat map over two numeric axes, each cell centred on its node, with a
+/// colour bar: diverging (ColorBrewer's RdBu) and symmetric about zero, or
+/// viridis from zero.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeatMap {
+    /// Caption above the map.
+    pub title: String,
     /// The horizontal axis: name and values.
-    cols: (String, Vec<f64>),
+    pub cols: (String, Vec<f64>),
     /// The vertical axis.
-    rows: (String, Vec<f64>),
+    pub rows: (String, Vec<f64>),
     /// `values[row][col]`, in display units.
-    values: Vec<Vec<f64>>,
+    pub values: Vec<Vec<f64>>,
     /// A scale symmetric about zero (signed components) or from zero
     /// (`|p|`).
-    diverging: bool,
-    unit: &'static str,
+    pub diverging: bool,
+    /// The colour bar's unit.
+    pub unit: String,
+    /// Image size in pixels (SVG user units).
+    pub size: (u32, u32),
 }
 
 fn err<E: std::fmt::Display>(e: E) -> String {
@@ -449,7 +461,19 @@ fn diverging(t: f64) -> RGBColor {
     ramp(&STOPS, 0.5 * (t + 1.0))
 }
 
-fn heat_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, heat: &Heat) -> Result<(), String>
+impl HeatMap {
+    pub(super) fn draw<DB: DrawingBackend>(
+        &self,
+        root: DrawingArea<DB, Shift>,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        heat_on(root, self)
+    }
+}
+
+fn heat_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, heat: &HeatMap) -> Result<(), String>
 where
     DB::ErrorType: 'static,
 {
@@ -523,7 +547,7 @@ where
     bar.configure_mesh()
         .disable_mesh()
         .disable_x_axis()
-        .y_desc(heat.unit)
+        .y_desc(heat.unit.as_str())
         .y_label_formatter(&|v| tick(*v))
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 16))

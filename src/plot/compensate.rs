@@ -1,21 +1,17 @@
 //! The figures of `chain compensate --plot` (seed 003's Figures 4-9 and the
-//! residuals), drawn with the CLI's plotting layer ([`crate::cli::plot`]).
+//! residuals).
 
-use std::path::{Path, PathBuf};
+use crate::compensate::{Analysis, PolyFit};
+use crate::plot::{self, Figures, Series, XyChart};
 
-use chain::compensate::{Analysis, PolyFit};
-
-use crate::cli::plot::{self, PlotError, Series, XyChart};
-
-/// Writes the figures of an analysis into `dir` (created if missing), each as
-/// PNG and SVG, and returns the paths written:
+/// The figures of an analysis:
 ///
 /// - `swing_fit_order{p}`: measured `Δθ` and the order-`p` fit, one per order
 ///   (the seed's Figures 4-8);
 /// - `swing_fits`: the measured `Δθ` and every fit (Figure 9);
 /// - `swing_residuals`: `Δθ` before and the residual predicted after
 ///   compensation with the selected law.
-pub fn write_plots(analysis: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+pub fn charts(analysis: &Analysis) -> Figures {
     let measured: Vec<(f64, f64)> = analysis
         .points
         .iter()
@@ -32,7 +28,7 @@ pub fn write_plots(analysis: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, Plot
     };
     let x_label = "commanded swing angle θ (°)";
     let y_label = "swing-angle error Δθ (°)";
-    let mut written = Vec::new();
+    let mut written = Figures::default();
     for (i, fit) in analysis.fits.iter().enumerate() {
         let chart = XyChart::new(
             format!("Order-{} fit of Δθ (R² = {:.4})", fit.order, fit.r2),
@@ -46,7 +42,7 @@ pub fn write_plots(analysis: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, Plot
                 .width(3),
         )
         .hline(0.0);
-        written.extend(chart.write(dir, &format!("swing_fit_order{}", fit.order))?);
+        written.push(format!("swing_fit_order{}", fit.order), chart);
     }
     let mut all = XyChart::new("Δθ fitted by polynomials of each order", x_label, y_label)
         .series(Series::points("measured Δθ", measured.clone()).color(plot::GREY))
@@ -61,7 +57,7 @@ pub fn write_plots(analysis: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, Plot
             .width(2),
         );
     }
-    written.extend(all.write(dir, "swing_fits")?);
+    written.push("swing_fits", all);
     let residuals: Vec<(f64, f64)> = analysis
         .points
         .iter()
@@ -87,6 +83,6 @@ pub fn write_plots(analysis: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, Plot
         .color(plot::color(0)),
     )
     .hline(0.0);
-    written.extend(residual_chart.write(dir, "swing_residuals")?);
-    Ok(written)
+    written.push("swing_residuals", residual_chart);
+    written
 }

@@ -2,24 +2,40 @@
 //! and after the allocation per component, and the tightening `σ0/σ` per
 //! error.
 
-use std::path::PathBuf;
+use reliability::allocate::{self, Allocation, ErrorBounds};
+use reliability::{Algorithm, Form, ReliabilityError, Study, StudyResult};
 
-use reliability::allocate::{Allocation, ErrorBounds};
+use super::{Figures, Legend, Series, XyChart};
+use crate::ops::allocate::AllocationRun;
 
-use super::{Legend, PlotError, Series, XyChart};
+/// The charts of an allocation: the grid's reliability per component
+/// before (FORM on the initial statistics) and after (the allocated
+/// standard deviations), both evaluated here, and the tightening.
+pub fn charts(run: &AllocationRun) -> Result<Figures, ReliabilityError> {
+    let stds: Vec<f64> = run.result.std.iter().map(|(_, s)| *s).collect();
+    let before = (run.study).run(&Algorithm::Form(Form::default()), &())?;
+    let (_, after) = allocate::evaluate(&run.model, &run.parameters, &run.study, &stds)?;
+    Ok(comparison(
+        &run.machine,
+        &run.study,
+        &run.bounds,
+        &run.result,
+        &before,
+        &after,
+    ))
+}
 
 /// Before/after reliability over the grid per component, and the tightening
 /// `σ0/σ` per error (per round for the paper's procedure).
-pub(crate) fn write_all(
-    dir: &std::path::Path,
+fn comparison(
     machine: &str,
-    study: &reliability::Study,
+    study: &Study,
     bounds: &[ErrorBounds],
     r: &Allocation,
-    before: &reliability::StudyResult,
-    after: &reliability::StudyResult,
-) -> Result<Vec<PathBuf>, PlotError> {
-    let mut files = Vec::new();
+    before: &StudyResult,
+    after: &StudyResult,
+) -> Figures {
+    let mut figures = Figures::default();
     let np = study.points().len();
     let axes: Vec<&str> = study
         .spec()
@@ -30,7 +46,7 @@ pub(crate) fn write_all(
         .collect();
     let req = study.spec().requirement;
     for (t, target) in study.targets().iter().enumerate() {
-        let pts = |res: &reliability::StudyResult| -> Vec<(f64, f64)> {
+        let pts = |res: &StudyResult| -> Vec<(f64, f64)> {
             res.cases[t * np..(t + 1) * np]
                 .iter()
                 .enumerate()
@@ -52,7 +68,7 @@ pub(crate) fn write_all(
         if let Some(q) = req {
             chart = chart.hline(q.min * 100.0);
         }
-        files.extend(chart.write(dir, &format!("allocate_{}", target.name()))?);
+        figures.push(format!("allocate_{}", target.name()), chart);
     }
     let mut chart = XyChart::new(
         format!("{machine}: tightening per error ({})", r.strategy),
@@ -88,9 +104,12 @@ pub(crate) fn write_all(
     // Nothing tightened (the requirement held as given): no tightening to
     // draw, said instead of a chart without data.
     if tightened == 0 {
-        eprintln!("note: no error was tightened (the requirement holds as given); no tightening chart written");
+        figures.notes.push(
+            "note: no error was tightened (the requirement holds as given); no tightening chart written"
+                .to_string(),
+        );
     } else {
-        files.extend(chart.write(dir, "allocate_tightening")?);
+        figures.push("allocate_tightening", chart);
     }
-    Ok(files)
+    figures
 }

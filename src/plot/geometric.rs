@@ -2,21 +2,15 @@
 //! direction of the normalised coefficients `C` (in %), largest first, like
 //! Figures 3-5 of seed 004, each as PNG and SVG.
 
-use std::path::{Path, PathBuf};
+use super::{BarChart, Figures};
+use crate::ops::sensitivity::GeometricReport;
+use crate::ops::views::where_text;
 
-use super::BarChart;
-use chain_core::geometric::GeometricSensitivity;
-
-/// Writes `geometric_<component>.{png,svg}` for every direction in which
-/// some error acts; returns the files written.
-pub(crate) fn write_all(
-    dir: &Path,
-    machine: &str,
-    where_: &str,
-    result: &GeometricSensitivity,
-) -> miette::Result<Vec<PathBuf>> {
-    let mut files = Vec::new();
-    for (k, c) in result.components.iter().enumerate() {
+/// `geometric_<component>` for every direction in which some error acts.
+pub fn charts(doc: &GeometricReport) -> Figures {
+    let (machine, where_) = (&doc.machine, where_text(&doc.where_));
+    let mut figures = Figures::default();
+    for (k, c) in doc.result.components.iter().enumerate() {
         let ranked: Vec<_> = c.ranked.iter().filter(|e| e.c > 0.0).collect();
         if ranked.is_empty() {
             continue;
@@ -34,7 +28,7 @@ pub(crate) fn write_all(
                 ranked.iter().map(|e| 100.0 * e.c).collect(),
             )
         };
-        files.extend(chart.write(dir, &format!("geometric_{}", c.component.name()))?);
+        figures.push(format!("geometric_{}", c.component.name()), chart);
     }
-    Ok(files)
+    figures
 }

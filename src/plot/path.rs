@@ -1,28 +1,28 @@
 //! `--plot DIR` of `chain path`: the reliability of every target and the
 //! standard deviation of the toleranced error components along the path
-//! (PNG and SVG), drawn with the CLI's [`super::XyChart`].
+//! (PNG and SVG), as [`super::XyChart`]s.
 //! Instants without axis values (unreachable poses) have no point.
 
-use std::path::{Path, PathBuf};
-
-use super::{Legend, Series, XyChart};
+use super::{Figures, Legend, Series, XyChart};
 use reliability::Quantity;
 
-use crate::cli::render::path::label;
-use chain::ops::path::PathDocument;
+use crate::ops::path::PathDocument;
+use crate::ops::views::quantity_label;
 
-/// Writes `path_reliability`, `path_std` and, when an orientation component
-/// is toleranced, `path_std_angular`; returns the files written. Writes
-/// nothing when no instant was evaluated.
-pub(crate) fn write_all(dir: &Path, doc: &PathDocument) -> miette::Result<Vec<PathBuf>> {
+/// `path_reliability`, `path_std` and, when an orientation component is
+/// toleranced, `path_std_angular`; none (and a note) when no instant was
+/// evaluated.
+pub fn charts(doc: &PathDocument) -> Figures {
     let r = &doc.result;
+    let mut files = Figures::default();
     if r.evaluated() == 0 {
-        eprintln!("note: no evaluated instant; no chart written");
-        return Ok(Vec::new());
+        files
+            .notes
+            .push("note: no evaluated instant; no chart written".to_string());
+        return files;
     }
     let x_label = if doc.head.has_t { "t" } else { "row" };
     let method = r.method.title();
-    let mut files = Vec::new();
 
     let mut chart = XyChart::new(
         format!(
@@ -48,7 +48,7 @@ pub(crate) fn write_all(dir: &Path, doc: &PathDocument) -> miette::Result<Vec<Pa
         chart = chart.hline(100.0 * req.min);
     }
     let chart = with_legend_room(chart, false);
-    files.extend(chart.write(dir, "path_reliability")?);
+    files.push("path_reliability", chart);
 
     // Standard deviations, lengths and angles on separate charts.
     let toleranced = |k: &usize| {
@@ -81,11 +81,11 @@ pub(crate) fn write_all(dir: &Path, doc: &PathDocument) -> miette::Result<Vec<Pa
                 .iter()
                 .filter_map(|rec| rec.result.as_ref().map(|e| (rec.instant.t, e.std(q))))
                 .collect();
-            chart = chart.series(Series::line_points(label(q), points));
+            chart = chart.series(Series::line_points(quantity_label(q), points));
         }
-        files.extend(with_legend_room(chart, true).write(dir, stem)?);
+        files.push(stem, with_legend_room(chart, true));
     }
-    Ok(files)
+    files
 }
 
 /// Fits the y range to the data and reference lines, with an empty band

@@ -1,16 +1,24 @@
-//! Located diagnostics for machine files and the settings files of `chain
-//! motion`.
+//! Located diagnostics: the refusals of every file chain-core reads
+//! (machine files, values files and their CSV tables, the settings files of
+//! `chain motion`, measurement, candidate and positioning run files).
 //!
-//! Every rule of the machine-file contract that a file can break has one
-//! [`Problem`] variant, and its wording lives here and nowhere else: the YAML
-//! loader ([`crate::load`]) attaches a problem to an [`Origin`] (file, line,
+//! Every diagnostic is a typed problem, and its wording lives in one place:
+//! each rule a file can break is one variant, worded by one match arm of
+//! [`Problem::describe`] (headline, note, help, span label, code). The rules
+//! of the machine-file contract are variants of [`Problem`] itself: the YAML
+//! loader ([`crate::load`]) attaches a problem to an [`Origin`](crate::model::Origin) (file, line,
 //! column, key path) to make a [`LoadError`], and the `machine!` macro can
 //! attach the same problem to a token span, so both front ends say the same
-//! thing about the same mistake. The settings loader ([`crate::settings`])
-//! reads the same located tree and reports through the same types: the
-//! shared rules (unknown key, wrong type, ...) with their variants, its own
-//! rules (names of its two machines, angles, the roll) as a
-//! [`Problem::Message`] that it words itself.
+//! thing about the same mistake. The readers of the other files share the
+//! rules they have in common (unknown key, wrong type, ...) and word their
+//! own through their subject's enum, a variant of [`Problem`] worded in this
+//! module's file of that subject: [`ValuesProblem`] (`values.rs`),
+//! [`SettingsProblem`] (`settings.rs`), [`MeasurementsProblem`] and
+//! [`PositioningProblem`] (`measured.rs`); a CSV file's shape and cells are
+//! [`CsvProblem`]s ([`crate::tabular`], whose wording the command line's CSV
+//! messages share). A crate that reads files of its own words its problems
+//! the same way, as an enum implementing [`Describe`], wrapped by
+//! [`Problem::foreign`].
 //!
 //! [`Diagnostics`] is the error type of [`crate::load_str`], of
 //! [`crate::settings::load_settings_str`] and their friends: a non-empty list
@@ -19,15 +27,32 @@
 //! [`miette::Diagnostic`] it also carries the file text (labels at the spans)
 //! and the remaining errors as `related()` diagnostics.
 
-use std::fmt;
-
+mod located;
+mod measured;
+mod names;
+mod settings;
 #[cfg(feature = "miette")]
-use miette::{LabeledSpan, MietteError, MietteSpanContents, SourceCode, SourceSpan, SpanContents};
+mod snippet;
+mod values;
 
-use crate::model::{ErrorKind, Origin};
+use std::fmt;
+use std::sync::Arc;
 
-/// One thing wrong with a machine description (or a settings file),
-/// independent of where it is.
+pub use located::{Diagnostics, LoadError};
+#[cfg(feature = "csv")]
+pub(crate) use measured::RUN_FILE_HEADER;
+pub use measured::{MeasurementsProblem, PositioningProblem};
+pub use names::{closest, shortened, QUOTED_CHARS};
+pub use settings::SettingsProblem;
+#[cfg(feature = "miette")]
+pub use snippet::Snippet;
+pub use values::ValuesProblem;
+
+use crate::model::ErrorKind;
+use crate::tabular::CsvProblem;
+
+/// One thing wrong with a machine description (or another file chain-core
+/// reads), independent of where it is.
 ///
 /// `Display` gives the full message (headline plus the parenthesised note);
 /// [`Problem::describe`] gives all its parts (headline, note, help, span
@@ -377,6 +402,9 @@ pub enum Problem {
     },
     /// A function slot with neither `powers` nor `basis`.
     MissingBasis,
+    /// `basis: powers`: the power basis is written `powers: [..]`, without
+    /// `basis`.
+    PowersAsBasis,
     /// A function name declared again with a different basis, on another
     /// axis or in a slot of another kind.
     FunctionRedeclared {
@@ -431,55 +459,77 @@ pub enum Problem {
         /// The body that named it first.
         other: String,
     },
-    /// A rule of a settings file, worded by its reader.
-    Message(Message),
+    // The other files' rules, each subject's enum boxed so that a
+    // `Problem` stays small.
+    /// A rule of a values file or of a CSV table it names.
+    Values(Box<ValuesProblem>),
+    /// A CSV file's shape or one of its cells (every CSV reader).
+    Csv(Box<CsvProblem>),
+    /// A rule of a settings file of `chain motion`.
+    Settings(Box<SettingsProblem>),
+    /// A rule of a measurement or candidate file.
+    Measurements(Box<MeasurementsProblem>),
+    /// A rule of a positioning run file.
+    Positioning(Box<PositioningProblem>),
+    /// A rule of a file read by a crate outside chain-core, worded by that
+    /// crate's own typed problem ([`Describe`]).
+    Foreign(Foreign),
 }
 
-/// A problem worded at run time by the reader of a file other than a machine
-/// file (the settings of `chain motion`): the payload of [`Problem::Message`].
-#[derive(Debug, Clone, PartialEq)]
-pub struct Message {
-    /// The headline.
-    pub text: String,
-    /// The closest valid name, if one is close: the headline ends with
-    /// `(did you mean ...)`.
-    pub suggestion: Option<String>,
-    /// A longer hint, if one helps.
-    pub help: Option<String>,
-    /// The short label of the span.
-    pub label: &'static str,
-    /// A stable code, e.g. `chain::settings::unknown_name`.
-    pub code: &'static str,
+/// A typed problem that words itself: every part of its message from one
+/// match arm per variant, as [`Problem::describe`] words chain-core's. A
+/// crate reading files of its own implements it for its problem enum and
+/// reports through [`Problem::foreign`].
+pub trait Describe: fmt::Debug + Send + Sync + 'static {
+    /// Every part of the message of this problem.
+    fn describe(&self) -> Description;
 }
 
-impl Message {
-    /// `text`, with the span's `label` and a stable `code`.
-    pub fn new(text: impl Into<String>, label: &'static str, code: &'static str) -> Message {
-        Message {
-            text: text.into(),
-            suggestion: None,
-            help: None,
-            label,
-            code,
-        }
-    }
+/// A problem of a crate outside chain-core: the payload of
+/// [`Problem::Foreign`]. Two are equal when they read the same.
+#[derive(Debug, Clone)]
+pub struct Foreign(Arc<dyn Describe>);
 
-    /// With a hint.
-    pub fn help(mut self, help: impl Into<String>) -> Message {
-        self.help = Some(help.into());
-        self
-    }
-
-    /// With the closest valid name, if there is one.
-    pub fn suggest(mut self, suggestion: Option<&str>) -> Message {
-        self.suggestion = suggestion.map(str::to_string);
-        self
+impl Foreign {
+    /// The problem itself.
+    pub fn get(&self) -> &dyn Describe {
+        &*self.0
     }
 }
 
-impl From<Message> for Problem {
-    fn from(message: Message) -> Problem {
-        Problem::Message(message)
+impl PartialEq for Foreign {
+    fn eq(&self, other: &Foreign) -> bool {
+        self.0.describe() == other.0.describe()
+    }
+}
+
+impl From<ValuesProblem> for Problem {
+    fn from(problem: ValuesProblem) -> Problem {
+        Problem::Values(Box::new(problem))
+    }
+}
+
+impl From<CsvProblem> for Problem {
+    fn from(problem: CsvProblem) -> Problem {
+        Problem::Csv(Box::new(problem))
+    }
+}
+
+impl From<SettingsProblem> for Problem {
+    fn from(problem: SettingsProblem) -> Problem {
+        Problem::Settings(Box::new(problem))
+    }
+}
+
+impl From<MeasurementsProblem> for Problem {
+    fn from(problem: MeasurementsProblem) -> Problem {
+        Problem::Measurements(Box::new(problem))
+    }
+}
+
+impl From<PositioningProblem> for Problem {
+    fn from(problem: PositioningProblem) -> Problem {
+        Problem::Positioning(Box::new(problem))
     }
 }
 
@@ -518,7 +568,11 @@ pub struct Description {
 
 impl Description {
     /// A description with its code, span label and headline; no note, no help.
-    fn new(code: &'static str, label: &'static str, headline: impl Into<String>) -> Description {
+    pub fn new(
+        code: &'static str,
+        label: &'static str,
+        headline: impl Into<String>,
+    ) -> Description {
         Description {
             headline: headline.into(),
             note: None,
@@ -529,15 +583,25 @@ impl Description {
     }
 
     /// With a note (`None` leaves it out).
-    fn note(mut self, note: impl Into<Option<String>>) -> Description {
+    pub fn note(mut self, note: impl Into<Option<String>>) -> Description {
         self.note = note.into();
         self
     }
 
     /// With a hint (`None` leaves it out).
-    fn help(mut self, help: impl Into<Option<String>>) -> Description {
+    pub fn help(mut self, help: impl Into<Option<String>>) -> Description {
         self.help = help.into();
         self
+    }
+
+    /// The headline `text`, ending with `(did you mean `…`?)` when there is
+    /// a closest valid name.
+    pub fn suggesting(text: impl Into<String>, suggestion: &Option<String>) -> String {
+        let text = text.into();
+        match did_you_mean(suggestion) {
+            Some(s) => format!("{text} ({s})"),
+            None => text,
+        }
     }
 }
 
@@ -931,6 +995,12 @@ impl Problem {
                 "no basis",
                 "a function slot needs `powers: [..]` or `basis: legendre | chebyshev | fourier`",
             ),
+            Problem::PowersAsBasis => D::new(
+                "chain::unknown_value",
+                "unknown value",
+                "unknown basis `powers`",
+            )
+            .help("the power basis is written `powers: [1, 2]`, without `basis`".to_string()),
             Problem::FunctionRedeclared {
                 name,
                 difference,
@@ -1003,16 +1073,19 @@ impl Problem {
                  by slot"
                     .to_string(),
             ),
-            Problem::Message(m) => D::new(
-                m.code,
-                m.label,
-                match did_you_mean(&m.suggestion) {
-                    Some(s) => format!("{} ({s})", m.text),
-                    None => m.text.clone(),
-                },
-            )
-            .help(m.help.clone()),
+            Problem::Values(p) => p.describe(),
+            Problem::Csv(p) => p.describe(),
+            Problem::Settings(p) => p.describe(),
+            Problem::Measurements(p) => p.describe(),
+            Problem::Positioning(p) => p.describe(),
+            Problem::Foreign(p) => p.0.describe(),
         }
+    }
+
+    /// The problem of a crate outside chain-core, worded by its own
+    /// [`Describe`].
+    pub fn foreign(problem: impl Describe) -> Problem {
+        Problem::Foreign(Foreign(Arc::new(problem)))
     }
 
     /// The main message, without the parenthesised note
@@ -1076,399 +1149,6 @@ impl fmt::Display for Problem {
     }
 }
 
-/// The most characters of an input's text a message quotes
-/// ([`shortened`]).
-pub const QUOTED_CHARS: usize = 40;
-
-/// `text` as a message quotes it: whole when it has at most
-/// [`QUOTED_CHARS`] characters, else its first [`QUOTED_CHARS`] and `…`
-/// (so a refused 5,000-digit cell is not echoed in full). The one
-/// shortening of every located message (YAML scalars, CSV cells, names in
-/// numbers).
-pub fn shortened(text: &str) -> std::borrow::Cow<'_, str> {
-    match text.char_indices().nth(QUOTED_CHARS) {
-        None => std::borrow::Cow::Borrowed(text),
-        Some((end, _)) => std::borrow::Cow::Owned(format!("{}…", &text[..end])),
-    }
-}
-
-/// The closest candidate to `name` by edit distance, if it is close enough to
-/// be a plausible typo (at most a third of the longer name's length, and at
-/// least one edit is always allowed; a case-only difference always matches).
-/// Failing that, a candidate of at least three characters that is a prefix of
-/// `name` (`minimum` → `min`) or that `name` is a prefix of.
-pub fn closest<'a, I>(name: &str, candidates: I) -> Option<&'a str>
-where
-    I: IntoIterator<Item = &'a str>,
-{
-    let lower = name.to_lowercase();
-    let mut best: Option<(usize, &'a str)> = None;
-    let mut prefixed: Option<&'a str> = None;
-    for cand in candidates {
-        if cand == name {
-            continue;
-        }
-        let cl = cand.to_lowercase();
-        let d = if cl == lower {
-            0
-        } else {
-            edit_distance(&lower, &cl)
-        };
-        let longest = name.chars().count().max(cand.chars().count());
-        let allowed = (longest / 3).max(1);
-        if d <= allowed && best.is_none_or(|(bd, _)| d < bd) {
-            best = Some((d, cand));
-        }
-        let shortest = name.chars().count().min(cand.chars().count());
-        if prefixed.is_none() && shortest >= 3 && (lower.starts_with(&cl) || cl.starts_with(&lower))
-        {
-            prefixed = Some(cand);
-        }
-    }
-    best.map(|(_, c)| c).or(prefixed)
-}
-
-/// Optimal-string-alignment distance (Levenshtein plus adjacent transpositions).
-fn edit_distance(a: &str, b: &str) -> usize {
-    let a: Vec<char> = a.chars().collect();
-    let b: Vec<char> = b.chars().collect();
-    let n = b.len();
-    let mut prev2 = vec![0usize; n + 1];
-    let mut prev: Vec<usize> = (0..=n).collect();
-    let mut cur = vec![0usize; n + 1];
-    for (i, &ca) in a.iter().enumerate() {
-        cur[0] = i + 1;
-        for (j, &cb) in b.iter().enumerate() {
-            let cost = usize::from(ca != cb);
-            let mut v = (prev[j] + cost).min(prev[j + 1] + 1).min(cur[j] + 1);
-            if i > 0 && j > 0 && a.get(i - 1) == Some(&cb) && b.get(j - 1) == Some(&ca) {
-                v = v.min(prev2[j - 1] + 1);
-            }
-            cur[j + 1] = v;
-        }
-        std::mem::swap(&mut prev2, &mut prev);
-        std::mem::swap(&mut prev, &mut cur);
-    }
-    prev[n]
-}
-
-/// One located error in a machine file (or settings file).
-#[derive(Debug, Clone, PartialEq)]
-pub struct LoadError {
-    /// The file name as given to the loader.
-    pub file: String,
-    /// Where: byte span, line, column and key path. A `line` of 0 means the
-    /// error concerns the file as a whole (it could not be read).
-    pub origin: Origin,
-    /// What is wrong.
-    pub problem: Problem,
-}
-
-impl LoadError {
-    /// A located error.
-    pub fn new(file: impl Into<String>, origin: Origin, problem: Problem) -> LoadError {
-        LoadError {
-            file: file.into(),
-            origin,
-            problem,
-        }
-    }
-
-    #[cfg(feature = "miette")]
-    fn label(&self, source_len: usize) -> Option<LabeledSpan> {
-        if self.origin.line == 0 {
-            return None;
-        }
-        let offset = self.origin.offset.min(source_len);
-        let len = self.origin.len.min(source_len - offset);
-        Some(LabeledSpan::new_with_span(
-            Some(self.problem.label().to_string()),
-            (offset, len),
-        ))
-    }
-}
-
-impl fmt::Display for LoadError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:", self.file)?;
-        if self.origin.line > 0 {
-            write!(f, "{}:{}:", self.origin.line, self.origin.column)?;
-        }
-        write!(f, " {}", self.problem.headline())?;
-        if !self.origin.key.is_empty() {
-            write!(f, " at key `{}`", self.origin.key)?;
-        }
-        if let Some(note) = self.problem.note() {
-            write!(f, " ({note})")?;
-        }
-        Ok(())
-    }
-}
-
-impl std::error::Error for LoadError {}
-
-#[cfg(feature = "miette")]
-impl miette::Diagnostic for LoadError {
-    fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        Some(Box::new(self.problem.code()))
-    }
-
-    fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        self.problem
-            .help()
-            .map(|h| Box::new(h) as Box<dyn fmt::Display>)
-    }
-
-    fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
-        // Related errors render against the parent's source; without it we
-        // cannot know the length, so the caller (`Diagnostics`) clamps.
-        self.label(usize::MAX)
-            .map(|l| Box::new(std::iter::once(l)) as Box<dyn Iterator<Item = LabeledSpan>>)
-    }
-}
-
-/// A related error rendered against the parent's source text, with its span
-/// clamped to that text.
-#[cfg_attr(not(feature = "miette"), allow(dead_code))]
-#[derive(Debug, Clone)]
-struct Related {
-    error: LoadError,
-    source_len: usize,
-}
-
-impl fmt::Display for Related {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        self.error.fmt(f)
-    }
-}
-
-impl std::error::Error for Related {}
-
-#[cfg(feature = "miette")]
-impl miette::Diagnostic for Related {
-    fn code<'b>(&'b self) -> Option<Box<dyn fmt::Display + 'b>> {
-        self.error.code()
-    }
-
-    fn help<'b>(&'b self) -> Option<Box<dyn fmt::Display + 'b>> {
-        self.error.help()
-    }
-
-    fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
-        if self.source_len == 0 {
-            return None;
-        }
-        self.error
-            .label(self.source_len)
-            .map(|l| Box::new(std::iter::once(l)) as Box<dyn Iterator<Item = LabeledSpan>>)
-    }
-}
-
-/// All errors found in one machine file (or settings file): never empty.
-///
-/// `Display` shows the first error (`file:line:column: message at key `k``)
-/// followed by how many more there are; the alternate form (`{:#}`) lists every
-/// error, one per line. As a [`miette::Diagnostic`] it renders the first error
-/// with a labelled snippet of the file and the others as related diagnostics.
-pub struct Diagnostics {
-    // Boxed so that `Result<Machine, Diagnostics>` stays small.
-    inner: Box<Inner>,
-}
-
-#[cfg_attr(not(feature = "miette"), allow(dead_code))]
-struct Inner {
-    file: String,
-    #[cfg(feature = "miette")]
-    source: Snippet,
-    source_len: usize,
-    errors: Vec<LoadError>,
-    related: Vec<Related>,
-}
-
-impl fmt::Debug for Diagnostics {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("Diagnostics")
-            .field("errors", &self.inner.errors)
-            .finish_non_exhaustive()
-    }
-}
-
-impl Diagnostics {
-    /// The diagnostics of `file` (whose text is `source`) from a list of
-    /// errors; `None` if the list is empty. Errors are sorted by position
-    /// (stable, so errors at one place keep their order).
-    pub fn new(
-        file: impl Into<String>,
-        source: impl Into<String>,
-        mut errors: Vec<LoadError>,
-    ) -> Option<Diagnostics> {
-        if errors.is_empty() {
-            return None;
-        }
-        errors.sort_by_key(|e| (e.origin.line, e.origin.column));
-        let file = file.into();
-        let source = source.into();
-        let source_len = source.len();
-        let related = errors
-            .iter()
-            .skip(1)
-            .map(|error| Related {
-                error: error.clone(),
-                source_len,
-            })
-            .collect();
-        Some(Diagnostics {
-            inner: Box::new(Inner {
-                #[cfg(feature = "miette")]
-                source: Snippet::new(file.clone(), source),
-                file,
-                source_len,
-                errors,
-                related,
-            }),
-        })
-    }
-
-    /// The diagnostics of `file` (whose text is `source`) from problems
-    /// located in it; `None` if there are none.
-    pub fn located(
-        file: &str,
-        source: impl Into<String>,
-        problems: impl IntoIterator<Item = (Origin, Problem)>,
-    ) -> Option<Diagnostics> {
-        let errors = problems
-            .into_iter()
-            .map(|(origin, problem)| LoadError::new(file, origin, problem))
-            .collect();
-        Diagnostics::new(file, source, errors)
-    }
-
-    /// A single error.
-    pub fn single(
-        file: impl Into<String>,
-        source: impl Into<String>,
-        origin: Origin,
-        problem: Problem,
-    ) -> Diagnostics {
-        let file = file.into();
-        let error = LoadError::new(file.clone(), origin, problem);
-        let source = source.into();
-        let source_len = source.len();
-        Diagnostics {
-            inner: Box::new(Inner {
-                #[cfg(feature = "miette")]
-                source: Snippet::new(file.clone(), source),
-                file,
-                source_len,
-                errors: vec![error],
-                related: Vec::new(),
-            }),
-        }
-    }
-
-    /// The file name.
-    pub fn file(&self) -> &str {
-        &self.inner.file
-    }
-
-    /// The errors, in source order.
-    pub fn errors(&self) -> &[LoadError] {
-        &self.inner.errors
-    }
-
-    /// Iterates over the errors in source order.
-    pub fn iter(&self) -> std::slice::Iter<'_, LoadError> {
-        self.inner.errors.iter()
-    }
-
-    /// The first error.
-    pub fn first(&self) -> &LoadError {
-        // `errors` is never empty by construction; fall back defensively.
-        &self.inner.errors[0]
-    }
-
-    /// The number of errors (at least 1).
-    pub fn len(&self) -> usize {
-        self.inner.errors.len()
-    }
-
-    /// Always false: a `Diagnostics` holds at least one error.
-    pub fn is_empty(&self) -> bool {
-        self.inner.errors.is_empty()
-    }
-}
-
-impl<'a> IntoIterator for &'a Diagnostics {
-    type Item = &'a LoadError;
-    type IntoIter = std::slice::Iter<'a, LoadError>;
-
-    fn into_iter(self) -> Self::IntoIter {
-        self.inner.errors.iter()
-    }
-}
-
-impl fmt::Display for Diagnostics {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if f.alternate() {
-            for (i, e) in self.inner.errors.iter().enumerate() {
-                if i > 0 {
-                    writeln!(f)?;
-                }
-                write!(f, "{e}")?;
-            }
-            return Ok(());
-        }
-        write!(f, "{}", self.first())?;
-        match self.inner.errors.len() {
-            0 | 1 => Ok(()),
-            2 => write!(f, " (and 1 more error)"),
-            n => write!(f, " (and {} more errors)", n - 1),
-        }
-    }
-}
-
-impl std::error::Error for Diagnostics {}
-
-#[cfg(feature = "miette")]
-impl miette::Diagnostic for Diagnostics {
-    fn code<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        self.first().code()
-    }
-
-    fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        self.first().help()
-    }
-
-    fn source_code(&self) -> Option<&dyn SourceCode> {
-        if self.inner.source_len == 0 {
-            None
-        } else {
-            Some(&self.inner.source)
-        }
-    }
-
-    fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
-        if self.inner.source_len == 0 {
-            return None;
-        }
-        self.first()
-            .label(self.inner.source_len)
-            .map(|l| Box::new(std::iter::once(l)) as Box<dyn Iterator<Item = LabeledSpan>>)
-    }
-
-    fn related<'a>(&'a self) -> Option<Box<dyn Iterator<Item = &'a dyn miette::Diagnostic> + 'a>> {
-        if self.inner.related.is_empty() {
-            return None;
-        }
-        Some(Box::new(
-            self.inner
-                .related
-                .iter()
-                .map(|r| r as &dyn miette::Diagnostic),
-        ))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1502,108 +1182,26 @@ mod tests {
             c.help().as_deref(),
             Some("std = tolerance / sigma_rule; give one of them")
         );
-        let m = Problem::Message(
-            Message::new(
-                "unknown machine `x`",
-                "unknown name",
-                "chain::settings::unknown_name",
-            )
-            .suggest(Some("y"))
-            .help("name one of the two machines"),
-        );
+        let m = Problem::from(SettingsProblem::UnknownName {
+            name: "x".into(),
+            generator: "g".into(),
+            within: "`values`",
+            names: vec!["y".into(), "z".into()],
+            suggestion: Some("y".into()),
+        });
         let d = m.describe();
-        assert_eq!(d.headline, "unknown machine `x` (did you mean `y`?)");
+        assert_eq!(
+            d.headline,
+            "`x` is not a parameter or variable of the generator `g` (did you mean `y`?)"
+        );
         assert_eq!(d.note, None);
-        assert_eq!(d.help.as_deref(), Some("name one of the two machines"));
+        assert_eq!(
+            d.help.as_deref(),
+            Some("`values` names the generator's parameters and variables: y, z")
+        );
         assert_eq!(
             (d.label, d.code),
             ("unknown name", "chain::settings::unknown_name")
         );
-    }
-}
-
-/// The widest source line handed to the diagnostic renderer whole: miette's
-/// graphical handler pads with the column as a formatting width, which
-/// panics beyond 65,535 ("Formatting argument out of range").
-#[cfg(feature = "miette")]
-const SNIPPET_WIDE: usize = 4096;
-
-/// Bytes of context kept either side of the located span on a wider line.
-#[cfg(feature = "miette")]
-const SNIPPET_CONTEXT: usize = 120;
-
-/// The source text of a diagnostic as the renderer reads it: a file's name
-/// and text, whose snippets are the file's own lines, except that a line
-/// wider than 4,096 bytes (a machine file written as one line of JSON) is
-/// cut to a window around the located span, with the line and column of the
-/// window's start, so that rendering never fails.
-#[cfg(feature = "miette")]
-#[derive(Debug, Clone)]
-pub struct Snippet {
-    name: String,
-    text: String,
-}
-
-#[cfg(feature = "miette")]
-impl Snippet {
-    /// The source `text` of the file `name`.
-    pub fn new(name: impl Into<String>, text: impl Into<String>) -> Snippet {
-        Snippet {
-            name: name.into(),
-            text: text.into(),
-        }
-    }
-}
-
-#[cfg(feature = "miette")]
-impl SourceCode for Snippet {
-    fn read_span<'a>(
-        &'a self,
-        span: &SourceSpan,
-        before: usize,
-        after: usize,
-    ) -> Result<Box<dyn SpanContents<'a> + 'a>, MietteError> {
-        let full = self.text.read_span(span, before, after)?;
-        let wide = full
-            .data()
-            .split(|&b| b == b'\n')
-            .any(|line| line.len() > SNIPPET_WIDE);
-        if !wide {
-            let contents = MietteSpanContents::new_named(
-                self.name.clone(),
-                full.data(),
-                *full.span(),
-                full.line(),
-                full.column(),
-                full.line_count(),
-            );
-            return Ok(Box::new(contents.with_language("yaml")));
-        }
-        // The window: the span's own line, SNIPPET_CONTEXT bytes either side
-        // of the span, at most SNIPPET_WIDE bytes, on character boundaries.
-        let text = self.text.as_str();
-        let start = span.offset().min(text.len());
-        let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
-        let line_end = text[start..].find('\n').map_or(text.len(), |i| start + i);
-        let end = (start + span.len()).min(line_end);
-        let mut a = start.saturating_sub(SNIPPET_CONTEXT).max(line_start);
-        let mut b = (end + SNIPPET_CONTEXT).min(line_end).min(a + SNIPPET_WIDE);
-        while !text.is_char_boundary(a) {
-            a -= 1;
-        }
-        while !text.is_char_boundary(b) {
-            b -= 1;
-        }
-        let line = text[..a].bytes().filter(|&c| c == b'\n').count();
-        let column = text[line_start..a].chars().count();
-        let contents = MietteSpanContents::new_named(
-            self.name.clone(),
-            &text.as_bytes()[a..b],
-            (a, b - a).into(),
-            line,
-            column,
-            1,
-        );
-        Ok(Box::new(contents.with_language("yaml")))
     }
 }

@@ -5,11 +5,9 @@
 //! of `B_i` per target. (Labels spell the means out: the renderer places a
 //! combining macron badly.)
 
-use std::path::{Path, PathBuf};
-
 use chain_core::measured::positioning::{Direction, PositioningDocument};
 
-use crate::cli::plot::{self, Legend, PlotError, Series, XyChart};
+use crate::plot::{self, Figures, Legend, Series, XyChart};
 
 /// A statistic in a title: four significant digits.
 fn short(v: f64) -> String {
@@ -21,9 +19,8 @@ fn short(v: f64) -> String {
     format!("{v:.digits$}")
 }
 
-/// Writes `positioning.png/.svg` and `positioning_reversal.png/.svg` into
-/// `dir` (created if missing) and returns the paths written.
-pub fn write(dir: &Path, doc: &PositioningDocument) -> Result<Vec<PathBuf>, PlotError> {
+/// `positioning` and `positioning_reversal`.
+pub fn charts(doc: &PositioningDocument) -> Figures {
     let u = doc.unit.name();
     let k = doc.k;
     let x_label = format!("target ({})", doc.target_unit);
@@ -99,7 +96,8 @@ pub fn write(dir: &Path, doc: &PositioningDocument) -> Result<Vec<PathBuf>, Plot
     )
     .legend(Legend::UpperLeft)
     .hline(0.0);
-    let mut written = chart.write(dir, "positioning")?;
+    let mut written = Figures::default();
+    written.push("positioning", chart);
     let reversal = XyChart::new(
         format!(
             "Reversal B_i = mean ↑ − mean ↓: B = {}, mean {} {u}",
@@ -111,8 +109,8 @@ pub fn write(dir: &Path, doc: &PositioningDocument) -> Result<Vec<PathBuf>, Plot
     )
     .series(Series::line_points("B_i", curve(&|i| ts[i].reversal)).color(plot::color(2)))
     .hline(0.0);
-    written.extend(reversal.write(dir, "positioning_reversal")?);
-    Ok(written)
+    written.push("positioning_reversal", reversal);
+    written
 }
 
 /// The points of each direction's runs, for the chart.

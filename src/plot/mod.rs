@@ -1,28 +1,42 @@
-//! A small plotting layer over [`plotters`]: charts described as data, drawn
-//! to PNG and SVG.
+//! The charts of every command's `--plot`, computed from the command's
+//! document and drawn with [`plotters`] (feature `plot`).
 //!
-//! Text is rendered with DejaVu Sans, embedded in the binary (the `dejavu`
+//! A chart is data ([`XyChart`], [`BarChart`], [`map::HeatMap`],
+//! [`reliability::CellMap`], one [`Chart`]); each command's module builds
+//! its [`Figures`] (the charts with their file stems, and the notes on
+//! charts left out) from the command's `ops` document: [`map::charts`],
+//! [`reliability::charts`], [`sensitivity::charts`], [`allocate::charts`],
+//! [`path::charts`], [`motion::charts`], [`positioning::charts`],
+//! [`compensate::charts`]. A chart is drawn as an SVG string in memory
+//! ([`Chart::svg`], what a report inlines) or as a PNG file
+//! ([`Chart::png`]); [`Figures::write`] writes both files of every chart
+//! into a directory through the caller's [`Files`] (the CLI's writes each
+//! file atomically; [`Direct`] writes it in place).
+//!
+//! Text is rendered with DejaVu Sans, embedded in the library (the `dejavu`
 //! crate) and registered with plotters' `ab_glyph` renderer, so no system
 //! font or fontconfig is needed.
 //!
-//! ```ignore
-//! use crate::cli::plot::{Series, XyChart};
+//! ```
+//! use chain::plot::{Chart, Series, XyChart};
 //! let chart = XyChart::new("Δθ", "θ (°)", "Δθ (°)")
 //!     .series(Series::points("measured", vec![(1.0, 0.1), (2.0, 0.2)]))
 //!     .series(Series::line("fit", vec![(1.0, 0.1), (2.0, 0.2)]))
 //!     .hline(0.0);
-//! let files = chart.write(std::path::Path::new("plots"), "delta_theta")?;
-//! # Ok::<(), crate::cli::plot::PlotError>(())
+//! let svg = Chart::from(chart).svg()?;
+//! assert!(svg.starts_with("<svg"));
+//! # Ok::<(), chain::plot::PlotError>(())
 //! ```
 
-pub(crate) mod allocate;
-pub(crate) mod compensate;
-pub(crate) mod geometric;
-pub(crate) mod map;
-pub(crate) mod motion;
-pub(crate) mod path;
-pub(crate) mod positioning;
-pub(crate) mod reliability;
+pub mod allocate;
+pub mod compensate;
+pub mod geometric;
+pub mod map;
+pub mod motion;
+pub mod path;
+pub mod positioning;
+pub mod reliability;
+pub mod sensitivity;
 
 use std::path::{Path, PathBuf};
 use std::sync::Once;
@@ -69,12 +83,13 @@ pub fn color(i: usize) -> RGBColor {
 }
 
 /// Errors of drawing a chart.
-#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+#[derive(Debug, thiserror::Error)]
+#[cfg_attr(feature = "cli", derive(miette::Diagnostic))]
 #[non_exhaustive]
 pub enum PlotError {
     /// The output directory could not be created.
     #[error("{path}: cannot create the plot directory: {source}")]
-    #[diagnostic(code(chain::plot::io))]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::plot::io)))]
     Io {
         /// The directory.
         path: String,
@@ -82,69 +97,238 @@ pub enum PlotError {
         #[source]
         source: std::io::Error,
     },
+    /// A chart's file could not be written.
+    #[error("{path}: cannot write the chart: {source}")]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::plot::write)))]
+    Write {
+        /// The image file.
+        path: String,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
     /// Drawing or writing the image failed.
     #[error("{path}: cannot draw the chart: {message}")]
-    #[diagnostic(code(chain::plot::draw))]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::plot::draw)))]
     Draw {
-        /// The image file.
+        /// The image file (`<stem>.svg` for an SVG drawn in memory).
         path: String,
         /// What the backend said.
         message: String,
     },
     /// No series has a finite point.
     #[error("chart `{title}` has no finite data to draw")]
-    #[diagnostic(code(chain::plot::no_data))]
+    #[cfg_attr(feature = "cli", diagnostic(code(chain::plot::no_data)))]
     NoData {
         /// The chart's title.
         title: String,
     },
 }
 
-/// The two backends behind one type, so that each chart is drawn by one
-/// function for both of its files.
-pub enum Area<'a> {
-    /// The PNG.
-    Bitmap(DrawingArea<BitMapBackend<'a>, Shift>),
-    /// The SVG.
-    Svg(DrawingArea<SVGBackend<'a>, Shift>),
+/// One chart, as data.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Chart {
+    /// Line and scatter series on linear axes.
+    Xy(XyChart),
+    /// Bars of named values.
+    Bar(BarChart),
+    /// A heat map over two numeric axes with a colour bar (`chain map`).
+    Heat(map::HeatMap),
+    /// A map of labelled cells, each printed with its value (the
+    /// reliability maps).
+    Cells(reliability::CellMap),
 }
 
-/// Draws one chart as `dir/stem.png` and `dir/stem.svg` (creating `dir`),
-/// each written atomically (`cli/atomic.rs`); returns both paths.
-pub fn write_both(
-    dir: &Path,
-    stem: &str,
-    size: (u32, u32),
-    draw: impl Fn(Area<'_>) -> Result<(), String>,
-) -> Result<Vec<PathBuf>, PlotError> {
+impl From<XyChart> for Chart {
+    fn from(chart: XyChart) -> Chart {
+        Chart::Xy(chart)
+    }
+}
+
+impl From<BarChart> for Chart {
+    fn from(chart: BarChart) -> Chart {
+        Chart::Bar(chart)
+    }
+}
+
+impl Chart {
+    /// The image size in pixels (SVG user units).
+    pub fn size(&self) -> (u32, u32) {
+        match self {
+            Chart::Xy(c) => c.size,
+            Chart::Bar(c) => c.size,
+            Chart::Heat(c) => c.size,
+            Chart::Cells(c) => c.size,
+        }
+    }
+
+    /// Refuses a chart without data before anything is drawn.
+    fn check(&self) -> Result<(), PlotError> {
+        match self {
+            Chart::Xy(c) => c.ranges().map(|_| ()),
+            _ => Ok(()),
+        }
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        match self {
+            Chart::Xy(c) => c.draw(root, c.ranges().map_err(|e| e.to_string())?),
+            Chart::Bar(c) => c.draw(root),
+            Chart::Heat(c) => c.draw(root),
+            Chart::Cells(c) => c.draw(root),
+        }
+    }
+
+    /// The chart as an SVG document, in memory.
+    pub fn svg(&self) -> Result<String, PlotError> {
+        self.svg_named("chart.svg")
+    }
+
+    /// The SVG, a drawing error naming `path`.
+    fn svg_named(&self, path: &str) -> Result<String, PlotError> {
+        self.check()?;
+        ensure_fonts();
+        let mut text = String::new();
+        {
+            let root = SVGBackend::with_string(&mut text, self.size()).into_drawing_area();
+            self.draw(root).map_err(|message| PlotError::Draw {
+                path: path.to_string(),
+                message,
+            })?;
+        }
+        Ok(text)
+    }
+
+    /// Draws the chart as a PNG file at `path` (the bitmap backend encodes
+    /// it by the path's extension, which must be `png`).
+    pub fn png(&self, path: &Path) -> Result<(), PlotError> {
+        self.check()?;
+        ensure_fonts();
+        let root = BitMapBackend::new(path, self.size()).into_drawing_area();
+        self.draw(root).map_err(|message| PlotError::Draw {
+            path: path.display().to_string(),
+            message,
+        })
+    }
+}
+
+/// A chart and the stem of its files.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    /// The file name without its extension, relative to the plot directory
+    /// (`/` separates a subdirectory: `compensated/map_px`).
+    pub stem: String,
+    /// The chart.
+    pub chart: Chart,
+}
+
+impl Figure {
+    /// A chart with its stem.
+    pub fn new(stem: impl Into<String>, chart: impl Into<Chart>) -> Figure {
+        Figure {
+            stem: stem.into(),
+            chart: chart.into(),
+        }
+    }
+
+    /// `dir/<stem>.<extension>`.
+    fn path(&self, dir: &Path, extension: &str) -> PathBuf {
+        let mut parts: Vec<&str> = self.stem.split('/').collect();
+        let last = parts.pop().unwrap_or_default();
+        let mut path = parts.iter().fold(dir.to_path_buf(), |p, s| p.join(s));
+        path.push(format!("{last}.{extension}"));
+        path
+    }
+}
+
+/// The charts of one command's document, and the notes on those left out
+/// (each a line `note: …`, for the caller to show).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Figures {
+    /// The charts, in the order their files are written.
+    pub figures: Vec<Figure>,
+    /// Why a chart is missing (a map of one point, nothing tightened, no
+    /// evaluated instant).
+    pub notes: Vec<String>,
+}
+
+impl Figures {
+    /// Adds a chart.
+    pub fn push(&mut self, stem: impl Into<String>, chart: impl Into<Chart>) {
+        self.figures.push(Figure::new(stem, chart));
+    }
+
+    /// Adds the charts and notes of `other`, its stems under `subdir`.
+    pub fn nest(&mut self, subdir: &str, other: Figures) {
+        self.figures
+            .extend(other.figures.into_iter().map(|f| Figure {
+                stem: format!("{subdir}/{}", f.stem),
+                chart: f.chart,
+            }));
+        self.notes.extend(other.notes);
+    }
+
+    /// Writes every chart as `dir/<stem>.png` and `dir/<stem>.svg` (creating
+    /// `dir` and the subdirectories the stems name), each file through
+    /// `files`; returns the paths written, PNG before SVG, in chart order.
+    pub fn write(&self, dir: &Path, files: &dyn Files) -> Result<Vec<PathBuf>, PlotError> {
+        create_dir(dir)?;
+        let mut written = Vec::with_capacity(2 * self.figures.len());
+        for figure in &self.figures {
+            let png = figure.path(dir, "png");
+            let svg = figure.path(dir, "svg");
+            if let Some(parent) = png.parent() {
+                create_dir(parent)?;
+            }
+            files.write(&png, &mut |at| figure.chart.png(at))?;
+            let text = figure.chart.svg_named(&svg.display().to_string())?;
+            files.write(&svg, &mut |at| {
+                std::fs::write(at, text.as_bytes()).map_err(|source| PlotError::Write {
+                    path: svg.display().to_string(),
+                    source,
+                })
+            })?;
+            written.extend([png, svg]);
+        }
+        Ok(written)
+    }
+}
+
+/// `dir` and its parents, created if missing.
+fn create_dir(dir: &Path) -> Result<(), PlotError> {
     std::fs::create_dir_all(dir).map_err(|source| PlotError::Io {
         path: dir.display().to_string(),
         source,
-    })?;
-    ensure_fonts();
-    let png = dir.join(format!("{stem}.png"));
-    let svg = dir.join(format!("{stem}.svg"));
-    for (path, bitmap) in [(&png, true), (&svg, false)] {
-        crate::cli::atomic::write_via(
-            path,
-            |tmp| {
-                let area = if bitmap {
-                    Area::Bitmap(BitMapBackend::new(tmp, size).into_drawing_area())
-                } else {
-                    Area::Svg(SVGBackend::new(tmp, size).into_drawing_area())
-                };
-                draw(area).map_err(|message| PlotError::Draw {
-                    path: path.display().to_string(),
-                    message,
-                })
-            },
-            |source| PlotError::Io {
-                path: path.display().to_string(),
-                source,
-            },
-        )?;
+    })
+}
+
+/// How [`Figures::write`] puts a file at `path`: `fill` writes the file at
+/// the path it is given (the bitmap backend opens that path itself), which
+/// may be a temporary one the implementation then moves to `path`.
+pub trait Files {
+    /// Writes `path` through `fill`.
+    fn write(
+        &self,
+        path: &Path,
+        fill: &mut dyn FnMut(&Path) -> Result<(), PlotError>,
+    ) -> Result<(), PlotError>;
+}
+
+/// Writes each file in place, at its own path.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Direct;
+
+impl Files for Direct {
+    fn write(
+        &self,
+        path: &Path,
+        fill: &mut dyn FnMut(&Path) -> Result<(), PlotError>,
+    ) -> Result<(), PlotError> {
+        fill(path)
     }
-    Ok(vec![png, svg])
 }
 
 /// Viridis, five stops, linearly interpolated (`t` in [0, 1]).
@@ -307,16 +491,6 @@ impl XyChart {
     pub fn legend(mut self, legend: Legend) -> XyChart {
         self.legend = legend;
         self
-    }
-
-    /// Writes `dir/stem.png` and `dir/stem.svg` (creating `dir`) and returns
-    /// both paths.
-    pub fn write(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, PlotError> {
-        let ranges = self.ranges()?;
-        write_both(dir, stem, self.size, |area| match area {
-            Area::Bitmap(a) => self.draw(a, ranges),
-            Area::Svg(a) => self.draw(a, ranges),
-        })
     }
 
     /// Axis ranges: the explicit ones, or the finite data padded by 3 % (x)
@@ -540,15 +714,6 @@ impl BarChart {
             value_decimals: None,
             size: (1000, 600),
         }
-    }
-
-    /// Writes `dir/stem.png` and `dir/stem.svg` (creating `dir`) and returns
-    /// both paths.
-    pub fn write(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, PlotError> {
-        write_both(dir, stem, self.size, |area| match area {
-            Area::Bitmap(a) => self.draw(a),
-            Area::Svg(a) => self.draw(a),
-        })
     }
 
     fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), String>

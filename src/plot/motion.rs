@@ -3,39 +3,61 @@
 //! series against time, and the truncation error over the roll against the
 //! series order (log scales), each as PNG and SVG.
 
-use std::path::{Path, PathBuf};
-
-use super::{Legend, Series as Line, XyChart};
+use super::{Figures, Legend, Series as Line, XyChart};
+use crate::ops::motion::MotionDocument;
 use chain_core::model::JointKind;
 use chain_core::motion::Series;
 
-/// What the charts show.
-pub(crate) struct View<'a> {
+/// What the charts show of a run.
+struct View<'a> {
     /// Chart title prefix.
-    pub title: String,
+    title: String,
     /// CNC variables.
-    pub variables: &'a [String],
+    variables: &'a [String],
     /// Their joint kinds.
-    pub kinds: &'a [JointKind],
+    kinds: &'a [JointKind],
     /// Instants.
-    pub times: &'a [f64],
+    times: &'a [f64],
     /// The exact motion at each instant.
-    pub exact: &'a [Vec<f64>],
+    exact: &'a [Vec<f64>],
     /// The Maclaurin series.
-    pub series: &'a Series,
+    series: &'a Series,
     /// The requested order.
-    pub order: usize,
+    order: usize,
     /// `errors[m][k]`.
-    pub errors: &'a [Vec<f64>],
+    errors: &'a [Vec<f64>],
     /// Per-axis tolerance, if given.
-    pub tolerance: Option<&'a [f64]>,
+    tolerance: Option<&'a [f64]>,
 }
 
-/// Writes `motion_<variable>.{png,svg}` for every axis,
-/// `series_error.{png,svg}` and `truncation_error.{png,svg}`; returns the
-/// files written.
-pub(crate) fn write_all(dir: &Path, v: &View<'_>) -> miette::Result<Vec<PathBuf>> {
-    let mut files = Vec::new();
+impl<'a> View<'a> {
+    /// What the charts draw of `doc`'s run.
+    fn of(doc: &'a MotionDocument) -> View<'a> {
+        let run = &doc.conversion;
+        View {
+            title: format!(
+                "{} → {} ({})",
+                run.motion.generator_name(),
+                run.motion.cnc_name(),
+                doc.settings.name
+            ),
+            variables: run.motion.variables(),
+            kinds: run.motion.kinds(),
+            times: &run.times,
+            exact: &run.exact,
+            series: &run.series,
+            order: run.order,
+            errors: &run.errors,
+            tolerance: run.required.as_ref().map(|r| r.tolerance.as_slice()),
+        }
+    }
+}
+
+/// `motion_<variable>` for every axis, `series_error` and
+/// `truncation_error`.
+pub fn charts(doc: &MotionDocument) -> Figures {
+    let v = &View::of(doc);
+    let mut files = Figures::default();
     for (k, name) in v.variables.iter().enumerate() {
         let unit = match v.kinds[k] {
             JointKind::Rotary => "rad",
@@ -60,7 +82,7 @@ pub(crate) fn write_all(dir: &Path, v: &View<'_>) -> miette::Result<Vec<PathBuf>
         .series(Line::line("exact", exact).width(5))
         .series(Line::line(format!("Maclaurin, order {}", v.order), approx))
         .legend(Legend::UpperLeft);
-        files.extend(chart.write(dir, &format!("motion_{}", file_stem(name)))?);
+        files.push(format!("motion_{}", file_stem(name)), chart);
     }
     let mut chart = XyChart::new(
         format!("{}: error of the order-{} series", v.title, v.order),
@@ -78,11 +100,7 @@ pub(crate) fn write_all(dir: &Path, v: &View<'_>) -> miette::Result<Vec<PathBuf>
             .collect();
         chart = chart.series(Line::line(name.clone(), points));
     }
-    files.extend(
-        chart
-            .legend(Legend::LowerRight)
-            .write(dir, "series_error")?,
-    );
+    files.push("series_error", chart.legend(Legend::LowerRight));
     let mut chart = XyChart::new(
         format!("{}: truncation error over the roll", v.title),
         "series order m",
@@ -106,8 +124,8 @@ pub(crate) fn write_all(dir: &Path, v: &View<'_>) -> miette::Result<Vec<PathBuf>
             chart = chart.hline(l);
         }
     }
-    files.extend(chart.write(dir, "truncation_error")?);
-    Ok(files)
+    files.push("truncation_error", chart);
+    files
 }
 
 /// A file-name-safe form of a variable name.

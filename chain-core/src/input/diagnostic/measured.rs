@@ -1,0 +1,360 @@
+//! The rules of the measured files: measurement and candidate files (codes
+//! `chain::measurements::*`) and positioning run files
+//! (`chain::positioning::*`).
+
+use super::Description as D;
+use crate::measured::measurements::Layout;
+use crate::measured::positioning::Direction;
+
+/// What a positioning run file's header names (the help of an empty file or
+/// an unknown column).
+pub(crate) const RUN_FILE_HEADER: &str =
+    "the header names `target`, `direction`, `run`, and `measured` or `deviation`";
+
+/// One thing wrong with a measurement or candidate file, worded by
+/// [`MeasurementsProblem::describe`].
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum MeasurementsProblem {
+    /// A header and no record.
+    NoRows {
+        /// Measurements or candidates.
+        layout: Layout,
+    },
+    /// A measured value's column in a candidate file.
+    MeasuredInCandidates {
+        /// The column.
+        column: String,
+    },
+    /// A column that is neither a variable, a parameter nor a measurement
+    /// column.
+    UnknownColumn {
+        /// The column.
+        column: String,
+        /// The machine.
+        machine: String,
+        /// Its axis variables.
+        variables: Vec<String>,
+        /// The measurement columns of this layout, as a header names them
+        /// (`` `dpx,dpy,dpz` or `ux,uy,uz,d` ``).
+        measured: String,
+        /// Measurements or candidates.
+        layout: Layout,
+        /// The closest valid column, if one is close.
+        suggestion: Option<String>,
+    },
+    /// Axis variables without a column.
+    MissingPose {
+        /// The variables.
+        variables: Vec<String>,
+    },
+    /// A symbolic parameter without a column.
+    MissingParameter {
+        /// The parameter.
+        name: String,
+    },
+    /// Some but not all of one kind's columns.
+    PartialColumns {
+        /// The kind's columns, comma-separated.
+        names: String,
+    },
+    /// No measured value column.
+    NoValues {
+        /// The measurement columns, as a header names them.
+        expected: String,
+    },
+    /// The columns of two kinds of measurement.
+    TwoKinds {
+        /// Each kind's columns, as a header names them.
+        kinds: Vec<String>,
+    },
+    /// A direction that is not a unit vector.
+    NotUnit {
+        /// Its length.
+        norm: f64,
+    },
+    /// A standard deviation that is not positive.
+    StdNotPositive {
+        /// Its value.
+        value: f64,
+    },
+}
+
+impl MeasurementsProblem {
+    /// Every part of the message of this problem: one match arm per
+    /// variant.
+    pub fn describe(&self) -> D {
+        match self {
+            MeasurementsProblem::NoRows { layout } => {
+                let (what, help) = match layout {
+                    Layout::Measurements => {
+                        ("measurement", "each row after the header is one measurement")
+                    }
+                    Layout::Candidates => (
+                        "candidate pose",
+                        "each row after the header is one candidate pose",
+                    ),
+                };
+                D::new(
+                    "chain::measurements::no_rows",
+                    "no rows",
+                    format!("the file has a header but no {what} row"),
+                )
+                .help(help.to_string())
+            }
+            MeasurementsProblem::MeasuredInCandidates { column } => D::new(
+                "chain::measurements::measured_in_candidates",
+                "measured value",
+                format!("column `{column}` is a measured value: a candidate file gives only where to measure"),
+            )
+            .help("the candidate columns are the axis variables, parameters per row, `ux,uy,uz` for measurements along a direction, and optionally `std`".to_string()),
+            MeasurementsProblem::UnknownColumn {
+                column,
+                machine,
+                variables,
+                measured,
+                layout,
+                suggestion,
+            } => D::new(
+                "chain::measurements::unknown_column",
+                "unknown column",
+                D::suggesting(
+                    format!("column `{column}` is neither an axis variable, a parameter of machine `{machine}`, nor a measurement column"),
+                    suggestion,
+                ),
+            )
+            .help(format!(
+                "the columns are the axis variables ({}), parameters, {}",
+                variables.join(", "),
+                match layout {
+                    Layout::Measurements => format!("{measured}, and optionally `std`"),
+                    Layout::Candidates => format!("optionally {measured} and `std`"),
+                }
+            )),
+            MeasurementsProblem::MissingPose { variables } => D::new(
+                "chain::measurements::missing_pose",
+                "missing pose column",
+                format!(
+                    "the header has no column for the axis variable{} {}: every row needs the whole pose",
+                    if variables.len() == 1 { "" } else { "s" },
+                    quoted(variables.iter().map(String::as_str))
+                ),
+            ),
+            MeasurementsProblem::MissingParameter { name } => D::new(
+                "chain::measurements::missing_parameter",
+                "missing parameter",
+                format!("parameter `{name}` is symbolic in the machine file and the header has no column for it"),
+            ),
+            MeasurementsProblem::PartialColumns { names } => D::new(
+                "chain::measurements::partial_columns",
+                "partial columns",
+                format!("the header has only some of `{names}`: give all of them"),
+            ),
+            MeasurementsProblem::NoValues { expected } => D::new(
+                "chain::measurements::no_values",
+                "no measured values",
+                format!("the header has no measured values: expected {expected}"),
+            ),
+            MeasurementsProblem::TwoKinds { kinds } => D::new(
+                "chain::measurements::two_kinds",
+                "two kinds",
+                format!(
+                    "the header has both {}: a file holds one kind of measurement",
+                    kinds.join(" and ")
+                ),
+            ),
+            MeasurementsProblem::NotUnit { norm } => D::new(
+                "chain::measurements::not_unit",
+                "not a unit vector",
+                format!("the direction (ux, uy, uz) has length {norm}, not 1"),
+            ),
+            MeasurementsProblem::StdNotPositive { value } => D::new(
+                "chain::measurements::std_not_positive",
+                "not positive",
+                format!("the standard deviation must be positive, got {value}"),
+            ),
+        }
+    }
+}
+
+/// One thing wrong with a positioning run file, worded by
+/// [`PositioningProblem::describe`].
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum PositioningProblem {
+    /// A column a run file does not have.
+    UnknownColumn {
+        /// The column.
+        column: String,
+        /// The closest valid column, if one is close.
+        suggestion: Option<String>,
+    },
+    /// Both `measured` and `deviation`.
+    BothValueColumns,
+    /// Required columns missing.
+    MissingColumns {
+        /// The missing ones of `target`, `direction`, `run`.
+        columns: Vec<&'static str>,
+        /// Whether neither `measured` nor `deviation` is there.
+        value: bool,
+    },
+    /// A `direction` cell that is not a direction.
+    Direction {
+        /// The cell as written.
+        text: String,
+    },
+    /// A `run` cell that is not a run number.
+    Run {
+        /// The cell as written.
+        text: String,
+    },
+    /// A `measured` value whose deviation from the target is not finite.
+    DeviationNotFinite {
+        /// The cell as written.
+        cell: String,
+    },
+    /// A (target, direction, run) given twice.
+    Repeated {
+        /// The target.
+        target: f64,
+        /// The direction.
+        direction: Direction,
+        /// The run.
+        run: usize,
+        /// The line of its first occurrence.
+        first_line: usize,
+    },
+    /// Fewer than two targets.
+    TooFewTargets {
+        /// The number of targets.
+        count: usize,
+        /// The one target.
+        target: f64,
+    },
+    /// A target without a run that another (target, direction) has.
+    UnequalRuns {
+        /// The target.
+        target: f64,
+        /// Its runs moving up.
+        up: usize,
+        /// Its runs moving down.
+        down: usize,
+        /// The run it lacks.
+        missing: usize,
+        /// The direction that lacks it.
+        direction: Direction,
+        /// The most runs of any (target, direction).
+        runs: usize,
+    },
+    /// Fewer than two runs per direction.
+    TooFewRuns {
+        /// The runs per direction.
+        runs: usize,
+    },
+}
+
+impl PositioningProblem {
+    /// Every part of the message of this problem: one match arm per
+    /// variant.
+    pub fn describe(&self) -> D {
+        match self {
+            PositioningProblem::UnknownColumn { column, suggestion } => D::new(
+                "chain::positioning::unknown_column",
+                "unknown column",
+                D::suggesting(
+                    format!("column `{column}` is not a column of a positioning run file"),
+                    suggestion,
+                ),
+            )
+            .help(RUN_FILE_HEADER.to_string()),
+            PositioningProblem::BothValueColumns => D::new(
+                "chain::positioning::value_columns",
+                "both",
+                "the header has both `measured` and `deviation`: give exactly one",
+            ),
+            PositioningProblem::MissingColumns { columns, value } => {
+                let mut missing = columns.clone();
+                if *value {
+                    missing.push("measured` or `deviation");
+                }
+                D::new(
+                    "chain::positioning::missing_column",
+                    "missing column",
+                    format!("the header has no column {}", quoted(missing.into_iter())),
+                )
+            }
+            PositioningProblem::Direction { text } => D::new(
+                "chain::positioning::direction",
+                "direction",
+                if text.is_empty() {
+                    "column `direction`: the cell is empty".to_string()
+                } else {
+                    format!("column `direction`: `{text}` is not a direction")
+                },
+            )
+            .help("a direction is `up` (or `+`, approached moving in the positive direction) or `down` (or `-`)".to_string()),
+            PositioningProblem::Run { text } => D::new(
+                "chain::positioning::run",
+                "run",
+                if text.is_empty() {
+                    "column `run`: the cell is empty".to_string()
+                } else {
+                    format!("column `run`: `{text}` is not a run number 1, 2, …")
+                },
+            ),
+            PositioningProblem::DeviationNotFinite { cell } => D::new(
+                "chain::csv::not_finite",
+                "not finite",
+                format!("column `measured`: `{cell}` minus the target is not finite"),
+            ),
+            PositioningProblem::Repeated {
+                target,
+                direction,
+                run,
+                first_line,
+            } => D::new(
+                "chain::positioning::repeated",
+                "repeated",
+                format!(
+                    "target {target}, direction {}, run {run} is given twice (first on line {first_line})",
+                    direction.name()
+                ),
+            ),
+            PositioningProblem::TooFewTargets { count, target } => D::new(
+                "chain::positioning::too_few_targets",
+                "one target",
+                format!("the file has {count} target ({target}): an ISO 230-2 run needs at least 2"),
+            ),
+            PositioningProblem::UnequalRuns {
+                target,
+                up,
+                down,
+                missing,
+                direction,
+                runs,
+            } => D::new(
+                "chain::positioning::unequal_runs",
+                "unequal runs",
+                format!(
+                    "target {target} has {up} run(s) {} and {down} {}, no run {missing} {}: every target needs the same runs 1..{runs} in both directions",
+                    Direction::Up.name(),
+                    Direction::Down.name(),
+                    direction.name(),
+                ),
+            ),
+            PositioningProblem::TooFewRuns { runs } => D::new(
+                "chain::positioning::too_few_runs",
+                "one run",
+                format!("the file has {runs} run per direction: the standard uncertainty s needs at least 2 (ISO 230-2 asks for 5)"),
+            ),
+        }
+    }
+}
+
+/// Names as a message lists them: `` `a`, `b` ``.
+fn quoted<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    names
+        .map(|n| format!("`{n}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
