@@ -37,6 +37,7 @@ fn candidates(m: &Machine, p: &[f64], n: usize) -> Vec<Measurement> {
             observed: Observed::Point,
             values: vec![],
             std: None,
+            setup: None,
         })
         .collect()
 }

@@ -120,12 +120,18 @@ def allocate_json(
 
 def identify_json(
     model: Model,
-    path: Optional[str],
-    text: Optional[str],
-    file: str,
+    measurements: Optional[Tuple[Optional[str], Optional[str], str]],
+    spheres: Optional[Tuple[Optional[str], Optional[str], str]],
+    setup: Optional[str],
     params: Sequence[Tuple[str, float]],
     prior: bool,
     validate: Optional[Tuple[Optional[str], Optional[str], str]] = None,
+    rank_tol: Optional[float] = None,
+    fix: Optional[Sequence[str]] = None,
+    estimate: Optional[Sequence[str]] = None,
+    iterate: bool = False,
+    holdout: Optional[float] = None,
+    seed: Optional[int] = None,
 ) -> Tuple[str, str]: ...
 def plan_json(
     model: Model,

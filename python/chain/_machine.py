@@ -521,7 +521,7 @@ class Machine:
 
     def identify(
         self,
-        measurements: Union[str, "os.PathLike[str]", Mapping[str, ArrayLike]],
+        measurements: Optional[Union[str, "os.PathLike[str]", Mapping[str, ArrayLike]]] = None,
         prior: bool = False,
         params: Params = None,
         values_out: Optional[Union[str, "os.PathLike[str]"]] = None,
@@ -534,23 +534,33 @@ class Machine:
         iterate: bool = False,
         holdout: Optional[float] = None,
         seed: Optional[int] = None,
+        spheres: Optional[Union[str, "os.PathLike[str]", Mapping[str, Any]]] = None,
+        setup: Optional[str] = None,
     ) -> "IdentifyResult":
         """The error parameters from measurements, ``chain identify --measurements M --format json``.
 
-        ``measurements``: the CSV's path, or its columns as a dict of 1-D
-        arrays (a pandas DataFrame works too) named as the CSV's header:
-        the axis variables, any per-row parameters, ``dpx, dpy, dpz`` or
-        ``ux, uy, uz, d``, optionally ``std``; ``name`` names them in
-        messages and in the document's ``file``. ``prior``: the
+        ``measurements``: the CSV's path, its text (a string holding a
+        line break), or its columns as a dict of 1-D arrays (a pandas
+        DataFrame works too) named as the CSV's header: the axis variables,
+        any per-row parameters, ``dpx, dpy, dpz`` or ``ux, uy, uz, d``,
+        optionally ``std``; ``name`` names them in messages and in the
+        document's ``file``. ``spheres`` (``--spheres``), instead of
+        ``measurements``: sphere probings as a path, CSV text or columns
+        (every axis variable, rotary ones in degrees; optionally ``sphere``,
+        whose values may be text, and ``std``); each sphere's position is
+        estimated beside the errors (the document's ``setups``), never
+        written into values. ``setup="ball"`` (``--setup ball``): the
+        measurement records are an R-test's, whose ball set-up offsets are
+        estimated likewise. ``prior``: the
         ``statistics`` as a Gaussian prior (``--prior``); ``values_out``:
         also write the estimates as a values file (``--values-out``);
-        ``validate``: measurements held out of the fit, as ``measurements``
-        (``--validate``; ``validate_name`` names columns given as a dict):
-        the document's ``validation`` gives the error they show before and
-        after the estimates' correction. ``rank_tol`` (``--rank-tol``): a
-        fixed relative tolerance instead of the noise rule; ``fix`` /
-        ``estimate`` (``--fix`` / ``--estimate``): the error parameters to
-        fix at 0, or the only ones to estimate, instead of the
+        ``validate``: records held out of the fit, as ``measurements`` (or
+        ``spheres``) (``--validate``; ``validate_name`` names text or
+        columns): the document's ``validation`` gives the error they show
+        before and after the estimates' correction. ``rank_tol``
+        (``--rank-tol``): a fixed relative tolerance instead of the noise
+        rule; ``fix`` / ``estimate`` (``--fix`` / ``--estimate``): the error
+        parameters to fix at 0, or the only ones to estimate, instead of the
         elimination's choice (the document's ``subset``); ``iterate``
         (``--iterate``): fit the exact kinematics from the linear estimate
         (the document's ``iteration``); ``holdout`` / ``seed``
@@ -559,16 +569,21 @@ class Machine:
         """
         from ._results import IdentifyResult
 
-        path, text = _csv_input(measurements, "measurements")
-        held_out = None
-        if validate is not None:
-            v_path, v_text = _csv_input(validate, "validate")
-            held_out = (v_path, v_text, v_path if v_path is not None else validate_name)
+        def file_input(data: Any, what: str, label: str, text_columns: Sequence[str] = ()) -> Tuple[Optional[str], Optional[str], str]:
+            if isinstance(data, str) and "\n" in data:
+                return (None, data, label)
+            path, text = _csv_input(data, what, text_columns)
+            return (path, text, path if path is not None else label)
+
+        text_columns = ("sphere",) if spheres is not None else ()
+        records = None if measurements is None else file_input(measurements, "measurements", name)
+        probings = None if spheres is None else file_input(spheres, "spheres", name if name != "<measurements>" else "<spheres>", ("sphere",))
+        held_out = None if validate is None else file_input(validate, "validate", validate_name, text_columns)
         doc, values_text = _chain.identify_json(
             self._model,
-            path,
-            text,
-            name,
+            records,
+            probings,
+            None if setup is None else str(setup),
             _params(params),
             bool(prior),
             held_out,
@@ -786,15 +801,30 @@ def _table_source(data: Any, what: str) -> Tuple[Optional[str], Optional[Mapping
     return None, data
 
 
-def _csv_input(data: Any, what: str) -> Tuple[Optional[str], Optional[str]]:
-    """A CSV path, or columns (a dict of 1-D arrays, or a DataFrame) as the CSV's text."""
+def _csv_input(data: Any, what: str, text_columns: Sequence[str] = ()) -> Tuple[Optional[str], Optional[str]]:
+    """A CSV path, or columns (a dict of 1-D arrays, or a DataFrame) as the CSV's text.
+
+    Columns named in ``text_columns`` (a sphere's identifier) are written as
+    their values' text; every other column must hold finite numbers.
+    """
     path, data = _table_source(data, what)
     if data is None:
         return path, None
     names = [str(n) for n in data]
-    columns = []
+    columns: List[Any] = []
     n = None
     for name, values in zip(names, data.values()):
+        if name in text_columns:
+            cells = [str(v) for v in (values.tolist() if hasattr(values, "tolist") else list(values))]
+            bad = [c for c in cells if "," in c or "\n" in c or '"' in c]
+            if bad:
+                raise ValueError(f"{what}[{name!r}] has an identifier {bad[0]!r} with a comma, quote or line break")
+            if n is None:
+                n = len(cells)
+            elif len(cells) != n:
+                raise ValueError(f"{what}[{name!r}] has {len(cells)} values, {names[0]!r} has {n}")
+            columns.append(cells)
+            continue
         a = _float_array(values, f"{what}[{name!r}]")
         if a.ndim != 1:
             raise ValueError(f"{what}[{name!r}] of shape {a.shape}: expected a 1-D column")
@@ -808,7 +838,7 @@ def _csv_input(data: Any, what: str) -> Tuple[Optional[str], Optional[str]]:
         columns.append(a)
     lines = [",".join(names)]
     for i in range(n or 0):
-        lines.append(",".join(repr(float(c[i])) for c in columns))
+        lines.append(",".join(c[i] if isinstance(c, list) else repr(float(c[i])) for c in columns))
     return None, "\n".join(lines) + "\n"
 
 

@@ -12,7 +12,7 @@
 use chain::ops::identify::{IdentifyOpsError, IdentifyRequest};
 use chain::ops::plan::{self, PlanRequest};
 use chain::ops::Worded;
-use chain_core::measured::{Layout, Measurements, MeasurementsError};
+use chain_core::measured::{Layout, Measurements, MeasurementsError, SetupKind};
 use chain_core::model::Machine;
 use chain_core::plan::Kind;
 use chain_core::values::{Values, ValuesError};
@@ -23,7 +23,9 @@ use chain::ops::map::{MapOpsError, MapRequest};
 use chain::ops::resolve::AxisPoints;
 use chain::ops::source as ops_source;
 
-use crate::{choice, load_error, resolve_error, source, study_error, to_json, value_error, Model};
+use crate::{
+    choice, load_error, resolve_error, source, study_error, to_json, value_error, FileInput, Model,
+};
 
 /// A measurement or candidate CSV: read from `path`, or parsed from `text`
 /// named `file` ([`chain::ops::source::read_measurements`], the GIL
@@ -59,21 +61,22 @@ pub(crate) fn read_values(
 }
 
 /// `chain identify --format json` (and the values file `--values-out`
-/// writes): the measurements from `path` or `text` (named `file`); the
-/// held-out ones of `--validate`, if any, from `validate` (a path, or text
-/// and its name).
+/// writes): the measurement CSV `measurements` or the sphere-probing CSV
+/// `spheres` (each a path, or text and its name), `setup` (`--setup`,
+/// `"ball"`); the held-out records of `--validate`, if any, from
+/// `validate`, read as the fitted ones are.
 #[pyfunction]
-#[pyo3(signature = (model, path, text, file, params, prior, validate=None, rank_tol=None, fix=None, estimate=None, iterate=false, holdout=None, seed=None))]
+#[pyo3(signature = (model, measurements, spheres, setup, params, prior, validate=None, rank_tol=None, fix=None, estimate=None, iterate=false, holdout=None, seed=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_json(
     py: Python<'_>,
     model: &Model,
-    path: Option<&str>,
-    text: Option<&str>,
-    file: &str,
+    measurements: Option<FileInput>,
+    spheres: Option<FileInput>,
+    setup: Option<&str>,
     params: Vec<(String, f64)>,
     prior: bool,
-    validate: Option<(Option<String>, Option<String>, String)>,
+    validate: Option<FileInput>,
     rank_tol: Option<f64>,
     fix: Option<Vec<String>>,
     estimate: Option<Vec<String>>,
@@ -81,13 +84,11 @@ pub(crate) fn identify_json(
     holdout: Option<f64>,
     seed: Option<u64>,
 ) -> PyResult<(String, String)> {
-    let validate = match &validate {
-        Some((path, text, file)) => Some(source(path.as_deref(), text.as_deref(), file)?),
-        None => None,
-    };
     let request = IdentifyRequest {
-        measurements: source(path, text, file)?,
-        validate,
+        measurements: measurements.as_ref().map(FileInput::source).transpose()?,
+        spheres: spheres.as_ref().map(FileInput::source).transpose()?,
+        setup: setup.map(choice::<SetupKind>).transpose()?,
+        validate: validate.as_ref().map(FileInput::source).transpose()?,
         params: &params,
         prior,
         rank_tol,

@@ -1,6 +1,6 @@
 //! The options that take one of a closed set of values (`--method`,
 //! `--sided`, `--system`, `--controller`, `--frame`, `--kind`, `--select`,
-//! `--strategy`, `--rank`, `--target`): each value's spelling and its
+//! `--strategy`, `--rank`, `--target`, `--setup`): each value's spelling and its
 //! one-line help written once, here, as a [`Choice`]. The CLI parses them
 //! with [`parser`] (clap lists the spellings and their help in `--help`);
 //! Python parses the same strings with [`Choice::parse`]; both refuse an
@@ -8,7 +8,7 @@
 
 use chain_core::compensation::controllers::Controller;
 use chain_core::diagnostic::shortened;
-use chain_core::measured::MeasurementKind;
+use chain_core::measured::{MeasurementKind, SetupKind};
 use chain_core::model::{Frame, Sided};
 use reliability::allocate::StrategyName;
 use reliability::Method;
@@ -218,6 +218,26 @@ impl Choice for MeasurementKind {
             MeasurementKind::Direction => {
                 "The deviation along the candidate's `ux, uy, uz` (one row); the file must have them"
             }
+        }
+    }
+}
+
+impl Choice for SetupKind {
+    const WHAT: &'static str = "a set-up";
+    // A sphere's set-up comes with a sphere file (`--spheres`); `--setup`
+    // names the set-up of ordinary measurement records.
+    const ALL: &'static [SetupKind] = &[SetupKind::Ball];
+
+    fn name(self) -> &'static str {
+        SetupKind::name(self)
+    }
+
+    fn help(self) -> &'static str {
+        match self {
+            SetupKind::Ball => {
+                "An R-test: the ball's three set-up offsets on the table are unknowns of the fit (reported, not written into values)"
+            }
+            SetupKind::Sphere => "A sphere probed on the table (a sphere file)",
         }
     }
 }

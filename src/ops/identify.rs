@@ -15,12 +15,13 @@
 
 pub mod document;
 
+use chain_core::measured::SetupKind;
 use chain_core::measured::{
     DesignError, HoldoutError, Identification, IdentifyError, IdentifyOptions, MeasurementsError,
     SubsetSide,
 };
 #[cfg(feature = "records")]
-use chain_core::measured::{Holdout, Layout, Measurements, SubsetChoice};
+use chain_core::measured::{Holdout, Layout, Measurements, Setup, SubsetChoice};
 #[cfg(feature = "records")]
 use chain_core::Machine;
 use serde::{Serialize, Serializer};
@@ -37,10 +38,19 @@ use super::worded::{diagnostic, Worded};
 #[cfg(feature = "records")]
 #[derive(Debug, Clone)]
 pub struct IdentifyRequest<'a> {
-    /// `--measurements`: the measurement CSV.
-    pub measurements: Source<'a>,
-    /// `--validate`: measurements held out of the fit (the same columns),
-    /// where the estimates' prediction is reported.
+    /// `--measurements`: the measurement CSV (this or `spheres`).
+    pub measurements: Option<Source<'a>>,
+    /// `--spheres`: a sphere-probing CSV (five-axis spec), whose spheres'
+    /// positions are estimated beside the errors (this or
+    /// `measurements`).
+    pub spheres: Option<Source<'a>>,
+    /// `--setup ball`: every measurement record is taken against one
+    /// R-test ball whose set-up offsets are estimated (with
+    /// `measurements` only).
+    pub setup: Option<SetupKind>,
+    /// `--validate`: records held out of the fit (the same columns as the
+    /// fitted file, the same spheres), where the estimates' prediction is
+    /// reported.
     pub validate: Option<Source<'a>>,
     /// `--param NAME=VALUE`: the parameters the CSVs have no column for.
     pub params: &'a [(String, f64)],
@@ -68,13 +78,23 @@ pub struct IdentifyRequest<'a> {
 #[cfg(feature = "records")]
 #[derive(Debug, Clone)]
 pub struct CheckedIdentify<'a> {
-    measurements: Source<'a>,
+    records: Records<'a>,
     validate: Option<Source<'a>>,
     params: &'a [(String, f64)],
     prior: bool,
     options: IdentifyOptions,
     iterate: bool,
     holdout: Option<Holdout>,
+}
+
+/// Which records a checked request reads.
+#[cfg(feature = "records")]
+#[derive(Debug, Clone, Copy)]
+enum Records<'a> {
+    /// A measurement CSV, each record against the set-up if one is given.
+    Measurements(Source<'a>, Option<SetupKind>),
+    /// A sphere-probing CSV.
+    Spheres(Source<'a>),
 }
 
 /// The document of `chain identify` (JSON: [`IdentifyDocument`]) with the
@@ -98,6 +118,27 @@ impl Serialize for IdentifyRun {
 /// Why `chain identify` cannot run, in the options' words.
 #[derive(Debug, thiserror::Error)]
 pub enum IdentifyOpsError {
+    /// Neither `--measurements` nor `--spheres`, or both.
+    #[error("--measurements: give the measurement CSV (--measurements M.csv) or a sphere-probing CSV (--spheres S.csv), {}", if *.both { "not both" } else { "one of them" })]
+    Records {
+        /// Both were given.
+        both: bool,
+    },
+    /// `--setup` with `--spheres`.
+    #[error("--setup: the spheres of --spheres are already set-ups whose positions are estimated; --setup ball is for the records of --measurements")]
+    SetupWithSpheres,
+    /// A held-out record on a set-up the fit does not have.
+    #[error("{file}: line {line}: {kind} `{name}` is not among the fitted file's, so its position is not known; hold out probings of the fitted spheres")]
+    UnknownSetup {
+        /// The held-out file.
+        file: String,
+        /// The record's line.
+        line: usize,
+        /// `sphere` or `ball`.
+        kind: &'static str,
+        /// Its identifier.
+        name: String,
+    },
     /// `--fix` with `--estimate`.
     #[error("--fix: cannot be given with --estimate (one names the fixed parameters, the other the estimated ones)")]
     FixWithEstimate,
@@ -184,6 +225,10 @@ impl Worded for IdentifyOpsError {
     fn own_code(&self) -> Option<&'static str> {
         match self {
             IdentifyOpsError::FixWithEstimate => Some("chain::identify::subset"),
+            IdentifyOpsError::Records { .. } | IdentifyOpsError::SetupWithSpheres => {
+                Some("chain::identify::records")
+            }
+            IdentifyOpsError::UnknownSetup { .. } => Some("chain::identify::setup"),
             IdentifyOpsError::SeedWithoutHoldout | IdentifyOpsError::HoldoutWithValidate => {
                 Some("chain::identify::holdout")
             }
@@ -194,6 +239,12 @@ impl Worded for IdentifyOpsError {
     fn own_help(&self) -> Option<String> {
         let help = match self {
             IdentifyOpsError::FixWithEstimate => SUBSET_HELP,
+            IdentifyOpsError::Records { .. } | IdentifyOpsError::SetupWithSpheres => {
+                "measurements along the tool point or a direction go in --measurements (with --setup ball for an R-test); sphere probings (rotary axes in degrees) in --spheres"
+            }
+            IdentifyOpsError::UnknownSetup { .. } => {
+                "--validate takes probings of the spheres of the fitted file at other positions"
+            }
             IdentifyOpsError::SeedWithoutHoldout
             | IdentifyOpsError::HoldoutWithValidate
             | IdentifyOpsError::Holdout(_) => HOLDOUT_HELP,
@@ -284,8 +335,14 @@ impl<'a> IdentifyRequest<'a> {
         if holdout.is_some() && self.validate.is_some() {
             return Err(IdentifyOpsError::HoldoutWithValidate);
         }
+        let records = match (self.measurements, self.spheres) {
+            (Some(m), None) => Records::Measurements(m, self.setup),
+            (None, Some(s)) if self.setup.is_none() => Records::Spheres(s),
+            (None, Some(_)) => return Err(IdentifyOpsError::SetupWithSpheres),
+            (m, _) => return Err(IdentifyOpsError::Records { both: m.is_some() }),
+        };
         Ok(CheckedIdentify {
-            measurements: self.measurements,
+            records,
             validate: self.validate,
             params: self.params,
             prior: self.prior,
@@ -303,9 +360,19 @@ impl CheckedIdentify<'_> {
     /// holdout's split, the identification, its document and values file.
     pub fn run(&self, machine: &Machine) -> Result<IdentifyRun, IdentifyOpsError> {
         super::resolve::check_parameters(machine, self.params)?;
-        let measurements = read(self.measurements, machine, self.params)?;
+        let measurements = self.read(None, machine)?;
         let validation = (self.validate)
-            .map(|v| read(v, machine, self.params))
+            .map(|v| {
+                let held = self.read(Some(v), machine)?;
+                let file = held.file.clone();
+                held.onto_setups(&measurements.setups)
+                    .map_err(|(line, setup)| IdentifyOpsError::UnknownSetup {
+                        file,
+                        line,
+                        kind: setup.kind.name(),
+                        name: setup.name,
+                    })
+            })
             .transpose()?;
         let split = match self.holdout {
             Some(h) => Some(
@@ -338,17 +405,37 @@ impl CheckedIdentify<'_> {
     }
 }
 
-/// A measurement CSV for `machine` from a file or from the caller's bytes.
 #[cfg(feature = "records")]
-fn read(
-    source: Source<'_>,
-    machine: &Machine,
-    params: &[(String, f64)],
-) -> Result<Measurements, IdentifyOpsError> {
-    Ok(super::source::read_measurements(
-        source,
-        machine,
-        params,
-        Layout::Measurements,
-    )?)
+impl CheckedIdentify<'_> {
+    /// The records of the request (or, with `validate`, that file read as
+    /// the request's records are) for `machine`: a measurement CSV on its
+    /// set-up, or a sphere-probing CSV.
+    fn read(
+        &self,
+        validate: Option<Source<'_>>,
+        machine: &Machine,
+    ) -> Result<Measurements, IdentifyOpsError> {
+        let params = self.params;
+        Ok(match self.records {
+            Records::Measurements(source, setup) => {
+                let source = validate.unwrap_or(source);
+                let read = super::source::read_measurements(
+                    source,
+                    machine,
+                    params,
+                    Layout::Measurements,
+                )?;
+                match setup {
+                    Some(kind) => read.on_setup(Setup {
+                        name: kind.name().to_string(),
+                        kind,
+                    }),
+                    None => read,
+                }
+            }
+            Records::Spheres(source) => {
+                super::source::read_spheres(validate.unwrap_or(source), machine, params)?
+            }
+        })
+    }
 }

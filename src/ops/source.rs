@@ -87,6 +87,20 @@ pub fn read_measurements(
     }
 }
 
+/// A sphere-probing CSV for `machine` (five-axis spec).
+pub fn read_spheres(
+    source: Source<'_>,
+    machine: &Machine,
+    params: &[(String, f64)],
+) -> Result<Measurements, MeasurementsError> {
+    match source {
+        Source::Path(path) => Measurements::read_spheres(path, machine, params),
+        Source::Bytes { name, bytes } => {
+            Measurements::spheres_from_bytes(bytes, name, machine, params)
+        }
+    }
+}
+
 /// A values file for `machine`.
 pub fn read_values(source: Source<'_>, machine: &Machine) -> Result<Values, ValuesError> {
     match source {

@@ -100,6 +100,26 @@ enum Factor<'a> {
     Error([f64; 6], &'a ErrorSlots),
 }
 
+/// The nominal tool point at a pose and the rotation into the machine
+/// file's frame ([`ExactChain::nominal`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Nominal {
+    /// `T_wt(q, 0) · t`: the tool point in the workpiece frame.
+    pub point: [f64; 3],
+    /// From the workpiece frame into the machine file's: `I` with `frame:
+    /// workpiece`, `R_wt(q, 0)ᵀ` with `frame: tool` (machine-format spec
+    /// §1).
+    pub to_frame: [[f64; 3]; 3],
+}
+
+impl Nominal {
+    /// A workpiece-frame vector `v` in the machine file's frame.
+    pub fn in_frame(&self, v: [f64; 3]) -> [f64; 3] {
+        let r = &self.to_frame;
+        std::array::from_fn(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2])
+    }
+}
+
 /// The exact kinematics of a machine with finite error values.
 #[derive(Debug, Clone, Copy)]
 pub struct ExactChain<'m> {
@@ -183,6 +203,22 @@ impl<'m> ExactChain<'m> {
         let pt = Self::product(&self.factors(self.machine.tool, q, p, e, &w));
         let tp = Vector3::from_fn(|i, _| self.machine.tool_point[i].eval(p));
         (pw.inverse().then(&pt), tp)
+    }
+
+    /// The nominal tool point and the rotation into the machine's frame at
+    /// `(q, p)`.
+    pub fn nominal(&self, q: &[f64], p: &[f64]) -> Nominal {
+        let zero = vec![0.0; self.machine.errors.len()];
+        let (t0, tp) = self.pose(q, p, &zero);
+        let x = t0.apply(&tp);
+        let to_frame = match self.machine.frame {
+            Frame::Workpiece => Matrix3::identity(),
+            Frame::Tool => t0.r.transpose(),
+        };
+        Nominal {
+            point: [x.x, x.y, x.z],
+            to_frame: std::array::from_fn(|i| std::array::from_fn(|j| to_frame[(i, j)])),
+        }
     }
 
     /// The exact tool-point deviation `p(q, e)` in the machine's frame

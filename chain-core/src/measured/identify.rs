@@ -137,6 +137,14 @@ pub struct Prior {
 }
 
 impl Prior {
+    /// The prior with `count` more unknowns without one (mean 0, infinite
+    /// std: weight 0), the set-ups' positions after the machine's errors.
+    pub fn with_free(mut self, count: usize) -> Prior {
+        self.mean.extend(std::iter::repeat_n(0.0, count));
+        self.std.extend(std::iter::repeat_n(f64::INFINITY, count));
+        self
+    }
+
     /// The `statistics` section of `machine` as independent Gaussians for
     /// `errors` (normal entries as given; uniform ones by their mean and
     /// standard deviation). Every error needs an entry.
@@ -535,12 +543,22 @@ pub fn identify(
             let inv = chol.inverse();
             let cov = DMatrix::from_fn(n, n, |i, j| e[i] * inv[(i, j)] * e[j]);
             let x = &cov * rhs;
-            // Directions the data did not inform (prior-standardised).
-            let k = DMatrix::from_fn(n, n, |i, j| p.std[i] * fisher[(i, j)] * p.std[j]);
+            // Directions the data did not inform (prior-standardised), over
+            // the machine's errors: the set-ups' positions (no prior) are
+            // profiled out of the information first.
+            let ne = n - 3 * design.setups.len();
+            let fisher_e = profiled(&fisher, ne);
+            let k = DMatrix::from_fn(ne, ne, |i, j| p.std[i] * fisher_e[(i, j)] * p.std[j]);
             let (kappa, w) = symmetric_svd(&k);
             let limit = 1.0 / (UNINFORMED * UNINFORMED) - 1.0;
-            let dirs: Vec<usize> = (0..n).filter(|&i| kappa[i] < limit).collect();
-            let raw = DMatrix::from_fn(n, dirs.len(), |i, c| p.std[i] * w[(i, dirs[c])]);
+            let dirs: Vec<usize> = (0..ne).filter(|&i| kappa[i] < limit).collect();
+            let raw = DMatrix::from_fn(n, dirs.len(), |i, c| {
+                if i < ne {
+                    p.std[i] * w[(i, dirs[c])]
+                } else {
+                    0.0
+                }
+            });
             (x, cov, orthonormal(&raw), Some(s2.sqrt()))
         }
     };
@@ -594,6 +612,7 @@ pub fn identify(
             s_max,
             tolerance,
             names: &design.errors,
+            forced: 3 * design.setups.len(),
         };
         let (by, kept) = subset::choose(&problem, rank, structural, &options.subset)?;
         // The elimination solves in the determined directions; a chosen
@@ -654,6 +673,23 @@ pub fn identify(
         noise: noise_rule,
         subset,
     })
+}
+
+/// The information on the first `ne` unknowns with the others profiled
+/// out: the Schur complement `F_ee − F_es F_ss⁺ F_se` (the others' block
+/// through nalgebra's pseudo-inverse); `F` itself when there are no others.
+fn profiled(f: &DMatrix<f64>, ne: usize) -> DMatrix<f64> {
+    let n = f.nrows();
+    if ne == n {
+        return f.clone();
+    }
+    let fee = f.view((0, 0), (ne, ne));
+    let fes = f.view((0, ne), (ne, n - ne));
+    let fss = f.view((ne, ne), (n - ne, n - ne)).into_owned();
+    let inv = fss
+        .pseudo_inverse(1e-14)
+        .unwrap_or_else(|_| DMatrix::zeros(n - ne, n - ne));
+    fee - fes * inv * fes.transpose()
 }
 
 /// Rows per block of [`gram`] and [`leverages`]: the unit of parallel work

@@ -5,8 +5,9 @@
 //! # Formulas
 //!
 //! With `f_i(x)` the exact model of scalar row `i` (a component of the
-//! exact deviation [`super::exact::ExactChain`], or `uᵀ` of it along a
-//! direction) and `a_i x` its first-order model:
+//! exact deviation [`super::exact::ExactChain`], less the position of its
+//! record's set-up if it has one, or `uᵀ` of it along a direction) and
+//! `a_i x` its first-order model:
 //!
 //! - **check**: `δ_i = f_i(x̂) − a_i x̂` at the measured poses with the
 //!   linear estimate `x̂`; the first order is **not adequate** when some
@@ -97,25 +98,43 @@ pub fn exact_rows(
     let chain = ExactChain::new(machine);
     let m = design.b.len();
     let n = x.len();
+    let ne = design.machine_errors();
+    let (errors, setups) = x.split_at(ne);
     let mut f = vec![0.0; m];
     let mut jac = jacobian.then(|| DMatrix::zeros(m, n));
     let mut i = 0;
     while i < m {
         let r = design.origin[i].0;
         let rec = &records[r];
-        let (dev, j) = if jacobian {
-            let (d, j) = chain.deviation_and_jacobian(&rec.q, &rec.p, x);
+        let (mut dev, j) = if jacobian {
+            let (d, j) = chain.deviation_and_jacobian(&rec.q, &rec.p, errors);
             (d, Some(j))
         } else {
-            (chain.deviation(&rec.q, &rec.p, x), None)
+            (chain.deviation(&rec.q, &rec.p, errors), None)
         };
+        // A set-up's position s: the deviation less s, in the machine's
+        // frame (`docs/five-axis.md`).
+        let setup = rec.setup.map(|g| (g, chain.nominal(&rec.q, &rec.p)));
+        if let Some((g, nominal)) = &setup {
+            let s = nominal.in_frame([setups[3 * g], setups[3 * g + 1], setups[3 * g + 2]]);
+            for (d, s) in dev.iter_mut().zip(s) {
+                *d -= s;
+            }
+        }
         let observed = &rec.observed;
         let rows = observed.rows();
         for c in 0..rows {
             f[i + c] = observed.row(c, dev);
             if let (Some(out), Some(j)) = (jac.as_mut(), &j) {
-                for k in 0..n {
+                for k in 0..ne {
                     out[(i + c, k)] = observed.row(c, [j[(0, k)], j[(1, k)], j[(2, k)]]);
+                }
+                if let Some((g, nominal)) = &setup {
+                    for l in 0..3 {
+                        let mut unit = [0.0; 3];
+                        unit[l] = -1.0;
+                        out[(i + c, ne + 3 * g + l)] = observed.row(c, nominal.in_frame(unit));
+                    }
                 }
             }
         }
@@ -155,14 +174,15 @@ pub fn check(
         .fold(0.0f64, |a, (d, w)| a.max((d * w).abs()));
     let exceeds_noise = noise.is_some_and(|s| worst > s);
     let chain = ExactChain::new(machine);
-    let mut largest = vec![0.0f64; x.len()];
+    let ne = design.machine_errors();
+    let mut largest = vec![0.0f64; ne];
     for rec in records {
         let wj = chain.weights(&rec.q);
         for (j, l) in largest.iter_mut().enumerate() {
             *l = l.max((wj[j] * x[j]).abs());
         }
     }
-    let large_angles = (0..x.len())
+    let large_angles = (0..ne)
         .filter(|&j| {
             matches!(
                 machine.errors[j].kind,

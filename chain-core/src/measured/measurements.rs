@@ -218,6 +218,52 @@ impl Observed {
     }
 }
 
+/// What kind of instrument set-up a [`Setup`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SetupKind {
+    /// A sphere fixed on the table, probed at several rotary positions
+    /// (five-axis spec, sphere probing records): its centre is the
+    /// unknown.
+    Sphere,
+    /// The ball of an R-test (five-axis spec, `--setup ball`): its
+    /// set-up offset on the table is the unknown.
+    Ball,
+}
+
+impl SetupKind {
+    /// The kind in words (`sphere`, `ball`).
+    pub fn name(self) -> &'static str {
+        match self {
+            SetupKind::Sphere => "sphere",
+            SetupKind::Ball => "ball",
+        }
+    }
+}
+
+/// An instrument set-up whose position on the workpiece (table) is not
+/// known: three unknowns of the fit beside the machine's errors, entering
+/// each of its records' tool-point rows with `−I` (in the machine file's
+/// frame), reported but never written into values.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Setup {
+    /// Its identifier (a sphere file's `sphere` column; `ball`).
+    pub name: String,
+    /// What it is.
+    pub kind: SetupKind,
+}
+
+impl Setup {
+    /// The names of its three unknowns: `sphere 1.x`, `ball.y`, …
+    pub fn unknowns(&self) -> [String; 3] {
+        let stem = match self.kind {
+            SetupKind::Sphere => format!("sphere {}", self.name),
+            SetupKind::Ball => self.name.clone(),
+        };
+        ["x", "y", "z"].map(|c| format!("{stem}.{c}"))
+    }
+}
+
 /// One measurement (or candidate pose).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Measurement {
@@ -235,6 +281,9 @@ pub struct Measurement {
     pub values: Vec<f64>,
     /// Its standard deviation, if the CSV has a `std` column.
     pub std: Option<f64>,
+    /// The set-up whose unknown position it measures against (an index
+    /// into [`Measurements::setups`]), if any.
+    pub setup: Option<usize>,
 }
 
 /// The measurements (or candidates) of one CSV file.
@@ -248,6 +297,9 @@ pub struct Measurements {
     pub weighted: bool,
     /// The records in file order.
     pub rows: Vec<Measurement>,
+    /// The set-ups the records' [`Measurement::setup`] index (none for an
+    /// ordinary measurement file).
+    pub setups: Vec<Setup>,
 }
 
 /// Why a measurement CSV was refused: its problems, located (file, line,
@@ -318,6 +370,35 @@ impl Holdout {
 }
 
 impl Measurements {
+    /// Every record measured against one set-up `setup` (an R-test's ball:
+    /// `--setup ball`).
+    pub fn on_setup(mut self, setup: Setup) -> Measurements {
+        for r in &mut self.rows {
+            r.setup = Some(0);
+        }
+        self.setups = vec![setup];
+        self
+    }
+
+    /// The records with their set-ups indexed into `setups` (the fit's, for
+    /// records held out of it), matched by name and kind; `Err` with the
+    /// first record whose set-up is not among them.
+    pub fn onto_setups(mut self, setups: &[Setup]) -> Result<Measurements, (usize, Setup)> {
+        let map: Vec<Option<usize>> = (self.setups.iter())
+            .map(|s| setups.iter().position(|t| t == s))
+            .collect();
+        for r in &mut self.rows {
+            if let Some(g) = r.setup {
+                match map[g] {
+                    Some(to) => r.setup = Some(to),
+                    None => return Err((r.line, self.setups[g].clone())),
+                }
+            }
+        }
+        self.setups = setups.to_vec();
+        Ok(self)
+    }
+
     /// Splits the records into those fitted and those held out:
     /// `round(fraction × n)`
     /// records chosen by a seeded shuffle (`rand`'s `SliceRandom::shuffle`,
@@ -357,6 +438,7 @@ impl Measurements {
                 .filter(|(_, &o)| o == keep)
                 .map(|(r, _)| r.clone())
                 .collect(),
+            setups: self.setups.clone(),
         };
         Ok((
             side(false, self.file.clone()),
@@ -451,6 +533,7 @@ impl Measurements {
             machine: machine.name.clone(),
             weighted: columns.std.is_some(),
             rows,
+            setups: Vec::new(),
         })
     }
 }
@@ -697,6 +780,7 @@ impl Columns {
             observed,
             values,
             std,
+            setup: None,
         })
     }
 }
@@ -735,7 +819,8 @@ pub const DESIGN_LIMIT: f64 = 1e100;
 /// The design matrix of a set of records, in the model's orders.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Design {
-    /// The error names (columns), the model's order.
+    /// The unknowns' names (columns): the model's errors in its order,
+    /// then three per set-up ([`Setup::unknowns`]).
     pub errors: Vec<String>,
     /// `A`, one row per scalar measurement (row-major, `rows × N`).
     pub a: nalgebra::DMatrix<f64>,
@@ -746,6 +831,17 @@ pub struct Design {
     /// Each row's record (index into the records) and component
     /// ([`MeasuredComponent::name`]: `dpx`, `dpy`, `dpz` or `d`).
     pub origin: Vec<(usize, MeasuredComponent)>,
+    /// The set-ups whose positions are the last `3 × setups.len()`
+    /// unknowns.
+    pub setups: Vec<Setup>,
+}
+
+impl Design {
+    /// The number of the machine's errors: the unknowns before the
+    /// set-ups'.
+    pub fn machine_errors(&self) -> usize {
+        self.errors.len() - 3 * self.setups.len()
+    }
 }
 
 /// Why a design could not be built from records.
@@ -780,15 +876,45 @@ pub enum DesignError {
         /// `, divided by its std,` when the record is weighted.
         weighted: &'static str,
     },
+    /// A record measured against a set-up the design was not given.
+    #[error("line {line}: the record's set-up is not among the design's")]
+    Setup {
+        /// The record's line in its CSV.
+        line: usize,
+    },
 }
 
 impl Design {
     /// The design of `records` (in `machine`'s orders) through `model`.
-    /// Candidates (no values) give `b = 0`.
+    /// Candidates (no values) give `b = 0`. Records with a set-up are
+    /// refused ([`Design::with_setups`] takes them).
     pub fn new<M: ErrorModel + ?Sized>(
         model: &M,
         machine: &Machine,
         records: &[Measurement],
+    ) -> Result<Design, DesignError> {
+        Design::with_setups(model, machine, records, &[])
+    }
+
+    /// The design of the records of `measurements` with their set-ups.
+    pub fn of<M: ErrorModel + ?Sized>(
+        model: &M,
+        machine: &Machine,
+        measurements: &Measurements,
+    ) -> Result<Design, DesignError> {
+        Design::with_setups(model, machine, &measurements.rows, &measurements.setups)
+    }
+
+    /// The design of `records` whose set-up indices point into `setups`:
+    /// a record on set-up `g` has, besides the model's rows, the rows of
+    /// `−I` (in the machine file's frame at its pose:
+    /// [`super::exact::Nominal::in_frame`]) in the columns of `g`'s three
+    /// unknowns (`docs/five-axis.md`).
+    pub fn with_setups<M: ErrorModel + ?Sized>(
+        model: &M,
+        machine: &Machine,
+        records: &[Measurement],
+        setups: &[Setup],
     ) -> Result<Design, DesignError> {
         let order = |what: &'static str, model: &[&str], machine: Vec<&str>| {
             if model == machine.as_slice() {
@@ -815,10 +941,16 @@ impl Design {
         if records.iter().any(|r| r.std.is_some() != weighted) {
             return Err(DesignError::MixedStd);
         }
+        if let Some(r) = (records.iter()).find(|r| r.setup.is_some_and(|g| g >= setups.len())) {
+            return Err(DesignError::Setup { line: r.line });
+        }
+        let chain = super::exact::ExactChain::new(machine);
         let n = model.errors().len();
+        let width = n + 3 * setups.len();
         let m: usize = records.iter().map(|r| r.observed.rows()).sum();
-        let mut flat = vec![0.0; m * n];
+        let mut flat = vec![0.0; m * width];
         let mut scratch = vec![0.0; 6 * n];
+        let mut rows_n = vec![0.0; 3 * n];
         let mut b = Vec::with_capacity(m);
         let mut std = weighted.then(|| Vec::with_capacity(m));
         let mut origin = Vec::with_capacity(m);
@@ -831,11 +963,28 @@ impl Design {
                 &r.p,
                 &r.observed,
                 &mut scratch,
-                &mut flat[at * n..(at + k) * n],
+                &mut rows_n[..k * n],
             );
+            let out = &mut flat[at * width..(at + k) * width];
+            for c in 0..k {
+                out[c * width..c * width + n].copy_from_slice(&rows_n[c * n..(c + 1) * n]);
+            }
+            if let Some(g) = r.setup {
+                // The set-up's position s enters as −s in the workpiece
+                // frame: column l is −(unit l) in the machine's frame.
+                let nominal = chain.nominal(&r.q, &r.p);
+                for l in 0..3 {
+                    let mut unit = [0.0; 3];
+                    unit[l] = -1.0;
+                    let col = nominal.in_frame(unit);
+                    for c in 0..k {
+                        out[c * width + n + 3 * g + l] = r.observed.row(c, col);
+                    }
+                }
+            }
             // Every value the solvers will see, weighted as they will see it.
             let w = r.std.map_or(1.0, |s| 1.0 / s);
-            let rows = &flat[at * n..(at + k) * n];
+            let rows = &flat[at * width..(at + k) * width];
             let within = |x: f64| x.abs() <= DESIGN_LIMIT;
             let finite = w.is_finite()
                 && rows.iter().all(|a| within(a * w))
@@ -859,12 +1008,15 @@ impl Design {
             }
             at += k;
         }
+        let mut errors: Vec<String> = model.errors().iter().map(|e| e.to_string()).collect();
+        errors.extend(setups.iter().flat_map(Setup::unknowns));
         Ok(Design {
-            errors: model.errors().iter().map(|e| e.to_string()).collect(),
-            a: nalgebra::DMatrix::from_row_slice(m, n, &flat),
+            errors,
+            a: nalgebra::DMatrix::from_row_slice(m, width, &flat),
             b,
             std,
             origin,
+            setups: setups.to_vec(),
         })
     }
 }

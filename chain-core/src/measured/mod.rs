@@ -9,7 +9,9 @@
 //! problem (or its Gaussian-prior posterior) through an SVD; [`plan`] chooses
 //! where to measure (a D-optimal subset of the candidates); [`positioning`]
 //! reads an axis's ISO 230-2 positioning runs and evaluates them, and
-//! [`positioning_values`] writes them into a values file.
+//! [`positioning_values`] writes them into a values file; [`spheres`] reads
+//! sphere-probing records, whose sphere positions are unknowns of the fit
+//! beside the errors ([`Setup`]).
 
 mod estimate;
 pub mod exact;
@@ -20,6 +22,7 @@ pub mod plan;
 pub mod positioning;
 pub mod positioning_values;
 pub mod predict;
+pub mod spheres;
 pub mod subset;
 
 pub use identify::{
@@ -27,7 +30,7 @@ pub use identify::{
 };
 pub use measurements::{
     design_rows, Design, DesignError, Holdout, HoldoutError, Layout, MeasuredComponent,
-    Measurement, MeasurementKind, Measurements, MeasurementsError, Observed,
+    Measurement, MeasurementKind, Measurements, MeasurementsError, Observed, Setup, SetupKind,
 };
 pub use predict::{predict, ErrorStats, Prediction};
 pub use subset::{ChosenBy, Fixed, FixedStatus, Subset, SubsetChoice};

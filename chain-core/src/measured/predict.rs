@@ -1,6 +1,7 @@
 //! How an identification predicts measurements it was not fitted to
 //! (held-out measurements, from a file or split off the fitted ones): the error a machine shows
-//! at held-out poses before correction (the measured values `b`) and after
+//! at held-out poses before correction (the measured values `b`, from the
+//! set-ups' estimated positions when there are set-ups) and after
 //! it (`b − A x̂`, the
 //! measured values less what the estimates predict through the same exact
 //! sensitivity rows the fit used), the numbers a calibration engineer
@@ -71,13 +72,26 @@ pub fn predict(design: &Design, r: &Identification) -> Prediction {
     let predicted: Vec<f64> = (0..design.b.len())
         .map(|i| design.a.row(i).iter().zip(&x).map(|(a, x)| a * x).sum())
         .collect();
-    predict_rows(design, &predicted)
+    predict_rows(design, &predicted, &x)
 }
 
-/// The prediction at the rows of `design` when the model predicts
-/// `predicted` there (one value per scalar row): the exact kinematics of
-/// the exact-kinematics iteration's values, say.
-pub fn predict_rows(design: &Design, predicted: &[f64]) -> Prediction {
+/// The prediction at the rows of `design` when the model with the
+/// unknowns `x` predicts `predicted` there (one value per scalar row): the
+/// exact kinematics of the exact-kinematics iteration's values, say.
+///
+/// With set-ups ([`super::Setup`]: a sphere probed, an R-test ball) the
+/// error the machine shows uncorrected is measured from the set-ups'
+/// estimated positions: `b − A_s x_s` (the set-ups' columns of the design,
+/// which are exact: a position enters linearly), not `b` (a sphere
+/// record's `b` is the negated nominal tool point).
+pub fn predict_rows(design: &Design, predicted: &[f64], x: &[f64]) -> Prediction {
+    let ne = design.machine_errors();
+    let before: Vec<f64> = (0..design.b.len())
+        .map(|i| {
+            let setup: f64 = (ne..x.len()).map(|j| design.a[(i, j)] * x[j]).sum();
+            design.b[i] - setup
+        })
+        .collect();
     let after: Vec<f64> = (design.b.iter().zip(predicted))
         .map(|(b, p)| b - p)
         .collect();
@@ -87,7 +101,7 @@ pub fn predict_rows(design: &Design, predicted: &[f64]) -> Prediction {
     Prediction {
         measurements: records.len(),
         rows: design.b.len(),
-        before: ErrorStats::of(&design.b, &record),
+        before: ErrorStats::of(&before, &record),
         after: ErrorStats::of(&after, &record),
     }
 }

@@ -185,6 +185,10 @@ pub(crate) struct Problem<'a> {
     pub tolerance: f64,
     /// The unknowns' names.
     pub names: &'a [String],
+    /// The last `forced` unknowns (set-up positions, [`super::Setup`]) are
+    /// always estimated: the elimination takes them first, and the
+    /// caller's lists name the others.
+    pub forced: usize,
 }
 
 impl Problem<'_> {
@@ -204,13 +208,16 @@ impl Problem<'_> {
 }
 
 /// Column-pivoted Gram–Schmidt on the columns `candidates` of `c`: up to
-/// `steps` pivots, each the candidate with the largest remaining norm (ties
-/// within 1e-9 relative to the first), stopping when the largest is at most
-/// `floor`. Returns the pivots in order and every candidate's remaining
-/// norm after them (infinite for a pivot).
+/// `steps` pivots, the first `forced` candidates in their order (each while
+/// its remaining norm is above `floor`), then each the candidate with the
+/// largest remaining norm (ties within 1e-9 relative to the first),
+/// stopping when the largest is at most `floor`. Returns the pivots in
+/// order and every candidate's remaining norm after them (infinite for a
+/// pivot).
 fn pivots(
     c: &DMatrix<f64>,
     candidates: &[usize],
+    forced: usize,
     steps: usize,
     floor: f64,
 ) -> (Vec<usize>, Vec<f64>) {
@@ -220,18 +227,26 @@ fn pivots(
         .collect();
     let mut chosen: Vec<usize> = Vec::new();
     let mut taken = vec![false; candidates.len()];
-    for _ in 0..steps {
+    for step in 0..steps {
         let norms: Vec<f64> = cols.iter().map(|v| v.norm()).collect();
-        let best = (0..cols.len())
-            .filter(|&i| !taken[i])
-            .map(|i| norms[i])
-            .fold(0.0f64, f64::max);
-        if best <= floor {
-            break;
-        }
-        let Some(p) = (0..cols.len()).find(|&i| !taken[i] && norms[i] >= best * (1.0 - 1e-9))
-        else {
-            break;
+        let p = if step < forced.min(cols.len()) {
+            if norms[step] <= floor {
+                continue;
+            }
+            step
+        } else {
+            let best = (0..cols.len())
+                .filter(|&i| !taken[i])
+                .map(|i| norms[i])
+                .fold(0.0f64, f64::max);
+            if best <= floor {
+                break;
+            }
+            let Some(p) = (0..cols.len()).find(|&i| !taken[i] && norms[i] >= best * (1.0 - 1e-9))
+            else {
+                break;
+            };
+            p
         };
         taken[p] = true;
         chosen.push(candidates[p]);
@@ -289,21 +304,26 @@ pub(crate) fn choose(
     choice: &SubsetChoice,
 ) -> Result<(ChosenBy, Vec<usize>), IdentifyError> {
     let n = p.d.len();
-    let all: Vec<usize> = (0..n).collect();
+    let ne = n - p.forced;
+    let forced: Vec<usize> = (ne..n).collect();
+    let errors = &p.names[..ne];
     let (by, mut kept) = match choice {
         SubsetChoice::Elimination => {
-            let (chosen, _) = pivots(&p.truncated(r), &all, r, 0.0);
+            // The set-ups' positions first, then the errors.
+            let order: Vec<usize> = forced.iter().copied().chain(0..ne).collect();
+            let (chosen, _) = pivots(&p.truncated(r), &order, p.forced, r, 0.0);
             (ChosenBy::Elimination, chosen)
         }
         SubsetChoice::Fix(names) => {
-            let fixed = indices(SubsetSide::Fixed, names, p.names)?;
+            let fixed = indices(SubsetSide::Fixed, names, errors)?;
             (
                 ChosenBy::Fix,
-                all.iter().copied().filter(|j| !fixed.contains(j)).collect(),
+                (0..n).filter(|j| !fixed.contains(j)).collect(),
             )
         }
         SubsetChoice::Estimate(names) => {
-            let estimated = indices(SubsetSide::Estimated, names, p.names)?;
+            let mut estimated = indices(SubsetSide::Estimated, names, errors)?;
+            estimated.extend(&forced);
             (ChosenBy::Estimate, estimated)
         }
     };
@@ -313,7 +333,7 @@ pub(crate) fn choose(
         // tolerance once the others are taken out (the structural design).
         let floor = p.tolerance * p.s_max();
         let c = p.truncated(structural);
-        let (chosen, remaining) = pivots(&c, &kept, kept.len(), floor);
+        let (chosen, remaining) = pivots(&c, &kept, 0, kept.len(), floor);
         if chosen.len() < kept.len() {
             let mut names: Vec<String> = kept
                 .iter()

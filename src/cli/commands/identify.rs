@@ -1,4 +1,5 @@
-//! `chain identify FILE --measurements M.csv [--prior] [--validate M2.csv]
+//! `chain identify FILE (--measurements M.csv [--setup ball] | --spheres S.csv)
+//! [--prior] [--validate M2.csv]
 //! [--holdout FRACTION [--seed S]] [--rank-tol TOL]
 //! [--fix NAME,... | --estimate NAME,...] [--iterate]
 //! [--param NAME=VALUE]... [--format table|json] [--values-out VALUES.yaml]`.
@@ -14,6 +15,7 @@ use std::path::PathBuf;
 
 use chain::ops::identify::IdentifyRequest;
 use chain::ops::source::Source;
+use chain_core::measured::SetupKind;
 
 use crate::cli::args::ParamArgs;
 use crate::cli::loaded::Loaded;
@@ -39,7 +41,18 @@ pub struct IdentifyArgs {
     /// radians), any parameters per row, `dpx,dpy,dpz` or `ux,uy,uz,d`,
     /// optionally `std`.
     #[arg(long, value_name = "M.csv")]
-    pub measurements: PathBuf,
+    pub measurements: Option<PathBuf>,
+    /// A sphere-probing CSV instead of measurements: every axis variable
+    /// (rotary ones in degrees) at which the probe centre sits at the
+    /// sphere centre, optionally `sphere` and `std`; each sphere's position
+    /// on the table is estimated beside the errors.
+    #[arg(long, value_name = "S.csv")]
+    pub spheres: Option<PathBuf>,
+    /// `ball`: an R-test: the measurement records are taken against one
+    /// ball whose three set-up offsets on the table are estimated beside
+    /// the errors.
+    #[arg(long, value_name = "KIND", value_parser = chain::ops::choice::parser::<SetupKind>())]
+    pub setup: Option<SetupKind>,
     /// Use the machine file's `statistics` as a Gaussian prior (the answer
     /// is the posterior mean and covariance).
     #[arg(long)]
@@ -88,7 +101,9 @@ pub struct IdentifyArgs {
 /// before the machine file is read.
 pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
     let request = IdentifyRequest {
-        measurements: Source::Path(&args.measurements),
+        measurements: args.measurements.as_deref().map(Source::Path),
+        spheres: args.spheres.as_deref().map(Source::Path),
+        setup: args.setup,
         validate: args.validate.as_deref().map(Source::Path),
         params: &args.param.params,
         prior: args.prior,

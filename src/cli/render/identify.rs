@@ -68,6 +68,17 @@ fn table(d: &IdentifyDocument) -> String {
             ""
         }
     );
+    // The set-ups' unknowns are listed with their set-up below.
+    let setup_unknowns: Vec<String> = (d.setups.iter())
+        .flat_map(|u| {
+            chain_core::measured::Setup {
+                name: u.name.clone(),
+                kind: u.kind,
+            }
+            .unknowns()
+        })
+        .collect();
+    let machine_error = |name: &String| !setup_unknowns.contains(name);
     let width = d
         .estimates
         .0
@@ -84,7 +95,7 @@ fn table(d: &IdentifyDocument) -> String {
                 .iteration
                 .as_ref()
                 .map_or(&sub.estimates, |it| &it.estimates);
-            for (name, e) in &values.0 {
+            for (name, e) in values.0.iter().filter(|(n, _)| machine_error(n)) {
                 let std = e.std.map_or("—".to_string(), num);
                 let note = match sub.fixed.iter().find(|f| &f.error == name) {
                     Some(f) => format!("  fixed, {}: {}", f.status.words(), f.words),
@@ -111,10 +122,30 @@ fn table(d: &IdentifyDocument) -> String {
             }
         }
         None => {
-            for (name, e) in &d.estimates.0 {
+            for (name, e) in d.estimates.0.iter().filter(|(n, _)| machine_error(n)) {
                 let std = e.std.map_or("—".to_string(), num);
                 let _ = writeln!(s, "{name:<width$}  {:>14}  {std:>14}", num(e.value));
             }
+        }
+    }
+    if !d.setups.is_empty() {
+        let _ = writeln!(
+            s,
+            "
+set-ups estimated beside the errors (workpiece frame, mm; not written into values):"
+        );
+        for u in &d.setups {
+            let coords: Vec<String> = (["x", "y", "z"].iter().enumerate())
+                .map(|(l, c)| {
+                    let std = u.std[l].map_or("—".to_string(), num);
+                    format!("{c} = {} ± {std}", num(u.position[l]))
+                })
+                .collect();
+            let label = match u.kind {
+                chain_core::measured::SetupKind::Sphere => format!("sphere {}", u.name),
+                chain_core::measured::SetupKind::Ball => u.name.clone(),
+            };
+            let _ = writeln!(s, "  {label}: {}", coords.join(", "));
         }
     }
     if !d.groups.is_empty() {

@@ -12,7 +12,7 @@ use chain_core::measured::iterate::{self, FirstOrderCheck, Iteration, ANGLE_LIMI
 use chain_core::measured::predict::{predict, predict_rows, Prediction};
 use chain_core::measured::subset::{ChosenBy, FixedStatus, Subset, TERM_CUTOFF};
 use chain_core::measured::{
-    identify, Design, Holdout, Identification, MeasuredComponent, Measurements,
+    identify, Design, Holdout, Identification, MeasuredComponent, Measurements, SetupKind,
 };
 use chain_core::named::NameMap;
 use chain_core::Machine;
@@ -100,6 +100,27 @@ pub struct IdentifyDocument {
     /// The prediction at held-out measurements (`--validate`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub validation: Option<Validation>,
+    /// The set-ups whose positions were estimated beside the errors
+    /// (`--spheres`, `--setup ball`; absent without them): never written
+    /// into values.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub setups: Vec<SetupDoc>,
+}
+
+/// An estimated set-up position in the document: a sphere's centre, or an
+/// R-test ball's set-up offset, in the workpiece (table) frame, mm.
+#[derive(Debug, Clone, Serialize)]
+pub struct SetupDoc {
+    /// Its identifier.
+    pub name: String,
+    /// `sphere` or `ball`.
+    pub kind: SetupKind,
+    /// Its position `[x, y, z]` from the reported solution (`--iterate`'s
+    /// exact fit when given, else the least-squares subset, else the
+    /// posterior).
+    pub position: [f64; 3],
+    /// The std of each coordinate (null where it cannot be estimated).
+    pub std: [Option<f64>; 3],
 }
 
 /// The first-order check in the document.
@@ -410,6 +431,9 @@ pub struct Identified {
     pub check: FirstOrderCheck,
     /// `--iterate`'s fit.
     pub iteration: Option<Iteration>,
+    /// The count of set-ups whose positions are the last `3 × setups`
+    /// unknowns.
+    pub setups: usize,
 }
 
 /// `chain identify`: the design of `measurements` through the machine's
@@ -428,7 +452,7 @@ pub fn identify_document(
     check_fit(prior, options, iterate)?;
     let model = chain_core::compile(machine);
     let design_of = |m: &Measurements| {
-        Design::new(&model, machine, &m.rows).map_err(|reason| IdentifyOpsError::Design {
+        Design::of(&model, machine, m).map_err(|reason| IdentifyOpsError::Design {
             file: m.file.clone(),
             reason,
         })
@@ -438,7 +462,10 @@ pub fn identify_document(
         .map(|v| design_of(v).map(|d| (v, d)))
         .transpose()?;
     let prior = if prior {
-        Some(Prior::from_machine(machine, &design.errors).map_err(IdentifyOpsError::Identify)?)
+        let ne = design.machine_errors();
+        let prior = Prior::from_machine(machine, &design.errors[..ne])
+            .map_err(IdentifyOpsError::Identify)?;
+        Some(prior.with_free(design.errors.len() - ne))
     } else {
         None
     };
@@ -472,7 +499,7 @@ pub fn identify_document(
             Some(it) => {
                 let x: Vec<f64> = it.estimates.iter().map(|e| e.value).collect();
                 let (rows, _) = iterate::exact_rows(machine, &v.rows, &d, &x, false);
-                predict_rows(&d, &rows)
+                predict_rows(&d, &rows, &x)
             }
             None => predict(&d, &result),
         },
@@ -482,6 +509,7 @@ pub fn identify_document(
         result,
         check,
         iteration,
+        setups: design.setups.len(),
     })
 }
 
@@ -541,8 +569,31 @@ impl IdentifyDocument {
             noise: r.noise,
             subset: r.subset.as_ref().map(|s| SubsetDoc::new(s, &r.errors)),
             validation: None,
+            setups: setup_docs(design, r, iteration),
         }
     }
+}
+
+/// The set-ups' estimated positions: the last `3 × setups` unknowns of the
+/// reported solution.
+fn setup_docs(design: &Design, r: &Identification, iteration: Option<&Iteration>) -> Vec<SetupDoc> {
+    let estimates: Vec<Estimate> = match (iteration, &r.subset) {
+        (Some(it), _) => it.estimates.clone(),
+        (None, Some(sub)) => sub.estimates.clone(),
+        (None, None) => r.estimates.0.iter().map(|(_, e)| *e).collect(),
+    };
+    let ne = design.machine_errors();
+    (design.setups.iter().enumerate())
+        .map(|(g, setup)| {
+            let at = |l: usize| estimates[ne + 3 * g + l];
+            SetupDoc {
+                name: setup.name.clone(),
+                kind: setup.kind,
+                position: std::array::from_fn(|l| at(l).value),
+                std: std::array::from_fn(|l| at(l).std),
+            }
+        })
+        .collect()
 }
 
 /// `a`, `a and b`, `a, b and c`.
@@ -704,7 +755,10 @@ pub fn values_file(m: &Machine, source: &str, identified: &Identified) -> String
             .as_ref()
             .is_some_and(|sub| !sub.estimated.contains(&j))
     };
-    for (name, e) in r.errors.iter().zip(&estimates) {
+    // The set-ups' positions (the unknowns after the machine's errors) are
+    // the instrument's, not the machine's: never written into values.
+    let ne = r.parameters - 3 * identified.setups;
+    for (name, e) in r.errors.iter().zip(&estimates).take(ne) {
         match e.std {
             Some(std) => {
                 let _ = writeln!(s, "  {name}: {{value: {:?}, std: {:?}}}", e.value, std);
@@ -714,9 +768,9 @@ pub fn values_file(m: &Machine, source: &str, identified: &Identified) -> String
             }
         }
     }
-    let all_std = (0..r.parameters).all(|j| fixed(j) || estimates[j].std.is_some());
+    let all_std = (0..ne).all(|j| fixed(j) || estimates[j].std.is_some());
     if all_std {
-        let n = r.parameters;
+        let n = ne;
         let sd: Vec<f64> = (0..n).map(|j| covariance[(j, j)].max(0.0).sqrt()).collect();
         let mut pairs = Vec::new();
         for i in 0..n {

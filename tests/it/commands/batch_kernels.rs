@@ -15,6 +15,7 @@ use crate::common::Points;
 use chain::core::ErrorModel;
 
 chain::machine!(pub AcTrunnion = "examples/machines/ac_trunnion.yaml");
+chain::machine!(pub AcTrunnionRotary = "examples/machines/ac_trunnion_rotary.yaml");
 chain::machine!(pub Cnc5Bevel = "examples/machines/cnc5_bevel.yaml");
 chain::machine!(pub CradleGenerator = "examples/machines/cradle_generator.yaml");
 chain::machine!(pub GantryGrinder = "examples/machines/gantry_grinder.yaml");
@@ -29,8 +30,9 @@ chain::machine!(pub Panda = "examples/robots/panda_mdh.yaml");
 chain::machine!(pub BcHeadTable = "chain-macro/benches/machines/bc_head_table.yaml");
 
 /// The machine files with a type above.
-const DECLARED: [&str; 12] = [
+const DECLARED: [&str; 13] = [
     "machines/ac_trunnion.yaml",
+    "machines/ac_trunnion_rotary.yaml",
     "machines/cnc5_bevel.yaml",
     "machines/cradle_generator.yaml",
     "machines/gantry_grinder.yaml",
@@ -190,6 +192,7 @@ macro_rules! compare {
 #[test]
 fn batched_kernels_equal_the_per_point_functions_on_every_example() {
     compare!(AcTrunnion);
+    compare!(AcTrunnionRotary);
     compare!(Cnc5Bevel);
     compare!(CradleGenerator);
     compare!(GantryGrinder);

@@ -136,6 +136,7 @@ fn simulate(
                 observed: Observed::Point,
                 values: (0..3).map(|c| err[c] + sigma * gauss(rng)).collect(),
                 std: Some(sigma),
+                setup: None,
             }
         })
         .collect()
@@ -279,6 +280,7 @@ fn gantry_position_only_null_space_is_the_analytic_one() {
             observed: Observed::Point,
             values: vec![0.0; 3],
             std: None,
+            setup: None,
         })
         .collect();
     let r = identify(
@@ -652,6 +654,7 @@ fn directions_identify_like_points() {
                 observed: Observed::Direction { u },
                 values: vec![d + 1e-3 * gauss(&mut rng)],
                 std: Some(1e-3),
+                setup: None,
             });
         }
     }
@@ -789,6 +792,7 @@ fn cli_directions_and_prior_without_std_are_the_library_answer() {
             observed: Observed::Direction { u },
             values: vec![u[0] * err[0] + u[1] * err[1] + u[2] * err[2] + 1e-3 * gauss(&mut rng)],
             std: Some(1e-3),
+            setup: None,
         });
     }
     let csv = write(

@@ -141,6 +141,7 @@ fn measured(m: &Machine, e: &[f64], count: usize, sigma: f64, rng: &mut Rng) -> 
                 observed: Observed::Point,
                 values: (0..3).map(|c| err[c] + sigma * gauss(rng)).collect(),
                 std: None,
+                setup: None,
             }
         })
         .collect();
@@ -149,6 +150,7 @@ fn measured(m: &Machine, e: &[f64], count: usize, sigma: f64, rng: &mut Rng) -> 
         machine: m.name.clone(),
         weighted: false,
         rows,
+        setups: Vec::new(),
     }
 }
 

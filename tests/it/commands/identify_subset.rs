@@ -55,6 +55,7 @@ fn simulate(
                 observed: Observed::Point,
                 values: (0..3).map(|c| err[c] + sigma * gauss(rng)).collect(),
                 std: None,
+                setup: None,
             }
         })
         .collect()

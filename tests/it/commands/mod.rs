@@ -26,6 +26,7 @@ mod generated_into;
 mod geometric_sensitivity;
 mod identify;
 mod identify_iterate;
+mod identify_spheres;
 mod identify_subset;
 mod inverse;
 mod inverse_pose;

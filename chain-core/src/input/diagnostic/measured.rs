@@ -78,6 +78,32 @@ pub enum MeasurementsProblem {
         /// Its value.
         value: f64,
     },
+    /// A sphere file's column that is neither an axis variable, a
+    /// parameter, `sphere` nor `std`.
+    SphereUnknownColumn {
+        /// The column.
+        column: String,
+        /// The machine.
+        machine: String,
+        /// Its axis variables.
+        variables: Vec<String>,
+        /// The closest valid column, if one is close.
+        suggestion: Option<String>,
+    },
+    /// A sphere file with a header and no probing.
+    SphereNoRows,
+    /// A sphere probed fewer than [`crate::measured::spheres::MIN_PROBINGS`]
+    /// times.
+    SphereTooFew {
+        /// The sphere's identifier.
+        sphere: String,
+        /// Its probings.
+        probings: usize,
+    },
+    /// An empty `sphere` cell.
+    SphereEmptyId,
+    /// A probing whose nominal tool point is not finite.
+    SphereNotFinite,
 }
 
 impl MeasurementsProblem {
@@ -172,6 +198,50 @@ impl MeasurementsProblem {
                 "chain::measurements::std_not_positive",
                 "not positive",
                 format!("the standard deviation must be positive, got {value}"),
+            ),
+            MeasurementsProblem::SphereUnknownColumn {
+                column,
+                machine,
+                variables,
+                suggestion,
+            } => D::new(
+                "chain::spheres::unknown_column",
+                "unknown column",
+                D::suggesting(
+                    format!("column `{column}` is neither an axis variable, a parameter of machine `{machine}`, `sphere` nor `std`"),
+                    suggestion,
+                ),
+            )
+            .help(format!(
+                "a sphere file's columns are the axis variables ({}; rotary ones in degrees), parameters, and optionally `sphere` and `std`",
+                variables.join(", ")
+            )),
+            MeasurementsProblem::SphereNoRows => D::new(
+                "chain::spheres::no_rows",
+                "no rows",
+                "the file has a header but no probing row".to_string(),
+            )
+            .help("each row after the header is one probing: the axis positions at which the probe centre sits at the sphere centre".to_string()),
+            MeasurementsProblem::SphereTooFew { sphere, probings } => D::new(
+                "chain::spheres::too_few",
+                "too few probings",
+                format!(
+                    "sphere `{sphere}` is probed {probings} time{}: one probing only locates the sphere, at least {} are needed to tell anything of the machine",
+                    if *probings == 1 { "" } else { "s" },
+                    crate::measured::spheres::MIN_PROBINGS
+                ),
+            )
+            .help("probe each sphere at several rotary positions, or leave this sphere's rows out".to_string()),
+            MeasurementsProblem::SphereEmptyId => D::new(
+                "chain::spheres::empty_id",
+                "empty identifier",
+                "the `sphere` cell is empty".to_string(),
+            )
+            .help("give every probing its sphere's identifier, or leave the `sphere` column out for one sphere".to_string()),
+            MeasurementsProblem::SphereNotFinite => D::new(
+                "chain::spheres::not_finite",
+                "not finite",
+                "the nominal tool point at this probing's axis positions is not finite (an axis position or a parameter out of range)".to_string(),
             ),
         }
     }
