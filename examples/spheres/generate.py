@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Writes the sphere-probing and R-test examples of ac_trunnion_rotary.yaml.
+"""Writes the sphere-probing and R-test examples of ac_trunnion_rotary.yaml and
+the sphere-probing example of bc_table_rotary.yaml.
 
     python3 examples/spheres/generate.py
 
@@ -16,6 +17,9 @@ writes, beside this script:
                  at 25 positions (A -45..45, C 0..288 deg by 72), the ball's
                  displacement dpx, dpy, dpz against the nest (measurement CSV:
                  rotary in radians)
+  bc_truth.yaml  the known location errors of the B/C table's B and C axes
+  bc_probing.csv two spheres on the B/C table probed at B -60..60 deg by 30,
+                 C 0..270 deg by 90
 
 Python 3 standard library only. The positions are computed here, NOT by
 chain: this script has its own model of the machine, the exact 4x4 product
@@ -23,6 +27,10 @@ chain: this script has its own model of the machine, the exact 4x4 product
   T(parent -> body) = Trans(offset) . E(location_errors) . J(q)
   E(d, eps) = [exp([eps x]) (Rodrigues), d]
   T_wt = inv(P(c_table)) . P(spindle),   probe centre = T_wt(q, e) . 0
+
+(the A/C trunnion: the table on Y, the A cradle about x, the C table; the
+tool on X and Z. The B/C table: the table on X, the B cradle about y, the C
+table; the tool on Y and Z)
 
 (machine-format spec section 1), so that chain identify recovering
 truth.yaml from these files checks chain's own derivation. A probing solves
@@ -55,6 +63,21 @@ TRUTH = {
 # The spheres' centres in the table (C) frame, mm: one low near the table,
 # one on a 160 mm column (what a second height adds: docs/five-axis.md).
 SPHERES = {"low": (80.0, -50.0, 20.0), "high": (-60.0, 40.0, 180.0)}
+# The B/C table (bc_table_rotary.yaml): its parameters, true location
+# errors (mm, rad) and spheres.
+BC_TOOL_LENGTH = 120.0
+BC_CRADLE = 150.0
+BC_TRUTH = {
+    "EX0B": -0.012,
+    "EZ0B": 0.018,
+    "EA0B": -2.5e-5,
+    "EC0B": 1.5e-5,
+    "EX0C": 0.008,
+    "EY0C": 0.014,
+    "EA0C": -3.5e-5,
+    "EB0C": 2.0e-5,
+}
+BC_SPHERES = {"low": (-70.0, 60.0, 25.0), "high": (50.0, -40.0, 160.0)}
 # The R-test ball's nominal place on the table and its set-up offset (the
 # unknown the fit estimates beside the errors), mm.
 BALL = (60.0, 30.0, 90.0)
@@ -95,7 +118,7 @@ def inverse(t):
 
 
 def probe_centre(x, y, z, a, c, e):
-    """T_wt(q, e) . 0 in the table frame (a, c in rad)."""
+    """The A/C trunnion's T_wt(q, e) . 0 in the table frame (a, c in rad)."""
     table = matmul(trans(0, y, 0), trans(0, 0, CRADLE))
     table = matmul(table, err(0, e["EY0A"], e["EZ0A"], 0, e["EB0A"], e["EC0A"]))
     table = matmul(table, rot(0, a))
@@ -107,16 +130,29 @@ def probe_centre(x, y, z, a, c, e):
     return [t[0][3], t[1][3], t[2][3]]
 
 
-def solve(s, a, c, e):
+def bc_probe_centre(x, y, z, b, c, e):
+    """The B/C table's T_wt(q, e) . 0 in the table frame (b, c in rad)."""
+    table = matmul(trans(x, 0, 0), trans(0, 0, BC_CRADLE))
+    table = matmul(table, err(e["EX0B"], 0, e["EZ0B"], e["EA0B"], 0, e["EC0B"]))
+    table = matmul(table, rot(1, b))
+    table = matmul(table, trans(0, 0, -BC_CRADLE))
+    table = matmul(table, err(e["EX0C"], e["EY0C"], 0, e["EA0C"], e["EB0C"], 0))
+    table = matmul(table, rot(2, c))
+    tool = matmul(matmul(trans(0, y, 0), trans(0, 0, z)), trans(0, 0, BC_TOOL_LENGTH))
+    t = matmul(inverse(table), tool)
+    return [t[0][3], t[1][3], t[2][3]]
+
+
+def solve(s, a, c, e, centre=probe_centre):
     """The slides x, y, z at which the probe centre sits at s."""
     q = [0.0, 0.0, 0.0]
     for _ in range(4):
-        f0 = probe_centre(*q, a, c, e)
+        f0 = centre(*q, a, c, e)
         cols = []
         for k in range(3):
             q1 = list(q)
             q1[k] += 1.0
-            f1 = probe_centre(*q1, a, c, e)
+            f1 = centre(*q1, a, c, e)
             cols.append([f1[i] - f0[i] for i in range(3)])
         r = [s[i] - f0[i] for i in range(3)]
 
@@ -159,15 +195,30 @@ def main():
     with open(os.path.join(here, "rtest.csv"), "w") as f:
         f.write("\n".join(rows) + "\n")
 
-    lines = [
-        "# The true location errors of examples/machines/ac_trunnion_rotary.yaml",
-        "# (written by examples/spheres/generate.py).",
-        "machine: ac_trunnion_rotary",
-        "units: {linear: mm, angular: rad}",
-        "values:",
-    ] + [f"  {k}: {v!r}" for k, v in TRUTH.items()]
-    with open(os.path.join(here, "truth.yaml"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+    def truth(name, machine, values):
+        lines = [
+            f"# The true location errors of examples/machines/{machine}.yaml",
+            "# (written by examples/spheres/generate.py).",
+            f"machine: {machine}",
+            "units: {linear: mm, angular: rad}",
+            "values:",
+        ] + [f"  {k}: {v!r}" for k, v in values.items()]
+        with open(os.path.join(here, name), "w") as f:
+            f.write("\n".join(lines) + "\n")
+
+    truth("truth.yaml", "ac_trunnion_rotary", TRUTH)
+
+    # The B/C table, after the A/C files (their noise is drawn first).
+    rows = ["sphere,B,C,x,y,z,std"]
+    for sphere, s in BC_SPHERES.items():
+        for b in (-60, -30, 0, 30, 60):
+            for c in (0, 90, 180, 270):
+                x, y, z = solve(s, math.radians(b), math.radians(c), BC_TRUTH, bc_probe_centre)
+                noisy = [v + rng.gauss(0.0, SIGMA_PROBE) for v in (x, y, z)]
+                rows.append(f"{sphere},{b:g},{c:g},{noisy[0]:.6f},{noisy[1]:.6f},{noisy[2]:.6f},{SIGMA_PROBE:g}")
+    with open(os.path.join(here, "bc_probing.csv"), "w") as f:
+        f.write("\n".join(rows) + "\n")
+    truth("bc_truth.yaml", "bc_table_rotary", BC_TRUTH)
 
 
 if __name__ == "__main__":

@@ -106,6 +106,9 @@ enum Factor<'a> {
 pub struct Nominal {
     /// `T_wt(q, 0) · t`: the tool point in the workpiece frame.
     pub point: [f64; 3],
+    /// `P(tool)(q, 0) · t`: the tool point in the root body's (the bed's)
+    /// frame, where the axes move it.
+    pub in_root: [f64; 3],
     /// From the workpiece frame into the machine file's: `I` with `frame:
     /// workpiece`, `R_wt(q, 0)ᵀ` with `frame: tool` (machine-format spec
     /// §1).
@@ -211,12 +214,15 @@ impl<'m> ExactChain<'m> {
         let zero = vec![0.0; self.machine.errors.len()];
         let (t0, tp) = self.pose(q, p, &zero);
         let x = t0.apply(&tp);
+        let w = self.weights(q);
+        let root = Self::product(&self.factors(self.machine.tool, q, p, &zero, &w)).apply(&tp);
         let to_frame = match self.machine.frame {
             Frame::Workpiece => Matrix3::identity(),
             Frame::Tool => t0.r.transpose(),
         };
         Nominal {
             point: [x.x, x.y, x.z],
+            in_root: [root.x, root.y, root.z],
             to_frame: std::array::from_fn(|i| std::array::from_fn(|j| to_frame[(i, j)])),
         }
     }

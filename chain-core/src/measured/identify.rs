@@ -613,6 +613,7 @@ pub fn identify(
             tolerance,
             names: &design.errors,
             forced: 3 * design.setups.len(),
+            scales: &design.scales,
         };
         let (by, kept) = subset::choose(&problem, rank, structural, &options.subset)?;
         // The elimination solves in the determined directions; a chosen

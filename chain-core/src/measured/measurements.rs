@@ -834,6 +834,89 @@ pub struct Design {
     /// The set-ups whose positions are the last `3 × setups.len()`
     /// unknowns.
     pub setups: Vec<Setup>,
+    /// Each unknown's physical scale ([`physical_scales`]): the size an
+    /// error of it plausibly has, in its own unit.
+    pub scales: Vec<f64>,
+}
+
+/// Each unknown's physical scale, for choosing among errors that act alike
+/// (`docs/identify.md`, "Subsets that stay physical"):
+///
+/// - an error with a `statistics` entry in the machine file: its std;
+/// - otherwise a linear error: the length `L`, the root mean square of the
+///   given linear errors' stds (1 mm when none is given);
+/// - otherwise an angle (angular or squareness): `L / R`, the angle that
+///   moves a point at the lever arm `R` of the measured poses by `L`. `R`
+///   is the root mean square distance of the records' nominal tool points
+///   in the root body's frame (where the axes move them) from their
+///   centroid; the distance from the root's origin when every record is
+///   at one place; 1 mm for no record;
+/// - a set-up's coordinate: `L` (they are always estimated);
+///
+/// and a function slot's coefficient without a statistic: its slot's scale
+/// over the root mean square of its basis function at the records (a
+/// power-basis coefficient of `y` at `y ≈ 300` mm is `L / 300` per mm).
+pub fn physical_scales(
+    machine: &Machine,
+    names: &[&str],
+    records: &[Measurement],
+    setups: usize,
+) -> Vec<f64> {
+    use crate::model::ErrorKind;
+    let chain = super::exact::ExactChain::new(machine);
+    let error = |n: &str| machine.error_index(n);
+    let linear = |n: &str| error(n).is_none_or(|j| machine.errors[j].kind == ErrorKind::Linear);
+    let given = |n: &str| {
+        (error(n).and_then(|j| machine.statistic(j)))
+            .map(|s| s.distribution.std())
+            .filter(|s| s.is_finite() && *s > 0.0)
+    };
+    let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
+    let stds: Vec<f64> = names
+        .iter()
+        .filter(|n| linear(n))
+        .filter_map(|n| given(n))
+        .collect();
+    let length = if stds.is_empty() { 1.0 } else { rms(&stds) };
+    let points: Vec<[f64; 3]> = (records.iter())
+        .map(|r| chain.nominal(&r.q, &r.p).in_root)
+        .filter(|p| p.iter().all(|v| v.is_finite()))
+        .collect();
+    let k = points.len().max(1) as f64;
+    let centroid: [f64; 3] = std::array::from_fn(|i| points.iter().map(|p| p[i]).sum::<f64>() / k);
+    let distance = |c: [f64; 3]| {
+        let d: Vec<f64> = (points.iter())
+            .map(|p| ((0..3).map(|i| (p[i] - c[i]).powi(2)).sum::<f64>()).sqrt())
+            .collect();
+        rms(&d)
+    };
+    let lever = [distance(centroid), distance([0.0; 3]), 1.0]
+        .into_iter()
+        .find(|r| *r > 0.0 && r.is_finite())
+        .unwrap_or(1.0);
+    // A function slot's coefficient acts through its basis function w_j(q):
+    // its size is the slot's over the root mean square of w_j at the
+    // records (1 for a constant).
+    let mut w2 = vec![0.0; machine.errors.len()];
+    for r in records {
+        for (a, w) in w2.iter_mut().zip(chain.weights(&r.q)) {
+            *a += w * w;
+        }
+    }
+    let basis = |n: &str| {
+        error(n)
+            .map(|j| (w2[j] / records.len().max(1) as f64).sqrt())
+            .filter(|w| *w > 0.0 && w.is_finite())
+            .unwrap_or(1.0)
+    };
+    (names.iter())
+        .map(|n| match given(n) {
+            Some(s) => s,
+            None if linear(n) => length / basis(n),
+            None => length / lever / basis(n),
+        })
+        .chain(std::iter::repeat_n(length, 3 * setups))
+        .collect()
 }
 
 impl Design {
@@ -1010,6 +1093,7 @@ impl Design {
         }
         let mut errors: Vec<String> = model.errors().iter().map(|e| e.to_string()).collect();
         errors.extend(setups.iter().flat_map(Setup::unknowns));
+        let scales = physical_scales(machine, model.errors(), records, setups.len());
         Ok(Design {
             errors,
             a: nalgebra::DMatrix::from_row_slice(m, width, &flat),
@@ -1017,6 +1101,7 @@ impl Design {
             std,
             origin,
             setups: setups.to_vec(),
+            scales,
         })
     }
 }

@@ -185,6 +185,9 @@ pub(crate) struct Problem<'a> {
     pub tolerance: f64,
     /// The unknowns' names.
     pub names: &'a [String],
+    /// Each unknown's physical scale ([`super::measurements::physical_scales`]):
+    /// what keeps the elimination's carriers plausible ([`plausible`]).
+    pub scales: &'a [f64],
     /// The last `forced` unknowns (set-up positions, [`super::Setup`]) are
     /// always estimated: the elimination takes them first, and the
     /// caller's lists name the others.
@@ -312,7 +315,7 @@ pub(crate) fn choose(
             // The set-ups' positions first, then the errors.
             let order: Vec<usize> = forced.iter().copied().chain(0..ne).collect();
             let (chosen, _) = pivots(&p.truncated(r), &order, p.forced, r, 0.0);
-            (ChosenBy::Elimination, chosen)
+            (ChosenBy::Elimination, plausible(p, chosen, r))
         }
         SubsetChoice::Fix(names) => {
             let fixed = indices(SubsetSide::Fixed, names, errors)?;
@@ -351,6 +354,68 @@ pub(crate) fn choose(
         }
     }
     Ok((by, kept))
+}
+
+/// How far beyond its physical scale a kept error's estimate may be moved
+/// by a fixed error of plausible size before the two change places
+/// ([`plausible`]): two orders of magnitude.
+pub const IMPLAUSIBLE: f64 = 100.0;
+
+/// The elimination's subset `kept` with its carriers kept plausible
+/// (`docs/identify.md`, "Subsets that stay physical"). For each fixed
+/// error `j`, its relation `c_j = F_SS⁻¹ F_Sj` to the kept ones in the
+/// design truncated to its `directions` determined directions says that a
+/// kept `k`'s estimate stands for `x_k + c_jk x_j`: an error `j` of its
+/// physical size `s_j` ([`Problem::scales`]) moves it by `|c_jk| s_j`. When
+/// that exceeds [`IMPLAUSIBLE`] × `s_k` for some `k` (the machine's order
+/// chose a carrier that cannot stay plausible: a flange angle standing for
+/// a tool offset 0.09 mm off its axis), `j` is kept instead of the `k` it
+/// moves most (the span is the same, `c_jk ≠ 0`). Repeated until no such
+/// pair is left; an error once swapped out is not taken back, so at most
+/// one swap per error. Exact ties and plausible carriers keep the machine's
+/// order, as the elimination chose.
+fn plausible(p: &Problem<'_>, mut kept: Vec<usize>, directions: usize) -> Vec<usize> {
+    let n = p.d.len();
+    let ne = n - p.forced;
+    let c = p.truncated(directions);
+    let info_t = |i: usize, j: usize| c.column(i).dot(&c.column(j)) / (p.d[i] * p.d[j]);
+    let mut out = vec![false; n];
+    loop {
+        kept.sort_unstable();
+        let k = kept.len();
+        // Equilibrated F_SS (as `solve` forms it) and its Cholesky.
+        let e: Vec<f64> = kept.iter().map(|&j| p.d[j]).collect();
+        let fss = DMatrix::from_fn(k, k, |a, b| e[a] * info_t(kept[a], kept[b]) * e[b]);
+        let Some(ch) = nalgebra::Cholesky::new(fss) else {
+            return kept;
+        };
+        let mut best: Option<(f64, usize, usize)> = None;
+        for j in (0..ne).filter(|j| !kept.contains(j) && !out[*j]) {
+            if p.info[(j, j)] <= 0.0 {
+                continue;
+            }
+            let fsj = DVector::from_fn(k, |a, _| e[a] * info_t(kept[a], j));
+            let cj = ch.solve(&fsj);
+            for (a, &kk) in kept.iter().enumerate() {
+                if kk >= ne {
+                    continue;
+                }
+                let moved = (cj[a] * e[a]).abs() * p.scales[j];
+                let ratio = moved / p.scales[kk];
+                if ratio > IMPLAUSIBLE && best.is_none_or(|(r, _, _)| ratio > r) {
+                    best = Some((ratio, j, kk));
+                }
+            }
+        }
+        match best {
+            Some((_, j, kk)) => {
+                kept.retain(|&x| x != kk);
+                kept.push(j);
+                out[kk] = true;
+            }
+            None => return kept,
+        }
+    }
 }
 
 /// The least-squares solution of the subset `kept` (the others at 0) in

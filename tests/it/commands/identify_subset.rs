@@ -206,6 +206,101 @@ fn a_tool_offset_along_the_last_axis_is_its_location_error() {
     assert!((terms[0].1 + 1.0 / 50.0).abs() < 1e-12, "{terms:?}");
 }
 
+/// Subsets that stay physical (`docs/identify.md`): the arm with its tool
+/// 0.09 mm off the flange axis (a probe nearly on it, as the public UR5
+/// laser-tracker calibration's). The rotation about the last axis, EX6,
+/// then moves the tool point by `ex × (0, 0, 0.09)`: its column is exactly
+/// −0.09 × TY's, and the machine's order would keep EX6, whose estimate
+/// would stand for EX6 − 11.11·TY (1.4 rad for TY = −0.13 mm). A
+/// plausible-size TY (1 mm, no statistics) would move EX6 by 11 rad, far
+/// beyond an angle's scale (1 mm over the arm's lever arm): TY is kept and
+/// estimated at its true value, EX6 is fixed with the relation in the
+/// usual words; the other relations and the estimates of the errors that
+/// act alone with nothing else do not change.
+#[test]
+fn a_tool_just_off_the_flange_axis_keeps_the_tool_offset() {
+    let text = std::fs::read_to_string(example_file("robots/arm6_offsets.yaml")).unwrap();
+    assert!(text.contains("offset: [100, 0, 50]"));
+    let near = text.replace("offset: [100, 0, 50]", "offset: [100, 0, 0.09]");
+    let m = chain::core::load_str(&near, "arm6_near.yaml").unwrap();
+    let mut rng = Rng::new(77);
+    let (mut e, _) = arm_truth(&m, &mut rng);
+    e[m.error_index("TY").unwrap()] = -0.13;
+    e[m.error_index("EX6").unwrap()] = 0.0;
+    let qs = arm_poses(300, FULL, &mut rng);
+    let records = simulate(&m, &qs, &e, 0.01, &mut rng);
+    let r = solve(&m, &records, &IdentifyOptions::default());
+    assert!(estimated(&r, "TY"), "{:?}", r.subset);
+    assert!(!estimated(&r, "EX6"));
+    let (status, terms) = relation(&r, "EX6");
+    assert_eq!(status, FixedStatus::Redundant);
+    assert_eq!(terms.len(), 1, "{terms:?}");
+    assert_eq!(terms[0].0, "TY");
+    assert!((terms[0].1 + 0.09).abs() < 1e-9, "{terms:?}");
+    // TY's estimate is its own value plus what the fixed ones it carries
+    // contribute (EX6 is 0 here), within 3 std.
+    let sub = r.subset.as_ref().unwrap();
+    let ty = index(&r, "TY");
+    let mut truth = e[ty];
+    for f in &sub.fixed {
+        for &(k, c) in &f.relation {
+            if k == ty {
+                truth += c * e[f.index];
+            }
+        }
+    }
+    let got = sub.estimates[ty];
+    let sd = got.std.unwrap();
+    assert!(
+        (got.value - truth).abs() < 3.0 * sd,
+        "TY {} ± {sd} vs {truth}",
+        got.value
+    );
+    assert!((got.value + 0.13).abs() < 0.01, "{}", got.value);
+    // The swap changes nothing else: estimated with EX6 in TY's place (the
+    // machine order's choice), every other estimate is the same.
+    let with_ex6: Vec<String> = (sub.estimated.iter())
+        .map(|&k| match r.errors[k].as_str() {
+            "TY" => "EX6".to_string(),
+            n => n.to_string(),
+        })
+        .collect();
+    let options = IdentifyOptions {
+        subset: SubsetChoice::Estimate(with_ex6),
+        ..Default::default()
+    };
+    let before = solve(&m, &records, &options);
+    let old = before.subset.as_ref().unwrap();
+    // The same subset chosen by name (solved, as every chosen subset, in
+    // the structural directions: the elimination's solve leaves out the
+    // weak ones).
+    let named: Vec<String> = (sub.estimated.iter())
+        .map(|&k| r.errors[k].clone())
+        .collect();
+    let options = IdentifyOptions {
+        subset: SubsetChoice::Estimate(named),
+        ..Default::default()
+    };
+    let chosen = solve(&m, &records, &options);
+    let sub = chosen.subset.as_ref().unwrap();
+    let ex6 = old.estimates[index(&before, "EX6")].value;
+    assert!(
+        (ex6 - (-0.13 / -0.09)).abs() < 0.2,
+        "EX6 would be {ex6} rad"
+    );
+    // (The same span through another basis, in floating point: EX6's
+    // column is 0.09 mm / 500 mm the size of the others', so the two solves
+    // agree to about 1e-7, not to the last digit.)
+    for &k in sub.estimated.iter().filter(|&&k| k != ty) {
+        let (a, b) = (sub.estimates[k].value, old.estimates[k].value);
+        assert!(
+            (a - b).abs() <= 1e-6 * a.abs().max(1e-6),
+            "{}: {a} vs {b}",
+            r.errors[k]
+        );
+    }
+}
+
 /// A three-axis machine whose X slide has a location error along its own
 /// axis (OX, before the joint) and a positioning error with a constant
 /// term (EXX_0, Legendre degree 1): the two columns are identical, and the
