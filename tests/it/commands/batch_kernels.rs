@@ -16,6 +16,7 @@ use chain::core::ErrorModel;
 
 chain::machine!(pub AcTrunnion = "examples/machines/ac_trunnion.yaml");
 chain::machine!(pub AcTrunnionRotary = "examples/machines/ac_trunnion_rotary.yaml");
+chain::machine!(pub BcTableRotary = "examples/machines/bc_table_rotary.yaml");
 chain::machine!(pub Cnc5Bevel = "examples/machines/cnc5_bevel.yaml");
 chain::machine!(pub CradleGenerator = "examples/machines/cradle_generator.yaml");
 chain::machine!(pub GantryGrinder = "examples/machines/gantry_grinder.yaml");
@@ -30,9 +31,10 @@ chain::machine!(pub Panda = "examples/robots/panda_mdh.yaml");
 chain::machine!(pub BcHeadTable = "chain-macro/benches/machines/bc_head_table.yaml");
 
 /// The machine files with a type above.
-const DECLARED: [&str; 13] = [
+const DECLARED: [&str; 14] = [
     "machines/ac_trunnion.yaml",
     "machines/ac_trunnion_rotary.yaml",
+    "machines/bc_table_rotary.yaml",
     "machines/cnc5_bevel.yaml",
     "machines/cradle_generator.yaml",
     "machines/gantry_grinder.yaml",
@@ -193,6 +195,7 @@ macro_rules! compare {
 fn batched_kernels_equal_the_per_point_functions_on_every_example() {
     compare!(AcTrunnion);
     compare!(AcTrunnionRotary);
+    compare!(BcTableRotary);
     compare!(Cnc5Bevel);
     compare!(CradleGenerator);
     compare!(GantryGrinder);

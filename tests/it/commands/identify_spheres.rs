@@ -601,4 +601,33 @@ fn the_examples_recover_their_truth() {
     // The generator's noise is 0.5 µm per coordinate.
     let after = probed["validation"]["after"]["rms"].as_f64().unwrap();
     assert!(after < 1e-3, "{after}");
+    // The B/C table: its B axis's location errors and the C axis's.
+    let truth: Vec<(String, f64)> = std::fs::read_to_string(dir.join("bc_truth.yaml"))
+        .unwrap()
+        .lines()
+        .filter(|l| l.starts_with("  "))
+        .map(|l| {
+            let (name, value) = l.trim().split_once(": ").unwrap();
+            (name.to_string(), value.parse().unwrap())
+        })
+        .collect();
+    assert_eq!(truth.len(), 8);
+    let bc = common::example_file("machines/bc_table_rotary.yaml");
+    let doc = cli::ok_json(&[
+        "identify",
+        bc.to_str().unwrap(),
+        "--spheres",
+        &path("bc_probing.csv"),
+        "--iterate",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(doc["rank"], 14);
+    for (name, v) in &truth {
+        let (got, sd) = estimate(&doc["iteration"], name);
+        assert!(
+            (got - v).abs() < 3.0 * sd,
+            "B/C {name}: {got} ± {sd} vs {v}"
+        );
+    }
 }
