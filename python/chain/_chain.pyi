@@ -141,6 +141,7 @@ def plan_json(
     count: int,
     kind: Optional[str],
     params: Sequence[Tuple[str, float]],
+    spheres: bool = False,
 ) -> str: ...
 def map_json(
     model: Model,

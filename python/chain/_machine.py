@@ -608,6 +608,7 @@ class Machine:
         kind: Optional[str] = None,
         params: Params = None,
         name: str = "<candidates>",
+        spheres: bool = False,
     ) -> "PlanResult":
         """Where to measure, ``chain plan --candidates C --count K --format json``.
 
@@ -615,13 +616,18 @@ class Machine:
         1-D arrays (the axis variables, any per-row parameters, ``ux, uy,
         uz`` for directions, optionally ``std``); ``k``: how many to choose
         (``--count``); ``kind``: ``"point"`` or ``"direction"`` (``--kind``).
+        ``spheres=True`` (``--spheres-candidates``): the candidates are
+        sphere probings (the sphere file's columns: rotary axes in degrees,
+        optionally ``sphere``, whose values may be text, and ``std``), each
+        sphere's position counted among the unknowns.
         """
         from ._results import PlanResult
 
         if not isinstance(k, int) or isinstance(k, bool) or k < 1:
             raise ValueError(f"k must be a positive integer (the count of candidates to choose), not {k!r}")
-        path, text = _csv_input(candidates, "candidates")
-        return PlanResult._from_json(_chain.plan_json(self._model, path, text, name, k, kind, _params(params)))
+        path, text = _csv_input(candidates, "candidates", ("sphere",) if spheres else ())
+        doc = _chain.plan_json(self._model, path, text, name, k, kind, _params(params), bool(spheres))
+        return PlanResult._from_json(doc)
 
 
     def sobol(

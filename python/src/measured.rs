@@ -111,7 +111,7 @@ pub(crate) fn identify_json(
 /// `chain plan --format json`: `count` of the candidates from `path` or
 /// `text` (named `file`); `kind`: `None`, `"point"` or `"direction"`.
 #[pyfunction]
-#[pyo3(signature = (model, path, text, file, count, kind, params))]
+#[pyo3(signature = (model, path, text, file, count, kind, params, spheres=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn plan_json(
     py: Python<'_>,
@@ -122,11 +122,18 @@ pub(crate) fn plan_json(
     count: usize,
     kind: Option<&str>,
     params: Vec<(String, f64)>,
+    spheres: bool,
 ) -> PyResult<String> {
     let m = &model.machine;
     let kind = kind.map(choice::<Kind>).transpose()?;
     chain::ops::resolve::check_parameters(m, &params).map_err(|e| resolve_error(py, model, e))?;
-    let candidates = read_measurements(py, m, path, text, file, &params, Layout::Candidates)?;
+    let candidates = if spheres {
+        let source = source(path, text, file)?;
+        let read = py.allow_threads(|| ops_source::read_spheres(source, m, &params));
+        read.map_err(|e: MeasurementsError| load_error(py, e.diagnostics()))?
+    } else {
+        read_measurements(py, m, path, text, file, &params, Layout::Candidates)?
+    };
     let request = PlanRequest { count, kind };
     let doc = py
         .allow_threads(|| plan::run(m, &candidates, &request))

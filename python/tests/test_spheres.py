@@ -70,3 +70,11 @@ def test_bad_sphere_files_and_options_are_refused_in_the_cli_words(cli_error):
         m.identify(RTEST, setup="bal")
     with pytest.raises(ValueError, match="or a sphere-probing CSV"):
         m.identify()
+
+
+def test_plan_over_sphere_candidates_equals_the_cli(cli):
+    m = chain.Machine.load(MACHINE)
+    want = cli("plan", MACHINE, "--spheres-candidates", PROBING, "--count", 8)
+    got = m.plan(PROBING, 8, spheres=True, name=str(PROBING)).to_dict()
+    assert got == want
+    assert len(want["errors"]) == want["rank"] == 14

@@ -3,10 +3,12 @@
 //! the identifiable subspace, against `count` taken evenly (the D-optimal
 //! design is [`chain_core::plan::plan`]). The candidates are read by the
 //! adapter (a file or stdin for the CLI, a path or columns for Python)
-//! through `chain_core::measured::Measurements`; the kind, the document and
+//! through `chain_core::measured::Measurements` (a candidate file, or
+//! sphere-probing candidates whose spheres' positions are unknowns of the
+//! plan as of the fit: `docs/five-axis.md`); the kind, the document and
 //! every refusal in the options' words are this module's.
 
-use chain_core::measured::Measurements;
+use chain_core::measured::{Design, Measurements};
 use chain_core::plan::{self, Kind, KindError, Plan, PlanError, Rows};
 use chain_core::{ErrorModel, Machine};
 use serde::Serialize;
@@ -158,7 +160,10 @@ pub fn run(
         }));
     }
     let model = chain_core::compile(machine);
-    let rows = Rows::of(&model, machine, &candidates.rows).map_err(refused)?;
+    // Sphere-probing candidates bring their spheres' positions as unknowns
+    // (counted in the plan, as the fit will estimate them).
+    let design = Design::of(&model, machine, candidates).map_err(|e| refused(e.into()))?;
+    let rows = Rows::from_design(&design).map_err(refused)?;
     let result = plan::plan(&rows, count).map_err(refused)?;
     Ok(PlanDocument {
         machine: machine.name.clone(),

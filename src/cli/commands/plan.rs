@@ -1,4 +1,4 @@
-//! `chain plan FILE --candidates C.csv --count K [--kind point|direction]
+//! `chain plan FILE (--candidates C.csv | --spheres-candidates C.csv) --count K [--kind point|direction]
 //! [--param NAME=VALUE]... [--format table|json]`.
 //!
 //! Where to measure (measured-machines spec, section 5): `K` of the candidate
@@ -38,8 +38,18 @@ pub struct PlanArgs {
     /// measured values: a column per axis variable (rotary in radians),
     /// optional columns of parameters given per row, `ux,uy,uz` for
     /// direction measurements, optionally `std`; `-` reads stdin.
-    #[arg(long, value_name = "C.csv")]
-    pub candidates: PathBuf,
+    #[arg(
+        long,
+        value_name = "C.csv",
+        required_unless_present = "spheres_candidates"
+    )]
+    pub candidates: Option<PathBuf>,
+    /// Candidate sphere probings instead (the sphere file's columns: every
+    /// axis variable, rotary ones in degrees, optionally `sphere` and
+    /// `std`): the K probings that determine the location errors best,
+    /// each sphere's position counted among the unknowns.
+    #[arg(long, value_name = "C.csv", conflicts_with = "candidates")]
+    pub spheres_candidates: Option<PathBuf>,
     /// How many candidates to choose.
     #[arg(long, value_name = "K")]
     pub count: usize,
@@ -60,17 +70,26 @@ pub fn exec(args: PlanArgs) -> miette::Result<()> {
     let loaded = Loaded::new(&args.file)?;
     let m = &loaded.machine;
     args.param.check_names(m)?;
-    let name = display(&args.candidates);
-    let candidates = if args.candidates.as_os_str() == "-" {
-        let (_, bytes) = crate::cli::csv_input::read_input(
-            &args.candidates,
-            chain_core::bounded::MEASUREMENT_BYTES,
-        )?;
-        let text = String::from_utf8(bytes)
-            .map_err(|e| miette::miette!(code = "chain::utf8", "{name}: not UTF-8 text ({e})"))?;
-        Measurements::parse(&text, &name, m, &args.param.params, Layout::Candidates)?
-    } else {
-        Measurements::read(&args.candidates, m, &args.param.params, Layout::Candidates)?
+    let candidates = match (&args.candidates, &args.spheres_candidates) {
+        (_, Some(spheres)) => Measurements::read_spheres(spheres, m, &args.param.params)?,
+        (Some(path), None) if path.as_os_str() == "-" => {
+            let name = display(path);
+            let (_, bytes) =
+                crate::cli::csv_input::read_input(path, chain_core::bounded::MEASUREMENT_BYTES)?;
+            let text = String::from_utf8(bytes).map_err(|e| {
+                miette::miette!(code = "chain::utf8", "{name}: not UTF-8 text ({e})")
+            })?;
+            Measurements::parse(&text, &name, m, &args.param.params, Layout::Candidates)?
+        }
+        (Some(path), None) => {
+            Measurements::read(path, m, &args.param.params, Layout::Candidates)?
+        }
+        (None, None) => {
+            return Err(miette::miette!(
+                code = "chain::plan::candidates",
+                "--candidates: give the candidate CSV (--candidates C.csv) or sphere-probing candidates (--spheres-candidates C.csv)"
+            ))
+        }
     };
     let request = PlanRequest {
         count: args.count,

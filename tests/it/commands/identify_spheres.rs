@@ -631,3 +631,64 @@ fn the_examples_recover_their_truth() {
         );
     }
 }
+
+/// `chain plan --spheres-candidates`: the K probings of the example's grid
+/// that determine the location errors best, the spheres' positions counted
+/// among the unknowns (14 = 8 errors + 2 × 3); the chosen probings,
+/// identified on their own, determine every unknown (rank 14), and their
+/// information beats K taken evenly.
+#[test]
+fn plan_chooses_probings_with_the_spheres_counted() {
+    let machine = common::example_file("machines/ac_trunnion_rotary.yaml");
+    let probing = common::example_file("spheres/probing.csv");
+    let m = machine.to_str().unwrap();
+    let doc = cli::ok_json(&[
+        "plan",
+        m,
+        "--spheres-candidates",
+        probing.to_str().unwrap(),
+        "--count",
+        "8",
+        "--format",
+        "json",
+    ]);
+    let errors: Vec<&str> = doc["errors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e.as_str().unwrap())
+        .collect();
+    assert_eq!(errors.len(), 14, "{errors:?}");
+    assert!(errors.contains(&"sphere low.x") && errors.contains(&"sphere high.z"));
+    assert_eq!(doc["rank"], 14);
+    let optimal = doc["optimal"]["log_det"].as_f64().unwrap();
+    let even = doc["even"]["log_det"].as_f64().unwrap_or(f64::NEG_INFINITY);
+    assert!(optimal >= even, "{optimal} vs {even}");
+    // The chosen probings as a sphere file of their own.
+    let text = std::fs::read_to_string(&probing).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let mut chosen = format!("{}\n", lines[0]);
+    for c in doc["optimal"]["candidates"].as_array().unwrap() {
+        chosen.push_str(lines[1 + c.as_u64().unwrap() as usize]);
+        chosen.push('\n');
+    }
+    let file = cli::scratch_file("chosen.csv", &chosen);
+    let fit = cli::ok_json(&[
+        "identify",
+        m,
+        "--spheres",
+        file.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert_eq!(fit["rank"], 14, "{fit:#}");
+    // Every expected std of the plan is the fit's std on those probings
+    // (the rows carry the file's std: absolute stds), within the linear
+    // model's rounding.
+    let stds = doc["optimal"]["std"].as_array().unwrap();
+    for (name, sd) in errors.iter().zip(stds) {
+        let want = sd.as_f64().unwrap();
+        let got = fit["subset"]["estimates"][*name]["std"].as_f64().unwrap();
+        assert!((got - want).abs() <= 1e-6 * want, "{name}: {got} vs {want}");
+    }
+}
