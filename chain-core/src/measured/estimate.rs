@@ -167,3 +167,47 @@ pub struct Estimate {
     /// many rows as the rank, the noise cannot be estimated).
     pub std: Option<f64>,
 }
+
+/// The noise variance a least-squares fit of `k` unknowns to `m` rows
+/// reports its covariance in: 1 with a `std` column (`weighted`: the rows
+/// are in units of their stated std), `RSS/(m − k)` without one, `None`
+/// when there is no residual degree of freedom.
+pub(crate) fn noise_scale2(weighted: bool, rss: f64, m: usize, k: usize) -> Option<f64> {
+    if weighted {
+        Some(1.0)
+    } else if m > k {
+        Some(rss / (m - k) as f64)
+    } else {
+        None
+    }
+}
+
+/// The covariance over all `n` unknowns and every unknown's estimate, from
+/// the `estimated` ones' inverse information `inv` (`k × k`, in
+/// `estimated`'s order, per unit noise) and the noise variance `scale2`
+/// ([`noise_scale2`]): `scale2 · inv` on the estimated block, zero rows and
+/// columns for the fixed unknowns, NaN when the noise is unknown; each
+/// estimate's std the root of its diagonal, `None` for a fixed unknown, an
+/// unknown noise or a non-finite diagonal.
+pub(crate) fn covariance(
+    values: &[f64],
+    estimated: &[usize],
+    inv: &nalgebra::DMatrix<f64>,
+    scale2: Option<f64>,
+) -> (nalgebra::DMatrix<f64>, Vec<Estimate>) {
+    let n = values.len();
+    let mut covariance = nalgebra::DMatrix::zeros(n, n);
+    for (a, &i) in estimated.iter().enumerate() {
+        for (b, &j) in estimated.iter().enumerate() {
+            covariance[(i, j)] = scale2.map_or(f64::NAN, |s2| s2 * inv[(a, b)]);
+        }
+    }
+    let estimates = (0..n)
+        .map(|j| Estimate {
+            value: values[j],
+            std: (estimated.contains(&j) && scale2.is_some() && covariance[(j, j)].is_finite())
+                .then(|| covariance[(j, j)].max(0.0).sqrt()),
+        })
+        .collect();
+    (covariance, estimates)
+}

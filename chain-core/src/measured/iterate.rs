@@ -14,8 +14,10 @@
 //!   `|δ_i| / σ_i` exceeds the noise scale (`σ_i` the row's std, 1
 //!   without a `std` column; the noise scale `s` of the fit, or 1 with a
 //!   `std` column when the fit has no degree of freedom).
-//! - **angles**: an angular error whose largest angle at the measured poses,
-//!   `max_q |w_j(q) x_j|`, exceeds [`ANGLE_LIMIT`] is flagged: beyond it the
+//! - **angles**: an angular error motion whose largest angle at the measured
+//!   poses, `max_q |Σ_j w_j(q) x_j|` over its slot's errors (one constant, or
+//!   a function slot's coefficients), exceeds [`ANGLE_LIMIT`] is flagged by
+//!   its name (the function's for a slot): beyond it the
 //!   dropped second-order terms (`θ²/2` of the angle times the lever) are
 //!   no longer negligible against the first-order ones on a metre-sized
 //!   machine.
@@ -33,8 +35,9 @@
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
+use super::estimate::{covariance, noise_scale2, Estimate};
 use super::exact::ExactChain;
-use super::identify::{Estimate, Identification};
+use super::identify::Identification;
 use super::measurements::{Design, Measurement};
 use crate::model::{ErrorKind, Machine};
 
@@ -54,8 +57,10 @@ pub struct FirstOrderCheck {
     pub noise: Option<f64>,
     /// Whether some row's difference exceeds the noise.
     pub exceeds_noise: bool,
-    /// The angular errors beyond [`ANGLE_LIMIT`] at the measured poses,
-    /// with their largest angle (rad).
+    /// The angular error motions beyond [`ANGLE_LIMIT`] at the measured
+    /// poses (a constant error by its name, a function slot by the
+    /// function's: its whole value, not each coefficient), with their
+    /// largest angle (rad).
     pub large_angles: Vec<(String, f64)>,
 }
 
@@ -173,23 +178,45 @@ pub fn check(
         .zip(&w)
         .fold(0.0f64, |a, (d, w)| a.max((d * w).abs()));
     let exceeds_noise = noise.is_some_and(|s| worst > s);
+    // Each angular error motion's largest angle at the measured poses: a
+    // function slot's value Σ_k w_k(q) x_k (named by the function), or a
+    // constant error's value; in the order of their first error.
     let chain = ExactChain::new(machine);
     let ne = design.machine_errors();
-    let mut largest = vec![0.0f64; ne];
-    for rec in records {
-        let wj = chain.weights(&rec.q);
-        for (j, l) in largest.iter_mut().enumerate() {
-            *l = l.max((wj[j] * x[j]).abs());
+    let angular = |j: usize| {
+        matches!(
+            machine.errors[j].kind,
+            ErrorKind::Angular | ErrorKind::Squareness
+        )
+    };
+    let mut motions: Vec<(usize, String, Vec<usize>)> = Vec::new();
+    let mut in_function = vec![false; ne];
+    for f in &machine.functions {
+        let members: Vec<usize> = f.coefficients.iter().map(|(j, _)| *j).collect();
+        for &j in &members {
+            in_function[j] = true;
+        }
+        if let Some(&first) = members.iter().min() {
+            if angular(first) {
+                motions.push((first, f.name.clone(), members));
+            }
         }
     }
-    let large_angles = (0..ne)
-        .filter(|&j| {
-            matches!(
-                machine.errors[j].kind,
-                ErrorKind::Angular | ErrorKind::Squareness
-            ) && largest[j] > ANGLE_LIMIT
-        })
-        .map(|j| (r.errors[j].clone(), largest[j]))
+    for j in (0..ne).filter(|&j| angular(j) && !in_function[j]) {
+        motions.push((j, r.errors[j].clone(), vec![j]));
+    }
+    motions.sort_by_key(|(first, _, _)| *first);
+    let mut largest = vec![0.0f64; motions.len()];
+    for rec in records {
+        let wj = chain.weights(&rec.q);
+        for ((_, _, members), l) in motions.iter().zip(largest.iter_mut()) {
+            let angle: f64 = members.iter().map(|&j| wj[j] * x[j]).sum();
+            *l = l.max(angle.abs());
+        }
+    }
+    let large_angles = (motions.into_iter().zip(largest))
+        .filter(|(_, l)| *l > ANGLE_LIMIT)
+        .map(|((_, name, _), l)| (name, l))
         .collect();
     FirstOrderCheck {
         max,
@@ -209,7 +236,6 @@ pub fn iterate(
     estimated: &[usize],
     start: &[f64],
 ) -> Iteration {
-    let n = start.len();
     let k = estimated.len();
     let m = design.b.len();
     let w = inv_sigma(design);
@@ -299,13 +325,7 @@ pub fn iterate(
     let res: Vec<f64> = design.b.iter().zip(&f).map(|(b, f)| b - f).collect();
     let rms = (res.iter().map(|r| r * r).sum::<f64>() / m.max(1) as f64).sqrt();
     let max = res.iter().fold(0.0f64, |a, r| a.max(r.abs()));
-    let scale2 = if weighted {
-        Some(1.0)
-    } else if m > k {
-        Some(rss / (m - k) as f64)
-    } else {
-        None
-    };
+    let scale2 = noise_scale2(weighted, rss, m, k);
     // Equilibrated Cholesky; a singular H leaves the std unknown (NaN),
     // never 0.
     let e: Vec<f64> = (0..k)
@@ -319,19 +339,7 @@ pub fn iterate(
         }
         None => DMatrix::from_element(k, k, f64::NAN),
     };
-    let mut covariance = DMatrix::zeros(n, n);
-    for (a, &i) in estimated.iter().enumerate() {
-        for (b, &j) in estimated.iter().enumerate() {
-            covariance[(i, j)] = scale2.map_or(f64::NAN, |s2| s2 * hinv[(a, b)]);
-        }
-    }
-    let estimates = (0..n)
-        .map(|j| Estimate {
-            value: x[j],
-            std: (estimated.contains(&j) && scale2.is_some() && covariance[(j, j)].is_finite())
-                .then(|| covariance[(j, j)].max(0.0).sqrt()),
-        })
-        .collect();
+    let (covariance, estimates) = covariance(&x, estimated, &hinv, scale2);
     Iteration {
         iterations,
         converged,

@@ -42,7 +42,9 @@
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
-use super::estimate::{Estimate, IdentifyError, SubsetProblem, SubsetSide};
+use super::estimate::{
+    covariance, noise_scale2, Estimate, IdentifyError, SubsetProblem, SubsetSide,
+};
 
 /// Relation weights (in equilibrated units: the share of the fixed
 /// unknown's unit-norm effect carried by an estimated one) below this are
@@ -472,26 +474,8 @@ pub(crate) fn solve(p: &Problem<'_>, by: ChosenBy, kept: &[usize], directions: u
     } else {
         0.0
     };
-    let scale2 = if p.weighted {
-        Some(1.0)
-    } else if m > k {
-        Some(rss / (m - k) as f64)
-    } else {
-        None
-    };
-    let mut covariance = DMatrix::zeros(n, n);
-    for (a, &i) in kept.iter().enumerate() {
-        for (b, &j) in kept.iter().enumerate() {
-            covariance[(i, j)] = scale2.map_or(f64::NAN, |s2| s2 * inv_phys[(a, b)]);
-        }
-    }
-    let estimates = (0..n)
-        .map(|j| Estimate {
-            value: x[j],
-            std: (kept.contains(&j) && scale2.is_some())
-                .then(|| covariance[(j, j)].max(0.0).sqrt()),
-        })
-        .collect();
+    let scale2 = noise_scale2(p.weighted, rss, m, k);
+    let (covariance, estimates) = covariance(x.as_slice(), kept, &inv_phys, scale2);
     let fixed = (0..n)
         .filter(|j| !kept.contains(j))
         .map(|j| {

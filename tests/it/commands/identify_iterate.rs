@@ -449,3 +449,62 @@ fn bad_options_are_refused_before_the_files_are_read() {
         assert!(!err.contains("nonexistent"), "{extra:?}: {err}");
     }
 }
+
+/// The large-angle flag is per error motion: a function slot's whole value
+/// `Σ_k w_k(q) x_k`, named by the function, not each coefficient. An X
+/// slide's roll `EAX = c0 + c1·x` with `c0 = 0.006` rad and `c1·800 mm =
+/// 0.006` rad reaches 0.012 rad at x = 800 (beyond the 0.01 rad limit)
+/// though neither coefficient's term does; a yaw whose terms cancel
+/// (0.008 − 0.008·x/800, at most 0.008 rad) is not flagged though its
+/// constant alone nearly is and its slope term reaches 0.008.
+#[test]
+fn the_large_angle_flag_is_per_error_motion() {
+    let text = "machine: roll
+bodies:
+  bed: {}
+  x_slide:
+    parent: bed
+    joint: {type: prismatic, axis: +x, variable: x}
+    errors:
+      ex: {name: EAX, powers: [0, 1]}
+      ez: {name: ECX, powers: [0, 1]}
+      dy: EYX
+  tool: {parent: x_slide, offset: [0, 0, 300]}
+workpiece: bed
+tool: tool
+";
+    let m = chain::core::load_str(text, "roll.yaml").unwrap();
+    let mut e = vec![0.0; m.errors.len()];
+    for (name, v) in [
+        ("EAX_0", 0.006),
+        ("EAX_1", 0.006 / 800.0),
+        ("ECX_0", 0.008),
+        ("ECX_1", -0.008 / 800.0),
+    ] {
+        e[m.error_index(name).unwrap()] = v;
+    }
+    let exact = Exact::new(&m);
+    let p = exact.file_parameters();
+    let records: Vec<Measurement> = (0..=8)
+        .map(|i| {
+            let q = vec![100.0 * i as f64];
+            let err = exact.exact_error(&q, &p, &e);
+            Measurement {
+                line: i + 2,
+                q,
+                p: p.clone(),
+                observed: Observed::Point,
+                values: err[..3].to_vec(),
+                std: None,
+                setup: None,
+            }
+        })
+        .collect();
+    let model = chain::core::compile(&m);
+    let design = chain::core::measured::Design::new(&model, &m, &records).unwrap();
+    let r = chain::core::measured::identify(&design, None, &IdentifyOptions::default()).unwrap();
+    let check = chain::core::measured::iterate::check(&m, &records, &design, &r, &e);
+    assert_eq!(check.large_angles.len(), 1, "{:?}", check.large_angles);
+    assert_eq!(check.large_angles[0].0, "EAX");
+    assert!((check.large_angles[0].1 - 0.012).abs() < 1e-12);
+}
