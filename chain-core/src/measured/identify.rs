@@ -612,6 +612,7 @@ pub fn identify(
             s_max,
             tolerance,
             names: &design.errors,
+            structural,
             forced: 3 * design.setups.len(),
             scales: &design.scales,
         };

@@ -32,10 +32,14 @@
 //!   (the share of `j`'s unit-norm effect carried by `k`), below
 //!   [`TERM_CUTOFF`] are left out of the words (kept in the JSON). The part
 //!   of `j`'s column the estimated ones do not carry, `ρ_j = √(1 −
-//!   F_jS c_j / F_jj)`, decides its status: at most the rank tolerance ×
-//!   `s_max` is **redundant** (structurally: the measurements cannot tell
-//!   it from the combination), otherwise **weak** (chosen by the noise
-//!   rule: the data do not determine it beyond their noise) or **fixed**
+//!   F_jS c_j / F_jj)`, is reported; the status is decided in the
+//!   structural design (its determined and weak directions): the fixed
+//!   column's norm left after the estimated ones by Gram–Schmidt at most
+//!   the rank tolerance × `s_max` is **redundant** (structurally: the
+//!   measurements cannot tell it from the combination), otherwise **weak**
+//!   (chosen by the noise rule: the data do not determine it beyond their
+//!   noise; never under a fixed `--rank-tol`, which has no weak
+//!   directions) or **fixed**
 //!   (by the caller's choice: fixing it biases the estimates by its true
 //!   value times the part `ρ_j` the others do not carry).
 
@@ -190,6 +194,9 @@ pub(crate) struct Problem<'a> {
     /// Each unknown's physical scale ([`super::measurements::physical_scales`]):
     /// what keeps the elimination's carriers plausible ([`plausible`]).
     pub scales: &'a [f64],
+    /// The structural rank: the directions above the rank tolerance (the
+    /// determined ones and the weak ones the noise rule left out).
+    pub structural: usize,
     /// The last `forced` unknowns (set-up positions, [`super::Setup`]) are
     /// always estimated: the elimination takes them first, and the
     /// caller's lists name the others.
@@ -476,6 +483,21 @@ pub(crate) fn solve(p: &Problem<'_>, by: ChosenBy, kept: &[usize], directions: u
     };
     let scale2 = noise_scale2(p.weighted, rss, m, k);
     let (covariance, estimates) = covariance(x.as_slice(), kept, &inv_phys, scale2);
+    // Whether the kept columns carry a fixed one structurally: its norm
+    // left after them by Gram–Schmidt in the structural design (the
+    // determined and the weak directions), against the rank floor.
+    // Redundant at most the floor; otherwise it is separable and fixed only
+    // because the noise rule left its directions out (weak) or by choice.
+    // (The reported `residual` is the full design's part, from a
+    // difference that cancels for a redundant one: it decides nothing.)
+    let order: Vec<usize> = (kept.iter().copied())
+        .chain((0..n).filter(|j| !kept.contains(j)))
+        .collect();
+    let (_, rest) = pivots(&p.truncated(p.structural), &order, k, k, 0.0);
+    let mut structural_rest = vec![0.0; n];
+    for (at, &j) in order.iter().enumerate() {
+        structural_rest[j] = rest[at];
+    }
     let fixed = (0..n)
         .filter(|j| !kept.contains(j))
         .map(|j| {
@@ -497,7 +519,7 @@ pub(crate) fn solve(p: &Problem<'_>, by: ChosenBy, kept: &[usize], directions: u
             let full_ss = DMatrix::from_fn(k, k, |a, b| p.info[(kept[a], kept[b])]);
             let left = fjj - 2.0 * c.dot(&full_sj) + c.dot(&(&full_ss * &c));
             let residual = (left / fjj).max(0.0).sqrt();
-            let status = if residual <= floor {
+            let status = if structural_rest[j] <= floor {
                 FixedStatus::Redundant
             } else if by == ChosenBy::Elimination {
                 FixedStatus::Weak

@@ -683,3 +683,55 @@ fn the_cli_chooses_the_subset_as_the_library_does() {
         assert!(err.contains(wanted), "{extra:?}: {err}");
     }
 }
+
+/// The status of a fixed error is decided in the structural design: under
+/// a fixed `--rank-tol` there are no weak directions, so a fixed error is
+/// redundant (its column lies in the estimated ones' span there), never
+/// weak. Two unit columns at θ = 0.017 rad with `rank_tol = 1e-2`: their
+/// singular values' ratio tan(θ/2) = 0.0085 is below the tolerance, so one
+/// is fixed; its part left in the full design, sin θ = 0.017, is above the
+/// floor 1e-2 · s_max = 0.0141, which the full design's difference called
+/// weak.
+#[test]
+fn under_a_fixed_rank_tolerance_nothing_is_weak() {
+    use chain::core::measured::{MeasuredComponent, MeasurementKind};
+    let theta: f64 = 0.017;
+    let m = 6;
+    let mut a = nalgebra::DMatrix::zeros(m, 3);
+    a[(0, 0)] = 1.0;
+    a[(0, 1)] = theta.cos();
+    a[(1, 1)] = theta.sin();
+    a[(2, 2)] = 1.0;
+    let x = [0.3, 0.0, -0.2];
+    let b: Vec<f64> = (0..m)
+        .map(|i| (0..3).map(|j| a[(i, j)] * x[j]).sum::<f64>() + 1e-4 * (i as f64 - 2.5))
+        .collect();
+    let design = Design {
+        errors: vec!["A".into(), "B".into(), "C".into()],
+        a,
+        b,
+        std: None,
+        origin: (0..m)
+            .map(|i| {
+                let component = MeasuredComponent {
+                    kind: MeasurementKind::Point,
+                    index: i % 3,
+                };
+                (i / 3, component)
+            })
+            .collect(),
+        setups: Vec::new(),
+        scales: vec![1.0; 3],
+    };
+    let options = IdentifyOptions {
+        rank_tol: Some(1e-2),
+        ..Default::default()
+    };
+    let r = identify(&design, None, &options).unwrap();
+    assert_eq!(r.rank, 2);
+    let sub = r.subset.as_ref().unwrap();
+    assert_eq!(sub.fixed.len(), 1);
+    let f = &sub.fixed[0];
+    assert!(f.residual > 1e-2 * r.singular_values[0], "{}", f.residual);
+    assert_eq!(f.status, FixedStatus::Redundant);
+}
