@@ -216,6 +216,10 @@ pub struct AliasGroup {
     pub column_rank: usize,
     /// The indices of the group's vectors in the basis.
     pub vectors: Vec<usize>,
+    /// How many of those are weak directions (seen by the measurements,
+    /// but only within their noise: left out by the noise rule) rather
+    /// than directions the measurements cannot see at all.
+    pub weak: usize,
 }
 
 /// The result of [`identify`].
@@ -628,7 +632,25 @@ pub fn identify(
     } else {
         None
     };
-    let (basis, groups) = grouped_basis(&unidentifiable_basis);
+    let (basis, mut groups) = grouped_basis(&unidentifiable_basis);
+    if prior.is_none() && rank < structural {
+        // Each group's vectors inside the structural null space: the
+        // singular values of Nᵀ G equal to 1; the others are weak.
+        for g in &mut groups {
+            let gv = DMatrix::from_fn(n, g.vectors.len(), |i, c| basis[(i, g.vectors[c])]);
+            let inside = if null.ncols() == 0 {
+                0
+            } else {
+                let m = null.tr_mul(&gv);
+                let svd = nalgebra::SVD::new(m, false, false);
+                svd.singular_values
+                    .iter()
+                    .filter(|s| **s > 1.0 - 1e-6)
+                    .count()
+            };
+            g.weak = g.vectors.len() - inside;
+        }
+    }
     let unidentifiable = (0..basis.ncols())
         .map(|k| {
             (0..n)
@@ -898,6 +920,7 @@ pub fn grouped_basis(basis: &DMatrix<f64>) -> (DMatrix<f64>, Vec<AliasGroup>) {
             column_rank: members.len() - indices.len(),
             members,
             vectors: indices,
+            weak: 0,
         });
     }
     let m = if columns.is_empty() {

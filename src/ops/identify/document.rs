@@ -27,6 +27,10 @@ pub struct GroupDoc {
     pub errors: Vec<String>,
     /// How many independent combinations of them the data cannot tell.
     pub vectors: usize,
+    /// How many of those the measurements see, but only within their noise
+    /// (weak directions the noise rule left out; absent when none).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub weak: usize,
     /// The same in words.
     pub explanation: String,
 }
@@ -532,8 +536,9 @@ impl IdentifyDocument {
             .map(|g| {
                 let errors: Vec<String> = g.members.iter().map(|&j| r.errors[j].clone()).collect();
                 GroupDoc {
-                    explanation: explain(design, r, &g.members, g.vectors.len()),
+                    explanation: explain(design, r, &g.members, g.vectors.len(), g.weak),
                     vectors: g.vectors.len(),
+                    weak: g.weak,
                     errors,
                 }
             })
@@ -596,6 +601,11 @@ fn setup_docs(design: &Design, r: &Identification, iteration: Option<&Iteration>
         .collect()
 }
 
+/// Whether a count is zero (a key left out of the document).
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
 /// `a`, `a and b`, `a, b and c`.
 fn and_list(names: &[String]) -> String {
     match names {
@@ -609,10 +619,41 @@ fn and_list(names: &[String]) -> String {
 /// of its members: when they are all parallel (column rank 1), which
 /// measured components they act on (named by the quantities they measure,
 /// in the components' order) and whether as a constant (an offset);
-/// otherwise how many independent combinations they act through.
-fn explain(design: &Design, r: &Identification, members: &[usize], vectors: usize) -> String {
+/// otherwise how many independent combinations they act through. A group
+/// with `weak` directions (seen, but only within the noise) says so instead
+/// of "cannot be seen".
+fn explain(
+    design: &Design,
+    r: &Identification,
+    members: &[usize],
+    vectors: usize,
+    weak: usize,
+) -> String {
     let names: Vec<String> = members.iter().map(|&j| r.errors[j].clone()).collect();
     let list = and_list(&names);
+    if weak > 0 {
+        // Seen, within the noise: not "cannot be seen".
+        let combinations = |k: usize| {
+            if k == 1 {
+                "one combination".to_string()
+            } else {
+                format!("{k} combinations")
+            }
+        };
+        let unseen = vectors - weak;
+        return format!(
+            "{list} act through {} independent combinations; {} of them {} seen by these measurements only within their noise (the noise rule leaves {} out){}",
+            members.len() - unseen,
+            combinations(weak),
+            if weak == 1 { "is" } else { "are" },
+            if weak == 1 { "it" } else { "them" },
+            if unseen > 0 {
+                format!("; {} cannot be seen at all", combinations(unseen))
+            } else {
+                String::new()
+            }
+        );
+    }
     if r.prior {
         return format!(
             "the measurements leave {} of {list} at the prior (posterior std above {} × the prior std along {})",

@@ -12,8 +12,8 @@
 use crate::common;
 
 use chain::core::measured::{
-    identify, Design, FixedStatus, Identification, IdentifyOptions, Measurement, Observed,
-    SubsetChoice,
+    identify, Design, FixedStatus, Identification, IdentifyOptions, Measurement, Measurements,
+    Observed, SubsetChoice,
 };
 use chain::core::{ErrorModel, Machine};
 use common::{example_file, gauss, Exact, Rng};
@@ -734,4 +734,53 @@ fn under_a_fixed_rank_tolerance_nothing_is_weak() {
     let f = &sub.fixed[0];
     assert!(f.residual > 1e-2 * r.singular_values[0], "{}", f.residual);
     assert_eq!(f.status, FixedStatus::Redundant);
+}
+
+/// Weak directions are worded as what they are: seen by the measurements,
+/// but only within their noise (not "cannot be seen"). The arm with its
+/// wrist joints J4 and J6 moved only ±0.2 rad (the setting of
+/// `weak_directions_are_left_out_not_estimated_wildly`): the groups that
+/// hold a weak direction count it, and their words say so; the others keep
+/// the structural words.
+#[test]
+fn weak_directions_are_worded_as_seen_within_the_noise() {
+    let m = arm();
+    let mut rng = Rng::new(101);
+    let (e, _) = arm_truth_sized(&m, 0.1, &mut rng);
+    let qs = arm_poses(300, [3.0, 1.5, 1.5, 0.2, 2.0, 0.2], &mut rng);
+    let records = Measurements {
+        file: "arm.csv".into(),
+        machine: m.name.clone(),
+        weighted: false,
+        rows: simulate(&m, &qs, &e, 0.001, &mut rng),
+        setups: Vec::new(),
+    };
+    let done = chain::ops::identify::identify_document(
+        &m,
+        &records,
+        false,
+        &IdentifyOptions::default(),
+        false,
+        None,
+    )
+    .unwrap();
+    let weak = done.result.noise.weak;
+    assert!(weak >= 1);
+    let groups = &done.document.groups;
+    let counted: usize = groups.iter().map(|g| g.weak).sum();
+    assert_eq!(counted, weak, "{groups:#?}");
+    for g in groups {
+        if g.weak > 0 {
+            assert!(
+                g.explanation.contains("only within their noise")
+                    && !g
+                        .explanation
+                        .contains("cannot be seen in these measurements"),
+                "{}",
+                g.explanation
+            );
+        } else {
+            assert!(!g.explanation.contains("noise"), "{}", g.explanation);
+        }
+    }
 }
