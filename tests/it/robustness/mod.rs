@@ -10,6 +10,7 @@ mod extreme_values;
 mod fuzz;
 mod fuzz_structured;
 mod golden_outputs;
+mod library_words;
 mod malformed_input;
 mod option_ranges;
 mod output_errors;
