@@ -648,27 +648,7 @@ fn classify(
         let variables = missing.iter().map(|n| n.to_string()).collect();
         problems.push(*located(header_origin, P::MissingPose { variables }));
     }
-    let mut p = Vec::new();
-    for param in &m.parameters {
-        match find(&param.name) {
-            Some(c) => p.push(Ok(c)),
-            None => {
-                let value = overrides
-                    .iter()
-                    .rev()
-                    .find(|(n, _)| *n == param.name)
-                    .map(|(_, v)| *v)
-                    .or(param.value);
-                match value {
-                    Some(v) => p.push(Err(v)),
-                    None => {
-                        let name = param.name.clone();
-                        problems.push(*located(header_origin, P::MissingParameter { name }));
-                    }
-                }
-            }
-        }
-    }
+    let p = parameter_columns(m, overrides, header, header_origin, &mut problems);
     // The records' kind: the one kind some of whose columns the header has,
     // else the one kind that has no column in this layout (a candidate
     // tool point); all of its columns are then needed.
@@ -722,6 +702,40 @@ fn classify(
         }
         _ => Err(problems),
     }
+}
+
+/// Per parameter of `m`, its column in `header`, or the value it takes
+/// without one (the last of `overrides` naming it, then the machine
+/// file's); a symbolic parameter with neither is a problem located at the
+/// header. The one rule of the measurement, candidate and sphere files.
+#[cfg(feature = "csv")]
+pub(crate) fn parameter_columns(
+    m: &Machine,
+    overrides: &[(String, f64)],
+    header: &[(String, Origin)],
+    header_origin: &Origin,
+    problems: &mut Vec<(Origin, Problem)>,
+) -> Vec<Result<usize, f64>> {
+    let mut p = Vec::new();
+    for param in &m.parameters {
+        match header.iter().position(|(h, _)| *h == param.name) {
+            Some(c) => p.push(Ok(c)),
+            None => {
+                let value = (overrides.iter().rev())
+                    .find(|(n, _)| *n == param.name)
+                    .map(|(_, v)| *v)
+                    .or(param.value);
+                match value {
+                    Some(v) => p.push(Err(v)),
+                    None => {
+                        let name = param.name.clone();
+                        problems.push(*located(header_origin, P::MissingParameter { name }));
+                    }
+                }
+            }
+        }
+    }
+    p
 }
 
 #[cfg(feature = "csv")]

@@ -231,26 +231,13 @@ impl SphereColumns {
                 P::MissingPose { variables: missing }.into(),
             ));
         }
-        let mut p = Vec::new();
-        for param in &m.parameters {
-            match find(&param.name) {
-                Some(c) => p.push(Ok(c)),
-                None => {
-                    let value = (overrides.iter().rev())
-                        .find(|(n, _)| *n == param.name)
-                        .map(|(_, v)| *v)
-                        .or(param.value);
-                    match value {
-                        Some(v) => p.push(Err(v)),
-                        None => {
-                            let name = param.name.clone();
-                            let problem = P::MissingParameter { name };
-                            problems.push((header_origin.clone(), problem.into()));
-                        }
-                    }
-                }
-            }
-        }
+        let p = super::measurements::parameter_columns(
+            m,
+            overrides,
+            header,
+            header_origin,
+            &mut problems,
+        );
         if problems.is_empty() {
             Ok(SphereColumns {
                 q,

@@ -545,6 +545,20 @@ fn sphere_files_and_options_are_refused_located() {
     );
 }
 
+/// The `NAME: VALUE` entries of a values file of constants (the
+/// generator's truth files), read here without chain.
+fn constants(path: &std::path::Path) -> Vec<(String, f64)> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| l.starts_with("  "))
+        .map(|l| {
+            let (name, value) = l.trim().split_once(": ").unwrap();
+            (name.to_string(), value.parse().unwrap())
+        })
+        .collect()
+}
+
 /// `examples/spheres/` (made by its own generator, not by chain): every
 /// location error within 3 std of `truth.yaml`, from the probings with
 /// `--iterate` and from the R-test; the held-out probings corrected to the
@@ -553,15 +567,7 @@ fn sphere_files_and_options_are_refused_located() {
 fn the_examples_recover_their_truth() {
     let machine = common::example_file("machines/ac_trunnion_rotary.yaml");
     let dir = common::example_file("spheres");
-    let truth: Vec<(String, f64)> = std::fs::read_to_string(dir.join("truth.yaml"))
-        .unwrap()
-        .lines()
-        .filter(|l| l.starts_with("  "))
-        .map(|l| {
-            let (name, value) = l.trim().split_once(": ").unwrap();
-            (name.to_string(), value.parse().unwrap())
-        })
-        .collect();
+    let truth = constants(&dir.join("truth.yaml"));
     assert_eq!(truth.len(), 8);
     let path = |f: &str| dir.join(f).to_str().unwrap().to_string();
     let m = machine.to_str().unwrap();
@@ -602,15 +608,7 @@ fn the_examples_recover_their_truth() {
     let after = probed["validation"]["after"]["rms"].as_f64().unwrap();
     assert!(after < 1e-3, "{after}");
     // The B/C table: its B axis's location errors and the C axis's.
-    let truth: Vec<(String, f64)> = std::fs::read_to_string(dir.join("bc_truth.yaml"))
-        .unwrap()
-        .lines()
-        .filter(|l| l.starts_with("  "))
-        .map(|l| {
-            let (name, value) = l.trim().split_once(": ").unwrap();
-            (name.to_string(), value.parse().unwrap())
-        })
-        .collect();
+    let truth = constants(&dir.join("bc_truth.yaml"));
     assert_eq!(truth.len(), 8);
     let bc = common::example_file("machines/bc_table_rotary.yaml");
     let doc = cli::ok_json(&[

@@ -94,21 +94,7 @@ impl Loader {
                     span: k.span,
                     path: f.path("joint"),
                 };
-                match variable {
-                    Some(n) => {
-                        if let Some(s) = n.as_str() {
-                            self.seen_variables.insert(s.to_string());
-                            j.variable_text = Some(s.to_string());
-                        }
-                        let p = f.path("variable");
-                        j.variable = self.ident(n, &p, "variable").map(|name| Use {
-                            name,
-                            span: n.span,
-                            path: p,
-                        });
-                    }
-                    None => self.missing(&f, "variable"),
-                }
+                self.joint_variable(&f, variable, &mut j);
                 Some(j)
             }
         };

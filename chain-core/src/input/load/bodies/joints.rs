@@ -65,7 +65,20 @@ impl Loader {
             Some(n) => j.axis = self.signed_axis(n, &f.path("axis")),
             None => self.missing(&f, "axis"),
         }
-        match f.get("variable") {
+        self.joint_variable(&f, f.get("variable"), &mut j);
+        j
+    }
+
+    /// A joint's `variable` entry `n` of the fields `f` (a missing one
+    /// refused at `f`): the name noted as seen and kept for messages, and
+    /// its use. The one rule of a joint and a DH row's joint.
+    pub(super) fn joint_variable(
+        &mut self,
+        f: &crate::input::load::reader::Fields<'_>,
+        n: Option<&Node>,
+        j: &mut RawJoint,
+    ) {
+        match n {
             Some(n) => {
                 if let Some(s) = n.as_str() {
                     self.seen_variables.insert(s.to_string());
@@ -78,9 +91,8 @@ impl Loader {
                     path: p,
                 });
             }
-            None => self.missing(&f, "variable"),
+            None => self.missing(f, "variable"),
         }
-        j
     }
 
     /// `+x` … `-z`.
