@@ -690,3 +690,62 @@ fn plan_chooses_probings_with_the_spheres_counted() {
         assert!((got - want).abs() <= 1e-6 * want, "{name}: {got} vs {want}");
     }
 }
+
+/// `--prior` and `--holdout` with sphere probings: the trunnion with a
+/// `statistics` entry for each location error (0.05 mm, 1e-4 rad); the
+/// posterior keeps every error within 3 std of the truth and the spheres,
+/// which have no prior, are estimated from the data alone (their std as
+/// the least-squares fit's, within 10 %); a holdout of a quarter of the
+/// probings is predicted to the probe's noise.
+#[test]
+fn spheres_with_a_prior_and_a_holdout() {
+    let (m, file, e) = setup("spheres_prior");
+    let mut text = std::fs::read_to_string(&file).unwrap();
+    text.push_str("statistics:\n");
+    for (name, _) in TRUTH {
+        // EX0C, EY0A, ...: an offset; EA0C, EB0A, ...: a tilt.
+        let std = if matches!(&name[1..2], "X" | "Y" | "Z") {
+            "0.05"
+        } else {
+            "1e-4"
+        };
+        text.push_str(&format!(
+            "  {name}: {{dist: normal, mean: 0, std: {std}}}\n"
+        ));
+    }
+    let file = cli::write(file.parent().unwrap(), "trunnion_stats.yaml", &text);
+    let mut rng = Rng::new(55);
+    let csv = sphere_file(&m, &e, &[("1", [80.0, -50.0, 60.0])], 5e-4, &mut rng, true);
+    let s = cli::write(file.parent().unwrap(), "spheres.csv", &csv);
+    let (f, s) = (file.to_str().unwrap(), s.to_str().unwrap());
+    let post = cli::ok_json(&["identify", f, "--spheres", s, "--prior", "--format", "json"]);
+    assert_eq!(post["prior"], true);
+    for (name, truth) in TRUTH {
+        let (v, sd) = estimate(&post, name);
+        assert!(
+            (v - truth).abs() < 3.0 * sd,
+            "{name}: {v} ± {sd} vs {truth}"
+        );
+    }
+    let ls = cli::ok_json(&["identify", f, "--spheres", s, "--format", "json"]);
+    for l in 0..3 {
+        let (a, b) = (
+            post["setups"][0]["std"][l].as_f64().unwrap(),
+            ls["setups"][0]["std"][l].as_f64().unwrap(),
+        );
+        assert!((a / b - 1.0).abs() < 0.1, "{l}: {a} vs {b}");
+    }
+    let held = cli::ok_json(&[
+        "identify",
+        f,
+        "--spheres",
+        s,
+        "--holdout",
+        "0.25",
+        "--format",
+        "json",
+    ]);
+    let v = &held["validation"];
+    assert_eq!(v["measurements"], 5);
+    assert!(v["after"]["rms"].as_f64().unwrap() < 2e-3, "{v:#}");
+}
