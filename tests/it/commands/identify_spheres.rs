@@ -130,6 +130,14 @@ fn setup(name: &str) -> (Machine, std::path::PathBuf, Vec<f64>) {
     (m, file, e)
 }
 
+/// `chain identify MACHINE ARGS --format json`'s document.
+fn identify_json(machine: &str, args: &[&str]) -> Value {
+    let mut all = vec!["identify", machine];
+    all.extend_from_slice(args);
+    all.extend(["--format", "json"]);
+    cli::ok_json(&all)
+}
+
 /// The estimate and std of `name` in a document's `estimates`.
 fn estimate(doc: &Value, name: &str) -> (f64, f64) {
     let e = &doc["estimates"][name];
@@ -144,14 +152,7 @@ fn one_sphere_finds_the_location_errors_and_the_sphere() {
     let sphere = [80.0, -50.0, 60.0];
     let csv = sphere_file(&m, &e, &[("1", sphere)], sigma, &mut rng, true);
     let s = cli::write(file.parent().unwrap(), "spheres.csv", &csv);
-    let doc = cli::ok_json(&[
-        "identify",
-        file.to_str().unwrap(),
-        "--spheres",
-        s.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
+    let doc = identify_json(file.to_str().unwrap(), &["--spheres", s.to_str().unwrap()]);
     // 8 errors + 3 sphere coordinates, 20 probings of 3 rows.
     assert_eq!(doc["parameters"], 11, "{doc:#}");
     assert_eq!(doc["rows"], 60);
@@ -254,19 +255,18 @@ fn two_spheres_iterate_and_predict_held_out_probings_as_the_product_does() {
     let s = cli::write(&dir, "fit.csv", &fit);
     let v = cli::write(&dir, "held.csv", &held);
     let values = dir.join("values.yaml");
-    let doc = cli::ok_json(&[
-        "identify",
+    let doc = identify_json(
         file.to_str().unwrap(),
-        "--spheres",
-        s.to_str().unwrap(),
-        "--validate",
-        v.to_str().unwrap(),
-        "--iterate",
-        "--values-out",
-        values.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
+        &[
+            "--spheres",
+            s.to_str().unwrap(),
+            "--validate",
+            v.to_str().unwrap(),
+            "--iterate",
+            "--values-out",
+            values.to_str().unwrap(),
+        ],
+    );
     assert_eq!(doc["parameters"], 14, "{doc:#}");
     assert_eq!(doc["rank"], 14);
     let it = &doc["iteration"];
@@ -360,14 +360,7 @@ fn the_whole_trunnion_names_what_one_sphere_cannot_separate() {
     let mut rng = Rng::new(52);
     let csv = sphere_file(&m, &e, &[("1", [80.0, -50.0, 60.0])], 5e-4, &mut rng, true);
     let s = cli::scratch_file("whole.csv", &csv);
-    let doc = cli::ok_json(&[
-        "identify",
-        file.to_str().unwrap(),
-        "--spheres",
-        s.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
+    let doc = identify_json(file.to_str().unwrap(), &["--spheres", s.to_str().unwrap()]);
     assert_eq!(doc["parameters"], 44);
     let groups = doc["groups"].as_array().unwrap();
     assert!(!groups.is_empty(), "{doc:#}");
@@ -426,16 +419,10 @@ fn an_r_test_estimates_the_ball_set_up_beside_the_errors() {
         }
     }
     let r = cli::write(file.parent().unwrap(), "rtest.csv", &csv);
-    let doc = cli::ok_json(&[
-        "identify",
+    let doc = identify_json(
         file.to_str().unwrap(),
-        "--measurements",
-        r.to_str().unwrap(),
-        "--setup",
-        "ball",
-        "--format",
-        "json",
-    ]);
+        &["--measurements", r.to_str().unwrap(), "--setup", "ball"],
+    );
     assert_eq!(doc["parameters"], 11, "{doc:#}");
     assert_eq!(doc["rank"], 11);
     for (name, truth) in TRUTH {
@@ -571,27 +558,20 @@ fn the_examples_recover_their_truth() {
     assert_eq!(truth.len(), 8);
     let path = |f: &str| dir.join(f).to_str().unwrap().to_string();
     let m = machine.to_str().unwrap();
-    let probed = cli::ok_json(&[
-        "identify",
+    let probed = identify_json(
         m,
-        "--spheres",
-        &path("probing.csv"),
-        "--validate",
-        &path("validate.csv"),
-        "--iterate",
-        "--format",
-        "json",
-    ]);
-    let rtest = cli::ok_json(&[
-        "identify",
+        &[
+            "--spheres",
+            &path("probing.csv"),
+            "--validate",
+            &path("validate.csv"),
+            "--iterate",
+        ],
+    );
+    let rtest = identify_json(
         m,
-        "--measurements",
-        &path("rtest.csv"),
-        "--setup",
-        "ball",
-        "--format",
-        "json",
-    ]);
+        &["--measurements", &path("rtest.csv"), "--setup", "ball"],
+    );
     for (name, v) in &truth {
         let (got, sd) = estimate(&probed["iteration"], name);
         assert!(
@@ -611,15 +591,10 @@ fn the_examples_recover_their_truth() {
     let truth = constants(&dir.join("bc_truth.yaml"));
     assert_eq!(truth.len(), 8);
     let bc = common::example_file("machines/bc_table_rotary.yaml");
-    let doc = cli::ok_json(&[
-        "identify",
+    let doc = identify_json(
         bc.to_str().unwrap(),
-        "--spheres",
-        &path("bc_probing.csv"),
-        "--iterate",
-        "--format",
-        "json",
-    ]);
+        &["--spheres", &path("bc_probing.csv"), "--iterate"],
+    );
     assert_eq!(doc["rank"], 14);
     for (name, v) in &truth {
         let (got, sd) = estimate(&doc["iteration"], name);
@@ -671,14 +646,7 @@ fn plan_chooses_probings_with_the_spheres_counted() {
         chosen.push('\n');
     }
     let file = cli::scratch_file("chosen.csv", &chosen);
-    let fit = cli::ok_json(&[
-        "identify",
-        m,
-        "--spheres",
-        file.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
+    let fit = identify_json(m, &["--spheres", file.to_str().unwrap()]);
     assert_eq!(fit["rank"], 14, "{fit:#}");
     // Every expected std of the plan is the fit's std on those probings
     // (the rows carry the file's std: absolute stds), within the linear
@@ -718,7 +686,7 @@ fn spheres_with_a_prior_and_a_holdout() {
     let csv = sphere_file(&m, &e, &[("1", [80.0, -50.0, 60.0])], 5e-4, &mut rng, true);
     let s = cli::write(file.parent().unwrap(), "spheres.csv", &csv);
     let (f, s) = (file.to_str().unwrap(), s.to_str().unwrap());
-    let post = cli::ok_json(&["identify", f, "--spheres", s, "--prior", "--format", "json"]);
+    let post = identify_json(f, &["--spheres", s, "--prior"]);
     assert_eq!(post["prior"], true);
     for (name, truth) in TRUTH {
         let (v, sd) = estimate(&post, name);
@@ -727,7 +695,7 @@ fn spheres_with_a_prior_and_a_holdout() {
             "{name}: {v} ± {sd} vs {truth}"
         );
     }
-    let ls = cli::ok_json(&["identify", f, "--spheres", s, "--format", "json"]);
+    let ls = identify_json(f, &["--spheres", s]);
     for l in 0..3 {
         let (a, b) = (
             post["setups"][0]["std"][l].as_f64().unwrap(),
@@ -735,16 +703,7 @@ fn spheres_with_a_prior_and_a_holdout() {
         );
         assert!((a / b - 1.0).abs() < 0.1, "{l}: {a} vs {b}");
     }
-    let held = cli::ok_json(&[
-        "identify",
-        f,
-        "--spheres",
-        s,
-        "--holdout",
-        "0.25",
-        "--format",
-        "json",
-    ]);
+    let held = identify_json(f, &["--spheres", s, "--holdout", "0.25"]);
     let v = &held["validation"];
     assert_eq!(v["measurements"], 5);
     assert!(v["after"]["rms"].as_f64().unwrap() < 2e-3, "{v:#}");
