@@ -378,6 +378,30 @@ impl NominalBody {
 /// `error_into`; `sensitivity`, the `*_into` writers, `NONZEROS` and
 /// `sensitivity_nonzeros`, with the batched kernels ([`batch_functions`]);
 /// and the `ErrorModel` methods that write through them.
+/// The stores of a sensitivity into `out`: every one of the `6 × n`
+/// entries of the dense layout (a zero written where no entry is), and the
+/// non-zero `entries` (`(component, error, negative, expression)`) in their
+/// order, the sparse layout. The one rule of the `machine!` type's kernels
+/// and its batched ones.
+fn sensitivity_stores(
+    n: usize,
+    entries: &[(usize, usize, bool, TokenStream)],
+) -> (Vec<TokenStream>, Vec<TokenStream>) {
+    let store = |k: usize, value: &TokenStream| {
+        let k = lit(k);
+        quote!(out[#k] = #value;)
+    };
+    let mut flat: Vec<TokenStream> = vec![quote!(0.0); 6 * n];
+    for (c, j, negative, e) in entries {
+        flat[c * n + j] = signed(*negative, e);
+    }
+    let dense = flat.iter().enumerate().map(|(k, v)| store(k, v)).collect();
+    let sparse = (entries.iter().enumerate())
+        .map(|(k, (_, _, negative, e))| store(k, &signed(*negative, e)))
+        .collect();
+    (dense, sparse)
+}
+
 fn macro_functions(
     model: &SymbolicModel,
     krate: &TokenStream,
@@ -390,22 +414,7 @@ fn macro_functions(
     let sens_assign = &sens.assign;
     let sens_entries = &sens.entries;
     let total = 6 * model.errors.len();
-    let mut flat: Vec<TokenStream> = vec![quote!(0.0); total];
-    for (c, j, negative, e) in sens_entries {
-        flat[c * model.errors.len() + j] = signed(*negative, e);
-    }
-    let flat_stores = flat.iter().enumerate().map(|(k, value)| {
-        let k = lit(k);
-        quote!(out[#k] = #value;)
-    });
-    let nonzero_stores = sens_entries
-        .iter()
-        .enumerate()
-        .map(|(k, (_, _, negative, e))| {
-            let value = signed(*negative, e);
-            let k = lit(k);
-            quote!(out[#k] = #value;)
-        });
+    let (flat_stores, nonzero_stores) = sensitivity_stores(model.errors.len(), sens_entries);
     let nonzeros = sens_entries.iter().map(|(c, j, _, _)| {
         let (c, j) = (lit(*c), lit(*j));
         quote!((#c, #j))
@@ -735,22 +744,7 @@ fn batch_functions(
     let (v, p_len, n_len) = (lit(nv), lit(np), lit(n));
     let width = 6 * n;
     let k = sens_entries.len();
-    let mut flat: Vec<TokenStream> = vec![quote!(0.0); width];
-    for (c, j, negative, e) in sens_entries {
-        flat[c * n + j] = signed(*negative, e);
-    }
-    let flat_stores = flat.iter().enumerate().map(|(i, value)| {
-        let i = lit(i);
-        quote!(out[#i] = #value;)
-    });
-    let nz_stores = sens_entries
-        .iter()
-        .enumerate()
-        .map(|(i, (_, _, negative, e))| {
-            let value = signed(*negative, e);
-            let i = lit(i);
-            quote!(out[#i] = #value;)
-        });
+    let (flat_stores, nz_stores) = sensitivity_stores(n, sens_entries);
     let err_stores = err_rows.iter().enumerate().map(|(c, row)| {
         let c = lit(c);
         quote!(out[#c] = #row;)

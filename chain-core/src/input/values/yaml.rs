@@ -18,7 +18,8 @@ use crate::yaml::{self, Node};
 pub const TOP_KEYS: &[&str] = &["machine", "description", "units", "values", "correlation"];
 /// Keys of `units`.
 pub const UNITS_KEYS: &[&str] = &["linear", "angular"];
-/// Keys of one entry of `values` given as a mapping.
+/// Keys of one entry of `values` given as a mapping; those after `table`
+/// are a table's options (refused beside a `value`).
 pub const ENTRY_KEYS: &[&str] = &[
     "value",
     "std",
@@ -290,16 +291,9 @@ impl Reader {
             return;
         }
         if let Some((_, vn)) = value {
-            for extra in [
-                "column",
-                "interpolation",
-                "extrapolate",
-                "reverse",
-                "reverse_std",
-                "reverse_points",
-                "std_points",
-                "reverse_std_points",
-            ] {
+            // The table's own options: every entry key after `table`.
+            let options = ENTRY_KEYS.iter().skip_while(|k| **k != "table").skip(1);
+            for &extra in options {
                 if let Some((kn, _)) = fields.entry(extra) {
                     let not = ValuesProblem::KeyNotForConstant {
                         key: extra,
