@@ -114,6 +114,24 @@ def test_values_posterior_is_the_cli_json(tmp_path, cli):
         "reliability", GANTRY, "--values", values, "--method", "is", "--samples", 300, "--seed", 2, "--acceptance")
 
 
+def test_a_carried_error_is_the_cli_json(tmp_path, cli, cli_error):
+    # docs/posterior.md, "Fixed and carried": ezx is taken as exact.
+    values = tmp_path / "carried.yaml"
+    values.write_text(POSTERIOR.replace("correlation:", "  ezx: {value: 2.0e-6, carried_by: [dxx, eyx]}\ncorrelation:"))
+    m = chain.Machine.load(GANTRY)
+    doc = m.reliability(values=values, acceptance=True).to_dict()
+    assert doc == cli("reliability", GANTRY, "--values", values, "--acceptance")
+    assert doc["posterior"]["values"][4] == {"name": "ezx", "mean": 2.0e-6, "carried_by": ["dxx", "eyx"]}
+    assert "ezx" not in [s["error"] for s in doc["acceptance"]["sensitivity"]]
+    values.write_text(POSTERIOR.replace("correlation:", "  ezx: {value: 0, carried_by: [dxq]}\ncorrelation:"))
+    with pytest.raises(chain.MachineError) as info:
+        m.reliability(values=values)
+    assert (info.value.line, info.value.column) == (7, 32)
+    assert "`dxq` in `carried_by` of `ezx` is not an error parameter" in str(info.value)
+    assert "`dxq` in `carried_by` of `ezx` is not an error parameter" in flat(
+        cli_error("reliability", GANTRY, "--values", values))
+
+
 def test_a_bad_posterior_is_located_in_the_values_file(tmp_path, cli_error):
     values = tmp_path / "posterior.yaml"
     values.write_text(POSTERIOR.replace("[dxy, dxz, 0.2]", "[dxy, dxq, 0.2]"))

@@ -159,7 +159,8 @@ impl Inputs {
     /// within the block are uncorrelated.
     ///
     /// Refused ([`ReliabilityError::InvalidDistribution`]): a pair naming an
-    /// input out of range or an input with itself, a pair given twice, a
+    /// input out of range or an input with itself, a fixed input
+    /// ([`Marginal::fixed`]), a pair given twice, a
     /// non-finite `ρ` or `|ρ| ≥ 1`, a `ρ` the two marginals cannot attain,
     /// and an adjusted matrix that is not positive definite (its smallest
     /// eigenvalue and the pair where the factorisation fails are named). No
@@ -201,6 +202,12 @@ impl Inputs {
             let (na, nb) = (&inputs.names[p.a], &inputs.names[p.b]);
             if p.a == p.b {
                 return bad(format!("correlation of `{na}` with itself"));
+            }
+            if let Some(f) = [p.a, p.b].into_iter().find(|&j| inputs.stds[j] == 0.0) {
+                return bad(format!(
+                    "correlation of `{na}` and `{nb}`: `{}` is a fixed value, which correlates with nothing",
+                    inputs.names[f]
+                ));
             }
             if !p.rho.is_finite() || p.rho.abs() >= 1.0 {
                 return bad(format!(
@@ -895,6 +902,40 @@ mod tests {
     }
 
     #[test]
+    fn a_fixed_value_is_the_normal_at_std_zero() {
+        let f = Marginal::fixed(0.25).unwrap();
+        assert_eq!((f.family(), f.mean(), f.std()), (Family::Fixed, 0.25, 0.0));
+        assert!(f.is_normal() && Marginal::fixed(f64::NAN).is_err());
+        for u in [-3.0, 0.0, 2.5] {
+            assert_eq!(
+                (f.to_physical(u), f.dx_du(u), f.d2x_du2(u)),
+                (0.25, 0.0, 0.0)
+            );
+            assert_eq!((f.dx_dmean(u), f.dx_dstd(u)), (1.0, u));
+        }
+        assert_eq!(
+            (f.cdf(0.2), f.cdf(0.25), f.sf(0.2), f.sf(0.25)),
+            (0.0, 1.0, 1.0, 0.0)
+        );
+        assert_eq!(
+            (f.to_standard(0.25), f.to_standard(0.3)),
+            (0.0, f64::INFINITY)
+        );
+        assert_eq!(f.support(), (0.25, 0.25));
+        // Its input takes a draw like any other, so the others' streams
+        // are those without it.
+        let names = ["a", "b"].map(String::from).to_vec();
+        let n = Marginal::normal(1.0, 2.0).unwrap();
+        let with = Inputs::new(names.clone(), vec![f, n]).unwrap();
+        let without = Inputs::new(names, vec![n, n]).unwrap();
+        let (mut x, mut y) = ([0.0; 2], [0.0; 2]);
+        with.sample(&mut CaseRng::new(7, 0, 0), &mut x);
+        without.sample(&mut CaseRng::new(7, 0, 0), &mut y);
+        assert_eq!((x[0], x[1]), (0.25, y[1]));
+        assert!(with.is_affine());
+    }
+
+    #[test]
     fn bad_correlations_are_refused() {
         let names = ["a", "b", "c"].map(String::from).to_vec();
         let m = vec![Marginal::normal(0.0, 1.0).unwrap(); 3];
@@ -909,6 +950,11 @@ mod tests {
         assert!(run(&[c(0, 1, f64::NAN)]).contains("strictly between"));
         assert!(run(&[c(0, 1, 0.5), c(1, 0, 0.2)]).contains("twice"));
         assert!(run(&[c(0, 5, 0.5)]).contains("3 inputs"));
+        // A fixed value correlates with nothing.
+        let mut fixed = m.clone();
+        fixed[2] = Marginal::fixed(1.5).unwrap();
+        let e = Inputs::correlated(names.clone(), fixed, &[c(0, 2, 0.5)]).unwrap_err();
+        assert!(e.to_string().contains("`c` is a fixed value"), "{e}");
         // Each |ρ| < 1, but the matrix is not positive definite.
         let e = run(&[c(0, 1, 0.9), c(1, 2, 0.9), c(0, 2, -0.9)]);
         assert!(

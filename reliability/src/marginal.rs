@@ -23,7 +23,8 @@ pub(crate) const SQRT_3: f64 = 1.732_050_807_568_877_2;
 /// [`Marginal::truncated_normal`], [`Marginal::weibull`],
 /// [`Marginal::gumbel`], [`Marginal::triangular`], [`Marginal::rayleigh`]
 /// and [`Marginal::with_moments`]; the law is private), so every `Marginal`
-/// has a finite mean and a positive spread; [`Marginal::family`] and the
+/// has a finite mean and a positive spread, except the one degenerate law
+/// [`Marginal::fixed`] (spread 0, an error whose spread other inputs carry); [`Marginal::family`] and the
 /// accessors read it back. It serialises as its family's name under `dist`
 /// and that family's parameters: `{"dist": "normal", "mean": …, "std": …}`,
 /// `{"dist": "uniform", "min": …, "max": …}`,
@@ -62,6 +63,10 @@ pub enum Family {
     Triangular,
     /// Rayleigh (scale, shift).
     Rayleigh,
+    /// A fixed value, the degenerate normal `x = v + 0·u`: an error whose
+    /// spread other inputs already carry (a values file's `carried_by`,
+    /// docs/posterior.md).
+    Fixed,
 }
 
 /// The validated law behind a [`Marginal`].
@@ -85,6 +90,8 @@ enum Law {
     Triangular(Triangular),
     /// Rayleigh.
     Rayleigh(Rayleigh),
+    /// A fixed value (no spread).
+    Fixed { value: f64 },
 }
 
 impl Marginal {
@@ -96,6 +103,19 @@ impl Marginal {
             )));
         }
         Ok(Marginal(Law::Normal { mean, std }))
+    }
+
+    /// A fixed value `v` (finite): the degenerate normal `x = v + 0·u` of an
+    /// error whose spread is carried by other inputs (docs/posterior.md,
+    /// "Fixed and carried"). It has no density; its `u` does not move it,
+    /// so every method sees it as the constant it is.
+    pub fn fixed(value: f64) -> Result<Marginal, ReliabilityError> {
+        if !value.is_finite() {
+            return Err(ReliabilityError::InvalidDistribution(format!(
+                "fixed({value}): the value must be finite"
+            )));
+        }
+        Ok(Marginal(Law::Fixed { value }))
     }
 
     /// A validated uniform marginal: finite bounds, `min < max`.
@@ -152,6 +172,7 @@ impl Marginal {
     pub fn mean(&self) -> f64 {
         match self.0 {
             Law::Normal { mean, .. } => mean,
+            Law::Fixed { value } => value,
             Law::Uniform { min, max } => 0.5 * (min + max),
             _ => self.moments()[0],
         }
@@ -161,6 +182,7 @@ impl Marginal {
     pub fn std(&self) -> f64 {
         match self.0 {
             Law::Normal { std, .. } => std,
+            Law::Fixed { .. } => 0.0,
             Law::Uniform { min, max } => (max - min) / (2.0 * SQRT_3),
             _ => self.moments()[1],
         }
@@ -170,6 +192,7 @@ impl Marginal {
     fn moments(&self) -> [f64; 2] {
         match &self.0 {
             Law::Normal { mean, std } => [*mean, *std],
+            Law::Fixed { value } => [*value, 0.0],
             Law::Uniform { .. } => [self.mean(), self.std()],
             Law::Lognormal(l) => [l.mean, l.std],
             Law::TruncatedNormal(t) => t.moments(),
@@ -191,12 +214,14 @@ impl Marginal {
             Law::Gumbel(_) => Family::Gumbel,
             Law::Triangular(_) => Family::Triangular,
             Law::Rayleigh(_) => Family::Rayleigh,
+            Law::Fixed { .. } => Family::Fixed,
         }
     }
 
     /// The support `(lower, upper)`: `(−∞, +∞)` for a normal and a Gumbel,
     /// `(min, max)` for a uniform and a triangular, `(shift, ∞)` for a
-    /// lognormal, Weibull and Rayleigh, the bounds of a truncated normal.
+    /// lognormal, Weibull and Rayleigh, the bounds of a truncated normal,
+    /// `(v, v)` for a fixed value.
     pub fn support(&self) -> (f64, f64) {
         let inf = f64::INFINITY;
         match self.0 {
@@ -207,6 +232,7 @@ impl Marginal {
             Law::Weibull(w) => (w.shift, inf),
             Law::Triangular(t) => (t.min, t.max),
             Law::Rayleigh(r) => (r.shift, inf),
+            Law::Fixed { value } => (value, value),
         }
     }
 
@@ -215,6 +241,7 @@ impl Marginal {
     pub fn cdf(&self, x: f64) -> f64 {
         match self.0 {
             Law::Uniform { min, max } => ((x - min) / (max - min)).clamp(0.0, 1.0),
+            Law::Fixed { value } => f64::from(u8::from(x >= value)),
             _ => normal::cdf(self.to_standard(x)),
         }
     }
@@ -223,13 +250,15 @@ impl Marginal {
     pub fn sf(&self, x: f64) -> f64 {
         match self.0 {
             Law::Uniform { min, max } => ((max - x) / (max - min)).clamp(0.0, 1.0),
+            Law::Fixed { value } => f64::from(u8::from(x < value)),
             _ => normal::sf(self.to_standard(x)),
         }
     }
 
-    /// The density `f(x)`.
+    /// The density `f(x)` (0 for a fixed value, a point mass without one).
     pub fn pdf(&self, x: f64) -> f64 {
         match &self.0 {
+            Law::Fixed { .. } => 0.0,
             Law::Normal { mean, std } => normal::pdf((x - mean) / std) / std,
             Law::Uniform { min, max } => {
                 if (*min..=*max).contains(&x) {
@@ -252,9 +281,10 @@ impl Marginal {
         self.to_physical(normal::inverse_cdf(p))
     }
 
-    /// True for a normal marginal (its transformation is affine).
+    /// True for a normal marginal and a fixed value, its degenerate case
+    /// (the transformation is affine).
     pub fn is_normal(&self) -> bool {
-        matches!(self.0, Law::Normal { .. })
+        matches!(self.0, Law::Normal { .. } | Law::Fixed { .. })
     }
 
     /// The same family with another mean and standard deviation.
@@ -271,7 +301,7 @@ impl Marginal {
             )));
         }
         Ok(Marginal(match &self.0 {
-            Law::Normal { .. } => return Marginal::normal(mean, std),
+            Law::Normal { .. } | Law::Fixed { .. } => return Marginal::normal(mean, std),
             Law::Uniform { .. } => {
                 return Marginal::uniform(mean - SQRT_3 * std, mean + SQRT_3 * std)
             }
@@ -289,6 +319,7 @@ impl Marginal {
     pub fn to_physical(&self, u: f64) -> f64 {
         match &self.0 {
             Law::Normal { mean, std } => mean + std * u,
+            Law::Fixed { value } => *value,
             Law::Uniform { min, max } => min + (max - min) * normal::cdf(u),
             Law::Lognormal(l) => l.x(u),
             Law::TruncatedNormal(t) => t.x(u),
@@ -299,10 +330,18 @@ impl Marginal {
         }
     }
 
-    /// `u = T⁻¹(x) = Φ⁻¹(F(x))`, from whichever tail does not cancel.
+    /// `u = T⁻¹(x) = Φ⁻¹(F(x))`, from whichever tail does not cancel (for
+    /// a fixed value every `u` gives `v`: 0 there, `±∞` elsewhere).
     pub fn to_standard(&self, x: f64) -> f64 {
         match &self.0 {
             Law::Normal { mean, std } => (x - mean) / std,
+            Law::Fixed { value } => {
+                if x == *value {
+                    0.0
+                } else {
+                    f64::INFINITY.copysign(x - value)
+                }
+            }
             Law::Uniform { min, max } => normal::inverse_cdf((x - min) / (max - min)),
             Law::Lognormal(l) => l.u(x),
             Law::TruncatedNormal(t) => t.u(x),
@@ -318,6 +357,7 @@ impl Marginal {
     pub fn dx_du(&self, u: f64) -> f64 {
         match &self.0 {
             Law::Normal { std, .. } => *std,
+            Law::Fixed { .. } => 0.0,
             Law::Uniform { min, max } => (max - min) * normal::pdf(u),
             Law::Lognormal(l) => l.dx_du(u),
             Law::TruncatedNormal(t) => t.dx_du(u),
@@ -333,7 +373,7 @@ impl Marginal {
     #[inline]
     pub fn d2x_du2(&self, u: f64) -> f64 {
         match &self.0 {
-            Law::Normal { .. } => 0.0,
+            Law::Normal { .. } | Law::Fixed { .. } => 0.0,
             Law::Uniform { min, max } => -(max - min) * u * normal::pdf(u),
             Law::Lognormal(l) => l.d2x_du2(u),
             Law::TruncatedNormal(t) => t.d2x_du2(u),
@@ -357,12 +397,13 @@ impl Marginal {
     }
 
     /// `∂x/∂σ` at fixed `u` (the marginal parametrised by mean and std, the
-    /// mean held): `u` for a normal, `√3·(2Φ(u) − 1)` for a uniform,
+    /// mean held): `u` for a normal and a fixed value (the normal at
+    /// `σ = 0`), `√3·(2Φ(u) − 1)` for a uniform,
     /// `(x − μ)/σ` for the other location-scale families, `crate::families`
     /// for the lognormal, Weibull and truncated normal.
     pub fn dx_dstd(&self, u: f64) -> f64 {
         match &self.0 {
-            Law::Normal { .. } => u,
+            Law::Normal { .. } | Law::Fixed { .. } => u,
             Law::Uniform { .. } => SQRT_3 * (2.0 * normal::cdf(u) - 1.0),
             Law::Lognormal(l) => l.dx_dmoments(u)[1],
             Law::TruncatedNormal(t) => t.dx_dmoments(u)[1],
@@ -378,7 +419,8 @@ impl Marginal {
 
     /// One physical sample: `μ + σ·z` for a normal and `min + (max − min)·U`
     /// for a uniform (a standard normal `z`, a uniform `U` on `[0, 1)`), `T(u)`
-    /// of a standard normal draw for the other families.
+    /// of a standard normal draw for the other families (a fixed value takes
+    /// its draw too, so the other inputs' streams do not depend on it).
     #[inline]
     pub fn sample(&self, rng: &mut CaseRng) -> f64 {
         match self.0 {

@@ -21,6 +21,9 @@
 //! - a constant with `std`: normal with the value as mean and that std;
 //! - a constant without `std`: the `statistics` marginal of the error, same
 //!   family and spread, its mean moved to the value;
+//! - a constant with `carried_by: [NAME, ...]` (a redundant error an
+//!   identification fixed, whose effect the named estimates carry): the
+//!   fixed value ([`Marginal::fixed`]), its spread being theirs;
 //! - an error the file does not give: its `statistics` marginal, unchanged;
 //! - the errors named in `correlation` (each with a `std` in the file) form
 //!   one correlated normal block, `x_B = μ_B + D_B·L·u_B` with `L` the
@@ -31,7 +34,7 @@
 //! `chain::posterior::*`): a table (an error motion varies along its axis,
 //! a posterior mean is a constant), a `std` of 0, a correlation entry that
 //! is not `[NAME, NAME, ρ]`, an unknown name (with the closest), a name with
-//! no `std` in the file, a name paired with itself, a pair given twice,
+//! no `std` in the file (in `correlation` or `carried_by`), a name paired with itself, a pair given twice,
 //! `|ρ| ≥ 1` or a non-finite `ρ`, and a correlation matrix that is not
 //! positive definite (at `correlation`, naming the errors and the smallest
 //! eigenvalue). Everything the values file itself refuses is refused first
@@ -94,6 +97,10 @@ pub struct PosteriorValue {
     /// Its standard deviation, if the file gives one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub std: Option<f64>,
+    /// The estimates that carry its spread (`carried_by`): it is then a
+    /// fixed input at `mean` (docs/posterior.md, "Fixed and carried").
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub carried_by: Vec<String>,
 }
 
 /// A tabulated error's input at one point: `(error index, mean, std)`
@@ -164,6 +171,8 @@ enum PosteriorProblem {
     },
     /// A name of `correlation` without a `std`.
     NoStd { name: String },
+    /// A carrier of `carried_by` not given with a `std` in this file.
+    CarrierWithoutStd { name: String, carrier: String },
     /// A correlation outside (-1, 1).
     Range { rho: f64 },
     /// An error correlated with itself.
@@ -212,6 +221,12 @@ impl Describe for PosteriorProblem {
                 format!("`{name}` has no `std` in this values file: a correlation needs the standard deviations of both errors"),
             )
             .help(format!("give it as `{name}: {{value: V, std: S}}` under `values`")),
+            PosteriorProblem::CarrierWithoutStd { name, carrier } => D::new(
+                "chain::posterior::carrier_without_std",
+                "carrier without std",
+                format!("`{name}` is carried by `{carrier}`, which has no `std` in this values file"),
+            )
+            .help(format!("a carried error is taken as exact because its carriers' std holds its spread: give `{carrier}: {{value: V, std: S}}`, or drop `carried_by` to keep `{name}`'s statistics spread")),
             PosteriorProblem::Range { rho } => D::new(
                 "chain::posterior::correlation_range",
                 "out of range",
@@ -295,7 +310,14 @@ impl Posterior {
         for e in values.entries() {
             let origin = e.origin.clone().unwrap_or_else(|| origin_at(0, "values"));
             match (&e.given, e.kind) {
-                (Given::Constant { value, std }, EntryKind::Error | EntryKind::Coefficient) => {
+                (
+                    Given::Constant {
+                        value,
+                        std,
+                        carried_by,
+                    },
+                    EntryKind::Error | EntryKind::Coefficient,
+                ) => {
                     if *std == Some(0.0) {
                         let name = e.name.clone();
                         problems.push((origin, PosteriorProblem::ZeroStd { name }.into()));
@@ -304,10 +326,25 @@ impl Posterior {
                         name: e.name.clone(),
                         mean: *value,
                         std: *std,
+                        carried_by: carried_by.clone(),
                     });
                 }
                 (Given::Table { .. }, _) => tables.push(e.name.clone()),
                 (Given::Constant { .. }, EntryKind::Function) => {}
+            }
+        }
+        // A carried error's spread is its carriers' std: each needs one.
+        for e in values.entries() {
+            let Given::Constant { carried_by, .. } = &e.given else {
+                continue;
+            };
+            for carrier in carried_by {
+                if !given.iter().any(|v| v.name == *carrier && v.std.is_some()) {
+                    let origin = e.origin.clone().unwrap_or_else(|| origin_at(0, "values"));
+                    let (name, carrier) = (e.name.clone(), carrier.clone());
+                    let problem = PosteriorProblem::CarrierWithoutStd { name, carrier };
+                    problems.push((origin, problem.into()));
+                }
             }
         }
         let parsed = yaml::parse(text);
@@ -485,6 +522,7 @@ impl Posterior {
                     name: e.name.clone(),
                     mean,
                     std,
+                    carried_by: Vec::new(),
                 }),
                 None => self.value(&e.name).cloned(),
             };
@@ -494,6 +532,9 @@ impl Posterior {
                     std: Some(std),
                     ..
                 }) => Marginal::normal(*mean, *std),
+                Some(PosteriorValue {
+                    mean, carried_by, ..
+                }) if !carried_by.is_empty() => Marginal::fixed(*mean),
                 _ => {
                     let stat =
                         machine

@@ -402,16 +402,17 @@ pub fn identify(
     let coords: Vec<f64> = (0..structural)
         .map(|k| v.column(k).dot(&dg0) / singular[k])
         .collect();
-    let rss_perp = y.norm_squared() - coords.iter().map(|c| c * c).sum::<f64>();
+    // The residual itself, y − B·D·Σ_k v_k c_k/s_k (‖y‖² − Σc² would lose
+    // the digits of a clean fit to cancellation).
+    let x_perp = DVector::from_fn(n, |i, _| {
+        d[i] * (0..structural)
+            .map(|k| v[(i, k)] * coords[k] / singular[k])
+            .sum::<f64>()
+    });
+    let rss_perp = (&y - &bm * &x_perp).norm_squared();
     let deviation = y.norm();
     let noisy = if options.rank_tol.is_none() && prior.is_none() {
-        noise_rule(
-            &singular[..structural],
-            &coords,
-            rss_perp.max(0.0),
-            m,
-            deviation,
-        )
+        noise_rule(&singular[..structural], &coords, rss_perp, m, deviation)
     } else {
         None
     };

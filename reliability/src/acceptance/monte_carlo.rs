@@ -201,7 +201,9 @@ impl Acceptance {
             (var / total).sqrt()
         };
         let sensitivity = if self.sensitivity {
+            // A fixed input (`carried_by`) has no spread to be sensitive to.
             (0..n)
+                .filter(|&j| inputs.stds()[j] > 0.0)
                 .map(|j| AcceptanceSensitivity {
                     error: inputs.names()[j].clone(),
                     dr_dstd: acc[1 + n + j] / total,

@@ -37,9 +37,9 @@ impl Acceptance {
         };
         let names = inputs.names();
         let zero_sens = || {
-            names
-                .iter()
-                .map(|e| AcceptanceSensitivity {
+            (names.iter().zip(inputs.stds()))
+                .filter(|(_, s)| **s > 0.0)
+                .map(|(e, _)| AcceptanceSensitivity {
                     error: e.clone(),
                     dr_dstd: 0.0,
                     dr_dmean: 0.0,
@@ -129,7 +129,9 @@ impl Acceptance {
         let (p, se) = mean_se(&acc, 0, per_shift);
         let converged = self.samples.is_some() || 3.0 * se <= self.tolerance;
         let sensitivity = if sens.is_some() {
+            // A fixed input (`carried_by`) has no spread to be sensitive to.
             (0..n)
+                .filter(|&j| inputs.stds()[j] > 0.0)
                 .map(|j| {
                     let (dm, dm_se) = mean_se(&acc, 1 + j, per_shift);
                     let (ds, ds_se) = mean_se(&acc, 1 + n + j, per_shift);
@@ -496,8 +498,14 @@ impl ScoreMatrices {
                 bmat[(j, k)] = x[j] - x0[j];
             }
         }
-        let binv = bmat
-            .clone()
+        // A fixed input's row and column of B are zero, and so are its
+        // entries of Q (it is no direction of u the constraints see): a 1 on
+        // its diagonal inverts the rest unchanged and leaves its scores 0.
+        let mut invertible = bmat.clone();
+        for j in (0..n).filter(|&j| inputs.stds()[j] == 0.0) {
+            invertible[(j, j)] = 1.0;
+        }
+        let binv = invertible
             .try_inverse()
             .ok_or(ReliabilityError::NonFinite("the inverse of the input map"))?;
         let mut c = vec![0.0; n * r];
@@ -523,7 +531,7 @@ impl ScoreMatrices {
     }
 
     /// The mean scores `(B⁻ᵀQᵀw)_j` and the std scores
-    /// `((B⁻ᵀQᵀw)_j(BQᵀw)_j − κ_j)/σ_j`.
+    /// `((B⁻ᵀQᵀw)_j(BQᵀw)_j − κ_j)/σ_j` (0 for a fixed input).
     #[inline]
     fn scores(&self, w: &[f64], mean: &mut Vec<f64>, std: &mut Vec<f64>) {
         mean.resize(self.n, 0.0);
@@ -533,7 +541,12 @@ impl ScoreMatrices {
             let a = dot(&self.c[j * r..(j + 1) * r], w);
             let b = dot(&self.d[j * r..(j + 1) * r], w);
             mean[j] = a;
-            std[j] = (a * b - self.kappa[j]) / self.stds[j];
+            // 0 for a fixed input: the probability is even in its σ.
+            std[j] = if self.stds[j] > 0.0 {
+                (a * b - self.kappa[j]) / self.stds[j]
+            } else {
+                0.0
+            };
         }
     }
 }

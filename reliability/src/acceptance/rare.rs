@@ -118,6 +118,10 @@ impl<'a> Series<'a> {
                     return None;
                 };
                 let m = inputs.marginals()[j];
+                if m.std() == 0.0 {
+                    // A fixed input: the row is a constant, a general one.
+                    return None;
+                }
                 let (s_lo, s_hi) = m.support();
                 let z = |t: f64| {
                     if t.is_nan() || t <= s_lo {

@@ -715,8 +715,12 @@ fn explain(
 /// the form `chain reliability --values` reads, docs/posterior.md);
 /// `source` names the measurement file in its first comment. Without a
 /// prior the values are the subset's least-squares solution: a fixed
-/// unknown is written as its nominal value 0 without a `std` (a reader
-/// keeps its `statistics` spread), with a comment saying why it is fixed;
+/// unknown is written as its nominal value 0 without a `std`, with a
+/// comment saying why it is fixed; a redundant one (its effect carried by
+/// estimated errors) names them in `carried_by`, so that a reliability
+/// study takes it as exact instead of counting its spread twice
+/// (docs/posterior.md, "Fixed and carried"); the others keep their
+/// `statistics` spread;
 /// with `--iterate` the values are the exact fit's. Angular errors beyond
 /// the first-order range are named in a comment.
 pub fn values_file(m: &Machine, source: &str, identified: &Identified) -> String {
@@ -735,13 +739,26 @@ pub fn values_file(m: &Machine, source: &str, identified: &Identified) -> String
             ""
         }
     );
+    // The set-ups' positions (the unknowns after the machine's errors) are
+    // the instrument's, not the machine's: never written into values.
+    let ne = r.parameters - 3 * identified.setups;
+    let mut carried: Vec<(String, Vec<String>)> = Vec::new();
     let estimates: Vec<Estimate> = match &r.subset {
         Some(sub) => {
             let doc = SubsetDoc::new(sub, &r.errors);
+            for f in (doc.fixed.iter()).filter(|f| f.status == FixedStatus::Redundant) {
+                let carriers: Vec<String> = (f.relation.0.iter())
+                    .map(|(name, _)| name.clone())
+                    .filter(|name| r.errors[..ne].contains(name))
+                    .collect();
+                if !carriers.is_empty() {
+                    carried.push((f.error.clone(), carriers));
+                }
+            }
             if !doc.fixed.is_empty() {
                 let _ = writeln!(
                     s,
-                    "# least squares on {} of {} unknowns; fixed at their nominal value 0 (no std: the statistics spread is kept):",
+                    "# least squares on {} of {} unknowns; fixed at their nominal value 0 (no std; a redundant one is carried_by the estimates that carry its effect and taken as exact, the others keep their statistics spread):",
                     doc.estimated.len(),
                     r.parameters
                 );
@@ -796,15 +813,17 @@ pub fn values_file(m: &Machine, source: &str, identified: &Identified) -> String
             .as_ref()
             .is_some_and(|sub| !sub.estimated.contains(&j))
     };
-    // The set-ups' positions (the unknowns after the machine's errors) are
-    // the instrument's, not the machine's: never written into values.
-    let ne = r.parameters - 3 * identified.setups;
     for (name, e) in r.errors.iter().zip(&estimates).take(ne) {
-        match e.std {
-            Some(std) => {
+        let carriers = carried.iter().find(|(n, _)| n == name);
+        match (e.std, carriers) {
+            (Some(std), _) => {
                 let _ = writeln!(s, "  {name}: {{value: {:?}, std: {:?}}}", e.value, std);
             }
-            None => {
+            (None, Some((_, by))) => {
+                let by = by.join(", ");
+                let _ = writeln!(s, "  {name}: {{value: {:?}, carried_by: [{by}]}}", e.value);
+            }
+            (None, None) => {
                 let _ = writeln!(s, "  {name}: {:?}", e.value);
             }
         }

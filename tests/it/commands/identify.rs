@@ -903,7 +903,8 @@ fn reliability_after_calibration_reads_the_identified_posterior() {
     // g = t − a·e (upper-sided, t = 0.03 mm), β = (t − a·μ) / √(aᵀ Σ a),
     // Σ = D R D from the file's std and correlation triples; an error
     // written without a std (fixed by the least-squares subset) keeps its
-    // statistics spread about the written value.
+    // statistics spread about the written value, unless it is
+    // `carried_by` estimated errors (redundant: exact, spread 0).
     let n = m.errors.len();
     let index = |x: &str| m.errors.iter().position(|e| e.name == x).unwrap();
     let model = chain::core::compile(&m);
@@ -928,11 +929,12 @@ fn reliability_after_calibration_reads_the_identified_posterior() {
             .iter()
             .enumerate()
             .map(|(j, x)| {
-                posterior
-                    .value(&x.name)
-                    .unwrap()
-                    .std
-                    .unwrap_or_else(|| m.statistic(j).unwrap().distribution.std())
+                let v = posterior.value(&x.name).unwrap();
+                match v.std {
+                    Some(s) => s,
+                    None if !v.carried_by.is_empty() => 0.0,
+                    None => m.statistic(j).unwrap().distribution.std(),
+                }
             })
             .collect();
         let mut cov = DMatrix::from_fn(n, n, |i, j| if i == j { sd[i] * sd[i] } else { 0.0 });
@@ -968,6 +970,8 @@ fn reliability_after_calibration_reads_the_identified_posterior() {
     assert!(json["rank"].as_u64().unwrap() < m.errors.len() as u64);
     let text = std::fs::read_to_string(&ls).unwrap();
     assert!(text.contains("fixed at their nominal value 0"), "{text}");
+    // The grinder's redundant errors are written carried by their carriers.
+    assert!(text.contains("carried_by: ["), "{text}");
     assert!(
         !text.contains(", 1.0]") && !text.contains(", -1.0]"),
         "{text}"

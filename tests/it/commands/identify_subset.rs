@@ -645,7 +645,10 @@ fn the_cli_chooses_the_subset_as_the_library_does() {
         "{text}"
     );
     assert!(text.contains("# DY2 stands for DY2 + DY3 + DY4"), "{text}");
-    assert!(text.contains("\n  DY3: 0.0\n"), "{text}");
+    assert!(
+        text.contains("\n  DY3: {value: 0.0, carried_by: [DY2]}\n"),
+        "{text}"
+    );
     // The table says what each row is.
     let table = ok_stdout(&base);
     assert!(
@@ -783,4 +786,41 @@ fn weak_directions_are_worded_as_seen_within_the_noise() {
             assert!(!g.explanation.contains("noise"), "{}", g.explanation);
         }
     }
+}
+
+/// The noise σ̂ of the noise rule is the root mean square of the residual
+/// itself, not of `‖y‖² − Σc²`: on data a thousand million times cleaner
+/// than their deviation (linear rows, 0.2 mm errors, 1e-10 mm noise) that
+/// difference loses every digit to cancellation, while σ̂ agrees to 1e-6
+/// with the test's own least squares (nalgebra's SVD on the same rows, the
+/// structural rank 27, `√(RSS/(m − 27))`).
+#[test]
+fn the_noise_is_the_residual_of_clean_data() {
+    let m = arm();
+    let mut rng = Rng::new(5);
+    let (e, _) = arm_truth(&m, &mut rng);
+    let mut records = simulate(&m, &arm_poses(200, FULL, &mut rng), &e, 0.0, &mut rng);
+    let model = chain::core::compile(&m);
+    let rows = Design::new(&model, &m, &records).unwrap().a;
+    let ev = nalgebra::DVector::from_column_slice(&e);
+    let linear = &rows * &ev;
+    for (i, r) in records.iter_mut().enumerate() {
+        for c in 0..3 {
+            r.values[c] = linear[3 * i + c] + 1e-10 * gauss(&mut rng);
+        }
+    }
+    let design = Design::new(&model, &m, &records).unwrap();
+    let r = identify(&design, None, &IdentifyOptions::default()).unwrap();
+    assert_eq!(r.noise.structural_rank, 27);
+    let b = nalgebra::DVector::from_column_slice(&design.b);
+    let svd = design.a.clone().svd(true, true);
+    let s_max = svd.singular_values.max();
+    let x = svd.solve(&b, 1e-9 * s_max).unwrap();
+    let rss = (&b - &design.a * &x).norm_squared();
+    let want = (rss / (design.b.len() - 27) as f64).sqrt();
+    assert!((want / 1e-10 - 1.0).abs() < 0.1, "{want}");
+    // The cancelling form is far off here: ‖y‖² is 1e17 times the RSS.
+    assert!(b.norm_squared() > 1e16 * rss);
+    let got = r.noise.noise.expect("a noise estimate");
+    assert!((got / want - 1.0).abs() < 1e-6, "σ̂ {got} vs {want}");
 }

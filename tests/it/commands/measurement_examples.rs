@@ -185,6 +185,7 @@ fn covariance(m: &Machine, file: &Path, value: &[f64]) -> Vec<Vec<f64>> {
             Given::Constant {
                 value: v,
                 std: Some(s),
+                ..
             } => {
                 assert!(
                     (v - value[j]).abs() <= 1e-12 * v.abs().max(1e-9),
@@ -198,6 +199,7 @@ fn covariance(m: &Machine, file: &Path, value: &[f64]) -> Vec<Vec<f64>> {
             Given::Constant {
                 value: v,
                 std: None,
+                ..
             } => {
                 assert!(v == 0.0 && value[j] == 0.0, "{}: {v}", entry.name);
                 order.push(j);

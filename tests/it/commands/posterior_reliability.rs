@@ -666,3 +666,149 @@ fn the_general_routes_meet_the_closed_form_with_correlated_inputs() {
         assert!((total - 1.0).abs() < 1e-12);
     }
 }
+
+/// A redundant error written `carried_by` its carriers (what `chain identify
+/// --values-out` writes for an error the least-squares subset fixed because
+/// estimated ones carry its effect) is an exact input: FORM is the closed
+/// form with its std 0 and its value as mean, the sampling methods agree
+/// with it, and the acceptance probability lists no sensitivity for it
+/// (docs/posterior.md, "Fixed and carried").
+#[test]
+fn carried_errors_are_exact_inputs() {
+    let m = load_example(MACHINE);
+    let text = POSTERIOR.replace(
+        "correlation:",
+        "  ezx: {value: 2.0e-6, carried_by: [dxx, eyx]}\ncorrelation:",
+    );
+    let values = posterior_file("carried", &text);
+    let mut law = Law::of(&m);
+    let j = m.error_index("ezx").unwrap();
+    // Without carried_by the statistics spread (0.05/6000 rad) is kept.
+    assert!(law.std[j] > 8e-6);
+    law.mean[j] = 2.0e-6;
+    law.std[j] = 0.0;
+    let doc = ok_json(&[
+        "reliability",
+        &machine_path(),
+        "--values",
+        &values,
+        "--format",
+        "json",
+    ]);
+    let mut checked = 0;
+    let mut moved = 0.0f64;
+    for (k, case) in doc["results"].as_array().unwrap().iter().enumerate() {
+        if k % 11 != 0 {
+            continue;
+        }
+        let c = (COMPONENTS.iter())
+            .position(|n| case["component"] == *n)
+            .unwrap();
+        let q = q_of(&m, &case["point"]);
+        let a = row(&m, &q, c);
+        let (want, beta) = law.reliability(&a);
+        assert!(close(case["beta"].as_f64().unwrap(), beta, 1e-8), "{case}");
+        assert_eq!(case["exact"], true);
+        let mut spread = Law::of(&m);
+        spread.mean[j] = 2.0e-6;
+        moved = moved.max((spread.reliability(&a).0 - want).abs());
+        checked += 1;
+    }
+    assert!(checked >= 30);
+    // Its spread would have mattered: the carried input changes R.
+    assert!(moved > 1e-4, "{moved}");
+    assert_eq!(doc["posterior"]["values"][4]["carried_by"][1], "eyx");
+    // Monte Carlo over the same inputs agrees within its standard error.
+    let mc = ok_json(&[
+        "reliability",
+        &machine_path(),
+        "--values",
+        &values,
+        "--method",
+        "mc",
+        "--samples",
+        "20000",
+        "--grid",
+        "x=500",
+        "--grid",
+        "y=1000",
+        "--grid",
+        "z=0",
+        "--format",
+        "json",
+    ]);
+    for case in mc["results"].as_array().unwrap() {
+        let c = (COMPONENTS.iter())
+            .position(|n| case["component"] == *n)
+            .unwrap();
+        let a = row(&m, &q_of(&m, &case["point"]), c);
+        let want = law.reliability(&a).0;
+        let pf = 1.0 - case["reliability"].as_f64().unwrap();
+        let se = (pf.max(1e-5) * (1.0 - pf) / 20000.0).sqrt();
+        assert!((pf - (1.0 - want)).abs() <= 4.0 * se, "{case}: {want}");
+    }
+    // The acceptance probability runs; a fixed input has no sensitivity.
+    let acc = ok_json(&[
+        "reliability",
+        &machine_path(),
+        "--values",
+        &values,
+        "--acceptance",
+        "--format",
+        "json",
+    ]);
+    let sens = acc["acceptance"]["sensitivity"].as_array().unwrap();
+    assert_eq!(sens.len(), m.errors.len() - 1);
+    assert!(sens.iter().all(|s| s["error"] != "ezx"));
+    let p = acc["acceptance"]["probability"].as_f64().unwrap();
+    assert!(p > 0.0 && p < 1.0, "{p}");
+}
+
+/// `carried_by`'s refusals, located: beside a std, an unknown carrier
+/// (with the closest name), the entry itself, a table, and a carrier the
+/// file gives without a std.
+#[test]
+fn carried_by_refusals_are_located() {
+    let run = |name: &str, entry: &str| {
+        let text = format!("machine: gantry_grinder\nvalues:\n  dxx: {{value: 0.004, std: 0.003}}\n  dxz: 0.001\n  {entry}\n");
+        let values = posterior_file(&format!("carried-{name}"), &text);
+        unwrapped(&fails(&[
+            "reliability",
+            &machine_path(),
+            "--values",
+            &values,
+        ]))
+    };
+    let e = run("with-std", "ezx: {value: 0, std: 1e-6, carried_by: [dxx]}");
+    assert!(
+        e.contains("posterior.yaml:5:") && e.contains("both a `std` and `carried_by`"),
+        "{e}"
+    );
+    let e = run("unknown", "ezx: {value: 0, carried_by: [dxq]}");
+    assert!(
+        e.contains("posterior.yaml:5:32") && e.contains("did you mean `dxx`"),
+        "{e}"
+    );
+    assert!(e.contains("values.ezx.carried_by[0]"), "{e}");
+    let e = run("self", "ezx: {value: 0, carried_by: [dxx, ezx]}");
+    assert!(
+        e.contains("posterior.yaml:5:37") && e.contains("`ezx` cannot carry itself"),
+        "{e}"
+    );
+    let e = run("list", "ezx: {value: 0, carried_by: dxx}");
+    assert!(e.contains("must be a list of error names"), "{e}");
+    let e = run(
+        "table",
+        "ezx: {points: [[0, 0], [1000, 1e-6]], carried_by: [dxx]}",
+    );
+    assert!(
+        e.contains("`carried_by` belongs to a constant `value`"),
+        "{e}"
+    );
+    let e = run("no-std", "ezx: {value: 0, carried_by: [dxz]}");
+    assert!(
+        e.contains("posterior.yaml:5:3")
+            && e.contains("`ezx` is carried by `dxz`, which has no `std`"),
+        "{e}"
+    );
+}

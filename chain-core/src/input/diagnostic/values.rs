@@ -27,6 +27,37 @@ pub enum ValuesProblem {
         /// The entry.
         name: String,
     },
+    /// `carried_by` beside a `std`.
+    CarriedWithStd {
+        /// The entry.
+        name: String,
+    },
+    /// `carried_by` that is not a non-empty list of names.
+    CarriersNotList {
+        /// The entry.
+        name: String,
+    },
+    /// A carrier that is the entry itself or is named twice.
+    CarrierTwice {
+        /// The entry.
+        name: String,
+        /// The carrier.
+        carrier: String,
+    },
+    /// A carrier that is no error parameter or coefficient of the machine.
+    UnknownCarrier {
+        /// The entry.
+        name: String,
+        /// The carrier as written.
+        carrier: String,
+        /// The closest name of the machine, if one is close.
+        suggestion: Option<String>,
+    },
+    /// `carried_by` beside a table.
+    CarriedOfTable {
+        /// The entry.
+        name: String,
+    },
     /// `std` a number beside a CSV `table` (there it names a column).
     StdOfTable {
         /// The entry.
@@ -129,6 +160,43 @@ impl ValuesProblem {
                 "chain::values::key_not_for_constant",
                 "not a table",
                 format!("`{key}` belongs to a table; `{name}` is given a `value`"),
+            ),
+            ValuesProblem::CarriedWithStd { name } => D::new(
+                "chain::values::carried_with_std",
+                "carried and a std",
+                format!("`{name}` is given both a `std` and `carried_by`"),
+            )
+            .help("`carried_by` says its spread is held by the estimates it names (an error identification fixed because others carry its effect); a `std` gives it a spread of its own: keep one".to_string()),
+            ValuesProblem::CarriersNotList { name } => D::new(
+                "chain::values::carriers_not_list",
+                "not a list of names",
+                format!("`carried_by` of `{name}` must be a list of error names"),
+            )
+            .help("write `carried_by: [NAME, ...]`, the estimated errors that carry its effect".to_string()),
+            ValuesProblem::CarrierTwice { name, carrier } => D::new(
+                "chain::values::carrier_twice",
+                "named again",
+                if carrier == name {
+                    format!("`{name}` cannot carry itself")
+                } else {
+                    format!("`{carrier}` is named twice in `carried_by` of `{name}`")
+                },
+            ),
+            ValuesProblem::UnknownCarrier { name, carrier, suggestion } => {
+                let d = D::new(
+                    "chain::values::unknown_carrier",
+                    "unknown error",
+                    format!("`{carrier}` in `carried_by` of `{name}` is not an error parameter of this machine"),
+                );
+                match suggestion {
+                    Some(s) => d.help(format!("did you mean `{s}`?")),
+                    None => d.help("`carried_by` names error parameters or coefficients of the machine file".to_string()),
+                }
+            }
+            ValuesProblem::CarriedOfTable { name } => D::new(
+                "chain::values::carried_of_table",
+                "not a constant",
+                format!("`carried_by` belongs to a constant `value`; `{name}` is given a table"),
             ),
             ValuesProblem::StdOfTable { name } => D::new(
                 "chain::values::key_not_for_table",

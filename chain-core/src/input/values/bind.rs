@@ -182,7 +182,7 @@ impl<'m> ValuesBuilder<'m> {
     /// A constant error parameter or coefficient (mm or rad). Given again,
     /// the later value holds.
     pub fn constant(&mut self, name: &str, value: f64) -> Result<(), BindError> {
-        self.constant_with(name, value, None, None)
+        self.constant_with(name, value, None, Vec::new(), None)
     }
 
     pub(super) fn constant_with(
@@ -190,6 +190,7 @@ impl<'m> ValuesBuilder<'m> {
         name: &str,
         value: f64,
         std: Option<f64>,
+        carried_by: Vec<String>,
         origin: Option<Origin>,
     ) -> Result<(), BindError> {
         let m = self.machine;
@@ -232,7 +233,11 @@ impl<'m> ValuesBuilder<'m> {
         self.record(Entry {
             name: name.to_string(),
             kind,
-            given: Given::Constant { value, std },
+            given: Given::Constant {
+                value,
+                std,
+                carried_by,
+            },
             origin,
         });
         Ok(())

@@ -35,6 +35,14 @@ pub enum Given {
         /// writes it; nothing here uses it).
         #[serde(skip_serializing_if = "Option::is_none")]
         std: Option<f64>,
+        /// `carried_by`: the estimated errors that carry this one's effect
+        /// (a redundant error an identification fixed: docs/posterior.md,
+        /// "Fixed and carried"); empty when the file does not say. A
+        /// reliability study then takes the value as exact instead of
+        /// keeping its `statistics` spread, which the carriers' `std`
+        /// already holds.
+        #[serde(skip_serializing_if = "Vec::is_empty")]
+        carried_by: Vec<String>,
     },
     /// A table along an axis.
     Table {

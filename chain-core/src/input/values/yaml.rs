@@ -8,7 +8,7 @@ use super::{
     ValuesError, MAX_VALUES_BYTES,
 };
 use super::{Extrapolation, Interpolation};
-use crate::diagnostic::{Diagnostics, Problem, ValuesProblem};
+use crate::diagnostic::{closest, Diagnostics, Problem, ValuesProblem};
 use crate::load::reader::{index, join, start_origin, Fields, TreeReader};
 use crate::model::{Machine, Origin};
 use crate::yaml::{self, Node};
@@ -23,6 +23,7 @@ pub const UNITS_KEYS: &[&str] = &["linear", "angular"];
 pub const ENTRY_KEYS: &[&str] = &[
     "value",
     "std",
+    "carried_by",
     "points",
     "table",
     "column",
@@ -266,7 +267,13 @@ impl Reader {
                 self.report(node.span, path, Problem::NotFinite { what: "the value" });
                 return;
             }
-            if let Err(e) = b.constant_with(name, value * factor, None, Some(key_origin.clone())) {
+            if let Err(e) = b.constant_with(
+                name,
+                value * factor,
+                None,
+                Vec::new(),
+                Some(key_origin.clone()),
+            ) {
                 self.problems.push((key_origin, bind_problem(&e)));
             }
             return;
@@ -333,9 +340,19 @@ impl Reader {
                 }
                 None => None,
             };
-            if let Err(e) = b.constant_with(name, v * factor, std, Some(key_origin.clone())) {
+            let Some(carried_by) = self.carriers(name, &fields, std.is_some(), m) else {
+                return;
+            };
+            let origin = Some(key_origin.clone());
+            if let Err(e) = b.constant_with(name, v * factor, std, carried_by, origin) {
                 self.problems.push((key_origin, bind_problem(&e)));
             }
+            return;
+        }
+        if let Some((kn, _)) = fields.entry("carried_by") {
+            let name = name.to_string();
+            let not = ValuesProblem::CarriedOfTable { name };
+            self.report(kn.span, fields.path("carried_by"), not.into());
             return;
         }
         if fields.get("points").is_none() {
@@ -431,6 +448,67 @@ impl Reader {
 
     /// The points, sources and reading of a table entry: its main table and
     /// whichever of `reverse`, `std` and `reverse_std` it gives.
+    /// The `carried_by` list of constant `name` (docs/posterior.md, "Fixed
+    /// and carried"): the machine's error parameters or coefficients, other
+    /// than `name`, each named once; refused beside a `std`. `None` when
+    /// something was reported.
+    fn carriers(
+        &mut self,
+        name: &str,
+        fields: &Fields<'_>,
+        has_std: bool,
+        m: &Machine,
+    ) -> Option<Vec<String>> {
+        let Some((kn, list)) = fields.entry("carried_by") else {
+            return Some(Vec::new());
+        };
+        let path = fields.path("carried_by");
+        if has_std {
+            let name = name.to_string();
+            self.report(kn.span, path, ValuesProblem::CarriedWithStd { name }.into());
+            return None;
+        }
+        let Some(items) = list.as_sequence().filter(|items| !items.is_empty()) else {
+            let name = name.to_string();
+            let not = ValuesProblem::CarriersNotList { name };
+            self.report(list.span, path, not.into());
+            return None;
+        };
+        let mut carriers: Vec<String> = Vec::with_capacity(items.len());
+        let mut fine = true;
+        for (i, item) in items.iter().enumerate() {
+            let at = index(&path, i);
+            let carrier = item.as_str().unwrap_or("").to_string();
+            let problem = if carrier.is_empty() {
+                Some(ValuesProblem::CarriersNotList {
+                    name: name.to_string(),
+                })
+            } else if carrier == name || carriers.contains(&carrier) {
+                Some(ValuesProblem::CarrierTwice {
+                    name: name.to_string(),
+                    carrier: carrier.clone(),
+                })
+            } else if m.error_index(&carrier).is_none() {
+                let names = m.errors.iter().map(|e| e.name.as_str());
+                Some(ValuesProblem::UnknownCarrier {
+                    name: name.to_string(),
+                    suggestion: closest(&carrier, names).map(str::to_string),
+                    carrier: carrier.clone(),
+                })
+            } else {
+                None
+            };
+            match problem {
+                Some(p) => {
+                    self.report(item.span, at, p.into());
+                    fine = false;
+                }
+                None => carriers.push(carrier),
+            }
+        }
+        fine.then_some(carriers)
+    }
+
     fn table_spec(
         &mut self,
         name: &str,
