@@ -6,7 +6,6 @@
 //! Python parses the same strings with [`Choice::parse`]; both refuse an
 //! unknown spelling in [`ChoiceError`]'s words.
 
-use chain_core::compensation::controllers::Controller;
 use chain_core::diagnostic::shortened;
 use chain_core::measured::{MeasurementKind, SetupKind};
 use chain_core::model::{Frame, Sided};
@@ -171,14 +170,7 @@ impl Choice for ExportController {
     fn help(self) -> &'static str {
         match self {
             ExportController::Grid => "The universal grid CSV: `δq` at every node and the residual",
-            ExportController::Tables(Controller::Beckhoff) => {
-                "Beckhoff TwinCAT / ISG volumetric compensation (`ISG_CSV`)"
-            }
-            ExportController::Tables(Controller::Linuxcnc) => "LinuxCNC `COMP_FILE` per joint",
-            ExportController::Tables(Controller::SiemensCec) => {
-                "Sinumerik CEC sag / cross-axis tables"
-            }
-            ExportController::Tables(Controller::Klipper) => "Klipper `SET_SKEW`",
+            ExportController::Tables(c) => c.capabilities().summary,
         }
     }
 }

@@ -8,7 +8,7 @@
 
 use chain_core::built::BuiltMachine;
 use chain_core::compensation::controllers::{
-    self, Controller, ControllerError, Export, ExportOptions, FormatReport,
+    self, Controller, ControllerError, Export, ExportOptions, FormatReport, Limit,
     BECKHOFF_DEFAULT_MAX_RECORDS, CEC_DEFAULT_MAX_POINTS, DEFAULT_STEP,
 };
 use chain_core::compensation::grid::{self, GridCompensation};
@@ -32,14 +32,17 @@ pub enum ExportController {
 }
 
 impl ExportController {
-    /// Every controller, in the order of `--controller`'s values.
-    pub const ALL: [ExportController; 5] = [
-        ExportController::Grid,
-        ExportController::Tables(Controller::Beckhoff),
-        ExportController::Tables(Controller::Linuxcnc),
-        ExportController::Tables(Controller::SiemensCec),
-        ExportController::Tables(Controller::Klipper),
-    ];
+    /// Every controller, in the order of `--controller`'s values: the grid,
+    /// then [`Controller::ALL`].
+    pub const ALL: [ExportController; 1 + Controller::ALL.len()] = {
+        let mut all = [ExportController::Grid; 1 + Controller::ALL.len()];
+        let mut i = 0;
+        while i < Controller::ALL.len() {
+            all[i + 1] = ExportController::Tables(Controller::ALL[i]);
+            i += 1;
+        }
+        all
+    };
 
     /// The name `--controller` takes.
     pub fn name(self) -> &'static str {
@@ -320,10 +323,11 @@ pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
                     "a per-axis table samples each axis over its travel: give the travel with --grid VAR=LO,HI and the table step with --step; --axes gives the nodes of --controller grid",
                 );
             }
-            if request.cec_max_points.is_some() && c != Controller::SiemensCec {
+            let limit = c.capabilities().limit;
+            if request.cec_max_points.is_some() && limit != Some(Limit::CecPoints) {
                 return refuse("--cec-max-points", "it limits the siemens-cec tables");
             }
-            if request.beckhoff_max_records.is_some() && c != Controller::Beckhoff {
+            if request.beckhoff_max_records.is_some() && limit != Some(Limit::BeckhoffRecords) {
                 return refuse("--beckhoff-max-records", "it limits the beckhoff tables");
             }
         }

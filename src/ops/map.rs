@@ -7,7 +7,7 @@
 //! `Machine.map` run it.
 
 use chain_core::built::{BuiltMachine, MapError, MapSummary, Points};
-use chain_core::compensation::controllers::{Controller, ExportOptions, DEFAULT_STEP};
+use chain_core::compensation::controllers::{ExportOptions, DEFAULT_STEP};
 use chain_core::compensation::grid::GridError;
 use chain_core::compensation::CompensationError;
 use chain_core::kinematics::Kinematics;
@@ -427,9 +427,13 @@ impl PreparedMap {
             let result = built
                 .compensated_map(export.correction.as_ref(), self.points.clone())
                 .map_err(compensation_error)?;
-            let (nodes, source) = match tables {
-                Controller::Klipper => (0, "shear factors, docs/export-controllers.md".to_string()),
-                _ => {
+            let capabilities = tables.capabilities();
+            let (nodes, source) = match capabilities.tables {
+                false => (
+                    0,
+                    format!("{}, docs/export-controllers.md", capabilities.holds),
+                ),
+                true => {
                     let points: Vec<String> = (export.report.axes.iter())
                         .map(|a| format!("{} {}", a.variable, a.points))
                         .collect();

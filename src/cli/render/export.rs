@@ -3,7 +3,7 @@
 //! report.
 
 use chain::ops::export::{ExportDocument, GridExport, TablesExport};
-use chain_core::compensation::controllers::{Controller, Term};
+use chain_core::compensation::controllers::Term;
 use chain_core::compensation::grid;
 
 use crate::cli::report::{Csv, Report};
@@ -111,17 +111,48 @@ impl Report for TablesExport {
             self.values_file
         );
         let _ = writeln!(out, "files: {}", r.files.join(", "));
-        let _ = writeln!(out);
-        let _ = writeln!(
-            out,
-            "{:<8} {:>5} {:>12} {:>12} {:>10} {:>7}",
-            "axis", "along", "min (mm)", "max (mm)", "step (mm)", "points"
-        );
+        if !r.axes.is_empty() {
+            let _ = writeln!(out);
+            let _ = writeln!(
+                out,
+                "{:<8} {:>5} {:>12} {:>12} {:>10} {:>7}",
+                "axis", "along", "min (mm)", "max (mm)", "step (mm)", "points"
+            );
+        }
         for a in &r.axes {
             let _ = writeln!(
                 out,
                 "{:<8} {:>5} {:>12} {:>12} {:>10} {:>7}",
                 a.variable, a.axis, a.min, a.max, a.step, a.points
+            );
+        }
+        if let Some(k) = &r.kinematics {
+            let _ = writeln!(out);
+            let axes: Vec<String> = k.axes.iter().map(|(c, v)| format!("{c} = {v}")).collect();
+            let _ = writeln!(out, "{}: joints {}", k.module, axes.join(", "));
+            let _ = writeln!(
+                out,
+                "  {:<28} {:>20} {:>22}  unit",
+                "parameter", "nominal", "identified"
+            );
+            for p in &k.parameters {
+                let _ = writeln!(
+                    out,
+                    "  {:<28} {:>20.9} {:>22.9}  {}",
+                    p.name, p.nominal, p.value, p.unit
+                );
+            }
+            for note in &k.notes {
+                let _ = writeln!(out, "  note: {note}");
+            }
+            let at: Vec<String> = (k.residual_at.iter())
+                .map(|(n, v)| format!("{n} = {v}"))
+                .collect();
+            let _ = writeln!(
+                out,
+                "  position error left over the grid (first order): rms {:.4} µm, largest at {}",
+                k.residual_rms * 1e3,
+                at.join(", ")
             );
         }
         let terms = |out: &mut String, title: &str, terms: &[Term]| {
@@ -163,7 +194,7 @@ impl Report for TablesExport {
             r.residual.position * 1e3,
             r.residual.orientation * 1e6
         );
-        if !r.axes.is_empty() && r.controller != Controller::Klipper {
+        if !r.axes.is_empty() && r.controller.capabilities().tables {
             let _ = writeln!(
                 out,
                 "linear resampling between table nodes: at most {:.4e} (mm, or rad for angular columns)",

@@ -18,6 +18,7 @@ mod downstream;
 mod export_cli;
 mod export_controllers;
 mod export_grid;
+mod export_rotary;
 mod finite_difference;
 mod function_slot_input;
 mod function_slot_reliability;

@@ -68,13 +68,6 @@ impl Correction for BeckhoffCorrection {
 pub(super) fn export<M: ErrorModel + Sync>(
     ctx: &Context<'_, M>,
 ) -> Result<Export, ControllerError> {
-    if ctx.axes.len() != 3 {
-        return Err(ControllerError::AxisCount {
-            controller: ctx.name(),
-            machine: ctx.machine.name.clone(),
-            found: ctx.axes.len(),
-        });
-    }
     let m = ctx.machine;
     // Single values: squareness and location errors of the axes' bodies.
     let mut singles: Vec<(String, String)> = Vec::new(); // (ISG name, chain name)

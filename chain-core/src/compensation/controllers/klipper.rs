@@ -110,13 +110,6 @@ fn squareness_errors<'m>(machine: &'m Machine, bodies: &[usize]) -> Vec<&'m str>
 pub(super) fn export<M: ErrorModel + Sync>(
     ctx: &Context<'_, M>,
 ) -> Result<Export, ControllerError> {
-    if ctx.axes.len() != 3 {
-        return Err(ControllerError::AxisCount {
-            controller: ctx.name(),
-            machine: ctx.machine.name.clone(),
-            found: ctx.axes.len(),
-        });
-    }
     let axes: [(usize, f64); 3] = std::array::from_fn(|k| {
         let a = ctx
             .axis_along(k)

@@ -49,6 +49,8 @@
 mod beckhoff;
 mod klipper;
 mod linuxcnc;
+mod linuxcnc_trt;
+mod rotary;
 mod siemens_cec;
 
 use serde::Serialize;
@@ -63,6 +65,8 @@ use crate::values::Values;
 pub use beckhoff::BeckhoffCorrection;
 pub use klipper::{KlipperCorrection, SkewFactors};
 pub use linuxcnc::{LinuxcncCorrection, LinuxcncTable};
+pub use linuxcnc_trt::{TrtCorrection, TrtModule, TrtPins};
+pub use rotary::{KinematicsParameter, KinematicsReport};
 pub use siemens_cec::CecCorrection;
 
 /// The default table step (mm): [`ExportOptions::step`].
@@ -89,15 +93,19 @@ pub enum Controller {
     SiemensCec,
     /// Klipper `[skew_correction]` / `SET_SKEW`.
     Klipper,
+    /// LinuxCNC `xyzac-trt-kins` / `xyzbc-trt-kins` (HAL pins).
+    LinuxcncTrt,
 }
 
 impl Controller {
-    /// All four, in the spec's table order.
-    pub const ALL: [Controller; 4] = [
+    /// Every format, in the specs' table order (measured-machines §6, then
+    /// five-axis "Output").
+    pub const ALL: [Controller; 5] = [
         Controller::Beckhoff,
         Controller::Linuxcnc,
         Controller::SiemensCec,
         Controller::Klipper,
+        Controller::LinuxcncTrt,
     ];
 
     /// The format's name (`beckhoff`, `linuxcnc`, `siemens-cec`,
@@ -108,6 +116,7 @@ impl Controller {
             Controller::Linuxcnc => "linuxcnc",
             Controller::SiemensCec => "siemens-cec",
             Controller::Klipper => "klipper",
+            Controller::LinuxcncTrt => "linuxcnc-trt",
         }
     }
 
@@ -115,6 +124,111 @@ impl Controller {
     pub fn from_name(name: &str) -> Option<Controller> {
         Controller::ALL.into_iter().find(|c| c.name() == name)
     }
+
+    /// What the format can hold: the one statement the shared code decides
+    /// from (which machines it takes, whether it writes tables along the
+    /// axes, the option that limits its tables), so that a new format is
+    /// one file and one arm here.
+    pub fn capabilities(self) -> Capabilities {
+        let linear = |count| Takes::LinearAxes { count };
+        match self {
+            Controller::Beckhoff => Capabilities {
+                summary: "Beckhoff TwinCAT / ISG volumetric compensation (`ISG_CSV`)",
+                holds: "the ISO 230-1 errors of the three linear axes, as tables along them",
+                takes: linear(Some(3)),
+                tables: true,
+                limit: Some(Limit::BeckhoffRecords),
+            },
+            Controller::Linuxcnc => Capabilities {
+                summary: "LinuxCNC `COMP_FILE` per joint",
+                holds: "each joint's positioning error along its own axis, as a table",
+                takes: linear(None),
+                tables: true,
+                limit: None,
+            },
+            Controller::SiemensCec => Capabilities {
+                summary: "Sinumerik CEC sag / cross-axis tables",
+                holds: "each straightness error, as a cross-axis table",
+                takes: linear(None),
+                tables: true,
+                limit: Some(Limit::CecPoints),
+            },
+            Controller::Klipper => Capabilities {
+                summary: "Klipper `SET_SKEW`",
+                holds: "shear factors",
+                takes: linear(Some(3)),
+                tables: false,
+                limit: None,
+            },
+            Controller::LinuxcncTrt => Capabilities {
+                summary: "LinuxCNC `xyzac-trt-kins` / `xyzbc-trt-kins` pins and rotary HOME_OFFSET",
+                holds: "the positions of the two rotary axis lines and their zeros",
+                takes: Takes::TableTable,
+                tables: false,
+                limit: None,
+            },
+        }
+    }
+}
+
+/// What a controller format can hold ([`Controller::capabilities`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Capabilities {
+    /// The format in a few words (the help of the controller's name).
+    pub summary: &'static str,
+    /// What it expresses, in a few words.
+    pub holds: &'static str,
+    /// The machines it describes.
+    pub takes: Takes,
+    /// True when it writes tables sampled along the axes (a table step and
+    /// travel apply, and linear resampling between nodes costs accuracy);
+    /// false when it holds constants only.
+    pub tables: bool,
+    /// The limit its tables must fit in, when the format has one the user
+    /// may give.
+    pub limit: Option<Limit>,
+}
+
+/// The machines a format describes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Takes {
+    /// Linear axes only, each moving the tool point along one of X, Y, Z
+    /// (each used once), no fixed rotation in the chain; `count`: exactly
+    /// that many.
+    LinearAxes {
+        /// The number of axes, when the format needs a given one.
+        count: Option<usize>,
+    },
+    /// A table-table five-axis machine: three linear axes along X, Y, Z
+    /// and two rotary axes carrying the workpiece, the tilting one
+    /// carrying the rotary table (`rotary.rs`).
+    TableTable,
+}
+
+impl Takes {
+    /// The machines it takes, in words (for a refusal).
+    pub fn words(self) -> String {
+        match self {
+            Takes::LinearAxes { count: Some(n) } => {
+                format!("{n} linear axes, one along each of X, Y, Z")
+            }
+            Takes::LinearAxes { count: None } => {
+                "linear axes, each along one of X, Y, Z".to_string()
+            }
+            Takes::TableTable => "a table-table five-axis machine (X, Y, Z along the frame's axes; a tilting axis carrying a rotary table, both carrying the workpiece)".to_string(),
+        }
+    }
+}
+
+/// A limit on a format's tables that the export options set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Limit {
+    /// The points of a CEC table ([`ExportOptions::cec_max_points`]).
+    CecPoints,
+    /// The Beckhoff records ([`ExportOptions::beckhoff_max_records`]).
+    BeckhoffRecords,
 }
 
 /// How an export samples the axes.
@@ -155,11 +269,13 @@ impl Default for ExportOptions {
 #[non_exhaustive]
 pub enum ControllerError {
     /// A rotary axis, where the format takes linear axes only.
-    #[error("`{controller}` takes linear axes only, and axis `{variable}` is rotary")]
+    #[error("`{controller}` takes {takes}, and axis `{variable}` is rotary")]
     #[cfg_attr(feature = "miette", diagnostic(code(chain::export::rotary_axis)))]
     RotaryAxis {
         /// The format.
         controller: &'static str,
+        /// The machines it takes, in words ([`Takes::words`]).
+        takes: String,
         /// The rotary variable.
         variable: String,
     },
@@ -172,12 +288,27 @@ pub enum ControllerError {
         /// What is not aligned.
         reason: String,
     },
+    /// A machine of another kind than the format describes.
+    #[error("`{controller}` takes {takes}; machine `{machine}` is not one: {reason}")]
+    #[cfg_attr(feature = "miette", diagnostic(code(chain::export::machine_kind)))]
+    MachineKind {
+        /// The format.
+        controller: &'static str,
+        /// The machines it takes, in words ([`Takes::words`]).
+        takes: String,
+        /// The machine.
+        machine: String,
+        /// Why not.
+        reason: String,
+    },
     /// Not the number of axes the format takes.
-    #[error("`{controller}` needs three linear axes X, Y, Z; machine `{machine}` has {found} axis variables")]
+    #[error("`{controller}` takes {takes}; machine `{machine}` has {found} axis variables")]
     #[cfg_attr(feature = "miette", diagnostic(code(chain::export::axis_count)))]
     AxisCount {
         /// The format.
         controller: &'static str,
+        /// The machines it takes, in words ([`Takes::words`]).
+        takes: String,
         /// The machine.
         machine: String,
         /// Its number of variables.
@@ -366,6 +497,11 @@ pub struct FormatReport {
     /// are any).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub directions: Vec<DirectionReport>,
+    /// For a format that holds a controller's kinematics (the rotary
+    /// formats): the parameters written and the checks of the controller's
+    /// own kinematics.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kinematics: Option<KinematicsReport>,
 }
 
 /// What one table's approach-direction columns hold (LinuxCNC's forward and
@@ -418,12 +554,14 @@ pub fn export<M: ErrorModel + Sync>(
     machine: &Machine,
     options: &ExportOptions,
 ) -> Result<Export, ControllerError> {
-    let ctx = Context::new(controller, built, machine, options)?;
+    let axes = || Context::new(controller, built, machine, options);
+    let table_table = || rotary::TableTable::new(controller, built, machine, options);
     match controller {
-        Controller::Beckhoff => beckhoff::export(&ctx),
-        Controller::Linuxcnc => linuxcnc::export(&ctx),
-        Controller::SiemensCec => siemens_cec::export(&ctx),
-        Controller::Klipper => klipper::export(&ctx),
+        Controller::Beckhoff => beckhoff::export(&axes()?),
+        Controller::Linuxcnc => linuxcnc::export(&axes()?),
+        Controller::SiemensCec => siemens_cec::export(&axes()?),
+        Controller::Klipper => klipper::export(&axes()?),
+        Controller::LinuxcncTrt => linuxcnc_trt::export(&table_table()?),
     }
 }
 
@@ -493,13 +631,31 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
         if !(options.step.is_finite() && options.step > 0.0) {
             return Err(ControllerError::BadStep { step: options.step });
         }
+        let takes = controller.capabilities().takes;
+        let Takes::LinearAxes { count } = takes else {
+            return Err(ControllerError::MachineKind {
+                controller: name,
+                takes: takes.words(),
+                machine: machine.name.clone(),
+                reason: "the format is not one of per-axis tables".to_string(),
+            });
+        };
         for v in &machine.variables {
             if v.kind == JointKind::Rotary {
                 return Err(ControllerError::RotaryAxis {
                     controller: name,
+                    takes: takes.words(),
                     variable: v.name.clone(),
                 });
             }
+        }
+        if count.is_some_and(|n| n != machine.variables.len()) {
+            return Err(ControllerError::AxisCount {
+                controller: name,
+                takes: takes.words(),
+                machine: machine.name.clone(),
+                found: machine.variables.len(),
+            });
         }
         for (n, _) in &options.travel {
             if machine.variable_index(n).is_none() {
@@ -532,40 +688,7 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
                     .unwrap_or(usize::MAX)
             })
             .collect();
-        // Travels.
-        let mut travels = Vec::new();
-        for (i, v) in machine.variables.iter().enumerate() {
-            let given = options.travel.iter().find(|(n, _)| *n == v.name);
-            let (lo, hi) = match given {
-                Some((_, [lo, hi])) => (*lo, *hi),
-                None => {
-                    let grid = machine
-                        .reliability
-                        .as_ref()
-                        .and_then(|r| r.grid.iter().find(|(k, _)| *k == i))
-                        .map(|(_, g)| g);
-                    match grid {
-                        Some(g) if !g.is_empty() => (
-                            g.iter().copied().fold(f64::INFINITY, f64::min),
-                            g.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-                        ),
-                        _ => {
-                            return Err(ControllerError::NoTravel {
-                                variable: v.name.clone(),
-                            })
-                        }
-                    }
-                }
-            };
-            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-                return Err(ControllerError::BadTravel {
-                    variable: v.name.clone(),
-                    lo,
-                    hi,
-                });
-            }
-            travels.push((lo, hi));
-        }
+        let travels = travels(machine, options)?;
         let reference: Vec<f64> = travels.iter().map(|t| t.0).collect();
         // The nominal Jacobian at the reference point.
         let kin = Kinematics::from_machine(machine);
@@ -920,11 +1043,55 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
                 resampling,
                 check_grid: accounting.check_grid,
                 directions: Vec::new(),
+                kinematics: None,
             },
             files,
             correction,
         }
     }
+}
+
+/// Each variable's travel `(min, max)`, machine order: the options' or the
+/// machine file's `reliability.grid` range; refused when neither gives one
+/// or it is not an interval.
+pub(crate) fn travels(
+    machine: &Machine,
+    options: &ExportOptions,
+) -> Result<Vec<(f64, f64)>, ControllerError> {
+    let mut travels = Vec::new();
+    for (i, v) in machine.variables.iter().enumerate() {
+        let given = options.travel.iter().find(|(n, _)| *n == v.name);
+        let (lo, hi) = match given {
+            Some((_, [lo, hi])) => (*lo, *hi),
+            None => {
+                let grid = machine
+                    .reliability
+                    .as_ref()
+                    .and_then(|r| r.grid.iter().find(|(k, _)| *k == i))
+                    .map(|(_, g)| g);
+                match grid {
+                    Some(g) if !g.is_empty() => (
+                        g.iter().copied().fold(f64::INFINITY, f64::min),
+                        g.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                    ),
+                    _ => {
+                        return Err(ControllerError::NoTravel {
+                            variable: v.name.clone(),
+                        })
+                    }
+                }
+            }
+        };
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(ControllerError::BadTravel {
+                variable: v.name.clone(),
+                lo,
+                hi,
+            });
+        }
+        travels.push((lo, hi));
+    }
+    Ok(travels)
 }
 
 /// What [`Context::account`] finds over the check grid.

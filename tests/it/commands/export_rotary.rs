@@ -1,0 +1,500 @@
+//! `chain export --controller linuxcnc-trt` (five-axis spec, "Output";
+//! docs/export-controllers.md) against LinuxCNC's own kinematics written in
+//! this test from `src/emc/kinematics/trtfuncs.c` in its compact form: the
+//! forward `P = Pc + R_z(k·C)·[d + R_t(k·T)·(J − Pc − d)]` (`k = −1` for
+//! `conventional-directions` 0, `+1` for 1; `R_t` about X for xyzac, Y for
+//! xyzbc; `d = (x-offset, y-offset, z-offset + tool-offset)`) and its exact
+//! inverse `J = Pc + d + R_t(−k·T)·[R_z(−k·C)·(P − Pc) − d]`. The written
+//! pins, home offsets and work offset are read back from the files, the
+//! joints for a target are what this inverse gives, and the tool point they
+//! reach is the independent numeric transform product of `tests/it/common`
+//! with the true errors: with position and zero errors only (what the format
+//! holds) the target is reached to second order; with axis tilts the
+//! largest miss over the grid is the report's residual.
+
+use crate::common;
+
+use chain::core::built::BuiltMachine;
+use chain::core::compensation::controllers::{export, Controller, Export, ExportOptions};
+use chain::core::values::ValuesBuilder;
+use chain::core::Machine;
+use common::cli::{fails, ok_json, ok_stdout, scratch, unwrapped, write};
+use common::{example_path, rot_axis, Exact, Rng};
+
+/// The A/C trunnion of the sphere example with the zero errors of its two
+/// rotary axes added (EA0A about the A axis, EC0C about the C axis), its
+/// rotary axes turned when `turned` (`axis: -x`, `-z`).
+fn trunnion(turned: bool) -> Machine {
+    let text = std::fs::read_to_string(example_path("ac_trunnion_rotary.yaml")).unwrap();
+    let mut text = text
+        .replace(
+            "{dy: EY0A, dz: EZ0A, ey: EB0A, ez: EC0A}",
+            "{dy: EY0A, dz: EZ0A, ex: EA0A, ey: EB0A, ez: EC0A}",
+        )
+        .replace(
+            "{dx: EX0C, dy: EY0C, ex: EA0C, ey: EB0C}",
+            "{dx: EX0C, dy: EY0C, ex: EA0C, ey: EB0C, ez: EC0C}",
+        );
+    if turned {
+        text = text
+            .replace("axis: +x, variable: A", "axis: -x, variable: A")
+            .replace("axis: +z, variable: C", "axis: -z, variable: C");
+    }
+    chain::core::load_str(&text, "trunnion.yaml").unwrap()
+}
+
+/// The travel of the trunnion and the table: x, y ±100, z −100..0 mm, the
+/// tilt ±1 rad, C a whole turn.
+fn options(m: &Machine) -> ExportOptions {
+    let travel = m
+        .variables
+        .iter()
+        .map(|v| {
+            let t = match v.name.as_str() {
+                "z" => [-100.0, 0.0],
+                "A" | "B" => [-1.0, 1.0],
+                "C" => [0.0, std::f64::consts::TAU],
+                _ => [-100.0, 100.0],
+            };
+            (v.name.clone(), t)
+        })
+        .collect();
+    ExportOptions {
+        travel,
+        provenance: "chain export --controller linuxcnc-trt".into(),
+        ..ExportOptions::default()
+    }
+}
+
+/// The export of `errors` (name, value) on `m`, and the true error vector.
+fn run(m: &Machine, errors: &[(&str, f64)]) -> (Export, Vec<f64>) {
+    let mut b = ValuesBuilder::new(m);
+    let mut e = vec![0.0; m.errors.len()];
+    for &(n, v) in errors {
+        b.constant(n, v).unwrap();
+        e[m.error_index(n).unwrap()] = v;
+    }
+    let p: Vec<f64> = m.parameters.iter().map(|p| p.value.unwrap()).collect();
+    let built = BuiltMachine::compile(m, b.build(), p).unwrap();
+    let export = export(Controller::LinuxcncTrt, &built, m, &options(m)).unwrap();
+    (export, e)
+}
+
+/// What the written files say: the module, the joint map (controller axis
+/// → machine variable and sign), nominal and identified pins by name, the
+/// direction setting, the home offset changes and the work offset change.
+struct Written {
+    module: String,
+    joints: Vec<(String, usize, f64)>,
+    nominal: Vec<(String, f64)>,
+    pins: Vec<(String, f64)>,
+    conventional: bool,
+    home: [f64; 2],
+    g54: [f64; 3],
+}
+
+fn read_back(m: &Machine, export: &Export) -> Written {
+    let hal = export
+        .files
+        .iter()
+        .find(|f| f.name.ends_with(".hal"))
+        .unwrap();
+    let readme = export
+        .files
+        .iter()
+        .find(|f| f.name.ends_with("README.txt"))
+        .unwrap();
+    let module = hal.name.trim_end_matches(".hal").to_string();
+    let mut w = Written {
+        module: module.clone(),
+        joints: Vec::new(),
+        nominal: Vec::new(),
+        pins: Vec::new(),
+        conventional: false,
+        home: [f64::NAN; 2],
+        g54: [f64::NAN; 3],
+    };
+    for line in hal.text.lines() {
+        if let Some(rest) = line.strip_prefix("# joints: ") {
+            let list = rest.split(" (").next().unwrap();
+            for item in list.split(", ") {
+                let (axis, var) = item.split_once(" = ").unwrap();
+                let (sign, name) = match var.strip_prefix('-') {
+                    Some(n) => (-1.0, n),
+                    None => (1.0, var),
+                };
+                w.joints
+                    .push((axis.to_string(), m.variable_index(name).unwrap(), sign));
+            }
+        }
+        let Some(rest) = line.strip_prefix(&format!("setp {module}.")) else {
+            continue;
+        };
+        let mut words = rest.split_whitespace();
+        let name = words.next().unwrap().to_string();
+        let value: f64 = words.next().unwrap().parse().unwrap();
+        if name == "conventional-directions" {
+            w.conventional = value == 1.0;
+            continue;
+        }
+        assert_eq!(words.next(), Some("#"), "{line}");
+        assert_eq!(words.next(), Some("nominal"), "{line}");
+        w.nominal
+            .push((name.clone(), words.next().unwrap().parse().unwrap()));
+        w.pins.push((name, value));
+    }
+    for line in readme.text.lines().filter(|l| !l.starts_with('#')) {
+        let (name, value) = line.split_once(" = ").unwrap();
+        let value: f64 = value.split_whitespace().next().unwrap().parse().unwrap();
+        match name {
+            "C HOME_OFFSET change" => w.home[1] = value,
+            "G54 X change" => w.g54[0] = value,
+            "G54 Y change" => w.g54[1] = value,
+            "G54 Z change" => w.g54[2] = value,
+            n if n.ends_with("HOME_OFFSET change") => w.home[0] = value,
+            other => panic!("{other}"),
+        }
+    }
+    assert_eq!(w.joints.len(), 5);
+    w
+}
+
+/// Rotation about axis `k` by `deg` degrees, applied to `v`.
+fn rot(k: usize, deg: f64, v: [f64; 3]) -> [f64; 3] {
+    common::apply3(&rot_axis(k, deg.to_radians()), v)
+}
+
+/// LinuxCNC's forward, compact form (module docs).
+fn forward(w: &Written, pins: &[(String, f64)], j: [f64; 3], t: f64, c: f64) -> [f64; 3] {
+    let get = |n: &str| pins.iter().find(|(k, _)| k == n).map_or(0.0, |(_, v)| *v);
+    let k = if w.conventional { 1.0 } else { -1.0 };
+    let pc = [get("x-rot-point"), get("y-rot-point"), get("z-rot-point")];
+    let d = [get("x-offset"), get("y-offset"), get("z-offset")];
+    let tilt_axis = if w.module.starts_with("xyzac") { 0 } else { 1 };
+    let inner = rot(
+        tilt_axis,
+        k * t,
+        std::array::from_fn(|i| j[i] - pc[i] - d[i]),
+    );
+    let outer = rot(2, k * c, std::array::from_fn(|i| d[i] + inner[i]));
+    std::array::from_fn(|i| pc[i] + outer[i])
+}
+
+/// Its exact inverse (module docs).
+fn inverse(w: &Written, pins: &[(String, f64)], p: [f64; 3], t: f64, c: f64) -> [f64; 3] {
+    let get = |n: &str| pins.iter().find(|(k, _)| k == n).map_or(0.0, |(_, v)| *v);
+    let k = if w.conventional { 1.0 } else { -1.0 };
+    let pc = [get("x-rot-point"), get("y-rot-point"), get("z-rot-point")];
+    let d = [get("x-offset"), get("y-offset"), get("z-offset")];
+    let tilt_axis = if w.module.starts_with("xyzac") { 0 } else { 1 };
+    let back = rot(2, -k * c, std::array::from_fn(|i| p[i] - pc[i]));
+    let inner = rot(tilt_axis, -k * t, std::array::from_fn(|i| back[i] - d[i]));
+    std::array::from_fn(|i| pc[i] + d[i] + inner[i])
+}
+
+/// The largest miss over `count` seeded commands in the travel: the target
+/// is the nominal tool point of `q`; LinuxCNC, with the written pins, home
+/// and work offsets, drives the joints `inverse(P − w)` and the rotary
+/// axes `h` less; the machine with the true errors `e` puts the tool where
+/// the numeric product says. Returns (calibrated, uncalibrated) misses.
+fn misses(m: &Machine, w: &Written, e: &[f64], qs: &[Vec<f64>]) -> (f64, f64) {
+    let exact = Exact::new(m);
+    let p = exact.file_parameters();
+    let zero = vec![0.0; m.variables.len()];
+    let p0 = exact.nominal(&zero, &p).1;
+    let at = |q: &[f64], e: &[f64]| -> [f64; 3] {
+        common::transform_point(&exact.t_wt(q, &p, e), exact.tool_point(&p))
+    };
+    let (mut cal, mut raw) = (0.0f64, 0.0f64);
+    for q in qs {
+        let target = exact.nominal(q, &p).1;
+        let lin: Vec<&(String, usize, f64)> = w.joints.iter().take(3).collect();
+        let j: [f64; 3] = std::array::from_fn(|k| lin[k].2 * q[lin[k].1]);
+        let (ti, ci) = (w.joints[3].1, w.joints[4].1);
+        let (t, c) = (q[ti].to_degrees(), q[ci].to_degrees());
+        // The controller's position of the uncalibrated command: the
+        // nominal machine's, measured from its zero.
+        let pos = forward(w, &w.nominal, j, t, c);
+        for i in 0..3 {
+            assert!(
+                (pos[i] - (target[i] - p0[i])).abs() < 1e-9,
+                "{q:?}: the nominal pins reproduce the machine"
+            );
+        }
+        let aim: [f64; 3] = std::array::from_fn(|i| pos[i] + w.g54[i]);
+        let j2 = inverse(w, &w.pins, aim, t, c);
+        let mut q2 = q.clone();
+        for k in 0..3 {
+            q2[lin[k].1] = lin[k].2 * j2[k];
+        }
+        q2[ti] = (t - w.home[0]).to_radians();
+        q2[ci] = (c - w.home[1]).to_radians();
+        let miss = |a: [f64; 3]| {
+            (0..3)
+                .map(|i| (a[i] - target[i]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        cal = cal.max(miss(at(&q2, e)));
+        raw = raw.max(miss(at(q, e)));
+    }
+    (cal, raw)
+}
+
+fn commands(m: &Machine, count: usize, seed: u64) -> Vec<Vec<f64>> {
+    let mut rng = Rng::new(seed);
+    let opts = options(m);
+    (0..count)
+        .map(|_| {
+            (opts.travel.iter())
+                .map(|(_, [lo, hi])| rng.range(*lo, *hi))
+                .collect()
+        })
+        .collect()
+}
+
+/// Position and zero errors of both axes: what xyzac-trt-kins holds. After
+/// write-back the tool reaches every target to second order (below 5 nm,
+/// against 30 µm uncalibrated), for both direction settings; the report
+/// says it expresses every term and leaves nothing.
+#[test]
+fn positions_and_zeros_are_held_to_second_order() {
+    let errors = [
+        ("EY0A", 0.020),
+        ("EZ0A", -0.015),
+        ("EA0A", 3e-5),
+        ("EX0C", 0.010),
+        ("EY0C", -0.025),
+        ("EC0C", -4e-5),
+    ];
+    for turned in [false, true] {
+        let m = trunnion(turned);
+        let (export, e) = run(&m, &errors);
+        let w = read_back(&m, &export);
+        assert_eq!(w.module, "xyzac-trt-kins");
+        assert_eq!(
+            w.conventional, turned,
+            "the direction setting follows the axes' sense"
+        );
+        let (cal, raw) = misses(&m, &w, &e, &commands(&m, 200, 7));
+        assert!(raw > 2e-2, "uncalibrated {raw}");
+        assert!(
+            cal < 5e-6,
+            "turned {turned}: calibrated miss {cal} mm (uncalibrated {raw})"
+        );
+        let r = &export.report;
+        assert!(
+            r.remaining.iter().all(|t| t.position < 1e-9),
+            "{:?}",
+            r.remaining
+        );
+        assert_eq!(r.expressed.len(), 6, "{:?}", r.expressed);
+        assert!(r.residual.position < 1e-9, "{:?}", r.residual);
+        let k = r.kinematics.as_ref().unwrap();
+        assert!(k.residual_rms < 1e-9);
+        // The zeros, in the joints' degrees: EA0A turns the table about +x
+        // (right-handed, the A joint's own sense unless turned).
+        let s = if turned { -1.0 } else { 1.0 };
+        assert!(
+            (w.home[0] - s * 3e-5f64.to_degrees()).abs() < 1e-9,
+            "{}",
+            w.home[0]
+        );
+        assert!(
+            (w.home[1] - s * (-4e-5f64).to_degrees()).abs() < 1e-9,
+            "{}",
+            w.home[1]
+        );
+    }
+}
+
+/// With the axis tilts of `examples/spheres/truth.yaml` (which the module
+/// cannot hold), the largest miss over the report's own grid is the
+/// residual the report states (first order against the exact product: 1 %).
+#[test]
+fn tilts_remain_and_the_report_says_how_much() {
+    let m = trunnion(false);
+    let errors = [
+        ("EY0A", 0.020),
+        ("EZ0A", -0.015),
+        ("EB0A", 3e-5),
+        ("EC0A", -2e-5),
+        ("EX0C", 0.010),
+        ("EY0C", -0.025),
+        ("EA0C", 4e-5),
+        ("EB0C", -3e-5),
+    ];
+    let (export, e) = run(&m, &errors);
+    let w = read_back(&m, &export);
+    let r = &export.report;
+    let names: Vec<&str> = r.remaining.iter().map(|t| t.name.as_str()).collect();
+    for tilt in ["EB0A", "EC0A", "EA0C", "EB0C"] {
+        assert!(names.contains(&tilt), "{names:?}");
+    }
+    for position in ["EY0A", "EZ0A", "EX0C", "EY0C"] {
+        assert!(!names.contains(&position), "{names:?}");
+    }
+    // The report's grid, every point.
+    let nodes = &r.check_grid;
+    let total: usize = nodes.iter().map(|(_, g)| g.len()).product();
+    let qs: Vec<Vec<f64>> = (0..total)
+        .map(|mut idx| {
+            let mut q = vec![0.0; nodes.len()];
+            for (k, (_, g)) in nodes.iter().enumerate().rev() {
+                q[k] = g[idx % g.len()];
+                idx /= g.len();
+            }
+            q
+        })
+        .collect();
+    let (cal, raw) = misses(&m, &w, &e, &qs);
+    let stated = r.residual.position;
+    assert!(stated > 1e-3 && stated < 0.5 * raw, "{stated} of {raw}");
+    assert!(
+        (cal / stated - 1.0).abs() < 0.01,
+        "measured {cal} vs stated {stated}"
+    );
+}
+
+/// The B/C table (xyzbc-trt-kins): held to second order through the exact
+/// inverse, and the report says that LinuxCNC master's own inverse is not
+/// that with conventional-directions 0 and these offsets.
+#[test]
+fn the_bc_table_and_the_master_inverse() {
+    let text = std::fs::read_to_string(example_path("bc_table_rotary.yaml")).unwrap();
+    let m = chain::core::load_str(&text, "bc.yaml").unwrap();
+    let errors = [
+        ("EX0B", -0.012),
+        ("EZ0B", 0.018),
+        ("EX0C", 0.008),
+        ("EY0C", 0.014),
+    ];
+    let (export, e) = run(&m, &errors);
+    let w = read_back(&m, &export);
+    assert_eq!(w.module, "xyzbc-trt-kins");
+    assert!(!w.conventional);
+    let (cal, raw) = misses(&m, &w, &e, &commands(&m, 200, 3));
+    assert!(raw > 1e-2 && cal < 5e-6, "{cal} / {raw}");
+    let notes = &export.report.kinematics.as_ref().unwrap().notes;
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.contains("not the inverse of its forward") && n.contains("bfb687e")),
+        "{notes:?}"
+    );
+}
+
+/// The CLI: the table shows the pins and notes, the JSON carries the
+/// kinematics; another machine and the per-axis formats' machines are
+/// refused with the kinds each format takes; `map --compensated
+/// linuxcnc-trt` runs the written correction.
+#[test]
+fn the_cli_writes_and_refuses() {
+    let machine = example_path("ac_trunnion_rotary.yaml");
+    let values = common::example_file("spheres/truth.yaml");
+    let dir = scratch("export-rotary");
+    let grid = [
+        "--grid",
+        "x=-100,100",
+        "--grid",
+        "y=-100,100",
+        "--grid",
+        "z=-100,0",
+        "--grid",
+        "A=-1,1",
+        "--grid",
+        "C=0,6.283185307179586",
+    ];
+    let mut args = vec![
+        "export",
+        machine.to_str().unwrap(),
+        "--values",
+        values.to_str().unwrap(),
+        "--controller",
+        "linuxcnc-trt",
+    ];
+    args.extend(grid);
+    let out = dir.join("out");
+    let mut with_out = args.clone();
+    with_out.extend(["--out", out.to_str().unwrap()]);
+    let table = ok_stdout(&with_out);
+    assert!(
+        table.contains("xyzac-trt-kins: joints X = x, Y = -y, Z = z, A = A, C = C"),
+        "{table}"
+    );
+    assert!(
+        table.contains("z-offset") && table.contains("A HOME_OFFSET change"),
+        "{table}"
+    );
+    let hal = std::fs::read_to_string(out.join("xyzac-trt-kins.hal")).unwrap();
+    assert!(hal.contains("setp xyzac-trt-kins.z-offset "), "{hal}");
+    args.extend(["--format", "json"]);
+    let json = ok_json(&args);
+    let k = &json["kinematics"];
+    assert_eq!(k["module"], "xyzac-trt-kins");
+    assert_eq!(k["parameters"][4]["name"], "z-offset");
+    assert_eq!(k["parameters"][4]["nominal"], 50.0);
+    // Another kind of machine.
+    let vmc = example_path("vmc3.yaml");
+    let vmc_values = common::example_file("values/vmc3.yaml");
+    let e = unwrapped(&fails(&[
+        "export",
+        vmc.to_str().unwrap(),
+        "--values",
+        vmc_values.to_str().unwrap(),
+        "--controller",
+        "linuxcnc-trt",
+    ]));
+    assert!(
+        e.contains("takes a table-table five-axis machine")
+            && e.contains("it has 3 linear and 0 rotary axes"),
+        "{e}"
+    );
+    let mut per_axis = vec![
+        "export",
+        machine.to_str().unwrap(),
+        "--values",
+        values.to_str().unwrap(),
+        "--controller",
+        "linuxcnc",
+    ];
+    per_axis.extend(grid);
+    let e = unwrapped(&fails(&per_axis));
+    assert!(
+        e.contains(
+            "`linuxcnc` takes linear axes, each along one of X, Y, Z, and axis `A` is rotary"
+        ),
+        "{e}"
+    );
+    // The compensated map: the tilts remain, far less than before.
+    let mut map = vec![
+        "map",
+        machine.to_str().unwrap(),
+        "--values",
+        values.to_str().unwrap(),
+    ];
+    map.extend([
+        "--grid",
+        "x=-100,100",
+        "--grid",
+        "y=-100,100",
+        "--grid",
+        "z=-100,0",
+        "--grid",
+        "A=-1,0,1",
+        "--grid",
+        "C=0,1.5,3,4.5",
+    ]);
+    let before = ok_json(&[map.clone(), vec!["--format", "json"]].concat());
+    let after = ok_json(
+        &[
+            map,
+            vec!["--compensated", "linuxcnc-trt", "--format", "json"],
+        ]
+        .concat(),
+    );
+    let largest = |d: &serde_json::Value| d["summary"]["volumetric"]["max"].as_f64().unwrap();
+    let (b, a) = (largest(&before), largest(&after["compensated"]));
+    assert!(a < 0.5 * b && a > 1e-3, "{a} vs {b}");
+    let _ = write(&dir, "done", "");
+}
