@@ -21,6 +21,8 @@ use chain::core::Machine;
 use common::cli::{fails, ok_json, ok_stdout, scratch, unwrapped, write};
 use common::{example_path, rot_axis, Exact, Rng};
 
+use super::identify_spheres::TRUTH;
+
 /// The A/C trunnion of the sphere example with the zero errors of its two
 /// rotary axes added (EA0A about the A axis, EC0C about the C axis), its
 /// rotary axes turned when `turned` (`axis: -x`, `-z`).
@@ -314,17 +316,7 @@ fn positions_and_zeros_are_held_to_second_order() {
 #[test]
 fn tilts_remain_and_the_report_says_how_much() {
     let m = trunnion(false);
-    let errors = [
-        ("EY0A", 0.020),
-        ("EZ0A", -0.015),
-        ("EB0A", 3e-5),
-        ("EC0A", -2e-5),
-        ("EX0C", 0.010),
-        ("EY0C", -0.025),
-        ("EA0C", 4e-5),
-        ("EB0C", -3e-5),
-    ];
-    let (export, e) = run(&m, &errors);
+    let (export, e) = run(&m, &TRUTH);
     let w = read_back(&m, &export);
     let r = &export.report;
     let names: Vec<&str> = r.remaining.iter().map(|t| t.name.as_str()).collect();
@@ -405,15 +397,20 @@ fn the_cli_writes_and_refuses() {
         "--grid",
         "C=0,6.283185307179586",
     ];
-    let mut args = vec![
-        "export",
-        machine.to_str().unwrap(),
-        "--values",
-        values.to_str().unwrap(),
-        "--controller",
-        "linuxcnc-trt",
-    ];
-    args.extend(grid);
+    let (machine, values) = (machine.to_str().unwrap(), values.to_str().unwrap());
+    let export_args = |controller| {
+        let mut a = vec![
+            "export",
+            machine,
+            "--values",
+            values,
+            "--controller",
+            controller,
+        ];
+        a.extend(grid);
+        a
+    };
+    let mut args = export_args("linuxcnc-trt");
     let out = dir.join("out");
     let mut with_out = args.clone();
     with_out.extend(["--out", out.to_str().unwrap()]);
@@ -450,16 +447,7 @@ fn the_cli_writes_and_refuses() {
             && e.contains("it has 3 linear and 0 rotary axes"),
         "{e}"
     );
-    let mut per_axis = vec![
-        "export",
-        machine.to_str().unwrap(),
-        "--values",
-        values.to_str().unwrap(),
-        "--controller",
-        "linuxcnc",
-    ];
-    per_axis.extend(grid);
-    let e = unwrapped(&fails(&per_axis));
+    let e = unwrapped(&fails(&export_args("linuxcnc")));
     assert!(
         e.contains(
             "`linuxcnc` takes linear axes, each along one of X, Y, Z, and axis `A` is rotary"
@@ -467,12 +455,7 @@ fn the_cli_writes_and_refuses() {
         "{e}"
     );
     // The compensated map: the tilts remain, far less than before.
-    let mut map = vec![
-        "map",
-        machine.to_str().unwrap(),
-        "--values",
-        values.to_str().unwrap(),
-    ];
+    let mut map = vec!["map", machine, "--values", values];
     map.extend([
         "--grid",
         "x=-100,100",

@@ -24,8 +24,8 @@ fn trunnion_text() -> String {
         .collect()
 }
 
-/// The true location errors (mm, rad).
-const TRUTH: [(&str, f64); 8] = [
+/// The true location errors (mm, rad): `examples/spheres/truth.yaml`.
+pub(super) const TRUTH: [(&str, f64); 8] = [
     ("EY0A", 0.020),
     ("EZ0A", -0.015),
     ("EB0A", 3e-5),

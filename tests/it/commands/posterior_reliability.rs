@@ -54,6 +54,16 @@ correlation:
   - [dxy, dxz, 0.2]
 ";
 
+/// `chain reliability` of the grinder with the posterior `values` and
+/// `extra` options, as JSON.
+fn reliability_json(values: &str, extra: &[&str]) -> Value {
+    let machine = machine_path();
+    let mut args = vec!["reliability", machine.as_str(), "--values", values];
+    args.extend(extra);
+    args.extend(["--format", "json"]);
+    ok_json(&args)
+}
+
 fn machine_path() -> String {
     example_path(MACHINE).to_str().unwrap().to_string()
 }
@@ -169,14 +179,7 @@ fn form_is_the_correlated_closed_form_at_grid_points() {
             == 6
     );
     let values = posterior_file("form", POSTERIOR);
-    let doc = ok_json(&[
-        "reliability",
-        &machine_path(),
-        "--values",
-        &values,
-        "--format",
-        "json",
-    ]);
+    let doc = reliability_json(&values, &[]);
     let results = doc["results"].as_array().unwrap();
     assert_eq!(results.len(), 3 * 125);
     let mut checked = 0;
@@ -687,14 +690,7 @@ fn carried_errors_are_exact_inputs() {
     assert!(law.std[j] > 8e-6);
     law.mean[j] = 2.0e-6;
     law.std[j] = 0.0;
-    let doc = ok_json(&[
-        "reliability",
-        &machine_path(),
-        "--values",
-        &values,
-        "--format",
-        "json",
-    ]);
+    let doc = reliability_json(&values, &[]);
     let mut checked = 0;
     let mut moved = 0.0f64;
     for (k, case) in doc["results"].as_array().unwrap().iter().enumerate() {
@@ -719,24 +715,21 @@ fn carried_errors_are_exact_inputs() {
     assert!(moved > 1e-4, "{moved}");
     assert_eq!(doc["posterior"]["values"][4]["carried_by"][1], "eyx");
     // Monte Carlo over the same inputs agrees within its standard error.
-    let mc = ok_json(&[
-        "reliability",
-        &machine_path(),
-        "--values",
+    let mc = reliability_json(
         &values,
-        "--method",
-        "mc",
-        "--samples",
-        "20000",
-        "--grid",
-        "x=500",
-        "--grid",
-        "y=1000",
-        "--grid",
-        "z=0",
-        "--format",
-        "json",
-    ]);
+        &[
+            "--method",
+            "mc",
+            "--samples",
+            "20000",
+            "--grid",
+            "x=500",
+            "--grid",
+            "y=1000",
+            "--grid",
+            "z=0",
+        ],
+    );
     for case in mc["results"].as_array().unwrap() {
         let c = (COMPONENTS.iter())
             .position(|n| case["component"] == *n)
@@ -748,15 +741,7 @@ fn carried_errors_are_exact_inputs() {
         assert!((pf - (1.0 - want)).abs() <= 4.0 * se, "{case}: {want}");
     }
     // The acceptance probability runs; a fixed input has no sensitivity.
-    let acc = ok_json(&[
-        "reliability",
-        &machine_path(),
-        "--values",
-        &values,
-        "--acceptance",
-        "--format",
-        "json",
-    ]);
+    let acc = reliability_json(&values, &["--acceptance"]);
     let sens = acc["acceptance"]["sensitivity"].as_array().unwrap();
     assert_eq!(sens.len(), m.errors.len() - 1);
     assert!(sens.iter().all(|s| s["error"] != "ezx"));
