@@ -28,7 +28,7 @@ use crate::compensation::{opening_line, Correction, ExportedFile};
 use crate::model_trait::{ErrorModel, OutOfRange};
 
 use super::rotary::{KinematicsParameter, KinematicsReport, TableTable, TrtModel};
-use super::{num, ControllerError, Export, FormatReport};
+use super::{interpolate_held, num, ControllerError, Export, FormatReport, LINUXCNC_MAX_POINTS};
 
 /// `TO_RAD` of LinuxCNC (`rtapi_math.h`: `M_PI / 180`).
 const TO_RAD: f64 = std::f64::consts::PI / 180.0;
@@ -226,6 +226,8 @@ pub struct TrtCorrection {
     linear: [(usize, f64); 3],
     tilt: usize,
     rotary: usize,
+    /// The rotary COMP_FILEs: (variable, nominal positions, trims), rad.
+    comp: Vec<(usize, Vec<f64>, Vec<f64>)>,
 }
 
 impl Correction for TrtCorrection {
@@ -241,6 +243,9 @@ impl Correction for TrtCorrection {
         }
         delta[self.tilt] = -self.zero[0].to_radians();
         delta[self.rotary] = -self.zero[1].to_radians();
+        for (v, nominal, trim) in &self.comp {
+            delta[*v] += interpolate_held(nominal, trim, q[*v]);
+        }
         Ok(())
     }
 }
@@ -249,6 +254,12 @@ pub(super) fn export<M: ErrorModel + Sync>(
     tt: &TableTable<'_, M>,
 ) -> Result<Export, ControllerError> {
     let m = tt.machine;
+    // The rotary axes' positioning errors go into a COMP_FILE each.
+    let comps: Vec<RotaryComp> = [tt.tilt, tt.rotary]
+        .into_iter()
+        .filter_map(|v| rotary_comp(tt, v).transpose())
+        .collect::<Result<_, _>>()?;
+    let held: Vec<String> = comps.iter().flat_map(|c| c.errors.clone()).collect();
     let mut tried = Vec::new();
     let mut found = None;
     'modules: for module in [TrtModule::Xyzac, TrtModule::Xyzbc] {
@@ -257,7 +268,7 @@ pub(super) fn export<M: ErrorModel + Sync>(
                 module,
                 conventional,
             };
-            match tt.fit(&model, 4) {
+            match tt.fit(&model, 4, &held) {
                 Ok(fit) => {
                     found = Some((model, fit));
                     break 'modules;
@@ -394,10 +405,17 @@ pub(super) fn export<M: ErrorModel + Sync>(
     for p in parameters.iter().filter(|p| p.unit.starts_with("mm (")) {
         readme.push_str(&format!("{} = {}\n", p.name, num(p.value)));
     }
+    for c in &comps {
+        let name = &m.variables[c.variable].name;
+        readme.push_str(&format!(
+            "# joint {name}'s positioning error ({}): in its [JOINT_n] section COMP_FILE = {name}.comp and COMP_FILE_TYPE = 1\n",
+            c.errors.join(" + ")
+        ));
+    }
     readme.push_str(&format!(
         "# {prefix}.hal holds the pins (loadrt {prefix}, then source or copy the setp lines into the machine's HAL file)\n"
     ));
-    let files = vec![
+    let mut files = vec![
         ExportedFile {
             name: format!("{prefix}.hal"),
             text: hal,
@@ -407,6 +425,14 @@ pub(super) fn export<M: ErrorModel + Sync>(
             text: readme,
         },
     ];
+    let mut resampling: f64 = 0.0;
+    for c in &comps {
+        files.push(ExportedFile {
+            name: format!("{}.comp", m.variables[c.variable].name),
+            text: c.text.clone(),
+        });
+        resampling = resampling.max(c.resampling);
+    }
     let correction = TrtCorrection {
         module,
         nominal,
@@ -416,6 +442,9 @@ pub(super) fn export<M: ErrorModel + Sync>(
         linear: tt.linear,
         tilt: tt.tilt,
         rotary: tt.rotary,
+        comp: (comps.iter())
+            .map(|c| (c.variable, c.nominal.clone(), c.trim.clone()))
+            .collect(),
     };
     Ok(Export {
         report: FormatReport {
@@ -426,7 +455,7 @@ pub(super) fn export<M: ErrorModel + Sync>(
             expressed: fit.expressed,
             remaining: fit.remaining,
             residual: fit.residual,
-            resampling: 0.0,
+            resampling,
             check_grid: tt.nodes.clone(),
             directions: Vec::new(),
             kinematics: Some(KinematicsReport {
@@ -441,6 +470,146 @@ pub(super) fn export<M: ErrorModel + Sync>(
         files,
         correction: Box::new(correction),
     })
+}
+
+/// The largest step of a rotary COMP_FILE (degrees).
+const COMP_STEP_DEG: f64 = 2.0;
+
+/// A rotary joint's COMP_FILE.
+struct RotaryComp {
+    /// The machine variable.
+    variable: usize,
+    /// The error parameters or function slots it holds.
+    errors: Vec<String>,
+    /// Nominal positions (rad).
+    nominal: Vec<f64>,
+    /// Trims (rad).
+    trim: Vec<f64>,
+    /// The largest difference, at the midpoints, between the error and
+    /// its linear reading (rad).
+    resampling: f64,
+    /// The file's text.
+    text: String,
+}
+
+/// The COMP_FILE of rotary variable `v` when its body has a positioning
+/// error (an error motion about the joint's own axis): trims `−s·e(q)` in
+/// degrees at every 2° of its travel and at its table's positions (`s` the
+/// joint axis's sign: the true angle is `q + s·e`), `COMP_FILE_TYPE = 1`,
+/// the same trim both directions, the comments below the data (LinuxCNC
+/// stops reading at the first line that is not three numbers;
+/// `usrmotintf.cc` `usrmotLoadComp`, at most `EMCMOT_COMP_SIZE` = 256
+/// lines).
+fn rotary_comp<M: ErrorModel + Sync>(
+    tt: &TableTable<'_, M>,
+    v: usize,
+) -> Result<Option<RotaryComp>, ControllerError> {
+    let m = tt.machine;
+    let body = &m.bodies[m.variables[v].body];
+    let Some(joint) = &body.joint else {
+        return Ok(None);
+    };
+    let slot = 3 + joint.axis.axis.index();
+    let mut errors: Vec<String> = Vec::new();
+    for &j in &body.errors.slots[slot] {
+        let name = match m.coefficient_of(j) {
+            Some((f, _)) => f.name.clone(),
+            None => m.errors[j].name.clone(),
+        };
+        if !errors.contains(&name) {
+            errors.push(name);
+        }
+    }
+    if errors.is_empty() {
+        return Ok(None);
+    }
+    let (lo, hi) = tt.travel[v];
+    let intervals = ((hi - lo).to_degrees() / COMP_STEP_DEG - 1e-9)
+        .ceil()
+        .max(1.0) as usize;
+    let mut nominal: Vec<f64> = (0..=intervals)
+        .map(|k| lo + (hi - lo) * k as f64 / intervals as f64)
+        .collect();
+    for name in &errors {
+        for q in tt.built.values().table_positions(name).unwrap_or_default() {
+            if q > lo && q < hi && nominal.iter().all(|n| (n - q).abs() > 1e-12) {
+                nominal.push(q);
+            }
+        }
+    }
+    nominal.sort_by(f64::total_cmp);
+    let name = &m.variables[v].name;
+    if nominal.len() > LINUXCNC_MAX_POINTS {
+        return Err(ControllerError::TooManyPoints {
+            controller: "LinuxCNC (EMCMOT_COMP_SIZE)",
+            variable: name.clone(),
+            lo,
+            hi,
+            step: COMP_STEP_DEG,
+            points: nominal.len(),
+            limit: LINUXCNC_MAX_POINTS,
+            hint: "; the positions of its table and the 2° steps of its travel exceed it: give a shorter travel",
+        });
+    }
+    let sign = joint.axis.sign();
+    let base = tt.grid[0].clone();
+    let error_at = |x: f64| -> Result<f64, ControllerError> {
+        let mut q = base.clone();
+        q[v] = x;
+        let parts = tt.parts(&q).map_err(|e| ControllerError::OutOfTable {
+            variable: name.clone(),
+            lo,
+            hi,
+            source: Box::new(e),
+        })?;
+        Ok((parts.iter())
+            .filter(|p| errors.contains(&p.name))
+            .map(|p| p.value)
+            .sum())
+    };
+    let trim: Vec<f64> = (nominal.iter())
+        .map(|&x| error_at(x).map(|e| -sign * e))
+        .collect::<Result<_, _>>()?;
+    let mut resampling: f64 = 0.0;
+    for w in nominal.windows(2) {
+        let x = 0.5 * (w[0] + w[1]);
+        let lin = interpolate_held(&nominal, &trim, x);
+        resampling = resampling.max((-sign * error_at(x)? - lin).abs());
+    }
+    let mut text = String::new();
+    for (x, t) in nominal.iter().zip(&trim) {
+        let (x, t) = (num(x.to_degrees()), num(t.to_degrees()));
+        text.push_str(&format!("{x} {t} {t}\n"));
+    }
+    let opening = format!(
+        "machine `{}`, rotary joint `{name}`: its positioning error {}",
+        m.name,
+        errors.join(" + ")
+    );
+    text.push_str(&format!("# {}\n", opening_line(&tt.provenance, &opening)));
+    text.push_str("# [JOINT_n] COMP_FILE_TYPE = 1: columns nominal (commanded joint angle) | trim moving + | trim moving -, degrees\n");
+    text.push_str(&format!(
+        "# trim = {}, e the error about the body's +{} axis (the joint turns about {}{}: the true angle is the reading {} e); LinuxCNC adds the trim to the command\n",
+        if sign > 0.0 { "-e" } else { "+e" },
+        ['x', 'y', 'z'][joint.axis.axis.index()],
+        if sign > 0.0 { "+" } else { "-" },
+        ['x', 'y', 'z'][joint.axis.axis.index()],
+        if sign > 0.0 { "+" } else { "-" }
+    ));
+    text.push_str(&format!(
+        "# every {COMP_STEP_DEG}° of {} to {} and the error's table positions; the same trim both directions; held at the end values outside\n",
+        num(lo.to_degrees()),
+        num(hi.to_degrees())
+    ));
+    text.push_str("# these comments must stay below the data: LinuxCNC stops reading at the first line that is not three numbers\n");
+    Ok(Some(RotaryComp {
+        variable: v,
+        errors,
+        nominal,
+        trim,
+        resampling,
+        text,
+    }))
 }
 
 fn param(name: &str, nominal: f64, value: f64, unit: &'static str) -> KinematicsParameter {

@@ -67,6 +67,8 @@ pub(crate) struct TableTable<'a, M> {
     pub grid: Vec<Vec<f64>>,
     /// The grid's nodes per variable (machine order), for the report.
     pub nodes: Vec<(String, Vec<f64>)>,
+    /// Each variable's travel (machine order).
+    pub travel: Vec<(f64, f64)>,
     /// [`ExportOptions::provenance`].
     pub provenance: String,
 }
@@ -230,6 +232,7 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
             to_built,
             grid,
             nodes,
+            travel,
             provenance: options.provenance.clone(),
         })
     }
@@ -272,8 +275,15 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
     }
 
     /// Fits `model`'s pins (nominal, then identified with the zero offsets)
-    /// over the grid (module docs).
-    pub fn fit(&self, model: &dyn TrtModel, pins: usize) -> Result<Fit, ControllerError> {
+    /// over the grid (module docs). The parts named in `elsewhere` are held
+    /// by another file of the format (a rotary axis's positioning error in
+    /// its table): left out of the fit and reported as expressed whole.
+    pub fn fit(
+        &self,
+        model: &dyn TrtModel,
+        pins: usize,
+        elsewhere: &[String],
+    ) -> Result<Fit, ControllerError> {
         let m = self.grid.len();
         let joints: Vec<([f64; 3], f64, f64)> = self.grid.iter().map(|q| self.joints(q)).collect();
         // Affine in the pins: f(θ) = f(0) + Σ θ_k (f(e_k) − f(0)).
@@ -317,7 +327,9 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
         }
         // To the nanometre: the fit reproduces the geometry to 1e-9 of the
         // travel, and a file should say 50, not 50.00000000000001.
-        let nominal: Vec<f64> = nominal.iter().map(|v| (v * 1e9).round() / 1e9).collect();
+        let nominal: Vec<f64> = (nominal.iter())
+            .map(|v| (v * 1e9).round() / 1e9 + 0.0)
+            .collect();
         // The identified machine: G = [∂f/∂θ, ∂f/∂a, ∂f/∂c (per degree),
         // I (the workpiece's zero)].
         let h = 1e-4;
@@ -356,6 +368,15 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
         let mut remaining: Vec<Term> = Vec::new();
         let mut left = vec![[0.0; 6]; m];
         for (p, name) in names.iter().enumerate() {
+            if elsewhere.contains(name) {
+                let mut held = term(name);
+                for at in &parts_at {
+                    held.position = held.position.max(norm(&at[p].error[..3]));
+                    held.orientation = held.orientation.max(norm(&at[p].error[3..]));
+                }
+                expressed.push(held);
+                continue;
+            }
             let e = DVector::from_fn(3 * m, |row, _| parts_at[row / 3][p].error[row % 3]);
             let x = solve(&e);
             let share = &g * &x;
