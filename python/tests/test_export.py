@@ -30,24 +30,28 @@ def test_export_is_the_cli_s(cli, controller, tmp_path):
         assert set(m.variables) <= set(frame[0])
 
 
-def test_rotary_export_is_the_cli_s(cli, cli_error, tmp_path):
-    """LinuxCNC's trt kinematics from the sphere example's true location errors: the CLI's JSON and files."""
+@pytest.mark.parametrize("controller,files,module", [
+    ("linuxcnc-trt", ["xyzac-trt-kins-README.txt", "xyzac-trt-kins.hal"], "xyzac-trt-kins"),
+    ("siemens-carr", ["TC_CARR.SPF"], "$TC_CARR (type P)"),
+])
+def test_rotary_export_is_the_cli_s(cli, cli_error, tmp_path, controller, files, module):
+    """The rotary formats from the sphere example's true location errors: the CLI's JSON and files."""
     machine = ROOT / "examples/machines/ac_trunnion_rotary.yaml"
     values = ROOT / "examples/spheres/truth.yaml"
     tau = 6.283185307179586
     grid = {"x": [-100.0, 100.0], "y": [-100.0, 100.0], "z": [-100.0, 0.0], "A": [-1.0, 1.0], "C": [0.0, tau]}
-    got = chain.Machine.load(machine).export(values, controller="linuxcnc-trt", grid=grid, out=tmp_path / "out")
+    got = chain.Machine.load(machine).export(values, controller=controller, grid=grid, out=tmp_path / "out")
     args = [a for k, v in grid.items() for a in ("--grid", f"{k}={v[0]!r},{v[1]!r}")]
-    assert got.to_dict() == cli("export", machine, "--values", values, "--controller", "linuxcnc-trt", *args)
-    assert got.to_dict()["kinematics"]["module"] == "xyzac-trt-kins"
-    assert sorted(got.files) == ["xyzac-trt-kins-README.txt", "xyzac-trt-kins.hal"]
+    assert got.to_dict() == cli("export", machine, "--values", values, "--controller", controller, *args)
+    assert got.to_dict()["kinematics"]["module"] == module
+    assert sorted(got.files) == files
     for name, text in got.files.items():
         assert (tmp_path / "out" / name).read_text() == text
     with pytest.raises(ValueError) as info:
-        chain.Machine.load(MACHINE).export(VALUES, controller="linuxcnc-trt", params={"L": 150})
+        chain.Machine.load(MACHINE).export(VALUES, controller=controller, params={"L": 150})
     assert "takes a table-table five-axis machine" in flat(str(info.value))
     assert flat(str(info.value)) in flat(cli_error("export", MACHINE, "--values", VALUES, "--controller",
-                                                   "linuxcnc-trt", "--param", "L=150"))
+                                                   controller, "--param", "L=150"))
 
 
 def test_export_points_and_refusals(cli_error, tmp_path):
@@ -66,7 +70,7 @@ def test_export_points_and_refusals(cli_error, tmp_path):
         m.export(VALUES, controller="linuxcnc", points=q, params={"L": 150})
     with pytest.raises(ValueError) as info:
         m.export(VALUES, controller="fanuc")
-    wording = "`fanuc` is not a controller: choose one of grid, beckhoff, linuxcnc, siemens-cec, klipper, linuxcnc-trt"
+    wording = "`fanuc` is not a controller: choose one of grid, beckhoff, linuxcnc, siemens-cec, klipper, linuxcnc-trt, siemens-carr"
     assert str(info.value) == wording
     assert wording in flat(cli_error("export", MACHINE, "--values", VALUES, "--controller", "fanuc"))
     with pytest.raises(ValueError) as info:

@@ -24,10 +24,12 @@
 
 use serde::Serialize;
 
-use crate::compensation::{opening_line, Correction, ExportedFile};
-use crate::model_trait::{ErrorModel, OutOfRange};
+use crate::compensation::{opening_line, ExportedFile};
+use crate::model_trait::ErrorModel;
 
-use super::rotary::{KinematicsParameter, KinematicsReport, TableTable, TrtModel};
+use super::rotary::{
+    KinematicsCorrection, KinematicsParameter, KinematicsReport, TableTable, TrtModel,
+};
 use super::{interpolate_held, num, ControllerError, Export, FormatReport, LINUXCNC_MAX_POINTS};
 
 /// `TO_RAD` of LinuxCNC (`rtapi_math.h`: `M_PI / 180`).
@@ -204,49 +206,18 @@ impl Model {
 }
 
 impl TrtModel for Model {
+    fn affine(&self) -> usize {
+        4
+    }
+
     fn forward(&self, pins: &[f64], j: [f64; 3], a: f64, c: f64) -> [f64; 3] {
         self.module.forward(&self.pins(pins), j, a, c)
     }
-}
 
-/// What LinuxCNC (with an inverse that inverts its forward:
-/// [`TrtModule::inverse_of_forward`]) adds to the commanded axes once the pins, home offsets
-/// and work offset are written: at the command `q` aimed at `P =
-/// forward(J, a, c)` with the nominal pins, the joints `inverse(P − w, a,
-/// c)` with the identified ones (`w` the workpiece's zero, which the work
-/// offset moves), and the rotary joints read `h` less (their `HOME_OFFSET`
-/// raised by `h`).
-#[derive(Debug, Clone)]
-pub struct TrtCorrection {
-    module: TrtModule,
-    nominal: TrtPins,
-    pins: TrtPins,
-    zero: [f64; 2],
-    work_offset: [f64; 3],
-    linear: [(usize, f64); 3],
-    tilt: usize,
-    rotary: usize,
-    /// The rotary COMP_FILEs: (variable, nominal positions, trims), rad.
-    comp: Vec<(usize, Vec<f64>, Vec<f64>)>,
-}
-
-impl Correction for TrtCorrection {
-    fn delta(&self, q: &[f64], delta: &mut [f64]) -> Result<(), OutOfRange> {
-        let j: [f64; 3] = std::array::from_fn(|k| self.linear[k].1 * q[self.linear[k].0]);
-        let (a, c) = (q[self.tilt].to_degrees(), q[self.rotary].to_degrees());
-        let p = self.module.forward(&self.nominal, j, a, c);
-        let p: [f64; 3] = std::array::from_fn(|k| p[k] - self.work_offset[k]);
-        let j2 = self.module.inverse_of_forward(&self.pins, p, a, c);
-        delta.iter_mut().for_each(|d| *d = 0.0);
-        for (k, &(v, s)) in self.linear.iter().enumerate() {
-            delta[v] = s * (j2[k] - j[k]);
-        }
-        delta[self.tilt] = -self.zero[0].to_radians();
-        delta[self.rotary] = -self.zero[1].to_radians();
-        for (v, nominal, trim) in &self.comp {
-            delta[*v] += interpolate_held(nominal, trim, q[*v]);
-        }
-        Ok(())
+    /// The exact inverse ([`TrtModule::inverse_of_forward`]): what LinuxCNC
+    /// 2.9 computes, and master where its inverse is right.
+    fn inverse(&self, pins: &[f64], p: [f64; 3], a: f64, c: f64) -> [f64; 3] {
+        self.module.inverse_of_forward(&self.pins(pins), p, a, c)
     }
 }
 
@@ -268,7 +239,7 @@ pub(super) fn export<M: ErrorModel + Sync>(
                 module,
                 conventional,
             };
-            match tt.fit(&model, 4, &held) {
+            match tt.fit(&model, &held) {
                 Ok(fit) => {
                     found = Some((model, fit));
                     break 'modules;
@@ -433,15 +404,16 @@ pub(super) fn export<M: ErrorModel + Sync>(
         });
         resampling = resampling.max(c.resampling);
     }
-    let correction = TrtCorrection {
-        module,
-        nominal,
-        pins,
+    let correction = KinematicsCorrection {
+        model: Box::new(model),
+        nominal: fit.nominal.clone(),
+        pins: fit.pins.clone(),
         zero: fit.zero,
         work_offset: fit.work_offset,
         linear: tt.linear,
         tilt: tt.tilt,
         rotary: tt.rotary,
+        zero_in_kinematics: false,
         comp: (comps.iter())
             .map(|c| (c.variable, c.nominal.clone(), c.trim.clone()))
             .collect(),

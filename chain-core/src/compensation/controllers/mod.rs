@@ -51,6 +51,7 @@ mod klipper;
 mod linuxcnc;
 mod linuxcnc_trt;
 mod rotary;
+mod siemens_carr;
 mod siemens_cec;
 
 use serde::Serialize;
@@ -65,8 +66,8 @@ use crate::values::Values;
 pub use beckhoff::BeckhoffCorrection;
 pub use klipper::{KlipperCorrection, SkewFactors};
 pub use linuxcnc::{LinuxcncCorrection, LinuxcncTable};
-pub use linuxcnc_trt::{TrtCorrection, TrtModule, TrtPins};
-pub use rotary::{KinematicsParameter, KinematicsReport};
+pub use linuxcnc_trt::{TrtModule, TrtPins};
+pub use rotary::{KinematicsCorrection, KinematicsParameter, KinematicsReport};
 pub use siemens_cec::CecCorrection;
 
 /// The default table step (mm): [`ExportOptions::step`].
@@ -95,17 +96,20 @@ pub enum Controller {
     Klipper,
     /// LinuxCNC `xyzac-trt-kins` / `xyzbc-trt-kins` (HAL pins).
     LinuxcncTrt,
+    /// SINUMERIK swivel data record `$TC_CARR` (kinematic type P).
+    SiemensCarr,
 }
 
 impl Controller {
     /// Every format, in the specs' table order (measured-machines §6, then
     /// five-axis "Output").
-    pub const ALL: [Controller; 5] = [
+    pub const ALL: [Controller; 6] = [
         Controller::Beckhoff,
         Controller::Linuxcnc,
         Controller::SiemensCec,
         Controller::Klipper,
         Controller::LinuxcncTrt,
+        Controller::SiemensCarr,
     ];
 
     /// The format's name (`beckhoff`, `linuxcnc`, `siemens-cec`,
@@ -117,6 +121,7 @@ impl Controller {
             Controller::SiemensCec => "siemens-cec",
             Controller::Klipper => "klipper",
             Controller::LinuxcncTrt => "linuxcnc-trt",
+            Controller::SiemensCarr => "siemens-carr",
         }
     }
 
@@ -163,6 +168,13 @@ impl Controller {
             Controller::LinuxcncTrt => Capabilities {
                 summary: "LinuxCNC `xyzac-trt-kins` / `xyzbc-trt-kins` pins and rotary HOME_OFFSET",
                 holds: "the positions of the two rotary axis lines and their zeros",
+                takes: Takes::TableTable,
+                tables: false,
+                limit: None,
+            },
+            Controller::SiemensCarr => Capabilities {
+                summary: "SINUMERIK swivel data record `$TC_CARR` (type P) as a part program",
+                holds: "the positions and directions of the two rotary axis lines and their zeros",
                 takes: Takes::TableTable,
                 tables: false,
                 limit: None,
@@ -562,6 +574,7 @@ pub fn export<M: ErrorModel + Sync>(
         Controller::SiemensCec => siemens_cec::export(&axes()?),
         Controller::Klipper => klipper::export(&axes()?),
         Controller::LinuxcncTrt => linuxcnc_trt::export(&table_table()?),
+        Controller::SiemensCarr => siemens_carr::export(&table_table()?),
     }
 }
 

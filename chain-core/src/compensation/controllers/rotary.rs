@@ -75,10 +75,81 @@ pub(crate) struct TableTable<'a, M> {
 
 /// A model of a table-table controller: its tool point from its joints and
 /// its pins (affine in the pins).
-pub(crate) trait TrtModel {
+pub(crate) trait TrtModel: Send + Sync {
+    /// How many of the pins enter affinely (the pivot points and offsets:
+    /// their nominal values are fitted to the machine file's kinematics).
+    fn affine(&self) -> usize;
+    /// The nominal values of the pins after those (axis directions, which
+    /// the model states), identified through their first-order effect.
+    fn fixed(&self) -> Vec<f64> {
+        Vec::new()
+    }
     /// `P = f(J, a, c; θ)`: `a` the tilting axis's and `c` the rotary
     /// table's angle in degrees.
     fn forward(&self, pins: &[f64], j: [f64; 3], a: f64, c: f64) -> [f64; 3];
+    /// The joints `J` the controller drives for `P` at the angles `a`, `c`:
+    /// the inverse of [`TrtModel::forward`].
+    fn inverse(&self, pins: &[f64], p: [f64; 3], a: f64, c: f64) -> [f64; 3];
+}
+
+/// What a table-table controller adds to the commanded axes once the
+/// identified pins, zero offsets and work offset are written (and a rotary
+/// joint's positioning error table, where the format has one): at the
+/// command `q` aimed at `P = f(J, a, c; θ₀)`, the joints `f⁻¹(P − w, a, c;
+/// θ)` (`w` the workpiece's zero, which the work offset moves), the rotary
+/// joints `h` less (the true angle is the reading plus `h`; or, where the
+/// format holds the zeros in its kinematics, the transformation turned by
+/// `h` instead) plus their table's trim.
+pub struct KinematicsCorrection {
+    pub(crate) model: Box<dyn TrtModel>,
+    pub(crate) nominal: Vec<f64>,
+    pub(crate) pins: Vec<f64>,
+    pub(crate) zero: [f64; 2],
+    pub(crate) work_offset: [f64; 3],
+    pub(crate) linear: [(usize, f64); 3],
+    pub(crate) tilt: usize,
+    pub(crate) rotary: usize,
+    /// Rotary positioning tables: (variable, nominal positions, trims), rad.
+    pub(crate) comp: Vec<(usize, Vec<f64>, Vec<f64>)>,
+    /// Where the zero offsets act: false, on the joints' readings (a home
+    /// offset: the joints are driven `h` less); true, inside the
+    /// kinematics (an axis offset: the joints read as before and the
+    /// transformation turns by the reading plus `h`).
+    pub(crate) zero_in_kinematics: bool,
+}
+
+impl std::fmt::Debug for KinematicsCorrection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("KinematicsCorrection")
+            .field("pins", &self.pins)
+            .field("zero", &self.zero)
+            .field("work_offset", &self.work_offset)
+            .finish_non_exhaustive()
+    }
+}
+
+impl crate::compensation::Correction for KinematicsCorrection {
+    fn delta(&self, q: &[f64], delta: &mut [f64]) -> Result<(), OutOfRange> {
+        let j: [f64; 3] = std::array::from_fn(|k| self.linear[k].1 * q[self.linear[k].0]);
+        let (a, c) = (q[self.tilt].to_degrees(), q[self.rotary].to_degrees());
+        let p = self.model.forward(&self.nominal, j, a, c);
+        let p: [f64; 3] = std::array::from_fn(|k| p[k] - self.work_offset[k]);
+        delta.iter_mut().for_each(|d| *d = 0.0);
+        let j2 = if self.zero_in_kinematics {
+            (self.model).inverse(&self.pins, p, a + self.zero[0], c + self.zero[1])
+        } else {
+            delta[self.tilt] = -self.zero[0].to_radians();
+            delta[self.rotary] = -self.zero[1].to_radians();
+            self.model.inverse(&self.pins, p, a, c)
+        };
+        for (k, &(v, s)) in self.linear.iter().enumerate() {
+            delta[v] = s * (j2[k] - j[k]);
+        }
+        for (v, nominal, trim) in &self.comp {
+            delta[*v] += super::interpolate_held(nominal, trim, q[*v]);
+        }
+        Ok(())
+    }
 }
 
 /// The fit of [`TableTable::fit`].
@@ -278,20 +349,21 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
     /// over the grid (module docs). The parts named in `elsewhere` are held
     /// by another file of the format (a rotary axis's positioning error in
     /// its table): left out of the fit and reported as expressed whole.
-    pub fn fit(
-        &self,
-        model: &dyn TrtModel,
-        pins: usize,
-        elsewhere: &[String],
-    ) -> Result<Fit, ControllerError> {
+    pub fn fit(&self, model: &dyn TrtModel, elsewhere: &[String]) -> Result<Fit, ControllerError> {
         let m = self.grid.len();
         let joints: Vec<([f64; 3], f64, f64)> = self.grid.iter().map(|q| self.joints(q)).collect();
-        // Affine in the pins: f(θ) = f(0) + Σ θ_k (f(e_k) − f(0)).
-        let zero = vec![0.0; pins];
+        let (pins, fixed) = (model.affine(), model.fixed());
+        let all = pins + fixed.len();
+        // Affine in the pins: f(θ) = f(0) + Σ θ_k (f(e_k) − f(0)), the
+        // fixed ones at their nominal values.
+        let with = |affine: Vec<f64>| -> Vec<f64> {
+            affine.into_iter().chain(fixed.iter().copied()).collect()
+        };
+        let zero = with(vec![0.0; pins]);
         let unit = |k: usize| {
             let mut e = vec![0.0; pins];
             e[k] = 1.0;
-            e
+            with(e)
         };
         let mut a = DMatrix::zeros(3 * m, pins);
         let mut b = DVector::zeros(3 * m);
@@ -327,13 +399,16 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
         }
         // To the nanometre: the fit reproduces the geometry to 1e-9 of the
         // travel, and a file should say 50, not 50.00000000000001.
-        let nominal: Vec<f64> = (nominal.iter())
-            .map(|v| (v * 1e9).round() / 1e9 + 0.0)
-            .collect();
+        let nominal: Vec<f64> = with(
+            (nominal.iter())
+                .map(|v| (v * 1e9).round() / 1e9 + 0.0)
+                .collect(),
+        );
         // The identified machine: G = [∂f/∂θ, ∂f/∂a, ∂f/∂c (per degree),
-        // I (the workpiece's zero)].
+        // I (the workpiece's zero)], the fixed pins' columns by central
+        // differences.
         let h = 1e-4;
-        let cols = pins + 5;
+        let cols = all + 5;
         let mut g = DMatrix::zeros(3 * m, cols);
         let mut parts_at: Vec<Vec<Part>> = Vec::with_capacity(m);
         for (i, (q, &(j, ta, tc))) in self.grid.iter().zip(&joints).enumerate() {
@@ -342,15 +417,27 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
                     g[(3 * i + r, k)] = a[(3 * i + r, k)];
                 }
             }
+            for k in pins..all {
+                let (mut up, mut down) = (nominal.clone(), nominal.clone());
+                up[k] += 1e-6;
+                down[k] -= 1e-6;
+                let (fu, fd) = (
+                    model.forward(&up, j, ta, tc),
+                    model.forward(&down, j, ta, tc),
+                );
+                for r in 0..3 {
+                    g[(3 * i + r, k)] = (fu[r] - fd[r]) / 2e-6;
+                }
+            }
             for (c, (da, dc)) in [(h, 0.0), (0.0, h)].into_iter().enumerate() {
                 let up = model.forward(&nominal, j, ta + da, tc + dc);
                 let down = model.forward(&nominal, j, ta - da, tc - dc);
                 for r in 0..3 {
-                    g[(3 * i + r, pins + c)] = (up[r] - down[r]) / (2.0 * h);
+                    g[(3 * i + r, all + c)] = (up[r] - down[r]) / (2.0 * h);
                 }
             }
             for r in 0..3 {
-                g[(3 * i + r, pins + 2 + r)] = 1.0;
+                g[(3 * i + r, all + 2 + r)] = 1.0;
             }
             parts_at.push(self.parts(q).map_err(|e| self.out_of_table(e))?);
         }
@@ -420,10 +507,10 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
             .map(|(v, x)| (v.name.clone(), *x))
             .collect();
         Ok(Fit {
-            pins: (0..pins).map(|k| nominal[k] + total[k]).collect(),
+            pins: (0..all).map(|k| nominal[k] + total[k]).collect(),
             nominal,
-            zero: [total[pins], total[pins + 1]],
-            work_offset: [total[pins + 2], total[pins + 3], total[pins + 4]],
+            zero: [total[all], total[all + 1]],
+            work_offset: [total[all + 2], total[all + 3], total[all + 4]],
             expressed,
             remaining,
             residual,
