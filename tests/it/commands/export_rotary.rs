@@ -277,6 +277,21 @@ fn misses(m: &Machine, w: &Written, e: &[f64], qs: &[Vec<f64>]) -> (f64, f64) {
     (cal, raw)
 }
 
+/// Every point of a report's grid (machine order, the last axis fastest).
+fn grid_points(nodes: &[(String, Vec<f64>)]) -> Vec<Vec<f64>> {
+    let total: usize = nodes.iter().map(|(_, g)| g.len()).product();
+    (0..total)
+        .map(|mut idx| {
+            let mut q = vec![0.0; nodes.len()];
+            for (k, (_, g)) in nodes.iter().enumerate().rev() {
+                q[k] = g[idx % g.len()];
+                idx /= g.len();
+            }
+            q
+        })
+        .collect()
+}
+
 fn commands(m: &Machine, count: usize, seed: u64) -> Vec<Vec<f64>> {
     let mut rng = Rng::new(seed);
     let opts = options(m);
@@ -362,17 +377,7 @@ fn tilts_remain_and_the_report_says_how_much() {
     }
     // The report's grid, every point.
     let nodes = &r.check_grid;
-    let total: usize = nodes.iter().map(|(_, g)| g.len()).product();
-    let qs: Vec<Vec<f64>> = (0..total)
-        .map(|mut idx| {
-            let mut q = vec![0.0; nodes.len()];
-            for (k, (_, g)) in nodes.iter().enumerate().rev() {
-                q[k] = g[idx % g.len()];
-                idx /= g.len();
-            }
-            q
-        })
-        .collect();
+    let qs = grid_points(nodes);
     let (cal, raw) = misses(&m, &w, &e, &qs);
     let stated = r.residual.position;
     assert!(stated > 1e-3 && stated < 0.5 * raw, "{stated} of {raw}");
@@ -842,17 +847,7 @@ fn the_siemens_record_holds_positions_directions_and_zeros() {
     // The sphere example's truth: what remains is stated.
     let (export, e) = carr_run(&m, &TRUTH);
     let nodes = &export.report.check_grid;
-    let total: usize = nodes.iter().map(|(_, g)| g.len()).product();
-    let qs: Vec<Vec<f64>> = (0..total)
-        .map(|mut idx| {
-            let mut q = vec![0.0; nodes.len()];
-            for (k, (_, g)) in nodes.iter().enumerate().rev() {
-                q[k] = g[idx % g.len()];
-                idx /= g.len();
-            }
-            q
-        })
-        .collect();
+    let qs = grid_points(nodes);
     let (cal, raw) = carr_misses(&m, &export, &e, &qs);
     let stated = export.report.residual.position;
     assert!(

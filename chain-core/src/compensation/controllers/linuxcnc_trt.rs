@@ -27,10 +27,8 @@ use serde::Serialize;
 use crate::compensation::{opening_line, ExportedFile};
 use crate::model_trait::ErrorModel;
 
-use super::rotary::{
-    KinematicsCorrection, KinematicsParameter, KinematicsReport, TableTable, TrtModel,
-};
-use super::{interpolate_held, num, ControllerError, Export, FormatReport, LINUXCNC_MAX_POINTS};
+use super::rotary::{KinematicsParameter, TableTable, TrtModel, Written};
+use super::{interpolate_held, num, ControllerError, Export, LINUXCNC_MAX_POINTS};
 
 /// `TO_RAD` of LinuxCNC (`rtapi_math.h`: `M_PI / 180`).
 const TO_RAD: f64 = std::f64::consts::PI / 180.0;
@@ -231,54 +229,30 @@ pub(super) fn export<M: ErrorModel + Sync>(
         .filter_map(|v| rotary_comp(tt, v).transpose())
         .collect::<Result<_, _>>()?;
     let held: Vec<String> = comps.iter().flat_map(|c| c.errors.clone()).collect();
-    let mut tried = Vec::new();
-    let mut found = None;
-    'modules: for module in [TrtModule::Xyzac, TrtModule::Xyzbc] {
-        for conventional in [false, true] {
-            let model = Model {
-                module,
-                conventional,
-            };
-            match tt.fit(&model, &held) {
-                Ok(fit) => {
-                    found = Some((model, fit));
-                    break 'modules;
-                }
-                Err(ControllerError::MachineKind { reason, .. }) => tried.push(format!(
-                    "{} with conventional-directions {}: {}",
+    let candidates = [TrtModule::Xyzac, TrtModule::Xyzbc]
+        .into_iter()
+        .flat_map(|module| {
+            [false, true].into_iter().map(move |conventional| {
+                let label = format!(
+                    "{} with conventional-directions {}",
                     module.name(),
-                    u8::from(conventional),
-                    reason.trim_start_matches("its nominal kinematics are not this model's: ")
-                )),
-                Err(e) => return Err(e),
-            }
-        }
-    }
-    let Some((model, fit)) = found else {
-        return Err(ControllerError::MachineKind {
-            controller: tt.controller.name(),
-            takes: tt.controller.capabilities().takes.words(),
-            machine: m.name.clone(),
-            reason: format!(
-                "its nominal kinematics are neither LinuxCNC module's ({})",
-                tried.join("; ")
-            ),
+                    u8::from(conventional)
+                );
+                (
+                    Model {
+                        module,
+                        conventional,
+                    },
+                    label,
+                )
+            })
         });
-    };
+    let none = "its nominal kinematics are neither LinuxCNC module's";
+    let (model, fit) = tt.fit_first(candidates, &held, none)?;
     let module = model.module;
     let nominal = model.pins(&fit.nominal);
     let pins = model.pins(&fit.pins);
-    let var = |i: usize| m.variables[i].name.as_str();
-    let letters = ['X', 'Y', 'Z'];
-    let mut axes: Vec<(String, String)> = (0..3)
-        .map(|k| {
-            let (v, s) = tt.linear[k];
-            let sign = if s < 0.0 { "-" } else { "" };
-            (letters[k].to_string(), format!("{sign}{}", var(v)))
-        })
-        .collect();
-    axes.push((module.tilt().to_string(), var(tt.tilt).to_string()));
-    axes.push(("C".to_string(), var(tt.rotary).to_string()));
+    let axes = tt.axis_names(&module.tilt().to_string(), "C");
     // The controller's own kinematics against themselves: the inverse of
     // the forward over the grid, with the identified pins.
     let round_trip = (tt.grid.iter())
@@ -404,44 +378,17 @@ pub(super) fn export<M: ErrorModel + Sync>(
         });
         resampling = resampling.max(c.resampling);
     }
-    let correction = KinematicsCorrection {
-        model: Box::new(model),
-        nominal: fit.nominal.clone(),
-        pins: fit.pins.clone(),
-        zero: fit.zero,
-        work_offset: fit.work_offset,
-        linear: tt.linear,
-        tilt: tt.tilt,
-        rotary: tt.rotary,
+    let written = Written {
+        module: prefix.to_string(),
+        parameters,
+        notes,
         zero_in_kinematics: false,
         comp: (comps.iter())
             .map(|c| (c.variable, c.nominal.clone(), c.trim.clone()))
             .collect(),
+        resampling,
     };
-    Ok(Export {
-        report: FormatReport {
-            controller: tt.controller,
-            machine: m.name.clone(),
-            files: files.iter().map(|f| f.name.clone()).collect(),
-            axes: Vec::new(),
-            expressed: fit.expressed,
-            remaining: fit.remaining,
-            residual: fit.residual,
-            resampling,
-            check_grid: tt.nodes.clone(),
-            directions: Vec::new(),
-            kinematics: Some(KinematicsReport {
-                module: prefix.to_string(),
-                axes,
-                parameters,
-                notes,
-                residual_rms: fit.residual_rms,
-                residual_at: fit.residual_at,
-            }),
-        },
-        files,
-        correction: Box::new(correction),
-    })
+    Ok(tt.finish(files, model, fit, axes, written))
 }
 
 /// The largest step of a rotary COMP_FILE (degrees).

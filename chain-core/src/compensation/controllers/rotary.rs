@@ -531,6 +531,119 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
     }
 }
 
+/// What a rotary format writes besides its files: its kinematics' name,
+/// the parameters and notes of the report, where its zeros act, its rotary
+/// tables and their resampling.
+pub(crate) struct Written {
+    /// The controller's kinematics, for the report.
+    pub module: String,
+    /// The parameters written (nominal and identified).
+    pub parameters: Vec<KinematicsParameter>,
+    /// What a user must know.
+    pub notes: Vec<String>,
+    /// [`KinematicsCorrection::zero_in_kinematics`].
+    pub zero_in_kinematics: bool,
+    /// Rotary positioning tables: (variable, nominal positions, trims), rad.
+    pub comp: Vec<(usize, Vec<f64>, Vec<f64>)>,
+    /// Their largest resampling difference (rad).
+    pub resampling: f64,
+}
+
+impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
+    /// The first of `candidates` (a model and how to name it) whose nominal
+    /// kinematics are the machine's, fitted ([`TableTable::fit`]); none,
+    /// the machine is refused naming each one's misfit after `none`.
+    pub fn fit_first<T: TrtModel + Copy>(
+        &self,
+        candidates: impl IntoIterator<Item = (T, String)>,
+        elsewhere: &[String],
+        none: &str,
+    ) -> Result<(T, Fit), ControllerError> {
+        let mut tried = Vec::new();
+        for (model, label) in candidates {
+            match self.fit(&model, elsewhere) {
+                Ok(fit) => return Ok((model, fit)),
+                Err(ControllerError::MachineKind { reason, .. }) => tried.push(format!(
+                    "{label}: {}",
+                    reason.trim_start_matches("its nominal kinematics are not this model's: ")
+                )),
+                Err(e) => return Err(e),
+            }
+        }
+        Err(ControllerError::MachineKind {
+            controller: self.controller.name(),
+            takes: self.controller.capabilities().takes.words(),
+            machine: self.machine.name.clone(),
+            reason: format!("{none} ({})", tried.join("; ")),
+        })
+    }
+
+    /// The controller's axes: X, Y, Z as the machine's variables (`-` where
+    /// one is turned) and the two rotary axes under the names given.
+    pub fn axis_names(&self, tilt: &str, rotary: &str) -> Vec<(String, String)> {
+        let var = |i: usize| self.machine.variables[i].name.clone();
+        let mut axes: Vec<(String, String)> = (0..3)
+            .map(|k| {
+                let (v, s) = self.linear[k];
+                let sign = if s < 0.0 { "-" } else { "" };
+                (["X", "Y", "Z"][k].to_string(), format!("{sign}{}", var(v)))
+            })
+            .collect();
+        axes.push((tilt.to_string(), var(self.tilt)));
+        axes.push((rotary.to_string(), var(self.rotary)));
+        axes
+    }
+
+    /// The [`Export`] of a rotary format: its `files`, the report of `fit`
+    /// with what it `written`, and the correction the controller applies
+    /// with `model`.
+    pub fn finish<T: TrtModel + 'static>(
+        &self,
+        files: Vec<crate::compensation::ExportedFile>,
+        model: T,
+        fit: Fit,
+        axes: Vec<(String, String)>,
+        written: Written,
+    ) -> super::Export {
+        let correction = KinematicsCorrection {
+            model: Box::new(model),
+            nominal: fit.nominal.clone(),
+            pins: fit.pins.clone(),
+            zero: fit.zero,
+            work_offset: fit.work_offset,
+            linear: self.linear,
+            tilt: self.tilt,
+            rotary: self.rotary,
+            comp: written.comp,
+            zero_in_kinematics: written.zero_in_kinematics,
+        };
+        super::Export {
+            report: super::FormatReport {
+                controller: self.controller,
+                machine: self.machine.name.clone(),
+                files: files.iter().map(|f| f.name.clone()).collect(),
+                axes: Vec::new(),
+                expressed: fit.expressed,
+                remaining: fit.remaining,
+                residual: fit.residual,
+                resampling: written.resampling,
+                check_grid: self.nodes.clone(),
+                directions: Vec::new(),
+                kinematics: Some(KinematicsReport {
+                    module: written.module,
+                    axes,
+                    parameters: written.parameters,
+                    notes: written.notes,
+                    residual_rms: fit.residual_rms,
+                    residual_at: fit.residual_at,
+                }),
+            },
+            files,
+            correction: Box::new(correction),
+        }
+    }
+}
+
 /// A term named `name` of size 0.
 fn term(name: &str) -> Term {
     Term {

@@ -30,10 +30,8 @@
 use crate::compensation::{opening_line, ExportedFile};
 use crate::model_trait::ErrorModel;
 
-use super::rotary::{
-    KinematicsCorrection, KinematicsParameter, KinematicsReport, TableTable, TrtModel,
-};
-use super::{num, ControllerError, Export, FormatReport};
+use super::rotary::{KinematicsParameter, TableTable, TrtModel, Written};
+use super::{num, ControllerError, Export};
 
 /// The record's model with its entered axis vectors' nominal values: pins
 /// `[l2 (3), l3 (3), v1 (3), v2 (3)]`.
@@ -92,45 +90,18 @@ pub(super) fn export<M: ErrorModel + Sync>(
     let m = tt.machine;
     let axis =
         |k: usize, s: f64| -> [f64; 3] { std::array::from_fn(|i| if i == k { s } else { 0.0 }) };
-    let mut tried = Vec::new();
-    let mut found = None;
-    'records: for v1 in [axis(0, -1.0), axis(0, 1.0), axis(1, -1.0), axis(1, 1.0)] {
-        for v2 in [axis(2, -1.0), axis(2, 1.0)] {
-            let record = Record { v1, v2 };
-            match tt.fit(&record, &[]) {
-                Ok(fit) => {
-                    found = Some((record, fit));
-                    break 'records;
-                }
-                Err(ControllerError::MachineKind { reason, .. }) => {
-                    tried.push(format!("v1 = {v1:?}, v2 = {v2:?}: {reason}"))
-                }
-                Err(e) => return Err(e),
-            }
-        }
-    }
-    let Some((record, fit)) = found else {
-        return Err(ControllerError::MachineKind {
-            controller: tt.controller.name(),
-            takes: tt.controller.capabilities().takes.words(),
-            machine: m.name.clone(),
-            reason: format!(
-                "no swivel data record of type P with axis vectors along the machine's axes reproduces its nominal kinematics ({})",
-                tried.join("; ")
-            ),
+    let candidates = [axis(0, -1.0), axis(0, 1.0), axis(1, -1.0), axis(1, 1.0)]
+        .into_iter()
+        .flat_map(|v1| {
+            [axis(2, -1.0), axis(2, 1.0)]
+                .into_iter()
+                .map(move |v2| (Record { v1, v2 }, format!("v1 = {v1:?}, v2 = {v2:?}")))
         });
-    };
+    let none = "no swivel data record of type P with axis vectors along the machine's axes reproduces its nominal kinematics";
+    let (record, fit) = tt.fit_first(candidates, &[], none)?;
     let var = |i: usize| m.variables[i].name.as_str();
     let letters = ['X', 'Y', 'Z'];
-    let mut axes: Vec<(String, String)> = (0..3)
-        .map(|k| {
-            let (v, s) = tt.linear[k];
-            let sign = if s < 0.0 { "-" } else { "" };
-            (letters[k].to_string(), format!("{sign}{}", var(v)))
-        })
-        .collect();
-    axes.push(("rotary axis 1".to_string(), var(tt.tilt).to_string()));
-    axes.push(("rotary axis 2".to_string(), var(tt.rotary).to_string()));
+    let axes = tt.axis_names("rotary axis 1", "rotary axis 2");
     let l4 = |p: &[f64]| -> [f64; 3] { std::array::from_fn(|i| -(p[i] + p[3 + i])) };
     let (n4, i4) = (l4(&fit.nominal), l4(&fit.pins));
     let mut parameters = Vec::new();
@@ -215,40 +186,13 @@ pub(super) fn export<M: ErrorModel + Sync>(
         name: "TC_CARR.SPF".into(),
         text,
     }];
-    let correction = KinematicsCorrection {
-        model: Box::new(record),
-        nominal: fit.nominal.clone(),
-        pins: fit.pins.clone(),
-        zero: fit.zero,
-        work_offset: fit.work_offset,
-        linear: tt.linear,
-        tilt: tt.tilt,
-        rotary: tt.rotary,
+    let written = Written {
+        module: "$TC_CARR (type P)".to_string(),
+        parameters,
+        notes,
         zero_in_kinematics: true,
         comp: Vec::new(),
+        resampling: 0.0,
     };
-    Ok(Export {
-        report: FormatReport {
-            controller: tt.controller,
-            machine: m.name.clone(),
-            files: files.iter().map(|f| f.name.clone()).collect(),
-            axes: Vec::new(),
-            expressed: fit.expressed,
-            remaining: fit.remaining,
-            residual: fit.residual,
-            resampling: 0.0,
-            check_grid: tt.nodes.clone(),
-            directions: Vec::new(),
-            kinematics: Some(KinematicsReport {
-                module: "$TC_CARR (type P)".to_string(),
-                axes,
-                parameters,
-                notes,
-                residual_rms: fit.residual_rms,
-                residual_at: fit.residual_at,
-            }),
-        },
-        files,
-        correction: Box::new(correction),
-    })
+    Ok(tt.finish(files, record, fit, axes, written))
 }
