@@ -323,6 +323,9 @@ pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
                     "a per-axis table samples each axis over its travel: give the travel with --grid VAR=LO,HI and the table step with --step; --axes gives the nodes of --controller grid",
                 );
             }
+            if request.step.is_some() && !step_applies(c) {
+                return refuse("--step", STEP_WHY);
+            }
             let limit = c.capabilities().limit;
             if request.cec_max_points.is_some() && limit != Some(Limit::CecPoints) {
                 return refuse("--cec-max-points", "it limits the siemens-cec tables");
@@ -333,6 +336,19 @@ pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
         }
     }
     Ok(())
+}
+
+/// Why a rotary format takes no table step.
+pub const STEP_WHY: &str = "a rotary format fits its controller's kinematics over each axis's travel (--grid VAR=LO,HI) and steps its rotary COMP_FILEs every 2°";
+
+/// Whether a table step acts on `controller`'s export: the per-axis
+/// formats sample each axis at it; the rotary formats (a table-table
+/// machine) fit over the travel.
+pub fn step_applies(controller: Controller) -> bool {
+    matches!(
+        controller.capabilities().takes,
+        chain_core::compensation::controllers::Takes::LinearAxes { .. }
+    )
 }
 
 /// Runs `chain export` of `machine` (`file` names it) with `values` (read

@@ -101,9 +101,15 @@ pub enum MapOpsError {
         /// What went wrong.
         error: Box<MapError>,
     },
-    /// `--compensation-step` with the grid correction.
-    #[error("--compensated grid does not take --compensation-step")]
-    StepWithGrid,
+    /// `--compensation-step` with a correction that takes no table step
+    /// (the grid correction, a rotary format).
+    #[error("--compensated {controller} does not take --compensation-step")]
+    Step {
+        /// The correction.
+        controller: &'static str,
+        /// Why not, and what to give instead.
+        why: &'static str,
+    },
     /// The compensation's export.
     #[error(transparent)]
     Export(Box<ExportOpsError>),
@@ -142,7 +148,7 @@ impl Worded for MapOpsError {
                 MapError::NoPoints => "chain::map::no_points",
                 _ => "chain::map::points",
             }),
-            MapOpsError::StepWithGrid => Some("chain::map::option"),
+            MapOpsError::Step { .. } => Some("chain::map::option"),
             MapOpsError::Export(e) => e.own_code(),
             _ => None,
         }
@@ -160,10 +166,7 @@ impl Worded for MapOpsError {
                 }
                 _ => None,
             },
-            MapOpsError::StepWithGrid => Some(
-                "the grid correction is exported at the nodes of --compensation-grid VAR=LO:HI:N"
-                    .into(),
-            ),
+            MapOpsError::Step { why, .. } => Some(why.to_string()),
             MapOpsError::Export(e) => e.own_help(),
             MapOpsError::Resolve(e) => e.own_help(),
             _ => None,
@@ -408,6 +411,10 @@ impl PreparedMap {
         };
         let controller = c.controller.name();
         if let ExportController::Tables(tables) = c.controller {
+            if c.step.is_some() && !export::step_applies(tables) {
+                let why = export::STEP_WHY;
+                return Err(MapOpsError::Step { controller, why });
+            }
             // The map's own range of an axis, where it is one (a single
             // value keeps the machine file's travel); the compensation grid
             // over it.
@@ -454,7 +461,9 @@ impl PreparedMap {
             });
         }
         if c.step.is_some() {
-            return Err(MapOpsError::StepWithGrid);
+            let why =
+                "the grid correction is exported at the nodes of --compensation-grid VAR=LO:HI:N";
+            return Err(MapOpsError::Step { controller, why });
         }
         // The correction grid: the map's (or the file's), each axis
         // replaceable.

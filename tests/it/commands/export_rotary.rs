@@ -486,6 +486,13 @@ fn the_cli_writes_and_refuses() {
             && e.contains("it has 3 linear and 0 rotary axes"),
         "{e}"
     );
+    let mut stepped = export_args("siemens-carr");
+    stepped.extend(["--step", "5"]);
+    let e = unwrapped(&fails(&stepped));
+    assert!(
+        e.contains("--controller siemens-carr does not take --step") && e.contains("every 2°"),
+        "{e}"
+    );
     let e = unwrapped(&fails(&export_args("linuxcnc")));
     assert!(
         e.contains(
@@ -507,6 +514,16 @@ fn the_cli_writes_and_refuses() {
         "--grid",
         "C=0,1.5,3,4.5",
     ]);
+    let stepped = [
+        map.clone(),
+        vec!["--compensated", "siemens-carr", "--compensation-step", "5"],
+    ]
+    .concat();
+    let e = unwrapped(&fails(&stepped));
+    assert!(
+        e.contains("--compensated siemens-carr does not take --compensation-step"),
+        "{e}"
+    );
     let before = ok_json(&[map.clone(), vec!["--format", "json"]].concat());
     let after = ok_json(
         &[
