@@ -68,8 +68,19 @@ fn options(m: &Machine) -> ExportOptions {
     }
 }
 
-/// The export of `errors` (name, value) on `m`, and the true error vector.
+/// The `linuxcnc-trt` export of `errors` (name, value) on `m`, and the
+/// true error vector.
 fn run(m: &Machine, errors: &[(&str, f64)]) -> (Export, Vec<f64>) {
+    run_for(Controller::LinuxcncTrt, m, errors)
+}
+
+/// [`run`] for `siemens-carr`.
+fn carr_run(m: &Machine, errors: &[(&str, f64)]) -> (Export, Vec<f64>) {
+    run_for(Controller::SiemensCarr, m, errors)
+}
+
+/// The export of `errors` on `m` for `controller`, and the true errors.
+fn run_for(controller: Controller, m: &Machine, errors: &[(&str, f64)]) -> (Export, Vec<f64>) {
     let mut b = ValuesBuilder::new(m);
     let mut e = vec![0.0; m.errors.len()];
     for &(n, v) in errors {
@@ -78,7 +89,9 @@ fn run(m: &Machine, errors: &[(&str, f64)]) -> (Export, Vec<f64>) {
     }
     let p: Vec<f64> = m.parameters.iter().map(|p| p.value.unwrap()).collect();
     let built = BuiltMachine::compile(m, b.build(), p).unwrap();
-    let export = export(Controller::LinuxcncTrt, &built, m, &options(m)).unwrap();
+    let mut options = options(m);
+    options.provenance = format!("chain export --controller {}", controller.name());
+    let export = export(controller, &built, m, &options).unwrap();
     (export, e)
 }
 
@@ -809,21 +822,6 @@ fn carr_misses(m: &Machine, export: &Export, e: &[f64], qs: &[Vec<f64>]) -> (f64
         raw = raw.max(miss(at(q)));
     }
     (cal, raw)
-}
-
-fn carr_run(m: &Machine, errors: &[(&str, f64)]) -> (Export, Vec<f64>) {
-    let mut b = ValuesBuilder::new(m);
-    let mut e = vec![0.0; m.errors.len()];
-    for &(n, v) in errors {
-        b.constant(n, v).unwrap();
-        e[m.error_index(n).unwrap()] = v;
-    }
-    let p: Vec<f64> = m.parameters.iter().map(|p| p.value.unwrap()).collect();
-    let built = BuiltMachine::compile(m, b.build(), p).unwrap();
-    let mut options = options(m);
-    options.provenance = "chain export --controller siemens-carr".into();
-    let export = export(Controller::SiemensCarr, &built, m, &options).unwrap();
-    (export, e)
 }
 
 /// SINUMERIK's swivel data record holds the axis lines' positions, their
