@@ -433,16 +433,7 @@ pub fn export<M: ErrorModel + Sync>(
     if count == 0 {
         return Err(CompensationError::NoPoints);
     }
-    // Kinematics' parameters by name from the model's.
-    let model_params = built.model().parameters();
-    let params: Vec<f64> = (kin.parameters().iter())
-        .map(|(n, _)| {
-            model_params
-                .iter()
-                .position(|m| m == n)
-                .map_or(f64::NAN, |i| built.parameters()[i])
-        })
-        .collect();
+    let params = super::kinematics_parameters(kin, built);
     let mut deltas = vec![0.0; count * nv];
     let mut residuals = vec![0.0; count];
     let residual = Residual::new(built);

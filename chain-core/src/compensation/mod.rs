@@ -261,6 +261,22 @@ pub(crate) fn opening_line(provenance: &str, rest: &str) -> String {
     }
 }
 
+/// The values of `kin`'s parameters from `built`'s, by name (NaN for one
+/// the model does not have).
+pub(crate) fn kinematics_parameters<M: ErrorModel>(
+    kin: &crate::kinematics::forward::Kinematics,
+    built: &BuiltMachine<M>,
+) -> Vec<f64> {
+    let model = built.model().parameters();
+    (kin.parameters().iter())
+        .map(|(n, _)| {
+            (model.iter())
+                .position(|m| m == n)
+                .map_or(f64::NAN, |i| built.parameters()[i])
+        })
+        .collect()
+}
+
 /// `r · v`.
 pub(crate) fn apply(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
     std::array::from_fn(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2])

@@ -510,20 +510,7 @@ impl Measurements {
             &csv.header_origin(),
         )
         .map_err(fail)?;
-        let mut problems = Vec::new();
-        let mut rows = Vec::with_capacity(csv.len());
-        for cells in csv.rows() {
-            match columns.record(&cells) {
-                Ok(row) => rows.push(row),
-                Err(p) => problems.push(*p),
-            }
-            if problems.len() >= 20 {
-                break;
-            }
-        }
-        if !problems.is_empty() {
-            return Err(fail(problems));
-        }
+        let rows = csv.read_rows(|cells| columns.record(cells)).map_err(fail)?;
         if rows.is_empty() {
             let empty = P::NoRows { layout }.into();
             return Err(fail(vec![(csv.header_origin(), empty)]));

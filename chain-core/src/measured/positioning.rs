@@ -287,21 +287,8 @@ impl Runs {
             RunsFileError(Diagnostics::located(file, text, problems).expect("a problem"))
         };
         let columns = RunColumns::classify(&csv).map_err(fail)?;
-        let mut problems: Vec<(Origin, Problem)> = Vec::new();
         // (target, direction, run) → (value, origin of the row's first cell).
-        let mut cells: Vec<Cell> = Vec::with_capacity(csv.len());
-        for row in csv.rows() {
-            match columns.cell(&row) {
-                Ok(c) => cells.push(c),
-                Err(p) => problems.push(*p),
-            }
-            if problems.len() >= 20 {
-                break;
-            }
-        }
-        if !problems.is_empty() {
-            return Err(fail(problems));
-        }
+        let cells: Vec<Cell> = csv.read_rows(|row| columns.cell(row)).map_err(fail)?;
         group(cells, kind, file).map_err(|p| fail(vec![*p]))
     }
 }

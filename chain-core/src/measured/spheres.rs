@@ -102,44 +102,35 @@ impl Measurements {
         let columns = SphereColumns::classify(machine, overrides, &csv.header, &header_origin)
             .map_err(fail)?;
         let chain = ExactChain::new(machine);
-        let mut problems: Vec<(Origin, Problem)> = Vec::new();
-        let mut rows = Vec::with_capacity(csv.len());
         let mut setups: Vec<Setup> = Vec::new();
         let mut first_line: BTreeMap<usize, Origin> = BTreeMap::new();
         let mut counts: Vec<usize> = Vec::new();
-        for cells in csv.rows() {
-            match columns.record(&chain, &cells) {
-                Ok((mut record, id)) => {
-                    let g = match setups.iter().position(|s| s.name == id) {
-                        Some(g) => g,
-                        None => {
-                            setups.push(Setup {
-                                name: id,
-                                kind: SetupKind::Sphere,
-                            });
-                            counts.push(0);
-                            setups.len() - 1
-                        }
-                    };
-                    counts[g] += 1;
-                    first_line.entry(g).or_insert_with(|| {
-                        cells.first().map_or(header_origin.clone(), |c| c.1.clone())
-                    });
-                    record.setup = Some(g);
-                    rows.push(record);
-                }
-                Err(p) => problems.push(*p),
-            }
-            if problems.len() >= 20 {
-                break;
-            }
-        }
-        if !problems.is_empty() {
-            return Err(fail(problems));
-        }
+        let rows = csv
+            .read_rows(|cells| {
+                let (mut record, id) = columns.record(&chain, cells)?;
+                let g = match setups.iter().position(|s| s.name == id) {
+                    Some(g) => g,
+                    None => {
+                        setups.push(Setup {
+                            name: id,
+                            kind: SetupKind::Sphere,
+                        });
+                        counts.push(0);
+                        setups.len() - 1
+                    }
+                };
+                counts[g] += 1;
+                first_line.entry(g).or_insert_with(|| {
+                    cells.first().map_or(header_origin.clone(), |c| c.1.clone())
+                });
+                record.setup = Some(g);
+                Ok(record)
+            })
+            .map_err(fail)?;
         if rows.is_empty() {
             return Err(fail(vec![(header_origin, P::SphereNoRows.into())]));
         }
+        let mut problems: Vec<(Origin, Problem)> = Vec::new();
         for (g, &count) in counts.iter().enumerate() {
             if count < MIN_PROBINGS {
                 let problem = P::SphereTooFew {

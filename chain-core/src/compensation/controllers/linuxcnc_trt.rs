@@ -429,16 +429,7 @@ fn rotary_comp<M: ErrorModel + Sync>(
         return Ok(None);
     };
     let slot = 3 + joint.axis.axis.index();
-    let mut errors: Vec<String> = Vec::new();
-    for &j in &body.errors.slots[slot] {
-        let name = match m.coefficient_of(j) {
-            Some((f, _)) => f.name.clone(),
-            None => m.errors[j].name.clone(),
-        };
-        if !errors.contains(&name) {
-            errors.push(name);
-        }
-    }
+    let errors = super::slot_motions(m, &body.errors.slots[slot]);
     if errors.is_empty() {
         return Ok(None);
     }

@@ -690,34 +690,12 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
                 reason: format!("body `{}` has a fixed rotation", b.name),
             });
         }
-        let to_built: Vec<usize> = machine
-            .variables
-            .iter()
-            .map(|v| {
-                built
-                    .variables()
-                    .iter()
-                    .position(|b| *b == v.name)
-                    .unwrap_or(usize::MAX)
-            })
-            .collect();
+        let to_built = built_order(machine, built);
         let travels = travels(machine, options)?;
         let reference: Vec<f64> = travels.iter().map(|t| t.0).collect();
         // The nominal Jacobian at the reference point.
         let kin = Kinematics::from_machine(machine);
-        let p: Vec<f64> = kin
-            .parameters()
-            .iter()
-            .map(|(n, _)| {
-                built
-                    .model()
-                    .parameters()
-                    .iter()
-                    .position(|m| m == n)
-                    .map(|k| built.parameters()[k])
-                    .unwrap_or(f64::NAN)
-            })
-            .collect();
+        let p = crate::compensation::kinematics_parameters(&kin, built);
         let jac = kin.jacobian(&reference, &p);
         let rot = kin.pose(&reference, &p).rotation;
         let mut used = [false; 3];
@@ -727,11 +705,8 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
             if machine.frame == crate::model::Frame::Tool {
                 col = std::array::from_fn(|r| (0..3).map(|c| rot[c][r] * col[c]).sum());
             }
-            let k = (0..3)
-                .max_by(|&a, &b| col[a].abs().total_cmp(&col[b].abs()))
-                .unwrap_or(0);
-            let off: f64 = (0..3).filter(|&c| c != k).map(|c| col[c].abs()).sum();
-            if (col[k].abs() - 1.0).abs() > 1e-9 || off > 1e-9 || used[k] {
+            let aligned = along_one_axis(col).filter(|&(k, _)| !used[k]);
+            let Some((k, sign)) = aligned else {
                 return Err(ControllerError::NotAligned {
                     controller: name,
                     reason: format!(
@@ -739,7 +714,7 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
                         v.name, col[0], col[1], col[2]
                     ),
                 });
-            }
+            };
             used[k] = true;
             let body = v.body;
             let joint = machine.bodies[body]
@@ -748,19 +723,7 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
                 .map(|j| j.axis.axis.index());
             let mut motions: Vec<SlotMotion> = Vec::new();
             for (s, slot) in machine.bodies[body].errors.slots.iter().enumerate() {
-                let mut names: Vec<String> = Vec::new();
-                for &j in slot {
-                    if machine.errors[j].kind == ErrorKind::Squareness {
-                        continue;
-                    }
-                    let n = match machine.coefficient_of(j) {
-                        Some((f, _)) => f.name.clone(),
-                        None => machine.errors[j].name.clone(),
-                    };
-                    if !names.contains(&n) {
-                        names.push(n);
-                    }
-                }
+                let mut names = slot_motions(machine, slot);
                 if names.len() > 1 {
                     return Err(ControllerError::SharedSlot {
                         controller: name,
@@ -789,7 +752,7 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
                 variable: i,
                 name: v.name.clone(),
                 frame_axis: k,
-                sign: col[k].signum(),
+                sign,
                 body,
                 joint_axis: joint.unwrap_or(k),
                 motions,
@@ -815,13 +778,7 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
 
     /// Machine-ordered `q` in the built model's variable order.
     pub fn built_q(&self, q: &[f64]) -> Vec<f64> {
-        let mut qb = vec![0.0; q.len()];
-        for (i, &b) in self.to_built.iter().enumerate() {
-            if let Some(x) = qb.get_mut(b) {
-                *x = q[i];
-            }
-        }
-        qb
+        in_built_order(&self.to_built, q)
     }
 
     /// The built machine's parts at machine-ordered `q`, by name.
@@ -1105,6 +1062,60 @@ pub(crate) fn travels(
         travels.push((lo, hi));
     }
     Ok(travels)
+}
+
+/// Machine variable index → the built model's index of the same name
+/// (`usize::MAX` for one the model lacks).
+pub(crate) fn built_order<M: ErrorModel>(machine: &Machine, built: &BuiltMachine<M>) -> Vec<usize> {
+    (machine.variables.iter())
+        .map(|v| {
+            (built.variables().iter())
+                .position(|b| *b == v.name)
+                .unwrap_or(usize::MAX)
+        })
+        .collect()
+}
+
+/// Machine-ordered `q` in the built model's order ([`built_order`]).
+pub(crate) fn in_built_order(to_built: &[usize], q: &[f64]) -> Vec<f64> {
+    let mut qb = vec![0.0; q.len()];
+    for (i, &b) in to_built.iter().enumerate() {
+        if let Some(x) = qb.get_mut(b) {
+            *x = q[i];
+        }
+    }
+    qb
+}
+
+/// The frame axis (0, 1, 2) and sign of a tool-point column that moves
+/// the tool point along one axis by exactly its own length (to 1e-9), else
+/// `None`: an axis a per-axis table or a controller's joint can stand for.
+pub(crate) fn along_one_axis(col: [f64; 3]) -> Option<(usize, f64)> {
+    let k = (0..3)
+        .max_by(|&a, &b| col[a].abs().total_cmp(&col[b].abs()))
+        .unwrap_or(0);
+    let off: f64 = (0..3).filter(|&c| c != k).map(|c| col[c].abs()).sum();
+    ((col[k].abs() - 1.0).abs() <= 1e-9 && off <= 1e-9).then(|| (k, col[k].signum()))
+}
+
+/// The error motions of an error slot (its error parameters, a function
+/// slot's coefficients by the function's name), each once, squareness left
+/// out.
+pub(crate) fn slot_motions(machine: &Machine, slot: &[usize]) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    for &j in slot {
+        if machine.errors[j].kind == ErrorKind::Squareness {
+            continue;
+        }
+        let n = match machine.coefficient_of(j) {
+            Some((f, _)) => f.name.clone(),
+            None => machine.errors[j].name.clone(),
+        };
+        if !names.contains(&n) {
+            names.push(n);
+        }
+    }
+    names
 }
 
 /// What [`Context::account`] finds over the check grid.

@@ -39,7 +39,10 @@ use crate::kinematics::forward::Kinematics;
 use crate::model::{Frame, JointKind, Machine};
 use crate::model_trait::{ErrorModel, OutOfRange};
 
-use super::{travels, Controller, ControllerError, ExportOptions, Term};
+use super::{
+    along_one_axis, built_order, in_built_order, travels, Controller, ControllerError,
+    ExportOptions, Term,
+};
 
 /// Nodes per linear axis in the fit grid.
 const LINEAR_NODES: usize = 5;
@@ -231,38 +234,22 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
             (rotary[1], rotary[0])
         };
         let kin = Kinematics::from_machine(machine);
-        let params: Vec<f64> = (kin.parameters().iter())
-            .map(|(n, _)| {
-                (built.model().parameters().iter())
-                    .position(|m| m == n)
-                    .map(|k| built.parameters()[k])
-                    .unwrap_or(f64::NAN)
-            })
-            .collect();
+        let params = crate::compensation::kinematics_parameters(&kin, built);
         let zero = vec![0.0; vars.len()];
         let jac = kin.jacobian(&zero, &params);
         let mut linear = [(usize::MAX, 0.0); 3];
         for i in (0..vars.len()).filter(|i| !rotary.contains(i)) {
             let col = [jac[i][0], jac[i][1], jac[i][2]];
-            let k = (0..3)
-                .max_by(|&a, &b| col[a].abs().total_cmp(&col[b].abs()))
-                .unwrap_or(0);
-            let off: f64 = (0..3).filter(|&c| c != k).map(|c| col[c].abs()).sum();
-            if (col[k].abs() - 1.0).abs() > 1e-9 || off > 1e-9 || linear[k].0 != usize::MAX {
+            let aligned = along_one_axis(col).filter(|&(k, _)| linear[k].0 == usize::MAX);
+            let Some((k, sign)) = aligned else {
                 return Err(not(format!(
                     "axis `{}` moves the tool point along ({:.6}, {:.6}, {:.6}) per mm at zero",
                     vars[i].name, col[0], col[1], col[2]
                 )));
-            }
-            linear[k] = (i, col[k].signum());
+            };
+            linear[k] = (i, sign);
         }
-        let to_built: Vec<usize> = (vars.iter())
-            .map(|v| {
-                (built.variables().iter())
-                    .position(|b| *b == v.name)
-                    .unwrap_or(usize::MAX)
-            })
-            .collect();
+        let to_built = built_order(machine, built);
         let p0 = kin.pose(&zero, &params).position;
         let travel = travels(machine, options)?;
         let nodes: Vec<(String, Vec<f64>)> = (vars.iter().zip(&travel))
@@ -324,13 +311,7 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
     /// The built machine's parts at `q`, their errors in the workpiece
     /// frame.
     pub fn parts(&self, q: &[f64]) -> Result<Vec<Part>, OutOfRange> {
-        let mut qb = vec![0.0; q.len()];
-        for (i, &b) in self.to_built.iter().enumerate() {
-            if let Some(x) = qb.get_mut(b) {
-                *x = q[i];
-            }
-        }
-        let mut parts = self.built.parts(&qb)?;
+        let mut parts = self.built.parts(&in_built_order(&self.to_built, q))?;
         if self.machine.frame == Frame::Tool {
             let r = self.kin.pose(q, &self.params).rotation;
             for part in &mut parts {

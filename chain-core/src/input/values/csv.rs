@@ -10,7 +10,11 @@
 
 use std::path::Path;
 
-use crate::diagnostic::Diagnostics;
+use crate::diagnostic::{Diagnostics, Problem};
+
+/// The most refused rows a reader of a CSV file reports
+/// ([`CsvFile::read_rows`]).
+pub const MAX_ROW_PROBLEMS: usize = 20;
 use crate::model::Origin;
 use crate::tabular::CsvProblem;
 
@@ -238,6 +242,31 @@ impl CsvFile {
     /// Whether there is no data row (never, for a parsed file).
     pub fn is_empty(&self) -> bool {
         self.lines.is_empty()
+    }
+
+    /// Every data row read by `read`, in order; or the problems of the rows
+    /// it refuses, in file order, at most [`MAX_ROW_PROBLEMS`] (a reader
+    /// reports the first ones rather than every row of a broken file).
+    pub fn read_rows<T>(
+        &self,
+        mut read: impl FnMut(&[(String, Origin)]) -> Result<T, Box<(Origin, Problem)>>,
+    ) -> Result<Vec<T>, Vec<(Origin, Problem)>> {
+        let mut rows = Vec::with_capacity(self.len());
+        let mut problems = Vec::new();
+        for cells in self.rows() {
+            match read(&cells) {
+                Ok(row) => rows.push(row),
+                Err(p) => problems.push(*p),
+            }
+            if problems.len() >= MAX_ROW_PROBLEMS {
+                break;
+            }
+        }
+        if problems.is_empty() {
+            Ok(rows)
+        } else {
+            Err(problems)
+        }
     }
 
     /// The data rows in order, each as its cells' texts and origins (key:
