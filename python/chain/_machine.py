@@ -438,18 +438,22 @@ class Machine:
         beckhoff_max_records: Optional[int] = None,
         params: Params = None,
         out: Union[None, str, "os.PathLike[str]"] = None,
+        angles: bool = False,
     ) -> "ExportResult":
         """Compensation for a controller, ``chain export --values VALUES --controller NAME --format json``.
 
         ``values`` as for :meth:`map`. ``controller``: ``"grid"`` (the
         universal grid CSV), ``"beckhoff"``, ``"linuxcnc"``,
-        ``"siemens-cec"`` or ``"klipper"``. ``grid``: the grid's nodes
-        (``grid``) or each axis's travel (the per-axis tables), ``--grid``;
-        ``points``: the grid export's nodes as an ``(N, V)`` array
-        (``--axes``); ``step``, ``cec_max_points``, ``beckhoff_max_records``:
-        the per-axis tables' options. The result's ``files`` maps each file's
-        name to its text; ``out``: also write them into that folder (created
-        if missing), as ``--out DIR``.
+        ``"siemens-cec"``, ``"klipper"``, or a rotary format of a
+        table-table machine: ``"linuxcnc-trt"``, ``"heidenhain"``,
+        ``"siemens-carr"``, ``"fanuc-tcp"``. ``grid``: the grid's nodes
+        (``grid``) or each axis's travel (the per-axis tables and rotary
+        formats), ``--grid``; ``points``: the grid export's nodes as an
+        ``(N, V)`` array (``--axes``); ``step``, ``cec_max_points``,
+        ``beckhoff_max_records``: the per-axis tables' options; ``angles``:
+        heidenhain's angle rows (``--angles``). The result's ``files`` maps
+        each file's name to its text; ``out``: also write them into that
+        folder (created if missing), as ``--out DIR``.
         """
         from ._results import ExportResult
 
@@ -461,7 +465,8 @@ class Machine:
             raise ValueError(f"controller must be a str, not {type(controller).__name__}")
         doc, files = _chain.export_json(
             self._model, path, text, name, controller, _grid_axes(grid), q,
-            _optional_float(step, "step"), cec_max_points, beckhoff_max_records, _params(params),
+            _optional_float(step, "step"), cec_max_points, beckhoff_max_records,
+            _bool(angles, "angles"), _params(params),
         )
         result = ExportResult._from_json(doc)
         result.__dict__["files"] = dict(files)
@@ -846,6 +851,13 @@ def _csv_input(data: Any, what: str, text_columns: Sequence[str] = ()) -> Tuple[
     for i in range(n or 0):
         lines.append(",".join(c[i] if isinstance(c, list) else repr(float(c[i])) for c in columns))
     return None, "\n".join(lines) + "\n"
+
+
+def _bool(x: Any, name: str) -> bool:
+    """``x`` when it is a bool; anything else raises ValueError naming ``name``."""
+    if not isinstance(x, bool):
+        raise ValueError(f"{name} must be True or False, not {x!r}")
+    return x
 
 
 def _optional_float(x: Any, name: str) -> Optional[float]:

@@ -14,10 +14,10 @@ use crate::{choice, resolve_error, study_error, to_json, value_error, Model};
 /// The compensation of the built machine `values` (a file `values_path`,
 /// or the text `values_text` named `values_file`) for `controller`; `grid`,
 /// `points` (rows in the machine's variable order, `--axes`), `step`,
-/// `cec_max_points`, `beckhoff_max_records` and `params` as the CLI's
+/// `cec_max_points`, `beckhoff_max_records`, `angles` and `params` as the CLI's
 /// options. Returns the summary document and the files `(name, text)`.
 #[pyfunction]
-#[pyo3(signature = (model, values_path, values_text, values_file, controller, grid, points, step, cec_max_points, beckhoff_max_records, params))]
+#[pyo3(signature = (model, values_path, values_text, values_file, controller, grid, points, step, cec_max_points, beckhoff_max_records, angles, params))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn export_json(
     py: Python<'_>,
@@ -31,6 +31,7 @@ pub(crate) fn export_json(
     step: Option<f64>,
     cec_max_points: Option<usize>,
     beckhoff_max_records: Option<usize>,
+    angles: bool,
     params: Vec<(String, f64)>,
 ) -> PyResult<(String, Vec<(String, String)>)> {
     let controller = choice::<ExportController>(controller)?;
@@ -46,6 +47,7 @@ pub(crate) fn export_json(
         step,
         cec_max_points,
         beckhoff_max_records,
+        angles,
     };
     let refused = |e: ExportOpsError| match e {
         ExportOpsError::Reliability(e) => study_error(py, &e, &model.file),

@@ -30,23 +30,37 @@ def test_export_is_the_cli_s(cli, controller, tmp_path):
         assert set(m.variables) <= set(frame[0])
 
 
-@pytest.mark.parametrize("controller,files,module", [
-    ("linuxcnc-trt", ["xyzac-trt-kins-README.txt", "xyzac-trt-kins.hal"], "xyzac-trt-kins"),
-    ("siemens-carr", ["TC_CARR.SPF"], "$TC_CARR (type P)"),
+@pytest.mark.parametrize("controller,files,module,angles", [
+    ("linuxcnc-trt", ["xyzac-trt-kins-README.txt", "xyzac-trt-kins.hal"], "xyzac-trt-kins", False),
+    ("heidenhain", ["KINEMATICS_ROTARY-README.txt", "KINEMATICS_ROTARY.TAB"],
+     "kinematics description (Trans rows of the rotary axes)", False),
+    ("heidenhain", ["KINEMATICS_ROTARY-README.txt", "KINEMATICS_ROTARY.TAB"],
+     "kinematics description (Trans rows of the rotary axes)", True),
+    ("siemens-carr", ["TC_CARR.SPF"], "$TC_CARR (type P)", False),
+    ("fanuc-tcp", ["TCP-README.txt", "TCP.PRM"], "tool centre point control, table rotation type (19680 = 12)", False),
 ])
-def test_rotary_export_is_the_cli_s(cli, cli_error, tmp_path, controller, files, module):
+def test_rotary_export_is_the_cli_s(cli, cli_error, tmp_path, controller, files, module, angles):
     """The rotary formats from the sphere example's true location errors: the CLI's JSON and files."""
     machine = ROOT / "examples/machines/ac_trunnion_rotary.yaml"
     values = ROOT / "examples/spheres/truth.yaml"
     tau = 6.283185307179586
     grid = {"x": [-100.0, 100.0], "y": [-100.0, 100.0], "z": [-100.0, 0.0], "A": [-1.0, 1.0], "C": [0.0, tau]}
-    got = chain.Machine.load(machine).export(values, controller=controller, grid=grid, out=tmp_path / "out")
+    got = chain.Machine.load(machine).export(values, controller=controller, grid=grid, out=tmp_path / "out",
+                                             angles=angles)
     args = [a for k, v in grid.items() for a in ("--grid", f"{k}={v[0]!r},{v[1]!r}")]
+    args += ["--angles"] if angles else []
     assert got.to_dict() == cli("export", machine, "--values", values, "--controller", controller, *args)
     assert got.to_dict()["kinematics"]["module"] == module
     assert sorted(got.files) == files
     for name, text in got.files.items():
         assert (tmp_path / "out" / name).read_text() == text
+    if controller != "heidenhain":
+        with pytest.raises(ValueError) as info:
+            chain.Machine.load(machine).export(values, controller=controller, grid=grid, angles=True)
+        assert flat(str(info.value)) in flat(cli_error("export", machine, "--values", values, "--controller",
+                                                       controller, *args, "--angles"))
+    with pytest.raises(ValueError, match="angles must be True or False"):
+        chain.Machine.load(machine).export(values, controller=controller, grid=grid, angles=1)
     with pytest.raises(ValueError) as info:
         chain.Machine.load(MACHINE).export(VALUES, controller=controller, params={"L": 150})
     assert "takes a table-table five-axis machine" in flat(str(info.value))
@@ -70,7 +84,7 @@ def test_export_points_and_refusals(cli_error, tmp_path):
         m.export(VALUES, controller="linuxcnc", points=q, params={"L": 150})
     with pytest.raises(ValueError) as info:
         m.export(VALUES, controller="fanuc")
-    wording = "`fanuc` is not a controller: choose one of grid, beckhoff, linuxcnc, siemens-cec, klipper, linuxcnc-trt, siemens-carr"
+    wording = "`fanuc` is not a controller: choose one of grid, beckhoff, linuxcnc, siemens-cec, klipper, linuxcnc-trt, heidenhain, siemens-carr, fanuc-tcp"
     assert str(info.value) == wording
     assert wording in flat(cli_error("export", MACHINE, "--values", VALUES, "--controller", "fanuc"))
     with pytest.raises(ValueError) as info:

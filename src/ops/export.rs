@@ -77,6 +77,10 @@ pub struct ExportRequest<'a> {
     pub cec_max_points: Option<usize>,
     /// `--beckhoff-max-records`.
     pub beckhoff_max_records: Option<usize>,
+    /// `--angles`: the formats that write the rotary axis lines' tilts on
+    /// request
+    /// (`chain_core::compensation::controllers::Capabilities::angles`).
+    pub angles: bool,
 }
 
 /// Why `chain export` cannot run.
@@ -309,6 +313,9 @@ pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
                     "the grid export corrects at the grid's nodes: give them with --grid VAR=LO:HI:N",
                 );
             }
+            if request.angles {
+                return refuse("--angles", ANGLES_WHY);
+            }
             if request.cec_max_points.is_some() || request.beckhoff_max_records.is_some() {
                 return refuse(
                     "--cec-max-points or --beckhoff-max-records",
@@ -333,10 +340,16 @@ pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
             if request.beckhoff_max_records.is_some() && limit != Some(Limit::BeckhoffRecords) {
                 return refuse("--beckhoff-max-records", "it limits the beckhoff tables");
             }
+            if request.angles && !c.capabilities().angles {
+                return refuse("--angles", ANGLES_WHY);
+            }
         }
     }
     Ok(())
 }
+
+/// Why a format takes no `--angles`.
+pub const ANGLES_WHY: &str = "it writes heidenhain's angle rows of the rotary axes (siemens-carr writes its axis vectors always; the other formats cannot hold an axis tilt)";
 
 /// Why a rotary format takes no table step.
 pub const STEP_WHY: &str = "a rotary format fits its controller's kinematics over each axis's travel (--grid VAR=LO,HI) and steps its rotary COMP_FILEs every 2°";
@@ -395,6 +408,7 @@ pub fn run(
                 beckhoff_max_records: (request.beckhoff_max_records)
                     .unwrap_or(BECKHOFF_DEFAULT_MAX_RECORDS),
                 provenance: request.controller.provenance(),
+                angles: request.angles,
             };
             let grid = request.points.grid();
             let export = table_export(c, &built, m, &options, grid, values_file)?;

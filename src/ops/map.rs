@@ -32,6 +32,8 @@ pub struct CompensationRequest<'a> {
     pub grid: &'a [(String, Vec<f64>)],
     /// `--compensation-step`: a per-axis format's largest table step (mm).
     pub step: Option<f64>,
+    /// `--compensation-angles`: heidenhain's angle rows.
+    pub angles: bool,
 }
 
 /// The request of `chain map`.
@@ -102,11 +104,14 @@ pub enum MapOpsError {
         error: Box<MapError>,
     },
     /// `--compensation-step` with a correction that takes no table step
-    /// (the grid correction, a rotary format).
-    #[error("--compensated {controller} does not take --compensation-step")]
-    Step {
+    /// (the grid correction, a rotary format), `--compensation-angles` with
+    /// one that has no angle rows.
+    #[error("--compensated {controller} does not take {option}")]
+    Option {
         /// The correction.
         controller: &'static str,
+        /// The option.
+        option: &'static str,
         /// Why not, and what to give instead.
         why: &'static str,
     },
@@ -148,7 +153,7 @@ impl Worded for MapOpsError {
                 MapError::NoPoints => "chain::map::no_points",
                 _ => "chain::map::points",
             }),
-            MapOpsError::Step { .. } => Some("chain::map::option"),
+            MapOpsError::Option { .. } => Some("chain::map::option"),
             MapOpsError::Export(e) => e.own_code(),
             _ => None,
         }
@@ -166,7 +171,7 @@ impl Worded for MapOpsError {
                 }
                 _ => None,
             },
-            MapOpsError::Step { why, .. } => Some(why.to_string()),
+            MapOpsError::Option { why, .. } => Some(why.to_string()),
             MapOpsError::Export(e) => e.own_help(),
             MapOpsError::Resolve(e) => e.own_help(),
             _ => None,
@@ -412,8 +417,20 @@ impl PreparedMap {
         let controller = c.controller.name();
         if let ExportController::Tables(tables) = c.controller {
             if c.step.is_some() && !export::step_applies(tables) {
-                let why = export::STEP_WHY;
-                return Err(MapOpsError::Step { controller, why });
+                let (option, why) = ("--compensation-step", export::STEP_WHY);
+                return Err(MapOpsError::Option {
+                    controller,
+                    option,
+                    why,
+                });
+            }
+            if c.angles && !tables.capabilities().angles {
+                let (option, why) = ("--compensation-angles", export::ANGLES_WHY);
+                return Err(MapOpsError::Option {
+                    controller,
+                    option,
+                    why,
+                });
             }
             // The map's own range of an axis, where it is one (a single
             // value keeps the machine file's travel); the compensation grid
@@ -427,6 +444,7 @@ impl PreparedMap {
             let options = ExportOptions {
                 step: c.step.unwrap_or(DEFAULT_STEP),
                 travel,
+                angles: c.angles,
                 ..ExportOptions::default()
             };
             let export =
@@ -460,10 +478,19 @@ impl PreparedMap {
                 result,
             });
         }
-        if c.step.is_some() {
-            let why =
-                "the grid correction is exported at the nodes of --compensation-grid VAR=LO:HI:N";
-            return Err(MapOpsError::Step { controller, why });
+        if c.step.is_some() || c.angles {
+            let (option, why) = match c.step {
+                Some(_) => (
+                    "--compensation-step",
+                    "the grid correction is exported at the nodes of --compensation-grid VAR=LO:HI:N",
+                ),
+                None => ("--compensation-angles", export::ANGLES_WHY),
+            };
+            return Err(MapOpsError::Option {
+                controller,
+                option,
+                why,
+            });
         }
         // The correction grid: the map's (or the file's), each axis
         // replaceable.

@@ -81,6 +81,10 @@ pub struct ExportArgs {
     /// (the vendor example's 2000 by default).
     #[arg(long, value_name = "N")]
     pub beckhoff_max_records: Option<usize>,
+    /// heidenhain: write the rotary axes' angle rows (each axis line's
+    /// tilts, `B0C`, `C0A`, ...) besides their position rows.
+    #[arg(long)]
+    pub angles: bool,
     #[command(flatten)]
     pub param: ParamArgs,
     /// Write the exported file(s) into DIR (created if missing) and the
@@ -106,6 +110,7 @@ pub fn exec(args: ExportArgs) -> miette::Result<()> {
         step: args.step,
         cec_max_points: args.cec_max_points,
         beckhoff_max_records: args.beckhoff_max_records,
+        angles: args.angles,
     };
     export::check(&request)?;
     if controller != ExportController::Grid && args.format == Some(ExportFormat::Csv) {

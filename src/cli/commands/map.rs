@@ -98,6 +98,10 @@ pub struct MapArgs {
         requires = "compensated"
     )]
     pub compensation_step: Option<f64>,
+    /// heidenhain: compensate with the rotary axes' angle rows too (as
+    /// `chain export --angles`).
+    #[arg(long = "compensation-angles", requires = "compensated")]
+    pub compensation_angles: bool,
 }
 
 /// Runs `chain map` ([`chain::ops::map`]).
@@ -121,6 +125,7 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
             controller,
             grid: &args.compensation_grid,
             step: args.compensation_step,
+            angles: args.compensation_angles,
         }),
         keep_points: true,
     };

@@ -8,6 +8,13 @@
 //! | [`Controller::Linuxcnc`] | `<variable>.comp` per joint (`COMP_FILE_TYPE = 1`), `linuxcnc-README.txt` | each joint's positioning error along its own axis, forward and reverse columns from the values' two approach directions where its table has them |
 //! | [`Controller::SiemensCec`] | `NC_CEC.INI` (`%_N_NC_CEC_INI`) | each straightness error, as a cross-axis table (base axis → compensation axis) |
 //! | [`Controller::Klipper`] | `skew_correction.cfg` | the squareness errors, as Klipper's shear factors `xy`, `xz`, `yz` |
+//! | [`Controller::LinuxcncTrt`] | `xyz?c-trt-kins.hal`, its README, rotary `<variable>.comp` | the rotary axis lines' positions (HAL pins), their zeros (`HOME_OFFSET`) and positioning errors |
+//! | [`Controller::Heidenhain`] | `KINEMATICS_ROTARY.TAB`, its README | the rotary axis lines' positions (`Trans` rows; with `angles` their tilts) |
+//! | [`Controller::SiemensCarr`] | `TC_CARR.SPF` | the rotary axis lines' positions, directions and zeros (`$TC_CARR`, type P) |
+//! | [`Controller::FanucTcp`] | `TCP.PRM`, its README | the rotary axis lines' positions (parameters 19700-19705) |
+//!
+//! The rotary formats take a table-table five-axis machine and fit their
+//! controller's kinematics over the travel (`rotary.rs`).
 //!
 //! # API
 //!
@@ -47,6 +54,8 @@
 //! `extrapolate: hold`).
 
 mod beckhoff;
+mod fanuc_tcp;
+mod heidenhain;
 mod klipper;
 mod linuxcnc;
 mod linuxcnc_trt;
@@ -96,20 +105,28 @@ pub enum Controller {
     Klipper,
     /// LinuxCNC `xyzac-trt-kins` / `xyzbc-trt-kins` (HAL pins).
     LinuxcncTrt,
+    /// HEIDENHAIN TNC kinematics description (`Trans` rows of the rotary
+    /// axes).
+    Heidenhain,
     /// SINUMERIK swivel data record `$TC_CARR` (kinematic type P).
     SiemensCarr,
+    /// FANUC tool centre point control, table rotation type (parameters
+    /// 19680-19705).
+    FanucTcp,
 }
 
 impl Controller {
     /// Every format, in the specs' table order (measured-machines §6, then
     /// five-axis "Output").
-    pub const ALL: [Controller; 6] = [
+    pub const ALL: [Controller; 8] = [
         Controller::Beckhoff,
         Controller::Linuxcnc,
         Controller::SiemensCec,
         Controller::Klipper,
         Controller::LinuxcncTrt,
+        Controller::Heidenhain,
         Controller::SiemensCarr,
+        Controller::FanucTcp,
     ];
 
     /// The format's name (`beckhoff`, `linuxcnc`, `siemens-cec`,
@@ -121,7 +138,9 @@ impl Controller {
             Controller::SiemensCec => "siemens-cec",
             Controller::Klipper => "klipper",
             Controller::LinuxcncTrt => "linuxcnc-trt",
+            Controller::Heidenhain => "heidenhain",
             Controller::SiemensCarr => "siemens-carr",
+            Controller::FanucTcp => "fanuc-tcp",
         }
     }
 
@@ -143,6 +162,7 @@ impl Controller {
                 takes: linear(Some(3)),
                 tables: true,
                 limit: Some(Limit::BeckhoffRecords),
+                angles: false,
             },
             Controller::Linuxcnc => Capabilities {
                 summary: "LinuxCNC `COMP_FILE` per joint",
@@ -150,6 +170,7 @@ impl Controller {
                 takes: linear(None),
                 tables: true,
                 limit: None,
+                angles: false,
             },
             Controller::SiemensCec => Capabilities {
                 summary: "Sinumerik CEC sag / cross-axis tables",
@@ -157,6 +178,7 @@ impl Controller {
                 takes: linear(None),
                 tables: true,
                 limit: Some(Limit::CecPoints),
+                angles: false,
             },
             Controller::Klipper => Capabilities {
                 summary: "Klipper `SET_SKEW`",
@@ -164,6 +186,7 @@ impl Controller {
                 takes: linear(Some(3)),
                 tables: false,
                 limit: None,
+                angles: false,
             },
             Controller::LinuxcncTrt => Capabilities {
                 summary: "LinuxCNC `xyzac-trt-kins` / `xyzbc-trt-kins` pins and rotary HOME_OFFSET",
@@ -171,6 +194,15 @@ impl Controller {
                 takes: Takes::TableTable,
                 tables: false,
                 limit: None,
+                angles: false,
+            },
+            Controller::Heidenhain => Capabilities {
+                summary: "HEIDENHAIN kinematics description: the rotary axes' `Trans` rows",
+                holds: "the positions of the two rotary axis lines (and their tilts, with the angle rows)",
+                takes: Takes::TableTable,
+                tables: false,
+                limit: None,
+                angles: true,
             },
             Controller::SiemensCarr => Capabilities {
                 summary: "SINUMERIK swivel data record `$TC_CARR` (type P) as a part program",
@@ -178,6 +210,16 @@ impl Controller {
                 takes: Takes::TableTable,
                 tables: false,
                 limit: None,
+                angles: false,
+            },
+            Controller::FanucTcp => Capabilities {
+                summary:
+                    "FANUC tool centre point control, table rotation type (parameters 19680-19705)",
+                holds: "the positions of the two rotary axis lines",
+                takes: Takes::TableTable,
+                tables: false,
+                limit: None,
+                angles: false,
             },
         }
     }
@@ -199,6 +241,9 @@ pub struct Capabilities {
     /// The limit its tables must fit in, when the format has one the user
     /// may give.
     pub limit: Option<Limit>,
+    /// True when the format writes the axis lines' tilts on request
+    /// (`--angles`); the others hold them always or never.
+    pub angles: bool,
 }
 
 /// The machines a format describes.
@@ -260,6 +305,9 @@ pub struct ExportOptions {
     /// naming what wrote it (a command line, say); empty (the default),
     /// that line opens with the machine.
     pub provenance: String,
+    /// `heidenhain`: write the rotary axis lines' angle rows (their tilts)
+    /// besides the position rows ([`Capabilities::angles`]).
+    pub angles: bool,
 }
 
 impl Default for ExportOptions {
@@ -270,6 +318,7 @@ impl Default for ExportOptions {
             cec_max_points: CEC_DEFAULT_MAX_POINTS,
             beckhoff_max_records: BECKHOFF_DEFAULT_MAX_RECORDS,
             provenance: String::new(),
+            angles: false,
         }
     }
 }
@@ -574,7 +623,9 @@ pub fn export<M: ErrorModel + Sync>(
         Controller::SiemensCec => siemens_cec::export(&axes()?),
         Controller::Klipper => klipper::export(&axes()?),
         Controller::LinuxcncTrt => linuxcnc_trt::export(&table_table()?),
+        Controller::Heidenhain => heidenhain::export(&table_table()?, options.angles),
         Controller::SiemensCarr => siemens_carr::export(&table_table()?),
+        Controller::FanucTcp => fanuc_tcp::export(&table_table()?),
     }
 }
 
@@ -1163,6 +1214,22 @@ pub(crate) fn interpolate_held(nodes: &[f64], values: &[f64], x: f64) -> f64 {
 }
 
 /// A number in a file: the shortest text that reads back as the same `f64`.
+/// `v` with at most `places` decimals, trailing zeros dropped (`-0` is
+/// `0`): a value written at a format's resolution.
+pub(crate) fn decimals(v: f64, places: usize) -> String {
+    let s = format!("{v:.places$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        s.as_str()
+    };
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.to_string()
+    }
+}
+
 pub(crate) fn num(v: f64) -> String {
     if v == 0.0 {
         "0".into()

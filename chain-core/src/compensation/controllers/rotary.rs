@@ -559,6 +559,30 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
         })
     }
 
+    /// Rounds `fit`'s identified pins to `places` decimals (the format's
+    /// resolution: what its file holds, so that the correction is the
+    /// file's) and returns the largest tool-point shift over the grid that
+    /// makes (mm).
+    pub fn round_pins(&self, model: &dyn TrtModel, fit: &mut Fit, places: i32) -> f64 {
+        let step = 10f64.powi(-places);
+        let rounded: Vec<f64> = (fit.pins.iter())
+            .map(|v| (v / step).round() * step)
+            .collect();
+        let mut shift: f64 = 0.0;
+        for q in &self.grid {
+            let (j, a, c) = self.joints(q);
+            let (before, after) = (
+                model.forward(&fit.pins, j, a, c),
+                model.forward(&rounded, j, a, c),
+            );
+            shift = shift.max(norm(&std::array::from_fn::<f64, 3, _>(|i| {
+                after[i] - before[i]
+            })));
+        }
+        fit.pins = rounded;
+        shift
+    }
+
     /// The controller's axes: X, Y, Z as the machine's variables (`-` where
     /// one is turned) and the two rotary axes under the names given.
     pub fn axis_names(&self, tilt: &str, rotary: &str) -> Vec<(String, String)> {
@@ -623,6 +647,21 @@ impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
             correction: Box::new(correction),
         }
     }
+}
+
+/// Rotation of `x` by `deg` degrees right-handed about `axis` (normalised;
+/// Rodrigues).
+pub(crate) fn rotate(axis: [f64; 3], deg: f64, x: [f64; 3]) -> [f64; 3] {
+    let n = (axis.iter().map(|a| a * a).sum::<f64>()).sqrt();
+    let k: [f64; 3] = std::array::from_fn(|i| axis[i] / n);
+    let (s, c) = deg.to_radians().sin_cos();
+    let dot: f64 = (0..3).map(|i| k[i] * x[i]).sum();
+    let cross = [
+        k[1] * x[2] - k[2] * x[1],
+        k[2] * x[0] - k[0] * x[2],
+        k[0] * x[1] - k[1] * x[0],
+    ];
+    std::array::from_fn(|i| x[i] * c + cross[i] * s + k[i] * dot * (1.0 - c))
 }
 
 /// A term named `name` of size 0.

@@ -30,8 +30,8 @@
 use crate::compensation::{opening_line, ExportedFile};
 use crate::model_trait::ErrorModel;
 
-use super::rotary::{KinematicsParameter, TableTable, TrtModel, Written};
-use super::{num, ControllerError, Export};
+use super::rotary::{rotate, KinematicsParameter, TableTable, TrtModel, Written};
+use super::{decimals, num, ControllerError, Export};
 
 /// The record's model with its entered axis vectors' nominal values: pins
 /// `[l2 (3), l3 (3), v1 (3), v2 (3)]`.
@@ -39,21 +39,6 @@ use super::{num, ControllerError, Export};
 struct Record {
     v1: [f64; 3],
     v2: [f64; 3],
-}
-
-/// Rotation of `x` by `deg` degrees right-handed about `axis` (normalised;
-/// Rodrigues).
-fn rotate(axis: [f64; 3], deg: f64, x: [f64; 3]) -> [f64; 3] {
-    let n = (axis.iter().map(|a| a * a).sum::<f64>()).sqrt();
-    let k: [f64; 3] = std::array::from_fn(|i| axis[i] / n);
-    let (s, c) = deg.to_radians().sin_cos();
-    let dot: f64 = (0..3).map(|i| k[i] * x[i]).sum();
-    let cross = [
-        k[1] * x[2] - k[2] * x[1],
-        k[2] * x[0] - k[0] * x[2],
-        k[0] * x[1] - k[1] * x[0],
-    ];
-    std::array::from_fn(|i| x[i] * c + cross[i] * s + k[i] * dot * (1.0 - c))
 }
 
 fn vec3(p: &[f64], at: usize) -> [f64; 3] {
@@ -98,7 +83,10 @@ pub(super) fn export<M: ErrorModel + Sync>(
                 .map(move |v2| (Record { v1, v2 }, format!("v1 = {v1:?}, v2 = {v2:?}")))
         });
     let none = "no swivel data record of type P with axis vectors along the machine's axes reproduces its nominal kinematics";
-    let (record, fit) = tt.fit_first(candidates, &[], none)?;
+    let (record, mut fit) = tt.fit_first(candidates, &[], none)?;
+    // To the nanometre (and 1e-9 of a unit vector): below that a value is
+    // the fit's round-off.
+    tt.round_pins(&record, &mut fit, 9);
     let var = |i: usize| m.variables[i].name.as_str();
     let letters = ['X', 'Y', 'Z'];
     let axes = tt.axis_names("rotary axis 1", "rotary axis 2");
@@ -173,7 +161,7 @@ pub(super) fn export<M: ErrorModel + Sync>(
     for (n, nominal, value) in &fields {
         text.push_str(&format!(
             "$TC_CARR{n}[1]={}    ; nominal {}\n",
-            num(*value),
+            decimals(*value, 9),
             num(*nominal)
         ));
     }
