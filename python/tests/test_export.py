@@ -68,6 +68,21 @@ def test_rotary_export_is_the_cli_s(cli, cli_error, tmp_path, controller, files,
                                                    controller, "--param", "L=150"))
 
 
+def test_beckhoff_rotary_terms_are_the_cli_s(cli):
+    """Beckhoff's volumetric tables of the A/C trunnion, rotary terms included: the CLI's JSON and files."""
+    machine = ROOT / "examples/machines/ac_trunnion_rotary.yaml"
+    values = ROOT / "examples/spheres/identified.yaml"
+    grid = {"x": [-100.0, 100.0], "y": [-100.0, 100.0], "z": [-100.0, 0.0],
+            "A": [-1.0471975511965976, 1.0471975511965976], "C": [0.0, 6.283185307179586]}
+    got = chain.Machine.load(machine).export(values, controller="beckhoff", grid=grid)
+    args = [a for k, v in grid.items() for a in ("--grid", f"{k}={v[0]!r},{v[1]!r}")]
+    assert got.to_dict() == cli("export", machine, "--values", values, "--controller", "beckhoff", *args)
+    assert [a["axis"] for a in got.to_dict()["axes"]] == ["Y", "A", "C", "X", "Z"]
+    for name, text in got.files.items():
+        assert text == (ROOT / "examples/spheres/beckhoff" / name).read_text()
+    assert "chain                    CAYXZ" in got.files["vol_comp_0.lis"]
+
+
 def test_export_points_and_refusals(cli_error, tmp_path):
     """Nodes from rows (`--axes`); options a controller does not take and values outside a table: the CLI's words."""
     m = chain.Machine.load(MACHINE)

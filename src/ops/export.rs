@@ -129,7 +129,7 @@ pub enum ExportOpsError {
     },
     /// A `--grid` value that is not a node of the per-axis tables.
     #[error(
-        "--grid {variable}=...: the {controller} tables sample `{variable}` at {points} nodes every {step} mm from {min} to {max}, and {what}"
+        "--grid {variable}=...: the {controller} tables sample `{variable}` at {points} nodes every {step} {unit} from {min} to {max}, and {what}"
     )]
     GridNodes {
         /// The controller.
@@ -144,6 +144,9 @@ pub enum ExportOpsError {
         min: f64,
         /// Its last node.
         max: f64,
+        /// The unit of the step and nodes (`mm`, or `°` for a rotary axis,
+        /// whose `--grid` values are radians).
+        unit: &'static str,
         /// What does not fit.
         what: String,
     },
@@ -442,11 +445,18 @@ pub fn table_export(
         let Some(a) = export.report.axes.iter().find(|a| a.variable == *name) else {
             continue;
         };
+        // The report gives a rotary axis's nodes in degrees.
+        let (unit, scale) = match a.axis {
+            'A' | 'B' | 'C' => ("°", 180.0 / std::f64::consts::PI),
+            _ => ("mm", 1.0),
+        };
         let off_node = given.iter().find(|&&v| {
+            let v = v * scale;
             let k = ((v - a.min) / a.step).round();
             (v - (a.min + k * a.step)).abs() > 1e-9 * a.step.max(1.0)
         });
         let what = match off_node {
+            Some(v) if scale != 1.0 => format!("{v} rad is not one of its nodes"),
             Some(v) => format!("{v} is not one of its nodes"),
             None if given.len() > 2 && given.len() != a.points => {
                 format!("it has {} values", given.len())
@@ -460,6 +470,7 @@ pub fn table_export(
             step: a.step,
             min: a.min,
             max: a.max,
+            unit,
             what,
         });
     }

@@ -126,6 +126,9 @@ impl Report for TablesExport {
                 a.variable, a.axis, a.min, a.max, a.step, a.points
             );
         }
+        if r.axes.iter().any(|a| matches!(a.axis, 'A' | 'B' | 'C')) {
+            let _ = writeln!(out, "(the rotary axes A, B, C in degrees)");
+        }
         if let Some(k) = &r.kinematics {
             let _ = writeln!(out);
             let axes: Vec<String> = k.axes.iter().map(|(c, v)| format!("{c} = {v}")).collect();

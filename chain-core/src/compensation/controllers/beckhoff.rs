@@ -18,23 +18,32 @@
 
 #![allow(clippy::needless_range_loop)] // component loops read best with indices
 
-use super::{num, Context, ControllerError, Export, AXIS, SLOT_LETTER};
+use super::{num, Context, ControllerError, Export, LinearAxis, AXIS, SLOT_LETTER};
 use crate::built::BuiltMachine;
 use crate::compensation::{opening_line, Correction, ExportedFile};
 use crate::eval::CompiledModel;
-use crate::model::JointKind;
+use crate::kinematics::forward::Kinematics;
+use crate::model::{Frame, JointKind};
 use crate::model_trait::{ErrorModel, OutOfRange};
 use crate::values::{Extrapolation, Interpolation, Table, ValuesBuilder};
+use nalgebra::{Matrix3, Vector3};
 
-/// What the controller adds to the commanded axes: `δq = −J⁻¹ Ê_p(q)`,
-/// `Ê` the tool-point error of chain's model with the exported values (the
-/// tables read linearly), at the commanded position (first order). A
-/// position outside the tables is refused (the vendor's behaviour there is
-/// not documented).
+/// What the controller adds to the commanded linear axes: `δq = −J⁻¹
+/// Ê_p(q)`, `J` the nominal Jacobian of the tool point's position in the
+/// linear axes at `q` and `Ê` the tool-point error of chain's model with the
+/// exported values (the tables read linearly), at the commanded position
+/// (first order); the rotary axes are left as commanded (TF5280 "only
+/// compensates for tool position"). A position outside the tables is
+/// refused (the vendor's behaviour there is not documented).
 pub struct BeckhoffCorrection {
     built: BuiltMachine<CompiledModel>,
-    /// Per machine variable: (frame axis, sign).
-    axes: Vec<(usize, f64)>,
+    /// The nominal kinematics and their parameters.
+    kin: Kinematics,
+    params: Vec<f64>,
+    /// The error is in the tool's frame (the machine file's `frame: tool`).
+    tool_frame: bool,
+    /// The linear variables (machine order).
+    linear: Vec<usize>,
     /// Machine variable index → built variable index.
     to_built: Vec<usize>,
 }
@@ -58,11 +67,53 @@ impl BeckhoffCorrection {
 impl Correction for BeckhoffCorrection {
     fn delta(&self, q: &[f64], delta: &mut [f64]) -> Result<(), OutOfRange> {
         let e = self.error(q)?;
-        for (v, (k, s)) in self.axes.iter().enumerate() {
-            delta[v] = -s * e[*k];
+        let jac = self.kin.jacobian(q, &self.params);
+        let rot = self.kin.pose(q, &self.params).rotation;
+        let mut j = Matrix3::zeros();
+        for (c, &v) in self.linear.iter().enumerate() {
+            for r in 0..3 {
+                j[(r, c)] = match self.tool_frame {
+                    false => jac[v][r],
+                    true => (0..3).map(|k| rot[k][r] * jac[v][k]).sum(),
+                };
+            }
+        }
+        let x = j
+            .try_inverse()
+            .map(|inv| inv * -Vector3::new(e[0], e[1], e[2]))
+            .unwrap_or_else(|| Vector3::repeat(f64::NAN));
+        delta.iter_mut().for_each(|d| *d = 0.0);
+        for (c, &v) in self.linear.iter().enumerate() {
+            delta[v] = x[c];
         }
         Ok(())
     }
+}
+
+/// An axis's letter in ISG's names: X, Y, Z for a linear axis, A, B, C for
+/// a rotary one.
+fn letter_of(axis: &LinearAxis) -> char {
+    match axis.rotary {
+        false => AXIS[axis.frame_axis],
+        true => ['A', 'B', 'C'][axis.frame_axis],
+    }
+}
+
+/// The axes from the workpiece to the tool (ISG's `chain`) and how many of
+/// them carry the workpiece (`workpiece_axes`).
+fn kinematic_chain<'c, M>(ctx: &'c Context<'_, M>) -> (Vec<&'c LinearAxis>, usize) {
+    let m = ctx.machine;
+    let on = |bodies: &[usize]| -> Vec<&'c LinearAxis> {
+        (bodies.iter())
+            .filter_map(|b| ctx.axes.iter().find(|a| a.body == *b))
+            .collect()
+    };
+    let mut workpiece = m.path_from_root(m.workpiece);
+    workpiece.reverse();
+    let mut chain = on(&workpiece);
+    let count = chain.len();
+    chain.extend(on(&m.path_from_root(m.tool)));
+    (chain, count)
 }
 
 pub(super) fn export<M: ErrorModel + Sync>(
@@ -86,7 +137,7 @@ pub(super) fn export<M: ErrorModel + Sync>(
                     if !single {
                         continue;
                     }
-                    let isg = format!("{}0{}", SLOT_LETTER[s], AXIS[axis.frame_axis]);
+                    let isg = format!("{}0{}", SLOT_LETTER[s], letter_of(axis));
                     if let Some((_, other)) =
                         singles.iter().find(|(n, c)| *n == isg && *c != e.name)
                     {
@@ -134,7 +185,7 @@ pub(super) fn export<M: ErrorModel + Sync>(
     ));
     csv.push_str("// ISO 230-1 error parameters, error = actual - nominal (not corrections): the controller derives the corrections\n");
     csv.push_str("// (sign convention of ISG's model UNCONFIRMED: if the compensation doubles the error, set `negate XYZ` in the list file)\n");
-    csv.push_str("// units: values mm (linear) and rad (angular); arguments X, Y, Z in mm; tables read linearly (Interpolation GRID)\n");
+    csv.push_str("// units: values mm (linear) and rad (angular); arguments X, Y, Z in mm, A, B, C in degrees; tables read linearly (Interpolation GRID)\n");
     let mut builder = ValuesBuilder::new(m);
     let mut exported: Vec<String> = Vec::new();
     if !singles.is_empty() {
@@ -169,7 +220,13 @@ pub(super) fn export<M: ErrorModel + Sync>(
     }
     for axis in &ctx.axes {
         let along = ctx.along(axis)?;
-        let letter = AXIS[axis.frame_axis];
+        let letter = letter_of(axis);
+        // The argument: mm, or degrees for a rotary axis (ISG: "in degrees
+        // (e.g. [0°, 360°]) for rotation axes").
+        let (unit, arg) = match axis.rotary {
+            false => ("mm", 1.0),
+            true => ("deg", 180.0 / std::f64::consts::PI),
+        };
         csv.push_str("#\n");
         let columns: Vec<(String, Option<&str>)> = (0..6)
             .map(|s| {
@@ -187,16 +244,16 @@ pub(super) fn export<M: ErrorModel + Sync>(
             .filter_map(|(c, n)| n.map(|n| format!("{c} = {n}")))
             .collect();
         csv.push_str(&format!(
-            "// axis {letter}: machine axis `{}`, {} to {} mm at {} mm; {}{}\n",
+            "// axis {letter}: machine axis `{}`, {} to {} {unit} at {} {unit}; {}{}\n",
             axis.name,
-            num(axis.nodes[0]),
-            num(axis.nodes[axis.nodes.len() - 1]),
-            num(axis.step),
+            num(axis.nodes[0] * arg),
+            num(axis.nodes[axis.nodes.len() - 1] * arg),
+            num(axis.step * arg),
             mapped.join(", "),
-            if mapped.len() < 6 {
-                "; the other columns: not in the machine's model (0)"
-            } else {
-                ""
+            match mapped.len() {
+                0 => "no error motion in the machine's model (0)",
+                6 => "",
+                _ => "; the other columns: not in the machine's model (0)",
             }
         ));
         csv.push(letter);
@@ -206,7 +263,7 @@ pub(super) fn export<M: ErrorModel + Sync>(
         }
         csv.push('\n');
         for (x, parts) in axis.nodes.iter().zip(&along) {
-            csv.push_str(&num(*x));
+            csv.push_str(&num(*x * arg));
             for (_, n) in &columns {
                 csv.push(' ');
                 csv.push_str(&num(n.map(|n| value_of(parts, n)).unwrap_or(0.0)));
@@ -256,23 +313,27 @@ pub(super) fn export<M: ErrorModel + Sync>(
     lis.push_str(&format!(
         "# start-up list (hochlauf.lis): vol_comp[0].file_name <folder>\\vol_comp_0.lis and vol_comp[0].max_records >= {records}\n"
     ));
-    lis.push_str("# X, Y, Z: logical axis numbers = the machine file's axis variables in order (renumber to your CNC's)\n");
-    let workpiece_side: Vec<&str> = ctx
-        .axes
-        .iter()
-        .filter(|a| m.path_from_root(m.workpiece).contains(&a.body))
-        .map(|a| a.name.as_str())
-        .collect();
+    lis.push_str("# X, Y, Z (A, B, C): logical axis numbers = the machine file's axis variables in order (renumber to your CNC's)\n");
+    let (chain, workpiece_axes) = kinematic_chain(ctx);
     lis.push_str(&format!(
-        "# `chain` and `workpiece_axes` are left at their defaults (their meaning for this layout is UNCONFIRMED); the machine's workpiece-side axes: {}\n",
-        if workpiece_side.is_empty() { "none".to_string() } else { workpiece_side.join(", ") }
+        "# chain: the axes from the workpiece to the tool ({}), the first {workpiece_axes} on the workpiece side (TF5280: an XYZBC table-table machine is `CBYXZ`)\n",
+        (chain.iter())
+            .map(|a| format!("{} = {}", letter_of(a), a.name))
+            .collect::<Vec<_>>()
+            .join(", ")
     ));
     lis.push_str("# switch on in NC code: #VOLCOMP ON [ID0]; reload after an update: #VOLCOMP OFF [ID0], #VOLCOMP [ID0 UPDATE]\n");
-    for k in 0..3 {
-        if let Some(a) = ctx.axis_along(k) {
-            lis.push_str(&format!("{:<24} {}\n", AXIS[k], a.variable + 1));
+    for rotary in [false, true] {
+        for k in 0..3 {
+            let axis = (ctx.axes.iter()).find(|a| a.frame_axis == k && a.rotary == rotary);
+            if let Some(a) = axis {
+                lis.push_str(&format!("{:<24} {}\n", letter_of(a), a.variable + 1));
+            }
         }
     }
+    let letters: String = chain.iter().map(|a| letter_of(a)).collect();
+    lis.push_str(&format!("{:<24} {letters}\n", "chain"));
+    lis.push_str(&format!("{:<24} {workpiece_axes}\n", "workpiece_axes"));
     lis.push_str(&format!("{:<24} GRID\n", "Interpolation"));
     lis.push_str(&format!("{:<24} chain_volcomp.csv\n", "file[0]"));
     lis.push_str(&format!("{:<24} ISG_CSV\n", "file_format[0]"));
@@ -312,10 +373,15 @@ pub(super) fn export<M: ErrorModel + Sync>(
                 .unwrap_or(0)
         })
         .collect();
-    debug_assert!(m.variables.iter().all(|v| v.kind == JointKind::Prismatic));
+    let kin = Kinematics::from_machine(m);
     let correction = BeckhoffCorrection {
+        params: crate::compensation::kinematics_parameters(&kin, ctx.built),
+        kin,
+        tool_frame: m.frame == Frame::Tool,
         built: seen,
-        axes: ctx.axes.iter().map(|a| (a.frame_axis, a.sign)).collect(),
+        linear: (0..m.variables.len())
+            .filter(|&v| m.variables[v].kind == JointKind::Prismatic)
+            .collect(),
         to_built,
     };
     // Resampling: the controller's position error against the exported

@@ -28,7 +28,7 @@ use crate::compensation::{opening_line, ExportedFile};
 use crate::model_trait::ErrorModel;
 
 use super::rotary::{KinematicsParameter, TableTable, TrtModel, Written};
-use super::{interpolate_held, num, ControllerError, Export, LINUXCNC_MAX_POINTS};
+use super::{interpolate_held, num, ControllerError, Export, LINUXCNC_MAX_POINTS, ROTARY_STEP_DEG};
 
 /// `TO_RAD` of LinuxCNC (`rtapi_math.h`: `M_PI / 180`).
 const TO_RAD: f64 = std::f64::consts::PI / 180.0;
@@ -391,9 +391,6 @@ pub(super) fn export<M: ErrorModel + Sync>(
     Ok(tt.finish(files, model, fit, axes, written))
 }
 
-/// The largest step of a rotary COMP_FILE (degrees).
-const COMP_STEP_DEG: f64 = 2.0;
-
 /// A rotary joint's COMP_FILE.
 struct RotaryComp {
     /// The machine variable.
@@ -434,7 +431,7 @@ fn rotary_comp<M: ErrorModel + Sync>(
         return Ok(None);
     }
     let (lo, hi) = tt.travel[v];
-    let intervals = ((hi - lo).to_degrees() / COMP_STEP_DEG - 1e-9)
+    let intervals = ((hi - lo).to_degrees() / ROTARY_STEP_DEG - 1e-9)
         .ceil()
         .max(1.0) as usize;
     let mut nominal: Vec<f64> = (0..=intervals)
@@ -455,7 +452,7 @@ fn rotary_comp<M: ErrorModel + Sync>(
             variable: name.clone(),
             lo,
             hi,
-            step: COMP_STEP_DEG,
+            step: ROTARY_STEP_DEG,
             points: nominal.len(),
             limit: LINUXCNC_MAX_POINTS,
             hint: "; the positions of its table and the 2° steps of its travel exceed it: give a shorter travel",
@@ -507,7 +504,7 @@ fn rotary_comp<M: ErrorModel + Sync>(
         if sign > 0.0 { "+" } else { "-" }
     ));
     text.push_str(&format!(
-        "# every {COMP_STEP_DEG}° of {} to {} and the error's table positions; the same trim both directions; held at the end values outside\n",
+        "# every {ROTARY_STEP_DEG}° of {} to {} and the error's table positions; the same trim both directions; held at the end values outside\n",
         num(lo.to_degrees()),
         num(hi.to_degrees())
     ));

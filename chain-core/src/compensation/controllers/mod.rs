@@ -88,6 +88,9 @@ pub const LINUXCNC_MAX_POINTS: usize = 256;
 /// interpolation points (`MD18342`, Function Manual K3); the 840D sl limit is
 /// unconfirmed, so a larger one is the user's to give.
 pub const CEC_DEFAULT_MAX_POINTS: usize = 200;
+/// The largest step (degrees) of a rotary axis's table: a LinuxCNC rotary
+/// `COMP_FILE`, the Beckhoff rotary terms.
+pub const ROTARY_STEP_DEG: f64 = 2.0;
 /// The Beckhoff vendor example's `vol_comp[i].max_records` (2000).
 pub const BECKHOFF_DEFAULT_MAX_RECORDS: usize = 2000;
 
@@ -154,12 +157,15 @@ impl Controller {
     /// axes, the option that limits its tables), so that a new format is
     /// one file and one arm here.
     pub fn capabilities(self) -> Capabilities {
-        let linear = |count| Takes::LinearAxes { count };
+        let linear = |count| Takes::LinearAxes { count, rotary: 0 };
         match self {
             Controller::Beckhoff => Capabilities {
                 summary: "Beckhoff TwinCAT / ISG volumetric compensation (`ISG_CSV`)",
-                holds: "the ISO 230-1 errors of the three linear axes, as tables along them",
-                takes: linear(Some(3)),
+                holds: "the ISO 230-1 errors of the three linear axes and of up to three rotary axes, as tables along them",
+                takes: Takes::LinearAxes {
+                    count: Some(3),
+                    rotary: 3,
+                },
                 tables: true,
                 limit: Some(Limit::BeckhoffRecords),
                 angles: false,
@@ -254,8 +260,11 @@ pub enum Takes {
     /// (each used once), no fixed rotation in the chain; `count`: exactly
     /// that many.
     LinearAxes {
-        /// The number of axes, when the format needs a given one.
+        /// The number of linear axes, when the format needs a given one.
         count: Option<usize>,
+        /// The most rotary axes it takes besides (each about one of X, Y,
+        /// Z, each used once).
+        rotary: usize,
     },
     /// A table-table five-axis machine: three linear axes along X, Y, Z
     /// and two rotary axes carrying the workpiece, the tilting one
@@ -267,11 +276,15 @@ impl Takes {
     /// The machines it takes, in words (for a refusal).
     pub fn words(self) -> String {
         match self {
-            Takes::LinearAxes { count: Some(n) } => {
-                format!("{n} linear axes, one along each of X, Y, Z")
-            }
-            Takes::LinearAxes { count: None } => {
-                "linear axes, each along one of X, Y, Z".to_string()
+            Takes::LinearAxes { count, rotary } => {
+                let linear = match count {
+                    Some(n) => format!("{n} linear axes, one along each of X, Y, Z"),
+                    None => "linear axes, each along one of X, Y, Z".to_string(),
+                };
+                match rotary {
+                    0 => linear,
+                    r => format!("{linear}, and up to {r} rotary axes, one about each of X, Y, Z"),
+                }
             }
             Takes::TableTable => "a table-table five-axis machine (X, Y, Z along the frame's axes; a tilting axis carrying a rotary table, both carrying the workpiece)".to_string(),
         }
@@ -363,7 +376,7 @@ pub enum ControllerError {
         reason: String,
     },
     /// Not the number of axes the format takes.
-    #[error("`{controller}` takes {takes}; machine `{machine}` has {found} axis variables")]
+    #[error("`{controller}` takes {takes}; machine `{machine}` has {found} linear axes")]
     #[cfg_attr(feature = "miette", diagnostic(code(chain::export::axis_count)))]
     AxisCount {
         /// The format.
@@ -372,7 +385,7 @@ pub enum ControllerError {
         takes: String,
         /// The machine.
         machine: String,
-        /// Its number of variables.
+        /// Its number of linear axis variables.
         found: usize,
     },
     /// The machine has none of the error terms the format expresses.
@@ -501,13 +514,14 @@ pub enum ControllerError {
 pub struct AxisSampling {
     /// The axis variable.
     pub variable: String,
-    /// The frame axis it moves the tool along (`X`, `Y`, `Z`).
+    /// The frame axis it moves the tool along (`X`, `Y`, `Z`), or turns it
+    /// about (`A`, `B`, `C`: a rotary axis).
     pub axis: char,
-    /// First node (mm).
+    /// First node (mm; degrees for a rotary axis).
     pub min: f64,
-    /// Last node (mm).
+    /// Last node (mm; degrees for a rotary axis).
     pub max: f64,
-    /// The step used (mm).
+    /// The step used (mm; degrees for a rotary axis).
     pub step: f64,
     /// The number of nodes.
     pub points: usize,
@@ -662,6 +676,9 @@ pub(crate) struct LinearAxis {
     pub nodes: Vec<f64>,
     /// The step used.
     pub step: f64,
+    /// A rotary axis (`frame_axis` the axis it turns the tool about, the
+    /// nodes in radians every [`ROTARY_STEP_DEG`] at most).
+    pub rotary: bool,
 }
 
 /// The machine's axes, sampled, and its parts at the nodes.
@@ -696,7 +713,7 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
             return Err(ControllerError::BadStep { step: options.step });
         }
         let takes = controller.capabilities().takes;
-        let Takes::LinearAxes { count } = takes else {
+        let Takes::LinearAxes { count, rotary } = takes else {
             return Err(ControllerError::MachineKind {
                 controller: name,
                 takes: takes.words(),
@@ -704,21 +721,21 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
                 reason: "the format is not one of per-axis tables".to_string(),
             });
         };
-        for v in &machine.variables {
-            if v.kind == JointKind::Rotary {
-                return Err(ControllerError::RotaryAxis {
-                    controller: name,
-                    takes: takes.words(),
-                    variable: v.name.clone(),
-                });
-            }
+        let turning = (machine.variables.iter()).filter(|v| v.kind == JointKind::Rotary);
+        if let Some(v) = turning.clone().nth(rotary) {
+            return Err(ControllerError::RotaryAxis {
+                controller: name,
+                takes: takes.words(),
+                variable: v.name.clone(),
+            });
         }
-        if count.is_some_and(|n| n != machine.variables.len()) {
+        let linear = machine.variables.len() - turning.count();
+        if count.is_some_and(|n| n != linear) {
             return Err(ControllerError::AxisCount {
                 controller: name,
                 takes: takes.words(),
                 machine: machine.name.clone(),
-                found: machine.variables.len(),
+                found: linear,
             });
         }
         for (n, _) in &options.travel {
@@ -744,24 +761,36 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
         let to_built = built_order(machine, built);
         let travels = travels(machine, options)?;
         let reference: Vec<f64> = travels.iter().map(|t| t.0).collect();
-        // The nominal Jacobian at the reference point.
+        // The nominal Jacobian at the reference point, the rotary axes at
+        // their zero (where the linear axes are along X, Y, Z).
         let kin = Kinematics::from_machine(machine);
         let p = crate::compensation::kinematics_parameters(&kin, built);
-        let jac = kin.jacobian(&reference, &p);
-        let rot = kin.pose(&reference, &p).rotation;
-        let mut used = [false; 3];
+        let at: Vec<f64> = (machine.variables.iter().zip(&reference))
+            .map(|(v, &r)| if v.kind == JointKind::Rotary { 0.0 } else { r })
+            .collect();
+        let jac = kin.jacobian(&at, &p);
+        let rot = kin.pose(&at, &p).rotation;
+        // Per kind (linear, rotary), the frame axes taken.
+        let mut used = [[false; 3]; 2];
         let mut axes = Vec::new();
         for (i, v) in machine.variables.iter().enumerate() {
-            let mut col = [jac[i][0], jac[i][1], jac[i][2]];
+            let turns = v.kind == JointKind::Rotary;
+            let from = if turns { 3 } else { 0 };
+            let mut col = [jac[i][from], jac[i][from + 1], jac[i][from + 2]];
             if machine.frame == crate::model::Frame::Tool {
                 col = std::array::from_fn(|r| (0..3).map(|c| rot[c][r] * col[c]).sum());
             }
+            let used = &mut used[usize::from(turns)];
             let aligned = along_one_axis(col).filter(|&(k, _)| !used[k]);
             let Some((k, sign)) = aligned else {
+                let (moves, unit) = match turns {
+                    false => ("moves the tool point along", "mm"),
+                    true => ("turns the tool about", "rad"),
+                };
                 return Err(ControllerError::NotAligned {
                     controller: name,
                     reason: format!(
-                        "axis `{}` moves the tool point along ({:.6}, {:.6}, {:.6}) per mm",
+                        "axis `{}` {moves} ({:.6}, {:.6}, {:.6}) per {unit}",
                         v.name, col[0], col[1], col[2]
                     ),
                 });
@@ -788,7 +817,11 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
                 }
             }
             let (lo, hi) = travels[i];
-            let intervals = ((hi - lo) / options.step - 1e-9).ceil().max(1.0) as usize;
+            let largest = match turns {
+                false => options.step,
+                true => ROTARY_STEP_DEG.to_radians(),
+            };
+            let intervals = ((hi - lo) / largest - 1e-9).ceil().max(1.0) as usize;
             let step = (hi - lo) / intervals as f64;
             let nodes = (0..=intervals)
                 .map(|k| {
@@ -809,6 +842,7 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
                 motions,
                 nodes,
                 step,
+                rotary: turns,
             });
         }
         Ok(Context {
@@ -927,13 +961,19 @@ impl<'a, M: ErrorModel + Sync> Context<'a, M> {
     pub fn sampling(&self) -> Vec<AxisSampling> {
         self.axes
             .iter()
-            .map(|a| AxisSampling {
-                variable: a.name.clone(),
-                axis: AXIS[a.frame_axis],
-                min: a.nodes[0],
-                max: a.nodes[a.nodes.len() - 1],
-                step: a.step,
-                points: a.nodes.len(),
+            .map(|a| {
+                let (letter, unit) = match a.rotary {
+                    false => (AXIS[a.frame_axis], 1.0),
+                    true => (['A', 'B', 'C'][a.frame_axis], 180.0 / std::f64::consts::PI),
+                };
+                AxisSampling {
+                    variable: a.name.clone(),
+                    axis: letter,
+                    min: a.nodes[0] * unit,
+                    max: a.nodes[a.nodes.len() - 1] * unit,
+                    step: a.step * unit,
+                    points: a.nodes.len(),
+                }
             })
             .collect()
     }
