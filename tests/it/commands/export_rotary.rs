@@ -330,20 +330,23 @@ fn commands(m: &Machine, count: usize, seed: u64) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// Position and zero errors of both rotary axes (mm, rad).
+const POSITIONS_AND_ZEROS: [(&str, f64); 6] = [
+    ("EY0A", 0.020),
+    ("EZ0A", -0.015),
+    ("EA0A", 3e-5),
+    ("EX0C", 0.010),
+    ("EY0C", -0.025),
+    ("EC0C", -4e-5),
+];
+
 /// Position and zero errors of both axes: what xyzac-trt-kins holds. After
 /// write-back the tool reaches every target to second order (below 5 nm,
 /// against 30 µm uncalibrated), for both direction settings; the report
 /// says it expresses every term and leaves nothing.
 #[test]
 fn positions_and_zeros_are_held_to_second_order() {
-    let errors = [
-        ("EY0A", 0.020),
-        ("EZ0A", -0.015),
-        ("EA0A", 3e-5),
-        ("EX0C", 0.010),
-        ("EY0C", -0.025),
-        ("EC0C", -4e-5),
-    ];
+    let errors = POSITIONS_AND_ZEROS;
     for turned in [false, true] {
         let m = trunnion(turned);
         let (export, e) = run(&m, &errors);
@@ -1172,14 +1175,7 @@ fn heidenhain_read(export: &Export) -> Read {
 /// a note), against 30 µm uncalibrated; the report leaves nothing.
 #[test]
 fn fanuc_and_heidenhain_hold_positions_and_zeros() {
-    let errors = [
-        ("EY0A", 0.020),
-        ("EZ0A", -0.015),
-        ("EA0A", 3e-5),
-        ("EX0C", 0.010),
-        ("EY0C", -0.025),
-        ("EC0C", -4e-5),
-    ];
+    let errors = POSITIONS_AND_ZEROS;
     for turned in [false, true] {
         let m = trunnion(turned);
         let qs = commands(&m, 200, 13);

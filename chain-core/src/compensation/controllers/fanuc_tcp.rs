@@ -163,22 +163,11 @@ pub(super) fn export<M: ErrorModel + Sync>(
             });
         }
     }
-    for (k, axis) in ["first", "second"].iter().enumerate() {
-        parameters.push(KinematicsParameter {
-            name: format!("reference position of the {axis} rotation axis: change"),
-            nominal: 0.0,
-            value: fit.zero[k],
-            unit: "deg",
-        });
-    }
-    for (i, c) in letters.iter().enumerate() {
-        parameters.push(KinematicsParameter {
-            name: format!("work offset {c} change"),
-            nominal: 0.0,
-            value: -fit.work_offset[i],
-            unit: "mm (work offset)",
-        });
-    }
+    parameters.extend(fit.zero_changes(
+        ["first", "second"].map(|a| format!("reference position of the {a} rotation axis: change")),
+        "deg",
+    ));
+    parameters.extend(fit.work_offset_changes("work offset", "mm (work offset)"));
     let bytes = [
         (19680u32, 12u8, "mechanical unit type: table rotation type"),
         (

@@ -225,22 +225,11 @@ pub(super) fn export<M: ErrorModel + Sync>(
         });
         rows.extend(after);
     }
-    for (k, name) in names.iter().enumerate() {
-        parameters.push(KinematicsParameter {
-            name: format!("{name} axis offset change"),
-            nominal: 0.0,
-            value: fit.zero[k],
-            unit: "deg (axis offset)",
-        });
-    }
-    for (i, c) in LINEAR.iter().enumerate() {
-        parameters.push(KinematicsParameter {
-            name: format!("preset {c} change"),
-            nominal: 0.0,
-            value: -fit.work_offset[i],
-            unit: "mm (preset)",
-        });
-    }
+    parameters.extend(fit.zero_changes(
+        names.clone().map(|n| format!("{n} axis offset change")),
+        "deg (axis offset)",
+    ));
+    parameters.extend(fit.work_offset_changes("preset", "mm (preset)"));
     let mut notes = vec![
         format!(
             "the workpiece side of the description: {} = `{}` (turning the table {} about +{}) carries {} = `{}` (turning it {} about +{}); the rows follow the machine's linear axes and end at the workpiece",

@@ -283,7 +283,7 @@ pub(super) fn export<M: ErrorModel + Sync>(
             u8::from(model.conventional)
         ));
     }
-    let parameters = vec![
+    let mut parameters = vec![
         param("x-rot-point", nominal.x_rot_point, pins.x_rot_point, "mm"),
         param("y-rot-point", nominal.y_rot_point, pins.y_rot_point, "mm"),
         param("z-rot-point", nominal.z_rot_point, pins.z_rot_point, "mm"),
@@ -292,17 +292,10 @@ pub(super) fn export<M: ErrorModel + Sync>(
             TrtModule::Xyzbc => param("x-offset", nominal.x_offset, pins.x_offset, "mm"),
         },
         param("z-offset", nominal.z_offset, pins.z_offset, "mm"),
-        param(
-            &format!("{} HOME_OFFSET change", module.tilt()),
-            0.0,
-            fit.zero[0],
-            "deg",
-        ),
-        param("C HOME_OFFSET change", 0.0, fit.zero[1], "deg"),
-        param("G54 X change", 0.0, -fit.work_offset[0], "mm (work offset)"),
-        param("G54 Y change", 0.0, -fit.work_offset[1], "mm (work offset)"),
-        param("G54 Z change", 0.0, -fit.work_offset[2], "mm (work offset)"),
     ];
+    let home = [module.tilt(), 'C'].map(|a| format!("{a} HOME_OFFSET change"));
+    parameters.extend(fit.zero_changes(home, "deg"));
+    parameters.extend(fit.work_offset_changes("G54", "mm (work offset)"));
     let mut hal = String::new();
     let head = opening_line(
         &tt.provenance,

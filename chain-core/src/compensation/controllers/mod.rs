@@ -204,7 +204,7 @@ impl Controller {
             },
             Controller::Heidenhain => Capabilities {
                 summary: "HEIDENHAIN kinematics description: the rotary axes' `Trans` rows",
-                holds: "the positions of the two rotary axis lines (and their tilts, with the angle rows)",
+                holds: "the positions of the two rotary axis lines, and with the angle rows their tilts",
                 takes: Takes::TableTable,
                 tables: false,
                 limit: None,

@@ -183,6 +183,36 @@ pub(crate) struct Fit {
     pub residual_at: Vec<(String, f64)>,
 }
 
+impl Fit {
+    /// The zero offsets as parameters changed from 0 (degrees; `names` the
+    /// tilt's and the table's), with `unit` (the place they go, as
+    /// `deg (axis offset)`).
+    pub fn zero_changes(&self, names: [String; 2], unit: &'static str) -> Vec<KinematicsParameter> {
+        (names.into_iter().zip(self.zero))
+            .map(|(name, value)| KinematicsParameter {
+                name,
+                nominal: 0.0,
+                value,
+                unit,
+            })
+            .collect()
+    }
+
+    /// The change of the workpiece's zero that moves the part back, per
+    /// axis X, Y, Z named `<what> X change` (mm, `unit` naming where it
+    /// goes: `mm (work offset)`).
+    pub fn work_offset_changes(&self, what: &str, unit: &'static str) -> Vec<KinematicsParameter> {
+        (["X", "Y", "Z"].iter().zip(self.work_offset))
+            .map(|(c, w)| KinematicsParameter {
+                name: format!("{what} {c} change"),
+                nominal: 0.0,
+                value: -w,
+                unit,
+            })
+            .collect()
+    }
+}
+
 impl<'a, M: ErrorModel + Sync> TableTable<'a, M> {
     /// Recognises `machine` as a table-table machine (three linear axes,
     /// each along one of X, Y, Z at `q = 0`; two rotary axes on the

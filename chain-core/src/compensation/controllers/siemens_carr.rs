@@ -124,14 +124,7 @@ pub(super) fn export<M: ErrorModel + Sync>(
             unit: "deg",
         });
     }
-    for (i, c) in letters.iter().enumerate() {
-        parameters.push(KinematicsParameter {
-            name: format!("work offset {c} change"),
-            nominal: 0.0,
-            value: -fit.work_offset[i],
-            unit: "mm (work offset)",
-        });
-    }
+    parameters.extend(fit.work_offset_changes("work offset", "mm (work offset)"));
     fields.sort_by_key(|f| f.0);
     let notes = vec![
         format!(
