@@ -19,7 +19,9 @@ from ._results import IdentifyResult, MapResult, PlanResult
 from ._results import Derivation, ReliabilityResult, Result, SobolResult
 from ._results import AllocationResult, GeometricSensitivityResult, SensitivityResult
 from ._results import CompensateResult, ExportResult, InverseResult, MotionResult, PathResult, PositioningResult
+from ._results import ThermalResult
 from ._positioning import positioning
+from ._thermal import thermal
 from ._compensate import compensate
 
 __all__ = [
@@ -42,8 +44,10 @@ __all__ = [
     "Result",
     "SensitivityResult",
     "SobolResult",
+    "ThermalResult",
     "compensate",
     "positioning",
+    "thermal",
 ]
 
 __version__ = "0.1.0"

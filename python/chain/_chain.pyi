@@ -167,6 +167,24 @@ def positioning_json(
 ) -> Tuple[str, Optional[str]]: ...
 
 
+# -- thermal drift tests (python/src/thermal.rs) ---------------------------------
+
+def thermal_json(
+    path: Optional[str],
+    text: Optional[str],
+    file: str,
+    displacements: Sequence[str],
+    temperatures: Sequence[str],
+    loads: Sequence[str],
+    pairs: Sequence[str],
+    fit: bool,
+    sensors: Optional[int],
+    lag: bool,
+    holdout: Optional[float],
+    fit_until: Optional[float],
+) -> Tuple[str, npt.NDArray[np.float64], List[Tuple[str, npt.NDArray[np.float64], npt.NDArray[np.float64]]]]: ...
+
+
 # -- inverse kinematics (python/src/inverse.rs) ----------------------------------
 
 def inverse_json(

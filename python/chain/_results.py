@@ -299,6 +299,27 @@ class PositioningResult(Result):
         return [dict(t) for t in self._document["targets"]]
 
 
+class ThermalResult(Result):
+    """``chain thermal --format json``: an ISO 230-3 drift test and, with a fit, its thermal models.
+
+    Attributes: ``file``, ``samples``, ``duration``, ``channels`` (per
+    displacement channel: ``name``, ``unit``, ``range``, ``max_drift``,
+    ``max_drift_at``; with a fit ``model``, ``fit``, ``holdout``),
+    ``temperatures``, ``pairs``, ``fit`` (the fit period). ``time``: the
+    samples' times (s); ``measured`` and ``predicted``: per channel name,
+    the drift and the model's prediction at every sample (with a fit), as
+    arrays. Rows of ``to_dataframe()``: one per displacement channel.
+    """
+
+    command = "thermal"
+    time: Any = None
+    measured: Dict[str, Any] = {}
+    predicted: Dict[str, Any] = {}
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        return [{k: v for k, v in c.items() if not isinstance(v, dict)} for c in self._document["channels"]]
+
+
 class InverseResult(Result):
     """``chain inverse --format json``: the axis values that reach each tool pose.
 

@@ -23,6 +23,7 @@ mod measured;
 mod motion;
 mod path;
 mod positioning;
+mod thermal;
 use std::mem::MaybeUninit;
 
 use chain::ops::choice::Choice;
@@ -589,6 +590,7 @@ fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sensitivity::geometric_json, m)?)?;
     m.add_function(wrap_pyfunction!(allocate::allocate_json, m)?)?;
     m.add_function(wrap_pyfunction!(positioning::positioning_json, m)?)?;
+    m.add_function(wrap_pyfunction!(thermal::thermal_json, m)?)?;
     m.add_function(wrap_pyfunction!(inverse::inverse_json, m)?)?;
     m.add_function(wrap_pyfunction!(path::path_json, m)?)?;
     m.add_function(wrap_pyfunction!(export::export_json, m)?)?;

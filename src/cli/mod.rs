@@ -17,7 +17,7 @@ mod study_text;
 
 use commands::{
     allocate, compensate, derive, export, identify, inverse, map, motion, path, plan, positioning,
-    reliability, sensitivity, sobol,
+    reliability, sensitivity, sobol, thermal,
 };
 
 use clap::{Parser, Subcommand};
@@ -59,6 +59,8 @@ enum Command {
     Export(export::ExportArgs),
     /// ISO 230-2 positioning: the statistics of an axis's bidirectional positioning runs (mean deviation per direction, reversal, repeatability, accuracy).
     Positioning(positioning::PositioningArgs),
+    /// ISO 230-3 thermal drift: the drift of each displacement channel, the temperatures, sensor-pair tilts, and with --fit a thermal model per channel from the temperature sensors (and lagged loads) with its held-out prediction.
+    Thermal(thermal::ThermalArgs),
     /// Motion conversion ("Precision Machining Technology of Jewelry on CNC Machine Tool", 2022): CNC axis motions reproducing a cradle-type generator's roll, and their Maclaurin series.
     Motion(motion::MotionArgs),
 }
@@ -80,5 +82,6 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Plan(args) => plan::exec(args),
         Command::Export(args) => export::exec(args),
         Command::Positioning(args) => positioning::exec(args),
+        Command::Thermal(args) => thermal::exec(args),
     }
 }

@@ -61,6 +61,7 @@ pub mod source;
 pub mod study;
 #[cfg(feature = "records")]
 pub mod tables;
+pub mod thermal;
 pub mod views;
 pub mod worded;
 

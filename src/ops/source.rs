@@ -2,7 +2,8 @@
 //! CLI's stdin, a Python string), and the one reader of each kind of input
 //! file: measurements and candidates (`identify`, `plan`), values files
 //! (`map`, `export`), motion settings (`motion`), positioning runs
-//! (`positioning`) and swing-angle measurements (`compensate`); the numeric
+//! (`positioning`), drift tests (`thermal`) and swing-angle measurements
+//! (`compensate`); the numeric
 //! tables are [`super::tables`]'. A path is read with its kind's bound and
 //! relative paths inside the file (a values file's tables, a settings
 //! file's machines) are resolved against its directory; bytes are named by
@@ -13,6 +14,7 @@
 use std::path::Path;
 
 use chain_core::measured::positioning::{AxisKind, Runs, RunsFileError};
+use chain_core::measured::thermal::{DriftFileError, DriftTest, Roles};
 use chain_core::measured::{Layout, Measurements, MeasurementsError};
 use chain_core::settings::{self, Settings, SettingsError};
 use chain_core::values::{Values, ValuesError};
@@ -130,6 +132,17 @@ pub fn read_runs(source: Source<'_>, kind: AxisKind) -> Result<Runs, RunsFileErr
         Source::Bytes { name, bytes } => {
             let text = chain_core::load::decode(bytes, name).map_err(RunsFileError)?;
             Runs::parse(text, name, kind)
+        }
+    }
+}
+
+/// The drift test of `chain thermal`, its columns' roles as given.
+pub fn read_drift(source: Source<'_>, roles: &Roles) -> Result<DriftTest, DriftFileError> {
+    match source {
+        Source::Path(path) => DriftTest::read(path, roles),
+        Source::Bytes { name, bytes } => {
+            let text = chain_core::load::decode(bytes, name).map_err(DriftFileError)?;
+            DriftTest::parse(text, name, roles)
         }
     }
 }

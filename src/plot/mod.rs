@@ -37,6 +37,7 @@ pub mod path;
 pub mod positioning;
 pub mod reliability;
 pub mod sensitivity;
+pub mod thermal;
 
 use std::path::{Path, PathBuf};
 use std::sync::Once;
@@ -137,6 +138,9 @@ pub enum Chart {
     /// A map of labelled cells, each printed with its value (the
     /// reliability maps).
     Cells(reliability::CellMap),
+    /// Line charts stacked in one figure, top to bottom (`chain thermal`:
+    /// the drift above the temperatures, on one time axis).
+    Stack(Vec<XyChart>),
 }
 
 impl From<XyChart> for Chart {
@@ -159,6 +163,10 @@ impl Chart {
             Chart::Bar(c) => c.size,
             Chart::Heat(c) => c.size,
             Chart::Cells(c) => c.size,
+            Chart::Stack(cs) => (
+                cs.iter().map(|c| c.size.0).max().unwrap_or(0),
+                cs.iter().map(|c| c.size.1).sum(),
+            ),
         }
     }
 
@@ -166,6 +174,7 @@ impl Chart {
     fn check(&self) -> Result<(), PlotError> {
         match self {
             Chart::Xy(c) => c.ranges().map(|_| ()),
+            Chart::Stack(cs) => cs.iter().try_for_each(|c| c.ranges().map(|_| ())),
             _ => Ok(()),
         }
     }
@@ -179,6 +188,16 @@ impl Chart {
             Chart::Bar(c) => c.draw(root),
             Chart::Heat(c) => c.draw(root),
             Chart::Cells(c) => c.draw(root),
+            Chart::Stack(cs) => {
+                // Each panel its own height, top to bottom.
+                let mut rest = root;
+                for c in cs {
+                    let (top, below) = rest.split_vertically(c.size.1);
+                    c.draw(top, c.ranges().map_err(|e| e.to_string())?)?;
+                    rest = below;
+                }
+                Ok(())
+            }
         }
     }
 

@@ -24,6 +24,8 @@ pub mod positioning_values;
 pub mod predict;
 pub mod spheres;
 pub mod subset;
+pub mod thermal;
+pub mod thermal_fit;
 
 pub use identify::{
     identify, Identification, IdentifyError, IdentifyOptions, NoiseRule, SubsetProblem, SubsetSide,

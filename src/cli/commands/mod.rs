@@ -15,3 +15,4 @@ pub mod positioning;
 pub mod reliability;
 pub mod sensitivity;
 pub mod sobol;
+pub mod thermal;

@@ -13,3 +13,4 @@ pub(crate) mod positioning;
 pub(crate) mod reliability;
 pub(crate) mod sensitivity;
 pub(crate) mod sobol;
+pub(crate) mod thermal;

@@ -47,4 +47,5 @@ mod sobol;
 mod sorm_cli;
 mod streamed;
 mod subset;
+mod thermal;
 mod values;

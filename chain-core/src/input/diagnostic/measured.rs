@@ -428,3 +428,112 @@ fn quoted<'a>(names: impl Iterator<Item = &'a str>) -> String {
         .collect::<Vec<_>>()
         .join(", ")
 }
+
+/// What a drift-test file's header names (the help of an empty file or a
+/// missing column).
+pub(crate) const DRIFT_FILE_HEADER: &str = "the header names `time` (or `time(s)`, `t(s)`), the displacement channels (a unit `(um)`, `(µm)` or `(mm)` at the end of the name), the temperatures (`(°C)`, `(degC)` or `(C)`) and any load (`spindle(rpm)`)";
+
+/// One thing wrong with an ISO 230-3 drift-test file, worded by
+/// [`DriftProblem::describe`].
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum DriftProblem {
+    /// No `time` column.
+    NoTime,
+    /// A time not after the previous row's.
+    TimeNotIncreasing {
+        /// The time.
+        time: f64,
+        /// The previous row's.
+        previous: f64,
+        /// The previous row's line.
+        previous_line: usize,
+    },
+    /// No displacement channel.
+    NoDisplacement {
+        /// The header's columns.
+        columns: Vec<String>,
+    },
+    /// Fewer than 3 rows.
+    TooFewRows {
+        /// The rows.
+        rows: usize,
+    },
+    /// A column named for a role that is not in the header.
+    NotAColumn {
+        /// The name.
+        name: String,
+        /// The role: `displacement`, `temperature`, `load`.
+        role: &'static str,
+        /// The closest column, if one is close.
+        suggestion: Option<String>,
+    },
+    /// A column named for two roles.
+    TwoRoles {
+        /// The column.
+        name: String,
+        /// The roles.
+        first: &'static str,
+        /// The other.
+        second: &'static str,
+    },
+}
+
+impl DriftProblem {
+    /// Every part of the message of this problem: one match arm per
+    /// variant.
+    pub fn describe(&self) -> D {
+        match self {
+            DriftProblem::NoTime => D::new(
+                "chain::thermal::no_time",
+                "no time",
+                "the header has no `time` column (seconds since the start of the test)",
+            )
+            .help(DRIFT_FILE_HEADER.to_string()),
+            DriftProblem::TimeNotIncreasing {
+                time,
+                previous,
+                previous_line,
+            } => D::new(
+                "chain::thermal::time",
+                "time",
+                format!("{time} s is not after {previous} s (line {previous_line}): the rows must be in increasing time"),
+            ),
+            DriftProblem::NoDisplacement { columns } => D::new(
+                "chain::thermal::no_displacement",
+                "no displacement",
+                format!(
+                    "no displacement channel among the columns {}",
+                    quoted(columns.iter().map(String::as_str))
+                ),
+            )
+            .help("end a displacement channel's name with its unit, `(um)` or `(mm)`, or name it as a displacement channel".to_string()),
+            DriftProblem::TooFewRows { rows } => D::new(
+                "chain::thermal::too_few_rows",
+                "rows",
+                format!("the file has {rows} row(s): a drift test needs at least 3"),
+            ),
+            DriftProblem::NotAColumn {
+                name,
+                role,
+                suggestion,
+            } => D::new(
+                "chain::thermal::not_a_column",
+                "header",
+                D::suggesting(
+                    format!("`{name}` is named as a {role} column but the header has no such column"),
+                    suggestion,
+                ),
+            ),
+            DriftProblem::TwoRoles {
+                name,
+                first,
+                second,
+            } => D::new(
+                "chain::thermal::two_roles",
+                "header",
+                format!("column `{name}` is named both as a {first} and as a {second} column"),
+            ),
+        }
+    }
+}

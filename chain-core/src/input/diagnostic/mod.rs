@@ -40,8 +40,10 @@ use std::sync::Arc;
 
 pub use located::{Diagnostics, LoadError};
 #[cfg(feature = "csv")]
+pub(crate) use measured::DRIFT_FILE_HEADER;
+#[cfg(feature = "csv")]
 pub(crate) use measured::RUN_FILE_HEADER;
-pub use measured::{MeasurementsProblem, PositioningProblem};
+pub use measured::{DriftProblem, MeasurementsProblem, PositioningProblem};
 pub use names::{closest, shortened, QUOTED_CHARS};
 pub use settings::SettingsProblem;
 #[cfg(feature = "miette")]
@@ -471,6 +473,8 @@ pub enum Problem {
     Measurements(Box<MeasurementsProblem>),
     /// A rule of a positioning run file.
     Positioning(Box<PositioningProblem>),
+    /// A rule of an ISO 230-3 drift-test file.
+    Drift(Box<DriftProblem>),
     /// A rule of a file read by a crate outside chain-core, worded by that
     /// crate's own typed problem ([`Describe`]).
     Foreign(Foreign),
@@ -524,6 +528,12 @@ impl From<SettingsProblem> for Problem {
 impl From<MeasurementsProblem> for Problem {
     fn from(problem: MeasurementsProblem) -> Problem {
         Problem::Measurements(Box::new(problem))
+    }
+}
+
+impl From<DriftProblem> for Problem {
+    fn from(problem: DriftProblem) -> Problem {
+        Problem::Drift(Box::new(problem))
     }
 }
 
@@ -1078,6 +1088,7 @@ impl Problem {
             Problem::Settings(p) => p.describe(),
             Problem::Measurements(p) => p.describe(),
             Problem::Positioning(p) => p.describe(),
+            Problem::Drift(p) => p.describe(),
             Problem::Foreign(p) => p.0.describe(),
         }
     }

@@ -1,0 +1,131 @@
+//! `chain thermal` as a request and a document (spec `thermal.md`,
+//! `docs/thermal.md`): the ISO 230-3 drift test's evaluation and, with a
+//! fit, the thermal model per displacement channel and its prediction. The
+//! CLI and `chain.thermal` run it.
+
+use serde::Serialize;
+
+use chain_core::measured::thermal::{self, DriftTest, Pair, ThermalDocument, ThermalError};
+use chain_core::measured::thermal_fit::{self, FitError, FitOptions, Prediction};
+
+use super::worded::{diagnostic, Worded};
+
+/// The request of `chain thermal`.
+#[derive(Debug, Clone)]
+pub struct ThermalRequest<'a> {
+    /// The drift test, read (and checked) from a file or text.
+    pub test: &'a DriftTest,
+    /// `--pair X1:X2=L`.
+    pub pairs: &'a [Pair],
+    /// `--fit` and its options.
+    pub fit: Option<FitOptions>,
+}
+
+/// What `chain thermal` gives: the document (its JSON), and with a fit the
+/// measured and predicted drift of every channel at every sample (its
+/// CSV).
+#[derive(Debug, Clone, Serialize)]
+pub struct Thermal {
+    /// The document of the spec.
+    #[serde(flatten)]
+    pub document: ThermalDocument,
+    /// Per displacement channel, with a fit: the drift and the model's
+    /// prediction at every sample.
+    #[serde(skip)]
+    pub predictions: Vec<Prediction>,
+    /// The samples' times (s).
+    #[serde(skip)]
+    pub time: Vec<f64>,
+}
+
+/// Why `chain thermal` cannot run as asked.
+#[derive(Debug, thiserror::Error)]
+pub enum ThermalOpsError {
+    /// A `--pair` that does not fit the file (its message is the
+    /// library's, not shown again as a cause).
+    #[error("--pair: {0}")]
+    Pair(ThermalError),
+    /// The fit's options or data.
+    #[error("--fit: {0}")]
+    Fit(FitError),
+    /// A `--pair` that is not `X1:X2=L`.
+    #[error("--pair {text}: {reason}")]
+    PairText {
+        /// As given.
+        text: String,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+impl From<ThermalError> for ThermalOpsError {
+    fn from(e: ThermalError) -> Self {
+        ThermalOpsError::Pair(e)
+    }
+}
+
+impl From<FitError> for ThermalOpsError {
+    fn from(e: FitError) -> Self {
+        ThermalOpsError::Fit(e)
+    }
+}
+
+impl Worded for ThermalOpsError {
+    fn own_code(&self) -> Option<&'static str> {
+        Some(match self {
+            ThermalOpsError::Pair(_) | ThermalOpsError::PairText { .. } => "chain::thermal::pair",
+            ThermalOpsError::Fit(_) => "chain::thermal::fit",
+        })
+    }
+
+    fn own_help(&self) -> Option<String> {
+        match self {
+            ThermalOpsError::Pair(_) | ThermalOpsError::PairText { .. } => Some(
+                "a pair is two displacement channels and their distance in mm: --pair 'X1(um):X2(um)=100', the first the sensor nearer the spindle nose".to_string(),
+            ),
+            ThermalOpsError::Fit(e) => e.help(),
+        }
+    }
+}
+
+diagnostic!(ThermalOpsError);
+
+/// A pair `X1:X2=L` (the sensors' names and their distance in mm).
+pub fn parse_pair(text: &str) -> Result<Pair, ThermalOpsError> {
+    let refuse = |reason: &str| ThermalOpsError::PairText {
+        text: text.to_string(),
+        reason: reason.to_string(),
+    };
+    let (names, distance) = text
+        .rsplit_once('=')
+        .ok_or_else(|| refuse("expected X1:X2=L (L the sensors' distance in mm)"))?;
+    let distance: f64 = distance
+        .trim()
+        .parse()
+        .map_err(|_| refuse(&format!("`{}` is not a distance in mm", distance.trim())))?;
+    let parts: Vec<&str> = names.split(':').collect();
+    let [first, second] = parts[..] else {
+        return Err(refuse("expected two channel names separated by one `:`"));
+    };
+    Ok(Pair {
+        first: first.trim().to_string(),
+        second: second.trim().to_string(),
+        distance,
+    })
+}
+
+/// Runs `chain thermal`.
+pub fn run(request: &ThermalRequest<'_>) -> Result<Thermal, ThermalOpsError> {
+    let mut document = thermal::evaluate(request.test, request.pairs)?;
+    let mut predictions = Vec::new();
+    if let Some(options) = &request.fit {
+        let fitted = thermal_fit::fit(request.test, options)?;
+        fitted.into_document(&mut document);
+        predictions = fitted.predictions;
+    }
+    Ok(Thermal {
+        document,
+        predictions,
+        time: request.test.time.clone(),
+    })
+}
