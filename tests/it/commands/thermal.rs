@@ -407,3 +407,37 @@ fn the_fit_finds_the_sensors_and_predicts_held_out_time() {
     let predicted: f64 = row[3].parse().unwrap();
     assert!((predicted - model_at(&x["model"], &cols, &sim.time, 600)).abs() < 1e-9);
 }
+
+/// `--plot DIR` writes the one figure, PNG and SVG, with the channels, the
+/// models and the temperatures in it.
+#[test]
+fn the_plot_is_one_figure() {
+    let sim = simulated(5);
+    let file = scratch_file("thermal-plot.csv", &sim.text);
+    let dir = common::cli::scratch("thermal-plot");
+    ok_stdout(&[
+        "thermal",
+        file.to_str().unwrap(),
+        "--fit",
+        "--holdout",
+        "0.3",
+        "--plot",
+        dir.to_str().unwrap(),
+    ]);
+    let svg = std::fs::read_to_string(dir.join("thermal.svg")).unwrap();
+    for label in [
+        "Z(um)",
+        "its model",
+        "end of the fit period",
+        "T_column(°C)",
+        "spindle(rpm)",
+    ] {
+        assert!(svg.contains(label), "{label}");
+    }
+    let png = std::fs::read(dir.join("thermal.png")).unwrap();
+    assert!(
+        png.starts_with(b"\x89PNG") && png.len() > 20_000,
+        "{}",
+        png.len()
+    );
+}
