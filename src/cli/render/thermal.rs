@@ -7,6 +7,13 @@ use chain_core::measured::thermal_fit::{Selection, TermKind};
 
 use crate::cli::report::{Csv, Report};
 
+/// The width of a name column: its longest name or its header.
+fn name_width<'a>(names: impl Iterator<Item = &'a str>, header: &str) -> usize {
+    names
+        .map(|n| n.chars().count())
+        .fold(header.chars().count(), usize::max)
+}
+
 impl Report for Thermal {
     fn table(&self) -> String {
         use std::fmt::Write;
@@ -22,10 +29,7 @@ impl Report for Thermal {
         );
         let _ = writeln!(out);
         let _ = writeln!(out, "drift δ = x(t) − x(0) per displacement channel:");
-        let width = (d.channels.iter().map(|c| c.name.chars().count()))
-            .chain([7])
-            .max()
-            .unwrap_or(7);
+        let width = name_width(d.channels.iter().map(|c| c.name.as_str()), "channel");
         let _ = writeln!(
             out,
             "  {:<width$}  {:>4}  {:>12}  {:>12}  {:>10}",
@@ -39,10 +43,7 @@ impl Report for Thermal {
             );
         }
         if !d.temperatures.is_empty() {
-            let width = (d.temperatures.iter().map(|c| c.name.chars().count()))
-                .chain([6])
-                .max()
-                .unwrap_or(6);
+            let width = name_width(d.temperatures.iter().map(|t| t.name.as_str()), "sensor");
             let _ = writeln!(out);
             let _ = writeln!(out, "temperatures (°C):");
             let _ = writeln!(
