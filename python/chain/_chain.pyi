@@ -164,6 +164,7 @@ def positioning_json(
     rotary: bool,
     model: Optional[Model],
     slot: Optional[str],
+    temperatures: Optional[Tuple[float, float, Optional[float], Optional[float], Optional[float], Optional[float]]] = None,
 ) -> Tuple[str, Optional[str]]: ...
 
 

@@ -52,6 +52,7 @@ def positioning(
     machine: Optional["Machine"] = None,
     slot: Optional[str] = None,
     values_out: Optional[Union[str, "os.PathLike[str]"]] = None,
+    temperatures: Optional[Mapping[str, float]] = None,
 ) -> PositioningResult:
     """The ISO 230-2 evaluation of positioning runs, ``chain positioning RUNS --format json``.
 
@@ -68,6 +69,12 @@ def positioning(
     deviations per approach direction, docs/positioning.md), kept as the
     result's ``values_text`` and written to ``values_out`` when given
     (``--values-out``).
+
+    ``temperatures``: correct a linear axis's runs to 20 °C (``--axis-temperature``
+    ...): a mapping with ``axis`` (°C) and ``axis_expansion`` (µm/(m·K)), optionally
+    ``instrument``, ``instrument_expansion``, ``temperature_uncertainty`` (K),
+    ``expansion_uncertainty`` (relative); the result's ``temperature`` states the
+    correction and its uncertainty.
     """
     path, text = _runs_input(runs)
     if isinstance(k, bool):
@@ -75,7 +82,24 @@ def positioning(
     if values_out is not None and (machine is None or slot is None):
         raise ValueError("values_out needs machine and slot")
     model = machine._model if machine is not None else None
-    doc, values_text = _chain.positioning_json(path, text, name, float(k), bool(rotary), model, slot)
+    temps = None
+    if temperatures is not None:
+        keys = ("axis", "axis_expansion", "instrument", "instrument_expansion",
+                "temperature_uncertainty", "expansion_uncertainty")
+        if not isinstance(temperatures, Mapping):
+            raise ValueError(f"temperatures must be a mapping, not {type(temperatures).__name__}")
+        unknown = [key for key in temperatures if key not in keys]
+        if unknown:
+            raise ValueError(f"temperatures: unknown key {unknown[0]!r} (keys: {', '.join(keys)})")
+        for key in keys[:2]:
+            if key not in temperatures:
+                raise ValueError(f"temperatures needs {key!r}")
+        values = [temperatures.get(key) for key in keys]
+        for key, v in zip(keys, values):
+            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
+                raise ValueError(f"temperatures[{key!r}] must be a number, not {v!r}")
+        temps = tuple(None if v is None else float(v) for v in values)
+    doc, values_text = _chain.positioning_json(path, text, name, float(k), bool(rotary), model, slot, temps)
     result = PositioningResult._from_json(doc)
     result.values_text = values_text
     if values_out is not None:

@@ -9,12 +9,17 @@ use pyo3::prelude::*;
 
 use crate::{load_error, source, to_json, value_error, Model};
 
+/// The run's temperatures as Python passes them: axis, its expansion,
+/// then the optional instrument temperature and expansion and the two
+/// uncertainties.
+type Temperatures = (f64, f64, Option<f64>, Option<f64>, Option<f64>, Option<f64>);
+
 /// The positioning document of the runs at `path`, or of `text` named
 /// `file`; `k` the coverage factor, `rotary` as `--rotary`. With `model`
 /// and `slot` (`--machine`, `--slot`), also the values file `--values-out`
 /// writes.
 #[pyfunction]
-#[pyo3(signature = (path, text, file, k, rotary, model, slot))]
+#[pyo3(signature = (path, text, file, k, rotary, model, slot, temperatures=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn positioning_json(
     py: Python<'_>,
@@ -25,6 +30,7 @@ pub(crate) fn positioning_json(
     rotary: bool,
     model: Option<&Model>,
     slot: Option<&str>,
+    temperatures: Option<Temperatures>,
 ) -> PyResult<(String, Option<String>)> {
     let k = Coverage::new(k).map_err(|e| value_error(e.to_string()))?;
     let kind = ops::axis_kind(rotary);
@@ -47,6 +53,7 @@ pub(crate) fn positioning_json(
         runs: &runs,
         k,
         values_out,
+        temperatures: temperatures.map(|t| ops::temperatures(t.0, t.1, t.2, t.3, t.4, t.5)),
     })
     .map_err(|e| value_error(e.to_string()))?;
     let (doc, values) = (done.document, done.values_text);

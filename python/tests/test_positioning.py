@@ -157,3 +157,16 @@ def test_compensate_is_the_cli_json(cli, cli_error):
     with pytest.raises(ValueError) as info:
         chain.compensate(bad, length=577.11, name="bad.csv")
     assert "z3" in str(info.value)
+
+
+def test_temperatures_are_the_cli_s(cli):
+    path = RUNS / "x_axis_runs.csv"
+    r = chain.positioning(path, temperatures={"axis": 23.5, "axis_expansion": 11.5, "instrument": 22.0,
+                                              "instrument_expansion": 11.0})
+    assert r.to_dict() == cli("positioning", path, "--axis-temperature", "23.5", "--axis-expansion", "11.5",
+                              "--instrument-temperature", "22", "--instrument-expansion", "11")
+    assert r.temperature["per_metre"] == pytest.approx(11.5 * 3.5 - 11.0 * 2.0)
+    with pytest.raises(ValueError, match="temperatures needs 'axis_expansion'"):
+        chain.positioning(path, temperatures={"axis": 23.5})
+    with pytest.raises(ValueError, match="a rotary axis's angles"):
+        chain.positioning(RUNS / "c_axis_runs.csv", rotary=True, temperatures={"axis": 23.0, "axis_expansion": 11.5})

@@ -4,6 +4,7 @@
 //! it.
 
 use chain_core::measured::positioning::{self, AxisKind, Coverage, PositioningDocument, Runs};
+use chain_core::measured::positioning_temperature::{self, TemperatureError, Temperatures};
 use chain_core::measured::positioning_values::{self, SlotError};
 use chain_core::Machine;
 
@@ -29,6 +30,8 @@ pub struct PositioningRequest<'a> {
     pub k: Coverage,
     /// `--values-out`.
     pub values_out: Option<ValuesOut<'a>>,
+    /// `--axis-temperature` and the rest: correct the runs to 20 °C.
+    pub temperatures: Option<Temperatures>,
 }
 
 /// What `chain positioning` gives: the document and, with `values_out`,
@@ -41,21 +44,31 @@ pub struct Positioned {
     pub values_text: Option<String>,
 }
 
-/// Why `chain positioning` cannot write its values file.
+/// Why `chain positioning` cannot run as asked.
 #[derive(Debug, thiserror::Error)]
-#[error("--slot {slot} (machine {file}): {error}{}", rotary_hint(error))]
-#[cfg_attr(
-    feature = "cli",
-    derive(miette::Diagnostic),
-    diagnostic(forward(error))
-)]
-pub struct PositioningError {
-    /// The slot given.
-    pub slot: String,
-    /// The machine file.
-    pub file: String,
-    /// Why the slot cannot take the run.
-    pub error: Box<SlotError>,
+#[cfg_attr(feature = "cli", derive(miette::Diagnostic))]
+pub enum PositioningError {
+    /// The values file's slot cannot take the run.
+    #[error("--slot {slot} (machine {file}): {error}{}", rotary_hint(error))]
+    #[cfg_attr(feature = "cli", diagnostic(forward(error)))]
+    Slot {
+        /// The slot given.
+        slot: String,
+        /// The machine file.
+        file: String,
+        /// Why the slot cannot take the run.
+        error: Box<SlotError>,
+    },
+    /// The correction to 20 °C cannot be made.
+    #[error("--axis-temperature: {0}")]
+    #[cfg_attr(
+        feature = "cli",
+        diagnostic(
+            code(chain::positioning::temperature),
+            help("give the scale's temperature and expansion coefficient (µm/(m·K)) of a linear axis; docs/positioning.md, \"At 20 °C\"")
+        )
+    )]
+    Temperature(TemperatureError),
 }
 
 /// What a slot of a rotary axis refused for linear runs adds: the option
@@ -79,14 +92,48 @@ pub fn axis_kind(rotary: bool) -> AxisKind {
     }
 }
 
+/// The default standard uncertainty of a temperature (K).
+pub const TEMPERATURE_UNCERTAINTY: f64 = 0.1;
+/// The default relative half-width of an expansion coefficient.
+pub const EXPANSION_UNCERTAINTY: f64 = 0.1;
+
+/// The temperatures of a run with the options' defaults: the instrument at
+/// 20 °C compensating nothing, 0.1 K, ±10 %.
+pub fn temperatures(
+    axis: f64,
+    axis_expansion: f64,
+    instrument: Option<f64>,
+    instrument_expansion: Option<f64>,
+    temperature_uncertainty: Option<f64>,
+    expansion_uncertainty: Option<f64>,
+) -> Temperatures {
+    Temperatures {
+        axis,
+        axis_expansion,
+        instrument: instrument.unwrap_or(20.0),
+        instrument_expansion: instrument_expansion.unwrap_or(0.0),
+        temperature_uncertainty: temperature_uncertainty.unwrap_or(TEMPERATURE_UNCERTAINTY),
+        expansion_uncertainty: expansion_uncertainty.unwrap_or(EXPANSION_UNCERTAINTY),
+    }
+}
+
 /// Runs `chain positioning`.
 pub fn run(request: &PositioningRequest<'_>) -> Result<Positioned, PositioningError> {
-    let document = positioning::evaluate(request.runs, request.k);
+    let document = match &request.temperatures {
+        None => positioning::evaluate(request.runs, request.k),
+        Some(at) => {
+            let (runs, correction) = positioning_temperature::correct(request.runs, at, request.k)
+                .map_err(PositioningError::Temperature)?;
+            let mut document = positioning::evaluate(&runs, request.k);
+            document.temperature = Some(correction);
+            document
+        }
+    };
     let values_text = match request.values_out {
         None => None,
         Some(out) => {
             let slot = positioning_values::slot(out.machine, out.slot, request.runs.kind).map_err(
-                |e| PositioningError {
+                |e| PositioningError::Slot {
                     slot: out.slot.to_string(),
                     file: out.machine_file.to_string(),
                     error: e,

@@ -20,6 +20,7 @@ pub mod iterate;
 pub mod measurements;
 pub mod plan;
 pub mod positioning;
+pub mod positioning_temperature;
 pub mod positioning_values;
 pub mod predict;
 pub mod spheres;

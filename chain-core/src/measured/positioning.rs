@@ -650,6 +650,10 @@ pub struct PositioningDocument {
     pub file: String,
     /// Every run's deviations, up runs first.
     pub points: Vec<RunPoints>,
+    /// The correction to 20 °C, when the runs were corrected
+    /// (`positioning_temperature`): every deviation above is corrected.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub temperature: Option<super::positioning_temperature::TemperatureCorrection>,
 }
 
 /// The mean of `x` (2.12).
@@ -760,6 +764,7 @@ pub fn evaluate(runs: &Runs, k: Coverage) -> PositioningDocument {
         target_unit: runs.kind.target_unit(),
         file: runs.file.clone(),
         points,
+        temperature: None,
     }
 }
 

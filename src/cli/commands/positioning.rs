@@ -57,6 +57,27 @@ pub struct PositioningArgs {
     /// (with `--values-out`).
     #[arg(long, value_name = "NAME", requires = "values_out")]
     pub slot: Option<String>,
+    /// Correct the runs to 20 °C: the axis's (scale's) temperature during
+    /// the runs (°C; docs/positioning.md, "At 20 °C").
+    #[arg(long, value_name = "C", requires = "axis_expansion")]
+    pub axis_temperature: Option<f64>,
+    /// The scale's expansion coefficient (µm/(m·K); steel about 11.5).
+    #[arg(long, value_name = "PPM", requires = "axis_temperature")]
+    pub axis_expansion: Option<f64>,
+    /// The instrument's (material sensor's) temperature [default: 20].
+    #[arg(long, value_name = "C", requires = "axis_temperature")]
+    pub instrument_temperature: Option<f64>,
+    /// The expansion coefficient the instrument compensates with
+    /// (µm/(m·K)) [default: 0, no compensation].
+    #[arg(long, value_name = "PPM", requires = "axis_temperature")]
+    pub instrument_expansion: Option<f64>,
+    /// The standard uncertainty of each temperature (K) [default: 0.1].
+    #[arg(long, value_name = "K", requires = "axis_temperature")]
+    pub temperature_uncertainty: Option<f64>,
+    /// The relative half-width of each expansion coefficient [default: 0.1,
+    /// ±10 %].
+    #[arg(long, value_name = "FRACTION", requires = "axis_temperature")]
+    pub expansion_uncertainty: Option<f64>,
 }
 
 /// `--k`: a number the library takes as a coverage factor.
@@ -85,10 +106,22 @@ pub fn exec(args: PositioningArgs) -> miette::Result<()> {
         }),
         _ => None,
     };
+    let temperatures = match (args.axis_temperature, args.axis_expansion) {
+        (Some(axis), Some(axis_expansion)) => Some(ops::temperatures(
+            axis,
+            axis_expansion,
+            args.instrument_temperature,
+            args.instrument_expansion,
+            args.temperature_uncertainty,
+            args.expansion_uncertainty,
+        )),
+        _ => None,
+    };
     let done = ops::run(&ops::PositioningRequest {
         runs: &runs,
         k: args.k,
         values_out,
+        temperatures,
     })?;
     let doc = done.document;
     if let (Some(out), Some(text)) = (&args.values_out, &done.values_text) {

@@ -109,6 +109,25 @@ impl Report for PositioningDocument {
             cell(self, a.B),
             cell(self, a.B_mean)
         );
+        if let Some(t) = &self.temperature {
+            let _ = writeln!(out);
+            let _ = writeln!(
+                out,
+                "corrected to 20 °C (docs/positioning.md): scale at {} °C, {} µm/(m·K); instrument at {} °C, {} µm/(m·K)",
+                t.at.axis, t.at.axis_expansion, t.at.instrument, t.at.instrument_expansion
+            );
+            let _ = writeln!(
+                out,
+                "  {:.4} µm/m from target {} (at the farthest target {}); its uncertainty U = {} (k = {}; u(T) = {} K, coefficients ±{} %)",
+                t.per_metre,
+                t.datum,
+                cell(self, t.largest),
+                cell(self, t.expanded),
+                self.k,
+                t.at.temperature_uncertainty,
+                t.at.expansion_uncertainty * 100.0
+            );
+        }
         out
     }
 

@@ -434,3 +434,78 @@ fn refusals_name_file_line_and_column() {
     let err = unwrapped(&fails(&["positioning", "no/such/runs.csv"]));
     assert!(err.contains("no/such/runs.csv"), "{err}");
 }
+
+/// ISO 230-2 at 20 °C (docs/positioning.md, "At 20 °C"): the example X
+/// axis measured with its scale at 23.5 °C (11.5 µm/(m·K)) and a laser's
+/// material sensor at 22 °C compensating with 11.0: every target's means are
+/// the uncorrected ones less `(P − P₀)·(α_s·ΔT_s − α_i·ΔT_i)`, the reversal
+/// unchanged; the uncertainty contribution is the test's root sum of
+/// squares of `α·L·u(T)` per temperature and `L·|ΔT|·α·r/√3` per
+/// coefficient, times k; a rotary axis is refused.
+#[test]
+fn the_runs_corrected_to_20_degrees() {
+    let path = "examples/positioning/x_axis_runs.csv";
+    let raw = ok_json(&["positioning", path, "--format", "json"]);
+    let at = ok_json(&[
+        "positioning",
+        path,
+        "--axis-temperature",
+        "23.5",
+        "--axis-expansion",
+        "11.5",
+        "--instrument-temperature",
+        "22",
+        "--instrument-expansion",
+        "11",
+        "--temperature-uncertainty",
+        "0.2",
+        "--expansion-uncertainty",
+        "0.1",
+        "--format",
+        "json",
+    ]);
+    let c = (11.5 * 3.5 - 11.0 * 2.0) * 1e-6;
+    let (raw_t, at_t) = (
+        raw["targets"].as_array().unwrap(),
+        at["targets"].as_array().unwrap(),
+    );
+    let p0 = raw_t[0]["target"].as_f64().unwrap();
+    for (r, a) in raw_t.iter().zip(at_t) {
+        let l = r["target"].as_f64().unwrap() - p0;
+        for key in ["mean_up", "mean_down", "mean"] {
+            let want = r[key].as_f64().unwrap() - l * c;
+            assert!(
+                (a[key].as_f64().unwrap() - want).abs() < 1e-12,
+                "{key} at {l}"
+            );
+        }
+        assert!((a["reversal"].as_f64().unwrap() - r["reversal"].as_f64().unwrap()).abs() < 1e-12);
+    }
+    let span = raw_t.last().unwrap()["target"].as_f64().unwrap() - p0;
+    let rect = 0.1 / 3f64.sqrt();
+    let u = ((11.5e-6 * span * 0.2).powi(2)
+        + (11.0e-6 * span * 0.2).powi(2)
+        + (span * 11.5e-6 * 3.5 * rect).powi(2)
+        + (span * 11.0e-6 * 2.0 * rect).powi(2))
+    .sqrt();
+    let t = &at["temperature"];
+    assert!(
+        (t["expanded"].as_f64().unwrap() - 2.0 * u).abs() < 1e-12,
+        "{t}"
+    );
+    assert!((t["largest"].as_f64().unwrap() - span * c).abs() < 1e-12);
+    assert!(raw.get("temperature").is_none());
+    let e = unwrapped(&fails(&[
+        "positioning",
+        "examples/positioning/c_axis_runs.csv",
+        "--rotary",
+        "--axis-temperature",
+        "23",
+        "--axis-expansion",
+        "11.5",
+    ]));
+    assert!(
+        e.contains("a rotary axis's angles do not change with its temperature"),
+        "{e}"
+    );
+}
