@@ -444,6 +444,20 @@ fn the_bc_table_and_the_master_inverse() {
     );
 }
 
+/// The grid of the compensated maps of the trunnion.
+const MAP_GRID: [&str; 10] = [
+    "--grid",
+    "x=-100,100",
+    "--grid",
+    "y=-100,100",
+    "--grid",
+    "z=-100,0",
+    "--grid",
+    "A=-1,0,1",
+    "--grid",
+    "C=0,1.5,3,4.5",
+];
+
 /// The CLI: the table shows the pins and notes, the JSON carries the
 /// kinematics; another machine and the per-axis formats' machines are
 /// refused with the kinds each format takes; `map --compensated
@@ -531,18 +545,7 @@ fn the_cli_writes_and_refuses() {
     );
     // The compensated map: the tilts remain, far less than before.
     let mut map = vec!["map", machine, "--values", values];
-    map.extend([
-        "--grid",
-        "x=-100,100",
-        "--grid",
-        "y=-100,100",
-        "--grid",
-        "z=-100,0",
-        "--grid",
-        "A=-1,0,1",
-        "--grid",
-        "C=0,1.5,3,4.5",
-    ]);
+    map.extend(MAP_GRID);
     let stepped = [
         map.clone(),
         vec!["--compensated", "siemens-carr", "--compensation-step", "5"],
@@ -1321,20 +1324,8 @@ fn the_cli_writes_fanuc_and_heidenhain() {
     );
     assert_eq!(json["kinematics"]["parameters"][2]["nominal"], 50.0);
     let mut map = vec!["map", machine, "--values", values];
-    map.extend([
-        "--grid",
-        "x=-100,100",
-        "--grid",
-        "y=-100,100",
-        "--grid",
-        "z=-100,0",
-        "--grid",
-        "A=-1,0,1",
-        "--grid",
-        "C=0,1.5,3,4.5",
-        "--format",
-        "json",
-    ]);
+    map.extend(MAP_GRID);
+    map.extend(["--format", "json"]);
     let largest = |args: Vec<&str>| {
         let d = ok_json(&[map.clone(), args].concat());
         d["compensated"]["summary"]["volumetric"]["max"]

@@ -31,7 +31,7 @@
 use crate::compensation::{opening_line, ExportedFile};
 use crate::model_trait::ErrorModel;
 
-use super::rotary::{rotate, KinematicsParameter, TableTable, TrtModel, Written};
+use super::rotary::{changes_text, rotate, KinematicsParameter, TableTable, TrtModel, Written};
 use super::{decimals, num, ControllerError, Export};
 
 /// The table rotation type's model: the first (master) axis along frame
@@ -240,14 +240,12 @@ pub(super) fn export<M: ErrorModel + Sync>(
     for note in &notes {
         readme.push_str(&format!("- {note}\n"));
     }
-    readme.push_str("\nThe rotary axes' reference positions (degrees):\n");
-    for p in parameters.iter().filter(|p| p.unit == "deg") {
-        readme.push_str(&format!("{} = {}\n", p.name, num(p.value)));
-    }
-    readme.push_str("\nThe workpiece's zero moves with a location error of an axis that carries it: re-probe the part, or add to its work offset (mm):\n");
-    for p in parameters.iter().filter(|p| p.unit.starts_with("mm (")) {
-        readme.push_str(&format!("{} = {}\n", p.name, num(p.value)));
-    }
+    readme.push_str(&changes_text(
+        &parameters,
+        "deg",
+        "The rotary axes' reference positions (degrees)",
+        "The workpiece's zero moves with a location error of an axis that carries it: re-probe the part, or add to its work offset (mm)",
+    ));
     let files = vec![
         ExportedFile {
             name: "TCP.PRM".into(),

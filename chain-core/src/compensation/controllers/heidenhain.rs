@@ -30,7 +30,7 @@
 use crate::compensation::{opening_line, ExportedFile};
 use crate::model_trait::ErrorModel;
 
-use super::rotary::{rotate, KinematicsParameter, TableTable, TrtModel, Written};
+use super::rotary::{changes_text, rotate, KinematicsParameter, TableTable, TrtModel, Written};
 use super::{decimals, num, ControllerError, Export};
 
 /// Frame axis letters of a translation and of a rotation.
@@ -312,14 +312,12 @@ pub(super) fn export<M: ErrorModel + Sync>(
     for note in &notes {
         readme.push_str(&format!("- {note}\n"));
     }
-    readme.push_str("\nThe rotary axes' offsets (degrees):\n");
-    for p in parameters.iter().filter(|p| p.unit.starts_with("deg (")) {
-        readme.push_str(&format!("{} = {}\n", p.name, num(p.value)));
-    }
-    readme.push_str("\nThe workpiece's zero moves with a location error of an axis that carries it: probe the preset again, or add to it (mm):\n");
-    for p in parameters.iter().filter(|p| p.unit.starts_with("mm (")) {
-        readme.push_str(&format!("{} = {}\n", p.name, num(p.value)));
-    }
+    readme.push_str(&changes_text(
+        &parameters,
+        "deg (axis offset)",
+        "The rotary axes' offsets (degrees)",
+        "The workpiece's zero moves with a location error of an axis that carries it: probe the preset again, or add to it (mm)",
+    ));
     let files = vec![
         ExportedFile {
             name: "KINEMATICS_ROTARY.TAB".into(),

@@ -694,6 +694,32 @@ pub(crate) fn rotate(axis: [f64; 3], deg: f64, x: [f64; 3]) -> [f64; 3] {
     std::array::from_fn(|i| x[i] * c + cross[i] * s + k[i] * dot * (1.0 - c))
 }
 
+/// A README's closing sections: under `zeros` the zero changes (the
+/// parameters of unit `zero_unit`), under `work` the workpiece's zero
+/// changes (unit `mm (…)`), one `name = value` line each.
+pub(crate) fn changes_text(
+    parameters: &[KinematicsParameter],
+    zero_unit: &str,
+    zeros: &str,
+    work: &str,
+) -> String {
+    let mut text = String::new();
+    for (heading, keep) in [
+        (
+            zeros,
+            &(|p: &KinematicsParameter| p.unit == zero_unit)
+                as &dyn Fn(&KinematicsParameter) -> bool,
+        ),
+        (work, &|p: &KinematicsParameter| p.unit.starts_with("mm (")),
+    ] {
+        text.push_str(&format!("\n{heading}:\n"));
+        for p in parameters.iter().filter(|p| keep(p)) {
+            text.push_str(&format!("{} = {}\n", p.name, super::num(p.value)));
+        }
+    }
+    text
+}
+
 /// A term named `name` of size 0.
 fn term(name: &str) -> Term {
     Term {
