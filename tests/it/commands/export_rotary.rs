@@ -444,6 +444,20 @@ fn the_bc_table_and_the_master_inverse() {
     );
 }
 
+/// The travel of the trunnion's exports.
+const EXPORT_GRID: [&str; 10] = [
+    "--grid",
+    "x=-100,100",
+    "--grid",
+    "y=-100,100",
+    "--grid",
+    "z=-100,0",
+    "--grid",
+    "A=-1,1",
+    "--grid",
+    "C=0,6.283185307179586",
+];
+
 /// The grid of the compensated maps of the trunnion.
 const MAP_GRID: [&str; 10] = [
     "--grid",
@@ -467,18 +481,7 @@ fn the_cli_writes_and_refuses() {
     let machine = example_path("ac_trunnion_rotary.yaml");
     let values = common::example_file("spheres/truth.yaml");
     let dir = scratch("export-rotary");
-    let grid = [
-        "--grid",
-        "x=-100,100",
-        "--grid",
-        "y=-100,100",
-        "--grid",
-        "z=-100,0",
-        "--grid",
-        "A=-1,1",
-        "--grid",
-        "C=0,6.283185307179586",
-    ];
+    let grid = EXPORT_GRID;
     let (machine, values) = (machine.to_str().unwrap(), values.to_str().unwrap());
     let export_args = |controller| {
         let mut a = vec![
@@ -1270,18 +1273,7 @@ fn the_cli_writes_fanuc_and_heidenhain() {
     let values = common::example_file("spheres/truth.yaml");
     let (machine, values) = (machine.to_str().unwrap(), values.to_str().unwrap());
     let dir = scratch("export-rotary-vendors");
-    let grid = [
-        "--grid",
-        "x=-100,100",
-        "--grid",
-        "y=-100,100",
-        "--grid",
-        "z=-100,0",
-        "--grid",
-        "A=-1,1",
-        "--grid",
-        "C=0,6.283185307179586",
-    ];
+    let grid = EXPORT_GRID;
     let export_args = |controller: &'static str| -> Vec<&str> {
         let mut a = vec![
             "export",

@@ -31,7 +31,9 @@
 use crate::compensation::{opening_line, ExportedFile};
 use crate::model_trait::ErrorModel;
 
-use super::rotary::{changes_text, rotate, KinematicsParameter, TableTable, TrtModel, Written};
+use super::rotary::{
+    changes_text, orientations, rotate, KinematicsParameter, TableTable, TrtModel, Written,
+};
 use super::{decimals, num, ControllerError, Export};
 
 /// The table rotation type's model: the first (master) axis along frame
@@ -122,22 +124,15 @@ pub(super) fn export<M: ErrorModel + Sync>(
     tt: &TableTable<'_, M>,
 ) -> Result<Export, ControllerError> {
     let m = tt.machine;
-    let candidates = [0usize, 1].into_iter().flat_map(|k1| {
-        [-1.0, 1.0].into_iter().flat_map(move |s1| {
-            [-1.0, 1.0].into_iter().map(move |s2| {
-                let model = TableType {
-                    first: (k1, s1),
-                    second: (2, s2),
-                };
-                let label = format!(
-                    "19682 = {}, 19684 = {}, 19687 = 3, 19689 = {}",
-                    code(k1),
-                    direction(s1),
-                    direction(s2)
-                );
-                (model, label)
-            })
-        })
+    let candidates = orientations().map(|[first, second]| {
+        let label = format!(
+            "19682 = {}, 19684 = {}, 19687 = {}, 19689 = {}",
+            code(first.0),
+            direction(first.1),
+            code(second.0),
+            direction(second.1)
+        );
+        (TableType { first, second }, label)
     });
     let none = "no table rotation type (19680 = 12) with its axes along the machine's axes reproduces its nominal kinematics";
     let (model, mut fit) = tt.fit_first(candidates, &[], none)?;

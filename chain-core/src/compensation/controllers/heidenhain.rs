@@ -30,7 +30,9 @@
 use crate::compensation::{opening_line, ExportedFile};
 use crate::model_trait::ErrorModel;
 
-use super::rotary::{changes_text, rotate, KinematicsParameter, TableTable, TrtModel, Written};
+use super::rotary::{
+    changes_text, orientations, rotate, KinematicsParameter, TableTable, TrtModel, Written,
+};
 use super::{decimals, num, ControllerError, Export};
 
 /// Frame axis letters of a translation and of a rotation.
@@ -142,23 +144,20 @@ pub(super) fn export<M: ErrorModel + Sync>(
     angles: bool,
 ) -> Result<Export, ControllerError> {
     let m = tt.machine;
-    let candidates = [0usize, 1].into_iter().flat_map(move |k1| {
-        [-1.0, 1.0].into_iter().flat_map(move |s1| {
-            [-1.0, 1.0].into_iter().map(move |s2| {
-                let model = Description {
-                    first: (k1, s1),
-                    second: (2, s2),
-                    angles,
-                };
-                let label = format!(
-                    "{} turning the table {}, C turning it {}",
-                    ANGULAR[k1],
-                    sense(s1),
-                    sense(s2)
-                );
-                (model, label)
-            })
-        })
+    let candidates = orientations().map(|[first, second]| {
+        let label = format!(
+            "{} turning the table {}, {} turning it {}",
+            ANGULAR[first.0],
+            sense(first.1),
+            ANGULAR[second.0],
+            sense(second.1)
+        );
+        let model = Description {
+            first,
+            second,
+            angles,
+        };
+        (model, label)
     });
     let none = "no description with a tilting axis about X or Y carrying a rotary table about Z reproduces its nominal kinematics";
     let (model, mut fit) = tt.fit_first(candidates, &[], none)?;

@@ -694,6 +694,17 @@ pub(crate) fn rotate(axis: [f64; 3], deg: f64, x: [f64; 3]) -> [f64; 3] {
     std::array::from_fn(|i| x[i] * c + cross[i] * s + k[i] * dot * (1.0 - c))
 }
 
+/// The axis orientations a table-table format tries on the machine: the
+/// tilting axis along X or Y, the rotary table along Z, each with a sense
+/// (`±1`): `[(frame axis, sense); 2]`, in the order tried.
+pub(crate) fn orientations() -> impl Iterator<Item = [(usize, f64); 2]> {
+    [0usize, 1].into_iter().flat_map(|k| {
+        [-1.0, 1.0]
+            .into_iter()
+            .flat_map(move |s1| [-1.0, 1.0].into_iter().map(move |s2| [(k, s1), (2, s2)]))
+    })
+}
+
 /// A README's closing sections: under `zeros` the zero changes (the
 /// parameters of unit `zero_unit`), under `work` the workpiece's zero
 /// changes (unit `mm (…)`), one `name = value` line each.

@@ -30,7 +30,7 @@
 use crate::compensation::{opening_line, ExportedFile};
 use crate::model_trait::ErrorModel;
 
-use super::rotary::{rotate, KinematicsParameter, TableTable, TrtModel, Written};
+use super::rotary::{orientations, rotate, KinematicsParameter, TableTable, TrtModel, Written};
 use super::{decimals, num, ControllerError, Export};
 
 /// The record's model with its entered axis vectors' nominal values: pins
@@ -75,13 +75,10 @@ pub(super) fn export<M: ErrorModel + Sync>(
     let m = tt.machine;
     let axis =
         |k: usize, s: f64| -> [f64; 3] { std::array::from_fn(|i| if i == k { s } else { 0.0 }) };
-    let candidates = [axis(0, -1.0), axis(0, 1.0), axis(1, -1.0), axis(1, 1.0)]
-        .into_iter()
-        .flat_map(|v1| {
-            [axis(2, -1.0), axis(2, 1.0)]
-                .into_iter()
-                .map(move |v2| (Record { v1, v2 }, format!("v1 = {v1:?}, v2 = {v2:?}")))
-        });
+    let candidates = orientations().map(|[(k1, s1), (k2, s2)]| {
+        let (v1, v2) = (axis(k1, s1), axis(k2, s2));
+        (Record { v1, v2 }, format!("v1 = {v1:?}, v2 = {v2:?}"))
+    });
     let none = "no swivel data record of type P with axis vectors along the machine's axes reproduces its nominal kinematics";
     let (record, mut fit) = tt.fit_first(candidates, &[], none)?;
     // To the nanometre (and 1e-9 of a unit vector): below that a value is
