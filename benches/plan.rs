@@ -38,6 +38,7 @@ fn candidates(m: &Machine, p: &[f64], n: usize) -> Vec<Measurement> {
             values: vec![],
             std: None,
             setup: None,
+            temperatures: Vec::new(),
         })
         .collect()
 }

@@ -20,6 +20,7 @@ pub mod measured;
 mod model_trait;
 pub mod named;
 pub mod symbolic;
+pub mod thermal_state;
 
 // The stages' modules also at flat paths (`chain_core::load`,
 // `chain_core::inverse`, ...), which downstream code and the docs use.

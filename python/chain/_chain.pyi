@@ -68,6 +68,7 @@ def reliability_json(
     acceptance: bool,
     acceptance_tolerance: float,
     approach: Optional[str],
+    temperatures: Sequence[Tuple[str, float]],
 ) -> str: ...
 def sobol_json(
     model: Model,
@@ -91,6 +92,7 @@ def sensitivity_reliability_json(
     sided: Optional[str],
     values: Optional[str],
     approach: Optional[str],
+    temperatures: Sequence[Tuple[str, float]],
 ) -> str: ...
 def geometric_json(
     model: Model,
@@ -132,6 +134,7 @@ def identify_json(
     iterate: bool = False,
     holdout: Optional[float] = None,
     seed: Optional[int] = None,
+    temperatures: Sequence[Tuple[str, float]] = (),
 ) -> Tuple[str, str]: ...
 def plan_json(
     model: Model,
@@ -152,6 +155,7 @@ def map_json(
     points: Optional[npt.NDArray[np.float64]],
     params: Sequence[Tuple[str, float]],
     approach: Optional[str],
+    temperatures: Sequence[Tuple[str, float]],
 ) -> str: ...
 
 # -- positioning runs (python/src/positioning.rs) ------------------------------
@@ -183,7 +187,14 @@ def thermal_json(
     lag: bool,
     holdout: Optional[float],
     fit_until: Optional[float],
-) -> Tuple[str, npt.NDArray[np.float64], List[Tuple[str, npt.NDArray[np.float64], npt.NDArray[np.float64]]]]: ...
+    model: Optional[Model] = None,
+    slots: Sequence[Tuple[str, str]] = (),
+) -> Tuple[
+    str,
+    npt.NDArray[np.float64],
+    List[Tuple[str, npt.NDArray[np.float64], npt.NDArray[np.float64]]],
+    Optional[str],
+]: ...
 
 
 # -- inverse kinematics (python/src/inverse.rs) ----------------------------------
@@ -232,7 +243,9 @@ def export_json(
     step: Optional[float],
     cec_max_points: Optional[int],
     beckhoff_max_records: Optional[int],
+    angles: bool,
     params: Sequence[Tuple[str, float]],
+    temperatures: Sequence[Tuple[str, float]],
 ) -> Tuple[str, List[Tuple[str, str]]]: ...
 
 

@@ -30,18 +30,27 @@ def _approach(approach: Union[None, str, Mapping[str, str]]) -> Optional[str]:
     raise ValueError(f"approach must be a str or a mapping, not {type(approach).__name__}")
 
 
-def _params(params: Params) -> List[Tuple[str, float]]:
-    if params is None:
+def _named_numbers(given: Optional[Mapping[str, float]], what: str, of: str, entry: str) -> List[Tuple[str, float]]:
+    if given is None:
         return []
-    if not isinstance(params, Mapping):
-        raise TypeError(f"params must be a mapping of parameter name to value, not {type(params).__name__}")
+    if not isinstance(given, Mapping):
+        raise TypeError(f"{what} must be a mapping of {of}, not {type(given).__name__}")
     out = []
-    for name, value in params.items():
+    for name, value in given.items():
         try:
             out.append((str(name), float(value)))
         except (TypeError, ValueError):
-            raise ValueError(f"parameter `{name}`: {value!r} is not a number") from None
+            raise ValueError(f"{entry} `{name}`: {value!r} is not a number") from None
     return out
+
+
+def _params(params: Params) -> List[Tuple[str, float]]:
+    return _named_numbers(params, "params", "parameter name to value", "parameter")
+
+
+def _temperatures(temperature: Optional[Mapping[str, float]]) -> List[Tuple[str, float]]:
+    """``temperature={"T_x": 28.0}``: ``--temperature T_x=28`` (°C)."""
+    return _named_numbers(temperature, "temperature", "sensor name to °C", "sensor")
 
 
 def _float_array(x: ArrayLike, name: str) -> np.ndarray:
@@ -220,6 +229,7 @@ class Machine:
         acceptance: bool = False,
         acceptance_tolerance: float = 1e-3,
         approach: Union[None, str, Mapping[str, str]] = None,
+        temperature: Optional[Mapping[str, float]] = None,
     ) -> ReliabilityResult:
         """Machining-accuracy reliability over the file's grid, ``chain reliability --format json``.
 
@@ -247,7 +257,9 @@ class Machine:
           ``{"x": "up"}``);
         - ``acceptance=True``: also the whole-machine acceptance probability
           (the document's ``acceptance``; also computed when the file sets
-          ``reliability.acceptance: true``), to ``acceptance_tolerance``.
+          ``reliability.acceptance: true``), to ``acceptance_tolerance``;
+        - ``temperature``: the thermal state of a machine with ``sensors``,
+          ``{sensor: °C}`` (``--temperature``; docs/thermal.md).
         """
         if samples is not None and (not isinstance(samples, int) or isinstance(samples, bool) or samples < 0):
             raise ValueError(f"samples must be a non-negative integer, not {samples!r}")
@@ -268,6 +280,7 @@ class Machine:
         text = _chain.reliability_json(
             self._model, method, samples, seed, cov, axes, _params(params), sided, system,
             system_tolerance, path, acceptance, acceptance_tolerance, _approach(approach),
+            _temperatures(temperature),
         )
         return ReliabilityResult._from_json(text)
 
@@ -404,6 +417,7 @@ class Machine:
         points: Optional[ArrayLike] = None,
         params: Params = None,
         approach: Union[None, str, Mapping[str, str]] = None,
+        temperature: Optional[Mapping[str, float]] = None,
     ) -> "MapResult":
         """The error map of the built machine, ``chain map --values VALUES --format json``.
 
@@ -414,7 +428,9 @@ class Machine:
         axis values in ``variables`` order instead (``--axes``).
         ``approach``: which direction of the bidirectional tables to map
         (``--approach``): ``"up"``, ``"down"``, ``"mean"`` (the default),
-        ``"x=up,y=down"`` or ``{"x": "up"}``.
+        ``"x=up,y=down"`` or ``{"x": "up"}``. ``temperature``: the thermal
+        state of a machine with ``sensors``, ``{sensor: °C}``
+        (``--temperature``; docs/thermal.md).
         """
         from ._results import MapResult
 
@@ -423,7 +439,15 @@ class Machine:
         if points is not None:
             q, _ = _rows(points, "points", len(self.variables), "the variables " + ", ".join(self.variables))
         text_json = _chain.map_json(
-            self._model, path, text, name, _grid_axes(grid), q, _params(params), _approach(approach)
+            self._model,
+            path,
+            text,
+            name,
+            _grid_axes(grid),
+            q,
+            _params(params),
+            _approach(approach),
+            _temperatures(temperature),
         )
         return MapResult._from_json(text_json)
 
@@ -439,6 +463,7 @@ class Machine:
         params: Params = None,
         out: Union[None, str, "os.PathLike[str]"] = None,
         angles: bool = False,
+        temperature: Optional[Mapping[str, float]] = None,
     ) -> "ExportResult":
         """Compensation for a controller, ``chain export --values VALUES --controller NAME --format json``.
 
@@ -451,7 +476,9 @@ class Machine:
         formats), ``--grid``; ``points``: the grid export's nodes as an
         ``(N, V)`` array (``--axes``); ``step``, ``cec_max_points``,
         ``beckhoff_max_records``: the per-axis tables' options; ``angles``:
-        heidenhain's angle rows (``--angles``). The result's ``files`` maps
+        heidenhain's angle rows (``--angles``); ``temperature``: the
+        thermal state the tables are for (``--temperature``, as for
+        :meth:`map`). The result's ``files`` maps
         each file's name to its text; ``out``: also write them into that
         folder (created if missing), as ``--out DIR``.
         """
@@ -466,7 +493,7 @@ class Machine:
         doc, files = _chain.export_json(
             self._model, path, text, name, controller, _grid_axes(grid), q,
             _optional_float(step, "step"), cec_max_points, beckhoff_max_records,
-            _bool(angles, "angles"), _params(params),
+            _bool(angles, "angles"), _params(params), _temperatures(temperature),
         )
         result = ExportResult._from_json(doc)
         result.__dict__["files"] = dict(files)
@@ -541,6 +568,7 @@ class Machine:
         seed: Optional[int] = None,
         spheres: Optional[Union[str, "os.PathLike[str]", Mapping[str, Any]]] = None,
         setup: Optional[str] = None,
+        temperature: Optional[Mapping[str, float]] = None,
     ) -> "IdentifyResult":
         """The error parameters from measurements, ``chain identify --measurements M --format json``.
 
@@ -571,6 +599,11 @@ class Machine:
         (the document's ``iteration``); ``holdout`` / ``seed``
         (``--holdout`` / ``--seed``): hold that fraction of the records out
         of the fit and report the prediction at them (``validation``).
+        A machine with ``sensors``: a column named after a sensor gives each
+        record's temperature (°C), and the thermal coefficients are
+        identified with the geometric ones; ``temperature``
+        (``--temperature``, ``{sensor: °C}``) is the state of the records
+        whose file has no column for a sensor (docs/thermal.md).
         """
         from ._results import IdentifyResult
 
@@ -598,6 +631,7 @@ class Machine:
             bool(iterate),
             None if holdout is None else float(holdout),
             None if seed is None else int(seed),
+            _temperatures(temperature),
         )
         if values_out is not None:
             with open(os.fspath(values_out), "w", encoding="utf-8") as f:
@@ -684,6 +718,7 @@ class Machine:
         sided: Optional[str] = None,
         values: Optional[Union[str, "os.PathLike[str]"]] = None,
         approach: Union[None, str, Mapping[str, str]] = None,
+        temperature: Optional[Mapping[str, float]] = None,
     ) -> SensitivityResult:
         """Reliability sensitivity, ``chain sensitivity --kind reliability --format json``.
 
@@ -693,12 +728,20 @@ class Machine:
         ``|dR/dstd|``: at one point ``at`` (every axis variable), otherwise
         the mean over the reliability grid (``grid`` replacing axes).
         ``values``: a values file with a calibration's posterior (``--values``);
-        ``approach``: the direction of its bidirectional tables (``--approach``).
+        ``approach``: the direction of its bidirectional tables (``--approach``);
+        ``temperature``: the thermal state (``--temperature``).
         """
         point = _at_point(at)
         path = None if values is None else os.fspath(values)
         text = _chain.sensitivity_reliability_json(
-            self._model, point, _grid_axes(grid), _params(params), sided, path, _approach(approach)
+            self._model,
+            point,
+            _grid_axes(grid),
+            _params(params),
+            sided,
+            path,
+            _approach(approach),
+            _temperatures(temperature),
         )
         return SensitivityResult._from_json(text)
 

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import os
-from typing import Any, Mapping, Optional, Sequence, Tuple, Union
+from typing import TYPE_CHECKING, Any, Mapping, Optional, Sequence, Tuple, Union
 
 from . import _chain
 from ._machine import _csv_input, _optional_float
 from ._results import ThermalResult
+
+if TYPE_CHECKING:
+    from ._machine import Machine
 
 Pair = Union[str, Tuple[str, str, float]]
 
@@ -48,6 +51,9 @@ def thermal(
     lag: bool = False,
     holdout: Optional[float] = None,
     fit_until: Optional[float] = None,
+    machine: Optional["Machine"] = None,
+    slots: Optional[Mapping[str, str]] = None,
+    values_out: Union[None, str, "os.PathLike[str]"] = None,
 ) -> ThermalResult:
     """An ISO 230-3 drift test, ``chain thermal RUN --format json``.
 
@@ -63,7 +69,12 @@ def thermal(
     at most ``sensors`` temperature sensors (``--sensors``, default 4),
     ``lag`` responses to the loads (``--lag``), fitted on the first
     ``1 - holdout`` of the duration (``--holdout``) or before ``fit_until``
-    seconds (``--fit-until``). A refused file raises ``MachineError`` with
+    seconds (``--fit-until``). ``machine`` and ``slots`` (``--machine``,
+    ``--slot``; ``{"EZS": "Z(um)"}``): the fitted models as the thermal
+    coefficients of the machine's thermal terms ``{name, per}``, the values
+    file's text in the result's ``values_text`` (and the document's
+    ``values``), written to ``values_out`` too (``--values-out``;
+    docs/thermal.md). A refused file raises ``MachineError`` with
     the CLI's message, located; a refused option ``ValueError`` with the
     CLI's words.
 
@@ -84,13 +95,25 @@ def thermal(
             raise ValueError(f"{what} must be True or False, not {flag!r}")
     if sensors is not None and (isinstance(sensors, bool) or not isinstance(sensors, int) or sensors < 0):
         raise ValueError(f"sensors must be a non-negative integer, not {sensors!r}")
-    doc, time, predictions = _chain.thermal_json(
+    if (machine is None) != (slots is None):
+        raise ValueError("machine and slots go together: the machine whose thermal terms take the channels' models")
+    if slots is not None and not isinstance(slots, Mapping):
+        raise TypeError(f"slots must be a mapping of thermal term to channel, not {type(slots).__name__}")
+    if values_out is not None and machine is None:
+        raise ValueError("values_out writes the fitted models into a machine's values: give machine and slots")
+    doc, time, predictions, values_text = _chain.thermal_json(
         path, text, name,
         _names(displacements, "displacements"), _names(temperatures, "temperatures"), _names(loads, "loads"),
         [_pair(p) for p in (pairs or [])],
         fit, sensors, lag, _optional_float(holdout, "holdout"), _optional_float(fit_until, "fit_until"),
+        None if machine is None else machine._model,
+        [(str(k), str(v)) for k, v in (slots or {}).items()],
     )
+    if values_out is not None and values_text is not None:
+        with open(os.fspath(values_out), "w", encoding="utf-8") as f:
+            f.write(values_text)
     result = ThermalResult._from_json(doc)
+    result.values_text = values_text
     result.time = time
     result.measured = {c: m for c, m, _ in predictions}
     result.predicted = {c: p for c, _, p in predictions}

@@ -17,7 +17,7 @@ use crate::{choice, resolve_error, study_error, to_json, value_error, Model};
 /// `cec_max_points`, `beckhoff_max_records`, `angles` and `params` as the CLI's
 /// options. Returns the summary document and the files `(name, text)`.
 #[pyfunction]
-#[pyo3(signature = (model, values_path, values_text, values_file, controller, grid, points, step, cec_max_points, beckhoff_max_records, angles, params))]
+#[pyo3(signature = (model, values_path, values_text, values_file, controller, grid, points, step, cec_max_points, beckhoff_max_records, angles, params, temperatures))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn export_json(
     py: Python<'_>,
@@ -33,6 +33,7 @@ pub(crate) fn export_json(
     beckhoff_max_records: Option<usize>,
     angles: bool,
     params: Vec<(String, f64)>,
+    temperatures: Vec<(String, f64)>,
 ) -> PyResult<(String, Vec<(String, String)>)> {
     let controller = choice::<ExportController>(controller)?;
     let rows = match &points {
@@ -48,6 +49,7 @@ pub(crate) fn export_json(
         cec_max_points,
         beckhoff_max_records,
         angles,
+        temperatures: &temperatures,
     };
     let refused = |e: ExportOpsError| match e {
         ExportOpsError::Reliability(e) => study_error(py, &e, &model.file),

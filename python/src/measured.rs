@@ -66,7 +66,7 @@ pub(crate) fn read_values(
 /// `"ball"`); the held-out records of `--validate`, if any, from
 /// `validate`, read as the fitted ones are.
 #[pyfunction]
-#[pyo3(signature = (model, measurements, spheres, setup, params, prior, validate=None, rank_tol=None, fix=None, estimate=None, iterate=false, holdout=None, seed=None))]
+#[pyo3(signature = (model, measurements, spheres, setup, params, prior, validate=None, rank_tol=None, fix=None, estimate=None, iterate=false, holdout=None, seed=None, temperatures=Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_json(
     py: Python<'_>,
@@ -83,6 +83,7 @@ pub(crate) fn identify_json(
     iterate: bool,
     holdout: Option<f64>,
     seed: Option<u64>,
+    temperatures: Vec<(String, f64)>,
 ) -> PyResult<(String, String)> {
     let request = IdentifyRequest {
         measurements: measurements.as_ref().map(FileInput::source).transpose()?,
@@ -97,6 +98,7 @@ pub(crate) fn identify_json(
         holdout,
         seed,
         iterate,
+        temperatures: &temperatures,
     };
     let checked = request.check().map_err(|e| value_error(e.with_help()))?;
     let m = &model.machine;
@@ -145,7 +147,7 @@ pub(crate) fn plan_json(
 /// from `values_path` or `values_text` named `values_file`) over the grid
 /// (`grid` overriding the file's) or at the rows of `points` (`(N, V)`).
 #[pyfunction]
-#[pyo3(signature = (model, values_path, values_text, values_file, grid, points, params, approach))]
+#[pyo3(signature = (model, values_path, values_text, values_file, grid, points, params, approach, temperatures))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn map_json(
     py: Python<'_>,
@@ -157,6 +159,7 @@ pub(crate) fn map_json(
     points: Option<PyReadonlyArray2<'_, f64>>,
     params: Vec<(String, f64)>,
     approach: Option<&str>,
+    temperatures: Vec<(String, f64)>,
 ) -> PyResult<String> {
     let m = &model.machine;
     let (values, name) = read_values(py, m, values_path, values_text, values_file)?;
@@ -172,6 +175,7 @@ pub(crate) fn map_json(
         points,
         compensated: None,
         keep_points: true,
+        temperatures: &temperatures,
     };
     let ops_error = |e: MapOpsError| match e {
         MapOpsError::Reliability(e) => study_error(py, &e, &model.file),

@@ -34,7 +34,7 @@ fn run(py: Python<'_>, model: &Model, request: &SensitivityRequest<'_>) -> PyRes
 /// reliability grid (`grid` replacing axes). `values`: a values file with
 /// a calibration's posterior (`--values`), its tables read for `approach`.
 #[pyfunction]
-#[pyo3(signature = (model, at, grid, params, sided, values, approach))]
+#[pyo3(signature = (model, at, grid, params, sided, values, approach, temperatures))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn sensitivity_reliability_json(
     py: Python<'_>,
@@ -45,6 +45,7 @@ pub(crate) fn sensitivity_reliability_json(
     sided: Option<&str>,
     values: Option<&str>,
     approach: Option<&str>,
+    temperatures: Vec<(String, f64)>,
 ) -> PyResult<String> {
     let approach = parse_approach(approach)?;
     let request = SensitivityRequest {
@@ -55,6 +56,7 @@ pub(crate) fn sensitivity_reliability_json(
         grid: &grid,
         values: values.map(|v| SensitivityValues::File(Path::new(v))),
         approach: &approach,
+        temperatures: &temperatures,
     };
     run(py, model, &request)
 }
@@ -91,6 +93,7 @@ pub(crate) fn geometric_json(
         grid: &grid,
         values: nominal.map(SensitivityValues::Nominal),
         approach: &[],
+        temperatures: &[],
     };
     run(py, model, &request)
 }

@@ -73,7 +73,7 @@ pub(crate) fn parse_approach(approach: Option<&str>) -> PyResult<Vec<(Option<Str
 /// whole-machine acceptance probability (also when the file asks for it),
 /// to `acceptance_tolerance`.
 #[pyfunction]
-#[pyo3(signature = (model, method, samples, seed, cov, grid, params, sided, system, system_tolerance, values, acceptance, acceptance_tolerance, approach))]
+#[pyo3(signature = (model, method, samples, seed, cov, grid, params, sided, system, system_tolerance, values, acceptance, acceptance_tolerance, approach, temperatures))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn reliability_json(
     py: Python<'_>,
@@ -91,6 +91,7 @@ pub(crate) fn reliability_json(
     acceptance: bool,
     acceptance_tolerance: f64,
     approach: Option<&str>,
+    temperatures: Vec<(String, f64)>,
 ) -> PyResult<String> {
     let algorithm = algorithm_options(method, samples, seed, cov)?;
     let system = system_choice(system, system_tolerance)?;
@@ -106,6 +107,7 @@ pub(crate) fn reliability_json(
         approach: &approach,
         acceptance,
         acceptance_tolerance,
+        temperatures: &temperatures,
     };
     let run = py
         .allow_threads(|| ops_reliability::run(&model.machine, &model.file, &request, &()))

@@ -11,7 +11,7 @@ use chain_core::measured::thermal_fit::{FitOptions, Split, DEFAULT_SENSORS};
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
 
-use crate::{load_error, source, to_json, value_error};
+use crate::{load_error, source, to_json, value_error, Model};
 
 /// The drift test's document, the samples' times and, per displacement
 /// channel with a fit, `(channel, measured, predicted)`.
@@ -19,14 +19,17 @@ type ThermalOut<'py> = (
     String,
     Bound<'py, PyArray1<f64>>,
     Vec<(String, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)>,
+    Option<String>,
 );
 
 /// `chain thermal` of the file at `path`, or of `text` named `file`:
 /// `displacements`, `temperatures`, `loads`, `pairs` (`X1:X2=L`) and the
 /// fit's options as the CLI's (`fit`, `sensors`, `lag`, `holdout`,
-/// `fit_until`).
+/// `fit_until`); with `model` and `slots` (`--machine`, `--slot`) the
+/// fitted models as the machine's thermal coefficients, whose values file
+/// text is returned last (`--values-out`).
 #[pyfunction]
-#[pyo3(signature = (path, text, file, displacements, temperatures, loads, pairs, fit, sensors, lag, holdout, fit_until))]
+#[pyo3(signature = (path, text, file, displacements, temperatures, loads, pairs, fit, sensors, lag, holdout, fit_until, model=None, slots=Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn thermal_json<'py>(
     py: Python<'py>,
@@ -42,6 +45,8 @@ pub(crate) fn thermal_json<'py>(
     lag: bool,
     holdout: Option<f64>,
     fit_until: Option<f64>,
+    model: Option<PyRef<'py, Model>>,
+    slots: Vec<(String, String)>,
 ) -> PyResult<ThermalOut<'py>> {
     let refused = |e: ops::ThermalOpsError| value_error(e.with_help());
     let pairs = (pairs.iter())
@@ -76,6 +81,10 @@ pub(crate) fn thermal_json<'py>(
             lag,
             split,
         }),
+        into_machine: model.as_ref().map(|m| ops::IntoMachine {
+            machine: &m.machine,
+            slots: &slots,
+        }),
     };
     let done = py.allow_threads(|| ops::run(&request)).map_err(refused)?;
     let json = to_json(&done)?;
@@ -88,5 +97,6 @@ pub(crate) fn thermal_json<'py>(
             )
         })
         .collect();
-    Ok((json, done.time.into_pyarray(py), predictions))
+    let values = done.values.map(|v| v.text);
+    Ok((json, done.time.into_pyarray(py), predictions, values))
 }

@@ -80,3 +80,51 @@ def test_refusals_are_the_cli_messages(cli_error, tmp_path):
         chain.thermal(good, lag=True)
     with pytest.raises(ValueError, match="as run .* or as text, one of them"):
         chain.thermal()
+
+
+THERMAL_MACHINE = ROOT / "examples/thermal/vmc3_thermal.yaml"
+THERMAL_VALUES = ROOT / "examples/thermal/vmc3_thermal_values.yaml"
+
+
+def test_the_map_at_a_thermal_state_is_the_cli_s(cli):
+    m = chain.Machine.load(THERMAL_MACHINE)
+    got = m.map(THERMAL_VALUES, grid={"x": [0, 800], "y": [0], "z": [0, 500]}, temperature={"T_x": 28, "T_coltop": 23.5})
+    want = cli("map", THERMAL_MACHINE, "--values", THERMAL_VALUES, "--grid", "x=0,800", "--grid", "y=0", "--grid",
+               "z=0,500", "--temperature", "T_x=28,T_coltop=23.5")
+    assert got.to_dict() == want
+    assert want["temperatures"] == {"T_x": 28.0, "T_front": 20.0, "T_rear": 20.0, "T_head": 20.0, "T_coltop": 23.5}
+    # The X scale's growth: 11.5e-3 µm/mm/K · 800 mm · 8 K along −x (the
+    # table moves opposite to the tool), plus the reference map.
+    reference = m.map(THERMAL_VALUES, grid={"x": [0, 800], "y": [0], "z": [0, 500]}).to_dict()
+    for a, b in zip(want["points"], reference["points"]):
+        growth = -11.5e-6 * a["point"]["x"] * 8.0
+        assert a["error"]["px"] - b["error"]["px"] == pytest.approx(growth, abs=1e-12)
+
+
+def test_temperature_refusals_are_the_cli_s():
+    m = chain.Machine.load(THERMAL_MACHINE)
+    with pytest.raises(ValueError) as e:
+        m.map(THERMAL_VALUES, temperature={"T_z": 25})
+    assert "--temperature: `T_z` is not a sensor of machine `vmc3_thermal` (did you mean `T_x`?)" in flat(str(e.value))
+    with pytest.raises(ValueError, match="sensor `T_x`: 'hot' is not a number"):
+        m.map(THERMAL_VALUES, temperature={"T_x": "hot"})
+    with pytest.raises(TypeError, match="temperature must be a mapping of sensor name to °C"):
+        m.map(THERMAL_VALUES, temperature=[("T_x", 25)])
+
+
+def test_the_fitted_models_into_the_machine_are_the_cli_s(cli, tmp_path):
+    m = chain.Machine.load(THERMAL_MACHINE)
+    out = tmp_path / "spindle_values.yaml"
+    got = chain.thermal(RUN, fit=True, holdout=0.25, machine=m, slots={"EZS": "Z(um)"}, values_out=out)
+    cli_out = tmp_path / "cli_values.yaml"
+    want = cli("thermal", RUN, "--fit", "--holdout", "0.25", "--values-out", cli_out, "--machine", THERMAL_MACHINE,
+               "--slot", "EZS=Z(um)")
+    assert got.to_dict() == want
+    assert out.read_text(encoding="utf-8") == cli_out.read_text(encoding="utf-8") == got.values_text
+    assert [c["name"] for c in want["values"]["terms"][0]["coefficients"]] == [
+        "EZS_T_front", "EZS_T_rear", "EZS_T_head", "EZS_T_coltop"]
+    with pytest.raises(ValueError, match="machine and slots go together"):
+        chain.thermal(RUN, fit=True, machine=m)
+    with pytest.raises(ValueError) as e:
+        chain.thermal(RUN, fit=True, machine=m, slots={"EZX": "Z(um)"})
+    assert "--slot: `EZX` is not a thermal term `{name, per}` of machine `vmc3_thermal` (did you mean `EZS`?)" in flat(str(e.value))

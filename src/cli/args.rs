@@ -25,6 +25,22 @@ impl ParamArgs {
     }
 }
 
+/// `--temperature NAME=VALUE,...`: the thermal state at which a machine with
+/// `sensors` is evaluated (docs/thermal.md).
+#[derive(Debug, clap::Args)]
+pub struct ThermalArgs {
+    /// Temperature of a sensor of the machine file, `NAME=VALUE` in °C
+    /// (comma-separated or repeated; sensors not named stay at their
+    /// reference).
+    #[arg(
+        long = "temperature",
+        value_name = "NAME=VALUE",
+        value_delimiter = ',',
+        value_parser = parse_param
+    )]
+    pub temperatures: Vec<(String, f64)>,
+}
+
 /// `--param` and `--sided`: the model of a machine file with `statistics`.
 #[derive(Debug, clap::Args)]
 pub struct ModelArgs {

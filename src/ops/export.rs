@@ -81,6 +81,20 @@ pub struct ExportRequest<'a> {
     /// request
     /// (`chain_core::compensation::controllers::Capabilities::angles`).
     pub angles: bool,
+    /// `--temperature NAME=VALUE`: the thermal state the tables are for
+    /// (°C; sensors not named at their reference).
+    pub temperatures: &'a [(String, f64)],
+}
+
+/// What the written files say made them: the command, and a machine with
+/// sensors' thermal state (`at T_x = 28 °C`).
+fn provenance(controller: ExportController, state: &[(String, f64)]) -> String {
+    let command = controller.provenance();
+    if state.is_empty() {
+        return command;
+    }
+    let at: Vec<String> = state.iter().map(|(n, t)| format!("{n} = {t} °C")).collect();
+    format!("{command} at {}", at.join(", "))
 }
 
 /// Why `chain export` cannot run.
@@ -379,6 +393,8 @@ pub fn run(
     check(request)?;
     let m = machine;
     let params = Parameters::new(m, request.params)?.values()?;
+    let (values, state) = super::resolve::at_thermal_state(m, values, request.temperatures)?;
+    let provenance = provenance(request.controller, &state);
     let built_error = |e: chain_core::built::BuiltError| ExportOpsError::Built {
         values: values_file.to_string(),
         message: e.to_string(),
@@ -394,7 +410,7 @@ pub fn run(
                     error: Box::new(error),
                 }
             })?;
-            let file = result.file(&request.controller.provenance());
+            let file = result.file(&provenance);
             Ok(ExportDocument::Grid(GridExport {
                 values_file: values_file.to_string(),
                 files: vec![file.name.clone()],
@@ -410,7 +426,7 @@ pub fn run(
                 cec_max_points: request.cec_max_points.unwrap_or(CEC_DEFAULT_MAX_POINTS),
                 beckhoff_max_records: (request.beckhoff_max_records)
                     .unwrap_or(BECKHOFF_DEFAULT_MAX_RECORDS),
-                provenance: request.controller.provenance(),
+                provenance,
                 angles: request.angles,
             };
             let grid = request.points.grid();

@@ -71,6 +71,9 @@ pub struct IdentifyRequest<'a> {
     pub seed: Option<u64>,
     /// `--iterate`: fit the exact kinematics from the linear estimate.
     pub iterate: bool,
+    /// `--temperature NAME=VALUE`: the thermal state of the records whose
+    /// file has no column for a sensor (docs/thermal.md).
+    pub temperatures: &'a [(String, f64)],
 }
 
 /// An [`IdentifyRequest`] whose options are checked: what
@@ -81,6 +84,7 @@ pub struct CheckedIdentify<'a> {
     records: Records<'a>,
     validate: Option<Source<'a>>,
     params: &'a [(String, f64)],
+    temperatures: &'a [(String, f64)],
     prior: bool,
     options: IdentifyOptions,
     iterate: bool,
@@ -345,6 +349,7 @@ impl<'a> IdentifyRequest<'a> {
             records,
             validate: self.validate,
             params: self.params,
+            temperatures: self.temperatures,
             prior: self.prior,
             options,
             iterate: self.iterate,
@@ -360,6 +365,7 @@ impl CheckedIdentify<'_> {
     /// holdout's split, the identification, its document and values file.
     pub fn run(&self, machine: &Machine) -> Result<IdentifyRun, IdentifyOpsError> {
         super::resolve::check_parameters(machine, self.params)?;
+        super::resolve::thermal_factors(machine, self.temperatures)?;
         let measurements = self.read(None, machine)?;
         let validation = (self.validate)
             .map(|v| {
@@ -416,13 +422,17 @@ impl CheckedIdentify<'_> {
         machine: &Machine,
     ) -> Result<Measurements, IdentifyOpsError> {
         let params = self.params;
-        Ok(match self.records {
+        // A sensor without a column takes the state of `--temperature`:
+        // the parameters' rule (a column, else the caller's value).
+        let overrides: Vec<(String, f64)> =
+            params.iter().chain(self.temperatures).cloned().collect();
+        let mut read = match self.records {
             Records::Measurements(source, setup) => {
                 let source = validate.unwrap_or(source);
                 let read = super::source::read_measurements(
                     source,
                     machine,
-                    params,
+                    &overrides,
                     Layout::Measurements,
                 )?;
                 match setup {
@@ -436,6 +446,16 @@ impl CheckedIdentify<'_> {
             Records::Spheres(source) => {
                 super::source::read_spheres(validate.unwrap_or(source), machine, params)?
             }
-        })
+        };
+        // A sphere file has no sensor column: its records are at the state.
+        if !machine.sensors.is_empty() {
+            let state = machine
+                .temperatures(self.temperatures)
+                .map_err(super::resolve::ResolveError::Temperature)?;
+            for r in read.rows.iter_mut().filter(|r| r.temperatures.is_empty()) {
+                r.temperatures = state.clone();
+            }
+        }
+        Ok(read)
     }
 }

@@ -12,6 +12,7 @@ use chain_core::compensation::grid::GridError;
 use chain_core::compensation::CompensationError;
 use chain_core::kinematics::Kinematics;
 use chain_core::model::Frame;
+use chain_core::named::NameMap;
 use chain_core::values::{Approach, ApproachError, Entry, EntryKind, Reversal, Values};
 use chain_core::{Machine, MapResult};
 use reliability::ReliabilityError;
@@ -50,6 +51,9 @@ pub struct MapRequest<'a> {
     /// Keep every point's error (`false`: the summary alone, for a large
     /// map's table; the document then has no JSON form).
     pub keep_points: bool,
+    /// `--temperature NAME=VALUE`: the thermal state (°C; sensors not named
+    /// at their reference).
+    pub temperatures: &'a [(String, f64)],
 }
 
 /// Where the points of a map came from.
@@ -68,6 +72,9 @@ pub struct PreparedMap {
     pub file: String,
     /// The values file's name.
     pub values_file: String,
+    /// The thermal state mapped (every sensor, °C; empty for a machine
+    /// without sensors).
+    pub temperatures: Vec<(String, f64)>,
 }
 
 /// Why a map cannot be prepared.
@@ -211,6 +218,7 @@ pub fn prepare(
     }
     let params = Parameters::new(m, request.params)?.values()?;
     let (points, input) = request.points.resolve(m, file)?;
+    let (values, temperatures) = resolve::at_thermal_state(m, values, request.temperatures)?;
     let built = BuiltMachine::compile(m, values, params).map_err(|e| MapOpsError::Built {
         values: values_file.to_string(),
         message: e.to_string(),
@@ -221,6 +229,7 @@ pub fn prepare(
         input,
         file: file.to_string(),
         values_file: values_file.to_string(),
+        temperatures,
     })
 }
 
@@ -297,6 +306,8 @@ pub struct MapDocument {
     pub compensated: Option<Compensated>,
     /// Per bidirectional table, the reversal the approach read leaves out.
     pub reversals: Vec<Reversal>,
+    /// The thermal state (every sensor, °C; empty without sensors).
+    pub temperatures: Vec<(String, f64)>,
 }
 
 impl MapDocument {
@@ -321,6 +332,9 @@ struct CompensatedJson<'a> {
 /// The spec's JSON document, with `compensated` (`--compensated`) added.
 #[derive(Serialize)]
 struct MapJson<'a> {
+    /// The thermal state (a machine with sensors).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    temperatures: Option<NameMap<&'a str, f64>>,
     #[serde(flatten)]
     map: &'a MapResult,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -333,6 +347,14 @@ impl Serialize for MapDocument {
             return Err(serde::ser::Error::custom("the map kept no point"));
         };
         MapJson {
+            temperatures: (!self.temperatures.is_empty()).then(|| {
+                NameMap(
+                    self.temperatures
+                        .iter()
+                        .map(|(n, t)| (n.as_str(), *t))
+                        .collect(),
+                )
+            }),
             map,
             compensated: self.compensated.as_ref().map(|c| CompensatedJson {
                 controller: c.controller,
@@ -396,6 +418,7 @@ impl PreparedMap {
             result,
             compensated,
             reversals: values.reversals(),
+            temperatures: self.temperatures.clone(),
         })
     }
 

@@ -48,6 +48,8 @@ pub struct ReliabilityRequest<'a> {
     /// `--acceptance-tolerance`: the acceptance probability's absolute
     /// error (three standard errors), in (0, 1).
     pub acceptance_tolerance: f64,
+    /// `--temperature NAME=VALUE`: the thermal state (docs/thermal.md).
+    pub temperatures: &'a [(String, f64)],
 }
 
 impl Default for ReliabilityRequest<'_> {
@@ -63,6 +65,7 @@ impl Default for ReliabilityRequest<'_> {
             approach: &[],
             acceptance: false,
             acceptance_tolerance: ACCEPTANCE_TOLERANCE,
+            temperatures: &[],
         }
     }
 }
@@ -131,6 +134,7 @@ pub fn prepare(
         sided: request.sided,
         system,
         posterior: posterior.as_ref(),
+        temperatures: request.temperatures,
     };
     let (study, model) = study::study(machine, file, &options)?;
     let wanted = request.acceptance || (machine.reliability.as_ref()).is_some_and(|r| r.acceptance);

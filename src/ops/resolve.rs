@@ -175,6 +175,9 @@ pub enum ResolveError {
     /// together.
     #[error("--grid cannot be combined with --axes")]
     GridWithRows,
+    /// `--temperature` does not match the machine's sensors.
+    #[error("--temperature: {0}")]
+    Temperature(chain_core::model::TemperatureError),
     /// Rows that do not make points of the machine.
     #[error("{name}: {error}")]
     Rows {
@@ -197,6 +200,10 @@ impl ResolveError {
                 | ResolveError::UnknownAtVariable { .. }
                 | ResolveError::UnknownFixed { .. }
                 | ResolveError::MissingGrid { .. }
+                | ResolveError::Temperature(
+                    chain_core::model::TemperatureError::Unknown { .. }
+                        | chain_core::model::TemperatureError::NoSensors { .. }
+                )
         )
     }
 }
@@ -221,6 +228,7 @@ impl Worded for ResolveError {
             ResolveError::MissingAxisColumns { .. } => "chain::csv::missing_column",
             ResolveError::GridWithRows => "chain::cli::grid_with_axes",
             ResolveError::Rows { .. } => "chain::map::points",
+            ResolveError::Temperature(_) => "chain::cli::temperature",
         })
     }
 
@@ -280,6 +288,38 @@ fn variables(m: &Machine) -> Vec<String> {
 
 fn closest_variable(m: &Machine, name: &str) -> Option<String> {
     closest(name, m.variables.iter().map(|v| v.name.as_str())).map(str::to_string)
+}
+
+/// The thermal state of `--temperature NAME=VALUE,...` (°C; every sensor
+/// not named at its reference), and each error's thermal factor there
+/// ([`Machine::thermal_factors`]). The one rule of `--temperature`, for
+/// every command and Python's `temperature`.
+pub fn thermal_factors(
+    m: &Machine,
+    temperatures: &[(String, f64)],
+) -> Result<Vec<f64>, ResolveError> {
+    let t = m
+        .temperatures(temperatures)
+        .map_err(ResolveError::Temperature)?;
+    Ok(m.thermal_factors(&t))
+}
+
+/// `values` at the thermal state of `--temperature` ([`thermal_factors`],
+/// [`chain_core::values::Values::at_thermal_state`]) and the state itself,
+/// every sensor named with its °C (empty for a machine without sensors).
+pub fn at_thermal_state(
+    m: &Machine,
+    values: chain_core::values::Values,
+    temperatures: &[(String, f64)],
+) -> Result<(chain_core::values::Values, Vec<(String, f64)>), ResolveError> {
+    let t = m
+        .temperatures(temperatures)
+        .map_err(ResolveError::Temperature)?;
+    let state = (m.sensors.iter())
+        .zip(&t)
+        .map(|(s, t)| (s.name.clone(), *t))
+        .collect();
+    Ok((values.at_thermal_state(&m.thermal_factors(&t)), state))
 }
 
 /// Checks `--param NAME=VALUE` against the machine: every name one of its

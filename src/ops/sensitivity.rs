@@ -58,6 +58,8 @@ pub struct SensitivityRequest<'a> {
     pub values: Option<SensitivityValues<'a>>,
     /// `--approach` (`--kind reliability` with a values file).
     pub approach: &'a [(Option<String>, Approach)],
+    /// `--temperature NAME=VALUE` (`--kind reliability`): the thermal state.
+    pub temperatures: &'a [(String, f64)],
 }
 
 /// Why `chain sensitivity` cannot run.
@@ -192,6 +194,10 @@ pub fn check(request: &SensitivityRequest<'_>) -> Result<(), SensitivityOpsError
                 .into(),
             "add --kind geometric, or give a values file for the posterior",
         ),
+        (SensitivityKind::Geometric, _) if !request.temperatures.is_empty() => refuse(
+            "--kind geometric does not take --temperature".into(),
+            "the geometric coefficients S and C are those of the geometry; the thermal state of a study is --kind reliability --temperature NAME=VALUE",
+        ),
         (SensitivityKind::Geometric, _) if !request.approach.is_empty() => refuse(
             "--kind geometric does not take --approach".into(),
             "--approach chooses the direction of a values file's tables: use it with --kind reliability --values VALUES.yaml",
@@ -233,6 +239,7 @@ fn reliability_kind(
         sided: request.sided,
         system: None,
         posterior: posterior.as_ref(),
+        temperatures: request.temperatures,
     };
     let checked = study::check(machine, file, &options)?;
     let point = match request.at {

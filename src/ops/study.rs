@@ -9,6 +9,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use chain_core::model::{Origin, Sided};
+use chain_core::thermal_state::AtState;
 use chain_core::values::{Approach, ApproachError};
 use chain_core::{CompiledModel, Machine};
 use reliability::allocate::GridUse;
@@ -34,6 +35,10 @@ pub struct StudyOptions<'a> {
     pub system: Option<System>,
     /// `--values`: the inputs of a posterior (`None`: the `statistics`).
     pub posterior: Option<&'a Posterior>,
+    /// `--temperature NAME=VALUE`: the thermal state (°C; sensors not named
+    /// at their reference), whose factors scale the thermal coefficients'
+    /// columns (`docs/thermal.md`).
+    pub temperatures: &'a [(String, f64)],
 }
 
 /// Why a study cannot be built.
@@ -138,6 +143,8 @@ pub struct Checked {
     spec: StudySpec,
     inputs: Inputs,
     parameters: Vec<f64>,
+    /// Each error's thermal factor at the state of `--temperature`.
+    factors: Vec<f64>,
 }
 
 /// Checks the options against `machine` (`file` names it) and resolves the
@@ -169,10 +176,12 @@ pub fn check(
         Some(p) => p.inputs(machine)?,
     };
     let parameters = reliability::machine::parameters(machine, options.params)?;
+    let factors = resolve::thermal_factors(machine, options.temperatures)?;
     Ok(Checked {
         spec,
         inputs,
         parameters,
+        factors,
     })
 }
 
@@ -194,8 +203,14 @@ pub fn build(
         spec,
         inputs,
         parameters,
+        factors,
     } = checked;
-    let study = Study::on_demand(Arc::new(model.clone()), &parameters, inputs, spec)?;
+    let shared: reliability::study::SharedModel = if factors.iter().all(|f| *f == 1.0) {
+        Arc::new(model.clone())
+    } else {
+        Arc::new(AtState::new(model.clone(), factors))
+    };
+    let study = Study::on_demand(shared, &parameters, inputs, spec)?;
     Ok(match options.posterior {
         Some(p) => p.apply(machine, study)?,
         None => study,

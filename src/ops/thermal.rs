@@ -1,12 +1,14 @@
 //! `chain thermal` as a request and a document (spec `thermal.md`,
 //! `docs/thermal.md`): the ISO 230-3 drift test's evaluation and, with a
-//! fit, the thermal model per displacement channel and its prediction. The
-//! CLI and `chain.thermal` run it.
+//! fit, the thermal model per displacement channel and its prediction, and
+//! with `into_machine` those models as a machine's thermal coefficients.
+//! The CLI and `chain.thermal` run it.
 
 use serde::Serialize;
 
 use chain_core::measured::thermal::{self, DriftTest, Pair, ThermalDocument, ThermalError};
 use chain_core::measured::thermal_fit::{self, FitError, FitOptions, Prediction};
+use chain_core::measured::thermal_values::{self, ThermalValues, ThermalValuesError};
 
 use super::worded::{diagnostic, Worded};
 
@@ -19,6 +21,19 @@ pub struct ThermalRequest<'a> {
     pub pairs: &'a [Pair],
     /// `--fit` and its options.
     pub fit: Option<FitOptions>,
+    /// `--values-out` with `--machine` and `--slot`: the fitted models into
+    /// a machine's thermal terms.
+    pub into_machine: Option<IntoMachine<'a>>,
+}
+
+/// `--machine F --slot NAME=CHANNEL,...`: which channel's model each
+/// thermal term of the machine takes (docs/thermal.md).
+#[derive(Debug, Clone, Copy)]
+pub struct IntoMachine<'a> {
+    /// The machine.
+    pub machine: &'a chain_core::Machine,
+    /// `(term, channel)` per `--slot`.
+    pub slots: &'a [(String, String)],
 }
 
 /// What `chain thermal` gives: the document (its JSON), and with a fit the
@@ -36,6 +51,10 @@ pub struct Thermal {
     /// The samples' times (s).
     #[serde(skip)]
     pub time: Vec<f64>,
+    /// The thermal coefficients written for the machine (`--values-out`):
+    /// per term its coefficients (µm/K) and the intercept left out.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub values: Option<ThermalValues>,
 }
 
 /// Why `chain thermal` cannot run as asked.
@@ -48,6 +67,15 @@ pub enum ThermalOpsError {
     /// The fit's options or data.
     #[error("--fit: {0}")]
     Fit(FitError),
+    /// `--slot`: a fitted model that does not go into the machine's term.
+    #[error("--slot: {0}")]
+    Slot(Box<ThermalValuesError>),
+    /// `--slot` that is not `NAME=CHANNEL`.
+    #[error("--slot {0}: expected NAME=CHANNEL (a thermal term of the machine and a displacement channel)")]
+    SlotText(String),
+    /// `--values-out` without `--fit`, or without `--machine` and `--slot`.
+    #[error("{0}")]
+    ValuesOut(&'static str),
     /// A `--pair` that is not `X1:X2=L`.
     #[error("--pair {text}: {reason}")]
     PairText {
@@ -75,6 +103,8 @@ impl Worded for ThermalOpsError {
         Some(match self {
             ThermalOpsError::Pair(_) | ThermalOpsError::PairText { .. } => "chain::thermal::pair",
             ThermalOpsError::Fit(_) => "chain::thermal::fit",
+            ThermalOpsError::Slot(_) | ThermalOpsError::SlotText(_) => "chain::thermal::slot",
+            ThermalOpsError::ValuesOut(_) => "chain::thermal::values_out",
         })
     }
 
@@ -84,6 +114,9 @@ impl Worded for ThermalOpsError {
                 "a pair is two displacement channels and their distance in mm: --pair 'X1(um):X2(um)=100', the first the sensor nearer the spindle nose".to_string(),
             ),
             ThermalOpsError::Fit(e) => e.help(),
+            ThermalOpsError::Slot(_) | ThermalOpsError::SlotText(_) | ThermalOpsError::ValuesOut(_) => Some(
+                "--values-out V --machine F --slot EZS='Z(um)' writes the model of channel Z(um) as the coefficients of the machine's thermal term `{name: EZS, per: [...]}` (docs/thermal.md)".to_string(),
+            ),
         }
     }
 }
@@ -123,9 +156,39 @@ pub fn run(request: &ThermalRequest<'_>) -> Result<Thermal, ThermalOpsError> {
         fitted.into_document(&mut document);
         predictions = fitted.predictions;
     }
+    let values = match request.into_machine {
+        Some(into) => {
+            if request.fit.is_none() {
+                return Err(ThermalOpsError::ValuesOut(
+                    "--values-out writes the fitted models: give --fit",
+                ));
+            }
+            if into.slots.is_empty() {
+                return Err(ThermalOpsError::ValuesOut(
+                    "--values-out needs --slot NAME=CHANNEL: which thermal term takes which channel's model",
+                ));
+            }
+            Some(
+                thermal_values::thermal_values(into.machine, &document, into.slots)
+                    .map_err(|e| ThermalOpsError::Slot(Box::new(e)))?,
+            )
+        }
+        None => None,
+    };
     Ok(Thermal {
         document,
         predictions,
         time: request.test.time.clone(),
+        values,
     })
+}
+
+/// `--slot NAME=CHANNEL`.
+pub fn parse_slot(text: &str) -> Result<(String, String), ThermalOpsError> {
+    match text.split_once('=') {
+        Some((name, channel)) if !name.trim().is_empty() && !channel.trim().is_empty() => {
+            Ok((name.trim().to_string(), channel.trim().to_string()))
+        }
+        _ => Err(ThermalOpsError::SlotText(text.to_string())),
+    }
 }

@@ -266,7 +266,33 @@ pub struct ErrorParam {
     pub kind: ErrorKind,
     /// Where it was first used.
     pub origin: Origin,
+    /// A thermal coefficient's sensor (index into [`Machine::sensors`]):
+    /// the parameter is per kelvin of that sensor's deviation from its
+    /// reference, its effect multiplied by `ΔT = T − reference`
+    /// (`docs/thermal.md`, "Temperature in the machine model"). `None` for
+    /// every geometric error.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensor: Option<usize>,
 }
+
+/// A named condition of the machine (`sensors:` in the machine file): a
+/// temperature, in °C, whose deviation from its reference drives the
+/// thermal coefficients (`docs/thermal.md`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Sensor {
+    /// Its name (`T_spindle`).
+    pub name: String,
+    /// The temperature at which the geometric errors hold and every
+    /// thermal term is zero (°C; 20 °C, ISO 1, unless declared).
+    pub reference: f64,
+    /// Where it was declared.
+    pub origin: Origin,
+}
+
+/// The reference temperature of a sensor declared without one: 20 °C, the
+/// standard reference temperature of geometrical product specification
+/// (ISO 1).
+pub const REFERENCE_TEMPERATURE: f64 = 20.0;
 
 /// The basis of a function slot (measured-machines spec, section 1): how an
 /// error motion `F(q)` of a jointed body varies along its own joint variable
@@ -448,8 +474,14 @@ pub struct ErrorFunction {
     pub basis: Basis,
     /// Index into [`Machine::variables`] of the joint variable `q`.
     pub variable: usize,
-    /// `(error index, basis function)` per coefficient, in [`Basis::terms`] order.
+    /// `(error index, basis function)` per coefficient, in [`Basis::terms`]
+    /// order; a thermal function (`per:`) repeats the terms once per sensor,
+    /// sensor by sensor (each coefficient's [`ErrorParam::sensor`]).
     pub coefficients: Vec<(usize, BasisFn)>,
+    /// A thermal function's sensors (indices into [`Machine::sensors`]),
+    /// in the order of its `per:`; empty for a geometric function.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sensors: Vec<usize>,
     /// Where it was first declared.
     pub origin: Origin,
 }
@@ -821,6 +853,10 @@ pub struct Machine {
     /// correlations between errors with statistics, in file order.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub correlations: Vec<CorrelationEntry>,
+    /// The named conditions (temperature sensors) the thermal coefficients
+    /// read, in file order (`docs/thermal.md`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sensors: Vec<Sensor>,
 }
 
 /// One `[name, name, rho]` entry of the `correlation` list.
@@ -857,6 +893,41 @@ impl Machine {
         self.parameters.iter().position(|p| p.name == name)
     }
 
+    /// Index of the sensor with this name.
+    pub fn sensor_index(&self, name: &str) -> Option<usize> {
+        self.sensors.iter().position(|s| s.name == name)
+    }
+
+    /// Every sensor at its reference: the state at which the thermal
+    /// coefficients contribute nothing.
+    pub fn reference_temperatures(&self) -> Vec<f64> {
+        self.sensors.iter().map(|s| s.reference).collect()
+    }
+
+    /// The thermal factor of every error parameter at `temperatures` (°C,
+    /// one per sensor in [`Machine::sensors`] order): `T_s − reference_s` for
+    /// a thermal coefficient of sensor `s`, 1 for every other error. The
+    /// error at a thermal state is `Σ_j c_j(q) · g_j(T) · e_j`: the model's
+    /// coefficients `c_j(q)` are those of the geometry, and the state acts
+    /// on the values (`docs/thermal.md`).
+    pub fn thermal_factors(&self, temperatures: &[f64]) -> Vec<f64> {
+        self.errors
+            .iter()
+            .map(|e| match e.sensor {
+                Some(s) => {
+                    let reference = self.sensors.get(s).map_or(0.0, |x| x.reference);
+                    temperatures.get(s).map_or(0.0, |t| t - reference)
+                }
+                None => 1.0,
+            })
+            .collect()
+    }
+
+    /// True if some error parameter is a thermal coefficient.
+    pub fn is_thermal(&self) -> bool {
+        self.errors.iter().any(|e| e.sensor.is_some())
+    }
+
     /// The chain of body indices from the root to `body`, root first.
     pub fn path_from_root(&self, body: usize) -> Vec<usize> {
         let mut path = vec![body];
@@ -888,5 +959,93 @@ impl Machine {
     /// The statistics entry of an error, if any.
     pub fn statistic(&self, error: usize) -> Option<&Statistic> {
         self.statistics.iter().find(|s| s.error == error)
+    }
+}
+
+/// A thermal state that does not match the machine's sensors.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum TemperatureError {
+    /// The machine declares no sensor.
+    #[error("machine `{machine}` declares no sensors, so `{name}` has no temperature to set (a machine file lists them under `sensors:`)")]
+    NoSensors {
+        /// The machine.
+        machine: String,
+        /// The name given.
+        name: String,
+    },
+    /// Not a sensor of the machine.
+    #[error("`{name}` is not a sensor of machine `{machine}`{} (its sensors: {})", suggestion.as_ref().map(|s| format!(" (did you mean `{s}`?)")).unwrap_or_default(), sensors.join(", "))]
+    Unknown {
+        /// The name given.
+        name: String,
+        /// The machine.
+        machine: String,
+        /// Its sensors.
+        sensors: Vec<String>,
+        /// The closest sensor, if one is close.
+        suggestion: Option<String>,
+    },
+    /// A temperature that is not a finite number of °C, or below absolute
+    /// zero.
+    #[error("`{name}` = {value} °C is not a temperature (a finite value above −273.15 °C)")]
+    Value {
+        /// The sensor.
+        name: String,
+        /// The value given.
+        value: f64,
+    },
+    /// The same sensor given twice.
+    #[error("`{name}` is given twice ({first} and {second} °C)")]
+    Twice {
+        /// The sensor.
+        name: String,
+        /// The first value.
+        first: f64,
+        /// The second value.
+        second: f64,
+    },
+}
+
+impl Machine {
+    /// The thermal state of `given` (sensor name, °C): every sensor not
+    /// named stays at its reference. Refuses a name that is not a sensor, a
+    /// sensor named twice and a value that is not a temperature.
+    pub fn temperatures(&self, given: &[(String, f64)]) -> Result<Vec<f64>, TemperatureError> {
+        let mut t = self.reference_temperatures();
+        let mut seen: Vec<(usize, f64)> = Vec::new();
+        for (name, value) in given {
+            if self.sensors.is_empty() {
+                return Err(TemperatureError::NoSensors {
+                    machine: self.name.clone(),
+                    name: name.clone(),
+                });
+            }
+            let Some(s) = self.sensor_index(name) else {
+                let names = self.sensors.iter().map(|s| s.name.as_str());
+                return Err(TemperatureError::Unknown {
+                    name: name.clone(),
+                    machine: self.name.clone(),
+                    sensors: self.sensors.iter().map(|s| s.name.clone()).collect(),
+                    suggestion: crate::diagnostic::closest(name, names).map(str::to_string),
+                });
+            };
+            if !value.is_finite() || *value <= -273.15 {
+                return Err(TemperatureError::Value {
+                    name: name.clone(),
+                    value: *value,
+                });
+            }
+            if let Some(&(_, first)) = seen.iter().find(|(i, _)| *i == s) {
+                return Err(TemperatureError::Twice {
+                    name: name.clone(),
+                    first,
+                    second: *value,
+                });
+            }
+            seen.push((s, *value));
+            t[s] = *value;
+        }
+        Ok(t)
     }
 }

@@ -136,7 +136,10 @@ impl<'m> ExactChain<'m> {
     }
 
     /// The weight `w_j(q)` of every error in its slots: the basis function
-    /// of a function-slot coefficient at its joint variable, else 1.
+    /// of a function-slot coefficient at its joint variable, else 1. A
+    /// thermal coefficient's thermal factor is the caller's to apply (to
+    /// the errors and the Jacobian's columns, as
+    /// [`crate::thermal_state::AtState`] does): the chain is the geometry's.
     pub fn weights(&self, q: &[f64]) -> Vec<f64> {
         let mut w = vec![1.0; self.machine.errors.len()];
         for f in &self.machine.functions {

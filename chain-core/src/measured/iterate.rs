@@ -105,17 +105,35 @@ pub fn exact_rows(
     let n = x.len();
     let ne = design.machine_errors();
     let (errors, setups) = x.split_at(ne);
+    let thermal = machine.is_thermal();
     let mut f = vec![0.0; m];
     let mut jac = jacobian.then(|| DMatrix::zeros(m, n));
     let mut i = 0;
     while i < m {
         let r = design.origin[i].0;
         let rec = &records[r];
+        // At the record's thermal state a thermal coefficient acts as its
+        // value times ΔT, and its Jacobian column is scaled alike
+        // (docs/thermal.md).
+        let factors = thermal.then(|| rec.thermal_factors(machine));
+        let scaled: Vec<f64>;
+        let at_state = match &factors {
+            Some(fs) => {
+                scaled = errors.iter().zip(fs).map(|(e, f)| e * f).collect();
+                &scaled[..]
+            }
+            None => errors,
+        };
         let (mut dev, j) = if jacobian {
-            let (d, j) = chain.deviation_and_jacobian(&rec.q, &rec.p, errors);
+            let (d, mut j) = chain.deviation_and_jacobian(&rec.q, &rec.p, at_state);
+            if let Some(fs) = &factors {
+                for (k, f) in fs.iter().enumerate() {
+                    j.column_mut(k).scale_mut(*f);
+                }
+            }
             (d, Some(j))
         } else {
-            (chain.deviation(&rec.q, &rec.p, errors), None)
+            (chain.deviation(&rec.q, &rec.p, at_state), None)
         };
         // A set-up's position s: the deviation less s, in the machine's
         // frame (`docs/five-axis.md`).
@@ -208,7 +226,11 @@ pub fn check(
     motions.sort_by_key(|(first, _, _)| *first);
     let mut largest = vec![0.0f64; motions.len()];
     for rec in records {
-        let wj = chain.weights(&rec.q);
+        let factors = rec.thermal_factors(machine);
+        let wj: Vec<f64> = (chain.weights(&rec.q).iter())
+            .zip(&factors)
+            .map(|(w, f)| w * f)
+            .collect();
         for ((_, _, members), l) in motions.iter().zip(largest.iter_mut()) {
             let angle: f64 = members.iter().map(|&j| wj[j] * x[j]).sum();
             *l = l.max(angle.abs());

@@ -284,6 +284,23 @@ pub struct Measurement {
     /// The set-up whose unknown position it measures against (an index
     /// into [`Measurements::setups`]), if any.
     pub setup: Option<usize>,
+    /// The thermal state it was measured at (°C, one per sensor in the
+    /// machine's order: a sensor's column, else the caller's value, else
+    /// its reference); empty: every sensor at its reference
+    /// (`docs/thermal.md`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub temperatures: Vec<f64>,
+}
+
+impl Measurement {
+    /// Each error's thermal factor at this record's state
+    /// ([`Machine::thermal_factors`]).
+    pub fn thermal_factors(&self, machine: &Machine) -> Vec<f64> {
+        if self.temperatures.is_empty() {
+            return machine.thermal_factors(&machine.reference_temperatures());
+        }
+        machine.thermal_factors(&self.temperatures)
+    }
 }
 
 /// The measurements (or candidates) of one CSV file.
@@ -563,6 +580,9 @@ struct Columns {
     q: Vec<usize>,
     /// Per parameter, its column or its fixed value.
     p: Vec<Result<usize, f64>>,
+    /// Per sensor, its column or its fixed value (the caller's, else its
+    /// reference).
+    t: Vec<Result<usize, f64>>,
     /// What every record measures.
     kind: MeasurementKind,
     /// The kind's given columns (`ux,uy,uz`), in its order.
@@ -600,6 +620,7 @@ fn classify(
     for (name, origin) in header {
         let known = m.variable_index(name).is_some()
             || m.parameter_index(name).is_some()
+            || m.sensor_index(name).is_some()
             || measured.contains(&name.as_str());
         let measured_value = layout == Layout::Candidates
             && (MeasurementKind::ALL.iter()).any(|kind| kind.components().contains(&name.as_str()));
@@ -609,6 +630,7 @@ fn classify(
         } else if !known {
             let names: Vec<&str> = (m.variables.iter().map(|v| v.name.as_str()))
                 .chain(m.parameters.iter().map(|p| p.name.as_str()))
+                .chain(m.sensors.iter().map(|s| s.name.as_str()))
                 .chain(measured.iter().copied())
                 .collect();
             let problem = P::UnknownColumn {
@@ -636,6 +658,7 @@ fn classify(
         problems.push(*located(header_origin, P::MissingPose { variables }));
     }
     let p = parameter_columns(m, overrides, header, header_origin, &mut problems);
+    let t = sensor_columns(m, overrides, header);
     // The records' kind: the one kind some of whose columns the header has,
     // else the one kind that has no column in this layout (a candidate
     // tool point); all of its columns are then needed.
@@ -681,6 +704,7 @@ fn classify(
             Ok(Columns {
                 q,
                 p,
+                t,
                 kind,
                 given: given.to_vec(),
                 values: values.to_vec(),
@@ -725,6 +749,25 @@ pub(crate) fn parameter_columns(
     p
 }
 
+/// Per sensor of `m`, its column in `header`, or the temperature it takes
+/// without one: the last of `overrides` naming it (the thermal state the
+/// caller gives), else its reference (`docs/thermal.md`).
+#[cfg(feature = "csv")]
+pub(crate) fn sensor_columns(
+    m: &Machine,
+    overrides: &[(String, f64)],
+    header: &[(String, Origin)],
+) -> Vec<Result<usize, f64>> {
+    (m.sensors.iter())
+        .map(|s| match header.iter().position(|(h, _)| *h == s.name) {
+            Some(c) => Ok(c),
+            None => Err((overrides.iter().rev())
+                .find(|(n, _)| *n == s.name)
+                .map_or(s.reference, |(_, v)| *v)),
+        })
+        .collect()
+}
+
 #[cfg(feature = "csv")]
 impl Columns {
     /// One data row as a record.
@@ -749,6 +792,18 @@ impl Columns {
             .values
             .iter()
             .map(|&c| number(c))
+            .collect::<Result<Vec<_>, _>>()?;
+        let temperatures = (self.t.iter())
+            .map(|c| match c {
+                Ok(c) => {
+                    let t = number(*c)?;
+                    if t <= -273.15 {
+                        return Err(located(&cells[*c].1, P::NotATemperature { value: t }));
+                    }
+                    Ok(t)
+                }
+                Err(v) => Ok(*v),
+            })
             .collect::<Result<Vec<_>, _>>()?;
         let observed = match self.kind {
             MeasurementKind::Point => Observed::Point,
@@ -782,6 +837,7 @@ impl Columns {
             values,
             std,
             setup: None,
+            temperatures,
         })
     }
 }
@@ -900,8 +956,9 @@ pub fn physical_scales(
     // records (1 for a constant).
     let mut w2 = vec![0.0; machine.errors.len()];
     for r in records {
-        for (a, w) in w2.iter_mut().zip(chain.weights(&r.q)) {
-            *a += w * w;
+        let factors = r.thermal_factors(machine);
+        for ((a, w), f) in w2.iter_mut().zip(chain.weights(&r.q)).zip(factors) {
+            *a += (w * f) * (w * f);
         }
     }
     let basis = |n: &str| {
@@ -1030,6 +1087,7 @@ impl Design {
         }
         let chain = super::exact::ExactChain::new(machine);
         let n = model.errors().len();
+        let thermal = machine.is_thermal();
         let width = n + 3 * setups.len();
         let m: usize = records.iter().map(|r| r.observed.rows()).sum();
         let mut flat = vec![0.0; m * width];
@@ -1052,6 +1110,16 @@ impl Design {
             let out = &mut flat[at * width..(at + k) * width];
             for c in 0..k {
                 out[c * width..c * width + n].copy_from_slice(&rows_n[c * n..(c + 1) * n]);
+            }
+            // At the record's thermal state each thermal coefficient's
+            // column is its geometric column times ΔT (docs/thermal.md).
+            if thermal {
+                let factors = r.thermal_factors(machine);
+                for c in 0..k {
+                    for (v, f) in out[c * width..c * width + n].iter_mut().zip(&factors) {
+                        *v *= f;
+                    }
+                }
             }
             if let Some(g) = r.setup {
                 // The set-up's position s enters as −s in the workpiece

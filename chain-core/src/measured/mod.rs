@@ -27,6 +27,7 @@ pub mod spheres;
 pub mod subset;
 pub mod thermal;
 pub mod thermal_fit;
+pub mod thermal_values;
 
 pub use identify::{
     identify, Identification, IdentifyError, IdentifyOptions, NoiseRule, SubsetProblem, SubsetSide,

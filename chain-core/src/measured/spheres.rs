@@ -299,6 +299,7 @@ impl SphereColumns {
             values,
             std,
             setup: None,
+            temperatures: Vec::new(),
         };
         Ok((record, id))
     }

@@ -60,6 +60,12 @@ pub struct SymbolicModel {
     /// [`SymbolicModel::variables`] and [`SymbolicModel::errors`]); empty
     /// for a machine without any. The exports list them.
     pub functions: Vec<ErrorFunction>,
+    /// Per error, the sensor whose deviation from its reference multiplies
+    /// it (a thermal coefficient, `docs/thermal.md`): `(sensor name,
+    /// reference °C)`; `None` for a geometric error. The coefficients in
+    /// `components` are the geometry's; the thermal factor acts on the
+    /// value.
+    pub thermal: Vec<Option<(String, f64)>>,
 }
 
 impl SymbolicModel {
@@ -254,6 +260,14 @@ fn derive_direct(machine: &Machine, frame: Frame) -> SymbolicModel {
         nominal_position: std::array::from_fn(|i| position[i].value.clone()),
         components,
         functions: machine.functions.clone(),
+        thermal: machine
+            .errors
+            .iter()
+            .map(|e| {
+                let s = machine.sensors.get(e.sensor?)?;
+                Some((s.name.clone(), s.reference))
+            })
+            .collect(),
     }
 }
 
@@ -401,11 +415,13 @@ mod tests {
                     name: "dxc".into(),
                     kind: ErrorKind::Linear,
                     origin: o(),
+                    sensor: None,
                 },
                 ErrorParam {
                     name: "ezc".into(),
                     kind: ErrorKind::Angular,
                     origin: o(),
+                    sensor: None,
                 },
             ],
             bodies: vec![
@@ -455,6 +471,7 @@ mod tests {
             statistics: vec![],
             reliability: None,
             correlations: Vec::new(),
+            sensors: Vec::new(),
             functions: vec![],
         }
     }

@@ -45,6 +45,12 @@ pub struct DeriveJson {
     /// only when the machine has any. An addition to the spec.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub functions: Vec<FunctionJson>,
+    /// The thermal coefficients, present only when the machine has any:
+    /// error → `{"sensor": name, "reference": °C}`; the error's value is per
+    /// kelvin of `sensor − reference` (docs/thermal.md). An addition to the
+    /// spec.
+    #[serde(skip_serializing_if = "Map::is_empty")]
+    pub thermal: Map<String, Value>,
     /// `R_wt(q,0)` and `T_wt(q,0)·tool_point`.
     pub nominal: NominalJson,
     /// Per component, every error with a non-zero coefficient → coefficient.
@@ -129,6 +135,15 @@ pub fn to_json(model: &SymbolicModel) -> DeriveJson {
                     .iter()
                     .map(|(_, b)| text(&basis_poly(b, index_u16(f.variable))))
                     .collect(),
+            })
+            .collect(),
+        thermal: (model.errors.iter().zip(&model.thermal))
+            .filter_map(|(e, t)| {
+                let (sensor, reference) = t.as_ref()?;
+                Some((
+                    e.clone(),
+                    serde_json::json!({"sensor": sensor, "reference": reference}),
+                ))
             })
             .collect(),
         nominal: NominalJson {
@@ -258,16 +273,22 @@ fn scaled_text(q: &str, range: [f64; 2], latex: bool) -> String {
 pub(crate) fn function_text(model: &SymbolicModel, f: &ErrorFunction) -> String {
     let q = variable_name(model, f);
     let form = function_form(model, f);
-    let terms: Vec<String> = form
-        .terms
-        .iter()
-        .map(|(name, term)| match term {
-            Term::One => name.clone(),
-            Term::Power(1) => format!("{name}*{q}"),
-            Term::Power(k) => format!("{name}*{q}^{k}"),
-            Term::Orthogonal(p, k) => format!("{name}*{p}_{k}(t)"),
-            Term::Trig(fun, 1) => format!("{name}*{fun}({q})"),
-            Term::Trig(fun, k) => format!("{name}*{fun}({k}*{q})"),
+    let terms: Vec<String> = (form.terms.iter().zip(&f.coefficients))
+        .map(|((name, term), (j, _))| {
+            let text = match term {
+                Term::One => name.clone(),
+                Term::Power(1) => format!("{name}*{q}"),
+                Term::Power(k) => format!("{name}*{q}^{k}"),
+                Term::Orthogonal(p, k) => format!("{name}*{p}_{k}(t)"),
+                Term::Trig(fun, 1) => format!("{name}*{fun}({q})"),
+                Term::Trig(fun, k) => format!("{name}*{fun}({k}*{q})"),
+            };
+            match model.thermal.get(*j).and_then(Option::as_ref) {
+                Some((sensor, reference)) => {
+                    format!("{text}*({sensor} - {})", format_number(*reference))
+                }
+                None => text,
+            }
         })
         .collect();
     let t = form
@@ -386,6 +407,22 @@ pub fn to_text(model: &SymbolicModel) -> String {
         for f in &model.functions {
             out.push_str(&format!("  {}\n", function_text(model, f)));
         }
+    }
+    let thermal: Vec<String> = (model.errors.iter().zip(&model.thermal))
+        .filter_map(|(e, t)| {
+            let (sensor, reference) = t.as_ref()?;
+            Some(format!(
+                "{e} per K of {sensor} - {}",
+                format_number(*reference)
+            ))
+        })
+        .collect();
+    if !thermal.is_empty() {
+        out.push_str(&format!(
+            "thermal coefficients ({}): {}\n",
+            thermal.len(),
+            thermal.join(", ")
+        ));
     }
     out.push('\n');
     out.push_str("nominal rotation R_wt(q, 0):\n");

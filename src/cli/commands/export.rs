@@ -28,7 +28,7 @@ use chain_core::compensation::ExportedFile;
 use miette::MietteDiagnostic;
 
 use crate::cli::args::parse_grid_axis;
-use crate::cli::args::ParamArgs;
+use crate::cli::args::{ParamArgs, ThermalArgs};
 use crate::cli::csv_input::axes_points;
 use crate::cli::loaded::Loaded;
 use crate::cli::report;
@@ -87,6 +87,8 @@ pub struct ExportArgs {
     pub angles: bool,
     #[command(flatten)]
     pub param: ParamArgs,
+    #[command(flatten)]
+    pub thermal: ThermalArgs,
     /// Write the exported file(s) into DIR (created if missing) and the
     /// summary to stdout; without it the file goes to stdout.
     #[arg(long, value_name = "DIR")]
@@ -111,6 +113,7 @@ pub fn exec(args: ExportArgs) -> miette::Result<()> {
         cec_max_points: args.cec_max_points,
         beckhoff_max_records: args.beckhoff_max_records,
         angles: args.angles,
+        temperatures: &args.thermal.temperatures,
     };
     export::check(&request)?;
     if controller != ExportController::Grid && args.format == Some(ExportFormat::Csv) {

@@ -17,7 +17,7 @@ use chain::ops::identify::IdentifyRequest;
 use chain::ops::source::Source;
 use chain_core::measured::SetupKind;
 
-use crate::cli::args::ParamArgs;
+use crate::cli::args::{ParamArgs, ThermalArgs};
 use crate::cli::loaded::Loaded;
 use crate::cli::report;
 
@@ -87,6 +87,10 @@ pub struct IdentifyArgs {
     pub iterate: bool,
     #[command(flatten)]
     pub param: ParamArgs,
+    /// The thermal state of the records whose file has no column for a
+    /// sensor (a column named after a sensor gives each record's).
+    #[command(flatten)]
+    pub thermal: ThermalArgs,
     /// Output format.
     #[arg(long, value_enum, default_value = "table")]
     pub format: IdentifyFormat,
@@ -113,6 +117,7 @@ pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
         holdout: args.holdout,
         seed: args.seed,
         iterate: args.iterate,
+        temperatures: &args.thermal.temperatures,
     };
     let checked = request.check()?;
     let loaded = Loaded::new(&args.file)?;

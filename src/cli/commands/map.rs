@@ -24,7 +24,7 @@ use chain::ops::source::{self, Source};
 use chain_core::values::{parse_approaches, Approach};
 
 use crate::cli::args::parse_grid_axis;
-use crate::cli::args::ParamArgs;
+use crate::cli::args::{ParamArgs, ThermalArgs};
 use crate::cli::csv_input::axes_points;
 use crate::cli::loaded::Loaded;
 use crate::cli::progress::Progress;
@@ -72,6 +72,8 @@ pub struct MapArgs {
     pub axes: Option<PathBuf>,
     #[command(flatten)]
     pub param: ParamArgs,
+    #[command(flatten)]
+    pub thermal: ThermalArgs,
     /// Output format.
     #[arg(long, value_enum, default_value = "table")]
     pub format: MapFormat,
@@ -128,6 +130,7 @@ pub fn exec(args: MapArgs) -> miette::Result<()> {
             angles: args.compensation_angles,
         }),
         keep_points: true,
+        temperatures: &args.thermal.temperatures,
     };
     let report = |e: MapOpsError| match e {
         MapOpsError::Reliability(e) => loaded.report(e),

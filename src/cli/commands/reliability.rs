@@ -15,7 +15,7 @@ use std::path::PathBuf;
 
 use chain::ops::reliability::{self, ReliabilityOpsError, ReliabilityRequest};
 
-use crate::cli::args::{parse_grid_axis, AlgorithmArgs, ModelArgs, SystemArgs};
+use crate::cli::args::{parse_grid_axis, AlgorithmArgs, ModelArgs, SystemArgs, ThermalArgs};
 use crate::cli::loaded::Loaded;
 use crate::cli::progress::Progress;
 use crate::cli::report;
@@ -46,6 +46,8 @@ pub struct ReliabilityArgs {
     pub plot: Option<PathBuf>,
     #[command(flatten)]
     pub model: ModelArgs,
+    #[command(flatten)]
+    pub thermal: ThermalArgs,
     /// Replace the grid values of one axis, `VAR=V1,V2,...`, or `VAR=LO:HI:N` for N evenly spaced values from LO to HI (repeatable).
     #[arg(long = "grid", value_name = "VAR=V1,V2,...|VAR=LO:HI:N", value_parser = parse_grid_axis)]
     pub grid: Vec<(String, Vec<f64>)>,
@@ -91,6 +93,7 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
         approach: &approach,
         acceptance: args.acceptance,
         acceptance_tolerance: args.acceptance_tolerance,
+        temperatures: &args.thermal.temperatures,
     };
     let refused = |e: ReliabilityOpsError| match e {
         ReliabilityOpsError::Option(e) => miette::Report::new(e),

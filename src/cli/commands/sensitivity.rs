@@ -21,7 +21,7 @@ use chain::ops::sensitivity::{
 };
 use chain_core::geometric::NominalSizes;
 
-use crate::cli::args::{parse_grid_axis, parse_point, AtPoint, ModelArgs};
+use crate::cli::args::{parse_grid_axis, parse_point, AtPoint, ModelArgs, ThermalArgs};
 use crate::cli::loaded::Loaded;
 use crate::cli::report;
 
@@ -58,6 +58,9 @@ pub struct SensitivityArgs {
     pub format: SensitivityFormat,
     #[command(flatten)]
     pub model: ModelArgs,
+    /// `--kind reliability`: the thermal state of a machine with sensors.
+    #[command(flatten)]
+    pub thermal: ThermalArgs,
     /// What to compute.
     #[arg(long, value_enum, default_value = "reliability")]
     pub kind: SensitivityKind,
@@ -118,6 +121,7 @@ pub fn exec(args: SensitivityArgs) -> miette::Result<()> {
             ValuesArg::Nominal(n) => SensitivityValues::Nominal(*n),
         }),
         approach: &approach,
+        temperatures: &args.thermal.temperatures,
     };
     sensitivity::check(&request)?;
     let loaded = Loaded::new(&args.file)?;

@@ -11,6 +11,7 @@ use chain::ops::thermal as ops;
 use chain_core::measured::thermal::{Pair, Roles};
 use chain_core::measured::thermal_fit::{FitOptions, Split, DEFAULT_SENSORS};
 
+use crate::cli::loaded::Loaded;
 use crate::cli::{plot, report};
 
 /// Output formats of `chain thermal`.
@@ -73,6 +74,29 @@ pub struct ThermalArgs {
     /// predictions) into DIR as PNG and SVG.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    /// Write the fitted models as the thermal coefficients of a machine's
+    /// thermal terms, a values file that `chain map --temperature` reads
+    /// (with --fit, --machine and --slot).
+    #[arg(long, value_name = "VALUES.yaml", requires_all = ["machine", "slots"])]
+    pub values_out: Option<PathBuf>,
+    /// The machine file whose thermal terms take the models.
+    #[arg(long, value_name = "MACHINE.yaml", requires = "values_out")]
+    pub machine: Option<PathBuf>,
+    /// Which channel's model a thermal term `{name, per}` of the machine
+    /// takes: `NAME=CHANNEL` (comma-separated or repeated).
+    #[arg(
+        long = "slot",
+        value_name = "NAME=CHANNEL",
+        value_delimiter = ',',
+        value_parser = slot,
+        requires = "values_out"
+    )]
+    pub slots: Vec<(String, String)>,
+}
+
+/// `--slot`: `NAME=CHANNEL`.
+fn slot(text: &str) -> Result<(String, String), String> {
+    ops::parse_slot(text).map_err(|e| e.to_string())
 }
 
 /// `--pair`: `X1:X2=L`.
@@ -105,11 +129,25 @@ pub fn exec(args: ThermalArgs) -> miette::Result<()> {
             "--format csv writes the fit's predictions: give --fit"
         ));
     }
+    let loaded = match &args.machine {
+        Some(path) => Some(Loaded::new(path)?),
+        None => None,
+    };
+    let into_machine = loaded.as_ref().map(|l| ops::IntoMachine {
+        machine: &l.machine,
+        slots: &args.slots,
+    });
     let done = ops::run(&ops::ThermalRequest {
         test: &test,
         pairs: &args.pairs,
         fit,
+        into_machine,
     })?;
+    if let (Some(path), Some(values)) = (&args.values_out, &done.values) {
+        crate::cli::atomic::write(path, values.text.as_bytes())
+            .map_err(|e| miette::miette!("cannot write {}: {e}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
     if let Some(dir) = &args.plot {
         for f in plot::write(dir, &chain::plot::thermal::charts(&test, &done))? {
             eprintln!("wrote {}", f.display());

@@ -65,6 +65,12 @@ impl Report for MapDocument {
             constants,
             if constants == 1 { "" } else { "s" },
         );
+        if !self.temperatures.is_empty() {
+            let state: Vec<String> = (self.temperatures.iter())
+                .map(|(n, t)| format!("{n} = {t} °C"))
+                .collect();
+            let _ = writeln!(out, "thermal state: {}", state.join(", "));
+        }
         for r in &self.reversals {
             let (f, unit) = if r.unit == "mm" {
                 (1e3, "µm")

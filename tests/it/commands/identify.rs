@@ -137,6 +137,7 @@ fn simulate(
                 values: (0..3).map(|c| err[c] + sigma * gauss(rng)).collect(),
                 std: Some(sigma),
                 setup: None,
+                temperatures: Vec::new(),
             }
         })
         .collect()
@@ -281,6 +282,7 @@ fn gantry_position_only_null_space_is_the_analytic_one() {
             values: vec![0.0; 3],
             std: None,
             setup: None,
+            temperatures: Vec::new(),
         })
         .collect();
     let r = identify(
@@ -655,6 +657,7 @@ fn directions_identify_like_points() {
                 values: vec![d + 1e-3 * gauss(&mut rng)],
                 std: Some(1e-3),
                 setup: None,
+                temperatures: Vec::new(),
             });
         }
     }
@@ -793,6 +796,7 @@ fn cli_directions_and_prior_without_std_are_the_library_answer() {
             values: vec![u[0] * err[0] + u[1] * err[1] + u[2] * err[2] + 1e-3 * gauss(&mut rng)],
             std: Some(1e-3),
             setup: None,
+            temperatures: Vec::new(),
         });
     }
     let csv = write(

@@ -142,6 +142,7 @@ fn measured(m: &Machine, e: &[f64], count: usize, sigma: f64, rng: &mut Rng) -> 
                 values: (0..3).map(|c| err[c] + sigma * gauss(rng)).collect(),
                 std: None,
                 setup: None,
+                temperatures: Vec::new(),
             }
         })
         .collect();
@@ -497,6 +498,7 @@ tool: tool
                 values: err[..3].to_vec(),
                 std: None,
                 setup: None,
+                temperatures: Vec::new(),
             }
         })
         .collect();

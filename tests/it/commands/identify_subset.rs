@@ -56,6 +56,7 @@ fn simulate(
                 values: (0..3).map(|c| err[c] + sigma * gauss(rng)).collect(),
                 std: None,
                 setup: None,
+                temperatures: Vec::new(),
             }
         })
         .collect()

@@ -48,4 +48,5 @@ mod sorm_cli;
 mod streamed;
 mod subset;
 mod thermal;
+mod thermal_model;
 mod values;

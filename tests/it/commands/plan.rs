@@ -68,6 +68,7 @@ fn candidates(qs: &[Vec<f64>], p: &[f64], dirs: Option<&[[f64; 3]]>) -> Vec<Meas
             values: vec![],
             std: None,
             setup: None,
+            temperatures: Vec::new(),
         })
         .collect()
 }

@@ -845,6 +845,7 @@ pub fn with_function_slots(
                         name: format!("{}_{}", e.name, b.suffix()),
                         kind: e.kind,
                         origin: e.origin.clone(),
+                        sensor: None,
                     });
                 }
                 map.push(coefficients.iter().map(|(k, _)| *k).collect());
@@ -853,6 +854,7 @@ pub fn with_function_slots(
                     basis: basis.clone(),
                     variable: *variable,
                     coefficients,
+                    sensors: Vec::new(),
                     origin: e.origin.clone(),
                 });
             }

@@ -78,6 +78,11 @@ pub enum MeasurementsProblem {
         /// Its value.
         value: f64,
     },
+    /// A sensor's cell that is not a temperature (°C above absolute zero).
+    NotATemperature {
+        /// Its value.
+        value: f64,
+    },
     /// A sphere file's column that is neither an axis variable, a
     /// parameter, `sphere` nor `std`.
     SphereUnknownColumn {
@@ -194,6 +199,12 @@ impl MeasurementsProblem {
                 "not a unit vector",
                 format!("the direction (ux, uy, uz) has length {norm}, not 1"),
             ),
+            MeasurementsProblem::NotATemperature { value } => D::new(
+                "chain::measurements::not_a_temperature",
+                "not a temperature",
+                format!("{value} °C is below absolute zero"),
+            )
+            .help("a sensor's column holds the temperature of each record in °C".to_string()),
             MeasurementsProblem::StdNotPositive { value } => D::new(
                 "chain::measurements::std_not_positive",
                 "not positive",

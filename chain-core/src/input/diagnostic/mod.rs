@@ -350,6 +350,29 @@ pub enum Problem {
         /// The body.
         body: String,
     },
+    /// A thermal term (`per:`) names a sensor the machine does not declare.
+    UnknownSensor {
+        /// The name.
+        name: String,
+        /// The declared sensors.
+        sensors: Vec<String>,
+        /// The closest sensor, if one is close.
+        suggestion: Option<String>,
+    },
+    /// A sensor declared twice.
+    SensorTwice {
+        /// The name.
+        name: String,
+        /// The line of the first declaration.
+        line: usize,
+    },
+    /// A sensor named twice in one `per`.
+    DuplicateSensor {
+        /// The name.
+        name: String,
+    },
+    /// A thermal term in `squareness`.
+    ThermalNotAllowed,
     /// A function slot in `location_errors` or `squareness`, which take
     /// error names only.
     FunctionNotAllowed {
@@ -938,6 +961,45 @@ impl Problem {
             .help(
                 "a function slot is a function of the body's own joint variable; give the body a \
                  `joint`, or write a constant error name"
+                    .to_string(),
+            ),
+            Problem::UnknownSensor {
+                name,
+                sensors,
+                suggestion,
+            } => D::new(
+                "chain::unknown_sensor",
+                "unknown sensor",
+                format!("`{name}` is not a declared sensor"),
+            )
+            .note(did_you_mean(suggestion))
+            .help(if sensors.is_empty() {
+                "a thermal term's `per` names sensors declared under the top-level `sensors:` \
+                 (e.g. `sensors: {T_spindle: 20}`)"
+                    .to_string()
+            } else {
+                format!("the declared sensors: {}", sensors.join(", "))
+            }),
+            Problem::SensorTwice { name, line } => D::new(
+                "chain::sensor_twice",
+                "declared twice",
+                format!("sensor `{name}` is declared twice (first on line {line})"),
+            )
+            .help("each sensor is declared once under `sensors:`".to_string()),
+            Problem::DuplicateSensor { name } => D::new(
+                "chain::duplicate_sensor",
+                "named twice",
+                format!("sensor `{name}` is named twice in this `per`"),
+            )
+            .help("each sensor of a thermal term is named once".to_string()),
+            Problem::ThermalNotAllowed => D::new(
+                "chain::thermal_not_allowed",
+                "not a name",
+                "`squareness` takes error names only, not a thermal term".to_string(),
+            )
+            .help(
+                "a tilt that grows with temperature is an angular thermal term `{name: …, per: …}` \
+                 in the body's `errors` or `location_errors`"
                     .to_string(),
             ),
             Problem::FunctionNotAllowed { group } => D::new(

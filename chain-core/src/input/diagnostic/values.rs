@@ -314,6 +314,7 @@ fn bind(e: &BindError) -> D {
                 NotAMotion::Coefficient { function } => format!(
                     "give `{function}: {{points: ...}}` or `{function}: {{table: ...}}` instead"
                 ),
+                NotAMotion::Thermal { .. } => "give each thermal coefficient a number, its value per kelvin (docs/thermal.md); the error at a temperature is that value times the sensor's deviation from its reference".to_string(),
                 _ => "only an error motion (an error in the `errors` of one body with a joint) varies along an axis; give a number".to_string(),
             };
             D::new("chain::values::not_a_motion", "not an error motion", text).help(help)

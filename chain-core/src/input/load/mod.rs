@@ -53,6 +53,7 @@ pub const TOP_KEYS: &[&str] = &[
     "statistics",
     "correlation",
     "reliability",
+    "sensors",
 ];
 
 /// The highest degree, harmonic count or power of a function slot
@@ -240,6 +241,9 @@ struct Loader {
     /// Names of function slots that were refused (already reported): neither
     /// they nor `<name>_…` are reported again in `statistics`.
     failed_functions: HashSet<String>,
+    /// The `sensors` section (read before the bodies, whose thermal terms
+    /// name them).
+    sensors: Vec<crate::model::Sensor>,
 }
 
 impl TreeReader for Loader {
@@ -378,6 +382,9 @@ impl Loader {
         if let Some(p) = top.get("parameters") {
             self.parameters_section(p);
         }
+        if let Some(n) = top.get("sensors") {
+            self.sensors_section(n);
+        }
 
         let tree = match top.entry("bodies") {
             Some((k, v)) => self.bodies_section(k, v),
@@ -437,6 +444,7 @@ impl Loader {
             statistics: statistics?,
             reliability: reliability?,
             correlations: correlations?,
+            sensors: std::mem::take(&mut self.sensors),
         })
     }
 

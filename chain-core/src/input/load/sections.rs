@@ -114,6 +114,69 @@ impl Loader {
         }
     }
 
+    /// `sensors:` (`docs/thermal.md`): the named conditions the thermal
+    /// terms read, as a list of names (reference 20 °C, ISO 1) or a mapping
+    /// of name → reference temperature (°C) or `{reference: °C}`. A sensor
+    /// may not share a parameter's name (a measurement file's columns name
+    /// both).
+    pub(super) fn sensors_section(&mut self, node: &Node) {
+        let named: Vec<(&Node, Option<&Node>)> = match (node.as_sequence(), node.as_mapping()) {
+            (Some(items), _) => items.iter().map(|n| (n, None)).collect(),
+            (None, Some(entries)) => entries.iter().map(|(k, v)| (k, Some(v))).collect(),
+            _ => {
+                self.wrong_type(
+                    node,
+                    "sensors",
+                    "a list of sensor names or a mapping of name → reference °C",
+                );
+                return;
+            }
+        };
+        for (i, (k, v)) in named.into_iter().enumerate() {
+            let path = match v {
+                None => crate::input::load::index("sensors", i),
+                Some(_) => join("sensors", k.as_str().unwrap_or("")),
+            };
+            let Some(name) = self.ident(k, &path, "sensor") else {
+                continue;
+            };
+            let reference = match v {
+                None => Some(crate::model::REFERENCE_TEMPERATURE),
+                Some(v) if v.is_null() => Some(crate::model::REFERENCE_TEMPERATURE),
+                Some(v) if v.as_mapping().is_some() => {
+                    let Some(f) = self.fields(v, v.span, &path, &["reference"]) else {
+                        continue;
+                    };
+                    match f.get("reference") {
+                        Some(r) => self.finite(r, &f.path("reference"), "a reference temperature"),
+                        None => Some(crate::model::REFERENCE_TEMPERATURE),
+                    }
+                }
+                Some(v) => self.finite(v, &path, "a reference temperature"),
+            };
+            let Some(reference) = reference else { continue };
+            if let Some(first) = self.sensors.iter().find(|s| s.name == name) {
+                let line = first.origin.line;
+                self.report(k.span, path, Problem::SensorTwice { name, line });
+                continue;
+            }
+            if self.parameter_index.contains_key(&name) {
+                let problem = Problem::NameCollision {
+                    name,
+                    what: "sensor",
+                    other: "parameter",
+                };
+                self.report(k.span, path, problem);
+                continue;
+            }
+            self.sensors.push(crate::model::Sensor {
+                name,
+                reference,
+                origin: k.span.origin(path),
+            });
+        }
+    }
+
     /// `statistics: {error: {dist, ...}}`. `None` if any entry is invalid.
     pub(super) fn statistics_section(
         &mut self,

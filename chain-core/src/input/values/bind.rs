@@ -33,6 +33,12 @@ pub enum NotAMotion {
         /// The function.
         function: String,
     },
+    /// It is a thermal term (per kelvin of its sensors): its values are
+    /// coefficients, constants by definition (`docs/thermal.md`).
+    Thermal {
+        /// Its sensors.
+        sensors: Vec<String>,
+    },
 }
 
 impl std::fmt::Display for NotAMotion {
@@ -43,6 +49,11 @@ impl std::fmt::Display for NotAMotion {
                 "it is a location error of body `{body}` (placed before the joint: a constant)"
             ),
             NotAMotion::Squareness => write!(f, "it is a squareness term (a constant)"),
+            NotAMotion::Thermal { sensors } => write!(
+                f,
+                "it is thermal (per kelvin of {}), and a thermal term's values are constants per kelvin",
+                sensors.join(", ")
+            ),
             NotAMotion::NoJoint { body } => write!(
                 f,
                 "it is an error of body `{body}`, which has no joint to vary along"
@@ -341,6 +352,16 @@ impl<'m> ValuesBuilder<'m> {
         let m = self.machine;
         if let Some(fi) = m.function_index(name) {
             let f = &m.functions[fi];
+            if !f.sensors.is_empty() {
+                return Err(BindError::NotAMotion {
+                    name: name.to_string(),
+                    reason: NotAMotion::Thermal {
+                        sensors: (f.sensors.iter())
+                            .filter_map(|&s| m.sensors.get(s).map(|x| x.name.clone()))
+                            .collect(),
+                    },
+                });
+            }
             let Some(&(j0, _)) = f.coefficients.iter().find(|(_, b)| b.is_constant()) else {
                 return Err(BindError::NoConstantTerm {
                     name: name.to_string(),
@@ -424,6 +445,16 @@ fn describe_basis(basis: &crate::model::Basis) -> String {
 /// in the `errors` slots of exactly one body, which has a joint, and nowhere
 /// else.
 pub fn motion_variable(machine: &Machine, j: usize) -> Result<usize, NotAMotion> {
+    if let Some(s) = machine.errors[j].sensor {
+        return Err(NotAMotion::Thermal {
+            sensors: machine
+                .sensors
+                .get(s)
+                .map(|x| x.name.clone())
+                .into_iter()
+                .collect(),
+        });
+    }
     if let Some((f, _)) = machine.coefficient_of(j) {
         return Err(NotAMotion::Coefficient {
             function: f.name.clone(),

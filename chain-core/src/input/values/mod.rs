@@ -400,6 +400,23 @@ impl Values {
     }
 }
 
+impl Values {
+    /// These values at a thermal state: each constant multiplied by its
+    /// error's thermal factor ([`Machine::thermal_factors`], in
+    /// [`Values::errors`] order): a thermal coefficient's per-kelvin value
+    /// becomes its contribution `g_j(T) · e_j` at the state, every other
+    /// value (factor 1) is unchanged (`docs/thermal.md`). Tables never hold
+    /// a thermal coefficient (refused when bound), so only constants scale.
+    pub fn at_thermal_state(mut self, factors: &[f64]) -> Values {
+        for (c, f) in self.constants.iter_mut().zip(factors) {
+            if *f != 1.0 {
+                *c *= f;
+            }
+        }
+        self
+    }
+}
+
 impl ErrorValues for Values {
     /// `v(q)`: the constants, then every table at its axis value. `q` is in
     /// [`Values::variables`] order, `out` in [`Values::errors`] order (a

@@ -33,6 +33,17 @@ impl Loader {
             variables,
             ..Registry::default()
         };
+        // Sensors and axis variables share a measurement file's header.
+        for sensor in &self.sensors {
+            if r.variable_names.contains(&sensor.name) {
+                let problem = Problem::NameCollision {
+                    name: sensor.name.clone(),
+                    what: "sensor",
+                    other: "axis variable",
+                };
+                self.errors.push((sensor.origin.clone(), problem));
+            }
+        }
         let mut slots = vec![(ErrorSlots::default(), ErrorSlots::default()); raws.len()];
         for &old in order {
             let Some(raw) = raws.get(old) else { continue };
@@ -68,13 +79,15 @@ impl Loader {
                                 r.iso_owner.insert(u.name.clone(), raw.name.clone());
                                 indices.extend(self.error_use(u, kind, &mut r));
                             }
-                            Item::Function(f) => {
+                            Item::Function(f) => match (&f.basis, variable) {
+                                (None, _) => indices.extend(self.thermal_use(f, kind, &mut r)),
+                                (Some(basis), Some(v)) => {
+                                    indices.extend(self.function_use(f, basis, kind, v, &mut r));
+                                }
                                 // Without a valid variable the joint was
                                 // reported already.
-                                if let Some(v) = variable {
-                                    indices.extend(self.function_use(f, kind, v, &mut r));
-                                }
-                            }
+                                (Some(_), None) => {}
+                            },
                         }
                     }
                     let Some((loc, err)) = slots.get_mut(old) else {
@@ -144,6 +157,7 @@ impl Loader {
             name: u.name.clone(),
             kind,
             origin: u.span.origin(u.path.clone()),
+            sensor: None,
         }))
     }
 
@@ -153,6 +167,7 @@ impl Loader {
     fn function_use(
         &mut self,
         f: &RawFunction,
+        basis: &Basis,
         kind: ErrorKind,
         variable: usize,
         r: &mut Registry<'_>,
@@ -167,11 +182,17 @@ impl Loader {
                 .first()
                 .and_then(|(j, _)| r.errors.get(*j))
                 .map(|e| e.kind);
-            let difference = if first.basis != f.basis {
+            let difference = if first.basis != *basis {
                 Some(format!(
                     "with a different basis ({} here, {} first)",
-                    describe_basis(&f.basis),
+                    describe_basis(basis),
                     describe_basis(&first.basis)
+                ))
+            } else if first.sensors != f.per {
+                Some(format!(
+                    "per other sensors ({} here, {} first)",
+                    sensor_list(&self.sensors, &f.per),
+                    sensor_list(&self.sensors, &first.sensors)
                 ))
             } else if first.variable != variable {
                 let var = |i: usize| r.variables.get(i).map_or("?", |v| v.name.as_str());
@@ -203,12 +224,24 @@ impl Loader {
             return first.coefficients.iter().map(|(j, _)| *j).collect();
         }
 
-        // A new function: its name and every coefficient's must be new.
-        let terms = f.basis.terms();
-        let names: Vec<String> = terms
-            .iter()
-            .map(|t| format!("{name}_{}", t.suffix()))
-            .collect();
+        // A new function: its name and every coefficient's must be new. A
+        // thermal function has the terms once per sensor of its `per`.
+        let sensors: Vec<Option<usize>> = if f.per.is_empty() {
+            vec![None]
+        } else {
+            f.per.iter().copied().map(Some).collect()
+        };
+        let mut terms = Vec::new();
+        let mut names: Vec<String> = Vec::new();
+        for &s in &sensors {
+            for t in basis.terms() {
+                names.push(match s.and_then(|s| self.sensors.get(s)) {
+                    Some(sensor) => format!("{name}_{}_{}", t.suffix(), sensor.name),
+                    None => format!("{name}_{}", t.suffix()),
+                });
+                terms.push((t, s));
+            }
+        }
         let mut clashes = Vec::new();
         if let Some(other) = r.describe(name, &self.parameter_index) {
             clashes.push((format!("function `{name}`"), other));
@@ -233,12 +266,13 @@ impl Loader {
         let coefficients: Vec<(usize, crate::model::BasisFn)> = names
             .into_iter()
             .zip(terms)
-            .map(|(c, t)| {
+            .map(|(c, (t, sensor))| {
                 r.coefficient_of.insert(c.clone(), name.clone());
                 let j = r.push(ErrorParam {
                     name: c,
                     kind,
                     origin: origin.clone(),
+                    sensor,
                 });
                 (j, t)
             })
@@ -247,11 +281,98 @@ impl Loader {
         let indices = coefficients.iter().map(|(j, _)| *j).collect();
         r.functions.push(ErrorFunction {
             name: name.clone(),
-            basis: f.basis.clone(),
+            basis: basis.clone(),
             variable,
             coefficients,
+            sensors: f.per.clone(),
             origin,
         });
+        indices
+    }
+
+    /// Registers one declaration of a thermal term constant along the axis
+    /// (`{name, per}`): the constants `<name>_<sensor>`, one per sensor,
+    /// each per kelvin of its sensor (`docs/thermal.md`); returns their
+    /// indices (empty if refused).
+    fn thermal_use(
+        &mut self,
+        f: &RawFunction,
+        kind: ErrorKind,
+        r: &mut Registry<'_>,
+    ) -> Vec<usize> {
+        let name = &f.name.name;
+        let names: Vec<String> = (f.per.iter())
+            .filter_map(|&s| self.sensors.get(s))
+            .map(|s| format!("{name}_{}", s.name))
+            .collect();
+        if let Some(first) = r.thermal.get(name) {
+            let linear = |k: ErrorKind| k == ErrorKind::Linear;
+            let difference = if first.sensors != f.per {
+                Some(format!(
+                    "per other sensors ({} here, {} first)",
+                    sensor_list(&self.sensors, &f.per),
+                    sensor_list(&self.sensors, &first.sensors)
+                ))
+            } else if linear(first.kind) != linear(kind) {
+                Some(format!(
+                    "in a slot of another kind ({} here, {} first)",
+                    slot_kind(kind),
+                    slot_kind(first.kind)
+                ))
+            } else {
+                None
+            };
+            if let Some(difference) = difference {
+                let problem = Problem::FunctionRedeclared {
+                    name: name.clone(),
+                    difference,
+                    first: place(&first.origin),
+                };
+                self.report(f.name.span, f.name.path.clone(), problem);
+                return Vec::new();
+            }
+            return first.indices.clone();
+        }
+        let mut clashes = Vec::new();
+        if let Some(other) = r.describe(name, &self.parameter_index) {
+            clashes.push((format!("thermal term `{name}`"), other));
+        }
+        for c in &names {
+            if let Some(other) = r.describe(c, &self.parameter_index) {
+                clashes.push((format!("coefficient `{c}` of thermal term `{name}`"), other));
+            }
+        }
+        if !clashes.is_empty() {
+            for (what, other) in clashes {
+                let problem = Problem::FunctionClash { what, other };
+                self.report(f.name.span, f.name.path.clone(), problem);
+            }
+            self.failed_functions.insert(name.clone());
+            return Vec::new();
+        }
+        let origin = f.name.span.origin(f.name.path.clone());
+        let indices: Vec<usize> = names
+            .into_iter()
+            .zip(&f.per)
+            .map(|(c, &s)| {
+                r.coefficient_of.insert(c.clone(), name.clone());
+                r.push(ErrorParam {
+                    name: c,
+                    kind,
+                    origin: origin.clone(),
+                    sensor: Some(s),
+                })
+            })
+            .collect();
+        r.thermal.insert(
+            name.clone(),
+            ThermalTerm {
+                indices: indices.clone(),
+                sensors: f.per.clone(),
+                kind,
+                origin,
+            },
+        );
         indices
     }
 }
@@ -266,14 +387,28 @@ struct Registry<'v> {
     functions: Vec<ErrorFunction>,
     /// Function name → index into `functions`.
     function_by_name: HashMap<String, usize>,
-    /// Coefficient name → its function's name.
+    /// Coefficient name → its function's (or thermal term's) name.
     coefficient_of: HashMap<String, String>,
+    /// Thermal terms constant along the axis, by name.
+    thermal: HashMap<String, ThermalTerm>,
     /// Name given by `errors: iso` → the body whose `iso` gave it.
     iso_owner: HashMap<String, String>,
     /// Every variable name written in a joint.
     variable_names: HashSet<String>,
     /// The valid variables.
     variables: &'v [Variable],
+}
+
+/// A thermal term constant along the axis as first declared.
+struct ThermalTerm {
+    /// Its constants' indices, one per sensor.
+    indices: Vec<usize>,
+    /// Its sensors.
+    sensors: Vec<usize>,
+    /// The kind of its first slot.
+    kind: ErrorKind,
+    /// Where it was first declared.
+    origin: crate::model::Origin,
 }
 
 impl Registry<'_> {
@@ -296,6 +431,12 @@ impl Registry<'_> {
                 .and_then(|&i| self.functions.get(i))
                 .map_or_else(String::new, |f| format!(" (declared {})", place(&f.origin)));
             return Some(format!("a coefficient of function `{function}`{at}"));
+        }
+        if let Some(t) = self.thermal.get(name) {
+            return Some(format!(
+                "thermal term `{name}` (declared {})",
+                place(&t.origin)
+            ));
         }
         if let Some(f) = self
             .function_by_name
@@ -363,6 +504,17 @@ fn describe_basis(basis: &Basis) -> String {
         }
         Basis::Fourier { harmonics } => format!("fourier with {harmonics} harmonics"),
     }
+}
+
+/// Sensors by index, for messages: `T_x, T_spindle` (`none`).
+fn sensor_list(sensors: &[crate::model::Sensor], per: &[usize]) -> String {
+    if per.is_empty() {
+        return "none".to_string();
+    }
+    (per.iter())
+        .filter_map(|&s| sensors.get(s).map(|x| x.name.as_str()))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The kind of a slot, for messages.

@@ -23,6 +23,7 @@ const FUNCTION_KEYS: &[&str] = &[
     "range",
     "from",
     "harmonics",
+    "per",
 ];
 
 /// Values of a function slot's `basis` (the power basis is `powers: [..]`).
@@ -44,8 +45,12 @@ pub(super) const GROUPS: [(&str, &[&str]); 3] = [
 pub(super) struct RawFunction {
     /// The `name` value, located at it (key path `….name`).
     pub(super) name: Use,
-    /// The basis.
-    pub(super) basis: Basis,
+    /// The basis along the joint (`None`: a thermal term constant along
+    /// the axis, `{name, per}` alone).
+    pub(super) basis: Option<Basis>,
+    /// `per:`: the sensors (indices into the machine's) whose deviations
+    /// multiply it (`docs/thermal.md`); empty for a geometric function.
+    pub(super) per: Vec<usize>,
 }
 
 /// One entry of a slot.
@@ -201,17 +206,30 @@ impl Loader {
             }
             None
         };
-        if ctx.group != 1 {
+        // A thermal term constant along the axis (`{name, per}` without a
+        // basis) is a set of constants: any body, `errors` or
+        // `location_errors`.
+        let has = |key: &str| {
+            (node.as_mapping().unwrap_or(&[]))
+                .iter()
+                .any(|(k, _)| k.as_str() == Some(key))
+        };
+        let constant = has("per") && !has("powers") && !has("basis");
+        if ctx.group == 2 && has("per") {
+            return refused(self, Some(Problem::ThermalNotAllowed));
+        }
+        if ctx.group != 1 && !constant {
             let group = ctx.label;
             return refused(self, Some(Problem::FunctionNotAllowed { group }));
         }
         let kind = match ctx.joint {
             JointState::Present(kind) => kind,
-            JointState::Misspelt => return refused(self, None),
-            JointState::Absent => {
+            JointState::Misspelt if !constant => return refused(self, None),
+            JointState::Absent if !constant => {
                 let body = ctx.body.to_string();
                 return refused(self, Some(Problem::FunctionWithoutJoint { body }));
             }
+            JointState::Misspelt | JointState::Absent => None,
         };
         let function = self.function(node, path, kind, ctx.body);
         if function.is_none() {
@@ -255,6 +273,10 @@ impl Loader {
                 None
             }
         };
+        let per = match f.get("per") {
+            Some(n) => self.per(n, &f.path("per")),
+            None => Some(Vec::new()),
+        };
         let basis = match (f.entry("powers"), f.entry("basis")) {
             (Some(_), Some((k, _))) => {
                 let problem = Problem::Conflict {
@@ -267,9 +289,13 @@ impl Loader {
             (Some((_, p)), None) => {
                 self.not_for_basis(&f, "powers", &["degree", "range", "from", "harmonics"]);
                 self.powers(p, &f.path("powers"))
-                    .map(|powers| Basis::Powers { powers })
+                    .map(|powers| Some(Basis::Powers { powers }))
             }
-            (None, Some((_, b))) => self.named_basis(&f, b, kind, body),
+            (None, Some((_, b))) => self.named_basis(&f, b, kind, body).map(Some),
+            (None, None) if f.get("per").is_some() => {
+                self.not_for_basis(&f, "per", &["degree", "range", "from", "harmonics"]);
+                Some(None)
+            }
             (None, None) => {
                 if !f.suggested.contains(&"powers") && !f.suggested.contains(&"basis") {
                     self.report(node.span, path, Problem::MissingBasis);
@@ -283,7 +309,54 @@ impl Loader {
         Some(RawFunction {
             name: name?,
             basis: basis?,
+            per: per?,
         })
+    }
+
+    /// `per: SENSOR` or `per: [SENSOR, ...]`: declared sensors, each once.
+    fn per(&mut self, node: &Node, path: &str) -> Option<Vec<usize>> {
+        let items: Vec<(&Node, String)> = match node.as_sequence() {
+            Some(items) => items
+                .iter()
+                .enumerate()
+                .map(|(i, n)| (n, index(path, i)))
+                .collect(),
+            None => vec![(node, path.to_string())],
+        };
+        if items.is_empty() {
+            let what = "the sensor list";
+            self.report(node.span, path, Problem::EmptyList { what });
+            return None;
+        }
+        let mut out: Vec<usize> = Vec::new();
+        let mut complete = true;
+        for (n, p) in items {
+            let Some(name) = self.name(n, &p, "a sensor name") else {
+                complete = false;
+                continue;
+            };
+            match self.sensors.iter().position(|s| s.name == name) {
+                Some(s) if out.contains(&s) => {
+                    self.report(n.span, p, Problem::DuplicateSensor { name });
+                    complete = false;
+                }
+                Some(s) => out.push(s),
+                None => {
+                    let sensors: Vec<String> =
+                        self.sensors.iter().map(|s| s.name.clone()).collect();
+                    let suggestion =
+                        closest(&name, sensors.iter().map(String::as_str)).map(str::to_string);
+                    let problem = Problem::UnknownSensor {
+                        name,
+                        sensors,
+                        suggestion,
+                    };
+                    self.report(n.span, p, problem);
+                    complete = false;
+                }
+            }
+        }
+        complete.then_some(out)
     }
 
     /// `basis: legendre | chebyshev | fourier` and its keys.

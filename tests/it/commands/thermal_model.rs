@@ -1,0 +1,636 @@
+//! Temperature in the machine model (`docs/thermal.md`, "Temperature in the
+//! machine model"): sensors, thermal terms, `--temperature` in `map`,
+//! `export`, `reliability` and `identify`, each against the test's own
+//! closed form, and every refusal located.
+
+use crate::common;
+
+use common::cli::{fails, ok_json, ok_stdout, scratch, unwrapped, write};
+use common::Rng;
+use serde_json::Value;
+
+/// One X axis with a scale growth `EXT_1_T_x · x · (T_x − 20)`, and a
+/// spindle growing in z with two sensors (`T_sp` referenced at 21 °C).
+const MACHINE: &str = "\
+machine: scale1
+sensors:
+  T_x: 20
+  T_sp: {reference: 21}
+  T_col:
+bodies:
+  bed: {}
+  x_slide:
+    parent: bed
+    joint: {type: prismatic, axis: +x, variable: x}
+    errors:
+      dx: [EXX, {name: EXT, powers: [1], per: T_x}]
+  spindle:
+    parent: x_slide
+    offset: [0, 0, 100]
+    errors: {dz: {name: EZS, per: [T_sp, T_col]}}
+    location_errors: {ex: {name: EAC, per: T_col}}
+workpiece: bed
+tool: spindle
+reliability:
+  tolerance: {px: 0.05}
+  grid: {x: [0, 250, 500]}
+statistics:
+  EXX: {dist: normal, mean: 0, std: 0.002}
+  EXT_1_T_x: {dist: normal, mean: 11.5e-6, std: 0.5e-6}
+  EZS_T_sp: {dist: normal, mean: 0, std: 0.001}
+  EZS_T_col: {dist: normal, mean: 0, std: 0.001}
+  EAC_T_col: {dist: normal, mean: 0, std: 1e-6}
+";
+
+const VALUES: &str = "\
+machine: scale1
+values:
+  EXX: 0.001
+  EXT_1_T_x: 11.5e-6
+  EZS_T_sp: 0.0031
+  EZS_T_col: -0.0008
+  EAC_T_col: 2e-6
+";
+
+fn files(name: &str) -> (std::path::PathBuf, std::path::PathBuf) {
+    let dir = scratch(name);
+    (
+        write(&dir, "m.yaml", MACHINE),
+        write(&dir, "v.yaml", VALUES),
+    )
+}
+
+fn example(path: &str) -> String {
+    common::example_file(path).display().to_string()
+}
+
+fn s(p: &std::path::Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn the_map_at_a_thermal_state_is_the_growth_per_kelvin_times_the_deviation() {
+    let (m, v) = files("thermal-map");
+    let doc = ok_json(&[
+        "map",
+        s(&m),
+        "--values",
+        s(&v),
+        "--grid",
+        "x=0,125,500",
+        "--temperature",
+        "T_x=28,T_sp=25",
+        "--temperature",
+        "T_col=17.5",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(doc["temperatures"]["T_x"], 28.0);
+    assert_eq!(doc["temperatures"]["T_col"], 17.5);
+    for p in doc["points"].as_array().unwrap() {
+        let x = p["point"]["x"].as_f64().unwrap();
+        let e = &p["error"];
+        // px = EXX + α·x·ΔT_x, ΔT_x = 28 − 20.
+        let px = 0.001 + 11.5e-6 * x * 8.0;
+        assert!((e["px"].as_f64().unwrap() - px).abs() < 1e-15, "{x}: {e}");
+        // pz = 3.1 µm/K · (25 − 21) − 0.8 µm/K · (17.5 − 20).
+        let pz = 0.0031 * 4.0 - 0.0008 * -2.5;
+        assert!((e["pz"].as_f64().unwrap() - pz).abs() < 1e-15);
+        // ox = 2 µrad/K · (17.5 − 20).
+        assert!((e["ox"].as_f64().unwrap() - 2e-6 * -2.5).abs() < 1e-18);
+    }
+    // At the reference state every thermal term is zero, with or without
+    // `--temperature`; a machine with sensors names its state.
+    let reference = ok_json(&["map", s(&m), "--values", s(&v), "--format", "json"]);
+    assert_eq!(reference["temperatures"]["T_sp"], 21.0);
+    for p in reference["points"].as_array().unwrap() {
+        assert_eq!(p["error"]["px"], 0.001);
+        assert_eq!(p["error"]["pz"], 0.0);
+    }
+    let table = ok_stdout(&["map", s(&m), "--values", s(&v), "--temperature", "T_x=28"]);
+    assert!(
+        table.contains("thermal state: T_x = 28 °C, T_sp = 21 °C, T_col = 20 °C"),
+        "{table}"
+    );
+}
+
+#[test]
+fn the_thermal_terms_are_derived_as_the_geometry_and_named() {
+    let (m, _) = files("thermal-derive");
+    let text = ok_stdout(&["derive", s(&m)]);
+    assert!(
+        text.contains("EXT(x) = EXT_1_T_x*x*(T_x - 20)  (powers [1])"),
+        "{text}"
+    );
+    assert!(text.contains("EZS_T_sp per K of T_sp - 21"), "{text}");
+    let json = ok_json(&["derive", s(&m), "--format", "json"]);
+    assert_eq!(
+        json["errors"],
+        serde_json::json!(["EXX", "EXT_1_T_x", "EAC_T_col", "EZS_T_sp", "EZS_T_col"])
+    );
+    assert_eq!(
+        json["thermal"]["EZS_T_sp"],
+        serde_json::json!({"sensor": "T_sp", "reference": 21.0})
+    );
+    assert!(json["thermal"].get("EXX").is_none());
+    // The coefficients are the geometry's (the factor acts on the value).
+    assert_eq!(json["components"]["px"]["EXT_1_T_x"], "x");
+    assert_eq!(json["components"]["pz"]["EZS_T_col"], "1");
+}
+
+/// `Φ` by the error function's series in `common`.
+fn phi(x: f64) -> f64 {
+    common::normal_cdf(x)
+}
+
+#[test]
+fn reliability_at_a_thermal_state_is_the_closed_form_of_the_scaled_inputs() {
+    let (m, _) = files("thermal-reliability");
+    for (t, dt) in [("28", 8.0), ("14", -6.0)] {
+        let doc = ok_json(&[
+            "reliability",
+            s(&m),
+            "--temperature",
+            &format!("T_x={t}"),
+            "--format",
+            "json",
+        ]);
+        let cases = doc["results"].as_array().unwrap();
+        assert_eq!(cases.len(), 3);
+        for c in cases {
+            let x = c["point"]["x"].as_f64().unwrap();
+            // px = EXX + x·ΔT·EXT_1_T_x: normal, mean x·ΔT·11.5e-6, std
+            // √(0.002² + (x·ΔT·0.5e-6)²); upper-sided: β = (0.05 − mean)/std
+            // and R = Φ(β).
+            let mean = x * dt * 11.5e-6;
+            let std = (0.002f64.powi(2) + (x * dt * 0.5e-6).powi(2)).sqrt();
+            let beta = (0.05 - mean) / std;
+            let got = c["beta"].as_f64().unwrap();
+            assert!(
+                (got - beta).abs() < 1e-9 * beta,
+                "T_x = {t}, x = {x}: {got} vs {beta}"
+            );
+            let r = c["reliability"].as_f64().unwrap();
+            assert!((r - phi(beta)).abs() < 1e-7, "{r} vs {}", phi(beta));
+        }
+    }
+}
+
+#[test]
+fn identification_at_several_thermal_states_recovers_the_growth_per_kelvin() {
+    let dir = scratch("thermal-identify");
+    let m = write(&dir, "m.yaml", MACHINE);
+    // A laser along x and a probe along z at three X-scale temperatures and
+    // two spindle temperatures; 0.5 µm noise.
+    let mut rng = Rng::new(7);
+    let mut csv = String::from("x,T_x,T_sp,ux,uy,uz,d,std\n");
+    let noise = |rng: &mut Rng| {
+        let (u, v) = (rng.unit().max(1e-300), rng.unit());
+        5e-4 * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    };
+    for t in [20.0, 24.0, 28.0] {
+        for k in 0..=10 {
+            let x = 50.0 * k as f64;
+            for t_sp in [21.0, 26.0] {
+                let d = 0.001 + 11.5e-6 * x * (t - 20.0) + noise(&mut rng);
+                csv.push_str(&format!("{x},{t},{t_sp},1,0,0,{d},0.0005\n"));
+                let dz = 0.0031 * (t_sp - 21.0) + noise(&mut rng);
+                csv.push_str(&format!("{x},{t},{t_sp},0,0,1,{dz},0.0005\n"));
+            }
+        }
+    }
+    let meas = write(&dir, "meas.csv", &csv);
+    let out = dir.join("identified.yaml");
+    let doc = ok_json(&[
+        "identify",
+        s(&m),
+        "--measurements",
+        s(&meas),
+        "--format",
+        "json",
+        "--values-out",
+        s(&out),
+    ]);
+    let est = &doc["estimates"];
+    for (name, truth) in [("EXT_1_T_x", 11.5e-6), ("EZS_T_sp", 0.0031), ("EXX", 0.001)] {
+        let (v, sd) = (
+            est[name]["value"].as_f64().unwrap(),
+            est[name]["std"].as_f64().unwrap(),
+        );
+        assert!(
+            (v - truth).abs() < 3.0 * sd,
+            "{name}: {v} ± {sd} vs {truth}"
+        );
+    }
+    // The values written map at a thermal state: the identified growth.
+    let map = ok_json(&[
+        "map",
+        s(&m),
+        "--values",
+        s(&out),
+        "--grid",
+        "x=500",
+        "--temperature",
+        "T_x=30",
+        "--format",
+        "json",
+    ]);
+    let px = map["points"][0]["error"]["px"].as_f64().unwrap();
+    let expected = est["EXX"]["value"].as_f64().unwrap()
+        + est["EXT_1_T_x"]["value"].as_f64().unwrap() * 500.0 * 10.0;
+    assert!((px - expected).abs() < 1e-12, "{px} vs {expected}");
+    // Without a column, `--temperature` is every record's state: the
+    // spindle's sensor held at 26 °C makes the z rows all ΔT = 5.
+    let fixed: String = csv
+        .lines()
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            format!("{},{},{}\n", c[0], c[1], c[3..].join(","))
+        })
+        .collect();
+    let fixed = write(&dir, "fixed.csv", &fixed);
+    let doc = ok_json(&[
+        "identify",
+        s(&m),
+        "--measurements",
+        s(&fixed),
+        "--temperature",
+        "T_sp=26",
+        "--format",
+        "json",
+    ]);
+    // The z rows' mean is 3.1·2.5 µm over ΔT = 5: 1.55 µm/K.
+    let v = doc["estimates"]["EZS_T_sp"]["value"].as_f64().unwrap();
+    assert!((v - 0.00155).abs() < 2e-4, "{v}");
+}
+
+#[test]
+fn thermal_refusals_are_located() {
+    let dir = scratch("thermal-refusals");
+    let bad = write(&dir, "bad.yaml", &MACHINE.replace("per: T_x}", "per: T_y}"));
+    let e = unwrapped(&fails(&["derive", s(&bad)]));
+    assert!(e.contains("bad.yaml:12:47: `T_y` is not a declared sensor at key `bodies.x_slide.errors.dx[1].per` (did you mean `T_x`?)"), "{e}");
+    let twice = write(
+        &dir,
+        "twice.yaml",
+        &MACHINE.replace("[T_sp, T_col]", "[T_sp, T_sp]"),
+    );
+    let e = unwrapped(&fails(&["derive", s(&twice)]));
+    assert!(
+        e.contains("sensor `T_sp` is named twice in this `per`"),
+        "{e}"
+    );
+    let clash = write(
+        &dir,
+        "clash.yaml",
+        "machine: a\nparameters: {L: 1}\nsensors: [L, x]\nbodies:\n  bed: {}\n  s: {parent: bed, joint: {type: prismatic, axis: +x, variable: x}, squareness: {ez: {name: S, per: x}}}\nworkpiece: bed\ntool: s\n",
+    );
+    let e = unwrapped(&fails(&["derive", s(&clash)]));
+    assert!(
+        e.contains("clash.yaml:3:11: sensor `L` has the same name as a parameter"),
+        "{e}"
+    );
+    assert!(
+        e.contains("clash.yaml:3:14: sensor `x` has the same name as a axis variable"),
+        "{e}"
+    );
+    assert!(
+        e.contains("`squareness` takes error names only, not a thermal term"),
+        "{e}"
+    );
+    let (m, v) = files("thermal-refusals-options");
+    let e = unwrapped(&fails(&[
+        "map",
+        s(&m),
+        "--values",
+        s(&v),
+        "--temperature",
+        "T_q=28",
+    ]));
+    assert!(e.contains("--temperature: `T_q` is not a sensor of machine `scale1` (did you mean `T_x`?) (its sensors: T_x, T_sp, T_col)"), "{e}");
+    let e = unwrapped(&fails(&["reliability", s(&m), "--temperature", "T_x=-300"]));
+    assert!(
+        e.contains("--temperature: `T_x` = -300 °C is not a temperature"),
+        "{e}"
+    );
+    let e = unwrapped(&fails(&[
+        "map",
+        s(&m),
+        "--values",
+        s(&v),
+        "--temperature",
+        "T_x=20,T_x=21",
+    ]));
+    assert!(e.contains("`T_x` is given twice (20 and 21 °C)"), "{e}");
+    let plain = example("machines/vmc3.yaml");
+    let e = unwrapped(&fails(&[
+        "map",
+        &plain,
+        "--values",
+        &example("values/vmc3.yaml"),
+        "--temperature",
+        "T=21",
+    ]));
+    assert!(e.contains("machine `vmc3` declares no sensors"), "{e}");
+    let table = write(
+        &dir,
+        "table.yaml",
+        "machine: scale1\nvalues:\n  EXT: {points: [[0, 0], [500, 1]]}\n",
+    );
+    let e = unwrapped(&fails(&["map", s(&m), "--values", s(&table)]));
+    assert!(
+        e.contains("table.yaml:3:3: `EXT` cannot take a table: it is thermal (per kelvin of T_x)"),
+        "{e}"
+    );
+    let e = unwrapped(&fails(&[
+        "sensitivity",
+        s(&m),
+        "--kind",
+        "geometric",
+        "--temperature",
+        "T_x=25",
+    ]));
+    assert!(
+        e.contains("--kind geometric does not take --temperature"),
+        "{e}"
+    );
+    let meas = write(&dir, "cold.csv", "x,T_x,ux,uy,uz,d\n0,-280,1,0,0,0.001\n");
+    let e = unwrapped(&fails(&["identify", s(&m), "--measurements", s(&meas)]));
+    assert!(
+        e.contains("cold.csv:2:3: -280 °C is below absolute zero"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_machine_without_sensors_reads_and_maps_as_before() {
+    // The example's map is the golden one; its JSON has no thermal state.
+    let doc: Value = ok_json(&[
+        "map",
+        &example("machines/vmc3.yaml"),
+        "--values",
+        &example("values/vmc3.yaml"),
+        "--grid",
+        "x=0,800",
+        "--grid",
+        "y=0",
+        "--grid",
+        "z=0",
+        "--format",
+        "json",
+    ]);
+    assert!(doc.get("temperatures").is_none());
+}
+
+/// A spindle on one Z axis, its growth `EZS` per kelvin of three sensors
+/// and a tilt `EAS` per kelvin of one.
+const SPINDLE: &str = "\
+machine: spindle1
+sensors: [T_a, T_b, T_c]
+bodies:
+  bed: {}
+  z_head:
+    parent: bed
+    joint: {type: prismatic, axis: +z, variable: z}
+  spindle:
+    parent: z_head
+    errors: {dz: {name: EZS, per: [T_a, T_b, T_c]}}
+    location_errors: {ex: {name: EAS, per: T_a}}
+workpiece: bed
+tool: spindle
+";
+
+/// A drift test (2 h every 60 s, T_a and T_b rising at different rates, T_c
+/// cycling, the spindle started at 30 min) whose Z channel is
+/// `3·ΔT_a + 1.2·ΔT_b` µm exactly, X `0.5·ΔT_c` mm, and R the spindle
+/// rotor's growth, a 10 min lag of its speed (2e-4 µm/rpm).
+fn drift_csv() -> String {
+    let mut csv = String::from("time(s),Z(um),X(mm),R(um),T_a(°C),T_b(°C),T_c(°C),spindle(rpm)\n");
+    let mut lag = 0.0;
+    let mut speed = 0.0;
+    for k in 0..=120 {
+        let t = 60.0 * k as f64;
+        if k > 0 {
+            lag += (speed - lag) * (1.0 - (-60.0f64 / 600.0).exp());
+        }
+        speed = if t >= 1800.0 { 8000.0 } else { 0.0 };
+        let h = t / 3600.0;
+        let (a, b) = (20.0 + 4.0 * (1.0 - (-h).exp()), 21.0 + 0.8 * h * h);
+        let c = 19.5 + 0.5 * (std::f64::consts::TAU * h).sin();
+        let z = 3.0 * (a - 20.0) + 1.2 * (b - 21.0);
+        let x = 0.5 * (c - 19.5);
+        csv.push_str(&format!("{t},{z},{x},{},{a},{b},{c},{speed}\n", 2e-4 * lag));
+    }
+    csv
+}
+
+#[test]
+fn a_fitted_drift_model_is_written_as_the_machine_s_thermal_coefficients() {
+    let dir = scratch("thermal-values-out");
+    let m = write(&dir, "spindle.yaml", SPINDLE);
+    let run = write(&dir, "drift.csv", &drift_csv());
+    let out = dir.join("spindle_values.yaml");
+    let doc = ok_json(&[
+        "thermal",
+        s(&run),
+        "--fit",
+        "--sensors",
+        "2",
+        "--values-out",
+        s(&out),
+        "--machine",
+        s(&m),
+        "--slot",
+        "EZS=Z(um)",
+        "--format",
+        "json",
+    ]);
+    let written = &doc["values"]["terms"][0];
+    assert_eq!(written["slot"], "EZS");
+    let coefficient = |sensor: &str| {
+        (written["coefficients"].as_array().unwrap().iter())
+            .find(|c| c["sensor"] == sensor)
+            .unwrap()
+            .clone()
+    };
+    // The fit recovers the exact linear drift; the unchosen sensor is 0.
+    assert!((coefficient("T_a")["value"].as_f64().unwrap() - 3.0).abs() < 1e-9);
+    assert!((coefficient("T_b")["value"].as_f64().unwrap() - 1.2).abs() < 1e-9);
+    assert_eq!(coefficient("T_c")["value"], 0.0);
+    assert_eq!(coefficient("T_a")["column"], "T_a(°C)");
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        text.contains("EZS_T_c: 0  # µm/K: T_c is not in the fitted model"),
+        "{text}"
+    );
+    // `chain map` reads them at a thermal state: pz = Σ a_s ΔT_s.
+    let map = ok_json(&[
+        "map",
+        s(&m),
+        "--values",
+        s(&out),
+        "--grid",
+        "z=0",
+        "--temperature",
+        "T_a=25,T_b=22,T_c=30",
+        "--format",
+        "json",
+    ]);
+    let pz = map["points"][0]["error"]["pz"].as_f64().unwrap();
+    assert!((pz - (3.0 * 5.0 + 1.2 * 2.0) * 1e-3).abs() < 1e-11, "{pz}");
+    // A channel in mm is written in µm/K: X = 0.5 mm/K of T_c.
+    let doc = ok_json(&[
+        "thermal",
+        s(&run),
+        "--fit",
+        "--sensors",
+        "1",
+        "--values-out",
+        s(&out),
+        "--machine",
+        s(&m),
+        "--slot",
+        "EZS=X(mm)",
+        "--format",
+        "json",
+    ]);
+    let x = &doc["values"]["terms"][0]["coefficients"][2];
+    assert_eq!(x["sensor"], "T_c");
+    assert!((x["value"].as_f64().unwrap() - 500.0).abs() < 1e-6, "{x}");
+}
+
+#[test]
+fn a_drift_model_that_does_not_fit_the_machine_is_refused() {
+    let dir = scratch("thermal-values-refusals");
+    let m = write(&dir, "spindle.yaml", SPINDLE);
+    let run = write(&dir, "drift.csv", &drift_csv());
+    let out = dir.join("v.yaml");
+    let base = |slot: &str, extra: &[&str]| -> String {
+        let mut args = vec![
+            "thermal",
+            s(&run),
+            "--fit",
+            "--values-out",
+            s(&out),
+            "--machine",
+            s(&m),
+            "--slot",
+            slot,
+        ];
+        args.extend_from_slice(extra);
+        unwrapped(&fails(&args.iter().map(|a| &**a).collect::<Vec<&str>>()))
+    };
+    let e = base("EZX=Z(um)", &[]);
+    assert!(e.contains("--slot: `EZX` is not a thermal term `{name, per}` of machine `spindle1` (did you mean `EZS`?) (its thermal terms: EAS, EZS)"), "{e}");
+    let e = base("EAS=Z(um)", &[]);
+    assert!(
+        e.contains("--slot: `EAS` is an angular thermal term"),
+        "{e}"
+    );
+    let e = base("EZS=Z(mm)", &[]);
+    assert!(
+        e.contains("`Z(mm)` is not a displacement channel of"),
+        "{e}"
+    );
+    assert!(
+        e.contains("(did you mean `Z(um)`?) (its channels: Z(um), X(mm), R(um))"),
+        "{e}"
+    );
+    let e = base("EZS=R(um)", &["--lag"]);
+    assert!(
+        e.contains(
+            "--slot: the model of `R(um)` has a lag term (a response to `spindle(rpm)` in time)"
+        ),
+        "{e}"
+    );
+    let other = SPINDLE.replace("per: [T_a, T_b, T_c]", "per: [T_b, T_c]");
+    let other = write(&dir, "other.yaml", &other);
+    let e = unwrapped(&fails(&[
+        "thermal",
+        s(&run),
+        "--fit",
+        "--sensors",
+        "2",
+        "--values-out",
+        s(&out),
+        "--machine",
+        s(&other),
+        "--slot",
+        "EZS=Z(um)",
+    ]));
+    assert!(e.contains("the model of `Z(um)` uses `T_a(°C)`, sensor `T_a`, which `EZS` is not per (its sensors: T_b, T_c)"), "{e}");
+    let e = unwrapped(&fails(&[
+        "thermal",
+        s(&run),
+        "--values-out",
+        s(&out),
+        "--machine",
+        s(&m),
+        "--slot",
+        "EZS=Z(um)",
+    ]));
+    assert!(
+        e.contains("--values-out writes the fitted models: give --fit"),
+        "{e}"
+    );
+    let without = SPINDLE
+        .replace("[T_a, T_b, T_c]", "[T_b, T_c]")
+        .replace("per: T_a", "per: T_b");
+    let without = write(&dir, "without.yaml", &without);
+    let e = unwrapped(&fails(&[
+        "thermal",
+        s(&run),
+        "--fit",
+        "--sensors",
+        "2",
+        "--values-out",
+        s(&out),
+        "--machine",
+        s(&without),
+        "--slot",
+        "EZS=Z(um)",
+    ]));
+    assert!(
+        e.contains("uses `T_a(°C)`, which names no sensor of the machine (a column's header without its unit is the sensor's name; its sensors: T_b, T_c)"),
+        "{e}"
+    );
+    let e = base("EZS", &[]);
+    assert!(e.contains("--slot EZS: expected NAME=CHANNEL"), "{e}");
+}
+
+#[test]
+fn the_thermal_example_values_are_current() {
+    // examples/thermal/README.md's command; the header comment names the
+    // drift file as given, so the values from `machine:` on are compared.
+    let dir = scratch("thermal-example");
+    let out = dir.join("spindle_values.yaml");
+    ok_json(&[
+        "thermal",
+        &example("thermal/spindle_drift.csv"),
+        "--fit",
+        "--holdout",
+        "0.25",
+        "--values-out",
+        s(&out),
+        "--machine",
+        &example("thermal/vmc3_thermal.yaml"),
+        "--slot",
+        "EZS=Z(um)",
+        "--format",
+        "json",
+    ]);
+    let body = |t: &str| t[t.find("machine:").unwrap()..].to_string();
+    let written = std::fs::read_to_string(&out).unwrap();
+    let example_file = common::example_file("thermal/spindle_values.yaml");
+    if std::env::var_os("CHAIN_REGENERATE").is_some() {
+        let old = std::fs::read_to_string(&example_file).unwrap();
+        let head = &old[..old.find("machine:").unwrap()];
+        std::fs::write(&example_file, format!("{head}{}", body(&written))).unwrap();
+    }
+    let example_text = std::fs::read_to_string(&example_file).unwrap();
+    assert_eq!(
+        body(&written),
+        body(&example_text),
+        "rerun with CHAIN_REGENERATE=1"
+    );
+}
