@@ -49,6 +49,7 @@
 
 pub mod acceptance;
 pub mod allocate;
+pub mod conditional;
 pub mod directional;
 pub mod error;
 mod families;

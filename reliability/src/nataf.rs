@@ -31,26 +31,7 @@ const NODES: usize = 96;
 /// (`Σ w_k = 1`, `Σ w_k·f(v_k) ≈ E f(V)`, `V ~ N(0, 1)`).
 pub(crate) fn gauss_hermite() -> &'static (Vec<f64>, Vec<f64>) {
     static RULE: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
-    RULE.get_or_init(|| {
-        let n = NODES;
-        // Jacobi matrix of He_k: zero diagonal, off-diagonal √k.
-        let mut j = nalgebra::DMatrix::<f64>::zeros(n, n);
-        for k in 1..n {
-            let b = (k as f64).sqrt();
-            j[(k - 1, k)] = b;
-            j[(k, k - 1)] = b;
-        }
-        let eig = nalgebra::SymmetricEigen::new(j);
-        let mut pairs: Vec<(f64, f64)> = (0..n)
-            .map(|k| (eig.eigenvalues[k], eig.eigenvectors[(0, k)].powi(2)))
-            .collect();
-        pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let total: f64 = pairs.iter().map(|p| p.1).sum();
-        (
-            pairs.iter().map(|p| p.0).collect(),
-            pairs.iter().map(|p| p.1 / total).collect(),
-        )
-    })
+    RULE.get_or_init(|| crate::normal::gauss_hermite(NODES))
 }
 
 /// The physical (Pearson) correlation of `x_a`, `x_b` when their normal

@@ -103,6 +103,30 @@ pub fn beta_from_pf(pf: f64) -> f64 {
     -inverse_cdf(pf)
 }
 
+/// The probabilists' Gauss–Hermite rule of `n` nodes by Golub & Welsch
+/// (1969): the eigenvalues of the Jacobi matrix of `He_k` (zero diagonal,
+/// off-diagonal `√k`) and the squared first components of its eigenvectors,
+/// the weights normalised to sum to 1 (`Σ w_k f(v_k) ≈ E f(V)`,
+/// `V ~ N(0, 1)`, exact for polynomials of degree `2n − 1`).
+pub fn gauss_hermite(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut j = nalgebra::DMatrix::<f64>::zeros(n, n);
+    for k in 1..n {
+        let b = (k as f64).sqrt();
+        j[(k - 1, k)] = b;
+        j[(k, k - 1)] = b;
+    }
+    let eig = nalgebra::SymmetricEigen::new(j);
+    let mut pairs: Vec<(f64, f64)> = (0..n)
+        .map(|k| (eig.eigenvalues[k], eig.eigenvectors[(0, k)].powi(2)))
+        .collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let total: f64 = pairs.iter().map(|p| p.1).sum();
+    (
+        pairs.iter().map(|p| p.0).collect(),
+        pairs.iter().map(|p| p.1 / total).collect(),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

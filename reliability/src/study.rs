@@ -1293,8 +1293,9 @@ impl Study {
         }
     }
 
-    /// The study's result from its cases, every case in order.
-    pub(crate) fn finish(&self, method: Method, cases: Vec<CaseResult>) -> StudyResult {
+    /// The study's result from its cases, every case in order (its
+    /// summaries and requirement from the cases' reliabilities).
+    pub fn finish(&self, method: Method, cases: Vec<CaseResult>) -> StudyResult {
         let np = self.points.len();
         let summaries = self
             .targets

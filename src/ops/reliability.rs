@@ -9,17 +9,19 @@
 
 use std::path::Path;
 
-use chain_core::model::Sided;
+use chain_core::model::{Distribution, Sided};
 use chain_core::named::NameMap;
 use chain_core::values::Approach;
 use chain_core::{CompiledModel, Machine};
 use reliability::acceptance::{AcceptanceResult, AcceptanceSubset};
+use reliability::conditional::{self, Quadrature};
 use reliability::{
     Acceptance, Calls, CaseResult, CaseTally, FormCase, Method, Posterior, Progress, Rectangles,
     ReliabilityError, SormCase, Stopping, Study, StudyResult, SubsetLevel, Target,
 };
 use serde::{Serialize, Serializer};
 
+use super::resolve::ResolveError;
 use super::study::{self, AlgorithmOptions, OptionError, StudyError, StudyOptions, SystemChoice};
 
 /// The default absolute error of the acceptance probability.
@@ -105,6 +107,148 @@ pub struct Prepared {
     pub model: CompiledModel,
     algorithm: AlgorithmOptions,
     acceptance: Option<(f64, u64)>,
+    /// The thermal state: the fixed temperatures and the random ones with
+    /// the studies at the quadrature's nodes.
+    thermal: Option<Thermal>,
+}
+
+/// The temperatures of a study of a machine with sensors
+/// (`docs/thermal.md`): the fixed state and, for a sensor with a
+/// `statistics` entry that `--temperature` does not fix, what the studies at
+/// its temperatures are built from ([`reliability::conditional`]).
+#[derive(Debug)]
+struct Thermal {
+    /// Every sensor not random, °C.
+    fixed: Vec<(String, f64)>,
+    /// The random one, its distribution and marginal, and what its studies
+    /// are built from.
+    random: Option<RandomSensor>,
+}
+
+/// A random temperature and what a study at one of its values is built
+/// from.
+#[derive(Debug)]
+struct RandomSensor {
+    name: String,
+    distribution: Distribution,
+    marginal: reliability::Marginal,
+    machine: Machine,
+    checked: study::Checked,
+}
+
+impl RandomSensor {
+    /// The study at `fixed` and this sensor at `t` °C.
+    fn study_at(
+        &self,
+        fixed: &[(String, f64)],
+        t: f64,
+        model: &CompiledModel,
+        posterior: Option<&Posterior>,
+    ) -> Result<Study, ReliabilityError> {
+        let mut at = fixed.to_vec();
+        at.push((self.name.clone(), t));
+        let options = StudyOptions {
+            posterior,
+            temperatures: &at,
+            ..StudyOptions::default()
+        };
+        let built = (self.checked.clone().at_temperatures(&self.machine, &at))
+            .and_then(|c| study::build(&self.machine, model, c, &options));
+        built.map_err(|e| match e {
+            StudyError::Reliability(e) => e,
+            other => {
+                ReliabilityError::InvalidDistribution(format!("`{}` at {t} °C: {other}", self.name))
+            }
+        })
+    }
+}
+
+/// A sensor's random temperature in the document.
+#[derive(Debug, Clone, Serialize)]
+pub struct RandomTemperature {
+    /// The sensor.
+    pub sensor: String,
+    /// Its distribution (°C).
+    #[serde(flatten)]
+    pub distribution: Distribution,
+}
+
+/// The thermal state of a study (a machine with sensors): the JSON's
+/// `temperatures`.
+#[derive(Debug, Clone, Serialize)]
+pub struct TemperaturesDocument {
+    /// Every sensor that is not random, °C.
+    pub fixed: NameMap<String, f64>,
+    /// The random ones (`statistics` entries of sensors), integrated over.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub random: Vec<RandomTemperature>,
+    /// The rule that integrated over them and its error estimate.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quadrature: Option<Quadrature>,
+}
+
+/// The thermal state of `machine` under `temperatures` and its random
+/// temperature, if any.
+fn thermal(
+    machine: &Machine,
+    file: &str,
+    request: &ReliabilityRequest<'_>,
+    options: &StudyOptions<'_>,
+    wanted_acceptance: bool,
+) -> Result<Option<Thermal>, ReliabilityOpsError> {
+    if machine.sensors.is_empty() {
+        return Ok(None);
+    }
+    let state = machine
+        .temperatures(request.temperatures)
+        .map_err(|e| StudyError::from(ResolveError::Temperature(e)))?;
+    let given = |name: &str| request.temperatures.iter().any(|(n, _)| n == name);
+    let random: Vec<(String, Distribution)> = (machine.sensor_statistics.iter())
+        .map(|s| (machine.sensors[s.sensor].name.clone(), s.distribution))
+        .filter(|(n, _)| !given(n))
+        .collect();
+    let fixed: Vec<(String, f64)> = (machine.sensors.iter().zip(&state))
+        .filter(|(s, _)| !random.iter().any(|(n, _)| *n == s.name))
+        .map(|(s, t)| (s.name.clone(), *t))
+        .collect();
+    let names = || {
+        random
+            .iter()
+            .map(|(n, _)| n.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let random = match random.as_slice() {
+        [] => None,
+        [(name, distribution)] => {
+            if wanted_acceptance {
+                return Err(OptionError::new(
+                    "acceptance",
+                    format!("the acceptance probability is not integrated over the random temperature of {}: fix it with --temperature", names()),
+                )
+                .into());
+            }
+            Some(RandomSensor {
+                name: name.clone(),
+                distribution: *distribution,
+                marginal: reliability::machine::marginal(distribution)?,
+                machine: machine.clone(),
+                checked: study::check(machine, file, options)?,
+            })
+        }
+        _ => {
+            return Err(OptionError::new(
+                "temperature",
+                format!(
+                    "{} sensors have a distribution ({}); one is integrated over: fix the others with --temperature NAME=VALUE",
+                    random.len(),
+                    names()
+                ),
+            )
+            .into())
+        }
+    };
+    Ok(Some(Thermal { fixed, random }))
 }
 
 /// Checks the options and builds the study of `machine` (`file` names it).
@@ -138,6 +282,7 @@ pub fn prepare(
     };
     let (study, model) = study::study(machine, file, &options)?;
     let wanted = request.acceptance || (machine.reliability.as_ref()).is_some_and(|r| r.acceptance);
+    let thermal = thermal(machine, file, request, &options, wanted)?;
     Ok(Prepared {
         machine: machine.name.clone(),
         study,
@@ -145,6 +290,7 @@ pub fn prepare(
         model,
         algorithm: request.algorithm,
         acceptance: wanted.then_some((t, request.algorithm.seed)),
+        thermal,
     })
 }
 
@@ -191,19 +337,57 @@ impl Prepared {
     /// Runs the study (and the acceptance probability when asked),
     /// reporting the samples drawn to `progress`.
     pub fn run(self, progress: &dyn Progress) -> Result<ReliabilityRun, ReliabilityError> {
-        let result = self.study.run(&self.algorithm.algorithm(), progress)?;
+        let algorithm = self.algorithm.algorithm();
+        let mut quadrature = None;
+        let mut shown = self.study;
+        let result = match self
+            .thermal
+            .as_ref()
+            .and_then(|t| t.random.as_ref().map(|r| (t, r)))
+        {
+            Some((t, r)) => {
+                let posterior = self.posterior.as_ref();
+                let (mixed, account) =
+                    conditional::integrate(&shown, &r.marginal, |temperature| {
+                        r.study_at(&t.fixed, temperature, &self.model, posterior)?
+                            .run(&algorithm, &())
+                    })?;
+                quadrature = Some(account);
+                // The tables and plots read the study at the median
+                // temperature (at the reference, a thermal term is zero).
+                shown = r.study_at(&t.fixed, r.marginal.quantile(0.5), &self.model, posterior)?;
+                mixed
+            }
+            None => shown.run(&algorithm, progress)?,
+        };
+        let temperatures = self.thermal.as_ref().map(|t| TemperaturesDocument {
+            fixed: NameMap(t.fixed.clone()),
+            random: (t.random.iter())
+                .map(|r| RandomTemperature {
+                    sensor: r.name.clone(),
+                    distribution: r.distribution,
+                })
+                .collect(),
+            quadrature: quadrature.clone(),
+        });
         let mut notes = Vec::new();
+        if let Some(q) = quadrature.as_ref().filter(|q| !q.converged) {
+            notes.push(format!(
+                "warning: the integral over the random temperature stopped at {} intervals ({} studies) with an estimated relative error of {:.2e} (> {:.0e})",
+                q.intervals, q.studies, q.max_relative, conditional::RELATIVE_TOLERANCE
+            ));
+        }
         if self.algorithm.method == Method::Form {
-            notes.extend(study::form_limits_note(&self.study));
+            notes.extend(study::form_limits_note(&shown));
         }
         notes.extend(study::unconverged_warnings(
             &CaseTally::of(&result.cases),
             result.method,
-            self.study.variables(),
+            shown.variables(),
         ));
         let acceptance = match self.acceptance {
             Some((tolerance, seed)) => {
-                let a = acceptance(&self.study, tolerance, seed)?;
+                let a = acceptance(&shown, tolerance, seed)?;
                 if !a.converged {
                     notes.push(format!(
                         "warning: the acceptance probability did not converge: 3 standard errors = {:.2e} > {tolerance:.2e} after {} samples",
@@ -217,11 +401,12 @@ impl Prepared {
         };
         Ok(ReliabilityRun {
             machine: self.machine,
-            study: self.study,
+            study: shown,
             model: self.model,
             result,
             posterior: self.posterior,
             acceptance,
+            temperatures,
             notes,
         })
     }
@@ -255,6 +440,8 @@ pub struct ReliabilityRun {
     pub posterior: Option<Posterior>,
     /// The whole-machine acceptance probability, when asked.
     pub acceptance: Option<AcceptanceResult>,
+    /// The thermal state (a machine with sensors).
+    pub temperatures: Option<TemperaturesDocument>,
     /// Notes and warnings on the run (FORM's limits, cases that did not
     /// converge, an acceptance probability short of its tolerance), each a
     /// line `note: …` or `warning: …`; not part of the JSON.
@@ -267,6 +454,7 @@ impl ReliabilityRun {
         let mut doc = ReliabilityDocument::new(&self.machine, &self.study, &self.result);
         doc.posterior = self.posterior.as_ref();
         doc.acceptance = self.acceptance.as_ref().map(AcceptanceDocument::of);
+        doc.temperatures = self.temperatures.as_ref();
         doc
     }
 }
@@ -328,6 +516,10 @@ pub struct ReliabilityDocument<'a> {
     /// The whole-machine acceptance probability (`--acceptance`), when run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub acceptance: Option<AcceptanceDocument<'a>>,
+    /// The thermal state of a machine with sensors (fixed and random
+    /// temperatures, the rule over the random ones).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub temperatures: Option<&'a TemperaturesDocument>,
 }
 
 /// One case (target at a grid point) of a [`ReliabilityDocument`].
@@ -502,6 +694,7 @@ impl<'a> ReliabilityDocument<'a> {
             requirement: RequirementDocument::of(r),
             posterior: None,
             acceptance: None,
+            temperatures: None,
         }
     }
 }

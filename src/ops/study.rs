@@ -138,7 +138,7 @@ diagnostic!(StudyError);
 /// everything [`study`] checks before the model is derived (a long chain
 /// takes a minute to derive; a missing grid axis, an unknown `--param` or a
 /// missing statistic is refused before that).
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Checked {
     spec: StudySpec,
     inputs: Inputs,
@@ -183,6 +183,19 @@ pub fn check(
         parameters,
         factors,
     })
+}
+
+impl Checked {
+    /// The same study at the thermal state `temperatures` (°C; the sensors
+    /// not named at their reference).
+    pub fn at_temperatures(
+        mut self,
+        machine: &Machine,
+        temperatures: &[(String, f64)],
+    ) -> Result<Checked, StudyError> {
+        self.factors = resolve::thermal_factors(machine, temperatures)?;
+        Ok(self)
+    }
 }
 
 /// The study of a [`check`]ed machine, evaluated through `model` (compiled

@@ -857,6 +857,21 @@ pub struct Machine {
     /// read, in file order (`docs/thermal.md`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub sensors: Vec<Sensor>,
+    /// The `statistics` entries of sensors: the temperatures a reliability
+    /// study takes as random (`docs/thermal.md`, "Random temperatures").
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sensor_statistics: Vec<SensorStatistic>,
+}
+
+/// A sensor's `statistics` entry: its temperature's distribution (°C).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SensorStatistic {
+    /// Index into [`Machine::sensors`].
+    pub sensor: usize,
+    /// The temperature's distribution (°C).
+    pub distribution: Distribution,
+    /// Where the entry was declared.
+    pub origin: Origin,
 }
 
 /// One `[name, name, rho]` entry of the `correlation` list.

@@ -472,6 +472,7 @@ mod tests {
             reliability: None,
             correlations: Vec::new(),
             sensors: Vec::new(),
+            sensor_statistics: Vec::new(),
             functions: vec![],
         }
     }

@@ -35,6 +35,9 @@ impl Report for ReliabilityRun {
         if let Some(a) = &self.acceptance {
             table.push_str(&acceptance_table(&self.study, a));
         }
+        if let Some(t) = &self.temperatures {
+            table = format!("{}{table}", temperature_lines(t));
+        }
         match &self.posterior {
             None => table,
             Some(p) => format!("{}{table}", posterior_lines(p)),
@@ -439,4 +442,45 @@ fn acceptance_csv_row(a: &AcceptanceResult, axes: usize) -> Vec<String> {
     row.push(a.samples.to_string());
     row.push("0".to_string());
     row
+}
+
+/// The thermal state of a study, in words: the fixed temperatures, the
+/// random ones and the rule that integrated over them.
+fn temperature_lines(t: &chain::ops::reliability::TemperaturesDocument) -> String {
+    let mut out = String::new();
+    if !t.fixed.0.is_empty() {
+        let state: Vec<String> = (t.fixed.0.iter())
+            .map(|(n, v)| format!("{n} = {v} °C"))
+            .collect();
+        out.push_str(&format!("thermal state: {}\n", state.join(", ")));
+    }
+    if !t.random.is_empty() {
+        let random: Vec<String> = (t.random.iter())
+            .map(|r| format!("{} {}", r.sensor, distribution_text(&r.distribution)))
+            .collect();
+        out.push_str(&format!("random temperature: {}\n", random.join(", ")));
+        if let Some(q) = &t.quadrature {
+            out.push_str(&format!(
+                "  pf integrated over it by adaptive Gauss–Kronrod quadrature (docs/thermal.md): {} studies, estimated error ≤ {:.1e} relative\n",
+                q.studies, q.max_relative
+            ));
+        }
+    }
+    out
+}
+
+/// A distribution as the machine file writes it: `uniform(16, 26)`.
+fn distribution_text(d: &chain_core::model::Distribution) -> String {
+    serde_json::to_value(d)
+        .ok()
+        .and_then(|v| {
+            let o = v.as_object()?;
+            let name = o.get("dist")?.as_str()?.to_string();
+            let args: Vec<String> = (o.iter())
+                .filter(|(k, _)| *k != "dist")
+                .map(|(k, v)| format!("{k} {v}"))
+                .collect();
+            Some(format!("{name}({})", args.join(", ")))
+        })
+        .unwrap_or_default()
 }

@@ -634,3 +634,123 @@ fn the_thermal_example_values_are_current() {
         "rerun with CHAIN_REGENERATE=1"
     );
 }
+
+/// One X axis whose scale grows with a random room temperature.
+const ROOM: &str = "\
+machine: room1
+sensors: {T_x: 20}
+bodies:
+  bed: {}
+  x_slide:
+    parent: bed
+    joint: {type: prismatic, axis: +x, variable: x}
+    errors:
+      dx: [EXX, {name: EXT, powers: [1], per: T_x}]
+workpiece: bed
+tool: x_slide
+reliability:
+  tolerance: {px: 0.05}
+  grid: {x: [0, 250, 500]}
+statistics:
+  EXX: {dist: normal, mean: 0, std: 0.002}
+  EXT_1_T_x: {dist: normal, mean: 11.5e-6, std: 0.5e-6}
+  T_x: {dist: uniform, min: 16, max: 28}
+";
+
+/// `p_f(x) = ∫ Φ(−(0.05 − μ(T))/σ(T)) dT/12` over `T ∈ [16, 28]`:
+/// conditional on T, px is normal with mean `x·ΔT·11.5e-6` and std
+/// `√(0.002² + (x·ΔT·0.5e-6)²)`; composite Simpson on 200,000 intervals.
+fn room_pf(x: f64) -> f64 {
+    let n = 200_000;
+    let h = 12.0 / n as f64;
+    let f = |t: f64| {
+        let dt = t - 20.0;
+        let (mean, std) = (
+            x * dt * 11.5e-6,
+            (0.002f64.powi(2) + (x * dt * 0.5e-6).powi(2)).sqrt(),
+        );
+        common::normal_cdf(-(0.05 - mean) / std) / 12.0
+    };
+    let mut sum = f(16.0) + f(28.0);
+    for k in 1..n {
+        sum += f(16.0 + k as f64 * h) * if k % 2 == 1 { 4.0 } else { 2.0 };
+    }
+    sum * h / 3.0
+}
+
+#[test]
+fn reliability_over_a_random_room_temperature_is_the_integral_of_the_conditional_one() {
+    let dir = scratch("thermal-room");
+    let m = write(&dir, "room.yaml", ROOM);
+    let doc = ok_json(&["reliability", s(&m), "--format", "json"]);
+    assert_eq!(doc["temperatures"]["random"][0]["sensor"], "T_x");
+    assert_eq!(doc["temperatures"]["random"][0]["dist"], "uniform");
+    assert_eq!(doc["temperatures"]["quadrature"]["converged"], true);
+    for c in doc["results"].as_array().unwrap() {
+        let x = c["point"]["x"].as_f64().unwrap();
+        let (got, want) = (c["pf"].as_f64().unwrap(), room_pf(x));
+        assert!(
+            (got - want).abs() <= 1e-6 * want,
+            "x = {x}: {got} vs {want}"
+        );
+        let beta = c["beta"].as_f64().unwrap();
+        assert!((common::normal_cdf(-beta) / got - 1.0).abs() < 1e-9);
+    }
+    // Monte Carlo at each temperature: the same integral within its
+    // standard error (a bound: the temperatures' runs share the streams).
+    let mc = ok_json(&[
+        "reliability",
+        s(&m),
+        "--method",
+        "mc",
+        "--samples",
+        "20000",
+        "--grid",
+        "x=500",
+        "--format",
+        "json",
+    ]);
+    let c = &mc["results"][0];
+    let (pf, se) = (c["pf"].as_f64().unwrap(), c["std_error"].as_f64().unwrap());
+    assert!(
+        (pf - room_pf(500.0)).abs() < 4.0 * se,
+        "{pf} ± {se} vs {}",
+        room_pf(500.0)
+    );
+    // `--temperature` fixes it: the study at that state.
+    let fixed = ok_json(&[
+        "reliability",
+        s(&m),
+        "--temperature",
+        "T_x=28",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(fixed["temperatures"]["fixed"]["T_x"], 28.0);
+    assert!(fixed["temperatures"].get("random").is_none());
+    // What is not integrated is refused.
+    let e = unwrapped(&fails(&["reliability", s(&m), "--acceptance"]));
+    assert!(e.contains("the acceptance probability is not integrated over the random temperature of T_x: fix it with --temperature"), "{e}");
+    let two = ROOM
+        .replace("sensors: {T_x: 20}", "sensors: {T_x: 20, T_y: 20}")
+        .replace(
+            "  T_x: {dist",
+            "  T_y: {dist: normal, mean: 20, std: 1}\n  T_x: {dist",
+        );
+    let two = write(&dir, "two.yaml", &two);
+    let e = unwrapped(&fails(&["reliability", s(&two)]));
+    assert!(
+        e.contains("2 sensors have a distribution (T_y, T_x); one is integrated over"),
+        "{e}"
+    );
+    let bad = write(
+        &dir,
+        "bad.yaml",
+        &ROOM.replace("min: 16, max: 28}", "min: 16, max: 28, cost_weight: 2}"),
+    );
+    let e = unwrapped(&fails(&["derive", s(&bad)]));
+    assert!(
+        e.contains("`cost_weight` is an allocation key of an error; `T_x` is a sensor"),
+        "{e}"
+    );
+}

@@ -371,6 +371,13 @@ pub enum Problem {
         /// The name.
         name: String,
     },
+    /// An allocation key in a sensor's `statistics` entry.
+    SensorStatisticKey {
+        /// The key.
+        key: &'static str,
+        /// The sensor.
+        sensor: String,
+    },
     /// A thermal term in `squareness`.
     ThermalNotAllowed,
     /// A function slot in `location_errors` or `squareness`, which take
@@ -992,6 +999,12 @@ impl Problem {
                 format!("sensor `{name}` is named twice in this `per`"),
             )
             .help("each sensor of a thermal term is named once".to_string()),
+            Problem::SensorStatisticKey { key, sensor } => D::new(
+                "chain::sensor_statistic_key",
+                "not for a sensor",
+                format!("`{key}` is an allocation key of an error; `{sensor}` is a sensor, whose entry is its temperature's distribution"),
+            )
+            .help("a sensor's statistics entry takes `dist` and the distribution's keys (°C)".to_string()),
             Problem::ThermalNotAllowed => D::new(
                 "chain::thermal_not_allowed",
                 "not a name",

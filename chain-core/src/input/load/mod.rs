@@ -244,6 +244,8 @@ struct Loader {
     /// The `sensors` section (read before the bodies, whose thermal terms
     /// name them).
     sensors: Vec<crate::model::Sensor>,
+    /// The `statistics` entries of sensors.
+    sensor_statistics: Vec<crate::model::SensorStatistic>,
 }
 
 impl TreeReader for Loader {
@@ -445,6 +447,7 @@ impl Loader {
             reliability: reliability?,
             correlations: correlations?,
             sensors: std::mem::take(&mut self.sensors),
+            sensor_statistics: std::mem::take(&mut self.sensor_statistics),
         })
     }
 

@@ -198,6 +198,32 @@ impl Loader {
         for (k, v) in entries {
             let name = k.as_str().unwrap_or("");
             let path = join("statistics", name);
+            // A sensor's entry: its temperature's distribution (°C).
+            if let Some(sensor) = self.sensors.iter().position(|s| s.name == name) {
+                for key in ["cost_weight", "min_std"] {
+                    let given = (v.as_mapping().unwrap_or(&[]).iter())
+                        .find(|(kk, _)| kk.as_str() == Some(key));
+                    if let Some((kk, _)) = given {
+                        let problem = Problem::SensorStatisticKey {
+                            key,
+                            sensor: name.to_string(),
+                        };
+                        self.report(kk.span, join(&path, key), problem);
+                        complete = false;
+                    }
+                }
+                match self.statistic(k, v, &path) {
+                    Some((distribution, _, _)) => {
+                        self.sensor_statistics.push(crate::model::SensorStatistic {
+                            sensor,
+                            distribution,
+                            origin: k.span.origin(path),
+                        })
+                    }
+                    None => complete = false,
+                }
+                continue;
+            }
             let error = error_index.get(name).copied();
             if let Some(t) = tree {
                 let function = t.functions.iter().find(|f| f.name == name);
