@@ -227,6 +227,7 @@ def path_json(
     system_tolerance: Optional[float],
     axes_file: Optional[Tuple[Optional[str], Optional[str], str]] = None,
     poses_file: Optional[Tuple[Optional[str], Optional[str], str]] = None,
+    temperatures: Sequence[Tuple[str, float]] = (),
 ) -> str: ...
 
 

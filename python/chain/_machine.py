@@ -325,6 +325,7 @@ class Machine:
         sided: Optional[str] = None,
         system: Optional[str] = None,
         system_tolerance: Optional[float] = None,
+        temperature: Optional[Mapping[str, float]] = None,
     ) -> "PathResult":
         """Error and reliability along a path, ``chain path --axes AXES | --pose POSES --format json``.
 
@@ -342,7 +343,8 @@ class Machine:
         ``t``: the instants (``N`` values; the row numbers when omitted).
         ``fix``: variables held at a value (``--fix``). ``method``,
         ``samples``, ``seed``, ``cov``, ``sided``, ``system`` and
-        ``system_tolerance`` are :meth:`reliability`'s. Built, checked and
+        ``system_tolerance`` are :meth:`reliability`'s; ``temperature``: the
+        thermal state along the path (``--temperature``). Built, checked and
         run by ``chain::ops::path`` as the CLI's.
         """
         from ._results import PathResult
@@ -405,6 +407,7 @@ class Machine:
         text = _chain.path_json(
             self._model, header, axes_array, poses_array, t_array, _params(fix), _params(params),
             method, samples, seed, cov, sided, system, system_tolerance, axes_file, poses_file,
+            _temperatures(temperature),
         )
         return PathResult._from_json(text)
 

@@ -21,7 +21,7 @@ use crate::{
 /// CSV `--axes` or `--pose` reads) is given; the other keywords are the
 /// CLI's options.
 #[pyfunction]
-#[pyo3(signature = (model, header, axes, poses, t, fix, params, method, samples, seed, cov, sided, system, system_tolerance, axes_file=None, poses_file=None))]
+#[pyo3(signature = (model, header, axes, poses, t, fix, params, method, samples, seed, cov, sided, system, system_tolerance, axes_file=None, poses_file=None, temperatures=Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn path_json(
     py: Python<'_>,
@@ -41,6 +41,7 @@ pub(crate) fn path_json(
     system_tolerance: Option<f64>,
     axes_file: Option<FileInput>,
     poses_file: Option<FileInput>,
+    temperatures: Vec<(String, f64)>,
 ) -> PyResult<String> {
     let algorithm = algorithm_options(method, samples, seed, cov)?;
     let sided = sided_named(sided)?;
@@ -128,6 +129,7 @@ pub(crate) fn path_json(
         system,
         algorithm,
         input,
+        temperatures: &temperatures,
     };
     let doc = py
         .allow_threads(|| path::run(&model.machine, &request, &()))

@@ -130,31 +130,11 @@ def test_the_fitted_models_into_the_machine_are_the_cli_s(cli, tmp_path):
     assert "--slot: `EZX` is not a thermal term `{name, per}` of machine `vmc3_thermal` (did you mean `EZS`?)" in flat(str(e.value))
 
 
-ROOM = """\
-machine: room1
-sensors: {T_x: 20}
-bodies:
-  bed: {}
-  x_slide:
-    parent: bed
-    joint: {type: prismatic, axis: +x, variable: x}
-    errors:
-      dx: [EXX, {name: EXT, powers: [1], per: T_x}]
-workpiece: bed
-tool: x_slide
-reliability:
-  tolerance: {px: 0.05}
-  grid: {x: [0, 250, 500]}
-statistics:
-  EXX: {dist: normal, mean: 0, std: 0.002}
-  EXT_1_T_x: {dist: normal, mean: 11.5e-6, std: 0.5e-6}
-  T_x: {dist: uniform, min: 16, max: 28}
-"""
+ROOM = ROOT / "tests/data/thermal_room.yaml"
 
 
-def test_reliability_over_temperatures_is_the_cli_s(cli, tmp_path):
-    path = tmp_path / "room.yaml"
-    path.write_text(ROOM, encoding="utf-8")
+def test_reliability_over_temperatures_is_the_cli_s(cli):
+    path = ROOM
     m = chain.Machine.load(path)
     assert m.reliability().to_dict() == cli("reliability", path)
     assert m.reliability(temperature={"T_x": 27}).to_dict() == cli("reliability", path, "--temperature", "T_x=27")

@@ -84,6 +84,9 @@ pub struct PathRequest<'a> {
     pub algorithm: AlgorithmOptions,
     /// `--axes` or `--pose`.
     pub input: PathInput<'a>,
+    /// `--temperature NAME=VALUE`: the thermal state along the path
+    /// (docs/thermal.md).
+    pub temperatures: &'a [(String, f64)],
 }
 
 /// Why `chain path` cannot run.
@@ -189,6 +192,7 @@ pub fn prepare(machine: &Machine, request: &PathRequest<'_>) -> Result<PreparedP
     let inputs = machine::inputs(m)?;
     let params = machine::parameters(m, request.params)?;
     let fixed = resolve::fixed(m, request.fix)?;
+    let factors = resolve::thermal_factors(m, request.temperatures)?;
     let (has_t, instants) = match request.input {
         PathInput::Axes {
             source,
@@ -213,7 +217,12 @@ pub fn prepare(machine: &Machine, request: &PathRequest<'_>) -> Result<PreparedP
     };
     // The study keeps the model, not every instant's sensitivities: a
     // path of a million instants holds its points only.
-    let model = Arc::new(chain_core::compile(m));
+    let compiled = chain_core::compile(m);
+    let model: reliability::study::SharedModel = if factors.iter().all(|f| *f == 1.0) {
+        Arc::new(compiled)
+    } else {
+        Arc::new(chain_core::thermal_state::AtState::new(compiled, factors))
+    };
     let sided = spec.sided;
     let path = PathStudy::on_demand(model, &params, inputs, spec, instants)?;
     let algorithm = request.algorithm.algorithm();

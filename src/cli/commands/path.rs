@@ -10,7 +10,7 @@ use chain::ops::path::{self, PathInput, PathOpsError, PathRequest};
 use reliability::Method;
 
 use crate::cli::args::parse_assignment;
-use crate::cli::args::{AlgorithmArgs, ModelArgs, SystemArgs};
+use crate::cli::args::{AlgorithmArgs, ModelArgs, SystemArgs, ThermalArgs};
 use crate::cli::csv_input::{numeric_table, read_poses};
 use crate::cli::loaded::Loaded;
 use crate::cli::progress::Progress;
@@ -49,6 +49,8 @@ pub struct PathArgs {
     pub fix: Vec<(String, f64)>,
     #[command(flatten)]
     pub model: ModelArgs,
+    #[command(flatten)]
+    pub thermal: ThermalArgs,
     #[command(flatten)]
     pub algorithm: AlgorithmArgs,
     #[command(flatten)]
@@ -100,6 +102,7 @@ pub fn exec(args: PathArgs) -> miette::Result<()> {
         system,
         algorithm: args.algorithm.options(),
         input,
+        temperatures: &args.thermal.temperatures,
     };
     let report = |e: PathOpsError| match e {
         PathOpsError::Reliability(e) => loaded.report(e),

@@ -505,20 +505,17 @@ fn a_drift_model_that_does_not_fit_the_machine_is_refused() {
     let m = write(&dir, "spindle.yaml", SPINDLE);
     let run = write(&dir, "drift.csv", &drift_csv());
     let out = dir.join("v.yaml");
+    // `chain thermal RUN --values-out OUT` with `args` (the fit, the
+    // machine, the slot), refused.
+    let refused = |args: &[&str]| -> String {
+        let mut all = vec!["thermal", s(&run), "--values-out", s(&out)];
+        all.extend_from_slice(args);
+        unwrapped(&fails(&all))
+    };
     let base = |slot: &str, extra: &[&str]| -> String {
-        let mut args = vec![
-            "thermal",
-            s(&run),
-            "--fit",
-            "--values-out",
-            s(&out),
-            "--machine",
-            s(&m),
-            "--slot",
-            slot,
-        ];
+        let mut args = vec!["--fit", "--machine", s(&m), "--slot", slot];
         args.extend_from_slice(extra);
-        unwrapped(&fails(&args.iter().map(|a| &**a).collect::<Vec<&str>>()))
+        refused(&args)
     };
     let e = base("EZX=Z(um)", &[]);
     assert!(e.contains("--slot: `EZX` is not a thermal term `{name, per}` of machine `spindle1` (did you mean `EZS`?) (its thermal terms: EAS, EZS)"), "{e}");
@@ -543,32 +540,22 @@ fn a_drift_model_that_does_not_fit_the_machine_is_refused() {
         ),
         "{e}"
     );
-    let other = SPINDLE.replace("per: [T_a, T_b, T_c]", "per: [T_b, T_c]");
-    let other = write(&dir, "other.yaml", &other);
-    let e = unwrapped(&fails(&[
-        "thermal",
-        s(&run),
+    let other = write(
+        &dir,
+        "other.yaml",
+        &SPINDLE.replace("per: [T_a, T_b, T_c]", "per: [T_b, T_c]"),
+    );
+    let e = refused(&[
         "--fit",
         "--sensors",
         "2",
-        "--values-out",
-        s(&out),
         "--machine",
         s(&other),
         "--slot",
         "EZS=Z(um)",
-    ]));
+    ]);
     assert!(e.contains("the model of `Z(um)` uses `T_a(°C)`, sensor `T_a`, which `EZS` is not per (its sensors: T_b, T_c)"), "{e}");
-    let e = unwrapped(&fails(&[
-        "thermal",
-        s(&run),
-        "--values-out",
-        s(&out),
-        "--machine",
-        s(&m),
-        "--slot",
-        "EZS=Z(um)",
-    ]));
+    let e = refused(&["--machine", s(&m), "--slot", "EZS=Z(um)"]);
     assert!(
         e.contains("--values-out writes the fitted models: give --fit"),
         "{e}"
@@ -577,19 +564,15 @@ fn a_drift_model_that_does_not_fit_the_machine_is_refused() {
         .replace("[T_a, T_b, T_c]", "[T_b, T_c]")
         .replace("per: T_a", "per: T_b");
     let without = write(&dir, "without.yaml", &without);
-    let e = unwrapped(&fails(&[
-        "thermal",
-        s(&run),
+    let e = refused(&[
         "--fit",
         "--sensors",
         "2",
-        "--values-out",
-        s(&out),
         "--machine",
         s(&without),
         "--slot",
         "EZS=Z(um)",
-    ]));
+    ]);
     assert!(
         e.contains("uses `T_a(°C)`, which names no sensor of the machine (a column's header without its unit is the sensor's name; its sensors: T_b, T_c)"),
         "{e}"
@@ -635,27 +618,11 @@ fn the_thermal_example_values_are_current() {
     );
 }
 
-/// One X axis whose scale grows with a random room temperature.
-const ROOM: &str = "\
-machine: room1
-sensors: {T_x: 20}
-bodies:
-  bed: {}
-  x_slide:
-    parent: bed
-    joint: {type: prismatic, axis: +x, variable: x}
-    errors:
-      dx: [EXX, {name: EXT, powers: [1], per: T_x}]
-workpiece: bed
-tool: x_slide
-reliability:
-  tolerance: {px: 0.05}
-  grid: {x: [0, 250, 500]}
-statistics:
-  EXX: {dist: normal, mean: 0, std: 0.002}
-  EXT_1_T_x: {dist: normal, mean: 11.5e-6, std: 0.5e-6}
-  T_x: {dist: uniform, min: 16, max: 28}
-";
+/// One X axis whose scale grows with a random room temperature
+/// (`tests/data/thermal_room.yaml`, which the Python tests read too).
+fn room() -> String {
+    std::fs::read_to_string(common::root().join("tests/data/thermal_room.yaml")).unwrap()
+}
 
 /// `p_f(x) = ∫ Φ(−(0.05 − μ(T))/σ(T)) dT/12` over `T ∈ [16, 28]`:
 /// conditional on T, px is normal with mean `x·ΔT·11.5e-6` and std
@@ -681,7 +648,7 @@ fn room_pf(x: f64) -> f64 {
 #[test]
 fn reliability_over_a_random_room_temperature_is_the_integral_of_the_conditional_one() {
     let dir = scratch("thermal-room");
-    let m = write(&dir, "room.yaml", ROOM);
+    let m = write(&dir, "room.yaml", &room());
     let doc = ok_json(&["reliability", s(&m), "--format", "json"]);
     assert_eq!(doc["temperatures"]["random"][0]["sensor"], "T_x");
     assert_eq!(doc["temperatures"]["random"][0]["dist"], "uniform");
@@ -731,7 +698,7 @@ fn reliability_over_a_random_room_temperature_is_the_integral_of_the_conditional
     // What is not integrated is refused.
     let e = unwrapped(&fails(&["reliability", s(&m), "--acceptance"]));
     assert!(e.contains("the acceptance probability is not integrated over the random temperature of T_x: fix it with --temperature"), "{e}");
-    let two = ROOM
+    let two = room()
         .replace("sensors: {T_x: 20}", "sensors: {T_x: 20, T_y: 20}")
         .replace(
             "  T_x: {dist",
@@ -746,11 +713,44 @@ fn reliability_over_a_random_room_temperature_is_the_integral_of_the_conditional
     let bad = write(
         &dir,
         "bad.yaml",
-        &ROOM.replace("min: 16, max: 28}", "min: 16, max: 28, cost_weight: 2}"),
+        &room().replace("min: 16, max: 28}", "min: 16, max: 28, cost_weight: 2}"),
     );
     let e = unwrapped(&fails(&["derive", s(&bad)]));
     assert!(
         e.contains("`cost_weight` is an allocation key of an error; `T_x` is a sensor"),
         "{e}"
     );
+}
+
+#[test]
+fn a_path_at_a_thermal_state_is_the_grid_study_there() {
+    let (m, _) = files("thermal-path");
+    let dir = scratch("thermal-path-axes");
+    let axes = write(&dir, "axes.csv", "x\n0\n250\n500\n");
+    let path = ok_json(&[
+        "path",
+        s(&m),
+        "--axes",
+        s(&axes),
+        "--temperature",
+        "T_x=28",
+        "--format",
+        "json",
+    ]);
+    let grid = ok_json(&[
+        "reliability",
+        s(&m),
+        "--temperature",
+        "T_x=28",
+        "--format",
+        "json",
+    ]);
+    let instants = path["instants"].as_array().unwrap();
+    for (i, c) in grid["results"].as_array().unwrap().iter().enumerate() {
+        let r = instants[i]["reliability"]["px"].as_f64().unwrap();
+        assert!(
+            (r - c["reliability"].as_f64().unwrap()).abs() < 1e-15,
+            "{i}: {r} vs {c}"
+        );
+    }
 }

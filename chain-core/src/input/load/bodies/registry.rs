@@ -8,7 +8,9 @@ use super::slots::{Item, RawFunction};
 use super::{RawBody, Use};
 use crate::diagnostic::Problem;
 use crate::input::load::{Loader, TreeReader};
-use crate::model::{Basis, ErrorFunction, ErrorKind, ErrorParam, ErrorSlots, Slot, Variable};
+use crate::model::{
+    Basis, ErrorFunction, ErrorKind, ErrorParam, ErrorSlots, Origin, Slot, Variable,
+};
 
 impl Loader {
     /// Error parameters in order of first use, the function slots in order
@@ -212,13 +214,7 @@ impl Loader {
             } else {
                 None
             };
-            if let Some(difference) = difference {
-                let problem = Problem::FunctionRedeclared {
-                    name: name.clone(),
-                    difference,
-                    first: place(&first.origin),
-                };
-                self.report(f.name.span, f.name.path.clone(), problem);
+            if self.redeclared(f, difference, &first.origin) {
                 return Vec::new();
             }
             return first.coefficients.iter().map(|(j, _)| *j).collect();
@@ -242,24 +238,7 @@ impl Loader {
                 terms.push((t, s));
             }
         }
-        let mut clashes = Vec::new();
-        if let Some(other) = r.describe(name, &self.parameter_index) {
-            clashes.push((format!("function `{name}`"), other));
-        }
-        for c in &names {
-            if let Some(other) = r.describe(c, &self.parameter_index) {
-                clashes.push((format!("coefficient `{c}` of function `{name}`"), other));
-            }
-        }
-        if !clashes.is_empty() {
-            for (what, other) in clashes {
-                self.report(
-                    f.name.span,
-                    f.name.path.clone(),
-                    Problem::FunctionClash { what, other },
-                );
-            }
-            self.failed_functions.insert(name.clone());
+        if self.clashes(f, "function", &names, r) {
             return Vec::new();
         }
         let origin = f.name.span.origin(f.name.path.clone());
@@ -322,32 +301,12 @@ impl Loader {
             } else {
                 None
             };
-            if let Some(difference) = difference {
-                let problem = Problem::FunctionRedeclared {
-                    name: name.clone(),
-                    difference,
-                    first: place(&first.origin),
-                };
-                self.report(f.name.span, f.name.path.clone(), problem);
+            if self.redeclared(f, difference, &first.origin) {
                 return Vec::new();
             }
             return first.indices.clone();
         }
-        let mut clashes = Vec::new();
-        if let Some(other) = r.describe(name, &self.parameter_index) {
-            clashes.push((format!("thermal term `{name}`"), other));
-        }
-        for c in &names {
-            if let Some(other) = r.describe(c, &self.parameter_index) {
-                clashes.push((format!("coefficient `{c}` of thermal term `{name}`"), other));
-            }
-        }
-        if !clashes.is_empty() {
-            for (what, other) in clashes {
-                let problem = Problem::FunctionClash { what, other };
-                self.report(f.name.span, f.name.path.clone(), problem);
-            }
-            self.failed_functions.insert(name.clone());
+        if self.clashes(f, "thermal term", &names, r) {
             return Vec::new();
         }
         let origin = f.name.span.origin(f.name.path.clone());
@@ -374,6 +333,50 @@ impl Loader {
             },
         );
         indices
+    }
+}
+
+impl Loader {
+    /// Reports a redeclaration of `f` that differs from its first (declared
+    /// at `first`); true if it does.
+    fn redeclared(&mut self, f: &RawFunction, difference: Option<String>, first: &Origin) -> bool {
+        let Some(difference) = difference else {
+            return false;
+        };
+        let problem = Problem::FunctionRedeclared {
+            name: f.name.name.clone(),
+            difference,
+            first: place(first),
+        };
+        self.report(f.name.span, f.name.path.clone(), problem);
+        true
+    }
+
+    /// Reports every name of a new function or thermal term (`what`) and of
+    /// its coefficients `names` that is already something else; true if one
+    /// is.
+    fn clashes(&mut self, f: &RawFunction, what: &str, names: &[String], r: &Registry<'_>) -> bool {
+        let name = &f.name.name;
+        let mut clashes = Vec::new();
+        if let Some(other) = r.describe(name, &self.parameter_index) {
+            clashes.push((format!("{what} `{name}`"), other));
+        }
+        for c in names {
+            if let Some(other) = r.describe(c, &self.parameter_index) {
+                clashes.push((format!("coefficient `{c}` of {what} `{name}`"), other));
+            }
+        }
+        for (what, other) in &clashes {
+            let problem = Problem::FunctionClash {
+                what: what.clone(),
+                other: other.clone(),
+            };
+            self.report(f.name.span, f.name.path.clone(), problem);
+        }
+        if !clashes.is_empty() {
+            self.failed_functions.insert(name.clone());
+        }
+        !clashes.is_empty()
     }
 }
 
@@ -408,7 +411,7 @@ struct ThermalTerm {
     /// The kind of its first slot.
     kind: ErrorKind,
     /// Where it was first declared.
-    origin: crate::model::Origin,
+    origin: Origin,
 }
 
 impl Registry<'_> {
