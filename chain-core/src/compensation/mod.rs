@@ -37,6 +37,7 @@ pub struct ExportedFile {
 
 pub mod controllers;
 pub mod grid;
+pub mod thermal;
 
 use crate::built::{
     BuiltMachine, ComponentSummary, MapResult, MapSummary, Points, VolumetricSummary, MAP_BLOCK,

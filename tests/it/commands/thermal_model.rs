@@ -754,3 +754,292 @@ fn a_path_at_a_thermal_state_is_the_grid_study_there() {
         );
     }
 }
+
+/// `c*(V1-20)+c*(V2-20)…` (a written formula) with each variable's value
+/// from `var`.
+fn formula_with(text: &str, var: &dyn Fn(&str) -> f64) -> f64 {
+    if text == "0" {
+        return 0.0;
+    }
+    text.split('+')
+        .map(|term| {
+            let (c, rest) = term.split_once("*(").unwrap();
+            let (v, reference) = rest.trim_end_matches(')').split_once('-').unwrap();
+            c.parse::<f64>().unwrap() * (var(v) - reference.parse::<f64>().unwrap())
+        })
+        .sum()
+}
+
+/// A Siemens formula at temperatures `t` (°C by R parameter, 1-based).
+fn formula(text: &str, t: &[f64]) -> f64 {
+    formula_with(text, &|v: &str| {
+        t[v.trim_start_matches('R').parse::<usize>().unwrap() - 1]
+    })
+}
+
+#[test]
+fn the_siemens_temperature_compensation_applied_as_the_controller_applies_it_leaves_the_stated_remainder(
+) {
+    use chain_core::compensation::thermal::{fit, ThermalFormat};
+    let file = common::example_file("thermal/vmc3_thermal.yaml");
+    let values_file = common::example_file("thermal/vmc3_thermal_values.yaml");
+    let machine = chain_core::load_file(&file).unwrap();
+    let model = chain_core::compile(&machine);
+    let values = chain_core::values::Values::read(&values_file, &machine).unwrap();
+    let grid = [
+        ("x", [0.0, 200.0, 400.0, 600.0, 800.0]),
+        ("y", [0.0, 125.0, 250.0, 375.0, 500.0]),
+        ("z", [0.0, 125.0, 250.0, 375.0, 500.0]),
+    ];
+    let mut points = Vec::new();
+    for &y in &grid[1].1 {
+        for &x in &grid[0].1 {
+            for &z in &grid[2].1 {
+                points.push(vec![y, x, z]);
+            }
+        }
+    }
+    assert_eq!(
+        machine
+            .variables
+            .iter()
+            .map(|v| v.name.as_str())
+            .collect::<Vec<_>>(),
+        ["y", "x", "z"]
+    );
+    let law = fit(&machine, &model, &[150.0], &values, &points).unwrap();
+    let spf = &law.files(ThermalFormat::Siemens, "test")[0].text;
+    let sensors: Vec<String> = law.axes[0].lines.iter().map(|l| l.sensor.clone()).collect();
+    // Per axis its K0, tanβ and P0 as the SPF writes them.
+    let setting = |name: &str, axis: char| -> String {
+        let key = format!("$SA_TEMP_COMP_{name}[{axis}1]=");
+        spf.lines()
+            .find_map(|l| l.strip_prefix(&key))
+            .unwrap()
+            .to_string()
+    };
+    let dir = scratch("thermal-siemens");
+    let grid_args = [
+        "--grid",
+        "x=0,200,400,600,800",
+        "--grid",
+        "y=0,125,250,375,500",
+        "--grid",
+        "z=0,125,250,375,500",
+    ];
+    for (i, r) in law.remainder.iter().enumerate() {
+        // Sensor i alone 5 K above its reference.
+        let mut t: Vec<f64> = law.axes[0].lines.iter().map(|l| l.reference).collect();
+        t[i] += 5.0;
+        let state: Vec<String> = sensors
+            .iter()
+            .zip(&t)
+            .map(|(n, v)| format!("{n}={v}"))
+            .collect();
+        let joined = state.join(",");
+        let mut args = vec![
+            "map",
+            file.to_str().unwrap(),
+            "--values",
+            values_file.to_str().unwrap(),
+            "--temperature",
+            &joined,
+            "--format",
+            "json",
+        ];
+        args.extend_from_slice(&grid_args);
+        let hot = ok_json(&args);
+        let mut args = vec![
+            "map",
+            file.to_str().unwrap(),
+            "--values",
+            values_file.to_str().unwrap(),
+            "--format",
+            "json",
+        ];
+        args.extend_from_slice(&grid_args);
+        let cold = ok_json(&args);
+        let mut largest = 0.0f64;
+        for (h, c) in hot["points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(cold["points"].as_array().unwrap())
+        {
+            // The thermal part of the error, and the controller's
+            // ΔK = K0 + tanβ·(P − P0) added to each axis's command: the
+            // tool moves by ΔK along the axis (vmc3's nominal tool point
+            // relative to the table is (x, y, z + …), its machine file).
+            let mut left: Vec<f64> = ["px", "py", "pz"]
+                .iter()
+                .map(|k| h["error"][k].as_f64().unwrap() - c["error"][k].as_f64().unwrap())
+                .collect();
+            for (axis, var, sign, k) in [('X', "x", 1.0, 0), ('Y', "y", 1.0, 1), ('Z', "z", 1.0, 2)]
+            {
+                let p = h["point"][var].as_f64().unwrap();
+                let k0 = formula(&setting("ABS_VALUE", axis), &t);
+                let slope = formula(&setting("SLOPE", axis), &t);
+                let p0: f64 = setting("REF_POSITION", axis).parse().unwrap();
+                left[k] += sign * (k0 + slope * (p - p0));
+            }
+            largest = largest.max(left.iter().map(|v| v * v).sum::<f64>().sqrt());
+        }
+        assert!(
+            (largest - 5.0 * r.after).abs() < 1e-9 * r.before.max(1e-12) + 1e-12,
+            "{}: {largest} vs {}",
+            r.sensor,
+            5.0 * r.after
+        );
+        assert!(r.after <= r.before);
+    }
+    // The X scale's growth is a slope of X alone: held exactly; the
+    // column's tilt (z-dependent along Y) is not a line of Y.
+    let x = law.axes.iter().find(|a| a.axis == 'X').unwrap();
+    let tx = x.lines.iter().find(|l| l.sensor == "T_x").unwrap();
+    assert!((tx.slope - 11.5e-6).abs() < 1e-15, "{}", tx.slope);
+    let rx = law.remainder.iter().find(|r| r.sensor == "T_x").unwrap();
+    assert!(rx.after < 1e-12, "{rx:?}");
+    let rc = law
+        .remainder
+        .iter()
+        .find(|r| r.sensor == "T_coltop")
+        .unwrap();
+    assert!(rc.after > 1e-6, "{rc:?}");
+    let _ = dir;
+}
+
+#[test]
+fn the_linuxcnc_thermal_component_applied_as_hal_applies_it_leaves_the_stated_remainder() {
+    use chain_core::compensation::thermal::{fit, ThermalFormat};
+    let file = common::example_file("thermal/vmc3_thermal.yaml");
+    let values_file = common::example_file("thermal/vmc3_thermal_values.yaml");
+    let machine = chain_core::load_file(&file).unwrap();
+    let model = chain_core::compile(&machine);
+    let values = chain_core::values::Values::read(&values_file, &machine).unwrap();
+    let mut points = Vec::new();
+    for y in [0.0, 250.0, 500.0] {
+        for x in [0.0, 400.0, 800.0] {
+            for z in [0.0, 250.0, 500.0] {
+                points.push(vec![y, x, z]);
+            }
+        }
+    }
+    let law = fit(&machine, &model, &[150.0], &values, &points).unwrap();
+    let files = law.files(ThermalFormat::Linuxcnc, "test");
+    let text = |name: &str| files.iter().find(|f| f.name == name).unwrap().text.clone();
+    let (comp, hal, ini) = (
+        text("thermal_comp.comp"),
+        text("thermal_comp.hal"),
+        text("thermal_comp.ini"),
+    );
+    // The HAL wiring of the external offsets (docs/src/motion/external-offsets.adoc).
+    for a in ["x", "y", "z"] {
+        assert!(
+            hal.contains(&format!(
+                "net tc-counts-{a} thermal-comp.counts-{a} => axis.{a}.eoffset-counts"
+            )),
+            "{hal}"
+        );
+        assert!(hal.contains(&format!(
+            "net tc-pos-{a} axis.{a}.pos-cmd => thermal-comp.pos-{a}"
+        )));
+        assert!(hal.contains(&format!("setp axis.{a}.eoffset-scale 0.00001")));
+        assert!(ini.contains(&format!(
+            "[AXIS_{}]\nOFFSET_AV_RATIO = 0.1",
+            a.to_uppercase()
+        )));
+    }
+    assert!(comp.contains("pin in float temp_t_front = 20 "), "{comp}");
+    assert!(comp.contains("if (!is_on || !homed) d = 0;"));
+    // Each axis's `d = (K0) + (m)*(pos_a - P0);` as the component computes
+    // it, its counts rounded at k = 100000 per mm, the offset added to the
+    // command (axis.c: the external offset adds to the axis position).
+    let t = [
+        ("T_x", 27.0),
+        ("T_front", 31.0),
+        ("T_rear", 26.0),
+        ("T_head", 24.0),
+        ("T_coltop", 22.5),
+    ];
+    let temp = |v: &str| -> f64 {
+        t.iter()
+            .find(|(n, _)| format!("temp_{}", n.to_lowercase()) == v)
+            .unwrap()
+            .1
+    };
+    let d_line = |a: char| -> (String, String, f64) {
+        let l = comp
+            .lines()
+            .find(|l| l.trim_start().starts_with("d = (") && l.contains(&format!("pos_{a} - ")))
+            .unwrap();
+        let l = l.trim().trim_start_matches("d = (").trim_end_matches(");");
+        let (k0, rest) = l.split_once(") + (").unwrap();
+        let (m, p0) = rest.split_once(&format!(")*(pos_{a} - ")).unwrap();
+        (k0.to_string(), m.to_string(), p0.parse().unwrap())
+    };
+    let state: Vec<String> = t.iter().map(|(n, v)| format!("{n}={v}")).collect();
+    let joined = state.join(",");
+    let grid = [
+        "--grid",
+        "x=0,400,800",
+        "--grid",
+        "y=0,250,500",
+        "--grid",
+        "z=0,250,500",
+    ];
+    let map = |temps: Option<&str>| {
+        let mut args = vec![
+            "map",
+            file.to_str().unwrap(),
+            "--values",
+            values_file.to_str().unwrap(),
+            "--format",
+            "json",
+        ];
+        if let Some(s) = temps {
+            args.extend_from_slice(&["--temperature", s]);
+        }
+        args.extend_from_slice(&grid);
+        ok_json(&args)
+    };
+    let (hot, cold) = (map(Some(&joined)), map(None));
+    // What the law leaves at this state, from its per-sensor parts: the
+    // remainder is linear in ΔT, so the test's own sum bounds it.
+    let bound: f64 = law
+        .remainder
+        .iter()
+        .map(|r| r.after * (t.iter().find(|(n, _)| *n == r.sensor).unwrap().1 - 20.0).abs())
+        .sum();
+    let mut largest = 0.0f64;
+    let mut thermal = 0.0f64;
+    for (h, c) in hot["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(cold["points"].as_array().unwrap())
+    {
+        let mut left: Vec<f64> = ["px", "py", "pz"]
+            .iter()
+            .map(|k| h["error"][k].as_f64().unwrap() - c["error"][k].as_f64().unwrap())
+            .collect();
+        thermal = thermal.max(left.iter().map(|v| v * v).sum::<f64>().sqrt());
+        for (k, a) in ['x', 'y', 'z'].into_iter().enumerate() {
+            let (k0, m, p0) = d_line(a);
+            let pos = h["point"][a.to_string()].as_f64().unwrap();
+            let d = formula_with(&k0, &temp) + formula_with(&m, &temp) * (pos - p0);
+            let counts = if d >= 0.0 {
+                (d * 1e5 + 0.5).trunc()
+            } else {
+                (d * 1e5 - 0.5).trunc()
+            };
+            left[k] += counts * 1e-5;
+        }
+        largest = largest.max(left.iter().map(|v| v * v).sum::<f64>().sqrt());
+    }
+    // The counts' rounding adds at most half a count per axis.
+    assert!(
+        largest <= bound + 0.5e-5 * 3f64.sqrt() + 1e-12,
+        "{largest} vs {bound}"
+    );
+    assert!(largest < 0.2 * thermal, "{largest} of {thermal}");
+}
