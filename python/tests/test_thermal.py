@@ -140,3 +140,15 @@ def test_reliability_over_temperatures_is_the_cli_s(cli):
     assert m.reliability(temperature={"T_x": 27}).to_dict() == cli("reliability", path, "--temperature", "T_x=27")
     assert m.sensitivity_reliability(temperature={"T_x": 27}).to_dict() == cli(
         "sensitivity", path, "--temperature", "T_x=27")
+
+
+def test_the_thermal_export_is_the_cli_s(cli, tmp_path):
+    m = chain.Machine.load(THERMAL_MACHINE)
+    grid = {"x": [0, 400, 800], "y": [0, 250, 500], "z": [0, 250, 500]}
+    for controller in ("siemens-thermal", "linuxcnc-thermal"):
+        got = m.export(THERMAL_VALUES, controller=controller, grid=grid)
+        want = cli("export", THERMAL_MACHINE, "--values", THERMAL_VALUES, "--controller", controller, "--out",
+                   tmp_path / controller, "--grid", "x=0,400,800", "--grid", "y=0,250,500", "--grid", "z=0,250,500")
+        assert got.to_dict() == want
+        for name, text in got.files.items():
+            assert (tmp_path / controller / name).read_text(encoding="utf-8") == text

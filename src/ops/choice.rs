@@ -171,6 +171,12 @@ impl Choice for ExportController {
         match self {
             ExportController::Grid => "The universal grid CSV: `δq` at every node and the residual",
             ExportController::Tables(c) => c.capabilities().summary,
+            ExportController::Thermal(chain_core::compensation::thermal::ThermalFormat::Siemens) => {
+                "SINUMERIK temperature compensation: K0, tanβ and P0 per axis as formulas of the sensors (TEMP_COMP.SPF)"
+            }
+            ExportController::Thermal(chain_core::compensation::thermal::ThermalFormat::Linuxcnc) => {
+                "LinuxCNC external axis offsets from a HAL component of the sensors (thermal_comp.comp, .hal, .ini)"
+            }
         }
     }
 }

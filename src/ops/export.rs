@@ -12,6 +12,7 @@ use chain_core::compensation::controllers::{
     BECKHOFF_DEFAULT_MAX_RECORDS, CEC_DEFAULT_MAX_POINTS, DEFAULT_STEP,
 };
 use chain_core::compensation::grid::{self, GridCompensation};
+use chain_core::compensation::thermal::{self, ThermalExportError, ThermalFormat, ThermalLaw};
 use chain_core::compensation::{CompensationError, ExportedFile};
 use chain_core::kinematics::Kinematics;
 use chain_core::values::Values;
@@ -29,18 +30,23 @@ pub enum ExportController {
     Grid,
     /// A controller's per-axis tables.
     Tables(Controller),
+    /// A controller's temperature compensation of a machine with thermal
+    /// terms (`chain_core::compensation::thermal`).
+    Thermal(ThermalFormat),
 }
 
 impl ExportController {
     /// Every controller, in the order of `--controller`'s values: the grid,
     /// then [`Controller::ALL`].
-    pub const ALL: [ExportController; 1 + Controller::ALL.len()] = {
-        let mut all = [ExportController::Grid; 1 + Controller::ALL.len()];
+    pub const ALL: [ExportController; 3 + Controller::ALL.len()] = {
+        let mut all = [ExportController::Grid; 3 + Controller::ALL.len()];
         let mut i = 0;
         while i < Controller::ALL.len() {
             all[i + 1] = ExportController::Tables(Controller::ALL[i]);
             i += 1;
         }
+        all[i + 1] = ExportController::Thermal(ThermalFormat::Siemens);
+        all[i + 2] = ExportController::Thermal(ThermalFormat::Linuxcnc);
         all
     };
 
@@ -49,6 +55,8 @@ impl ExportController {
         match self {
             ExportController::Grid => "grid",
             ExportController::Tables(c) => c.name(),
+            ExportController::Thermal(ThermalFormat::Siemens) => "siemens-thermal",
+            ExportController::Thermal(ThermalFormat::Linuxcnc) => "linuxcnc-thermal",
         }
     }
 
@@ -140,6 +148,14 @@ pub enum ExportOpsError {
         values: String,
         /// What went wrong.
         error: Box<ControllerError>,
+    },
+    /// A temperature compensation the machine cannot take.
+    #[error("{values}: {error}")]
+    Thermal {
+        /// The values file.
+        values: String,
+        /// What went wrong.
+        error: Box<ThermalExportError>,
     },
     /// A `--grid` value that is not a node of the per-axis tables.
     #[error(
@@ -271,6 +287,24 @@ pub enum ExportDocument {
     Grid(GridExport),
     /// A per-axis table format.
     Tables(TablesExport),
+    /// A temperature compensation format.
+    Thermal(ThermalExport),
+}
+
+/// A temperature compensation's document: the law per axis and sensor and
+/// what it leaves (`docs/export-controllers.md`, "Thermal compensation").
+#[derive(Debug, Clone, Serialize)]
+pub struct ThermalExport {
+    /// The values file.
+    pub values_file: String,
+    /// The files' names.
+    pub files: Vec<String>,
+    /// The law.
+    #[serde(flatten)]
+    pub law: ThermalLaw,
+    /// The files themselves.
+    #[serde(skip)]
+    pub written: Vec<ExportedFile>,
 }
 
 /// The grid export's document.
@@ -307,6 +341,7 @@ impl ExportDocument {
         match self {
             ExportDocument::Grid(g) => std::slice::from_ref(&g.file),
             ExportDocument::Tables(t) => &t.files,
+            ExportDocument::Thermal(t) => &t.written,
         }
     }
 }
@@ -361,6 +396,30 @@ pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
                 return refuse("--angles", ANGLES_WHY);
             }
         }
+        ExportController::Thermal(_) => {
+            let why = "a temperature compensation is a law per axis fitted over the grid's points (--grid VAR=V1,V2,... per axis), per kelvin of each sensor";
+            if let AxisPoints::Rows { .. } = request.points {
+                return refuse("--axes", why);
+            }
+            if request.step.is_some() {
+                return refuse("--step", why);
+            }
+            if request.angles {
+                return refuse("--angles", ANGLES_WHY);
+            }
+            if request.cec_max_points.is_some() || request.beckhoff_max_records.is_some() {
+                return refuse(
+                    "--cec-max-points or --beckhoff-max-records",
+                    "they limit the siemens-cec and beckhoff tables",
+                );
+            }
+            if !request.temperatures.is_empty() {
+                return refuse(
+                    "--temperature",
+                    "the law holds at every temperature (the PLC or HAL evaluates it); its remainder is stated per kelvin of each sensor",
+                );
+            }
+        }
     }
     Ok(())
 }
@@ -393,6 +452,10 @@ pub fn run(
     check(request)?;
     let m = machine;
     let params = Parameters::new(m, request.params)?.values()?;
+    if let ExportController::Thermal(format) = request.controller {
+        // The law is per kelvin: the values as the file gives them.
+        return thermal_export(m, file, &values, values_file, &params, format, request);
+    }
     let (values, state) = super::resolve::at_thermal_state(m, values, request.temperatures)?;
     let provenance = provenance(request.controller, &state);
     let built_error = |e: chain_core::built::BuiltError| ExportOpsError::Built {
@@ -418,6 +481,9 @@ pub fn run(
                 file,
             }))
         }
+        ExportController::Thermal(format) => {
+            thermal_export(m, file, &values, values_file, &params, format, request)
+        }
         ExportController::Tables(c) => {
             let built = BuiltMachine::compile(m, values, params).map_err(built_error)?;
             let options = ExportOptions {
@@ -438,6 +504,35 @@ pub fn run(
             }))
         }
     }
+}
+
+/// A temperature compensation `format` of `m`'s thermal terms over the
+/// grid's points (`docs/export-controllers.md`, "Thermal compensation").
+fn thermal_export(
+    m: &Machine,
+    file: &str,
+    values: &Values,
+    values_file: &str,
+    params: &[f64],
+    format: ThermalFormat,
+    request: &ExportRequest<'_>,
+) -> Result<ExportDocument, ExportOpsError> {
+    let (points, _) = request.points.resolve(m, file)?;
+    let points: Vec<Vec<f64>> = (0..points.len()).map(|i| points.point(i)).collect();
+    let model = chain_core::compile(m);
+    let law = thermal::fit(m, &model, params, values, &points).map_err(|error| {
+        ExportOpsError::Thermal {
+            values: values_file.to_string(),
+            error: Box::new(error),
+        }
+    })?;
+    let written = law.files(format, &request.controller.provenance());
+    Ok(ExportDocument::Thermal(ThermalExport {
+        values_file: values_file.to_string(),
+        files: written.iter().map(|f| f.name.clone()).collect(),
+        law,
+        written,
+    }))
 }
 
 /// The per-axis export of `controller` with `options`, and `grid`'s values

@@ -438,6 +438,13 @@ impl PreparedMap {
             })
         };
         let controller = c.controller.name();
+        if let ExportController::Thermal(_) = c.controller {
+            return Err(MapOpsError::Option {
+                controller,
+                option: "a map",
+                why: "a temperature compensation is a law of the temperatures: `chain export --controller siemens-thermal | linuxcnc-thermal` states what it leaves per kelvin of each sensor (the map of a compensated thermal state is to come)",
+            });
+        }
         if let ExportController::Tables(tables) = c.controller {
             if c.step.is_some() && !export::step_applies(tables) {
                 let (option, why) = ("--compensation-step", export::STEP_WHY);

@@ -527,7 +527,9 @@ impl ThermalLaw {
                 "setp axis.{a}.eoffset-scale 0.00001\nsetp axis.{a}.eoffset-enable 1"
             );
         }
-        let mut ini = String::from("# add to each compensated axis's section of the INI file\n");
+        let mut ini = format!(
+            "# thermal_comp.ini - written by {provenance}\n# add to each compensated axis's section of the INI file\n"
+        );
         for law in &self.axes {
             let _ = writeln!(ini, "[AXIS_{}]\nOFFSET_AV_RATIO = 0.1", law.axis);
         }

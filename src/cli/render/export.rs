@@ -2,7 +2,7 @@
 //! export's summary (its CSV is the grid file), or a per-axis format's
 //! report.
 
-use chain::ops::export::{ExportDocument, GridExport, TablesExport};
+use chain::ops::export::{ExportDocument, GridExport, TablesExport, ThermalExport};
 use chain_core::compensation::controllers::Term;
 use chain_core::compensation::grid;
 
@@ -13,6 +13,7 @@ impl Report for ExportDocument {
         match self {
             ExportDocument::Grid(g) => g.table(),
             ExportDocument::Tables(t) => t.table(),
+            ExportDocument::Thermal(t) => t.table(),
         }
     }
 
@@ -20,6 +21,7 @@ impl Report for ExportDocument {
         match self {
             ExportDocument::Grid(g) => g.csv(out),
             ExportDocument::Tables(t) => t.csv(out),
+            ExportDocument::Thermal(t) => t.csv(out),
         }
     }
 }
@@ -227,5 +229,85 @@ impl Report for TablesExport {
             .collect();
         let _ = writeln!(out, "check grid: {}", grid.join(", "));
         out
+    }
+}
+
+impl Report for ThermalExport {
+    fn table(&self) -> String {
+        use std::fmt::Write;
+        let l = &self.law;
+        let mut out = String::new();
+        let _ = writeln!(
+            out,
+            "Temperature compensation of {}, values {}; files: {}",
+            l.machine,
+            self.values_file,
+            self.files.join(", ")
+        );
+        out.push_str("per axis: the correction added to its command, per kelvin of each sensor: offset at P0 + slope·(q − P0)\n\n");
+        let _ = writeln!(
+            out,
+            "{:<6} {:>10} {:<14} {:>16} {:>18}",
+            "axis", "P0 (mm)", "sensor", "offset (µm/K)", "slope (µm/m/K)"
+        );
+        for a in &l.axes {
+            for s in &a.lines {
+                let _ = writeln!(
+                    out,
+                    "{:<6} {:>10} {:<14} {:>16.4} {:>18.4}",
+                    format!("{} ({})", a.axis, a.variable),
+                    a.p0,
+                    s.sensor,
+                    s.offset * 1e3,
+                    s.slope * 1e6
+                );
+            }
+        }
+        out.push_str("\nwhat the law leaves, per kelvin of each sensor (largest tool-point error over the grid):\n");
+        let _ = writeln!(
+            out,
+            "{:<14} {:>14} {:>14}",
+            "sensor", "before (µm/K)", "after (µm/K)"
+        );
+        for r in &l.remainder {
+            let _ = writeln!(
+                out,
+                "{:<14} {:>14.4} {:>14.4}",
+                r.sensor,
+                r.before * 1e3,
+                r.after * 1e3
+            );
+        }
+        out
+    }
+
+    fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
+        out.header(
+            [
+                "axis",
+                "variable",
+                "p0",
+                "sensor",
+                "reference",
+                "offset",
+                "slope",
+            ]
+            .map(String::from)
+            .to_vec(),
+        );
+        for a in &self.law.axes {
+            for s in &a.lines {
+                out.row(vec![
+                    a.axis.to_string(),
+                    a.variable.clone(),
+                    format!("{}", a.p0),
+                    s.sensor.clone(),
+                    format!("{}", s.reference),
+                    format!("{}", s.offset),
+                    format!("{}", s.slope),
+                ]);
+            }
+        }
+        Some(())
     }
 }

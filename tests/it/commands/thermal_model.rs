@@ -1043,3 +1043,112 @@ fn the_linuxcnc_thermal_component_applied_as_hal_applies_it_leaves_the_stated_re
     );
     assert!(largest < 0.2 * thermal, "{largest} of {thermal}");
 }
+
+#[test]
+fn the_thermal_formats_are_export_controllers() {
+    let file = example("thermal/vmc3_thermal.yaml");
+    let values = example("thermal/vmc3_thermal_values.yaml");
+    let dir = scratch("thermal-export-cli");
+    let grid = [
+        "--grid",
+        "x=0,400,800",
+        "--grid",
+        "y=0,250,500",
+        "--grid",
+        "z=0,250,500",
+    ];
+    for (controller, names) in [
+        ("siemens-thermal", vec!["TEMP_COMP.SPF"]),
+        (
+            "linuxcnc-thermal",
+            vec!["thermal_comp.comp", "thermal_comp.hal", "thermal_comp.ini"],
+        ),
+    ] {
+        let out = dir.join(controller);
+        let mut args = vec![
+            "export",
+            &file,
+            "--values",
+            &values,
+            "--controller",
+            controller,
+            "--out",
+            s(&out),
+            "--format",
+            "json",
+        ];
+        args.extend_from_slice(&grid);
+        let doc = ok_json(&args);
+        assert_eq!(doc["files"], serde_json::json!(names));
+        for n in &names {
+            let text = std::fs::read_to_string(out.join(n)).unwrap();
+            assert!(
+                text.contains(&format!("chain export --controller {controller}")),
+                "{n}"
+            );
+        }
+        // The document is the library's law over the same grid.
+        let x = (doc["axes"].as_array().unwrap().iter())
+            .find(|a| a["axis"] == "X")
+            .unwrap();
+        let tx = (x["lines"].as_array().unwrap().iter())
+            .find(|l| l["sensor"] == "T_x")
+            .unwrap();
+        assert!((tx["slope"].as_f64().unwrap() - 11.5e-6).abs() < 1e-15);
+        let mut args = vec![
+            "export",
+            &file,
+            "--values",
+            &values,
+            "--controller",
+            controller,
+            "--out",
+            s(&out),
+        ];
+        args.extend_from_slice(&grid);
+        let table = ok_stdout(&args);
+        assert!(
+            table.contains("T_x") && table.contains("11.5000"),
+            "{table}"
+        );
+    }
+    let e = unwrapped(&fails(&[
+        "export",
+        &file,
+        "--values",
+        &values,
+        "--controller",
+        "siemens-thermal",
+        "--temperature",
+        "T_x=25",
+        "--out",
+        s(&dir),
+    ]));
+    assert!(
+        e.contains("--controller siemens-thermal does not take --temperature"),
+        "{e}"
+    );
+    let e = unwrapped(&fails(&[
+        "export",
+        &example("machines/vmc3.yaml"),
+        "--values",
+        &example("values/vmc3.yaml"),
+        "--controller",
+        "linuxcnc-thermal",
+        "--out",
+        s(&dir),
+    ]));
+    assert!(e.contains("machine `vmc3` has no thermal terms"), "{e}");
+    let e = unwrapped(&fails(&[
+        "map",
+        &file,
+        "--values",
+        &values,
+        "--compensated",
+        "siemens-thermal",
+    ]));
+    assert!(
+        e.contains("--compensated siemens-thermal does not take a map"),
+        "{e}"
+    );
+}
