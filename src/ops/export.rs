@@ -365,15 +365,7 @@ pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
                     "the grid export corrects at the grid's nodes: give them with --grid VAR=LO:HI:N",
                 );
             }
-            if request.angles {
-                return refuse("--angles", ANGLES_WHY);
-            }
-            if request.cec_max_points.is_some() || request.beckhoff_max_records.is_some() {
-                return refuse(
-                    "--cec-max-points or --beckhoff-max-records",
-                    "they limit the siemens-cec and beckhoff tables",
-                );
-            }
+            no_table_options(request)?;
         }
         ExportController::Tables(c) => {
             if let AxisPoints::Rows { .. } = request.points {
@@ -404,15 +396,7 @@ pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
             if request.step.is_some() {
                 return refuse("--step", why);
             }
-            if request.angles {
-                return refuse("--angles", ANGLES_WHY);
-            }
-            if request.cec_max_points.is_some() || request.beckhoff_max_records.is_some() {
-                return refuse(
-                    "--cec-max-points or --beckhoff-max-records",
-                    "they limit the siemens-cec and beckhoff tables",
-                );
-            }
+            no_table_options(request)?;
             if !request.temperatures.is_empty() {
                 return refuse(
                     "--temperature",
@@ -420,6 +404,29 @@ pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
                 );
             }
         }
+    }
+    Ok(())
+}
+
+/// Refuses the options of the per-axis tables (`--angles`, the table
+/// limits) for a format that writes none.
+fn no_table_options(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
+    let controller = request.controller.name();
+    let refuse = |option, why| {
+        Err(ExportOpsError::Option {
+            controller,
+            option,
+            why,
+        })
+    };
+    if request.angles {
+        return refuse("--angles", ANGLES_WHY);
+    }
+    if request.cec_max_points.is_some() || request.beckhoff_max_records.is_some() {
+        return refuse(
+            "--cec-max-points or --beckhoff-max-records",
+            "they limit the siemens-cec and beckhoff tables",
+        );
     }
     Ok(())
 }

@@ -777,6 +777,32 @@ fn formula(text: &str, t: &[f64]) -> f64 {
     })
 }
 
+/// The thermal part of vmc3_thermal's error at `state` (`T=V,...`) over
+/// `grid` (`--grid` arguments): per point, its axis values by name and
+/// `E(q, T) − E(q, T_ref)` (mm), from `chain map --temperature`.
+fn thermal_part(state: &str, grid: &[&str]) -> Vec<(Value, [f64; 3])> {
+    let file = example("thermal/vmc3_thermal.yaml");
+    let values = example("thermal/vmc3_thermal_values.yaml");
+    let map = |temps: Option<&str>| {
+        let mut args = vec!["map", &file, "--values", &values, "--format", "json"];
+        if let Some(t) = temps {
+            args.extend_from_slice(&["--temperature", t]);
+        }
+        args.extend_from_slice(grid);
+        ok_json(&args)
+    };
+    let (hot, cold) = (map(Some(state)), map(None));
+    let points = |d: &Value| d["points"].as_array().unwrap().clone();
+    points(&hot)
+        .into_iter()
+        .zip(points(&cold))
+        .map(|(h, c)| {
+            let e = |k: &str| h["error"][k].as_f64().unwrap() - c["error"][k].as_f64().unwrap();
+            (h["point"].clone(), [e("px"), e("py"), e("pz")])
+        })
+        .collect()
+}
+
 #[test]
 fn the_siemens_temperature_compensation_applied_as_the_controller_applies_it_leaves_the_stated_remainder(
 ) {
@@ -837,46 +863,16 @@ fn the_siemens_temperature_compensation_applied_as_the_controller_applies_it_lea
             .map(|(n, v)| format!("{n}={v}"))
             .collect();
         let joined = state.join(",");
-        let mut args = vec![
-            "map",
-            file.to_str().unwrap(),
-            "--values",
-            values_file.to_str().unwrap(),
-            "--temperature",
-            &joined,
-            "--format",
-            "json",
-        ];
-        args.extend_from_slice(&grid_args);
-        let hot = ok_json(&args);
-        let mut args = vec![
-            "map",
-            file.to_str().unwrap(),
-            "--values",
-            values_file.to_str().unwrap(),
-            "--format",
-            "json",
-        ];
-        args.extend_from_slice(&grid_args);
-        let cold = ok_json(&args);
         let mut largest = 0.0f64;
-        for (h, c) in hot["points"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .zip(cold["points"].as_array().unwrap())
-        {
+        for (point, part) in thermal_part(&joined, &grid_args) {
             // The thermal part of the error, and the controller's
             // ΔK = K0 + tanβ·(P − P0) added to each axis's command: the
             // tool moves by ΔK along the axis (vmc3's nominal tool point
             // relative to the table is (x, y, z + …), its machine file).
-            let mut left: Vec<f64> = ["px", "py", "pz"]
-                .iter()
-                .map(|k| h["error"][k].as_f64().unwrap() - c["error"][k].as_f64().unwrap())
-                .collect();
+            let mut left = part;
             for (axis, var, sign, k) in [('X', "x", 1.0, 0), ('Y', "y", 1.0, 1), ('Z', "z", 1.0, 2)]
             {
-                let p = h["point"][var].as_f64().unwrap();
+                let p = point[var].as_f64().unwrap();
                 let k0 = formula(&setting("ABS_VALUE", axis), &t);
                 let slope = formula(&setting("SLOPE", axis), &t);
                 let p0: f64 = setting("REF_POSITION", axis).parse().unwrap();
@@ -987,22 +983,6 @@ fn the_linuxcnc_thermal_component_applied_as_hal_applies_it_leaves_the_stated_re
         "--grid",
         "z=0,250,500",
     ];
-    let map = |temps: Option<&str>| {
-        let mut args = vec![
-            "map",
-            file.to_str().unwrap(),
-            "--values",
-            values_file.to_str().unwrap(),
-            "--format",
-            "json",
-        ];
-        if let Some(s) = temps {
-            args.extend_from_slice(&["--temperature", s]);
-        }
-        args.extend_from_slice(&grid);
-        ok_json(&args)
-    };
-    let (hot, cold) = (map(Some(&joined)), map(None));
     // What the law leaves at this state, from its per-sensor parts: the
     // remainder is linear in ΔT, so the test's own sum bounds it.
     let bound: f64 = law
@@ -1012,20 +992,12 @@ fn the_linuxcnc_thermal_component_applied_as_hal_applies_it_leaves_the_stated_re
         .sum();
     let mut largest = 0.0f64;
     let mut thermal = 0.0f64;
-    for (h, c) in hot["points"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .zip(cold["points"].as_array().unwrap())
-    {
-        let mut left: Vec<f64> = ["px", "py", "pz"]
-            .iter()
-            .map(|k| h["error"][k].as_f64().unwrap() - c["error"][k].as_f64().unwrap())
-            .collect();
+    for (point, part) in thermal_part(&joined, &grid) {
+        let mut left = part;
         thermal = thermal.max(left.iter().map(|v| v * v).sum::<f64>().sqrt());
         for (k, a) in ['x', 'y', 'z'].into_iter().enumerate() {
             let (k0, m, p0) = d_line(a);
-            let pos = h["point"][a.to_string()].as_f64().unwrap();
+            let pos = point[a.to_string()].as_f64().unwrap();
             let d = formula_with(&k0, &temp) + formula_with(&m, &temp) * (pos - p0);
             let counts = if d >= 0.0 {
                 (d * 1e5 + 0.5).trunc()
