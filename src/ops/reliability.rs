@@ -191,9 +191,8 @@ pub struct TemperaturesDocument {
 /// temperature, if any.
 fn thermal(
     machine: &Machine,
-    file: &str,
     request: &ReliabilityRequest<'_>,
-    options: &StudyOptions<'_>,
+    checked: &study::Checked,
     wanted_acceptance: bool,
 ) -> Result<Option<Thermal>, ReliabilityOpsError> {
     if machine.sensors.is_empty() {
@@ -233,7 +232,7 @@ fn thermal(
                 distribution: *distribution,
                 marginal: reliability::machine::marginal(distribution)?,
                 machine: machine.clone(),
-                checked: study::check(machine, file, options)?,
+                checked: checked.clone(),
             })
         }
         _ => {
@@ -280,9 +279,13 @@ pub fn prepare(
         posterior: posterior.as_ref(),
         temperatures: request.temperatures,
     };
-    let (study, model) = study::study(machine, file, &options)?;
+    // `study::study`'s steps, the checked study kept for the studies at a
+    // random temperature's values.
+    let checked = study::check(machine, file, &options)?;
+    let model = chain_core::compile(machine);
+    let study = study::build(machine, &model, checked.clone(), &options)?;
     let wanted = request.acceptance || (machine.reliability.as_ref()).is_some_and(|r| r.acceptance);
-    let thermal = thermal(machine, file, request, &options, wanted)?;
+    let thermal = thermal(machine, request, &checked, wanted)?;
     Ok(Prepared {
         machine: machine.name.clone(),
         study,

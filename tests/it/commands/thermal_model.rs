@@ -844,7 +844,6 @@ fn the_siemens_temperature_compensation_applied_as_the_controller_applies_it_lea
             .unwrap()
             .to_string()
     };
-    let dir = scratch("thermal-siemens");
     let grid_args = [
         "--grid",
         "x=0,200,400,600,800",
@@ -901,7 +900,6 @@ fn the_siemens_temperature_compensation_applied_as_the_controller_applies_it_lea
         .find(|r| r.sensor == "T_coltop")
         .unwrap();
     assert!(rc.after > 1e-6, "{rc:?}");
-    let _ = dir;
 }
 
 #[test]
