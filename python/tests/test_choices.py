@@ -37,7 +37,7 @@ CASES = [
      "`parallel` is not a system target: choose one of series, volumetric"),
     ("controller", lambda: _vmc3().export(VALUES, controller="fanuc"),
      ["export", VMC3, "--values", VALUES, "--controller", "fanuc"],
-     "`fanuc` is not a controller: choose one of grid, beckhoff, linuxcnc, siemens-cec, klipper, linuxcnc-trt, heidenhain, siemens-carr, fanuc-tcp, siemens-thermal, linuxcnc-thermal"),
+     "`fanuc` is not a controller: choose one of grid, beckhoff, linuxcnc, siemens-cec, klipper, linuxcnc-trt, heidenhain, siemens-carr, fanuc-tcp, siemens-thermal, linuxcnc-thermal, beckhoff-thermal, heidenhain-thermal, klipper-thermal"),
     ("frame", lambda: _vmc3().derive("base"), ["derive", VMC3, "--frame", "base"],
      "`base` is not a frame: choose one of tool, workpiece"),
     ("kind", lambda: chain.Machine.load(PROBE).plan(CANDIDATES, 40, kind="line"),

@@ -99,7 +99,7 @@ def test_export_points_and_refusals(cli_error, tmp_path):
         m.export(VALUES, controller="linuxcnc", points=q, params={"L": 150})
     with pytest.raises(ValueError) as info:
         m.export(VALUES, controller="fanuc")
-    wording = "`fanuc` is not a controller: choose one of grid, beckhoff, linuxcnc, siemens-cec, klipper, linuxcnc-trt, heidenhain, siemens-carr, fanuc-tcp, siemens-thermal, linuxcnc-thermal"
+    wording = "`fanuc` is not a controller: choose one of grid, beckhoff, linuxcnc, siemens-cec, klipper, linuxcnc-trt, heidenhain, siemens-carr, fanuc-tcp, siemens-thermal, linuxcnc-thermal, beckhoff-thermal, heidenhain-thermal, klipper-thermal"
     assert str(info.value) == wording
     assert wording in flat(cli_error("export", MACHINE, "--values", VALUES, "--controller", "fanuc"))
     with pytest.raises(ValueError) as info:

@@ -145,7 +145,8 @@ def test_reliability_over_temperatures_is_the_cli_s(cli):
 def test_the_thermal_export_is_the_cli_s(cli, tmp_path):
     m = chain.Machine.load(THERMAL_MACHINE)
     grid = {"x": [0, 400, 800], "y": [0, 250, 500], "z": [0, 250, 500]}
-    for controller in ("siemens-thermal", "linuxcnc-thermal"):
+    for controller in ("siemens-thermal", "linuxcnc-thermal", "beckhoff-thermal", "heidenhain-thermal",
+                       "klipper-thermal"):
         got = m.export(THERMAL_VALUES, controller=controller, grid=grid)
         want = cli("export", THERMAL_MACHINE, "--values", THERMAL_VALUES, "--controller", controller, "--out",
                    tmp_path / controller, "--grid", "x=0,400,800", "--grid", "y=0,250,500", "--grid", "z=0,250,500")

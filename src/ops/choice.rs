@@ -177,6 +177,15 @@ impl Choice for ExportController {
             ExportController::Thermal(chain_core::compensation::thermal::ThermalFormat::Linuxcnc) => {
                 "LinuxCNC external axis offsets from a HAL component of the sensors (thermal_comp.comp, .hal, .ini)"
             }
+            ExportController::Thermal(chain_core::compensation::thermal::ThermalFormat::Beckhoff) => {
+                "TwinCAT CNC temperature compensation: offset_0, coefficient and s0 per axis (P-AXIS-00271..00274) and the PLC function block that sets them (temp_comp_axes.lis, FB_TempComp.st)"
+            }
+            ExportController::Thermal(chain_core::compensation::thermal::ThermalFormat::Heidenhain) => {
+                "HEIDENHAIN TEMPCOMP formulas of the sensors' PLC words, an offset per axis within 31 characters (KINEMATICS_TEMPCOMP.TAB)"
+            }
+            ExportController::Thermal(chain_core::compensation::thermal::ThermalFormat::Klipper) => {
+                "Klipper [z_thermal_adjust]: Z only, one sensor (z_thermal_adjust.cfg)"
+            }
         }
     }
 }

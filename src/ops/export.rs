@@ -38,15 +38,19 @@ pub enum ExportController {
 impl ExportController {
     /// Every controller, in the order of `--controller`'s values: the grid,
     /// then [`Controller::ALL`].
-    pub const ALL: [ExportController; 3 + Controller::ALL.len()] = {
-        let mut all = [ExportController::Grid; 3 + Controller::ALL.len()];
+    pub const ALL: [ExportController; 1 + Controller::ALL.len() + ThermalFormat::ALL.len()] = {
+        let mut all =
+            [ExportController::Grid; 1 + Controller::ALL.len() + ThermalFormat::ALL.len()];
         let mut i = 0;
         while i < Controller::ALL.len() {
             all[i + 1] = ExportController::Tables(Controller::ALL[i]);
             i += 1;
         }
-        all[i + 1] = ExportController::Thermal(ThermalFormat::Siemens);
-        all[i + 2] = ExportController::Thermal(ThermalFormat::Linuxcnc);
+        let mut j = 0;
+        while j < ThermalFormat::ALL.len() {
+            all[i + 1 + j] = ExportController::Thermal(ThermalFormat::ALL[j]);
+            j += 1;
+        }
         all
     };
 
@@ -57,6 +61,9 @@ impl ExportController {
             ExportController::Tables(c) => c.name(),
             ExportController::Thermal(ThermalFormat::Siemens) => "siemens-thermal",
             ExportController::Thermal(ThermalFormat::Linuxcnc) => "linuxcnc-thermal",
+            ExportController::Thermal(ThermalFormat::Beckhoff) => "beckhoff-thermal",
+            ExportController::Thermal(ThermalFormat::Heidenhain) => "heidenhain-thermal",
+            ExportController::Thermal(ThermalFormat::Klipper) => "klipper-thermal",
         }
     }
 
@@ -527,13 +534,13 @@ fn thermal_export(
     let (points, _) = request.points.resolve(m, file)?;
     let points: Vec<Vec<f64>> = (0..points.len()).map(|i| points.point(i)).collect();
     let model = chain_core::compile(m);
-    let law = thermal::fit(m, &model, params, values, &points).map_err(|error| {
+    let law = thermal::fit(m, &model, params, values, &points, format).map_err(|error| {
         ExportOpsError::Thermal {
             values: values_file.to_string(),
             error: Box::new(error),
         }
     })?;
-    let written = law.files(format, &request.controller.provenance());
+    let written = law.files(&request.controller.provenance());
     Ok(ExportDocument::Thermal(ThermalExport {
         values_file: values_file.to_string(),
         files: written.iter().map(|f| f.name.clone()).collect(),

@@ -278,6 +278,18 @@ impl Report for ThermalExport {
                 r.after * 1e3
             );
         }
+        for a in l.axes.iter().filter(|a| a.formula.is_some()) {
+            let _ = writeln!(
+                out,
+                "TEMPCOMP {}: {}",
+                a.axis,
+                a.formula.as_deref().unwrap_or("")
+            );
+        }
+        let _ = writeln!(out, "\n{} holds {}", self.files.join(", "), l.holds);
+        for n in &l.notes {
+            let _ = writeln!(out, "- {n}");
+        }
         out
     }
 

@@ -335,7 +335,7 @@ fn bad_input_is_refused_clearly() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains(
-            "`fanuc` is not a controller: choose one of grid, beckhoff, linuxcnc, siemens-cec, klipper, linuxcnc-trt, heidenhain, siemens-carr, fanuc-tcp, siemens-thermal, linuxcnc-thermal"
+            "`fanuc` is not a controller: choose one of grid, beckhoff, linuxcnc, siemens-cec, klipper, linuxcnc-trt, heidenhain, siemens-carr, fanuc-tcp, siemens-thermal, linuxcnc-thermal, beckhoff-thermal, heidenhain-thermal, klipper-thermal"
         ),
         "{err}"
     );

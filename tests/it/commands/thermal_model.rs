@@ -755,13 +755,31 @@ fn a_path_at_a_thermal_state_is_the_grid_study_there() {
     }
 }
 
-/// `c*(V1-20)+c*(V2-20)…` (a written formula) with each variable's value
+/// `c*(V1-20)+c*(V2-20)-c*(V3-20)…` (a written formula) with each variable's value
 /// from `var`.
 fn formula_with(text: &str, var: &dyn Fn(&str) -> f64) -> f64 {
     if text == "0" {
         return 0.0;
     }
-    text.split('+')
+    // The terms: split before each sign outside parentheses.
+    let mut terms = vec![String::new()];
+    let mut depth = 0;
+    for c in text.chars() {
+        match c {
+            '(' => depth += 1,
+            ')' => depth -= 1,
+            '+' | '-'
+                if depth == 0
+                    && !terms.last().unwrap().is_empty()
+                    && !terms.last().unwrap().ends_with('e') =>
+            {
+                terms.push(String::new())
+            }
+            _ => {}
+        }
+        terms.last_mut().unwrap().push(c);
+    }
+    (terms.iter())
         .map(|term| {
             let (c, rest) = term.split_once("*(").unwrap();
             let (v, reference) = rest.trim_end_matches(')').split_once('-').unwrap();
@@ -803,38 +821,59 @@ fn thermal_part(state: &str, grid: &[&str]) -> Vec<(Value, [f64; 3])> {
         .collect()
 }
 
-#[test]
-fn the_siemens_temperature_compensation_applied_as_the_controller_applies_it_leaves_the_stated_remainder(
-) {
-    use chain_core::compensation::thermal::{fit, ThermalFormat};
+/// The `format` law of vmc3_thermal over the grid `x`, `y`, `z`
+/// (`[xs, ys, zs]`), spindle offset 150.
+fn vmc3_law(
+    format: chain_core::compensation::thermal::ThermalFormat,
+    grid: [&[f64]; 3],
+) -> chain_core::compensation::thermal::ThermalLaw {
     let file = common::example_file("thermal/vmc3_thermal.yaml");
     let values_file = common::example_file("thermal/vmc3_thermal_values.yaml");
     let machine = chain_core::load_file(&file).unwrap();
     let model = chain_core::compile(&machine);
     let values = chain_core::values::Values::read(&values_file, &machine).unwrap();
-    let grid = [
-        ("x", [0.0, 200.0, 400.0, 600.0, 800.0]),
-        ("y", [0.0, 125.0, 250.0, 375.0, 500.0]),
-        ("z", [0.0, 125.0, 250.0, 375.0, 500.0]),
-    ];
+    let names: Vec<&str> = machine.variables.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(names, ["y", "x", "z"]);
     let mut points = Vec::new();
-    for &y in &grid[1].1 {
-        for &x in &grid[0].1 {
-            for &z in &grid[2].1 {
+    for &y in grid[1] {
+        for &x in grid[0] {
+            for &z in grid[2] {
                 points.push(vec![y, x, z]);
             }
         }
     }
-    assert_eq!(
-        machine
-            .variables
-            .iter()
-            .map(|v| v.name.as_str())
-            .collect::<Vec<_>>(),
-        ["y", "x", "z"]
+    chain_core::compensation::thermal::fit(&machine, &model, &[150.0], &values, &points, format)
+        .unwrap()
+}
+
+/// The 3×3×3 grid of the thermal export tests, and its `--grid` arguments.
+const COARSE: [&[f64]; 3] = [
+    &[0.0, 400.0, 800.0],
+    &[0.0, 250.0, 500.0],
+    &[0.0, 250.0, 500.0],
+];
+const COARSE_ARGS: [&str; 6] = [
+    "--grid",
+    "x=0,400,800",
+    "--grid",
+    "y=0,250,500",
+    "--grid",
+    "z=0,250,500",
+];
+
+#[test]
+fn the_siemens_temperature_compensation_applied_as_the_controller_applies_it_leaves_the_stated_remainder(
+) {
+    use chain_core::compensation::thermal::ThermalFormat;
+    let law = vmc3_law(
+        ThermalFormat::Siemens,
+        [
+            &[0.0, 200.0, 400.0, 600.0, 800.0],
+            &[0.0, 125.0, 250.0, 375.0, 500.0],
+            &[0.0, 125.0, 250.0, 375.0, 500.0],
+        ],
     );
-    let law = fit(&machine, &model, &[150.0], &values, &points).unwrap();
-    let spf = &law.files(ThermalFormat::Siemens, "test")[0].text;
+    let spf = &law.files("test")[0].text;
     let sensors: Vec<String> = law.axes[0].lines.iter().map(|l| l.sensor.clone()).collect();
     // Per axis its K0, tanβ and P0 as the SPF writes them.
     let setting = |name: &str, axis: char| -> String {
@@ -904,22 +943,9 @@ fn the_siemens_temperature_compensation_applied_as_the_controller_applies_it_lea
 
 #[test]
 fn the_linuxcnc_thermal_component_applied_as_hal_applies_it_leaves_the_stated_remainder() {
-    use chain_core::compensation::thermal::{fit, ThermalFormat};
-    let file = common::example_file("thermal/vmc3_thermal.yaml");
-    let values_file = common::example_file("thermal/vmc3_thermal_values.yaml");
-    let machine = chain_core::load_file(&file).unwrap();
-    let model = chain_core::compile(&machine);
-    let values = chain_core::values::Values::read(&values_file, &machine).unwrap();
-    let mut points = Vec::new();
-    for y in [0.0, 250.0, 500.0] {
-        for x in [0.0, 400.0, 800.0] {
-            for z in [0.0, 250.0, 500.0] {
-                points.push(vec![y, x, z]);
-            }
-        }
-    }
-    let law = fit(&machine, &model, &[150.0], &values, &points).unwrap();
-    let files = law.files(ThermalFormat::Linuxcnc, "test");
+    use chain_core::compensation::thermal::ThermalFormat;
+    let law = vmc3_law(ThermalFormat::Linuxcnc, COARSE);
+    let files = law.files("test");
     let text = |name: &str| files.iter().find(|f| f.name == name).unwrap().text.clone();
     let (comp, hal, ini) = (
         text("thermal_comp.comp"),
@@ -948,15 +974,8 @@ fn the_linuxcnc_thermal_component_applied_as_hal_applies_it_leaves_the_stated_re
     // Each axis's `d = (K0) + (m)*(pos_a - P0);` as the component computes
     // it, its counts rounded at k = 100000 per mm, the offset added to the
     // command (axis.c: the external offset adds to the axis position).
-    let t = [
-        ("T_x", 27.0),
-        ("T_front", 31.0),
-        ("T_rear", 26.0),
-        ("T_head", 24.0),
-        ("T_coltop", 22.5),
-    ];
     let temp = |v: &str| -> f64 {
-        t.iter()
+        HOT.iter()
             .find(|(n, _)| format!("temp_{}", n.to_lowercase()) == v)
             .unwrap()
             .1
@@ -971,29 +990,9 @@ fn the_linuxcnc_thermal_component_applied_as_hal_applies_it_leaves_the_stated_re
         let (m, p0) = rest.split_once(&format!(")*(pos_{a} - ")).unwrap();
         (k0.to_string(), m.to_string(), p0.parse().unwrap())
     };
-    let state: Vec<String> = t.iter().map(|(n, v)| format!("{n}={v}")).collect();
-    let joined = state.join(",");
-    let grid = [
-        "--grid",
-        "x=0,400,800",
-        "--grid",
-        "y=0,250,500",
-        "--grid",
-        "z=0,250,500",
-    ];
-    // What the law leaves at this state, from its per-sensor parts: the
-    // remainder is linear in ΔT, so the test's own sum bounds it.
-    let bound: f64 = law
-        .remainder
-        .iter()
-        .map(|r| r.after * (t.iter().find(|(n, _)| *n == r.sensor).unwrap().1 - 20.0).abs())
-        .sum();
-    let mut largest = 0.0f64;
-    let mut thermal = 0.0f64;
-    for (point, part) in thermal_part(&joined, &grid) {
-        let mut left = part;
-        thermal = thermal.max(left.iter().map(|v| v * v).sum::<f64>().sqrt());
-        for (k, a) in ['x', 'y', 'z'].into_iter().enumerate() {
+    let (largest, thermal, bound) = applied(&law, &|point| {
+        std::array::from_fn(|k| {
+            let a = ['x', 'y', 'z'][k];
             let (k0, m, p0) = d_line(a);
             let pos = point[a.to_string()].as_f64().unwrap();
             let d = formula_with(&k0, &temp) + formula_with(&m, &temp) * (pos - p0);
@@ -1002,10 +1001,9 @@ fn the_linuxcnc_thermal_component_applied_as_hal_applies_it_leaves_the_stated_re
             } else {
                 (d * 1e5 - 0.5).trunc()
             };
-            left[k] += counts * 1e-5;
-        }
-        largest = largest.max(left.iter().map(|v| v * v).sum::<f64>().sqrt());
-    }
+            counts * 1e-5
+        })
+    });
     // The counts' rounding adds at most half a count per axis.
     assert!(
         largest <= bound + 0.5e-5 * 3f64.sqrt() + 1e-12,
@@ -1015,33 +1013,346 @@ fn the_linuxcnc_thermal_component_applied_as_hal_applies_it_leaves_the_stated_re
 }
 
 #[test]
+fn the_spindle_model_s_controller_examples_are_current() {
+    // examples/thermal/README.md's commands: the drift test's spindle
+    // model as a SINUMERIK and a LinuxCNC temperature compensation, over
+    // the machine's grid.
+    let dir = scratch("thermal-spindle-examples");
+    for (controller, folder, names) in [
+        ("siemens-thermal", "spindle_siemens", vec!["TEMP_COMP.SPF"]),
+        (
+            "linuxcnc-thermal",
+            "spindle_linuxcnc",
+            vec!["thermal_comp.comp", "thermal_comp.hal", "thermal_comp.ini"],
+        ),
+    ] {
+        let out = dir.join(folder);
+        let doc = ok_json(&[
+            "export",
+            &example("thermal/vmc3_thermal.yaml"),
+            "--values",
+            &example("thermal/spindle_values.yaml"),
+            "--controller",
+            controller,
+            "--out",
+            s(&out),
+            "--format",
+            "json",
+        ]);
+        // The spindle's growth along Z is a constant per kelvin of each
+        // sensor: the line holds it whole.
+        for r in doc["remainder"].as_array().unwrap() {
+            assert!(r["after"].as_f64().unwrap() < 1e-12, "{r}");
+        }
+        for n in names {
+            let written = std::fs::read_to_string(out.join(n)).unwrap();
+            let example_file = common::example_file(&format!("thermal/{folder}/{n}"));
+            if std::env::var_os("CHAIN_REGENERATE").is_some() {
+                std::fs::write(&example_file, &written).unwrap();
+            }
+            let example_text = std::fs::read_to_string(&example_file).unwrap();
+            assert_eq!(written, example_text, "{n}: rerun with CHAIN_REGENERATE=1");
+        }
+    }
+}
+
+/// The thermal state of the export tests (°C).
+const HOT: [(&str, f64); 5] = [
+    ("T_x", 27.0),
+    ("T_front", 31.0),
+    ("T_rear", 26.0),
+    ("T_head", 24.0),
+    ("T_coltop", 22.5),
+];
+
+/// A controller's correction applied over the coarse grid at [`HOT`]:
+/// `correct(point)` is the tool point's move along X, Y, Z the controller
+/// makes there. Returns the largest error left, the largest thermal error
+/// before, and the bound the law states (the remainder is linear in ΔT:
+/// `Σ_s after_s·|ΔT_s|`).
+fn applied(
+    law: &chain_core::compensation::thermal::ThermalLaw,
+    correct: &dyn Fn(&Value) -> [f64; 3],
+) -> (f64, f64, f64) {
+    let state: Vec<String> = HOT.iter().map(|(n, v)| format!("{n}={v}")).collect();
+    let bound: f64 = (law.remainder.iter())
+        .map(|r| r.after * (HOT.iter().find(|(n, _)| *n == r.sensor).unwrap().1 - 20.0).abs())
+        .sum();
+    let norm = |v: &[f64; 3]| v.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let (mut largest, mut thermal) = (0.0f64, 0.0f64);
+    for (point, part) in thermal_part(&state.join(","), &COARSE_ARGS) {
+        let mut left = part;
+        thermal = thermal.max(norm(&left));
+        for (l, d) in left.iter_mut().zip(correct(&point)) {
+            *l += d;
+        }
+        largest = largest.max(norm(&left));
+    }
+    (largest, thermal, bound)
+}
+
+/// A Structured Text sum of `c*(NAME - R)` terms (` + `, ` - ` between
+/// them), each name's value from `var`.
+fn st_sum(text: &str, var: &dyn Fn(&str) -> f64) -> f64 {
+    if text == "0.0" {
+        return 0.0;
+    }
+    (text
+        .replace(") + ", ")|+")
+        .replace(") - ", ")|-")
+        .split('|'))
+    .map(|term| {
+        let (c, rest) = term.split_once("*(").unwrap();
+        let (v, r) = rest.trim_end_matches(')').split_once(" - ").unwrap();
+        c.parse::<f64>().unwrap() * (var(v) - r.parse::<f64>().unwrap())
+    })
+    .sum()
+}
+
+#[test]
+fn the_beckhoff_temperature_compensation_applied_as_the_cnc_applies_it_leaves_the_stated_remainder()
+{
+    use chain_core::compensation::thermal::ThermalFormat;
+    let law = vmc3_law(ThermalFormat::Beckhoff, COARSE);
+    let files = law.files("test");
+    let text = |name: &str| files.iter().find(|f| f.name == name).unwrap().text.clone();
+    let (lis, st) = (text("temp_comp_axes.lis"), text("FB_TempComp.st"));
+    // Per axis its block of the axis list (P-AXIS-00271..00274).
+    let block = |a: char| {
+        lis.split(&format!("# axis {a} "))
+            .nth(1)
+            .unwrap()
+            .to_string()
+    };
+    let key = |a: char, k: &str| -> f64 {
+        (block(a).lines())
+            .find_map(|l| l.strip_prefix(&format!("lr_param.{k} ")))
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap()
+    };
+    let assigned = |name: String| -> String {
+        (st.lines())
+            .find_map(|l| l.strip_prefix(&format!("{name} := ")))
+            .unwrap()
+            .trim_end_matches(';')
+            .to_string()
+    };
+    let temp = |v: &str| HOT.iter().find(|(n, _)| *n == v).unwrap().1;
+    let (largest, thermal, bound) = applied(&law, &|point| {
+        std::array::from_fn(|k| {
+            let a = ['X', 'Y', 'Z'][k];
+            assert_eq!(key(a, "temp_comp"), 1.0);
+            let offset = assigned(format!("offset_0_{a}"));
+            let offset = offset
+                .strip_prefix("LREAL_TO_DINT(")
+                .unwrap()
+                .strip_suffix(')')
+                .unwrap();
+            // LREAL_TO_DINT rounds to the nearest integer, halves away
+            // from zero (Beckhoff Infosys, "REAL/LREAL_TO_<type>").
+            let offset = st_sum(offset, &temp).round();
+            let coefficient = st_sum(&assigned(format!("coefficient_{a}")), &temp);
+            let s0 = key(a, "temp_comp_position_0");
+            let s = point[a.to_ascii_lowercase().to_string()].as_f64().unwrap();
+            // Δs = offset_0 + coefficient·(s − s0): 0.1 µm, µm/m, added
+            // to the command (vmc3's axes move the tool along +X, +Y, +Z).
+            offset * 1e-4 + coefficient * 1e-6 * (s - s0 * 1e-4)
+        })
+    });
+    // offset_0's rounding adds at most 0.05 µm per axis.
+    assert!(
+        largest <= bound + 0.5e-4 * 3f64.sqrt() + 1e-12,
+        "{largest} vs {bound}"
+    );
+    assert!(largest < 0.2 * thermal, "{largest} of {thermal}");
+}
+
+/// A TEMPCOMP formula's value (`ĉ*W486-ĉ*W488+K`), each word's value from
+/// `word`.
+fn tempcomp_value(text: &str, word: &dyn Fn(&str) -> f64) -> f64 {
+    let b = text.as_bytes();
+    let mut terms = Vec::new();
+    let mut start = 0;
+    for i in 1..b.len() {
+        if (b[i] == b'+' || b[i] == b'-') && b[i - 1] != b'e' {
+            terms.push(&text[start..i]);
+            start = i;
+        }
+    }
+    terms.push(&text[start..]);
+    (terms.iter())
+        .map(|t| match t.split_once('*') {
+            Some((c, w)) => c.parse::<f64>().unwrap() * word(w),
+            None => t.parse::<f64>().unwrap(),
+        })
+        .sum()
+}
+
+#[test]
+fn the_heidenhain_tempcomp_formulas_evaluated_as_the_tnc_does_leave_the_stated_remainder() {
+    use chain_core::compensation::thermal::{ThermalFormat, TEMPCOMP_CHARS};
+    let law = vmc3_law(ThermalFormat::Heidenhain, COARSE);
+    let files = law.files("test");
+    let text = |name: &str| files.iter().find(|f| f.name == name).unwrap().text.clone();
+    let (tab, readme) = (
+        text("KINEMATICS_TEMPCOMP.TAB"),
+        text("KINEMATICS_TEMPCOMP-README.txt"),
+    );
+    // The words the PLC fills, by the README.
+    let words: Vec<(String, String)> = (readme.lines())
+        .filter_map(|l| l.trim().split_once(" = "))
+        .filter(|(w, _)| w.starts_with('W'))
+        .map(|(w, s)| (w.to_string(), s.to_string()))
+        .collect();
+    assert_eq!(words.len(), 5, "{readme}");
+    // Per row: Trans, its axis, COORD 0 and the formula.
+    let rows: Vec<(char, String)> = (tab.lines().skip(2))
+        .take_while(|l| *l != "[END]")
+        .map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            assert_eq!((f[1], f[3]), ("Trans", "0"), "{l}");
+            assert!(f[4].len() <= TEMPCOMP_CHARS, "{l}");
+            (f[2].chars().next().unwrap(), f[4].to_string())
+        })
+        .collect();
+    assert_eq!(rows.len(), 3, "{tab}");
+    assert!(tab.starts_with("BEGIN KINEMATICS_TEMPCOMP.TAB MM\nNR"));
+    let at = |t: &[f64]| -> [f64; 3] {
+        let word = |w: &str| {
+            let s = &words.iter().find(|(x, _)| x == w).unwrap().1;
+            let i = law.remainder.iter().position(|r| &r.sensor == s).unwrap();
+            t[i]
+        };
+        std::array::from_fn(|k| {
+            let axis = ['X', 'Y', 'Z'][k];
+            let (_, f) = rows.iter().find(|(a, _)| *a == axis).unwrap();
+            tempcomp_value(f, &word)
+        })
+    };
+    // 0 at the references: the constant is exact.
+    for v in at(&[20.0; 5]) {
+        assert!(v.abs() < 1e-15, "{v}");
+    }
+    // Sensor by sensor 5 K above its reference: the rows displace the
+    // table (the workpiece side), the tool point's error moves by them;
+    // what is left is five times the stated remainder.
+    for (i, r) in law.remainder.iter().enumerate() {
+        let mut t = [20.0; 5];
+        t[i] += 5.0;
+        let state: Vec<String> = (law.remainder.iter().zip(&t))
+            .map(|(r, v)| format!("{}={v}", r.sensor))
+            .collect();
+        let d = at(&t);
+        let mut largest = 0.0f64;
+        for (_, part) in thermal_part(&state.join(","), &COARSE_ARGS) {
+            let left: Vec<f64> = (0..3).map(|k| part[k] + d[k]).collect();
+            largest = largest.max(left.iter().map(|v| v * v).sum::<f64>().sqrt());
+        }
+        assert!(
+            (largest - 5.0 * r.after).abs() < 1e-9 * r.before + 1e-12,
+            "{}: {largest} vs {}",
+            r.sensor,
+            5.0 * r.after
+        );
+    }
+    // The spindle's growth along Z from T_front and T_rear is held (a
+    // constant per kelvin); T_head's does not fit the 31 characters; the
+    // X scale growth is a slope TEMPCOMP cannot hold (half of it left).
+    let after = |s: &str| {
+        law.remainder
+            .iter()
+            .find(|r| r.sensor == s)
+            .unwrap()
+            .clone()
+    };
+    assert!(after("T_front").after < 1e-12);
+    assert!((after("T_head").after - after("T_head").before).abs() < 1e-15);
+    assert!((after("T_x").after - 0.5 * after("T_x").before).abs() < 1e-12);
+    assert!(law.notes.iter().any(|n| n.contains("no room for T_head")));
+}
+
+#[test]
+fn klipper_s_z_thermal_adjust_applied_from_the_homing_temperature_leaves_the_stated_remainder() {
+    use chain_core::compensation::thermal::ThermalFormat;
+    let law = vmc3_law(ThermalFormat::Klipper, COARSE);
+    let cfg = &law.files("test")[0].text;
+    assert!(cfg.contains("\n[z_thermal_adjust]\ntemp_coeff: "), "{cfg}");
+    let coeff: f64 = (cfg.lines())
+        .find_map(|l| l.strip_prefix("temp_coeff: "))
+        .unwrap()
+        .parse()
+        .unwrap();
+    // One sensor on Z: the spindle's front bearing, 2.5 µm/K of growth
+    // (examples/thermal/vmc3_thermal_values.yaml).
+    assert_eq!(law.axes.len(), 1);
+    assert_eq!(law.axes[0].axis, 'Z');
+    assert_eq!(law.axes[0].lines.len(), 1);
+    assert_eq!(law.axes[0].lines[0].sensor, "T_front");
+    assert!((coeff - 0.0025).abs() < 1e-15, "{coeff}");
+    // Homed at 23 °C (front) and 21 °C (rear), run at 29 and 27:
+    // z_thermal_adjust.py moves Z by −temp_coeff·(T − T_ref), T_ref the
+    // front sensor at homing; homing took up the error there.
+    let state = |front: f64, rear: f64| {
+        format!("T_x=20,T_front={front},T_rear={rear},T_head=20,T_coltop=20")
+    };
+    let homed = thermal_part(&state(23.0, 21.0), &COARSE_ARGS);
+    let hot = thermal_part(&state(29.0, 27.0), &COARSE_ARGS);
+    let mut largest = 0.0f64;
+    for ((_, h), (_, r)) in homed.iter().zip(&hot) {
+        let mut left: Vec<f64> = (0..3).map(|k| r[k] - h[k]).collect();
+        left[2] += -coeff * (29.0 - 23.0);
+        largest = largest.max(left.iter().map(|v| v * v).sum::<f64>().sqrt());
+    }
+    // The front's growth is held; the rear's 6 K are left whole.
+    let rear = law.remainder.iter().find(|r| r.sensor == "T_rear").unwrap();
+    let front = law
+        .remainder
+        .iter()
+        .find(|r| r.sensor == "T_front")
+        .unwrap();
+    assert!(front.after < 1e-12, "{front:?}");
+    assert_eq!(rear.after, rear.before);
+    assert!(
+        (largest - 6.0 * rear.after).abs() < 1e-12,
+        "{largest} vs {}",
+        6.0 * rear.after
+    );
+}
+
+#[test]
 fn the_thermal_formats_are_export_controllers() {
     let file = example("thermal/vmc3_thermal.yaml");
     let values = example("thermal/vmc3_thermal_values.yaml");
     let dir = scratch("thermal-export-cli");
-    let grid = [
-        "--grid",
-        "x=0,400,800",
-        "--grid",
-        "y=0,250,500",
-        "--grid",
-        "z=0,250,500",
-    ];
-    for (controller, names) in [
-        ("siemens-thermal", vec!["TEMP_COMP.SPF"]),
+    let grid = COARSE_ARGS;
+    use chain_core::compensation::thermal::ThermalFormat;
+    for (format, names) in [
+        (ThermalFormat::Siemens, vec!["TEMP_COMP.SPF"]),
         (
-            "linuxcnc-thermal",
+            ThermalFormat::Linuxcnc,
             vec!["thermal_comp.comp", "thermal_comp.hal", "thermal_comp.ini"],
         ),
+        (
+            ThermalFormat::Beckhoff,
+            vec!["temp_comp_axes.lis", "FB_TempComp.st"],
+        ),
+        (
+            ThermalFormat::Heidenhain,
+            vec!["KINEMATICS_TEMPCOMP.TAB", "KINEMATICS_TEMPCOMP-README.txt"],
+        ),
+        (ThermalFormat::Klipper, vec!["z_thermal_adjust.cfg"]),
     ] {
-        let out = dir.join(controller);
+        let controller = format!("{}-thermal", format.name());
+        let out = dir.join(&controller);
         let mut args = vec![
             "export",
             &file,
             "--values",
             &values,
             "--controller",
-            controller,
+            &controller,
             "--out",
             s(&out),
             "--format",
@@ -1050,7 +1361,7 @@ fn the_thermal_formats_are_export_controllers() {
         args.extend_from_slice(&grid);
         let doc = ok_json(&args);
         assert_eq!(doc["files"], serde_json::json!(names));
-        for n in &names {
+        for n in names.iter().filter(|n| !n.ends_with(".TAB")) {
             let text = std::fs::read_to_string(out.join(n)).unwrap();
             assert!(
                 text.contains(&format!("chain export --controller {controller}")),
@@ -1058,30 +1369,49 @@ fn the_thermal_formats_are_export_controllers() {
             );
         }
         // The document is the library's law over the same grid.
-        let x = (doc["axes"].as_array().unwrap().iter())
-            .find(|a| a["axis"] == "X")
-            .unwrap();
-        let tx = (x["lines"].as_array().unwrap().iter())
-            .find(|l| l["sensor"] == "T_x")
-            .unwrap();
-        assert!((tx["slope"].as_f64().unwrap() - 11.5e-6).abs() < 1e-15);
+        let law = serde_json::to_value(vmc3_law(format, COARSE)).unwrap();
+        for key in ["format", "holds", "axes", "remainder", "notes"] {
+            common::json_to_roundoff(&law[key], &doc[key], key)
+                .unwrap_or_else(|e| panic!("{controller}: {e}"));
+        }
         let mut args = vec![
             "export",
             &file,
             "--values",
             &values,
             "--controller",
-            controller,
+            &controller,
             "--out",
             s(&out),
         ];
         args.extend_from_slice(&grid);
         let table = ok_stdout(&args);
         assert!(
-            table.contains("T_x") && table.contains("11.5000"),
+            table.contains("T_front") && table.contains(doc["holds"].as_str().unwrap()),
             "{table}"
         );
+        if format != ThermalFormat::Klipper && format != ThermalFormat::Heidenhain {
+            assert!(table.contains("11.5000"), "{table}");
+        }
     }
+    // Klipper corrects Z, and this machine has X only.
+    let (m, v) = files("thermal-klipper-no-z");
+    let e = unwrapped(&fails(&[
+        "export",
+        s(&m),
+        "--values",
+        s(&v),
+        "--controller",
+        "klipper-thermal",
+        "--grid",
+        "x=0,250,500",
+        "--out",
+        s(&dir),
+    ]));
+    assert!(
+        e.contains("machine `scale1` has no linear axis along Z: Klipper's [z_thermal_adjust] corrects Z only"),
+        "{e}"
+    );
     let e = unwrapped(&fails(&[
         "export",
         &file,

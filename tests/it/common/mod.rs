@@ -903,3 +903,43 @@ pub fn example_machines() -> Vec<std::path::PathBuf> {
     files.sort();
     files
 }
+
+/// `a` and `b` (at `at`) equal but for numbers that agree up to round-off
+/// (relative 1e-14, or both below 1e-14): the first difference, located.
+pub fn json_to_roundoff(
+    a: &serde_json::Value,
+    b: &serde_json::Value,
+    at: &str,
+) -> Result<(), String> {
+    match (a, b) {
+        (serde_json::Value::Number(x), serde_json::Value::Number(y)) => {
+            let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+            if roundoff(x, y) {
+                Ok(())
+            } else {
+                Err(format!("{at}: {x}, now {y}"))
+            }
+        }
+        (serde_json::Value::Object(x), serde_json::Value::Object(y)) => {
+            if x.keys().ne(y.keys()) {
+                return Err(format!("{at}: keys differ"));
+            }
+            x.iter()
+                .zip(y.values())
+                .try_for_each(|((k, v), w)| json_to_roundoff(v, w, &format!("{at}.{k}")))
+        }
+        (serde_json::Value::Array(x), serde_json::Value::Array(y)) if x.len() == y.len() => x
+            .iter()
+            .zip(y)
+            .enumerate()
+            .try_for_each(|(i, (v, w))| json_to_roundoff(v, w, &format!("{at}[{i}]"))),
+        (x, y) if x == y => Ok(()),
+        (x, y) => Err(format!("{at}: {x}, now {y}")),
+    }
+}
+
+/// Two printed numbers equal up to round-off (relative 1e-14, or both
+/// below 1e-14).
+pub fn roundoff(a: f64, b: f64) -> bool {
+    a == b || close(a, b, 1e-14, 0.0) || a.abs().max(b.abs()) < 1e-14
+}

@@ -48,45 +48,13 @@ fn roundoff(name: &str) -> bool {
     name.starts_with("allocate_optimal") || name.starts_with("path_cnc5")
 }
 
-/// Two printed numbers equal up to round-off.
-fn close(a: f64, b: f64) -> bool {
-    a == b || (a - b).abs() <= 1e-14 * a.abs().max(b.abs()) || a.abs().max(b.abs()) < 1e-14
-}
-
 /// `recorded` and `new` equal but for numbers that agree up to round-off
 /// (JSON numbers, or number tokens in text).
 fn equal_to_roundoff(recorded: &str, new: &str, json: bool) -> Result<(), String> {
     if json {
-        fn walk(a: &Value, b: &Value, at: &str) -> Result<(), String> {
-            match (a, b) {
-                (Value::Number(x), Value::Number(y)) => {
-                    let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
-                    if close(x, y) {
-                        Ok(())
-                    } else {
-                        Err(format!("{at}: {x}, now {y}"))
-                    }
-                }
-                (Value::Object(x), Value::Object(y)) => {
-                    if x.keys().ne(y.keys()) {
-                        return Err(format!("{at}: keys differ"));
-                    }
-                    x.iter()
-                        .zip(y.values())
-                        .try_for_each(|((k, v), w)| walk(v, w, &format!("{at}.{k}")))
-                }
-                (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
-                    .iter()
-                    .zip(y)
-                    .enumerate()
-                    .try_for_each(|(i, (v, w))| walk(v, w, &format!("{at}[{i}]"))),
-                (x, y) if x == y => Ok(()),
-                (x, y) => Err(format!("{at}: {x}, now {y}")),
-            }
-        }
         let a: Value = serde_json::from_str(recorded).unwrap();
         let b: Value = serde_json::from_str(new).map_err(|e| e.to_string())?;
-        return walk(&a, &b, "$");
+        return common::json_to_roundoff(&a, &b, "$");
     }
     let (a, b): (Vec<&str>, Vec<&str>) = (recorded.lines().collect(), new.lines().collect());
     if a.len() != b.len() {
@@ -102,7 +70,7 @@ fn equal_to_roundoff(recorded: &str, new: &str, json: bool) -> Result<(), String
                 let strip = |t: &str| t.trim_end_matches([',', ';', ')']).to_string();
                 x == y
                     || matches!((strip(x).parse::<f64>(), strip(y).parse::<f64>()),
-                        (Ok(p), Ok(q)) if close(p, q))
+                        (Ok(p), Ok(q)) if common::roundoff(p, q))
             });
         if !same {
             return Err(format!("line {}: {la:?}, now {lb:?}", i + 1));
