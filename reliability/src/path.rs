@@ -457,11 +457,11 @@ impl PathStudy {
         let study = study(spec, points)?;
         let nominal = (study.points().iter())
             .map(|q| {
-                let at = model.nominal(q, parameters).position.map(|x| x + 0.0);
+                let at = model.nominal(&q, parameters).position.map(|x| x + 0.0);
                 match at.iter().all(|x| x.is_finite()) {
                     true => Ok(at),
                     false => Err(ReliabilityError::Overflow {
-                        at: crate::study::point_text(study.variables(), q),
+                        at: crate::study::point_text(study.variables(), &q),
                         what: "nominal tool point".into(),
                     }),
                 }

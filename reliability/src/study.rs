@@ -103,6 +103,103 @@ impl Grid {
     }
 }
 
+/// The points of a study: a grid kept as its axes (each point formed when
+/// it is asked for, so a grid of 10⁷ points holds no point), or a list.
+#[derive(Debug, Clone)]
+pub enum Points {
+    /// The cartesian product of the axes, first axis slowest.
+    Grid {
+        /// The axes' values, in grid order.
+        axes: Vec<Vec<f64>>,
+        /// Per model variable, its axis.
+        of: Vec<usize>,
+        /// The number of points.
+        count: usize,
+    },
+    /// Explicit points, in the model's variable order.
+    Listed(Vec<Arc<[f64]>>),
+}
+
+impl Points {
+    /// The number of points.
+    pub fn len(&self) -> usize {
+        match self {
+            Points::Grid { count, .. } => *count,
+            Points::Listed(l) => l.len(),
+        }
+    }
+
+    /// True when there is no point.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Point `p`'s axis values (model variable order) into `out`.
+    pub fn fill(&self, p: usize, out: &mut [f64]) {
+        match self {
+            Points::Grid { axes, of, .. } => {
+                // The multi-index, last axis fastest ([`Grid::index`]).
+                let mut rest = p;
+                let mut idx = [0usize; 16];
+                let mut big = Vec::new();
+                let idx: &mut [usize] = if axes.len() <= 16 {
+                    &mut idx[..axes.len()]
+                } else {
+                    big.resize(axes.len(), 0);
+                    &mut big
+                };
+                for (a, values) in axes.iter().enumerate().rev() {
+                    let len = values.len().max(1);
+                    idx[a] = rest % len;
+                    rest /= len;
+                }
+                for (o, &a) in out.iter_mut().zip(of) {
+                    *o = axes[a][idx[a]];
+                }
+            }
+            Points::Listed(l) => out.copy_from_slice(&l[p]),
+        }
+    }
+
+    /// Point `p`'s axis values, in the model's variable order.
+    pub fn point(&self, p: usize) -> Arc<[f64]> {
+        match self {
+            Points::Grid { of, .. } => {
+                let mut q = vec![0.0; of.len()];
+                self.fill(p, &mut q);
+                q.into()
+            }
+            Points::Listed(l) => Arc::clone(&l[p]),
+        }
+    }
+
+    /// Every point, in order.
+    pub fn iter(&self) -> impl Iterator<Item = Arc<[f64]>> + '_ {
+        (0..self.len()).map(|p| self.point(p))
+    }
+
+    /// The points `range`, one after another (`range.len() × variables`
+    /// values).
+    pub fn flat(&self, range: Range<usize>) -> Vec<f64> {
+        let nv = self.variables();
+        let mut out = vec![0.0; range.len() * nv];
+        if nv > 0 {
+            for (p, q) in range.zip(out.chunks_exact_mut(nv)) {
+                self.fill(p, q);
+            }
+        }
+        out
+    }
+
+    /// The number of variables of a point.
+    fn variables(&self) -> usize {
+        match self {
+            Points::Grid { of, .. } => of.len(),
+            Points::Listed(l) => l.first().map_or(0, |q| q.len()),
+        }
+    }
+}
+
 /// A system limit state over several components.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -281,8 +378,8 @@ pub struct Study {
     point_inputs: Option<Vec<Inputs>>,
     variables: Vec<String>,
     spec: StudySpec,
-    /// The points, each shared with the cases at it.
-    points: Vec<Arc<[f64]>>,
+    /// The points: a grid kept as its axes, or a list.
+    points: Points,
     /// Per point, the `6 × N` sensitivity matrix `∂E/∂e`: kept, or
     /// evaluated when a case needs it.
     rows: Rows,
@@ -695,7 +792,7 @@ impl Study {
         let (inputs, variables) = checked_inputs(model, parameters, inputs)?;
         let points = grid_points(&spec.grid, &variables)?;
         let targets = targets(&spec)?;
-        let rows = Rows::Stored(evaluate(model, parameters, &points)?);
+        let rows = Rows::Stored(evaluate(model, parameters, &points, 0..points.len())?);
         Ok(Study::assemble(
             inputs, variables, spec, points, rows, targets,
         ))
@@ -730,12 +827,13 @@ impl Study {
         inputs: Inputs,
         variables: Vec<String>,
         spec: StudySpec,
-        points: Vec<Arc<[f64]>>,
+        points: Points,
         targets: Vec<Target>,
     ) -> Result<Study, ReliabilityError> {
-        for block in points.chunks(CASE_BLOCK) {
-            let rows = evaluate(&*model, parameters, block)?;
-            check_moments(&inputs, &variables, block, &rows)?;
+        for start in (0..points.len()).step_by(CASE_BLOCK) {
+            let block = start..(start + CASE_BLOCK).min(points.len());
+            let rows = evaluate(&*model, parameters, &points, block.clone())?;
+            check_moments(&inputs, &variables, &points, block, &rows)?;
         }
         let rows = Rows::OnDemand {
             model,
@@ -763,7 +861,7 @@ impl Study {
     ) -> Result<Study, ReliabilityError> {
         let (inputs, variables) = checked_inputs(model, parameters, inputs)?;
         let (spec, points, targets) = listed_points(spec, points, &variables)?;
-        let rows = Rows::Stored(evaluate(model, parameters, &points)?);
+        let rows = Rows::Stored(evaluate(model, parameters, &points, 0..points.len())?);
         Ok(Study::assemble(
             inputs, variables, spec, points, rows, targets,
         ))
@@ -788,7 +886,7 @@ impl Study {
         inputs: Inputs,
         variables: Vec<String>,
         spec: StudySpec,
-        points: Vec<Arc<[f64]>>,
+        points: Points,
         rows: Rows,
         targets: Vec<Target>,
     ) -> Study {
@@ -844,9 +942,9 @@ impl Study {
                 found: bad.len(),
             });
         }
-        for (p, (inputs, q)) in each.iter().zip(&self.points).enumerate() {
+        for (p, inputs) in each.iter().enumerate() {
             let rows = self.sensitivities(p..p + 1);
-            check_moments(inputs, &self.variables, std::slice::from_ref(q), &rows)?;
+            check_moments(inputs, &self.variables, &self.points, p..p + 1, &rows)?;
         }
         self.point_inputs = Some(each);
         Ok(self)
@@ -882,7 +980,7 @@ impl Study {
     }
 
     /// The grid points, in the model's variable order.
-    pub fn points(&self) -> &[Arc<[f64]>] {
+    pub fn points(&self) -> &Points {
         &self.points
     }
 
@@ -937,7 +1035,7 @@ impl Study {
             Rows::OnDemand { model, parameters } => {
                 // The constructor evaluated every point and found them finite;
                 // the same evaluation gives the same values.
-                let s = evaluate(&**model, parameters, &self.points[range]);
+                let s = evaluate(&**model, parameters, &self.points, range);
                 Cow::Owned(s.expect("sensitivities checked finite when the study was built"))
             }
         }
@@ -1278,7 +1376,7 @@ impl Study {
         let np = self.points.len();
         CaseResult {
             target: self.targets[i / np],
-            point: Arc::clone(&self.points[i % np]),
+            point: self.points.point(i % np),
             reliability,
             pf,
             beta,
@@ -1296,38 +1394,68 @@ impl Study {
     /// The study's result from its cases, every case in order (its
     /// summaries and requirement from the cases' reliabilities).
     pub fn finish(&self, method: Method, cases: Vec<CaseResult>) -> StudyResult {
-        let np = self.points.len();
-        let summaries = self
-            .targets
-            .iter()
-            .enumerate()
-            .map(|(t, target)| {
-                let rs: Vec<f64> = cases[t * np..(t + 1) * np]
-                    .iter()
-                    .map(|c| c.reliability)
-                    .collect();
-                let mean = rs.iter().sum::<f64>() / rs.len().max(1) as f64;
-                let min = rs.iter().copied().fold(f64::INFINITY, f64::min);
-                let max = rs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let mut running = Running::new(self.targets.len(), self.points.len());
+        running.add(0, &cases);
+        let mut result = self.finish_running(method, &running);
+        result.cases = cases;
+        result
+    }
+
+    /// The result of a run whose cases `running` added up, without the
+    /// cases.
+    fn finish_running(&self, method: Method, running: &Running) -> StudyResult {
+        let summaries = (self.targets.iter().zip(&running.targets))
+            .map(|(target, r)| {
+                let mean = r.sum / r.count.max(1) as f64;
                 Summary {
                     target: *target,
                     mean,
-                    min,
-                    max,
+                    min: r.min,
+                    max: r.max,
                     met: self
                         .spec
                         .requirement
-                        .map(|r| min >= r.min && mean >= r.mean),
+                        .map(|req| r.min >= req.min && mean >= req.mean),
                 }
             })
             .collect();
         StudyResult {
             method,
             variables: self.variables.clone(),
-            cases,
+            cases: Vec::new(),
             summaries,
             requirement: self.spec.requirement,
         }
+    }
+
+    /// Runs `algorithm` on every case in [`Study::run`]'s order, `block`
+    /// cases at a time (each block's cases exactly as `run` runs them: a
+    /// sampler's case on the streams of its index), hands each block to
+    /// `f` and keeps only the summaries: a study of 10⁷ points runs in the
+    /// memory of one block. The result's summaries equal `run`'s bit for
+    /// bit (the same sums in the same order); its `cases` are empty.
+    ///
+    /// # Errors
+    /// The first error of a block's run, or of `f`, ends the run.
+    pub fn run_blocks<E: From<ReliabilityError>>(
+        &self,
+        algorithm: &Algorithm,
+        progress: &dyn Progress,
+        block: usize,
+        mut f: impl FnMut(&[CaseResult]) -> Result<(), E>,
+    ) -> Result<StudyResult, E> {
+        let total = self.targets.len() * self.points.len();
+        let mut running = Running::new(self.targets.len(), self.points.len());
+        let mut start = 0;
+        while start < total {
+            let end = (start + block.max(1)).min(total);
+            let ids: Vec<usize> = (start..end).collect();
+            let cases = self.run_set(algorithm, CaseSet::Ids(&ids), progress)?;
+            running.add(start, &cases);
+            f(&cases)?;
+            start = end;
+        }
+        Ok(self.finish_running(algorithm.method(), &running))
     }
 
     /// The sensitivities of every target at point `p`.
@@ -1473,7 +1601,7 @@ fn listed_points(
     spec: StudySpec,
     points: Vec<Vec<f64>>,
     variables: &[String],
-) -> Result<(StudySpec, Vec<Arc<[f64]>>, Vec<Target>), ReliabilityError> {
+) -> Result<(StudySpec, Points, Vec<Target>), ReliabilityError> {
     if points.is_empty() {
         return Err(ReliabilityError::EmptyGrid("no point is given".into()));
     }
@@ -1494,7 +1622,11 @@ fn listed_points(
         ..spec
     };
     let targets = targets(&spec)?;
-    Ok((spec, points.into_iter().map(Arc::from).collect(), targets))
+    Ok((
+        spec,
+        Points::Listed(points.into_iter().map(Arc::from).collect()),
+        targets,
+    ))
 }
 
 /// The targets of `spec` in case order (its toleranced components, then its
@@ -1550,19 +1682,21 @@ fn targets(spec: &StudySpec) -> Result<Vec<Target>, ReliabilityError> {
 fn evaluate<M: ErrorModel + ?Sized>(
     model: &M,
     parameters: &[f64],
-    points: &[Arc<[f64]>],
+    points: &Points,
+    range: Range<usize>,
 ) -> Result<Vec<f64>, ReliabilityError> {
     let n6 = 6 * model.errors().len();
-    let qs: Vec<f64> = points.iter().flat_map(|q| q.iter()).copied().collect();
-    let mut flat = vec![0.0; points.len() * n6];
+    let nv = points.variables();
+    let qs = points.flat(range.clone());
+    let mut flat = vec![0.0; range.len() * n6];
     if model
         .sensitivity_points(&qs, parameters, &mut flat)
         .is_err()
     {
         // The points were checked against the model's variables; a model
         // whose lengths still disagree is evaluated point by point.
-        for (q, s) in points.iter().zip(flat.chunks_exact_mut(n6.max(1))) {
-            model.sensitivity(q, parameters, s);
+        for (k, s) in flat.chunks_exact_mut(n6.max(1)).enumerate() {
+            model.sensitivity(&qs[k * nv..(k + 1) * nv], parameters, s);
         }
     }
     if flat.iter().any(|v| !v.is_finite()) {
@@ -1577,12 +1711,13 @@ fn evaluate<M: ErrorModel + ?Sized>(
 fn check_moments(
     inputs: &Inputs,
     variables: &[String],
-    points: &[Arc<[f64]>],
+    points: &Points,
+    range: Range<usize>,
     rows: &[f64],
 ) -> Result<(), ReliabilityError> {
     let n = inputs.len();
     let means = inputs.means();
-    for (q, s) in points.iter().zip(rows.chunks_exact((6 * n).max(1))) {
+    for (p, s) in range.zip(rows.chunks_exact((6 * n).max(1))) {
         for c in Component::ALL {
             let row = &s[c.index() * n..(c.index() + 1) * n];
             let mean: f64 = row.iter().zip(means).map(|(s, m)| s * m).sum();
@@ -1594,7 +1729,7 @@ fn check_moments(
                 continue;
             };
             return Err(ReliabilityError::Overflow {
-                at: point_text(variables, q),
+                at: point_text(variables, &points.point(p)),
                 what: format!("{what} of {}", c.name()),
             });
         }
@@ -1615,26 +1750,68 @@ pub(crate) fn point_text(variables: &[String], q: &[f64]) -> String {
 }
 
 /// The points of a grid in the model's variable order (first grid axis
-/// slowest); a model without variables has the one empty point.
-fn grid_points(grid: &Grid, variables: &[String]) -> Result<Vec<Arc<[f64]>>, ReliabilityError> {
+/// slowest), kept as its axes; a model without variables has the one empty
+/// point.
+fn grid_points(grid: &Grid, variables: &[String]) -> Result<Points, ReliabilityError> {
     let axis_of = grid.axis_of(variables)?;
-    let count = grid.len().max(1);
-    Ok((0..count)
-        .map(|p| {
-            let idx = grid.index(p);
-            axis_of
-                .iter()
-                .map(|a| a.map_or(0.0, |a| grid.axes[a].1[idx[a]]))
-                .collect::<Vec<f64>>()
-                .into()
-        })
-        .collect())
+    Ok(Points::Grid {
+        axes: grid.axes.iter().map(|(_, v)| v.clone()).collect(),
+        // Every variable has its axis ([`Grid::axis_of`] refuses one without).
+        of: axis_of.iter().map(|a| a.unwrap_or(0)).collect(),
+        count: grid.len().max(1),
+    })
 }
 
 /// `Φ(I/σ_E)`: the closed-form reliability of one upper tolerance on a
 /// zero-mean normal component with standard deviation `σ_E` (Eq. 21, 31).
 pub fn closed_form_reliability(tolerance: f64, sigma_e: f64) -> f64 {
     normal::cdf(tolerance / sigma_e)
+}
+
+/// Each target's reliabilities added up case by case, in case order: the
+/// one account behind [`Study::finish`] and [`Study::run_blocks`].
+#[derive(Debug, Clone)]
+struct Running {
+    targets: Vec<RunningTarget>,
+    points: usize,
+}
+
+/// One target's running sum, least and largest reliability.
+#[derive(Debug, Clone)]
+struct RunningTarget {
+    sum: f64,
+    min: f64,
+    max: f64,
+    count: usize,
+}
+
+impl Running {
+    fn new(targets: usize, points: usize) -> Running {
+        Running {
+            targets: vec![
+                RunningTarget {
+                    // `Iterator::sum`'s start for floats: the same sums.
+                    sum: -0.0,
+                    min: f64::INFINITY,
+                    max: f64::NEG_INFINITY,
+                    count: 0,
+                };
+                targets
+            ],
+            points,
+        }
+    }
+
+    /// The cases `cases`, the first of them case `first` of the study.
+    fn add(&mut self, first: usize, cases: &[CaseResult]) {
+        for (k, c) in cases.iter().enumerate() {
+            let t = &mut self.targets[(first + k) / self.points.max(1)];
+            t.sum += c.reliability;
+            t.min = t.min.min(c.reliability);
+            t.max = t.max.max(c.reliability);
+            t.count += 1;
+        }
+    }
 }
 
 /// The cases a run covers: every case of the study (`All(n)`), or the
@@ -1726,7 +1903,7 @@ mod tests {
         let np = study.points().len();
         for (i, c) in r.cases.iter().enumerate() {
             assert_eq!(c.target, study.targets()[i / np]);
-            assert_eq!(c.point, study.points()[i % np]);
+            assert_eq!(c.point, study.points().point(i % np));
         }
         let sorm = Sorm::default();
         let s = study.run(&Algorithm::Sorm(sorm), &()).unwrap();
@@ -1737,13 +1914,93 @@ mod tests {
     }
 
     #[test]
+    fn a_run_in_blocks_hands_out_the_run_s_cases_and_summaries_bit_for_bit() {
+        // 4 × 3 × 3 points, the series system: 4 targets, 144 cases in
+        // blocks of 7 (the last short), every method.
+        let (m, model) = gantry();
+        let mut spec = machine::spec(&m, Some(System::Series)).unwrap();
+        spec.grid = Grid {
+            axes: vec![
+                ("x".into(), vec![0.0, 300.0, 700.0, 1000.0]),
+                ("y".into(), vec![-1500.0, 0.0, 1500.0]),
+                ("z".into(), vec![600.0, 1000.0, 1400.0]),
+            ],
+        };
+        spec.requirement = Some(Requirement {
+            min: 0.9,
+            mean: 0.95,
+        });
+        let inputs = machine::inputs(&m).unwrap();
+        let params = machine::parameters(&m, &[]).unwrap();
+        let model: SharedModel = Arc::new(model);
+        let study = Study::on_demand(model, &params, inputs, spec).unwrap();
+        let algorithms = [
+            Algorithm::Form(Form::default()),
+            Algorithm::Sorm(Sorm::default()),
+            Algorithm::MonteCarlo(MonteCarlo {
+                samples: 200,
+                seed: 3,
+                cov: None,
+            }),
+            Algorithm::ImportanceSampling(ImportanceSampling {
+                samples: 200,
+                seed: 5,
+                form: Form::default(),
+                cov: None,
+            }),
+            Algorithm::Directional(DirectionalSimulation {
+                samples: 50,
+                seed: 11,
+                cov: Some(0.5),
+            }),
+            Algorithm::Subset(SubsetSimulation::new(200, 7)),
+        ];
+        for a in &algorithms {
+            let whole = study.run(a, &()).unwrap();
+            let mut cases = Vec::new();
+            let mut blocks = 0;
+            let streamed = study
+                .run_blocks(a, &(), 7, |b: &[CaseResult]| {
+                    assert!(b.len() <= 7);
+                    cases.extend_from_slice(b);
+                    blocks += 1;
+                    Ok::<(), ReliabilityError>(())
+                })
+                .unwrap();
+            assert_eq!(blocks, 144usize.div_ceil(7), "{:?}", a.method());
+            assert!(streamed.cases.is_empty());
+            assert_eq!(cases, whole.cases, "{:?}", a.method());
+            for (x, y) in streamed.summaries.iter().zip(&whole.summaries) {
+                assert_eq!(x.mean.to_bits(), y.mean.to_bits(), "{:?}", a.method());
+                assert_eq!((x.min, x.max, x.met), (y.min, y.max, y.met));
+            }
+            assert_eq!(streamed.requirement_met(), whole.requirement_met());
+        }
+        // An error of the consumer ends the run.
+        let mut seen = 0;
+        let stopped = study.run_blocks(&algorithms[0], &(), 7, |_: &[CaseResult]| {
+            seen += 1;
+            if seen == 3 {
+                Err(ReliabilityError::NonFinite("stop"))
+            } else {
+                Ok(())
+            }
+        });
+        assert!(stopped.is_err());
+        assert_eq!(seen, 3);
+    }
+
+    #[test]
     fn at_points_equals_the_grid_study_at_the_same_points() {
         let (m, model) = gantry();
         let system = Some(System::Volumetric { tolerance: 0.04 });
         let grid = machine::study(&m, &model, &[], system).unwrap();
         // Every 7th grid point, in a shuffled order.
         let picked: Vec<usize> = (0..grid.points().len()).step_by(7).rev().collect();
-        let points = picked.iter().map(|&p| grid.points()[p].to_vec()).collect();
+        let points = picked
+            .iter()
+            .map(|&p| grid.points().point(p).to_vec())
+            .collect();
         let spec = machine::spec(&m, system).unwrap();
         let inputs = machine::inputs(&m).unwrap();
         let at = Study::at_points(&model, &[], inputs, spec, points).unwrap();

@@ -4,9 +4,12 @@
 //! machine's statistics or a calibration's posterior, with the
 //! whole-machine acceptance probability when asked. The CLI and
 //! `Machine.reliability` both [`prepare`] the study, [`Prepared::run`] it
-//! and print or return the same [`ReliabilityRun`], whose JSON is the
-//! [`ReliabilityDocument`] (with its [`AcceptanceDocument`]).
+//! and print or return the same [`ReliabilityRun`] (or the CLI writes
+//! [`Prepared::output`], the study run a block of cases at a time as it is
+//! written), whose JSON is the [`ReliabilityDocument`] (with its
+//! [`AcceptanceDocument`]).
 
+use std::cell::{Ref, RefCell};
 use std::path::Path;
 
 use chain_core::model::{Distribution, Sided};
@@ -15,6 +18,7 @@ use chain_core::values::Approach;
 use chain_core::{CompiledModel, Machine};
 use reliability::acceptance::{AcceptanceResult, AcceptanceSubset};
 use reliability::conditional::{self, Quadrature};
+use reliability::study::Algorithm;
 use reliability::{
     Acceptance, Calls, CaseResult, CaseTally, FormCase, Method, Posterior, Progress, Rectangles,
     ReliabilityError, SormCase, Stopping, Study, StudyResult, SubsetLevel, Target,
@@ -250,6 +254,24 @@ fn thermal(
     Ok(Some(Thermal { fixed, random }))
 }
 
+/// The thermal state's document, with the rule that integrated over a
+/// random temperature.
+fn temperatures(
+    thermal: Option<&Thermal>,
+    quadrature: Option<Quadrature>,
+) -> Option<TemperaturesDocument> {
+    thermal.map(|t| TemperaturesDocument {
+        fixed: NameMap(t.fixed.clone()),
+        random: (t.random.iter())
+            .map(|r| RandomTemperature {
+                sensor: r.name.clone(),
+                distribution: r.distribution,
+            })
+            .collect(),
+        quadrature,
+    })
+}
+
 /// Checks the options and builds the study of `machine` (`file` names it).
 pub fn prepare(
     machine: &Machine,
@@ -337,6 +359,32 @@ impl Prepared {
         }
     }
 
+    /// The output of the study run a block of cases at a time as it is
+    /// written, each block dropped once written ([`ReliabilityOutput`]):
+    /// `None` when the run needs every case at once (the acceptance
+    /// probability, a random temperature's mixture).
+    pub fn output<'a>(&'a self, progress: &'a dyn Progress) -> Option<ReliabilityOutput<'a>> {
+        let random = self.thermal.as_ref().is_some_and(|t| t.random.is_some());
+        if self.acceptance.is_some() || random {
+            return None;
+        }
+        Some(ReliabilityOutput {
+            machine: &self.machine,
+            study: &self.study,
+            method: self.algorithm.method,
+            columns: CaseColumns::of(self.algorithm.method, self.algorithm.cov.is_some(), false),
+            posterior: self.posterior.as_ref(),
+            acceptance: None,
+            temperatures: temperatures(self.thermal.as_ref(), None),
+            cases: Cases::Streamed {
+                algorithm: self.algorithm.algorithm(),
+                progress,
+            },
+            done: RefCell::new(None),
+            failed: RefCell::new(None),
+        })
+    }
+
     /// Runs the study (and the acceptance probability when asked),
     /// reporting the samples drawn to `progress`.
     pub fn run(self, progress: &dyn Progress) -> Result<ReliabilityRun, ReliabilityError> {
@@ -363,16 +411,7 @@ impl Prepared {
             }
             None => shown.run(&algorithm, progress)?,
         };
-        let temperatures = self.thermal.as_ref().map(|t| TemperaturesDocument {
-            fixed: NameMap(t.fixed.clone()),
-            random: (t.random.iter())
-                .map(|r| RandomTemperature {
-                    sensor: r.name.clone(),
-                    distribution: r.distribution,
-                })
-                .collect(),
-            quadrature: quadrature.clone(),
-        });
+        let temperatures = temperatures(self.thermal.as_ref(), quadrature.clone());
         let mut notes = Vec::new();
         if let Some(q) = quadrature.as_ref().filter(|q| !q.converged) {
             notes.push(format!(
@@ -402,7 +441,13 @@ impl Prepared {
             }
             None => None,
         };
+        let columns = CaseColumns::of(
+            self.algorithm.method,
+            self.algorithm.cov.is_some(),
+            acceptance.is_some(),
+        );
         Ok(ReliabilityRun {
+            columns,
             machine: self.machine,
             study: shown,
             model: self.model,
@@ -449,22 +494,303 @@ pub struct ReliabilityRun {
     /// converge, an acceptance probability short of its tolerance), each a
     /// line `note: …` or `warning: …`; not part of the JSON.
     pub notes: Vec<String>,
+    /// What the cases carry beyond FORM's account.
+    pub columns: CaseColumns,
 }
 
 impl ReliabilityRun {
-    /// The spec's document of the run.
-    pub fn document(&self) -> ReliabilityDocument<'_> {
-        let mut doc = ReliabilityDocument::new(&self.machine, &self.study, &self.result);
-        doc.posterior = self.posterior.as_ref();
-        doc.acceptance = self.acceptance.as_ref().map(AcceptanceDocument::of);
-        doc.temperatures = self.temperatures.as_ref();
-        doc
+    /// The output of the run, its cases in memory.
+    pub fn output(&self) -> ReliabilityOutput<'_> {
+        ReliabilityOutput {
+            machine: &self.machine,
+            study: &self.study,
+            method: self.result.method,
+            columns: self.columns,
+            posterior: self.posterior.as_ref(),
+            acceptance: self.acceptance.as_ref(),
+            temperatures: self.temperatures.clone(),
+            cases: Cases::Kept(&self.result),
+            done: RefCell::new(None),
+            failed: RefCell::new(None),
+        }
     }
 }
 
 impl Serialize for ReliabilityRun {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        self.document().serialize(serializer)
+        self.output().serialize(serializer)
+    }
+}
+
+/// What the cases of a run carry beyond FORM's account, known from the
+/// algorithm before any case runs (the CSV's columns): a sampler's standard
+/// error, CoV and samples; how it stopped (subset and directional
+/// simulation, a `--cov` target); subset simulation's levels; SORM's
+/// formulas.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CaseColumns {
+    /// A sampler's `std_error`, `cov`, `samples` (or the acceptance row's).
+    pub sampled: bool,
+    /// How the sampler stopped.
+    pub stopped: bool,
+    /// Subset simulation's levels.
+    pub leveled: bool,
+    /// SORM's three formulas.
+    pub sorm: bool,
+}
+
+impl CaseColumns {
+    /// The columns of `method` (with a target CoV: `cov`; with the
+    /// acceptance probability's row: `acceptance`).
+    pub fn of(method: Method, cov: bool, acceptance: bool) -> CaseColumns {
+        let sampler = !matches!(method, Method::Form | Method::Sorm);
+        CaseColumns {
+            sampled: sampler || acceptance,
+            stopped: matches!(method, Method::Subset | Method::Directional) || (sampler && cov),
+            leveled: method == Method::Subset,
+            sorm: method == Method::Sorm,
+        }
+    }
+}
+
+/// The output of `chain reliability`, whatever its format: the cases a
+/// block at a time ([`ReliabilityOutput::each_block`]; computed as they are
+/// written when the study is streamed, [`Prepared::output`]), then what
+/// they add up to ([`Done`]). Its `Serialize` is the spec's JSON; the CLI's
+/// table and CSV read it.
+pub struct ReliabilityOutput<'a> {
+    /// The machine's name.
+    pub machine: &'a str,
+    /// The study.
+    pub study: &'a Study,
+    /// The algorithm's method.
+    pub method: Method,
+    /// What the cases carry.
+    pub columns: CaseColumns,
+    /// The posterior of `--values`.
+    pub posterior: Option<&'a Posterior>,
+    /// The whole-machine acceptance probability (a run in memory).
+    pub acceptance: Option<&'a AcceptanceResult>,
+    /// The thermal state (a machine with sensors).
+    pub temperatures: Option<TemperaturesDocument>,
+    cases: Cases<'a>,
+    done: RefCell<Option<Done>>,
+    failed: RefCell<Option<ReliabilityError>>,
+}
+
+/// Where a [`ReliabilityOutput`]'s cases come from.
+enum Cases<'a> {
+    /// A run in memory: one block.
+    Kept(&'a StudyResult),
+    /// The study, run [`STREAM_BLOCK`] cases at a time.
+    Streamed {
+        algorithm: Algorithm,
+        progress: &'a dyn Progress,
+    },
+}
+
+/// The cases a streamed run runs and writes at a time.
+pub const STREAM_BLOCK: usize = 4096;
+
+/// The most points whose every reliability a table shows (the maps of the
+/// paper's Tables 2-4); a larger grid's table shows its extreme points.
+pub const TABLE_POINTS: usize = 10_000;
+
+/// The least reliable points a target keeps for a large grid's table.
+pub const EXTREME_POINTS: usize = 5;
+
+/// What the cases of a [`ReliabilityOutput`] add up to.
+#[derive(Debug, Clone)]
+pub struct Done {
+    /// The summaries and the requirement (`cases` empty).
+    pub result: StudyResult,
+    /// Every case's account.
+    pub tally: CaseTally,
+    /// Per target: its cases' account and its extreme points.
+    pub targets: Vec<TargetDone>,
+}
+
+/// One target's cases added up.
+#[derive(Debug, Clone)]
+pub struct TargetDone {
+    /// Its cases' account (calls, largest standard error, convergence).
+    pub tally: CaseTally,
+    /// Its [`EXTREME_POINTS`] least reliable cases, least first (the first
+    /// of equal ones first).
+    pub lowest: Vec<CaseResult>,
+    /// Its most reliable case (the first of equal ones).
+    pub highest: Option<CaseResult>,
+    /// The fewest and most samples of a case.
+    pub samples: Option<(u64, u64)>,
+}
+
+impl TargetDone {
+    fn new() -> TargetDone {
+        TargetDone {
+            tally: CaseTally::default(),
+            lowest: Vec::new(),
+            highest: None,
+            samples: None,
+        }
+    }
+
+    fn add(&mut self, c: &CaseResult) {
+        self.tally.add(c);
+        let at = self
+            .lowest
+            .partition_point(|k| k.reliability <= c.reliability);
+        if at < EXTREME_POINTS {
+            self.lowest.insert(at, c.clone());
+            self.lowest.truncate(EXTREME_POINTS);
+        }
+        if self
+            .highest
+            .as_ref()
+            .is_none_or(|h| c.reliability > h.reliability)
+        {
+            self.highest = Some(c.clone());
+        }
+        if let Some(n) = c.samples {
+            self.samples = Some(
+                self.samples
+                    .map_or((n, n), |(lo, hi)| (lo.min(n), hi.max(n))),
+            );
+        }
+    }
+}
+
+/// A streamed run's end: the study's error or the consumer's.
+enum Halt<E> {
+    Run(ReliabilityError),
+    Consumer(E),
+}
+
+impl<E> From<ReliabilityError> for Halt<E> {
+    fn from(e: ReliabilityError) -> Self {
+        Halt::Run(e)
+    }
+}
+
+impl ReliabilityOutput<'_> {
+    /// Hands every block of cases (in case order: target-major) to `f` and
+    /// keeps what they add up to ([`ReliabilityOutput::done`]). A run that
+    /// fails keeps its error ([`ReliabilityOutput::take_error`]) and ends
+    /// the blocks with `stop`'s value of it; `f`'s error ends them too.
+    pub fn each_block<E>(
+        &self,
+        mut f: impl FnMut(&[CaseResult]) -> Result<(), E>,
+        stop: impl Fn(&ReliabilityError) -> E,
+    ) -> Result<(), E> {
+        let np = self.study.points().len().max(1);
+        let mut tally = CaseTally::default();
+        let mut targets: Vec<TargetDone> = self
+            .study
+            .targets()
+            .iter()
+            .map(|_| TargetDone::new())
+            .collect();
+        let mut seen = 0usize;
+        let mut visit = |cases: &[CaseResult]| {
+            for c in cases {
+                tally.add(c);
+                targets[seen / np].add(c);
+                seen += 1;
+            }
+        };
+        let result = match &self.cases {
+            Cases::Kept(r) => {
+                visit(&r.cases);
+                f(&r.cases)?;
+                StudyResult {
+                    method: r.method,
+                    variables: r.variables.clone(),
+                    cases: Vec::new(),
+                    summaries: r.summaries.clone(),
+                    requirement: r.requirement,
+                }
+            }
+            Cases::Streamed {
+                algorithm,
+                progress,
+            } => {
+                let run = self
+                    .study
+                    .run_blocks(algorithm, *progress, STREAM_BLOCK, |b| {
+                        visit(b);
+                        f(b).map_err(Halt::Consumer)
+                    });
+                match run {
+                    Ok(r) => r,
+                    Err(Halt::Consumer(e)) => return Err(e),
+                    Err(Halt::Run(e)) => {
+                        let out = stop(&e);
+                        *self.failed.borrow_mut() = Some(e);
+                        return Err(out);
+                    }
+                }
+            }
+        };
+        *self.done.borrow_mut() = Some(Done {
+            result,
+            tally,
+            targets,
+        });
+        Ok(())
+    }
+
+    /// What the cases added up to, once every block is handed out.
+    pub fn done(&self) -> Option<Ref<'_, Done>> {
+        Ref::filter_map(self.done.borrow(), Option::as_ref).ok()
+    }
+
+    /// The error that ended the run, if one did.
+    pub fn take_error(&self) -> Option<ReliabilityError> {
+        self.failed.borrow_mut().take()
+    }
+
+    /// The notes and warnings of a streamed run, once its blocks are
+    /// handed out: FORM's limits and the cases that did not converge.
+    pub fn notes(&self) -> Vec<String> {
+        let mut notes = Vec::new();
+        if self.method == Method::Form {
+            notes.extend(study::form_limits_note(self.study));
+        }
+        if let Some(d) = self.done() {
+            notes.extend(study::unconverged_warnings(
+                &d.tally,
+                d.result.method,
+                self.study.variables(),
+            ));
+        }
+        notes
+    }
+
+    /// The grid's axes in file order, with their index in the model's
+    /// variables.
+    pub fn axes(&self) -> Vec<(&str, usize)> {
+        (self.study.spec().grid.axes.iter())
+            .filter_map(|(n, _)| {
+                let i = self.study.variables().iter().position(|v| v == n)?;
+                Some((n.as_str(), i))
+            })
+            .collect()
+    }
+}
+
+impl Serialize for ReliabilityOutput<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        ReliabilityDocument {
+            machine: self.machine,
+            method: self.method,
+            sided: self.study.spec().sided,
+            results: CaseDocuments(self),
+            summary: Summaries(self),
+            requirement: self.study.spec().requirement.map(|_| Requirement(self)),
+            posterior: self.posterior,
+            acceptance: self.acceptance.map(AcceptanceDocument::of),
+            temperatures: self.temperatures.as_ref(),
+        }
+        .serialize(serializer)
     }
 }
 
@@ -496,8 +822,10 @@ fn acceptance(
     .run(&system)
 }
 
-/// The document of a grid study (the spec's `reliability` JSON contract).
-#[derive(Debug, Serialize)]
+/// The document of a grid study (the spec's `reliability` JSON contract),
+/// formed as it is written: the cases as they come, then what they add up
+/// to.
+#[derive(Serialize)]
 pub struct ReliabilityDocument<'a> {
     /// The machine's name.
     pub machine: &'a str,
@@ -509,10 +837,10 @@ pub struct ReliabilityDocument<'a> {
     /// written).
     pub results: CaseDocuments<'a>,
     /// Each target's summary over the grid.
-    pub summary: NameMap<Target, SummaryDocument>,
+    pub summary: Summaries<'a>,
     /// The requirement and whether every target meets it.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub requirement: Option<RequirementDocument>,
+    pub requirement: Option<Requirement<'a>>,
     /// The posterior the inputs came from (a calibration's values file), when given.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub posterior: Option<&'a Posterior>,
@@ -567,34 +895,13 @@ pub struct CaseDocument<'a> {
     pub sorm: Option<&'a SormCase>,
 }
 
-/// The cases of a [`ReliabilityDocument`]: serialised as the list of their
-/// [`CaseDocument`]s, each formed when it is written, so that a document of
-/// a million cases is not a second copy of them.
-#[derive(Debug)]
-pub struct CaseDocuments<'a> {
-    /// The grid's axes in file order, with their index in the model's
-    /// variables.
-    axes: Vec<(&'a str, usize)>,
-    /// The cases, target-major.
-    cases: &'a [CaseResult],
-}
-
-impl<'a> CaseDocuments<'a> {
-    /// The number of cases.
-    pub fn len(&self) -> usize {
-        self.cases.len()
-    }
-
-    /// True when there is no case.
-    pub fn is_empty(&self) -> bool {
-        self.cases.is_empty()
-    }
-
-    /// Each case's document, target-major.
-    pub fn iter(&self) -> impl Iterator<Item = CaseDocument<'a>> + '_ {
-        self.cases.iter().map(|c| CaseDocument {
+impl<'a> CaseDocument<'a> {
+    /// The document of case `c`, its point on the grid's `axes` (file
+    /// order, each with its index in the model's variables).
+    pub fn of(c: &'a CaseResult, axes: &[(&'a str, usize)]) -> CaseDocument<'a> {
+        CaseDocument {
             component: c.target,
-            point: NameMap(self.axes.iter().map(|&(n, i)| (n, c.point[i])).collect()),
+            point: NameMap(axes.iter().map(|&(n, i)| (n, c.point[i])).collect()),
             reliability: c.reliability,
             pf: c.pf,
             beta: c.beta,
@@ -610,13 +917,65 @@ impl<'a> CaseDocuments<'a> {
             sampling: c.stopping,
             levels: c.levels.as_deref(),
             sorm: c.sorm.as_deref(),
-        })
+        }
     }
 }
 
+/// The cases of a [`ReliabilityDocument`]: serialised as the list of their
+/// [`CaseDocument`]s, each formed when it is written, a block at a time, so
+/// that a document of a million cases is never a copy of them (nor,
+/// streamed, a first one).
+pub struct CaseDocuments<'a>(&'a ReliabilityOutput<'a>);
+
 impl Serialize for CaseDocuments<'_> {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_seq(self.iter())
+        use serde::ser::{Error, SerializeSeq};
+        let axes = self.0.axes();
+        let mut seq = serializer.serialize_seq(None)?;
+        self.0.each_block(
+            |block| {
+                (block.iter()).try_for_each(|c| seq.serialize_element(&CaseDocument::of(c, &axes)))
+            },
+            |e| S::Error::custom(e),
+        )?;
+        seq.end()
+    }
+}
+
+/// Each target's summary of a [`ReliabilityDocument`], read once its cases
+/// are written.
+pub struct Summaries<'a>(&'a ReliabilityOutput<'a>);
+
+impl Serialize for Summaries<'_> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::Error;
+        let done = (self.0.done()).ok_or_else(|| S::Error::custom("the run did not finish"))?;
+        NameMap(
+            (done.result.summaries.iter())
+                .map(|s| {
+                    let doc = SummaryDocument {
+                        mean: s.mean,
+                        min: s.min,
+                        max: s.max,
+                        met: s.met,
+                    };
+                    (s.target, doc)
+                })
+                .collect(),
+        )
+        .serialize(serializer)
+    }
+}
+
+/// The requirement of a [`ReliabilityDocument`] and whether every target
+/// meets it, read once its cases are written.
+pub struct Requirement<'a>(&'a ReliabilityOutput<'a>);
+
+impl Serialize for Requirement<'_> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::Error;
+        let done = (self.0.done()).ok_or_else(|| S::Error::custom("the run did not finish"))?;
+        RequirementDocument::of(&done.result).serialize(serializer)
     }
 }
 
@@ -653,52 +1012,6 @@ impl RequirementDocument {
             mean: req.mean,
             met: r.requirement_met(),
         })
-    }
-}
-
-impl<'a> ReliabilityDocument<'a> {
-    /// The document of a study's result (no posterior: set
-    /// [`ReliabilityDocument::posterior`] when the inputs came from one).
-    pub fn new(machine: &'a str, study: &'a Study, r: &'a StudyResult) -> Self {
-        let ax: Vec<(&'a str, usize)> = study
-            .spec()
-            .grid
-            .axes
-            .iter()
-            .filter_map(|(n, _)| {
-                let i = study.variables().iter().position(|v| v == n)?;
-                Some((n.as_str(), i))
-            })
-            .collect();
-        let results = CaseDocuments {
-            axes: ax,
-            cases: &r.cases,
-        };
-        let summary = NameMap(
-            r.summaries
-                .iter()
-                .map(|s| {
-                    let doc = SummaryDocument {
-                        mean: s.mean,
-                        min: s.min,
-                        max: s.max,
-                        met: s.met,
-                    };
-                    (s.target, doc)
-                })
-                .collect(),
-        );
-        ReliabilityDocument {
-            machine,
-            method: r.method,
-            sided: study.spec().sided,
-            results,
-            summary,
-            requirement: RequirementDocument::of(r),
-            posterior: None,
-            acceptance: None,
-            temperatures: None,
-        }
     }
 }
 

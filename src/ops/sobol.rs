@@ -298,12 +298,7 @@ impl<'a> SobolDocument<'a> {
         let at = at_point.then(|| {
             NameMap::zip(
                 study.variables().iter().cloned(),
-                study
-                    .points()
-                    .first()
-                    .into_iter()
-                    .flat_map(|q| q.iter())
-                    .copied(),
+                (study.points().iter().next().into_iter()).flat_map(|q| q.to_vec()),
             )
         });
         let grid = (!at_point).then(|| NameMap(study.spec().grid.axes.clone()));

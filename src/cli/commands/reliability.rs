@@ -113,7 +113,26 @@ pub fn exec(args: ReliabilityArgs) -> miette::Result<()> {
         plan.verb,
         plan.unit,
     );
-    let run = prepared.run(&|n| bar.inc(n));
+    // Written as it runs, a block of cases at a time, unless the output
+    // needs every case at once (the charts, a small grid's maps).
+    let maps = args.format == ReliabilityFormat::Table
+        && prepared.study.points().len() <= chain::ops::reliability::TABLE_POINTS;
+    let inc = |n| bar.inc(n);
+    if let Some(output) = (args.plot.is_none() && !maps)
+        .then(|| prepared.output(&inc))
+        .flatten()
+    {
+        let written = report::emit(&output, args.format.into());
+        bar.finish();
+        if let Some(e) = output.take_error() {
+            return Err(loaded.report(e));
+        }
+        for note in output.notes() {
+            eprintln!("{note}");
+        }
+        return written;
+    }
+    let run = prepared.run(&inc);
     bar.finish();
     let run = run.map_err(|e| loaded.report(e))?;
     for note in &run.notes {

@@ -4,10 +4,12 @@
 //! probability (docs/acceptance.md); the posterior's listing. One CSV row
 //! per (target, point), then the acceptance row.
 
-use chain::ops::reliability::ReliabilityRun;
+use chain::ops::reliability::{
+    CaseColumns, Done, ReliabilityOutput, ReliabilityRun, EXTREME_POINTS, TABLE_POINTS,
+};
 use chain::ops::views::target_map;
 use reliability::acceptance::AcceptanceResult;
-use reliability::{normal, CaseTally, Stopping, Study, StudyResult, SubsetLevel};
+use reliability::{normal, CaseResult, CaseTally, Stopping, Study, StudyResult, SubsetLevel};
 
 use crate::cli::report::{Csv, Report};
 use crate::cli::study_text::{calls_text, fmt_num, posterior_lines, requirement_text, sided_title};
@@ -31,30 +33,62 @@ fn axes(study: &Study) -> Vec<(String, usize)> {
 
 impl Report for ReliabilityRun {
     fn table(&self) -> String {
-        let mut table = to_table(&self.machine, &self.study, &self.result);
-        if let Some(a) = &self.acceptance {
-            table.push_str(&acceptance_table(&self.study, a));
+        self.output().table()
+    }
+
+    fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
+        self.output().csv(out)
+    }
+}
+
+impl Report for ReliabilityOutput<'_> {
+    fn table(&self) -> String {
+        let study = self.study;
+        let np = study.points().len();
+        let mut table = if np <= TABLE_POINTS {
+            // Every point's map: the cases of a small grid, collected.
+            let mut cases = Vec::new();
+            let _ = self.each_block(
+                |b| {
+                    cases.extend_from_slice(b);
+                    Ok::<(), ()>(())
+                },
+                |_| (),
+            );
+            match self.done() {
+                Some(d) => {
+                    let mut r = d.result.clone();
+                    r.cases = cases;
+                    to_table(self.machine, study, &r)
+                }
+                None => String::new(),
+            }
+        } else {
+            let _ = self.each_block(|_| Ok::<(), ()>(()), |_| ());
+            match self.done() {
+                Some(d) => large_table(self, &d),
+                None => String::new(),
+            }
+        };
+        if let Some(a) = self.acceptance {
+            table.push_str(&acceptance_table(study, a));
         }
         if let Some(t) = &self.temperatures {
             table = format!("{}{table}", temperature_lines(t));
         }
-        match &self.posterior {
+        match self.posterior {
             None => table,
             Some(p) => format!("{}{table}", posterior_lines(p)),
         }
     }
 
     fn csv(&self, out: &mut Csv<'_>) -> Option<()> {
-        let (study, r) = (&self.study, &self.result);
-        let ax = axes(study);
-        // With the acceptance row, the sampling columns are always there
-        // (empty for FORM cases).
-        let sampled =
-            r.cases.first().is_some_and(|c| c.samples.is_some()) || self.acceptance.is_some();
+        let ax = axes(self.study);
+        let columns = self.columns;
         let mut header = vec!["component".to_string()];
         header.extend(ax.iter().map(|(n, _)| n.clone()));
         header.extend(["reliability", "pf", "beta"].map(String::from));
-        if sampled {
+        if columns.sampled {
             header.extend(["std_error", "cov", "samples"].map(String::from));
         }
         header.extend(
@@ -71,17 +105,14 @@ impl Report for ReliabilityRun {
         // The sampler's stopping rule, when it reports one (subset and
         // directional simulation, and any sampler run to a target CoV; not
         // FORM, SORM or a plain sample count).
-        let stopped = r.cases.iter().any(|c| c.stopping.is_some());
-        let leveled = r.cases.iter().any(|c| c.levels.is_some());
-        if stopped {
+        if columns.stopped {
             header.extend(["stopped_by", "sampler_converged"].map(String::from));
         }
-        if leveled {
+        if columns.leveled {
             header.push("levels".to_string());
         }
         // SORM's three formulas (`--method sorm`), last.
-        let sorm = r.cases.iter().any(|c| c.sorm.is_some());
-        if sorm {
+        if columns.sorm {
             header.extend(
                 [
                     "beta_breitung",
@@ -94,68 +125,173 @@ impl Report for ReliabilityRun {
         }
         let width = header.len();
         out.header(header);
-        for c in &r.cases {
-            let mut row = vec![c.target.to_string()];
-            row.extend(ax.iter().map(|(_, i)| fmt_num(c.point[*i])));
-            row.extend([c.reliability, c.pf, c.beta].map(csv_number));
-            if sampled && self.acceptance.is_some() {
-                row.push(c.std_error.map_or(String::new(), csv_number));
-                row.push(c.cov.map_or(String::new(), csv_number));
-                row.push(c.samples.map_or(String::new(), |v| v.to_string()));
-            } else if sampled {
-                row.push(format!("{:?}", c.std_error.unwrap_or(0.0)));
-                row.push(format!("{:?}", c.cov.unwrap_or(0.0)));
-                row.push(c.samples.unwrap_or(0).to_string());
-            }
-            match &c.form {
-                Some(f) => row.extend([
-                    f.termination.to_string(),
-                    f.converged.to_string(),
-                    f.iterations.to_string(),
-                    f.exact.to_string(),
-                ]),
-                None => row.extend((0..4).map(|_| String::new())),
-            }
-            row.push(c.calls.values.to_string());
-            row.push(c.calls.gradients.to_string());
-            if stopped {
-                match &c.stopping {
-                    Some(st) => row.extend([st.stopped_by.to_string(), st.converged.to_string()]),
-                    None => row.extend([String::new(), String::new()]),
+        // The Csv writer keeps its own first write error; a failed run is
+        // kept in the output for the command to report.
+        let _ = self.each_block(
+            |cases| {
+                for c in cases {
+                    out.row(csv_row(c, &ax, columns, self.acceptance.is_some()));
                 }
-            }
-            if leveled {
-                row.push(
-                    c.levels
-                        .as_ref()
-                        .map_or(String::new(), |l| l.len().to_string()),
-                );
-            }
-            if sorm {
-                match &c.sorm {
-                    Some(so) => {
-                        row.extend(
-                            [
-                                so.beta_breitung,
-                                so.beta_hohenbichler_rackwitz,
-                                so.beta_tvedt,
-                            ]
-                            .map(csv_number),
-                        );
-                        row.push(so.converged.to_string());
-                    }
-                    None => row.extend((0..4).map(|_| String::new())),
-                }
-            }
-            out.row(row);
-        }
-        if let Some(a) = &self.acceptance {
+                Ok::<(), ()>(())
+            },
+            |_| (),
+        );
+        if let Some(a) = self.acceptance {
             let mut row = acceptance_csv_row(a, ax.len());
             row.resize(width.max(row.len()), String::new());
             out.row(row);
         }
         Some(())
     }
+}
+
+/// One case's CSV row.
+fn csv_row(
+    c: &CaseResult,
+    ax: &[(String, usize)],
+    columns: CaseColumns,
+    acceptance: bool,
+) -> Vec<String> {
+    let mut row = vec![c.target.to_string()];
+    row.extend(ax.iter().map(|(_, i)| fmt_num(c.point[*i])));
+    row.extend([c.reliability, c.pf, c.beta].map(csv_number));
+    if columns.sampled && acceptance {
+        row.push(c.std_error.map_or(String::new(), csv_number));
+        row.push(c.cov.map_or(String::new(), csv_number));
+        row.push(c.samples.map_or(String::new(), |v| v.to_string()));
+    } else if columns.sampled {
+        row.push(format!("{:?}", c.std_error.unwrap_or(0.0)));
+        row.push(format!("{:?}", c.cov.unwrap_or(0.0)));
+        row.push(c.samples.unwrap_or(0).to_string());
+    }
+    match &c.form {
+        Some(f) => row.extend([
+            f.termination.to_string(),
+            f.converged.to_string(),
+            f.iterations.to_string(),
+            f.exact.to_string(),
+        ]),
+        None => row.extend((0..4).map(|_| String::new())),
+    }
+    row.push(c.calls.values.to_string());
+    row.push(c.calls.gradients.to_string());
+    if columns.stopped {
+        match &c.stopping {
+            Some(st) => row.extend([st.stopped_by.to_string(), st.converged.to_string()]),
+            None => row.extend([String::new(), String::new()]),
+        }
+    }
+    if columns.leveled {
+        row.push(
+            c.levels
+                .as_ref()
+                .map_or(String::new(), |l| l.len().to_string()),
+        );
+    }
+    if columns.sorm {
+        match &c.sorm {
+            Some(so) => {
+                row.extend(
+                    [
+                        so.beta_breitung,
+                        so.beta_hohenbichler_rackwitz,
+                        so.beta_tvedt,
+                    ]
+                    .map(csv_number),
+                );
+                row.push(so.converged.to_string());
+            }
+            None => row.extend((0..4).map(|_| String::new())),
+        }
+    }
+    row
+}
+
+/// The table of a grid of more than [`TABLE_POINTS`] points: per target
+/// its least reliable points and its most reliable one, the summary and
+/// the calls (`--format csv` lists every point).
+fn large_table(o: &ReliabilityOutput<'_>, d: &Done) -> String {
+    use std::fmt::Write as _;
+    let study = o.study;
+    let r = &d.result;
+    let ax = axes(study);
+    let mut out = String::new();
+    let sided = sided_title(study.spec().sided);
+    let _ = writeln!(
+        out,
+        "{}: machining-accuracy reliability ({}, {sided})",
+        o.machine,
+        r.method.title()
+    );
+    let _ = writeln!(
+        out,
+        "grid of {} points: more than {TABLE_POINTS}, so per target its {EXTREME_POINTS} least reliable points and its most reliable one (--format csv or json lists every point)",
+        study.points().len()
+    );
+    let at = |c: &CaseResult| -> String {
+        (ax.iter())
+            .map(|(n, i)| format!("{n} = {}", fmt_num(c.point[*i])))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    for (t, target) in study.targets().iter().enumerate() {
+        let done = &d.targets[t];
+        let _ = writeln!(out, "\n{target}: reliability (%)");
+        for (k, c) in done.lowest.iter().enumerate() {
+            let _ = writeln!(
+                out,
+                "  {:<9} {:>9.2}  at {}{}",
+                if k == 0 { "lowest" } else { "" },
+                100.0 * c.reliability,
+                at(c),
+                if c.converged() { "" } else { " *" }
+            );
+        }
+        if let Some(c) = &done.highest {
+            let _ = writeln!(
+                out,
+                "  {:<9} {:>9.2}  at {}{}",
+                "highest",
+                100.0 * c.reliability,
+                at(c),
+                if c.converged() { "" } else { " *" }
+            );
+        }
+        if let Some(s) = r.summaries.get(t) {
+            let _ = write!(
+                out,
+                "  summary: mean {:.2} %, min {:.2} %, max {:.2} %",
+                100.0 * s.mean,
+                100.0 * s.min,
+                100.0 * s.max
+            );
+            if let (Some(req), Some(met)) = (r.requirement, s.met) {
+                out.push_str(&requirement_text(&req, met));
+            }
+            out.push('\n');
+        }
+        if let Some((lo, hi)) = done.samples {
+            let samples = if lo == hi {
+                format!("{lo} samples per point")
+            } else {
+                format!("{lo} to {hi} samples per point")
+            };
+            let _ = writeln!(
+                out,
+                "  sampling: {samples}, largest standard error {:.2e}",
+                done.tally.max_std_error.unwrap_or(0.0)
+            );
+        }
+        let _ = writeln!(out, "  {}", calls_text(&done.tally, r.method));
+    }
+    let unconverged = d.tally.form_unconverged() + d.tally.sampler_unconverged;
+    if unconverged > 0 {
+        let _ = writeln!(
+            out,
+            "\n* not converged there: the value shown is not a converged reliability ({unconverged} cases in all; --format csv marks each)"
+        );
+    }
+    out
 }
 
 fn to_table(machine: &str, study: &Study, r: &StudyResult) -> String {

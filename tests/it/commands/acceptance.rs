@@ -250,7 +250,7 @@ fn one_component_at_one_point_is_the_closed_form() {
             let case = form
                 .cases
                 .iter()
-                .find(|c| c.target.name() == "py" && c.point == study.points()[p])
+                .find(|c| c.target.name() == "py" && c.point == study.points().point(p))
                 .unwrap();
             assert!((case.reliability - r.probability).abs() < 1e-12);
             let b = tol / sigma;

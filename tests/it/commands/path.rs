@@ -102,7 +102,7 @@ fn gantry_path_reliability_equals_the_grid_study_at_grid_points() {
         let mut matched = 0;
         for (k, q) in axes_of(&doc, &vars).into_iter().enumerate() {
             let q = q.expect("every gantry instant has axes");
-            let Some(p) = study.points().iter().position(|g| **g == *q) else {
+            let Some(p) = study.points().iter().position(|g| *g == *q) else {
                 continue;
             };
             matched += 1;

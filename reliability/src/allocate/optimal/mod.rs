@@ -133,7 +133,7 @@ pub(super) fn point_name(study: &Study, p: usize) -> String {
     study
         .display_order()
         .iter()
-        .map(|&i| format!("{}={}", vars[i], study.points()[p][i]))
+        .map(|&i| format!("{}={}", vars[i], study.points().point(p)[i]))
         .collect::<Vec<_>>()
         .join(", ")
 }
