@@ -351,23 +351,17 @@ impl Form {
 /// `g = I − s·(m + a·u)`: `β = (I − s·m)/|a|`, `α = s·a/|a|`.
 fn closed_form(a: &[f64], m: f64, tolerance: f64, sign: f64) -> Branch {
     let n = a.len();
-    let sigma = norm(a);
-    let mu_z = tolerance - sign * m;
-    if sigma.is_nan() || sigma <= 0.0 {
+    let (beta, sigma, termination) = closed_beta(a, m, tolerance, sign);
+    if termination == Termination::Degenerate {
         return Branch {
-            beta: if mu_z > 0.0 {
-                f64::INFINITY
-            } else {
-                f64::NEG_INFINITY
-            },
+            beta,
             u: vec![0.0; n],
             alpha: vec![0.0; n],
             gradient_norm: 0.0,
             iterations: 0,
-            termination: Termination::Degenerate,
+            termination,
         };
     }
-    let beta = mu_z / sigma;
     let alpha: Vec<f64> = a.iter().map(|v| sign * v / sigma).collect();
     Branch {
         beta,
@@ -375,8 +369,26 @@ fn closed_form(a: &[f64], m: f64, tolerance: f64, sign: f64) -> Branch {
         alpha,
         gradient_norm: sigma,
         iterations: 0,
-        termination: Termination::ClosedForm,
+        termination,
     }
+}
+
+/// The index of [`closed_form`]'s branch alone, allocating nothing: `(β,
+/// σ = |a|, termination)`, `β = (I − sign·m)/σ`, or `±∞` (degenerate) when
+/// `σ` is zero or NaN. What a grid study's closed-form cases compute, bit
+/// for bit as [`Form::run`] does.
+pub(crate) fn closed_beta(a: &[f64], m: f64, tolerance: f64, sign: f64) -> (f64, f64, Termination) {
+    let sigma = norm(a);
+    let mu_z = tolerance - sign * m;
+    if sigma.is_nan() || sigma <= 0.0 {
+        let beta = if mu_z > 0.0 {
+            f64::INFINITY
+        } else {
+            f64::NEG_INFINITY
+        };
+        return (beta, sigma, Termination::Degenerate);
+    }
+    (mu_z / sigma, sigma, Termination::ClosedForm)
 }
 
 /// Scratch buffers of the HL-RF evaluation.

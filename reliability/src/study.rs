@@ -1162,17 +1162,119 @@ impl Study {
         set: CaseSet<'_>,
         progress: &dyn Progress,
     ) -> Result<Vec<CaseResult>, ReliabilityError> {
-        self.cases_in_blocks(
-            set,
-            progress,
-            |e| form.run(e),
-            |i, r| {
-                let mut c = self.case(i, r.reliability, r.pf, r.beta);
-                c.form = Some(FormCase::of(&r));
-                c.calls = r.calls;
-                c
-            },
-        )
+        let keep = |i: usize, r: FormResult| {
+            let mut c = self.case(i, r.reliability, r.pf, r.beta);
+            c.form = Some(FormCase::of(&r));
+            c.calls = r.calls;
+            c
+        };
+        let plans: Vec<Option<Vec<(usize, f64)>>> =
+            self.targets.iter().map(|&t| self.closed_plan(t)).collect();
+        if plans.iter().all(Option::is_none) {
+            return self.cases_in_blocks(set, progress, |e| form.run(e), keep);
+        }
+        // Where FORM takes the closed form (every branch a half-space in
+        // normal inputs), each case computes what `Form::run` computes for
+        // it, without forming its event: the projection, `β` per branch,
+        // the nearest. A block of cases at a time, each run of consecutive
+        // points of one target from one evaluation of their sensitivities.
+        let (n, np) = (self.inputs.len(), self.points.len());
+        let n6 = 6 * n;
+        let total = set.len();
+        let mut cases = Vec::with_capacity(total);
+        let mut start = 0;
+        while start < total {
+            let end = (start + CASE_BLOCK).min(total);
+            let mut k = start;
+            while k < end {
+                let first = set.id(k);
+                let (t, p) = (first / np, first % np);
+                let mut e = k + 1;
+                while e < end && set.id(e) == set.id(e - 1) + 1 && set.id(e) / np == t {
+                    e += 1;
+                }
+                let s = self.sensitivities(p..p + (e - k));
+                let run: Result<Vec<CaseResult>, ReliabilityError> = (0..e - k)
+                    .into_par_iter()
+                    .map_init(
+                        || vec![0.0; n],
+                        |a, j| {
+                            let rows = &s[j * n6..(j + 1) * n6];
+                            let inputs = self.inputs_at(p + j);
+                            match &plans[t] {
+                                Some(plan) if inputs.is_affine() => {
+                                    Ok(self.closed_case(first + j, inputs, rows, plan, a))
+                                }
+                                _ => {
+                                    let state = self.limit_state_of(self.targets[t], rows)?;
+                                    Ok(keep(first + j, form.run(&Event::new(inputs, state)?)?))
+                                }
+                            }
+                        },
+                    )
+                    .collect();
+                cases.extend(run?);
+                k = e;
+            }
+            progress.advance((end - start) as u64);
+            start = end;
+        }
+        Ok(cases)
+    }
+
+    /// The components (index, tolerance) of `target` when FORM takes the
+    /// closed form on it in normal inputs: every branch a half-space (a
+    /// component or the series system; not the volumetric norm), every
+    /// tolerance valid (else the event's own refusal is wanted).
+    fn closed_plan(&self, target: Target) -> Option<Vec<(usize, f64)>> {
+        let tol = &self.spec.tolerances;
+        let plan: Vec<(usize, f64)> = match target {
+            Target::Component(c) => vec![(c.index(), tol.iter().find(|(x, _)| *x == c)?.1)],
+            Target::Series => tol.iter().map(|(c, t)| (c.index(), *t)).collect(),
+            Target::Volumetric => return None,
+        };
+        let valid = !plan.is_empty()
+            && !self.inputs.is_empty()
+            && plan.iter().all(|(_, t)| t.is_finite() && *t > 0.0);
+        valid.then_some(plan)
+    }
+
+    /// Case `i` in the closed form ([`Study::closed_plan`]'s `plan`) at the
+    /// point whose `6 × N` sensitivities are `rows`: FORM's branches
+    /// `g_b = I_c − sign·E_c` in `Form::run`'s order (per component `+`,
+    /// then `−` when two-sided), the nearest (the first of equal ones).
+    fn closed_case(
+        &self,
+        i: usize,
+        inputs: &Inputs,
+        rows: &[f64],
+        plan: &[(usize, f64)],
+        a: &mut [f64],
+    ) -> CaseResult {
+        let n = inputs.len();
+        let signs: &[f64] = match self.spec.sided {
+            Sided::Upper => &[1.0],
+            Sided::Two => &[1.0, -1.0],
+        };
+        let mut best: Option<(f64, Termination)> = None;
+        for &(c, tolerance) in plan {
+            let m = inputs.project(&rows[c * n..(c + 1) * n], a);
+            for &sign in signs {
+                let (beta, _, termination) = crate::form::closed_beta(a, m, tolerance, sign);
+                if best.is_none_or(|(b, _)| beta < b) {
+                    best = Some((beta, termination));
+                }
+            }
+        }
+        let (beta, termination) = best.unwrap_or((f64::NAN, Termination::Degenerate));
+        let mut c = self.case(i, normal::cdf(beta), normal::sf(beta), beta);
+        c.form = Some(FormCase {
+            termination,
+            converged: true,
+            iterations: 0,
+            exact: plan.len() == 1 && self.spec.sided == Sided::Upper,
+        });
+        c
     }
 
     /// Runs `run` on the event of every case of `set` and keeps `keep` of
@@ -1910,6 +2012,39 @@ mod tests {
         for i in [0, CASE_BLOCK - 1, CASE_BLOCK, total - 1] {
             let alone = sorm.run(&events[i]).unwrap();
             assert_eq!(s.cases[i].pf.to_bits(), alone.pf.to_bits(), "case {i}");
+        }
+    }
+
+    #[test]
+    fn the_closed_form_cases_equal_form_run_on_their_events_bit_for_bit() {
+        // One- and two-sided, the series system (several half-space
+        // branches): every case as `Form::run` gives it on its event.
+        let (m, model) = gantry();
+        for sided in [Sided::Upper, Sided::Two] {
+            let mut spec = machine::spec(&m, Some(System::Series)).unwrap();
+            spec.sided = sided;
+            spec.grid = Grid {
+                axes: vec![
+                    ("x".into(), vec![0.0, 500.0, 1000.0]),
+                    ("y".into(), vec![-1500.0, 0.0, 700.0, 1500.0]),
+                    ("z".into(), vec![600.0, 1400.0]),
+                ],
+            };
+            let inputs = machine::inputs(&m).unwrap();
+            let params = machine::parameters(&m, &[]).unwrap();
+            let study = Study::new(&model, &params, inputs, spec).unwrap();
+            assert_eq!(study.targets().len(), 4);
+            let form = Form::default();
+            let r = study.run(&Algorithm::Form(form), &()).unwrap();
+            let events = study.events().unwrap();
+            for (c, e) in r.cases.iter().zip(&events) {
+                let alone = form.run(e).unwrap();
+                assert_eq!(c.reliability.to_bits(), alone.reliability.to_bits());
+                assert_eq!(c.pf.to_bits(), alone.pf.to_bits());
+                assert_eq!(c.beta.to_bits(), alone.beta.to_bits());
+                assert_eq!(c.form, Some(FormCase::of(&alone)), "{sided:?}");
+                assert_eq!(c.calls, alone.calls);
+            }
         }
     }
 
