@@ -276,12 +276,46 @@ struct InverseJson<'a> {
     rows: Vec<RowJson<'a>>,
 }
 
-/// One pose row: its 1-based number, status and solutions `{variable: value}`.
+/// One pose row: its 1-based number, status and solutions `{variable: value}`;
+/// `stopped` (only when true) where the search gave up at its budget.
 #[derive(Serialize)]
 struct RowJson<'a> {
     row: usize,
     status: Status,
     solutions: Vec<NameMap<&'a str, f64>>,
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    stopped: bool,
+}
+
+/// The warning on the rows whose damped-Newton search gave up at its
+/// budget (`rows`: every row's solution, in order), if any.
+pub fn stopped_note(rows: &[Solution]) -> Option<String> {
+    let stopped: Vec<String> = (rows.iter().enumerate())
+        .filter(|(_, s)| s.stopped)
+        .map(|(k, _)| (k + 1).to_string())
+        .collect();
+    if stopped.is_empty() {
+        return None;
+    }
+    let shown = stopped.len().min(10);
+    let more = if stopped.len() > shown {
+        format!(" and {} more", stopped.len() - shown)
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "warning: row{} {}{more}: the damped-Newton search gave up after {} iterations before trying every start (`stopped` in the JSON): an `unreachable` there means no solution was found, not that none exists",
+        if stopped.len() == 1 { "" } else { "s" },
+        stopped[..shown].join(", "),
+        chain_core::kinematics::inverse::STEPS_PER_POSE
+    ))
+}
+
+impl InverseDocument {
+    /// The warnings on the run: the rows whose search gave up.
+    pub fn notes(&self) -> Vec<String> {
+        stopped_note(&self.rows).into_iter().collect()
+    }
 }
 
 impl Serialize for InverseDocument {
@@ -302,6 +336,7 @@ impl Serialize for InverseDocument {
                             )
                         })
                         .collect(),
+                    stopped: s.stopped,
                 })
                 .collect(),
         }

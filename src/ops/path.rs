@@ -193,6 +193,7 @@ pub fn prepare(machine: &Machine, request: &PathRequest<'_>) -> Result<PreparedP
     let params = machine::parameters(m, request.params)?;
     let fixed = resolve::fixed(m, request.fix)?;
     let factors = resolve::thermal_factors(m, request.temperatures)?;
+    let mut stopped = None;
     let (has_t, instants) = match request.input {
         PathInput::Axes {
             source,
@@ -201,7 +202,9 @@ pub fn prepare(machine: &Machine, request: &PathRequest<'_>) -> Result<PreparedP
         } => axes_instants(m, source, header, rows, &fixed)?,
         PathInput::Poses { has_t, rows, .. } => {
             let solver = super::inverse::solver(m, &params, &fixed)?;
-            let instants = solve_rows(&solver, rows, m.variables.len(), &fixed)
+            let solved = solve_rows(&solver, rows, m.variables.len(), &fixed);
+            stopped = super::inverse::stopped_note(&solved);
+            let instants = solved
                 .into_iter()
                 .zip(rows)
                 .enumerate()
@@ -226,7 +229,7 @@ pub fn prepare(machine: &Machine, request: &PathRequest<'_>) -> Result<PreparedP
     let sided = spec.sided;
     let path = PathStudy::on_demand(model, &params, inputs, spec, instants)?;
     let algorithm = request.algorithm.algorithm();
-    let mut notes = Vec::new();
+    let mut notes: Vec<String> = stopped.into_iter().collect();
     match path.study() {
         None => notes
             .push("note: no instant of the path has axis values; nothing to evaluate".to_string()),

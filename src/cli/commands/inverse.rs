@@ -58,6 +58,9 @@ pub fn exec(args: InverseArgs) -> miette::Result<()> {
         InverseOpsError::Resolve(e) => miette::Report::new(e),
         InverseOpsError::Machine(e) => miette::Report::new(e),
     })?;
+    for note in doc.notes() {
+        eprintln!("{note}");
+    }
     report::emit(&doc, args.format.into())
 }
 

@@ -418,3 +418,54 @@ fn cli_reports_the_newton_method() {
     assert_eq!(doc["rows"][0]["status"], "ok");
     assert!(!doc["rows"][0]["solutions"].as_array().unwrap().is_empty());
 }
+
+#[test]
+fn the_newton_search_gives_up_on_a_pose_at_its_budget_and_says_so() {
+    use chain_core::inverse::STEPS_PER_POSE;
+    // The Panda: seven rotary joints, a redundant arm, the damped-Newton
+    // fallback. Row 1 is out of reach; row 2 is the arm's pose at zero.
+    let file = common::example_file("robots/panda_mdh.yaml");
+    let m = chain_core::load_file(&file).unwrap();
+    let params: Vec<f64> = m.parameters.iter().map(|p| p.value.unwrap()).collect();
+    let kin = Kinematics::from_machine(&m);
+    let zero = kin.pose(&[0.0; 7], &params);
+    let [x, y, z] = zero.position;
+    let (i, j, k) = (
+        zero.rotation[0][2],
+        zero.rotation[1][2],
+        zero.rotation[2][2],
+    );
+    let poses = scratch_file(
+        "panda-poses.csv",
+        &format!("px,py,pz,i,j,k\n100000,0,0,0,0,1\n{x},{y},{z},{i},{j},{k}\n"),
+    );
+    let out = common::cli::chain(&inverse_args(&file, &poses, &[]));
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["method"], "newton");
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows[0]["status"], "unreachable");
+    assert_eq!(rows[0]["stopped"], true, "{}", rows[0]);
+    assert_ne!(rows[1]["status"], "unreachable");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    // (The reachable row stops too: a redundant arm's starts that do not
+    // converge use up the budget before all 257 are tried.)
+    assert!(
+        stderr.contains(&format!(
+            "warning: rows 1, 2: the damped-Newton search gave up after {STEPS_PER_POSE} iterations before trying every start"
+        )),
+        "{stderr}"
+    );
+    // The library's solution says so too, and a closed-form machine's
+    // rows never do.
+    let solver = Inverse::for_machine(&m, &params, &[]).unwrap();
+    let s = solver.solve([1e5, 0.0, 0.0], [0.0, 0.0, 1.0], &[0.0; 7]);
+    assert!(s.stopped && s.solutions.is_empty());
+    let csv = scratch_file("poses-ok.csv", "px,py,pz,i,j,k\n10,20,30,0,0,1\n");
+    let v = ok_json(&inverse_args(
+        &machine_path("cnc5_bevel"),
+        &csv,
+        &["--fix", "mu=0"],
+    ));
+    assert!(v["rows"][0].get("stopped").is_none());
+}

@@ -29,7 +29,7 @@
 
 mod newton;
 
-pub use newton::NewtonSolver;
+pub use newton::{NewtonSolver, STEPS_PER_POSE};
 
 use crate::kinematics::{Kinematics, NominalPose};
 use crate::model::{JointKind, Machine};
@@ -127,6 +127,11 @@ pub struct Solution {
     /// Full variable vectors (in the model's variable order), nearest to the
     /// previous values first.
     pub solutions: Vec<Vec<f64>>,
+    /// True when the damped-Newton search gave up on the pose at its budget
+    /// ([`STEPS_PER_POSE`] iterations) before it had tried
+    /// every start: `Unreachable` then means none was found, not that none
+    /// exists, and other solutions may exist.
+    pub stopped: bool,
 }
 
 /// The inverse kinematics of one machine, by the best method that applies.
@@ -222,7 +227,7 @@ impl Inverse {
         let first = self.solve(point, axis, prev);
         let singular = first.status == Status::Singular;
         let mut out: Vec<Vec<f64>> = Vec::new();
-        for mut q in first.solutions {
+        for mut q in first.solutions.iter().cloned() {
             if let Some(&(k, sign)) = self.spin.first() {
                 let r = self.kinematics.pose(&q, &self.params).rotation;
                 let w = log_so3(&mul(rotation, &tr(&r)));
@@ -234,7 +239,9 @@ impl Inverse {
                 out.push(q);
             }
         }
-        Solution::ranked(out, prev, &self.rotary, singular)
+        let mut solution = Solution::ranked(out, prev, &self.rotary, singular);
+        solution.stopped = first.stopped;
+        solution
     }
 }
 
@@ -252,6 +259,7 @@ impl Solution {
         Solution {
             status: Status::Unreachable,
             solutions: Vec::new(),
+            stopped: false,
         }
     }
 
@@ -284,6 +292,7 @@ impl Solution {
                 Status::Ok
             },
             solutions,
+            stopped: false,
         }
     }
 }

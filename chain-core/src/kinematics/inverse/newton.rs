@@ -25,6 +25,13 @@ use crate::model::JointKind;
 const MAX_STARTS: usize = 256;
 /// Most iterations per start.
 const MAX_ITERATIONS: usize = 100;
+/// Most damped-Newton iterations per pose, over all its starts (each one
+/// Jacobian and its damped trial steps): the bound on one pose's work. A
+/// start that converges takes about a dozen, so the starts of a redundant
+/// arm fit (257 × 12 ≈ 3,100); a pose that never converges (a target out of
+/// reach, an offset whose rounding exceeds every tolerance) stops here
+/// instead of running every start to its iteration limit (257 × 100).
+pub const STEPS_PER_POSE: usize = 4_000;
 
 /// Damped-Newton inverse kinematics for any machine.
 #[derive(Debug, Clone, PartialEq)]
@@ -81,15 +88,25 @@ impl NewtonSolver {
         }
         let mut found: Vec<Vec<f64>> = Vec::new();
         let mut singular = false;
-        for q0 in self.starts(&start) {
-            if let Some((q, rank_deficient)) = self.converge(q0, point, t) {
+        let mut budget = STEPS_PER_POSE;
+        let starts = self.starts(&start);
+        let count = starts.len();
+        let mut tried = 0;
+        for q0 in starts {
+            if budget == 0 {
+                break;
+            }
+            tried += 1;
+            if let Some((q, rank_deficient)) = self.converge(q0, point, t, &mut budget) {
                 if !found.iter().any(|o| same_point(o, &q, &self.rotary)) {
                     singular |= rank_deficient;
                     found.push(q);
                 }
             }
         }
-        Solution::ranked(found, prev, &self.rotary, singular)
+        let mut solution = Solution::ranked(found, prev, &self.rotary, singular);
+        solution.stopped = tried < count || (budget == 0 && tried == count);
+        solution
     }
 
     /// The previous values, then the rotary grid around them.
@@ -118,7 +135,13 @@ impl NewtonSolver {
 
     /// Levenberg–Marquardt from `q`; the wrapped solution and whether its
     /// Jacobian is rank deficient, or `None` if it does not converge.
-    fn converge(&self, mut q: Vec<f64>, point: V3, t: V3) -> Option<(Vec<f64>, bool)> {
+    fn converge(
+        &self,
+        mut q: Vec<f64>,
+        point: V3,
+        t: V3,
+        budget: &mut usize,
+    ) -> Option<(Vec<f64>, bool)> {
         let scale = 1.0f64.max(norm(point));
         let m = self.free.len();
         let residual = |q: &[f64]| -> ([f64; 6], V3, V3) {
@@ -147,6 +170,11 @@ impl NewtonSolver {
         let tight = |dp: V3, z: V3| norm(dp) <= 1e-13 * scale && norm(sub(z, t)) <= 1e-13;
         let loose = |dp: V3, z: V3| norm(dp) <= 1e-11 * scale && norm(sub(z, t)) <= 1e-12;
         for _ in 0..MAX_ITERATIONS {
+            // Every iteration counts against the pose's budget.
+            if *budget == 0 {
+                break;
+            }
+            *budget -= 1;
             let j = self.weighted_jacobian(&q, z, scale);
             if tight(dp, z) {
                 return Some(self.finish(q, &j));
