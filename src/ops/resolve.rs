@@ -37,6 +37,18 @@ pub enum ResolveError {
         /// The value.
         value: f64,
     },
+    /// A parameter value beyond any physical size
+    /// ([`chain_core::load::PHYSICAL_SIZE`]).
+    #[error(
+        "--param {name}: {value:e} is beyond any physical size: a parameter must be in {}",
+        chain_core::load::PHYSICAL_RANGE
+    )]
+    ParameterBeyondSize {
+        /// The parameter.
+        name: String,
+        /// The value.
+        value: f64,
+    },
     /// `--grid` names no axis variable of the machine.
     #[error("{file}: unknown axis variable `{name}`{}", did_you_mean(suggestion))]
     UnknownGridAxis {
@@ -213,6 +225,7 @@ impl Worded for ResolveError {
         Some(match self {
             ResolveError::UnknownParameter { .. } => "chain::cli::unknown_parameter",
             ResolveError::NonFiniteParameter { .. } => "chain::cli::param_not_finite",
+            ResolveError::ParameterBeyondSize { .. } => "chain::cli::param_out_of_range",
             ResolveError::UnknownGridAxis { .. } => "chain::reliability::unknown_name",
             ResolveError::EmptyGridAxis { .. } => "chain::cli::empty_grid_axis",
             ResolveError::NonFiniteGridValue { .. } => "chain::cli::grid_not_finite",
@@ -339,6 +352,12 @@ pub fn check_parameters(m: &Machine, params: &[(String, f64)]) -> Result<(), Res
         }
         if !value.is_finite() {
             return Err(ResolveError::NonFiniteParameter {
+                name: name.clone(),
+                value: *value,
+            });
+        }
+        if value.abs() > chain_core::load::PHYSICAL_SIZE {
+            return Err(ResolveError::ParameterBeyondSize {
                 name: name.clone(),
                 value: *value,
             });

@@ -194,3 +194,63 @@ fn axis_values_whose_moments_overflow_are_refused_naming_the_point() {
     let out = run(&["path", &gantry_file, "--axes", &axes, "--format", "json"]);
     assert!(out.status.success(), "{}", flat(&out.stderr));
 }
+
+/// An offset, a tool point or a parameter beyond any physical size (a
+/// kilometre in mm) is refused at load with its key and line, and so is a
+/// `--param` beyond it: such a value is a slip that would make every
+/// tolerance of the inverse kinematics meaningless.
+#[test]
+fn lengths_and_parameters_beyond_any_physical_size_are_refused_with_their_place() {
+    let vmc3 = std::fs::read_to_string(format!("{ROOT}/examples/machines/vmc3.yaml")).unwrap();
+    let broken = vmc3.replacen("offset: [0, -500, 0]", "offset: [1e15, -500, 0]", 1);
+    assert_ne!(broken, vmc3);
+    let line = broken.lines().position(|l| l.contains("1e15")).unwrap() + 1;
+    let file = scratch("far_offset.yaml", &broken);
+    let out = run(&["derive", &file]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let err = flat(&out.stderr);
+    assert!(err.contains(&format!("far_offset.yaml:{line}:")), "{err}");
+    assert!(
+        err.contains("a length (mm) must be in [-1e6, 1e6] (a kilometre in mm: beyond any machine), got 1000000000000000"),
+        "{err}"
+    );
+    assert!(err.contains("offset[0]"), "{err}");
+    // A parameter's value in the file, and one given with --param.
+    let internal =
+        std::fs::read_to_string(format!("{ROOT}/examples/machines/internal_grinder.yaml")).unwrap();
+    let (name, value) = {
+        let section = internal.split("parameters:").nth(1).unwrap();
+        let l = section.lines().find(|l| l.contains(':')).unwrap();
+        let (n, v) = l.split_once(':').unwrap();
+        (n.trim().to_string(), v.trim().to_string())
+    };
+    let broken = internal.replacen(&format!("{name}: {value}"), &format!("{name}: 2e9"), 1);
+    let line = broken.lines().position(|l| l.contains("2e9")).unwrap() + 1;
+    let file = scratch("far_parameter.yaml", &broken);
+    let out = run(&["derive", &file]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let err = flat(&out.stderr);
+    assert!(
+        err.contains(&format!("far_parameter.yaml:{line}:")),
+        "{err}"
+    );
+    assert!(
+        err.contains(&format!("parameters.{name}"))
+            && err.contains("a parameter value must be in [-1e6, 1e6]"),
+        "{err}"
+    );
+    let out = run(&[
+        "reliability",
+        &format!("{ROOT}/examples/machines/internal_grinder.yaml"),
+        "--param",
+        &format!("{name}=1e15"),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let err = flat(&out.stderr);
+    assert!(
+        err.contains(&format!(
+            "--param {name}: 1e15 is beyond any physical size: a parameter must be in [-1e6, 1e6]"
+        )),
+        "{err}"
+    );
+}

@@ -60,6 +60,17 @@ pub const TOP_KEYS: &[&str] = &[
 /// (measured-machines spec, section 1).
 pub const MAX_ORDER: u32 = 12;
 
+/// The largest magnitude of a length or a parameter in a machine file
+/// (offsets, the tool point, DH `a`/`d`, parameter values; and `--param`):
+/// 10⁶, a kilometre in mm (a million degrees for an angle). Nothing a
+/// machine holds comes near it; a value beyond it is a slip (a unit or an
+/// exponent) and would make every tolerance of the inverse kinematics and
+/// the reliability meaningless, so it is refused where it is written.
+pub const PHYSICAL_SIZE: f64 = 1e6;
+
+/// The range [`PHYSICAL_SIZE`] allows, in words.
+pub const PHYSICAL_RANGE: &str = "[-1e6, 1e6] (a kilometre in mm: beyond any machine)";
+
 /// Names the expression language reserves.
 pub const RESERVED: &[&str] = &["pi", "sin", "cos"];
 
@@ -331,6 +342,15 @@ impl Loader {
                 if let Expr::Num(v) = e {
                     if !v.is_finite() {
                         self.report(node.span, path, Problem::NotFinite { what: "the value" });
+                        return None;
+                    }
+                    if v.abs() > PHYSICAL_SIZE {
+                        let problem = Problem::OutOfRange {
+                            what: "a length (mm)",
+                            value: v,
+                            range: PHYSICAL_RANGE,
+                        };
+                        self.report(node.span, path, problem);
                         return None;
                     }
                 }

@@ -103,6 +103,18 @@ impl Loader {
             } else {
                 self.finite(v, &path, "a parameter value")
             };
+            let value = match value {
+                Some(x) if x.abs() > super::PHYSICAL_SIZE => {
+                    let problem = Problem::OutOfRange {
+                        what: "a parameter value",
+                        value: x,
+                        range: super::PHYSICAL_RANGE,
+                    };
+                    self.report(v.span, &path, problem);
+                    None
+                }
+                other => other,
+            };
             self.parameter_index
                 .entry(name.clone())
                 .or_insert(self.parameters.len());
