@@ -834,7 +834,6 @@ impl ThermalLaw {
     /// `KINEMATICS_TEMPCOMP.TAB` and its README (module docs).
     fn heidenhain(&self, provenance: &str) -> Vec<ExportedFile> {
         use std::fmt::Write;
-        let mut tab = String::from("BEGIN KINEMATICS_TEMPCOMP.TAB MM\n");
         let rows: Vec<[String; 5]> = (self.axes.iter().enumerate())
             .map(|(nr, a)| {
                 [
@@ -846,27 +845,11 @@ impl ThermalLaw {
                 ]
             })
             .collect();
-        let header = ["NR", "KEY", "AXIS", "COORD", "TEMPCOMP"];
-        let width: Vec<usize> = (0..5)
-            .map(|c| {
-                rows.iter()
-                    .map(|r| r[c].len())
-                    .fold(header[c].len(), usize::max)
-                    + 2
-            })
-            .collect();
-        let line = |r: [&str; 5]| -> String {
-            let mut l: String = (0..5)
-                .map(|c| format!("{:<w$}", r[c], w = width[c]))
-                .collect();
-            l.truncate(l.trim_end().len());
-            l + "\n"
-        };
-        tab.push_str(&line(header));
-        for r in &rows {
-            tab.push_str(&line(std::array::from_fn(|c| r[c].as_str())));
-        }
-        tab.push_str("[END]\n");
+        let tab = crate::compensation::controllers::tnc_table(
+            "KINEMATICS_TEMPCOMP.TAB",
+            ["NR", "KEY", "AXIS", "COORD", "TEMPCOMP"],
+            &rows,
+        );
         let mut readme = format!(
             "{provenance}: machine `{}`: HEIDENHAIN kinematics description, temperature compensation (TEMPCOMP)\n\n",
             self.machine

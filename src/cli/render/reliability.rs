@@ -257,25 +257,9 @@ fn large_table(o: &ReliabilityOutput<'_>, d: &Done) -> String {
                 if c.converged() { "" } else { " *" }
             );
         }
-        if let Some(s) = r.summaries.get(t) {
-            let _ = write!(
-                out,
-                "  summary: mean {:.2} %, min {:.2} %, max {:.2} %",
-                100.0 * s.mean,
-                100.0 * s.min,
-                100.0 * s.max
-            );
-            if let (Some(req), Some(met)) = (r.requirement, s.met) {
-                out.push_str(&requirement_text(&req, met));
-            }
-            out.push('\n');
-        }
+        out.push_str(&summary_line(r, t));
         if let Some((lo, hi)) = done.samples {
-            let samples = if lo == hi {
-                format!("{lo} samples per point")
-            } else {
-                format!("{lo} to {hi} samples per point")
-            };
+            let samples = samples_text(lo, hi);
             let _ = writeln!(
                 out,
                 "  sampling: {samples}, largest standard error {:.2e}",
@@ -368,19 +352,7 @@ fn to_table(machine: &str, study: &Study, r: &StudyResult) -> String {
                 let _ = writeln!(out, "  * not converged at {}", bad.join(", "));
             }
         }
-        if let Some(s) = r.summaries.get(t) {
-            let _ = write!(
-                out,
-                "  summary: mean {:.2} %, min {:.2} %, max {:.2} %",
-                100.0 * s.mean,
-                100.0 * s.min,
-                100.0 * s.max
-            );
-            if let (Some(req), Some(met)) = (r.requirement, s.met) {
-                out.push_str(&requirement_text(&req, met));
-            }
-            out.push('\n');
-        }
+        out.push_str(&summary_line(r, t));
         let cases = r.target_cases(t);
         let se = cases
             .iter()
@@ -436,11 +408,7 @@ fn sampling_text(cases: &[reliability::CaseResult], rule: Stopping, se: f64) -> 
         ns.iter().copied().min().unwrap_or(0),
         ns.iter().copied().max().unwrap_or(0),
     );
-    let samples = if lo == hi {
-        format!("{lo} samples per point")
-    } else {
-        format!("{lo} to {hi} samples per point")
-    };
+    let samples = samples_text(lo, hi);
     let met = cases.iter().filter(|c| c.sampler_converged()).count();
     let target = match rule.target_cov {
         Some(t) => format!(", target CoV {t} met at {met} of {} points", cases.len()),
@@ -619,4 +587,32 @@ fn distribution_text(d: &chain_core::model::Distribution) -> String {
             Some(format!("{name}({})", args.join(", ")))
         })
         .unwrap_or_default()
+}
+
+/// Target `t`'s summary line (mean, min, max; the requirement), or nothing
+/// without a summary.
+fn summary_line(r: &StudyResult, t: usize) -> String {
+    let Some(s) = r.summaries.get(t) else {
+        return String::new();
+    };
+    let mut out = format!(
+        "  summary: mean {:.2} %, min {:.2} %, max {:.2} %",
+        100.0 * s.mean,
+        100.0 * s.min,
+        100.0 * s.max
+    );
+    if let (Some(req), Some(met)) = (r.requirement, s.met) {
+        out.push_str(&requirement_text(&req, met));
+    }
+    out.push('\n');
+    out
+}
+
+/// `N samples per point`, or `LO to HI samples per point`.
+fn samples_text(lo: u64, hi: u64) -> String {
+    if lo == hi {
+        format!("{lo} samples per point")
+    } else {
+        format!("{lo} to {hi} samples per point")
+    }
 }

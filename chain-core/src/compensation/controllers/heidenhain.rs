@@ -260,7 +260,6 @@ pub(super) fn export<M: ErrorModel + Sync>(
             m.name
         ),
     );
-    let mut text = String::from("BEGIN KINEMATICS_ROTARY.TAB MM\n");
     let cells: Vec<[String; 5]> = (rows.iter().enumerate())
         .map(|(nr, row)| {
             let (coord, doc) = match row.value {
@@ -279,29 +278,11 @@ pub(super) fn export<M: ErrorModel + Sync>(
             ]
         })
         .collect();
-    // Fixed columns: each header name padded to its column's width.
-    let header = ["NR", "KEY", "AXIS", "COORD", "DOC"];
-    let width: Vec<usize> = (0..5)
-        .map(|c| {
-            cells
-                .iter()
-                .map(|r| r[c].len())
-                .fold(header[c].len(), usize::max)
-                + 2
-        })
-        .collect();
-    let line = |r: [&str; 5]| -> String {
-        let mut l: String = (0..5)
-            .map(|c| format!("{:<w$}", r[c], w = width[c]))
-            .collect();
-        l.truncate(l.trim_end().len());
-        l + "\n"
-    };
-    text.push_str(&line(header));
-    for r in &cells {
-        text.push_str(&line(std::array::from_fn(|c| r[c].as_str())));
-    }
-    text.push_str("[END]\n");
+    let text = tnc_table(
+        "KINEMATICS_ROTARY.TAB",
+        ["NR", "KEY", "AXIS", "COORD", "DOC"],
+        &cells,
+    );
     let mut readme = format!("{head}\n\n");
     readme.push_str("KINEMATICS_ROTARY.TAB: the workpiece side of the kinematics description (COORD identified, the machine file's nominal in DOC; mm and degrees; a TNC table: BEGIN line, fixed columns set by the header, [END])\n");
     readme.push_str(&format!(
@@ -345,4 +326,35 @@ fn sense(s: f64) -> &'static str {
     } else {
         "left-handed"
     }
+}
+
+/// A TNC table: its `BEGIN NAME MM` line, the header and the rows in fixed
+/// columns (each header name padded to its column's width), `[END]`.
+pub(crate) fn tnc_table<const C: usize>(
+    name: &str,
+    header: [&str; C],
+    rows: &[[String; C]],
+) -> String {
+    let width: Vec<usize> = (0..C)
+        .map(|c| {
+            rows.iter()
+                .map(|r| r[c].len())
+                .fold(header[c].len(), usize::max)
+                + 2
+        })
+        .collect();
+    let line = |r: [&str; C]| -> String {
+        let mut l: String = (0..C)
+            .map(|c| format!("{:<w$}", r[c], w = width[c]))
+            .collect();
+        l.truncate(l.trim_end().len());
+        l + "\n"
+    };
+    let mut text = format!("BEGIN {name} MM\n");
+    text.push_str(&line(header));
+    for r in rows {
+        text.push_str(&line(std::array::from_fn(|c| r[c].as_str())));
+    }
+    text.push_str("[END]\n");
+    text
 }

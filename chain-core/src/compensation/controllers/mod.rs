@@ -56,6 +56,7 @@
 mod beckhoff;
 mod fanuc_tcp;
 mod heidenhain;
+pub(crate) use heidenhain::tnc_table;
 mod klipper;
 mod linuxcnc;
 mod linuxcnc_trt;
