@@ -229,6 +229,17 @@ fn controller_message(e: &ControllerError) -> String {
     }
 }
 
+impl ExportOpsError {
+    /// `option` refused for the request's controller, and why.
+    fn option(request: &ExportRequest<'_>, option: &'static str, why: &'static str) -> Self {
+        ExportOpsError::Option {
+            controller: request.controller.name(),
+            option,
+            why,
+        }
+    }
+}
+
 impl Worded for ExportOpsError {
     fn own_code(&self) -> Option<&'static str> {
         match self {
@@ -356,14 +367,7 @@ impl ExportDocument {
 /// Refuses the options the chosen controller does not take, before
 /// anything is read.
 pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
-    let controller = request.controller.name();
-    let refuse = |option, why| {
-        Err(ExportOpsError::Option {
-            controller,
-            option,
-            why,
-        })
-    };
+    let refuse = |option, why| Err(ExportOpsError::option(request, option, why));
     match request.controller {
         ExportController::Grid => {
             if request.step.is_some() {
@@ -418,14 +422,7 @@ pub fn check(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
 /// Refuses the options of the per-axis tables (`--angles`, the table
 /// limits) for a format that writes none.
 fn no_table_options(request: &ExportRequest<'_>) -> Result<(), ExportOpsError> {
-    let controller = request.controller.name();
-    let refuse = |option, why| {
-        Err(ExportOpsError::Option {
-            controller,
-            option,
-            why,
-        })
-    };
+    let refuse = |option, why| Err(ExportOpsError::option(request, option, why));
     if request.angles {
         return refuse("--angles", ANGLES_WHY);
     }
@@ -466,18 +463,19 @@ pub fn run(
     check(request)?;
     let m = machine;
     let params = Parameters::new(m, request.params)?.values()?;
-    if let ExportController::Thermal(format) = request.controller {
-        // The law is per kelvin: the values as the file gives them.
-        return thermal_export(m, file, &values, values_file, &params, format, request);
-    }
-    let (values, state) = super::resolve::at_thermal_state(m, values, request.temperatures)?;
-    let provenance = provenance(request.controller, &state);
+    // The geometric formats read the values at the thermal state; a
+    // thermal law is per kelvin, the values as the file gives them.
+    let at_state = |values| -> Result<(Values, String), ExportOpsError> {
+        let (values, state) = super::resolve::at_thermal_state(m, values, request.temperatures)?;
+        Ok((values, provenance(request.controller, &state)))
+    };
     let built_error = |e: chain_core::built::BuiltError| ExportOpsError::Built {
         values: values_file.to_string(),
         message: e.to_string(),
     };
     match request.controller {
         ExportController::Grid => {
+            let (values, provenance) = at_state(values)?;
             let (points, _) = request.points.resolve(m, file)?;
             let built = BuiltMachine::compile(m, values, params).map_err(built_error)?;
             let kin = Kinematics::from_machine(m);
@@ -499,6 +497,7 @@ pub fn run(
             thermal_export(m, file, &values, values_file, &params, format, request)
         }
         ExportController::Tables(c) => {
+            let (values, provenance) = at_state(values)?;
             let built = BuiltMachine::compile(m, values, params).map_err(built_error)?;
             let options = ExportOptions {
                 step: request.step.unwrap_or(DEFAULT_STEP),

@@ -738,6 +738,14 @@ impl ReliabilityOutput<'_> {
         Ok(())
     }
 
+    /// The run's result with every case, when the run is in memory.
+    pub fn kept(&self) -> Option<&StudyResult> {
+        match &self.cases {
+            Cases::Kept(r) => Some(r),
+            Cases::Streamed { .. } => None,
+        }
+    }
+
     /// What the cases added up to, once every block is handed out.
     pub fn done(&self) -> Option<Ref<'_, Done>> {
         Ref::filter_map(self.done.borrow(), Option::as_ref).ok()

@@ -674,22 +674,6 @@ fn line(xs: &[f64], ys: &[f64], x0: f64) -> (f64, f64) {
 }
 
 impl ThermalLaw {
-    /// The correction `Δq_a` of axis `law` at axis position `x` and
-    /// temperatures `t` (°C by sensor name; a sensor not given at its
-    /// reference).
-    pub fn correction(law: &AxisLaw, x: f64, t: &[(String, f64)]) -> f64 {
-        law.lines
-            .iter()
-            .map(|l| {
-                let dt = t
-                    .iter()
-                    .find(|(n, _)| *n == l.sensor)
-                    .map_or(0.0, |(_, v)| v - l.reference);
-                dt * (l.offset + l.slope * (x - law.p0))
-            })
-            .sum()
-    }
-
     /// The files of the law's format.
     pub fn files(&self, provenance: &str) -> Vec<ExportedFile> {
         match self.format {

@@ -45,7 +45,9 @@ impl Report for ReliabilityOutput<'_> {
     fn table(&self) -> String {
         let study = self.study;
         let np = study.points().len();
-        let mut table = if np <= TABLE_POINTS {
+        let mut table = if let (true, Some(r)) = (np <= TABLE_POINTS, self.kept()) {
+            to_table(self.machine, study, r)
+        } else if np <= TABLE_POINTS {
             // Every point's map: the cases of a small grid, collected.
             let mut cases = Vec::new();
             let _ = self.each_block(
@@ -215,14 +217,7 @@ fn large_table(o: &ReliabilityOutput<'_>, d: &Done) -> String {
     let study = o.study;
     let r = &d.result;
     let ax = axes(study);
-    let mut out = String::new();
-    let sided = sided_title(study.spec().sided);
-    let _ = writeln!(
-        out,
-        "{}: machining-accuracy reliability ({}, {sided})",
-        o.machine,
-        r.method.title()
-    );
+    let mut out = title_line(o.machine, study, r);
     let _ = writeln!(
         out,
         "grid of {} points: more than {TABLE_POINTS}, so per target its {EXTREME_POINTS} least reliable points and its most reliable one (--format csv or json lists every point)",
@@ -280,13 +275,7 @@ fn large_table(o: &ReliabilityOutput<'_>, d: &Done) -> String {
 
 fn to_table(machine: &str, study: &Study, r: &StudyResult) -> String {
     use std::fmt::Write as _;
-    let mut out = String::new();
-    let sided = sided_title(study.spec().sided);
-    let _ = writeln!(
-        out,
-        "{machine}: machining-accuracy reliability ({}, {sided})",
-        r.method.title()
-    );
+    let mut out = title_line(machine, study, r);
     let mut marked = false;
     for (t, target) in study.targets().iter().enumerate() {
         let map = target_map(study, r, t);
@@ -615,4 +604,13 @@ fn samples_text(lo: u64, hi: u64) -> String {
     } else {
         format!("{lo} to {hi} samples per point")
     }
+}
+
+/// The table's first line: the machine, the method, the sides.
+fn title_line(machine: &str, study: &Study, r: &StudyResult) -> String {
+    format!(
+        "{machine}: machining-accuracy reliability ({}, {})\n",
+        r.method.title(),
+        sided_title(study.spec().sided)
+    )
 }
