@@ -83,9 +83,12 @@ fn benches(c: &mut Criterion) {
     g.sample_size(10);
     for (name, s) in &studies {
         let p = s.points().len() - 1;
-        let ls =
-            ToleranceLimitState::component(s.row(p, Component::Px).to_vec(), 0.03, Sided::Upper)
-                .expect("limit state");
+        let ls = ToleranceLimitState::component(
+            s.row(p, Component::Px).unwrap().to_vec(),
+            0.03,
+            Sided::Upper,
+        )
+        .expect("limit state");
         let event = Event::new(s.inputs(), Hidden(ls)).expect("event");
         let mc = MonteCarlo {
             samples: SAMPLES,

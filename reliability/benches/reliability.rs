@@ -80,9 +80,12 @@ fn benches(c: &mut Criterion) {
     g.finish();
 
     let p = corner(&study);
-    let ls =
-        ToleranceLimitState::component(study.row(p, Component::Px).to_vec(), 0.03, Sided::Upper)
-            .expect("limit state");
+    let ls = ToleranceLimitState::component(
+        study.row(p, Component::Px).unwrap().to_vec(),
+        0.03,
+        Sided::Upper,
+    )
+    .expect("limit state");
     let event = Event::new(study.inputs(), ls).expect("event");
     const SAMPLES: u64 = 1 << 20;
 

@@ -40,7 +40,7 @@ fn case() -> (Study, usize) {
 
 fn benches(c: &mut Criterion) {
     let (study, p) = case();
-    let row = study.row(p, Component::Px).to_vec();
+    let row = study.row(p, Component::Px).unwrap().to_vec();
     let a: Vec<f64> = row
         .iter()
         .zip(study.inputs().stds())

@@ -32,7 +32,7 @@ fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
         .position(|p| p[ix] == 1000.0 && p[iy] == 1500.0 && p[iz] == 1400.0)
         .ok_or("corner")?;
     let ls = ToleranceLimitState::component(
-        study.row(corner, Component::Px).to_vec(),
+        study.row(corner, Component::Px).unwrap().to_vec(),
         0.03,
         Sided::Upper,
     )?;

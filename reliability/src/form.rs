@@ -73,6 +73,16 @@ impl Termination {
         }
     }
 
+    /// Its position in [`Termination::ALL`].
+    pub fn index(self) -> usize {
+        match self {
+            Termination::ClosedForm => 0,
+            Termination::Converged => 1,
+            Termination::MaxIterations => 2,
+            Termination::Degenerate => 3,
+        }
+    }
+
     /// Every termination, in declaration order.
     pub const ALL: [Termination; 4] = [
         Termination::ClosedForm,
@@ -426,6 +436,13 @@ impl Work {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_termination_s_index_is_its_place_in_all() {
+        for (k, t) in Termination::ALL.iter().enumerate() {
+            assert_eq!(t.index(), k, "{t}");
+        }
+    }
+
     use super::*;
     use crate::inputs::{Inputs, Marginal};
     use crate::limit_state::Criterion;

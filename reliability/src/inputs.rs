@@ -335,10 +335,11 @@ impl Inputs {
     /// `sᵀx = m + a·u` when the map is affine ([`Inputs::is_affine`]);
     /// `|a| = √(sᵀΣs)` (for independent inputs `a_j = s_j·σ_j`).
     pub fn project(&self, s: &[f64], a: &mut [f64]) -> f64 {
+        // (`means` and `stds` are the marginals' own, formed with them.)
         let mut mean = 0.0;
-        for ((a, s), m) in a.iter_mut().zip(s).zip(&self.marginals) {
-            mean += s * m.mean();
-            *a = s * m.std();
+        for (((a, s), m), sd) in a.iter_mut().zip(s).zip(&self.means).zip(&self.stds) {
+            mean += s * m;
+            *a = s * sd;
         }
         if let Some(b) = &self.correlation {
             let k = b.members.len();

@@ -602,16 +602,16 @@ impl PathBlocks<'_> {
             Some((study, _)) => (0..n)
                 .into_par_iter()
                 .map(|k| {
-                    let moments = study.moments(first + k);
-                    InstantResult {
+                    let moments = study.moments(first + k)?;
+                    Ok(InstantResult {
                         nominal: path.nominal[first + k],
                         component_mean: moments.mean,
                         component_std: Component::ALL.map(|c| moments.std(c)),
                         volumetric: moments.volumetric(),
                         evaluated: k,
-                    }
+                    })
                 })
-                .collect(),
+                .collect::<Result<_, ReliabilityError>>()?,
             None => Vec::new(),
         }
         .into_iter();
@@ -738,7 +738,7 @@ mod tests {
         let (means, stds) = (inputs.means().to_vec(), inputs.stds().to_vec());
         for (k, rec) in [&r.records[0], &r.records[2]].into_iter().enumerate() {
             let e = rec.result.as_ref().unwrap();
-            let moments = path.study().unwrap().moments(k);
+            let moments = path.study().unwrap().moments(k).unwrap();
             assert_eq!(r.cases_of(e).len(), 4);
             for (t, c) in r.cases_of(e).enumerate() {
                 assert_eq!(c, &direct.cases[t * 2 + k]);

@@ -76,6 +76,7 @@
 use chain_core::model::Component;
 use serde::Serialize;
 
+use crate::error::ReliabilityError;
 use crate::inputs::Inputs;
 use crate::par::prelude::*;
 use crate::rng::CaseRng;
@@ -144,6 +145,10 @@ pub enum SobolError {
     #[error("no output to analyse: {0}")]
     #[cfg_attr(feature = "miette", diagnostic(code(chain::sobol::no_output)))]
     NoOutput(String),
+    /// The study refused a point (its sensitivities not finite).
+    #[error(transparent)]
+    #[cfg_attr(feature = "miette", diagnostic(transparent))]
+    Reliability(#[from] ReliabilityError),
 }
 
 /// The Saltelli-Jansen analysis: its sample size, seed and bootstrap.
@@ -357,8 +362,8 @@ impl Sobol {
     pub fn run_study(&self, study: &Study) -> Result<SobolResult, SobolError> {
         let k = study.inputs().len();
         let rows: Vec<Vec<f64>> = (0..study.points().len())
-            .map(|p| study.sensitivities(p..p + 1).into_owned())
-            .collect();
+            .map(|p| Ok(study.sensitivities(p..p + 1)?.into_owned()))
+            .collect::<Result<_, ReliabilityError>>()?;
         debug_assert!(rows.iter().all(|r| r.len() == 6 * k));
         self.run(study.inputs(), &rows, &study_outputs(study))
     }

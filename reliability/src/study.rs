@@ -543,27 +543,52 @@ impl CaseTally {
 
     /// Adds one case.
     pub fn add(&mut self, c: &CaseResult) {
+        self.add_parts(
+            Parts {
+                calls: c.calls,
+                form: c.form.as_ref(),
+                std_error: c.std_error,
+                sampler_converged: c.sampler_converged(),
+            },
+            || c.clone(),
+        );
+    }
+
+    /// Adds closed-form FORM cases ([`Study::run_totals`]), `counts[k]`
+    /// of them ended in [`Termination::ALL`]`[k]`: what [`CaseTally::add`]
+    /// makes of each (converged, no calls, no sampler).
+    fn add_closed(&mut self, counts: &[usize; Termination::ALL.len()]) {
+        let n: usize = counts.iter().sum();
+        self.cases += n;
+        self.forms += n;
+        self.forms_converged += n;
+        for (t, c) in self.terminations.iter_mut().zip(counts) {
+            *t += c;
+        }
+    }
+
+    /// Adds one case given by its parts, `case` forming it when the tally
+    /// keeps it (the first of a kind that did not converge).
+    fn add_parts(&mut self, c: Parts<'_>, case: impl Fn() -> CaseResult) {
         self.cases += 1;
         self.calls.values += c.calls.values;
         self.calls.gradients += c.calls.gradients;
-        if let Some(f) = &c.form {
+        if let Some(f) = c.form {
             self.forms += 1;
-            if let Some(k) = Termination::ALL.iter().position(|t| *t == f.termination) {
-                self.terminations[k] += 1;
-            }
+            self.terminations[f.termination.index()] += 1;
             if f.converged {
                 self.forms_converged += 1;
             } else if self.first_form_unconverged.is_none() {
-                self.first_form_unconverged = Some(c.clone());
+                self.first_form_unconverged = Some(case());
             }
         }
         if let Some(se) = c.std_error {
             self.max_std_error = Some(self.max_std_error.map_or(se, |m| m.max(se)));
         }
-        if !c.sampler_converged() {
+        if !c.sampler_converged {
             self.sampler_unconverged += 1;
             if self.first_sampler_unconverged.is_none() {
-                self.first_sampler_unconverged = Some(c.clone());
+                self.first_sampler_unconverged = Some(case());
             }
         }
     }
@@ -579,6 +604,171 @@ impl CaseTally {
     /// The cases whose FORM did not converge.
     pub fn form_unconverged(&self) -> usize {
         self.forms - self.forms_converged
+    }
+}
+
+/// What [`CaseTally`] reads of a case.
+#[derive(Clone, Copy)]
+struct Parts<'a> {
+    calls: Calls,
+    form: Option<&'a FormCase>,
+    std_error: Option<f64>,
+    sampler_converged: bool,
+}
+
+/// What a run's cases add up to without keeping them
+/// ([`Study::run_totals`], or [`Adding`] over the blocks of
+/// [`Study::run_blocks`]): what a grid's summary table shows.
+#[derive(Debug, Clone)]
+pub struct Totals {
+    /// The summaries and the requirement (`cases` empty).
+    pub result: StudyResult,
+    /// Every case's account.
+    pub tally: CaseTally,
+    /// Per target: its cases' account and its extreme cases.
+    pub targets: Vec<TargetTotals>,
+}
+
+/// One target's cases added up.
+#[derive(Debug, Clone, Default)]
+pub struct TargetTotals {
+    /// Its cases' account (calls, largest standard error, convergence).
+    pub tally: CaseTally,
+    /// Its least reliable cases (as many as asked for), least first (the
+    /// first of equal ones first).
+    pub lowest: Vec<CaseResult>,
+    /// Its most reliable case (the first of equal ones).
+    pub highest: Option<CaseResult>,
+    /// The fewest and most samples of a case.
+    pub samples: Option<(u64, u64)>,
+}
+
+impl TargetTotals {
+    /// Whether a case of reliability `r` is one of the extremes kept
+    /// (`keep` least reliable, the most reliable) when added now.
+    fn wants(&self, r: f64, keep: usize) -> bool {
+        let lowest = match self.lowest.get(keep.wrapping_sub(1)) {
+            // Below the last kept, or incomparable (as `partition_point`
+            // places a NaN first).
+            Some(last) => matches!(
+                r.partial_cmp(&last.reliability),
+                Some(std::cmp::Ordering::Less) | None
+            ),
+            None => keep > 0,
+        };
+        lowest || self.highest.as_ref().is_none_or(|h| r > h.reliability)
+    }
+
+    /// Adds a case given by its parts; `case` forms it when it is kept.
+    fn add_parts(
+        &mut self,
+        parts: Parts<'_>,
+        reliability: f64,
+        samples: Option<u64>,
+        keep: usize,
+        case: impl Fn() -> CaseResult,
+    ) {
+        self.tally.add_parts(parts, &case);
+        self.keep_extreme(reliability, samples, keep, case);
+    }
+
+    /// Keeps a case of reliability `r` among the extremes when it is one
+    /// (`case` forms it then), and its samples.
+    fn keep_extreme(
+        &mut self,
+        reliability: f64,
+        samples: Option<u64>,
+        keep: usize,
+        case: impl Fn() -> CaseResult,
+    ) {
+        if self.wants(reliability, keep) {
+            let c = case();
+            let at = self
+                .lowest
+                .partition_point(|k| k.reliability <= reliability);
+            if at < keep {
+                self.lowest.insert(at, c.clone());
+                self.lowest.truncate(keep);
+            }
+            if self
+                .highest
+                .as_ref()
+                .is_none_or(|h| reliability > h.reliability)
+            {
+                self.highest = Some(c);
+            }
+        }
+        if let Some(n) = samples {
+            self.samples = Some(
+                self.samples
+                    .map_or((n, n), |(lo, hi)| (lo.min(n), hi.max(n))),
+            );
+        }
+    }
+}
+
+/// [`Totals`] being added up, block by block in case order.
+#[derive(Debug, Clone)]
+pub struct Adding {
+    tally: CaseTally,
+    targets: Vec<TargetTotals>,
+    points: usize,
+    seen: usize,
+    keep: usize,
+}
+
+impl Adding {
+    /// Nothing added yet for `study`'s cases, keeping `keep` least
+    /// reliable cases per target.
+    pub fn new(study: &Study, keep: usize) -> Adding {
+        Adding {
+            tally: CaseTally::default(),
+            targets: vec![TargetTotals::default(); study.targets.len()],
+            points: study.points.len().max(1),
+            seen: 0,
+            keep,
+        }
+    }
+
+    /// Adds the next cases (in the study's case order).
+    pub fn add(&mut self, cases: &[CaseResult]) {
+        for c in cases {
+            self.add_case(self.seen / self.points, c);
+            self.seen += 1;
+        }
+    }
+
+    /// Adds case `c` of target `t` (each target's cases in their order).
+    fn add_case(&mut self, t: usize, c: &CaseResult) {
+        let parts = Parts {
+            calls: c.calls,
+            form: c.form.as_ref(),
+            std_error: c.std_error,
+            sampler_converged: c.sampler_converged(),
+        };
+        self.add_parts(t, parts, c.reliability, c.samples, || c.clone());
+    }
+
+    /// Adds a case of target `t` given by its parts.
+    fn add_parts(
+        &mut self,
+        t: usize,
+        parts: Parts<'_>,
+        reliability: f64,
+        samples: Option<u64>,
+        case: impl Fn() -> CaseResult,
+    ) {
+        self.tally.add_parts(parts, &case);
+        self.targets[t].add_parts(parts, reliability, samples, self.keep, case);
+    }
+
+    /// The totals, with the run's summaries `result`.
+    pub fn finish(self, result: StudyResult) -> Totals {
+        Totals {
+            result,
+            tally: self.tally,
+            targets: self.targets,
+        }
     }
 }
 
@@ -805,8 +995,10 @@ impl Study {
     /// [`ErrorModel::sensitivity_points`] equals its per-point values bit
     /// for bit (the runtime tape), every result equals [`Study::new`]'s.
     ///
-    /// The sensitivities are evaluated once here, a block at a time, to
-    /// refuse non-finite values as [`Study::new`] does.
+    /// Each point's sensitivities are checked when they are read (a point
+    /// whose values are not finite is refused as [`Study::new`] refuses it,
+    /// by the run, the moments or the rows that read it); [`Study::check`]
+    /// reads them all first.
     pub fn on_demand(
         model: SharedModel,
         parameters: &[f64],
@@ -816,11 +1008,13 @@ impl Study {
         let (inputs, variables) = checked_inputs(&*model, parameters, inputs)?;
         let points = grid_points(&spec.grid, &variables)?;
         let targets = targets(&spec)?;
-        Study::lazy(model, parameters, inputs, variables, spec, points, targets)
+        Ok(Study::lazy(
+            model, parameters, inputs, variables, spec, points, targets,
+        ))
     }
 
-    /// The study of checked points that evaluates `model` when asked, after
-    /// checking every point's sensitivities finite a block at a time.
+    /// The study of checked points that evaluates `model` when asked (each
+    /// point checked when it is read).
     fn lazy(
         model: SharedModel,
         parameters: &[f64],
@@ -829,19 +1023,12 @@ impl Study {
         spec: StudySpec,
         points: Points,
         targets: Vec<Target>,
-    ) -> Result<Study, ReliabilityError> {
-        for start in (0..points.len()).step_by(CASE_BLOCK) {
-            let block = start..(start + CASE_BLOCK).min(points.len());
-            let rows = evaluate(&*model, parameters, &points, block.clone())?;
-            check_moments(&inputs, &variables, &points, block, &rows)?;
-        }
+    ) -> Study {
         let rows = Rows::OnDemand {
             model,
             parameters: parameters.to_vec(),
         };
-        Ok(Study::assemble(
-            inputs, variables, spec, points, rows, targets,
-        ))
+        Study::assemble(inputs, variables, spec, points, rows, targets)
     }
 
     /// Evaluates the model's sensitivities at an explicit list of points
@@ -868,7 +1055,8 @@ impl Study {
     }
 
     /// [`Study::at_points`] keeping the model instead of the sensitivities,
-    /// as [`Study::on_demand`] does for a grid.
+    /// as [`Study::on_demand`] does for a grid; every point is checked here
+    /// ([`Study::check`]: a path is written as it runs).
     pub fn at_points_on_demand(
         model: SharedModel,
         parameters: &[f64],
@@ -878,7 +1066,9 @@ impl Study {
     ) -> Result<Study, ReliabilityError> {
         let (inputs, variables) = checked_inputs(&*model, parameters, inputs)?;
         let (spec, points, targets) = listed_points(spec, points, &variables)?;
-        Study::lazy(model, parameters, inputs, variables, spec, points, targets)
+        let study = Study::lazy(model, parameters, inputs, variables, spec, points, targets);
+        study.check()?;
+        Ok(study)
     }
 
     /// The shared part of the constructors, after their checks.
@@ -943,7 +1133,7 @@ impl Study {
             });
         }
         for (p, inputs) in each.iter().enumerate() {
-            let rows = self.sensitivities(p..p + 1);
+            let rows = self.sensitivities(p..p + 1)?;
             check_moments(inputs, &self.variables, &self.points, p..p + 1, &rows)?;
         }
         self.point_inputs = Some(each);
@@ -1028,37 +1218,73 @@ impl Study {
     /// The sensitivity matrices (`6 × N` each, component-major) of the
     /// points `range`: borrowed when the study keeps them, evaluated
     /// otherwise ([`Study::on_demand`]).
-    pub fn sensitivities(&self, range: Range<usize>) -> Cow<'_, [f64]> {
+    ///
+    /// # Errors
+    /// A point whose sensitivities, or the mean or variance of an error
+    /// component they give, are not finite (a study that keeps its model
+    /// checks each point when it is read; [`Study::check`] reads them all).
+    pub fn sensitivities(&self, range: Range<usize>) -> Result<Cow<'_, [f64]>, ReliabilityError> {
         let n6 = 6 * self.inputs.len();
         match &self.rows {
-            Rows::Stored(s) => Cow::Borrowed(&s[range.start * n6..range.end * n6]),
+            Rows::Stored(s) => Ok(Cow::Borrowed(&s[range.start * n6..range.end * n6])),
             Rows::OnDemand { model, parameters } => {
-                // The constructor evaluated every point and found them finite;
-                // the same evaluation gives the same values.
-                let s = evaluate(&**model, parameters, &self.points, range);
-                Cow::Owned(s.expect("sensitivities checked finite when the study was built"))
+                let s = evaluate(&**model, parameters, &self.points, range.clone())?;
+                check_moments(&self.inputs, &self.variables, &self.points, range, &s)?;
+                Ok(Cow::Owned(s))
             }
         }
     }
 
-    /// The sensitivity row `∂E_c/∂e` at point `p`.
-    pub fn row(&self, p: usize, c: Component) -> Cow<'_, [f64]> {
+    /// Reads every point's sensitivities once ([`Study::sensitivities`],
+    /// a block at a time on every core) to refuse a point whose values are
+    /// not finite before anything is run: for a caller that writes results
+    /// as they come and wants no refusal half-way. A study that keeps its
+    /// sensitivities was checked when it was built.
+    ///
+    /// # Errors
+    /// The first point (in order) whose values are not finite.
+    pub fn check(&self) -> Result<(), ReliabilityError> {
+        if let Rows::Stored(_) = self.rows {
+            return Ok(());
+        }
+        let np = self.points.len();
+        let blocks: Vec<Range<usize>> = (0..np)
+            .step_by(POINT_CHUNK)
+            .map(|s| s..(s + POINT_CHUNK).min(np))
+            .collect();
+        // The first refusal in point order: each block's, in order.
+        let refusals: Vec<Option<ReliabilityError>> = blocks
+            .into_par_iter()
+            .map(|b| self.sensitivities(b).err())
+            .collect();
+        match refusals.into_iter().flatten().next() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    /// The sensitivity row `∂E_c/∂e` at point `p` ([`Study::sensitivities`]'
+    /// refusals).
+    pub fn row(&self, p: usize, c: Component) -> Result<Cow<'_, [f64]>, ReliabilityError> {
         let n = self.inputs.len();
         let at = c.index() * n..(c.index() + 1) * n;
-        match self.sensitivities(p..p + 1) {
+        Ok(match self.sensitivities(p..p + 1)? {
             Cow::Borrowed(s) => Cow::Borrowed(&s[at]),
             Cow::Owned(s) => Cow::Owned(s[at].to_vec()),
-        }
+        })
     }
 
     /// The mean and covariance of the six error components at point `p`
     /// (exact linear propagation of the inputs' means and covariance:
     /// `Cov(E_a, E_b) = S_aᵀΣS_b`, [`Inputs::covariance`], the diagonal sum
     /// alone for independent inputs).
-    pub fn moments(&self, p: usize) -> ErrorMoments {
+    ///
+    /// # Errors
+    /// [`Study::sensitivities`]' refusals.
+    pub fn moments(&self, p: usize) -> Result<ErrorMoments, ReliabilityError> {
         let inputs = self.inputs_at(p);
         let means = inputs.means();
-        let s = self.sensitivities(p..p + 1);
+        let s = self.sensitivities(p..p + 1)?;
         let n = self.inputs.len();
         let row = |c: Component| &s[c.index() * n..(c.index() + 1) * n];
         let mut mean = [0.0; 6];
@@ -1070,7 +1296,7 @@ impl Study {
                 covariance[a.index()][b.index()] = inputs.covariance(ra, row(b));
             }
         }
-        ErrorMoments { mean, covariance }
+        Ok(ErrorMoments { mean, covariance })
     }
 
     /// The limit state of `target` at point `p`.
@@ -1079,7 +1305,7 @@ impl Study {
         target: Target,
         p: usize,
     ) -> Result<ToleranceLimitState, ReliabilityError> {
-        self.limit_state_of(target, &self.sensitivities(p..p + 1))
+        self.limit_state_of(target, &self.sensitivities(p..p + 1)?)
     }
 
     /// The limit state of `target` at the point whose `6 × N` sensitivity
@@ -1144,7 +1370,7 @@ impl Study {
         while i < cases.end {
             let (t, p) = (i / np, i % np);
             let last = (cases.end - t * np).min(np).min(p + CASE_BLOCK);
-            let s = self.sensitivities(p..last);
+            let s = self.sensitivities(p..last)?;
             for k in 0..last - p {
                 let state = self.limit_state_of(self.targets[t], &s[k * n6..(k + 1) * n6])?;
                 out.push(Event::new(self.inputs_at(p + k), state)?);
@@ -1193,7 +1419,7 @@ impl Study {
                 while e < end && set.id(e) == set.id(e - 1) + 1 && set.id(e) / np == t {
                     e += 1;
                 }
-                let s = self.sensitivities(p..p + (e - k));
+                let s = self.sensitivities(p..p + (e - k))?;
                 let run: Result<Vec<CaseResult>, ReliabilityError> = (0..e - k)
                     .into_par_iter()
                     .map_init(
@@ -1251,6 +1477,21 @@ impl Study {
         plan: &[(usize, f64)],
         a: &mut [f64],
     ) -> CaseResult {
+        let (beta, termination) = self.closed_best(inputs, rows, plan, a);
+        let mut c = self.case(i, normal::cdf(beta), normal::sf(beta), beta);
+        c.form = Some(self.closed_form_case(termination, plan));
+        c
+    }
+
+    /// The index `β` of a closed-form case ([`Study::closed_case`]) and how
+    /// its nearest branch ended, `a` scratch of `N` values.
+    fn closed_best(
+        &self,
+        inputs: &Inputs,
+        rows: &[f64],
+        plan: &[(usize, f64)],
+        a: &mut [f64],
+    ) -> (f64, Termination) {
         let n = inputs.len();
         let signs: &[f64] = match self.spec.sided {
             Sided::Upper => &[1.0],
@@ -1266,15 +1507,17 @@ impl Study {
                 }
             }
         }
-        let (beta, termination) = best.unwrap_or((f64::NAN, Termination::Degenerate));
-        let mut c = self.case(i, normal::cdf(beta), normal::sf(beta), beta);
-        c.form = Some(FormCase {
+        best.unwrap_or((f64::NAN, Termination::Degenerate))
+    }
+
+    /// FORM's account of a closed-form case of `plan`.
+    fn closed_form_case(&self, termination: Termination, plan: &[(usize, f64)]) -> FormCase {
+        FormCase {
             termination,
             converged: true,
             iterations: 0,
             exact: plan.len() == 1 && self.spec.sided == Sided::Upper,
-        });
-        c
+        }
     }
 
     /// Runs `run` on the event of every case of `set` and keeps `keep` of
@@ -1560,6 +1803,128 @@ impl Study {
         Ok(self.finish_running(algorithm.method(), &running))
     }
 
+    /// Runs `algorithm` on every case and adds them up without keeping
+    /// them ([`Totals`], `keep` least reliable cases per target): what
+    /// [`Adding`] makes of [`Study::run_blocks`]'s blocks, bit for bit,
+    /// in the memory of one block.
+    ///
+    /// Where FORM takes the closed form for every target (every input
+    /// normal and the same at every point, every branch a half-space,
+    /// [`Study::closed_plan`]), the grid is passed once, a block of points
+    /// at a time: one evaluation of the sensitivities serves every target,
+    /// the cases are computed in parallel without forming them, and a case
+    /// is formed only when it is one of the extremes kept.
+    ///
+    /// # Errors
+    /// The first error of the run.
+    pub fn run_totals(
+        &self,
+        algorithm: &Algorithm,
+        progress: &dyn Progress,
+        keep: usize,
+    ) -> Result<Totals, ReliabilityError> {
+        if let Algorithm::Form(_) = algorithm {
+            let plans: Option<Vec<Vec<(usize, f64)>>> =
+                self.targets.iter().map(|&t| self.closed_plan(t)).collect();
+            if let Some(plans) =
+                plans.filter(|_| self.point_inputs.is_none() && self.inputs.is_affine())
+            {
+                return self.closed_totals(&plans, progress, keep);
+            }
+        }
+        let mut adding = Adding::new(self, keep);
+        let result = self.run_blocks(algorithm, progress, CASE_BLOCK, |b| {
+            adding.add(b);
+            Ok::<(), ReliabilityError>(())
+        })?;
+        Ok(adding.finish(result))
+    }
+
+    /// [`Study::run_totals`] where every target's cases are closed-form
+    /// (`plans`, one per target).
+    fn closed_totals(
+        &self,
+        plans: &[Vec<(usize, f64)>],
+        progress: &dyn Progress,
+        keep: usize,
+    ) -> Result<Totals, ReliabilityError> {
+        let (nt, np, n) = (self.targets.len(), self.points.len(), self.inputs.len());
+        let n6 = 6 * n;
+        let mut running = Running::new(nt, np);
+        let mut adding = Adding::new(self, keep);
+        let mut rows = vec![0.0; POINT_BLOCK.min(np) * n6];
+        let mut closed = vec![(0.0, 0.0, Termination::ClosedForm); POINT_BLOCK.min(np) * nt];
+        for start in (0..np).step_by(POINT_BLOCK) {
+            let len = POINT_BLOCK.min(np - start);
+            let (rows, closed) = (&mut rows[..len * n6], &mut closed[..len * nt]);
+            // Per chunk of points: their sensitivities, then per point and
+            // target `β`, `R = Φ(β)` and how the nearest branch ended.
+            (rows.par_chunks_mut(POINT_CHUNK * n6.max(1)))
+                .zip(closed.par_chunks_mut(POINT_CHUNK * nt))
+                .enumerate()
+                .map_init(
+                    || (vec![0.0; n], Vec::new()),
+                    |(a, qs), (k, (rows, closed))| {
+                        let first = start + k * POINT_CHUNK;
+                        let m = closed.len() / nt.max(1);
+                        self.sensitivities_into(first..first + m, qs, rows)?;
+                        for (j, out) in closed.chunks_exact_mut(nt.max(1)).enumerate() {
+                            let s = &rows[j * n6..(j + 1) * n6];
+                            for (o, plan) in out.iter_mut().zip(plans) {
+                                let (beta, termination) =
+                                    self.closed_best(&self.inputs, s, plan, a);
+                                *o = (beta, normal::cdf(beta), termination);
+                            }
+                        }
+                        Ok(())
+                    },
+                )
+                .collect::<Result<(), ReliabilityError>>()?;
+            // In case order per target: the sums, the extremes, the tally.
+            for (t, plan) in plans.iter().enumerate() {
+                let mut counts = [0; Termination::ALL.len()];
+                let target = &mut adding.targets[t];
+                for j in 0..len {
+                    let (beta, reliability, termination) = closed[j * nt + t];
+                    running.add_case(t, reliability);
+                    counts[termination.index()] += 1;
+                    target.keep_extreme(reliability, None, keep, || {
+                        let i = t * np + start + j;
+                        let mut c = self.case(i, normal::cdf(beta), normal::sf(beta), beta);
+                        c.form = Some(self.closed_form_case(termination, plan));
+                        c
+                    });
+                }
+                target.tally.add_closed(&counts);
+                adding.tally.add_closed(&counts);
+            }
+            progress.advance((len * nt) as u64);
+        }
+        Ok(adding.finish(self.finish_running(Method::Form, &running)))
+    }
+
+    /// The sensitivities of the points `range` into `out` (`qs` scratch
+    /// for the points): copied when the study keeps them, evaluated
+    /// otherwise (and refused when not finite).
+    fn sensitivities_into(
+        &self,
+        range: Range<usize>,
+        qs: &mut Vec<f64>,
+        out: &mut [f64],
+    ) -> Result<(), ReliabilityError> {
+        let n6 = 6 * self.inputs.len();
+        match &self.rows {
+            Rows::Stored(s) => {
+                out.copy_from_slice(&s[range.start * n6..range.end * n6]);
+                Ok(())
+            }
+            Rows::OnDemand { model, parameters } => {
+                evaluate_into(&**model, parameters, &self.points, range.clone(), qs, out)?;
+                check_moments(&self.inputs, &self.variables, &self.points, range, out)
+            }
+        }
+    }
+
     /// The sensitivities of every target at point `p`.
     pub fn sensitivity_at(
         &self,
@@ -1582,11 +1947,19 @@ impl Study {
         &self,
         form: &Form,
     ) -> Result<Vec<TargetSensitivity>, ReliabilityError> {
-        let per_point: Vec<Vec<(Target, SensitivityResult)>> = (0..self.points.len())
-            .into_par_iter()
-            .map(|p| self.sensitivity_at(p, form))
-            .collect::<Result<_, _>>()?;
-        Ok(self.average(&per_point))
+        // A block of points at a time (in parallel within it), their
+        // sums added in point order: a grid of 10⁷ points holds one block.
+        let np = self.points.len();
+        let mut sums = Averaging::new(self.targets.len(), self.inputs.len());
+        for start in (0..np).step_by(CASE_BLOCK) {
+            let block: Vec<Vec<(Target, SensitivityResult)>> = (start
+                ..(start + CASE_BLOCK).min(np))
+                .into_par_iter()
+                .map(|p| self.sensitivity_at(p, form))
+                .collect::<Result<_, _>>()?;
+            sums.add(&block);
+        }
+        Ok(self.average(sums))
     }
 
     /// The sensitivities of every target at an arbitrary point (axis values in
@@ -1618,32 +1991,19 @@ impl Study {
             self.spec.clone(),
             vec![point.to_vec()],
         )?;
-        let at = single.sensitivity_at(0, form)?;
-        Ok(single.average(&[at]))
+        let mut sums = Averaging::new(single.targets.len(), single.inputs.len());
+        sums.add(&[single.sensitivity_at(0, form)?]);
+        Ok(single.average(sums))
     }
 
-    fn average(&self, per_point: &[Vec<(Target, SensitivityResult)>]) -> Vec<TargetSensitivity> {
-        let n = self.inputs.len();
-        let np = per_point.len().max(1) as f64;
+    /// The means of the sums `sums` (per target, its errors sorted by
+    /// `|∂R/∂σ|`).
+    fn average(&self, sums: Averaging) -> Vec<TargetSensitivity> {
+        let np = sums.points.max(1) as f64;
         self.targets
             .iter()
-            .enumerate()
-            .map(|(t, &target)| {
-                let mut acc = vec![[0.0f64; 5]; n];
-                let mut method = SensitivityMethod::Exact;
-                for point in per_point {
-                    let r = &point[t].1;
-                    if r.method == SensitivityMethod::Form {
-                        method = SensitivityMethod::Form;
-                    }
-                    for (a, s) in acc.iter_mut().zip(&r.inputs) {
-                        a[0] += s.dr_dstd;
-                        a[1] += s.dr_dmean;
-                        a[2] += s.importance;
-                        a[3] += s.dr_dstd.abs();
-                        a[4] += s.dr_dmean.abs();
-                    }
-                }
+            .zip(sums.targets)
+            .map(|(&target, (acc, method))| {
                 let mut errors: Vec<ErrorSensitivity> = acc
                     .iter()
                     .zip(self.inputs.names())
@@ -1664,6 +2024,42 @@ impl Study {
                 }
             })
             .collect()
+    }
+}
+
+/// Per target, the sums over the points of each error's sensitivities
+/// (`∂R/∂σ`, `∂R/∂μ`, importance and the two absolute values) and how they
+/// were obtained: what [`Study::sensitivity_mean`] averages.
+struct Averaging {
+    targets: Vec<(Vec<[f64; 5]>, SensitivityMethod)>,
+    points: usize,
+}
+
+impl Averaging {
+    fn new(targets: usize, inputs: usize) -> Averaging {
+        Averaging {
+            targets: vec![(vec![[0.0; 5]; inputs], SensitivityMethod::Exact); targets],
+            points: 0,
+        }
+    }
+
+    /// Adds the next points' sensitivities (per point, per target).
+    fn add(&mut self, per_point: &[Vec<(Target, SensitivityResult)>]) {
+        for point in per_point {
+            for ((acc, method), (_, r)) in self.targets.iter_mut().zip(point) {
+                if r.method == SensitivityMethod::Form {
+                    *method = SensitivityMethod::Form;
+                }
+                for (a, s) in acc.iter_mut().zip(&r.inputs) {
+                    a[0] += s.dr_dstd;
+                    a[1] += s.dr_dmean;
+                    a[2] += s.importance;
+                    a[3] += s.dr_dstd.abs();
+                    a[4] += s.dr_dmean.abs();
+                }
+            }
+            self.points += 1;
+        }
     }
 }
 
@@ -1787,24 +2183,64 @@ fn evaluate<M: ErrorModel + ?Sized>(
     points: &Points,
     range: Range<usize>,
 ) -> Result<Vec<f64>, ReliabilityError> {
+    let mut flat = vec![0.0; range.len() * 6 * model.errors().len()];
+    evaluate_into(model, parameters, points, range, &mut Vec::new(), &mut flat)?;
+    Ok(flat)
+}
+
+/// [`evaluate`] into `out` (`range.len()` matrices of `6 × N`), the points
+/// formed in `qs` (both reused by the caller from block to block).
+fn evaluate_into<M: ErrorModel + ?Sized>(
+    model: &M,
+    parameters: &[f64],
+    points: &Points,
+    range: Range<usize>,
+    qs: &mut Vec<f64>,
+    out: &mut [f64],
+) -> Result<(), ReliabilityError> {
     let n6 = 6 * model.errors().len();
     let nv = points.variables();
-    let qs = points.flat(range.clone());
-    let mut flat = vec![0.0; range.len() * n6];
-    if model
-        .sensitivity_points(&qs, parameters, &mut flat)
-        .is_err()
-    {
+    qs.clear();
+    qs.resize(range.len() * nv, 0.0);
+    if nv > 0 {
+        for (p, q) in range.zip(qs.chunks_exact_mut(nv)) {
+            points.fill(p, q);
+        }
+    }
+    if model.sensitivity_points(qs, parameters, out).is_err() {
         // The points were checked against the model's variables; a model
         // whose lengths still disagree is evaluated point by point.
-        for (k, s) in flat.chunks_exact_mut(n6.max(1)).enumerate() {
+        for (k, s) in out.chunks_exact_mut(n6.max(1)).enumerate() {
             model.sensitivity(&qs[k * nv..(k + 1) * nv], parameters, s);
         }
     }
-    if flat.iter().any(|v| !v.is_finite()) {
+    if !scan(out).0 {
         return Err(ReliabilityError::NonFinite("the model's sensitivities"));
     }
-    Ok(flat)
+    Ok(())
+}
+
+/// Whether every value of `s` is finite, and the largest `|s|` (NaN
+/// skipped): one pass in four lanes (what the compiler vectorises).
+fn scan(s: &[f64]) -> (bool, f64) {
+    let (mut big, mut bad) = ([0.0f64; 4], [false; 4]);
+    let mut chunks = s.chunks_exact(4);
+    for c in &mut chunks {
+        for k in 0..4 {
+            let v = c[k].abs();
+            bad[k] |= !v.is_finite();
+            big[k] = if v > big[k] { v } else { big[k] };
+        }
+    }
+    for &v in chunks.remainder() {
+        let v = v.abs();
+        bad[0] |= !v.is_finite();
+        big[0] = if v > big[0] { v } else { big[0] };
+    }
+    (
+        !(bad[0] | bad[1] | bad[2] | bad[3]),
+        big[0].max(big[1]).max(big[2].max(big[3])),
+    )
 }
 
 /// Refuses a point whose error moments are not finite: the mean `Σ s·μ` or
@@ -1819,7 +2255,20 @@ fn check_moments(
 ) -> Result<(), ReliabilityError> {
     let n = inputs.len();
     let means = inputs.means();
+    // A bound first: every partial sum of `Σ s·μ` is at most
+    // `max|s|·Σ|μ|` and of the independent variance `Σ s²σ²` at most
+    // `max s²·Σσ²`; below 1e300 both sums are finite, so only a point past
+    // the bound (or with correlated inputs) is summed here.
+    let (mu, var) = (
+        means.iter().map(|m| m.abs()).sum::<f64>(),
+        inputs.stds().iter().map(|s| s * s).sum::<f64>(),
+    );
+    let bounded = inputs.correlations().is_empty() && mu.is_finite() && var.is_finite();
     for (p, s) in range.zip(rows.chunks_exact((6 * n).max(1))) {
+        let (finite, big) = scan(s);
+        if bounded && finite && big * mu < 1e300 && big * big * var < 1e300 {
+            continue;
+        }
         for c in Component::ALL {
             let row = &s[c.index() * n..(c.index() + 1) * n];
             let mean: f64 = row.iter().zip(means).map(|(s, m)| s * m).sum();
@@ -1907,12 +2356,17 @@ impl Running {
     /// The cases `cases`, the first of them case `first` of the study.
     fn add(&mut self, first: usize, cases: &[CaseResult]) {
         for (k, c) in cases.iter().enumerate() {
-            let t = &mut self.targets[(first + k) / self.points.max(1)];
-            t.sum += c.reliability;
-            t.min = t.min.min(c.reliability);
-            t.max = t.max.max(c.reliability);
-            t.count += 1;
+            self.add_case((first + k) / self.points.max(1), c.reliability);
         }
+    }
+
+    /// A case of target `t` (the target's cases added in their order).
+    fn add_case(&mut self, t: usize, reliability: f64) {
+        let t = &mut self.targets[t];
+        t.sum += reliability;
+        t.min = t.min.min(reliability);
+        t.max = t.max.max(reliability);
+        t.count += 1;
     }
 }
 
@@ -1951,6 +2405,11 @@ impl CaseSet<'_> {
 
 /// The cases [`Study::run`] runs at a time with FORM or SORM.
 const CASE_BLOCK: usize = 4096;
+
+/// The points [`Study::run_totals`]'s closed-form pass evaluates at a time
+/// (every target's cases of them), and per task within the block.
+const POINT_BLOCK: usize = 4096;
+const POINT_CHUNK: usize = 256;
 
 /// `f` on every event: in parallel from 64 events on (below that the
 /// threads cost more than they save); results in event order.
@@ -2125,6 +2584,130 @@ mod tests {
         assert_eq!(seen, 3);
     }
 
+    /// [`Study::run_totals`] against [`Adding`] over [`Study::run_blocks`]'
+    /// blocks: the closed-form pass (one pass over a grid of more than one
+    /// [`POINT_BLOCK`], every target from one evaluation) and the blocks
+    /// give the same sums, tallies and extremes, bit for bit; kept and
+    /// on-demand sensitivities, one- and two-sided, components and the
+    /// series system, and a sampler (the blocks' own path).
+    #[test]
+    fn totals_equal_the_blocks_added_up_bit_for_bit() {
+        let (m, model) = gantry();
+        let params = machine::parameters(&m, &[]).unwrap();
+        let shared: SharedModel = Arc::new(model.clone());
+        let x: Vec<f64> = (0..47).map(|i| 1000.0 * i as f64 / 46.0).collect();
+        let y: Vec<f64> = (0..11).map(|i| -1500.0 + 300.0 * i as f64).collect();
+        let grid = Grid {
+            axes: vec![
+                ("x".into(), x),
+                ("y".into(), y),
+                // (1000 twice: equal cases, the first of them kept.)
+                (
+                    "z".into(),
+                    vec![
+                        600.0, 700.0, 800.0, 900.0, 1000.0, 1000.0, 1200.0, 1300.0, 1400.0,
+                    ],
+                ),
+            ],
+        };
+        let mut checked = 0;
+        for (sided, system) in [(Sided::Upper, None), (Sided::Two, Some(System::Series))] {
+            let mut spec = machine::spec(&m, system).unwrap();
+            spec.grid = grid.clone();
+            spec.sided = sided;
+            spec.requirement = Some(Requirement {
+                min: 0.9,
+                mean: 0.95,
+            });
+            let inputs = machine::inputs(&m).unwrap();
+            let kept = Study::new(&model, &params, inputs.clone(), spec.clone()).unwrap();
+            let lazy = Study::on_demand(shared.clone(), &params, inputs, spec).unwrap();
+            assert!(kept.points().len() > POINT_BLOCK);
+            for study in [&kept, &lazy] {
+                for keep in [0, 1, 5] {
+                    let a = Algorithm::Form(Form::default());
+                    let fast = study.run_totals(&a, &(), keep).unwrap();
+                    let mut adding = Adding::new(study, keep);
+                    let result = study
+                        .run_blocks(&a, &(), 1000, |b: &[CaseResult]| {
+                            adding.add(b);
+                            Ok::<(), ReliabilityError>(())
+                        })
+                        .unwrap();
+                    let slow = adding.finish(result);
+                    same_totals(&fast, &slow);
+                    assert_eq!(
+                        fast.tally.cases,
+                        study.targets().len() * study.points().len()
+                    );
+                    assert_eq!(fast.targets[0].lowest.len(), keep);
+                    checked += 1;
+                }
+            }
+        }
+        assert_eq!(checked, 12);
+        // A sampler adds up its blocks (a small grid).
+        let mut spec = machine::spec(&m, Some(System::Series)).unwrap();
+        spec.grid.axes[0].1.truncate(2);
+        let study = Study::on_demand(shared, &params, machine::inputs(&m).unwrap(), spec).unwrap();
+        let mc = Algorithm::MonteCarlo(MonteCarlo {
+            samples: 300,
+            seed: 1,
+            cov: None,
+        });
+        let totals = study.run_totals(&mc, &(), 3).unwrap();
+        let mut whole = study.run(&mc, &()).unwrap();
+        let mut adding = Adding::new(&study, 3);
+        adding.add(&whole.cases);
+        whole.cases.clear();
+        same_totals(&totals, &adding.finish(whole));
+        assert_eq!(totals.targets[0].samples, Some((300, 300)));
+    }
+
+    fn same_totals(a: &Totals, b: &Totals) {
+        for (x, y) in a.result.summaries.iter().zip(&b.result.summaries) {
+            assert_eq!(x.mean.to_bits(), y.mean.to_bits());
+            assert_eq!((x.min, x.max, x.met), (y.min, y.max, y.met));
+        }
+        assert_eq!(a.tally, b.tally);
+        for (x, y) in a.targets.iter().zip(&b.targets) {
+            assert_eq!(x.tally, y.tally);
+            assert_eq!(x.lowest, y.lowest);
+            assert_eq!(x.highest, y.highest);
+            assert_eq!(x.samples, y.samples);
+        }
+    }
+
+    /// A point whose moments overflow is refused by the closed-form pass
+    /// and by [`Study::check`] as by a run, naming the point.
+    #[test]
+    fn a_point_past_the_bound_is_refused_by_every_reader() {
+        let (m, model) = gantry();
+        let params = machine::parameters(&m, &[]).unwrap();
+        let mut spec = machine::spec(&m, None).unwrap();
+        spec.grid.axes[0].1 = vec![0.0, 1e300];
+        let study =
+            Study::on_demand(Arc::new(model), &params, machine::inputs(&m).unwrap(), spec).unwrap();
+        let form = Algorithm::Form(Form::default());
+        let run = study.run(&form, &()).unwrap_err().to_string();
+        assert!(
+            run.contains("x = 1e300") && run.contains("not finite"),
+            "{run}"
+        );
+        assert_eq!(study.check().unwrap_err().to_string(), run);
+        assert_eq!(
+            study.run_totals(&form, &(), 5).unwrap_err().to_string(),
+            run
+        );
+        // Within the bound, the sums decide (1e100 mm: variances of 1e200·σ²).
+        assert_eq!(
+            super::scan(&[1.0, -3.0, f64::INFINITY]),
+            (false, f64::INFINITY)
+        );
+        assert_eq!(super::scan(&[1.0, -3.0, 2.0, 0.5, -7.0]), (true, 7.0));
+        assert!(!super::scan(&[f64::NAN, 0.0, 0.0, 0.0]).0);
+    }
+
     #[test]
     fn at_points_equals_the_grid_study_at_the_same_points() {
         let (m, model) = gantry();
@@ -2154,7 +2737,7 @@ mod tests {
                 assert_eq!(a.target, b.target);
                 assert_eq!(a.reliability, b.reliability);
                 assert_eq!(a.beta, b.beta);
-                assert_eq!(grid.moments(p), at.moments(k));
+                assert_eq!(grid.moments(p).unwrap(), at.moments(k).unwrap());
             }
         }
     }
@@ -2231,7 +2814,7 @@ mod tests {
         let points = vec![vec![250.0, 1200.0, -750.0], vec![1000.0, 1500.0, 600.0]];
         let study = Study::at_points(&model, &[], inputs, spec, points).unwrap();
         for p in 0..2 {
-            let mo = study.moments(p);
+            let mo = study.moments(p).unwrap();
             for c in [Component::Px, Component::Py, Component::Pz] {
                 let event = study.event(Target::Component(c), p).unwrap();
                 let affine = event.affine().unwrap();

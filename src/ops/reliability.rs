@@ -599,65 +599,9 @@ pub const TABLE_POINTS: usize = 10_000;
 /// The least reliable points a target keeps for a large grid's table.
 pub const EXTREME_POINTS: usize = 5;
 
-/// What the cases of a [`ReliabilityOutput`] add up to.
-#[derive(Debug, Clone)]
-pub struct Done {
-    /// The summaries and the requirement (`cases` empty).
-    pub result: StudyResult,
-    /// Every case's account.
-    pub tally: CaseTally,
-    /// Per target: its cases' account and its extreme points.
-    pub targets: Vec<TargetDone>,
-}
-
-/// One target's cases added up.
-#[derive(Debug, Clone)]
-pub struct TargetDone {
-    /// Its cases' account (calls, largest standard error, convergence).
-    pub tally: CaseTally,
-    /// Its [`EXTREME_POINTS`] least reliable cases, least first (the first
-    /// of equal ones first).
-    pub lowest: Vec<CaseResult>,
-    /// Its most reliable case (the first of equal ones).
-    pub highest: Option<CaseResult>,
-    /// The fewest and most samples of a case.
-    pub samples: Option<(u64, u64)>,
-}
-
-impl TargetDone {
-    fn new() -> TargetDone {
-        TargetDone {
-            tally: CaseTally::default(),
-            lowest: Vec::new(),
-            highest: None,
-            samples: None,
-        }
-    }
-
-    fn add(&mut self, c: &CaseResult) {
-        self.tally.add(c);
-        let at = self
-            .lowest
-            .partition_point(|k| k.reliability <= c.reliability);
-        if at < EXTREME_POINTS {
-            self.lowest.insert(at, c.clone());
-            self.lowest.truncate(EXTREME_POINTS);
-        }
-        if self
-            .highest
-            .as_ref()
-            .is_none_or(|h| c.reliability > h.reliability)
-        {
-            self.highest = Some(c.clone());
-        }
-        if let Some(n) = c.samples {
-            self.samples = Some(
-                self.samples
-                    .map_or((n, n), |(lo, hi)| (lo.min(n), hi.max(n))),
-            );
-        }
-    }
-}
+/// What the cases of a [`ReliabilityOutput`] add up to: the summaries, the
+/// account of every case and of each target's, its extreme points.
+pub type Done = reliability::study::Totals;
 
 /// A streamed run's end: the study's error or the consumer's.
 enum Halt<E> {
@@ -681,25 +625,10 @@ impl ReliabilityOutput<'_> {
         mut f: impl FnMut(&[CaseResult]) -> Result<(), E>,
         stop: impl Fn(&ReliabilityError) -> E,
     ) -> Result<(), E> {
-        let np = self.study.points().len().max(1);
-        let mut tally = CaseTally::default();
-        let mut targets: Vec<TargetDone> = self
-            .study
-            .targets()
-            .iter()
-            .map(|_| TargetDone::new())
-            .collect();
-        let mut seen = 0usize;
-        let mut visit = |cases: &[CaseResult]| {
-            for c in cases {
-                tally.add(c);
-                targets[seen / np].add(c);
-                seen += 1;
-            }
-        };
+        let mut adding = reliability::study::Adding::new(self.study, EXTREME_POINTS);
         let result = match &self.cases {
             Cases::Kept(r) => {
-                visit(&r.cases);
+                adding.add(&r.cases);
                 f(&r.cases)?;
                 StudyResult {
                     method: r.method,
@@ -713,12 +642,15 @@ impl ReliabilityOutput<'_> {
                 algorithm,
                 progress,
             } => {
-                let run = self
-                    .study
-                    .run_blocks(algorithm, *progress, STREAM_BLOCK, |b| {
-                        visit(b);
-                        f(b).map_err(Halt::Consumer)
-                    });
+                // Every point read first, so that a refused one ends the
+                // run before a row is written.
+                let run = self.study.check().map_err(Halt::Run).and_then(|()| {
+                    self.study
+                        .run_blocks(algorithm, *progress, STREAM_BLOCK, |b| {
+                            adding.add(b);
+                            f(b).map_err(Halt::Consumer)
+                        })
+                });
                 match run {
                     Ok(r) => r,
                     Err(Halt::Consumer(e)) => return Err(e),
@@ -730,12 +662,27 @@ impl ReliabilityOutput<'_> {
                 }
             }
         };
-        *self.done.borrow_mut() = Some(Done {
-            result,
-            tally,
-            targets,
-        });
+        *self.done.borrow_mut() = Some(adding.finish(result));
         Ok(())
+    }
+
+    /// Runs the study and keeps only what its cases add up to
+    /// ([`ReliabilityOutput::done`]), no case handed out: what a large
+    /// grid's table shows ([`reliability::study::Study::run_totals`]: where FORM takes the
+    /// closed form, one pass over the grid for every target). A run that
+    /// fails keeps its error ([`ReliabilityOutput::take_error`]).
+    pub fn add_up(&self) {
+        let totals = match &self.cases {
+            Cases::Kept(_) => return self.each_block(|_| Ok::<(), ()>(()), |_| ()).unwrap_or(()),
+            Cases::Streamed {
+                algorithm,
+                progress,
+            } => self.study.run_totals(algorithm, *progress, EXTREME_POINTS),
+        };
+        match totals {
+            Ok(t) => *self.done.borrow_mut() = Some(t),
+            Err(e) => *self.failed.borrow_mut() = Some(e),
+        }
     }
 
     /// The run's result with every case, when the run is in memory.

@@ -123,7 +123,7 @@ impl Rectangles {
         let (mut lower, mut upper) = (Vec::with_capacity(k), Vec::with_capacity(k));
         for p in 0..np {
             for &(c, t) in &spec.tolerances {
-                rows.extend_from_slice(&study.row(p, c));
+                rows.extend_from_slice(&study.row(p, c)?);
                 upper.push(t);
                 lower.push(match spec.sided {
                     Sided::Upper => f64::NEG_INFINITY,

@@ -66,7 +66,7 @@ impl Report for ReliabilityOutput<'_> {
                 None => String::new(),
             }
         } else {
-            let _ = self.each_block(|_| Ok::<(), ()>(()), |_| ());
+            self.add_up();
             match self.done() {
                 Some(d) => large_table(self, &d),
                 None => String::new(),

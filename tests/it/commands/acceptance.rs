@@ -69,7 +69,7 @@ fn brute_force(study: &Study, samples: u64, seed: u64) -> (f64, f64) {
     let mut rows: Vec<(Vec<f64>, f64)> = Vec::new();
     for p in 0..study.points().len() {
         for &(c, t) in tol {
-            let row = study.row(p, c).to_vec();
+            let row = study.row(p, c).unwrap().to_vec();
             match rows.iter_mut().find(|(r, _)| *r == row) {
                 Some((_, tt)) => *tt = tt.min(t),
                 None => rows.push((row, t)),
@@ -220,7 +220,7 @@ fn gantry_sensitivities_equal_finite_differences() {
 fn one_component_at_one_point_is_the_closed_form() {
     let (_, _, study) = gantry();
     let p = 37;
-    let row = study.row(p, Component::Py).to_vec();
+    let row = study.row(p, Component::Py).unwrap().to_vec();
     let inputs = study.inputs().clone();
     let sigma: f64 = row
         .iter()

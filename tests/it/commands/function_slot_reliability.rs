@@ -82,7 +82,7 @@ fn px_spread_and_reliability_along_x_are_the_closed_forms() {
     let mut by_x: Vec<(f64, f64)> = Vec::new();
     for (p, point) in study.points().iter().enumerate() {
         let x = point[ix];
-        let moments = study.moments(p);
+        let moments = study.moments(p).unwrap();
         let s = sigma(x, SIGMA0, SIGMA1);
         assert!(
             close(moments.std(Component::Px), s, 1e-14),

@@ -241,7 +241,7 @@ fn grid_pooled_indices_equal_the_pooled_closed_form() {
     for c in [Component::Px, Component::Py, Component::Pz] {
         let mut v = vec![0.0; stds.len()];
         for p in 0..study.points().len() {
-            for (j, a) in study.row(p, c).iter().enumerate() {
+            for (j, a) in study.row(p, c).unwrap().iter().enumerate() {
                 v[j] += a * a * stds[j] * stds[j];
             }
         }

@@ -314,13 +314,17 @@ fn nonlinear_limit_states_importance_sampling_vs_ten_million_monte_carlo() {
     let volumetric = study.event(Target::Volumetric, p).expect("event");
     let two_sided = Event::new(
         study.inputs(),
-        ToleranceLimitState::component(study.row(p, Component::Px).to_vec(), 0.03, Sided::Two)
-            .expect("ls"),
+        ToleranceLimitState::component(
+            study.row(p, Component::Px).unwrap().to_vec(),
+            0.03,
+            Sided::Two,
+        )
+        .expect("ls"),
     )
     .expect("event");
     let mut rows = Vec::new();
     for c in [Component::Px, Component::Py, Component::Pz] {
-        rows.extend_from_slice(&study.row(p, c));
+        rows.extend_from_slice(&study.row(p, c).unwrap());
     }
     let series = Event::new(
         study.inputs(),
@@ -400,8 +404,12 @@ fn non_normal_inputs_use_the_root_finder() {
     let inputs = Inputs::new(base.names().to_vec(), marginals).expect("inputs");
     let event = Event::new(
         &inputs,
-        ToleranceLimitState::component(study.row(p, Component::Px).to_vec(), 0.03, Sided::Upper)
-            .expect("ls"),
+        ToleranceLimitState::component(
+            study.row(p, Component::Px).unwrap().to_vec(),
+            0.03,
+            Sided::Upper,
+        )
+        .expect("ls"),
     )
     .expect("event");
     let form = Form::default().run(&event).expect("form");
@@ -493,7 +501,7 @@ fn analytic_sensitivities_equal_central_differences() {
         (Component::Pz, (500.0, -750.0, 1000.0)),
     ] {
         let p = point(&study, x, y, z);
-        let row = study.row(p, c).to_vec();
+        let row = study.row(p, c).unwrap().to_vec();
         // A non-zero mean on two inputs makes ∂R/∂μ non-trivial.
         let base = study
             .inputs()

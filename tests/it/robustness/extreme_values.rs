@@ -188,6 +188,25 @@ fn axis_values_whose_moments_overflow_are_refused_naming_the_point() {
             );
         }
     }
+    // A grid past the table's points: its summary pass refuses the first
+    // such point as the run does, before writing anything.
+    let out = run(&[
+        "reliability",
+        &gantry_file,
+        "--grid",
+        "x=0:1e300:10001",
+        "--grid",
+        "y=-1500",
+        "--grid",
+        "z=600",
+    ]);
+    let err = flat(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(out.stdout.is_empty());
+    assert!(
+        err.contains("x = 1e296") && err.contains("standard deviation of py is not finite"),
+        "{err}"
+    );
     // Large but harmless values still run: 1e100 mm gives sensitivities of
     // 1e100 and variances of 1e200·σ².
     let axes = scratch("axes_1e100.csv", "x,y,z\n1e100,-1500,600\n");

@@ -195,7 +195,7 @@ pub(super) fn build(study: &Study, bounds: &[ErrorBounds]) -> Result<Problem, Al
     let mut used = vec![false; ne];
     for &c in &comps {
         for p in 0..np {
-            for (j, a) in study.row(p, c).iter().enumerate() {
+            for (j, a) in study.row(p, c)?.iter().enumerate() {
                 if *a != 0.0 {
                     used[j] = true;
                 }
@@ -221,7 +221,7 @@ pub(super) fn build(study: &Study, bounds: &[ErrorBounds]) -> Result<Problem, Al
     let mut keys: Vec<Vec<u64>> = Vec::new();
     for (ci, &(c, tol)) in spec.tolerances.iter().enumerate() {
         for p in 0..np {
-            let row = study.row(p, c);
+            let row = study.row(p, c)?;
             let m: f64 = row.iter().zip(means).map(|(a, mu)| a * mu).sum();
             let a2: Vec<f64> = var.iter().map(|&j| row[j] * row[j]).collect();
             let vfix: f64 = (0..ne)
