@@ -19,13 +19,15 @@ from ._results import IdentifyResult, MapResult, PlanResult
 from ._results import Derivation, ReliabilityResult, Result, SobolResult
 from ._results import AllocationResult, GeometricSensitivityResult, SensitivityResult
 from ._results import CompensateResult, ExportResult, InverseResult, MotionResult, PathResult, PositioningResult
-from ._results import ThermalResult
+from ._results import CircularResult, ThermalResult
 from ._positioning import positioning
+from ._circular import circular
 from ._thermal import thermal
 from ._compensate import compensate
 
 __all__ = [
     "AllocationResult",
+    "CircularResult",
     "CompensateResult",
     "Derivation",
     "ExportResult",
@@ -48,6 +50,7 @@ __all__ = [
     "compensate",
     "positioning",
     "thermal",
+    "circular",
 ]
 
 __version__ = "0.1.0"

@@ -172,6 +172,19 @@ def positioning_json(
 ) -> Tuple[str, Optional[str]]: ...
 
 
+# -- circular tests (python/src/circular.rs) -------------------------------------
+
+def circular_json(
+    path: Optional[str],
+    text: Optional[str],
+    file: str,
+    radius: Optional[float] = None,
+    feed: Optional[float] = None,
+    plane: Optional[str] = None,
+    arc: Optional[float] = None,
+) -> str: ...
+
+
 # -- thermal drift tests (python/src/thermal.rs) ---------------------------------
 
 def thermal_json(

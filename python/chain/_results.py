@@ -320,6 +320,41 @@ class ThermalResult(Result):
         return [{k: v for k, v in c.items() if not isinstance(v, dict)} for c in self._document["channels"]]
 
 
+class CircularResult(Result):
+    """``chain circular --format json``: an ISO 230-4 circular test evaluated per run and direction.
+
+    Attributes: ``file``, ``unit`` (``mm``), ``centre`` (``least_squares``),
+    ``arc``, ``runs`` (per run: ``run``, ``plane``, ``radius``, ``feed``,
+    ``directions`` with ``ccw`` and ``cw`` each ``G``, ``F_max``, ``F_min``,
+    ``centre``, ``radius_offset``, ``samples``; ``G_b``, ``H``,
+    ``centre_both``). Rows of ``to_dataframe()``: one per run and direction.
+    """
+
+    command = "circular"
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        rows = []
+        for r in self._document["runs"]:
+            for direction, d in r["directions"].items():
+                rows.append(
+                    {
+                        "run": r["run"],
+                        "plane": r["plane"],
+                        "radius": r["radius"],
+                        "feed": r["feed"],
+                        "direction": direction,
+                        "G": d["G"],
+                        "F_max": d["F_max"],
+                        "F_min": d["F_min"],
+                        "centre_1": d["centre"][0],
+                        "centre_2": d["centre"][1],
+                        "G_b": r["G_b"],
+                        "H": r["H"],
+                    }
+                )
+        return rows
+
+
 class InverseResult(Result):
     """``chain inverse --format json``: the axis values that reach each tool pose.
 

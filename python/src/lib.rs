@@ -16,6 +16,7 @@
 //! problems raise `MachineError` (a `ValueError`) with `file`, `line`,
 //! `column` and `key`.
 
+mod circular;
 mod compensate;
 mod export;
 mod inverse;
@@ -591,6 +592,7 @@ fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(allocate::allocate_json, m)?)?;
     m.add_function(wrap_pyfunction!(positioning::positioning_json, m)?)?;
     m.add_function(wrap_pyfunction!(thermal::thermal_json, m)?)?;
+    m.add_function(wrap_pyfunction!(circular::circular_json, m)?)?;
     m.add_function(wrap_pyfunction!(inverse::inverse_json, m)?)?;
     m.add_function(wrap_pyfunction!(path::path_json, m)?)?;
     m.add_function(wrap_pyfunction!(export::export_json, m)?)?;

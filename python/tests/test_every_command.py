@@ -61,6 +61,7 @@ CASES = [
      [EX / "data/swing_htm50200.csv", "--length", "577.11"]),
     ("positioning", lambda: chain.positioning(EX / "positioning/x_axis_runs.csv"),
      [EX / "positioning/x_axis_runs.csv"]),
+    ("circular", lambda: chain.circular(EX / "circular/runs.csv"), [EX / "circular/runs.csv"]),
 ]
 
 
@@ -130,6 +131,8 @@ BAD = [
     ("positioning", lambda t: chain.positioning(EX / "positioning/x_axis_runs.csv", k=0.0),
      lambda t: [EX / "positioning/x_axis_runs.csv", "--k", "0"], ValueError,
      "the coverage factor k must be a finite number > 0, not 0"),
+    ("circular", lambda t: chain.circular(EX / "circular/runs.csv", arc=0.0),
+     lambda t: [EX / "circular/runs.csv", "--arc", "0"], ValueError, "--arc 0: must be in (0, 360] degrees"),
 ]
 
 

@@ -16,8 +16,8 @@ pub mod report;
 mod study_text;
 
 use commands::{
-    allocate, compensate, derive, export, identify, inverse, map, motion, path, plan, positioning,
-    reliability, sensitivity, sobol, thermal,
+    allocate, circular, compensate, derive, export, identify, inverse, map, motion, path, plan,
+    positioning, reliability, sensitivity, sobol, thermal,
 };
 
 use clap::{Parser, Subcommand};
@@ -61,6 +61,8 @@ enum Command {
     Positioning(positioning::PositioningArgs),
     /// ISO 230-3 thermal drift: the drift of each displacement channel, the temperatures, sensor-pair tilts, and with --fit a thermal model per channel from the temperature sensors (and lagged loads) with its held-out prediction.
     Thermal(thermal::ThermalArgs),
+    /// ISO 230-4 circular test (ballbar): per run and direction the circular deviation G, the radial deviations F_max and F_min about the least-squares centre, and with both directions G(b) and the hysteresis H.
+    Circular(circular::CircularArgs),
     /// Motion conversion ("Precision Machining Technology of Jewelry on CNC Machine Tool", 2022): CNC axis motions reproducing a cradle-type generator's roll, and their Maclaurin series.
     Motion(motion::MotionArgs),
 }
@@ -83,5 +85,6 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Export(args) => export::exec(args),
         Command::Positioning(args) => positioning::exec(args),
         Command::Thermal(args) => thermal::exec(args),
+        Command::Circular(args) => circular::exec(args),
     }
 }

@@ -41,6 +41,7 @@
 
 pub mod allocate;
 pub mod choice;
+pub mod circular;
 pub mod compensate;
 #[cfg(feature = "json")]
 pub mod derive;

@@ -13,6 +13,7 @@
 
 use std::path::Path;
 
+use chain_core::measured::circular::{CircularFileError, CircularTest};
 use chain_core::measured::positioning::{AxisKind, Runs, RunsFileError};
 use chain_core::measured::thermal::{DriftFileError, DriftTest, Roles};
 use chain_core::measured::{Layout, Measurements, MeasurementsError};
@@ -143,6 +144,20 @@ pub fn read_drift(source: Source<'_>, roles: &Roles) -> Result<DriftTest, DriftF
         Source::Bytes { name, bytes } => {
             let text = chain_core::load::decode(bytes, name).map_err(DriftFileError)?;
             DriftTest::parse(text, name, roles)
+        }
+    }
+}
+
+/// The run file of `chain circular`, read with `options`.
+pub fn read_circular(
+    source: Source<'_>,
+    options: &chain_core::measured::circular::RunOptions,
+) -> Result<CircularTest, CircularFileError> {
+    match source {
+        Source::Path(path) => CircularTest::read(path, options),
+        Source::Bytes { name, bytes } => {
+            let text = chain_core::load::decode(bytes, name).map_err(CircularFileError)?;
+            CircularTest::parse(text, name, options)
         }
     }
 }

@@ -13,6 +13,7 @@
 //! sphere-probing records, whose sphere positions are unknowns of the fit
 //! beside the errors ([`Setup`]).
 
+pub mod circular;
 mod estimate;
 pub mod exact;
 pub mod identify;

@@ -2,6 +2,7 @@
 //! `chain::ops` call, and the document handed to the renderer and the plots.
 
 pub mod allocate;
+pub mod circular;
 pub mod compensate;
 pub mod derive;
 pub mod export;

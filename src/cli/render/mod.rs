@@ -2,6 +2,7 @@
 //! file per document; the JSON form is the document's own `Serialize`.
 
 pub(crate) mod allocate;
+pub(crate) mod circular;
 pub(crate) mod compensate;
 pub(crate) mod export;
 pub(crate) mod identify;

@@ -9,6 +9,7 @@ mod acceptance_rare;
 mod allocate;
 mod batch;
 mod batch_kernels;
+mod circular;
 mod compensate;
 mod cov_stopping;
 mod derivation_routes;

@@ -548,3 +548,151 @@ impl DriftProblem {
         }
     }
 }
+
+/// What the header of a circular-test file names (the help of its
+/// refusals).
+pub(crate) const CIRCULAR_FILE_HEADER: &str = "the header names `angle` (degrees), `direction` (`ccw` or `cw`) and `deviation` (mm; `deviation(um)` for µm), and optionally `run`, `radius` (mm), `feed` (mm/min) and `plane` (`xy`, `yz` or `zx`)";
+
+/// A rule of an ISO 230-4 circular-test file (`chain circular`), worded by
+/// [`CircularProblem::describe`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum CircularProblem {
+    /// A required column is missing.
+    MissingColumn {
+        /// The column (`angle`, `direction`, `deviation`).
+        name: &'static str,
+        /// The header's columns.
+        columns: Vec<String>,
+    },
+    /// A direction other than `ccw` or `cw`.
+    Direction {
+        /// The text.
+        found: String,
+    },
+    /// A plane other than `xy`, `yz`, `zx`.
+    Plane {
+        /// The text.
+        found: String,
+    },
+    /// A radius or feed that is not positive.
+    NotPositive {
+        /// `radius` or `feed`.
+        what: &'static str,
+        /// The value.
+        value: f64,
+    },
+    /// A run's radius, feed or plane differs from its first row's.
+    RunDiffers {
+        /// `radius`, `feed` or `plane`.
+        what: &'static str,
+        /// This row's.
+        value: String,
+        /// The first row's.
+        first: String,
+        /// The first row's line.
+        first_line: usize,
+        /// The run.
+        run: String,
+    },
+    /// A run with no radius (no `radius` column and no `--radius`).
+    NoRadius {
+        /// The run.
+        run: String,
+    },
+    /// Too few samples in a direction of a run to fit a circle.
+    TooFewSamples {
+        /// The run.
+        run: String,
+        /// `ccw` or `cw`.
+        direction: &'static str,
+        /// The samples.
+        count: usize,
+    },
+    /// A direction of a run that does not cover its arc.
+    NotCovered {
+        /// The run.
+        run: String,
+        /// `ccw` or `cw`.
+        direction: &'static str,
+        /// The widest gap between neighbouring angles (degrees), from.
+        from: f64,
+        /// To.
+        to: f64,
+        /// The arc the run must cover (degrees).
+        arc: f64,
+        /// The widest gap allowed (degrees).
+        allowed: f64,
+    },
+}
+
+impl CircularProblem {
+    /// Every part of the message of this problem: one match arm per
+    /// variant.
+    pub fn describe(&self) -> D {
+        match self {
+            CircularProblem::MissingColumn { name, columns } => D::new(
+                "chain::circular::missing_column",
+                "header",
+                format!(
+                    "the header has no `{name}` column (it has {})",
+                    quoted(columns.iter().map(String::as_str))
+                ),
+            )
+            .help(CIRCULAR_FILE_HEADER.to_string()),
+            CircularProblem::Direction { found } => D::new(
+                "chain::circular::direction",
+                "direction",
+                format!("`{found}` is not a direction: expected `ccw` (angle increasing) or `cw`"),
+            ),
+            CircularProblem::Plane { found } => D::new(
+                "chain::circular::plane",
+                "plane",
+                format!("`{found}` is not a plane: expected `xy`, `yz` or `zx`"),
+            ),
+            CircularProblem::NotPositive { what, value } => D::new(
+                "chain::circular::not_positive",
+                "value",
+                format!("the {what} must be positive, got {value}"),
+            ),
+            CircularProblem::RunDiffers {
+                what,
+                value,
+                first,
+                first_line,
+                run,
+            } => D::new(
+                "chain::circular::run_differs",
+                "value",
+                format!("run {run}: {what} {value} differs from its first row's {first} (line {first_line}); a run has one {what}"),
+            ),
+            CircularProblem::NoRadius { run } => D::new(
+                "chain::circular::no_radius",
+                "header",
+                format!("run {run} has no radius: the file has no `radius` column"),
+            )
+            .help("give the runs' nominal radius (mm): a `radius` column, or the radius every run without one takes".to_string()),
+            CircularProblem::TooFewSamples {
+                run,
+                direction,
+                count,
+            } => D::new(
+                "chain::circular::too_few_samples",
+                "run",
+                format!("run {run}, {direction}: {count} sample(s); a circle needs at least 8 around its arc"),
+            ),
+            CircularProblem::NotCovered {
+                run,
+                direction,
+                from,
+                to,
+                arc,
+                allowed,
+            } => D::new(
+                "chain::circular::not_covered",
+                "run",
+                format!("run {run}, {direction}: no sample between {from}° and {to}°, so it does not cover its {arc}° arc (the widest gap allowed is {allowed}°)"),
+            )
+            .help("a run covers the whole circle unless the arc it covers (degrees) is given; measure the missing part, or give that arc".to_string()),
+        }
+    }
+}

@@ -40,10 +40,10 @@ use std::sync::Arc;
 
 pub use located::{Diagnostics, LoadError};
 #[cfg(feature = "csv")]
-pub(crate) use measured::DRIFT_FILE_HEADER;
-#[cfg(feature = "csv")]
 pub(crate) use measured::RUN_FILE_HEADER;
-pub use measured::{DriftProblem, MeasurementsProblem, PositioningProblem};
+pub use measured::{CircularProblem, DriftProblem, MeasurementsProblem, PositioningProblem};
+#[cfg(feature = "csv")]
+pub(crate) use measured::{CIRCULAR_FILE_HEADER, DRIFT_FILE_HEADER};
 pub use names::{closest, shortened, QUOTED_CHARS};
 pub use settings::SettingsProblem;
 #[cfg(feature = "miette")]
@@ -505,6 +505,8 @@ pub enum Problem {
     Positioning(Box<PositioningProblem>),
     /// A rule of an ISO 230-3 drift-test file.
     Drift(Box<DriftProblem>),
+    /// A rule of an ISO 230-4 circular-test file.
+    Circular(Box<CircularProblem>),
     /// A rule of a file read by a crate outside chain-core, worded by that
     /// crate's own typed problem ([`Describe`]).
     Foreign(Foreign),
@@ -564,6 +566,12 @@ impl From<MeasurementsProblem> for Problem {
 impl From<DriftProblem> for Problem {
     fn from(problem: DriftProblem) -> Problem {
         Problem::Drift(Box::new(problem))
+    }
+}
+
+impl From<CircularProblem> for Problem {
+    fn from(problem: CircularProblem) -> Problem {
+        Problem::Circular(Box::new(problem))
     }
 }
 
@@ -1164,6 +1172,7 @@ impl Problem {
             Problem::Measurements(p) => p.describe(),
             Problem::Positioning(p) => p.describe(),
             Problem::Drift(p) => p.describe(),
+            Problem::Circular(p) => p.describe(),
             Problem::Foreign(p) => p.0.describe(),
         }
     }

@@ -1,0 +1,64 @@
+"""chain.circular returns `chain circular --format json` for the same run file (a path, its text or
+its columns), and refuses what the CLI refuses with its words."""
+
+import math
+
+import numpy as np
+import pytest
+
+import chain
+from conftest import flat
+
+
+def _runs(tmp_path):
+    """Two directions at R = 100 mm: an ellipse 3 µm · sin 2θ about an offset of 5 µm along the first
+    axis, the clockwise path 1 µm outside (µm)."""
+    lines = ["angle,direction,deviation(um)"]
+    for d in ("ccw", "cw"):
+        for k in range(360):
+            t = k if d == "ccw" else 360 - k
+            r = 3 * math.sin(2 * math.radians(t)) + 5 * math.cos(math.radians(t)) + (1 if d == "cw" else 0)
+            lines.append(f"{t},{d},{r:.6f}")
+    path = tmp_path / "runs.csv"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_circular_is_the_cli_json(cli, tmp_path):
+    path = _runs(tmp_path)
+    r = chain.circular(path, radius=100, feed=1000)
+    want = cli("circular", path, "--radius", 100, "--feed", 1000)
+    assert r.command == "circular"
+    assert r.to_dict() == want
+    run = want["runs"][0]
+    assert abs(run["directions"]["ccw"]["G"] - 0.006) < 1e-6 and abs(run["H"] - 0.001) < 1e-6
+    # The text and the columns give the same document, named as asked.
+    text = path.read_text()
+    assert chain.circular(text=text, name=str(path), radius=100, feed=1000).to_dict() == want
+    rows = [line.split(",") for line in text.splitlines()[1:]]
+    columns = {
+        "angle": np.array([float(a) for a, _, _ in rows]),
+        "direction": [d for _, d, _ in rows],
+        "deviation(um)": np.array([float(v) for _, _, v in rows]),
+    }
+    by_columns = chain.circular(columns, radius=100, feed=1000).to_dict()
+    assert by_columns["runs"] == want["runs"]
+    frame = r.to_dataframe()
+    assert list(frame["direction"]) == ["ccw", "cw"] and list(frame["G"]) == [
+        run["directions"]["ccw"]["G"],
+        run["directions"]["cw"]["G"],
+    ]
+
+
+def test_refusals_are_the_cli_s(cli_error, tmp_path):
+    path = _runs(tmp_path)
+    with pytest.raises(chain.MachineError) as e:
+        chain.circular(path)
+    assert "run 1 has no radius" in flat(str(e.value))
+    assert "run 1 has no radius" in flat(cli_error("circular", path))
+    with pytest.raises(ValueError) as e:
+        chain.circular(path, radius=100, arc=400)
+    assert "--arc 400: must be in (0, 360] degrees" in str(e.value)
+    assert "--arc 400: must be in (0, 360] degrees" in flat(cli_error("circular", path, "--radius", 100, "--arc", 400))
+    with pytest.raises(ValueError):
+        chain.circular(path, text="angle\n", radius=100)

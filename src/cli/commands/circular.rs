@@ -1,0 +1,54 @@
+//! `chain circular RUNS.csv [--radius R] [--feed F] [--plane xy|yz|zx]
+//! [--arc DEG] [--format table|json]`: an ISO 230-4 circular test
+//! (ballbar) evaluated per run and direction (`../shared/spec/circular.md`,
+//! `docs/circular.md`), through [`chain::ops::circular`].
+
+use std::path::PathBuf;
+
+use chain::ops::circular as ops;
+use chain::ops::source::{self, Source};
+
+use crate::cli::report;
+
+/// Output formats of `chain circular`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CircularFormat {
+    /// Per run and direction G, F_max, F_min and the centre; G(b) and H.
+    Table,
+    /// The document of the circular spec.
+    Json,
+}
+
+report::formats!(CircularFormat: Table, Json);
+
+/// Arguments of `chain circular`.
+#[derive(Debug, clap::Args)]
+pub struct CircularArgs {
+    /// The run file (CSV): `angle` (degrees), `direction` (`ccw`, `cw`),
+    /// `deviation` (mm; `deviation(um)` for µm), and optionally `run`,
+    /// `radius`, `feed`, `plane`.
+    pub runs: PathBuf,
+    /// The nominal radius (mm) of runs whose file gives none.
+    #[arg(long, value_name = "R")]
+    pub radius: Option<f64>,
+    /// The feed (mm/min) of runs whose file gives none.
+    #[arg(long, value_name = "F")]
+    pub feed: Option<f64>,
+    /// The plane of runs whose file gives none: xy (default), yz or zx.
+    #[arg(long, value_name = "PLANE")]
+    pub plane: Option<String>,
+    /// The arc every direction covers, in degrees (default the whole
+    /// circle, 360).
+    #[arg(long, value_name = "DEG")]
+    pub arc: Option<f64>,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "table")]
+    pub format: CircularFormat,
+}
+
+/// Runs `chain circular` ([`chain::ops::circular`]).
+pub fn exec(args: CircularArgs) -> miette::Result<()> {
+    let options = ops::options(args.radius, args.feed, args.plane.as_deref(), args.arc)?;
+    let test = source::read_circular(Source::Path(&args.runs), &options)?;
+    report::emit(&ops::run(&test), args.format.into())
+}

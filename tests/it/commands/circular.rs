@@ -1,0 +1,284 @@
+//! `chain circular` (spec `circular.md`, `docs/circular.md`): the ISO
+//! 230-4 evaluation of simulated ballbar runs against the test's own
+//! arithmetic (a centre offset, an ellipse, a direction-dependent radius),
+//! the document's keys, and every refusal of a run file or option located.
+
+use crate::common;
+
+use common::cli::{fails, ok_json, ok_stdout, scratch_file, unwrapped};
+use serde_json::Value;
+
+/// A run file (µm) of two runs: run A at R = 100 mm, feed 1000, plane xy,
+/// both directions, 720 samples each, with a set-up offset (12, −7) µm, an
+/// ellipse 4 µm · cos 2θ and the clockwise path 1.5 µm outside; run B at
+/// R = 150 mm in zx, counter-clockwise only, round about an offset (3, 4).
+fn two_runs() -> String {
+    let mut s = String::from("run,radius,feed,plane,angle,direction,deviation(um)\n");
+    let offset = |c1: f64, c2: f64, r: f64, t: f64| {
+        // The exact radial deviation of a circle whose centre is (c1, c2).
+        let (sn, cs) = t.to_radians().sin_cos();
+        let across = -c1 * sn + c2 * cs;
+        (r * r - across * across).sqrt() + c1 * cs + c2 * sn - r
+    };
+    for (dir, ccw) in [("ccw", true), ("cw", false)] {
+        for k in 0..720 {
+            let t = if ccw {
+                0.5 * k as f64
+            } else {
+                360.0 - 0.5 * k as f64
+            };
+            let d = offset(0.012, -0.007, 100.0, t)
+                + 0.004 * (2.0 * t.to_radians()).cos()
+                + if ccw { 0.0 } else { 0.0015 };
+            s.push_str(&format!("A,100,1000,xy,{t},{dir},{}\n", d * 1e3));
+        }
+    }
+    for k in 0..360 {
+        let t = k as f64;
+        let d = offset(0.003, 0.004, 150.0, t);
+        s.push_str(&format!("B,150,2000,zx,{t},ccw,{}\n", d * 1e3));
+    }
+    s
+}
+
+fn num(v: &Value) -> f64 {
+    v.as_f64().expect("a number")
+}
+
+#[test]
+fn the_evaluation_is_the_test_s_own_arithmetic() {
+    let file = scratch_file("two_runs.csv", &two_runs());
+    let file = file.to_str().unwrap();
+    let doc = ok_json(&["circular", file, "--format", "json"]);
+    assert_eq!(doc["unit"], "mm");
+    assert_eq!(doc["centre"], "least_squares");
+    let runs = doc["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    let a = &runs[0];
+    assert_eq!(
+        (a["run"].as_str(), a["plane"].as_str()),
+        (Some("A"), Some("xy"))
+    );
+    assert_eq!((num(&a["radius"]), num(&a["feed"])), (100.0, 1000.0));
+    // The ellipse about the removed offset: G = 2·4 µm, F = ±4 µm (+1.5
+    // clockwise), to first order: the offset's and the ellipse's cross
+    // terms are about |c|·A/R = 14 µm · 4 µm / 100 mm ≈ 0.6 nm, so 1 nm.
+    for (dir, shift) in [("ccw", 0.0), ("cw", 0.0015)] {
+        let d = &a["directions"][dir];
+        let keys: Vec<&String> = d.as_object().unwrap().keys().collect();
+        for k in ["G", "F_max", "F_min", "centre"] {
+            assert!(keys.iter().any(|x| *x == k), "{dir}: {keys:?}");
+        }
+        assert!((num(&d["G"]) - 0.008).abs() < 1e-6, "{dir}: {d}");
+        assert!(
+            (num(&d["F_max"]) - (0.004 + shift)).abs() < 1e-6,
+            "{dir}: {d}"
+        );
+        assert!(
+            (num(&d["F_min"]) - (shift - 0.004)).abs() < 1e-6,
+            "{dir}: {d}"
+        );
+        assert!((num(&d["centre"][0]) - 0.012).abs() < 1e-6, "{d}");
+        assert!((num(&d["centre"][1]) + 0.007).abs() < 1e-6, "{d}");
+    }
+    assert!((num(&a["H"]) - 0.0015).abs() < 1e-6, "{a}");
+    assert!((num(&a["G_b"]) - 0.0095).abs() < 1e-6, "{a}");
+    // Run B: one direction, round: no G(b), no H.
+    let b = &runs[1];
+    assert_eq!(
+        (b["plane"].as_str(), num(&b["radius"])),
+        (Some("zx"), 150.0)
+    );
+    let ccw = &b["directions"]["ccw"];
+    assert!(num(&ccw["G"]) < 1e-9 && (num(&ccw["centre"][1]) - 0.004).abs() < 1e-9);
+    assert!(b["directions"].get("cw").is_none() && b["G_b"].is_null() && b["H"].is_null());
+    // The table says the same, in µm.
+    let table = ok_stdout(&["circular", file]);
+    assert!(
+        table.contains("run A: plane xy, radius 100 mm, feed 1000 mm/min"),
+        "{table}"
+    );
+    assert!(
+        table.contains("G(b) 9.50, circular hysteresis H 1.50"),
+        "{table}"
+    );
+    assert!(
+        table.contains("      8.00       4.00      -4.00      12.00      -7.00      720"),
+        "{table}"
+    );
+}
+
+#[test]
+fn every_refusal_is_located() {
+    let good = two_runs();
+    let check = |name: &str, text: &str, args: &[&str], needles: &[&str]| {
+        let file = scratch_file(name, text);
+        let mut all = vec!["circular", file.to_str().unwrap()];
+        all.extend_from_slice(args);
+        let err = unwrapped(&fails(&all));
+        for n in needles {
+            assert!(err.contains(n), "{name}: `{n}` missing from {err}");
+        }
+    };
+    check(
+        "no_direction.csv",
+        "angle,deviation\n0,1\n",
+        &["--radius", "100"],
+        &[
+            "no_direction.csv:1:",
+            "no `direction` column",
+            "chain::circular::missing_column",
+        ],
+    );
+    check(
+        "direction.csv",
+        &good.replacen(",ccw,", ",up,", 1),
+        &[],
+        &["direction.csv:2:", "`up` is not a direction"],
+    );
+    check(
+        "plane.csv",
+        &good.replacen(",xy,", ",xq,", 1),
+        &[],
+        &["plane.csv:2:", "`xq` is not a plane"],
+    );
+    check(
+        "radius.csv",
+        &good.replacen("A,100,", "A,-100,", 1),
+        &[],
+        &["radius.csv:2:", "the radius must be positive, got -100"],
+    );
+    // Line 5 of the file: the fourth sample of run A.
+    let lines: Vec<String> = good.lines().map(str::to_string).collect();
+    let mut changed = lines.clone();
+    changed[4] = changed[4].replacen("A,100,", "A,101,", 1);
+    check(
+        "differs.csv",
+        &(changed.join("\n") + "\n"),
+        &[],
+        &[
+            "differs.csv:5:",
+            "run A: radius 101 differs from its first row's 100 (line 2)",
+        ],
+    );
+    let gap: String = lines
+        .iter()
+        .filter(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            let t: f64 = cells[4].parse().unwrap_or(-1.0);
+            !(cells[0] == "B" && t > 30.0 && t < 60.0)
+        })
+        .map(|l| format!("{l}\n"))
+        .collect();
+    check(
+        "gap.csv",
+        &gap,
+        &[],
+        &[
+            "run B, ccw: no sample between 30° and 60°",
+            "widest gap allowed is 10°",
+        ],
+    );
+    let mut nan = lines.clone();
+    nan[2] = format!("{},nan", nan[2].rsplit_once(',').unwrap().0);
+    check(
+        "nan.csv",
+        &(nan.join("\n") + "\n"),
+        &[],
+        &["nan.csv:3:", "deviation(um)"],
+    );
+    let no_radius = "angle,direction,deviation\n".to_string()
+        + &(0..36)
+            .map(|k| format!("{},ccw,0\n", 10 * k))
+            .collect::<String>();
+    check(
+        "no_radius.csv",
+        &no_radius,
+        &[],
+        &[
+            "no_radius.csv:1:",
+            "run 1 has no radius",
+            "a `radius` column",
+        ],
+    );
+    // The options, named.
+    check(
+        "opt.csv",
+        &no_radius,
+        &["--radius", "100", "--arc", "400"],
+        &["--arc 400", "(0, 360]"],
+    );
+    check(
+        "opt2.csv",
+        &no_radius,
+        &["--radius", "100", "--plane", "ab"],
+        &["--plane ab"],
+    );
+    check(
+        "opt3.csv",
+        &no_radius,
+        &["--radius=-1"],
+        &["--radius -1", "positive"],
+    );
+}
+
+/// The example runs (examples/circular/generate.py: a time-domain
+/// simulation with stated errors): each run's least-squares centre is its
+/// stated set-up offset within 0.1 µm (the lag turns it by |c|·ωτ), and
+/// its radius offset the stated `r0` (the servo lag's `−v²τ²/(2R)`
+/// mostly) within 0.1 µm, in both directions.
+#[test]
+fn the_example_runs_read_their_stated_set_up() {
+    let file = common::example_file("circular/runs.csv");
+    let text = std::fs::read_to_string(&file).unwrap();
+    let offsets: Vec<(String, [f64; 2])> = text
+        .lines()
+        .find(|l| l.starts_with("# truth: set-up offset"))
+        .unwrap()
+        .split_whitespace()
+        .filter_map(|w| {
+            let (run, c) = w.split_once("=(")?;
+            let (a, b) = c.trim_end_matches(')').split_once(',')?;
+            Some((run.to_string(), [a.parse().ok()?, b.parse().ok()?]))
+        })
+        .collect();
+    assert_eq!(offsets.len(), 6);
+    let r0 = |run: &str| -> f64 {
+        let (plane, feed) = run.split_once('_').unwrap();
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(&format!("# derived {plane}:")))
+            .unwrap();
+        let at = line.find(&format!("{feed}=")).unwrap() + feed.len() + 1;
+        line[at..]
+            .split_whitespace()
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let doc = ok_json(&["circular", file.to_str().unwrap(), "--format", "json"]);
+    let runs = doc["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 6);
+    for run in runs {
+        let id = run["run"].as_str().unwrap();
+        let c = offsets.iter().find(|(r, _)| r == id).unwrap().1;
+        for dir in ["ccw", "cw"] {
+            let d = &run["directions"][dir];
+            for k in 0..2 {
+                let got = 1e3 * num(&d["centre"][k]);
+                assert!(
+                    (got - c[k]).abs() < 0.1,
+                    "{id} {dir}: centre {got} µm, stated {}",
+                    c[k]
+                );
+            }
+            let got = 1e3 * num(&d["radius_offset"]);
+            assert!(
+                (got - r0(id)).abs() < 0.1,
+                "{id} {dir}: r0 {got} µm, stated {}",
+                r0(id)
+            );
+        }
+    }
+}
