@@ -29,6 +29,7 @@
 //! ```
 
 pub mod allocate;
+pub mod circular;
 pub mod compensate;
 pub mod geometric;
 pub mod map;

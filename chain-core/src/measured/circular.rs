@@ -598,6 +598,20 @@ fn radii_about(points: &[(f64, f64)], centre: [f64; 2]) -> Vec<f64> {
         .collect()
 }
 
+/// The trace of direction `d` of `run` about `centre` (mm, as
+/// [`DirectionResult::centre`]): per sample its angle (degrees, as written)
+/// and its radial deviation from the nominal radius about that centre (mm,
+/// what `F_max` and `F_min` bound), in file order.
+pub fn trace(run: &Run, d: Direction, centre: [f64; 2]) -> Vec<(f64, f64)> {
+    let points: Vec<(f64, f64)> = (run.samples(d).iter())
+        .map(|s| (s.angle, run.radius + s.deviation))
+        .collect();
+    let radii = radii_about(&points, centre);
+    (points.iter().zip(radii))
+        .map(|(&(deg, _), r)| (deg, r - run.radius))
+        .collect()
+}
+
 /// One direction of a run evaluated (ISO 230-4, the LSC centre).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DirectionResult {

@@ -1,5 +1,5 @@
 //! `chain circular RUNS.csv [--radius R] [--feed F] [--plane xy|yz|zx]
-//! [--arc DEG] [--format table|json]`: an ISO 230-4 circular test
+//! [--arc DEG] [--format table|json] [--plot DIR]`: an ISO 230-4 circular test
 //! (ballbar) evaluated per run and direction (`../shared/spec/circular.md`,
 //! `docs/circular.md`), through [`chain::ops::circular`].
 
@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use chain::ops::circular as ops;
 use chain::ops::source::{self, Source};
 
-use crate::cli::report;
+use crate::cli::{plot, report};
 
 /// Output formats of `chain circular`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -44,11 +44,22 @@ pub struct CircularArgs {
     /// Output format.
     #[arg(long, value_enum, default_value = "table")]
     pub format: CircularFormat,
+    /// Write each run's polar plot (both directions about their
+    /// least-squares centres, the deviation magnified on a ring) into DIR
+    /// as PNG and SVG (`circular_<run>`).
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
 }
 
 /// Runs `chain circular` ([`chain::ops::circular`]).
 pub fn exec(args: CircularArgs) -> miette::Result<()> {
     let options = ops::options(args.radius, args.feed, args.plane.as_deref(), args.arc)?;
     let test = source::read_circular(Source::Path(&args.runs), &options)?;
-    report::emit(&ops::run(&test), args.format.into())
+    let done = ops::run(&test);
+    if let Some(dir) = &args.plot {
+        for f in plot::write(dir, &chain::plot::circular::charts(&test, &done))? {
+            eprintln!("wrote {}", f.display());
+        }
+    }
+    report::emit(&done, args.format.into())
 }

@@ -282,3 +282,42 @@ fn the_example_runs_read_their_stated_set_up() {
         }
     }
 }
+
+/// `--plot DIR`: one polar plot per run, PNG and SVG, both directions with
+/// their G and F in the legend, G(b) and H in the title, the rings' scale.
+#[test]
+fn the_polar_plots_are_one_per_run() {
+    let file = common::example_file("circular/runs.csv");
+    let dir = common::cli::scratch("circular-plot");
+    ok_stdout(&[
+        "circular",
+        file.to_str().unwrap(),
+        "--plot",
+        dir.to_str().unwrap(),
+    ]);
+    let doc = ok_json(&["circular", file.to_str().unwrap(), "--format", "json"]);
+    for run in doc["runs"].as_array().unwrap() {
+        let id = run["run"].as_str().unwrap();
+        let svg = std::fs::read_to_string(dir.join(format!("circular_{id}.svg"))).unwrap();
+        let g = |dir: &str| 1e3 * num(&run["directions"][dir]["G"]);
+        for label in [
+            format!("run {id}: "),
+            format!("ccw (G {:.2} µm", g("ccw")),
+            format!("cw (G {:.2} µm", g("cw")),
+            format!(
+                "G(b) {:.2} µm, H {:.2} µm",
+                1e3 * num(&run["G_b"]),
+                1e3 * num(&run["H"])
+            ),
+            "nominal radius (0 µm)".to_string(),
+        ] {
+            assert!(svg.contains(&label), "{id}: `{label}`");
+        }
+        let png = std::fs::read(dir.join(format!("circular_{id}.png"))).unwrap();
+        assert!(
+            png.starts_with(b"\x89PNG") && png.len() > 20_000,
+            "{}",
+            png.len()
+        );
+    }
+}
