@@ -58,7 +58,7 @@ def test_refusals_are_the_cli_s(cli_error, tmp_path):
     assert "run 1 has no radius" in flat(cli_error("circular", path))
     with pytest.raises(ValueError) as e:
         chain.circular(path, radius=100, arc=400)
-    assert "--arc 400: must be in (0, 360] degrees" in str(e.value)
-    assert "--arc 400: must be in (0, 360] degrees" in flat(cli_error("circular", path, "--radius", 100, "--arc", 400))
+    assert "--arc 400: must be in [45, 360] degrees" in str(e.value)
+    assert "--arc 400: must be in [45, 360] degrees" in flat(cli_error("circular", path, "--radius", 100, "--arc", 400))
     with pytest.raises(ValueError):
         chain.circular(path, text="angle\n", radius=100)

@@ -132,7 +132,7 @@ BAD = [
      lambda t: [EX / "positioning/x_axis_runs.csv", "--k", "0"], ValueError,
      "the coverage factor k must be a finite number > 0, not 0"),
     ("circular", lambda t: chain.circular(EX / "circular/runs.csv", arc=0.0),
-     lambda t: [EX / "circular/runs.csv", "--arc", "0"], ValueError, "--arc 0: must be in (0, 360] degrees"),
+     lambda t: [EX / "circular/runs.csv", "--arc", "0"], ValueError, "--arc 0: must be in [45, 360] degrees"),
 ]
 
 

@@ -644,21 +644,6 @@ pub struct TargetTotals {
 }
 
 impl TargetTotals {
-    /// Whether a case of reliability `r` is one of the extremes kept
-    /// (`keep` least reliable, the most reliable) when added now.
-    fn wants(&self, r: f64, keep: usize) -> bool {
-        let lowest = match self.lowest.get(keep.wrapping_sub(1)) {
-            // Below the last kept, or incomparable (as `partition_point`
-            // places a NaN first).
-            Some(last) => matches!(
-                r.partial_cmp(&last.reliability),
-                Some(std::cmp::Ordering::Less) | None
-            ),
-            None => keep > 0,
-        };
-        lowest || self.highest.as_ref().is_none_or(|h| r > h.reliability)
-    }
-
     /// Adds a case given by its parts; `case` forms it when it is kept.
     fn add_parts(
         &mut self,
@@ -681,20 +666,20 @@ impl TargetTotals {
         keep: usize,
         case: impl Fn() -> CaseResult,
     ) {
-        if self.wants(reliability, keep) {
+        // Where it would go among the least reliable (after equal ones),
+        // and whether it is the most reliable so far: the case is formed
+        // only when either holds.
+        let at = self
+            .lowest
+            .partition_point(|k| k.reliability <= reliability);
+        let highest = (self.highest.as_ref()).is_none_or(|h| reliability > h.reliability);
+        if at < keep || highest {
             let c = case();
-            let at = self
-                .lowest
-                .partition_point(|k| k.reliability <= reliability);
             if at < keep {
                 self.lowest.insert(at, c.clone());
                 self.lowest.truncate(keep);
             }
-            if self
-                .highest
-                .as_ref()
-                .is_none_or(|h| reliability > h.reliability)
-            {
+            if highest {
                 self.highest = Some(c);
             }
         }
@@ -982,9 +967,15 @@ impl Study {
         let (inputs, variables) = checked_inputs(model, parameters, inputs)?;
         let points = grid_points(&spec.grid, &variables)?;
         let targets = targets(&spec)?;
-        let rows = Rows::Stored(evaluate(model, parameters, &points, 0..points.len())?);
+        let rows = evaluate(model, parameters, &points, 0..points.len())?;
+        check_moments(&inputs, &variables, &points, 0..points.len(), &rows)?;
         Ok(Study::assemble(
-            inputs, variables, spec, points, rows, targets,
+            inputs,
+            variables,
+            spec,
+            points,
+            Rows::Stored(rows),
+            targets,
         ))
     }
 
@@ -1048,9 +1039,15 @@ impl Study {
     ) -> Result<Study, ReliabilityError> {
         let (inputs, variables) = checked_inputs(model, parameters, inputs)?;
         let (spec, points, targets) = listed_points(spec, points, &variables)?;
-        let rows = Rows::Stored(evaluate(model, parameters, &points, 0..points.len())?);
+        let rows = evaluate(model, parameters, &points, 0..points.len())?;
+        check_moments(&inputs, &variables, &points, 0..points.len(), &rows)?;
         Ok(Study::assemble(
-            inputs, variables, spec, points, rows, targets,
+            inputs,
+            variables,
+            spec,
+            points,
+            Rows::Stored(rows),
+            targets,
         ))
     }
 
@@ -1228,8 +1225,17 @@ impl Study {
         match &self.rows {
             Rows::Stored(s) => Ok(Cow::Borrowed(&s[range.start * n6..range.end * n6])),
             Rows::OnDemand { model, parameters } => {
-                let s = evaluate(&**model, parameters, &self.points, range.clone())?;
-                check_moments(&self.inputs, &self.variables, &self.points, range, &s)?;
+                let mut s = vec![0.0; range.len() * n6];
+                let points = &self.points;
+                evaluate_into(
+                    &**model,
+                    parameters,
+                    points,
+                    range.clone(),
+                    &mut Vec::new(),
+                    &mut s,
+                )?;
+                check_moments(&self.inputs, &self.variables, points, range, &s)?;
                 Ok(Cow::Owned(s))
             }
         }
@@ -1879,6 +1885,9 @@ impl Study {
                         Ok(())
                     },
                 )
+                .collect::<Vec<Result<(), ReliabilityError>>>()
+                .into_iter()
+                // The first refusal in point order, whatever the threads.
                 .collect::<Result<(), ReliabilityError>>()?;
             // In case order per target: the sums, the extremes, the tally.
             for (t, plan) in plans.iter().enumerate() {
@@ -2185,11 +2194,16 @@ fn evaluate<M: ErrorModel + ?Sized>(
 ) -> Result<Vec<f64>, ReliabilityError> {
     let mut flat = vec![0.0; range.len() * 6 * model.errors().len()];
     evaluate_into(model, parameters, points, range, &mut Vec::new(), &mut flat)?;
+    if !scan(&flat).0 {
+        return Err(ReliabilityError::NonFinite("the model's sensitivities"));
+    }
     Ok(flat)
 }
 
-/// [`evaluate`] into `out` (`range.len()` matrices of `6 × N`), the points
-/// formed in `qs` (both reused by the caller from block to block).
+/// The sensitivities of the points `range` into `out` (`range.len()`
+/// matrices of `6 × N`), the points formed in `qs` (both reused by the
+/// caller from block to block), unchecked: [`check_moments`] refuses a
+/// point with a non-finite value, naming it.
 fn evaluate_into<M: ErrorModel + ?Sized>(
     model: &M,
     parameters: &[f64],
@@ -2213,9 +2227,6 @@ fn evaluate_into<M: ErrorModel + ?Sized>(
         for (k, s) in out.chunks_exact_mut(n6.max(1)).enumerate() {
             model.sensitivity(&qs[k * nv..(k + 1) * nv], parameters, s);
         }
-    }
-    if !scan(out).0 {
-        return Err(ReliabilityError::NonFinite("the model's sensitivities"));
     }
     Ok(())
 }
@@ -2699,6 +2710,12 @@ mod tests {
             study.run_totals(&form, &(), 5).unwrap_err().to_string(),
             run
         );
+        // A study that keeps its sensitivities refuses it when built.
+        let mut spec = machine::spec(&m, None).unwrap();
+        spec.grid.axes[0].1 = vec![0.0, 1e300];
+        let (_, model) = gantry();
+        let kept = Study::new(&model, &params, machine::inputs(&m).unwrap(), spec);
+        assert_eq!(kept.unwrap_err().to_string(), run);
         // Within the bound, the sums decide (1e100 mm: variances of 1e200·σ²).
         assert_eq!(
             super::scan(&[1.0, -3.0, f64::INFINITY]),

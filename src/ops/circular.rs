@@ -70,11 +70,11 @@ pub fn options(
         _ => Ok(v),
     };
     let arc = match arc {
-        Some(a) if !(a.is_finite() && a > 0.0 && a <= 360.0) => {
+        Some(a) if !(a.is_finite() && (circular::MIN_ARC..=360.0).contains(&a)) => {
             return Err(CircularOpsError::Option {
                 option: "arc",
                 value: a,
-                rule: "must be in (0, 360] degrees",
+                rule: "must be in [45, 360] degrees",
             })
         }
         Some(a) => a,

@@ -62,6 +62,7 @@ pub fn charts(test: &CircularTest, doc: &Circular) -> Figures {
         let feed = run.feed.map_or(String::new(), |f| format!(", {f} mm/min"));
         let both = match (result.g_b, result.h) {
             (Some(g_b), Some(h)) => format!("; G(b) {:.2} µm, H {:.2} µm", g_b * 1e3, h * 1e3),
+            (Some(g_b), None) => format!("; G(b) {:.2} µm", g_b * 1e3),
             _ => String::new(),
         };
         let mut chart = XyChart::new(
@@ -100,7 +101,8 @@ pub fn charts(test: &CircularTest, doc: &Circular) -> Figures {
         for (k, ((d, r), t)) in directions.iter().zip(&traces).enumerate() {
             let mut points: Vec<(f64, f64)> =
                 t.iter().map(|&(deg, dev)| polar(deg, dev, ring)).collect();
-            if let Some(&first) = points.first() {
+            // Closed round the whole circle; a partial arc stays open.
+            if let (Some(&first), true) = (points.first(), doc.arc >= 360.0) {
                 points.push(first);
             }
             chart = chart.series(
@@ -118,23 +120,14 @@ pub fn charts(test: &CircularTest, doc: &Circular) -> Figures {
                 .width(2),
             );
         }
-        figures.push(format!("circular_{}", stem(&run.id)), chart);
+        // Distinct stems for identifiers that read alike as file names.
+        let mut name = format!("circular_{}", plot::file_stem(&run.id));
+        while figures.figures.iter().any(|f| f.stem == name) {
+            name.push('_');
+        }
+        figures.push(name, chart);
     }
     figures
-}
-
-/// A run identifier as a file stem: letters, digits, `-` and `_` kept,
-/// anything else `_`.
-fn stem(id: &str) -> String {
-    id.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
 }
 
 #[cfg(test)]
@@ -147,6 +140,5 @@ mod tests {
         assert_eq!(nice(12.0), 20.0);
         assert_eq!(nice(0.08), 0.1);
         assert_eq!(nice(50.0), 50.0);
-        assert_eq!(stem("xy f1000/2"), "xy_f1000_2");
     }
 }

@@ -48,6 +48,20 @@ use plotters::prelude::*;
 
 pub use plotters::style::RGBColor;
 
+/// A file-name-safe form of a name (a variable, a run): ASCII letters,
+/// digits, `_` and `-` kept, anything else `_`.
+pub fn file_stem(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
 /// Neutral grey for measured data.
 pub const GREY: RGBColor = RGBColor(90, 90, 90);
 

@@ -82,7 +82,7 @@ pub fn charts(doc: &MotionDocument) -> Figures {
         .series(Line::line("exact", exact).width(5))
         .series(Line::line(format!("Maclaurin, order {}", v.order), approx))
         .legend(Legend::UpperLeft);
-        files.push(format!("motion_{}", file_stem(name)), chart);
+        files.push(format!("motion_{}", super::file_stem(name)), chart);
     }
     let mut chart = XyChart::new(
         format!("{}: error of the order-{} series", v.title, v.order),
@@ -126,17 +126,4 @@ pub fn charts(doc: &MotionDocument) -> Figures {
     }
     files.push("truncation_error", chart);
     files
-}
-
-/// A file-name-safe form of a variable name.
-fn file_stem(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
 }

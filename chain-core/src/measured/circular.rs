@@ -24,8 +24,17 @@ use crate::model::Origin;
 /// Circular-test files larger than this are refused.
 pub const MAX_CIRCULAR_BYTES: usize = crate::bounded::MEASUREMENT_BYTES;
 
-/// The fewest samples a direction of a run needs.
+/// The fewest distinct angles a direction of a run needs.
 pub const MIN_SAMPLES: usize = 8;
+
+/// The shortest arc a run may cover (degrees): shorter, its circle is not
+/// determined (ISO 230-4 arcs are 90° or more).
+pub const MIN_ARC: f64 = 45.0;
+
+/// The largest radial deviation as a part of the radius: a ballbar's are
+/// micrometres on a radius of 50 mm or more; a tenth of the radius is a
+/// wrong unit (µm read as mm) or a wrong radius.
+pub const MAX_DEVIATION_PART: f64 = 0.1;
 
 /// The widest gap between neighbouring angles of a direction (degrees):
 /// wider, the trace does not show what happens there (a ballbar samples
@@ -467,13 +476,31 @@ fn group(
                 line: samples[0].line,
                 ..b.first.clone()
             };
-            if samples.len() < MIN_SAMPLES {
+            let mut angles: Vec<f64> = samples.iter().map(|s| s.angle.rem_euclid(360.0)).collect();
+            angles.sort_by(f64::total_cmp);
+            angles.dedup();
+            let large = (samples.iter()).find(|s| {
+                run.radius.is_finite() && s.deviation.abs() >= MAX_DEVIATION_PART * run.radius
+            });
+            if let Some(s) = large {
+                problems.push((
+                    Origin {
+                        line: s.line,
+                        ..b.first.clone()
+                    },
+                    CircularProblem::TooLarge {
+                        deviation: s.deviation,
+                        radius: run.radius,
+                    }
+                    .into(),
+                ));
+            } else if angles.len() < MIN_SAMPLES {
                 problems.push((
                     at,
                     CircularProblem::TooFewSamples {
                         run: run.id.clone(),
                         direction: d.name(),
-                        count: samples.len(),
+                        count: angles.len(),
                     }
                     .into(),
                 ));
@@ -508,6 +535,9 @@ fn group(
 /// it, the widest between neighbouring angles as written, or the arc's
 /// shortfall past the last. Allowed: [`MAX_GAP`].
 pub fn widest_gap(samples: &[Sample], arc: f64) -> Option<(f64, f64)> {
+    if samples.is_empty() {
+        return Some((0.0, arc));
+    }
     let allowed = MAX_GAP;
     let full = arc >= 360.0;
     let mut a: Vec<f64> = samples

@@ -55,12 +55,14 @@ impl Report for Circular {
             if let Some(d) = &r.directions.cw {
                 out.push_str(&row("cw", d));
             }
-            if let (Some(g_b), Some(h)) = (r.g_b, r.h) {
+            if let Some(g_b) = r.g_b {
+                let h = r.h.map_or(String::new(), |h| {
+                    format!(", circular hysteresis H {}", um(h))
+                });
                 let _ = writeln!(
                     out,
-                    "  bidirectional circular deviation G(b) {}, circular hysteresis H {}",
-                    um(g_b),
-                    um(h)
+                    "  bidirectional circular deviation G(b) {}{h}",
+                    um(g_b)
                 );
             }
         }

@@ -201,12 +201,34 @@ fn every_refusal_is_located() {
             "a `radius` column",
         ],
     );
+    // µm in a column read as mm: a deviation of a tenth of the radius.
+    check(
+        "large.csv",
+        &no_radius.replacen("\n20,ccw,0\n", "\n20,ccw,12\n", 1),
+        &["--radius", "100"],
+        &[
+            "large.csv:4:",
+            "a deviation of 12 mm on a radius of 100 mm",
+            "deviation(um)",
+        ],
+    );
+    // Enough rows, too few distinct angles.
+    let two_angles = "angle,direction,deviation\n".to_string()
+        + &(0..40)
+            .map(|k| format!("{},ccw,0\n", if k % 2 == 0 { 0 } else { 180 }))
+            .collect::<String>();
+    check(
+        "two_angles.csv",
+        &two_angles,
+        &["--radius", "100"],
+        &["run 1, ccw: 2 distinct angle(s); a circle needs at least 8"],
+    );
     // The options, named.
     check(
         "opt.csv",
         &no_radius,
         &["--radius", "100", "--arc", "400"],
-        &["--arc 400", "(0, 360]"],
+        &["--arc 400", "[45, 360]"],
     );
     check(
         "opt2.csv",

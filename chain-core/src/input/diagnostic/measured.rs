@@ -599,7 +599,14 @@ pub enum CircularProblem {
         /// The run.
         run: String,
     },
-    /// Too few samples in a direction of a run to fit a circle.
+    /// A deviation of a tenth of the radius or more.
+    TooLarge {
+        /// The deviation (mm).
+        deviation: f64,
+        /// The run's radius (mm).
+        radius: f64,
+    },
+    /// Too few distinct angles in a direction of a run to fit a circle.
     TooFewSamples {
         /// The run.
         run: String,
@@ -678,8 +685,19 @@ impl CircularProblem {
             } => D::new(
                 "chain::circular::too_few_samples",
                 "run",
-                format!("run {run}, {direction}: {count} sample(s); a circle needs at least 8 around its arc"),
+                format!(
+                    "run {run}, {direction}: {count} distinct angle(s); a circle needs at least {} around its arc",
+                    crate::measured::circular::MIN_SAMPLES
+                ),
             ),
+            CircularProblem::TooLarge { deviation, radius } => D::new(
+                "chain::circular::too_large",
+                "deviation",
+                format!(
+                    "a deviation of {deviation} mm on a radius of {radius} mm: a tenth of the radius or more is no ballbar reading"
+                ),
+            )
+            .help("a deviation column in µm is named `deviation(um)`; `deviation` is in mm".to_string()),
             CircularProblem::NotCovered {
                 run,
                 direction,
