@@ -967,6 +967,20 @@ impl Study {
         let (inputs, variables) = checked_inputs(model, parameters, inputs)?;
         let points = grid_points(&spec.grid, &variables)?;
         let targets = targets(&spec)?;
+        Study::kept(model, parameters, inputs, variables, spec, points, targets)
+    }
+
+    /// The study of checked points that keeps `model`'s sensitivities,
+    /// every point's checked here ([`check_moments`]).
+    fn kept<M: ErrorModel + ?Sized>(
+        model: &M,
+        parameters: &[f64],
+        inputs: Inputs,
+        variables: Vec<String>,
+        spec: StudySpec,
+        points: Points,
+        targets: Vec<Target>,
+    ) -> Result<Study, ReliabilityError> {
         let rows = evaluate(model, parameters, &points, 0..points.len())?;
         check_moments(&inputs, &variables, &points, 0..points.len(), &rows)?;
         Ok(Study::assemble(
@@ -1039,16 +1053,7 @@ impl Study {
     ) -> Result<Study, ReliabilityError> {
         let (inputs, variables) = checked_inputs(model, parameters, inputs)?;
         let (spec, points, targets) = listed_points(spec, points, &variables)?;
-        let rows = evaluate(model, parameters, &points, 0..points.len())?;
-        check_moments(&inputs, &variables, &points, 0..points.len(), &rows)?;
-        Ok(Study::assemble(
-            inputs,
-            variables,
-            spec,
-            points,
-            Rows::Stored(rows),
-            targets,
-        ))
+        Study::kept(model, parameters, inputs, variables, spec, points, targets)
     }
 
     /// [`Study::at_points`] keeping the model instead of the sensitivities,
