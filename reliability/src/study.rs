@@ -981,8 +981,13 @@ impl Study {
         points: Points,
         targets: Vec<Target>,
     ) -> Result<Study, ReliabilityError> {
-        let rows = evaluate(model, parameters, &points, 0..points.len())?;
-        check_moments(&inputs, &variables, &points, 0..points.len(), &rows)?;
+        let rows = evaluate(
+            model,
+            parameters,
+            (&inputs, &variables),
+            &points,
+            0..points.len(),
+        )?;
         Ok(Study::assemble(
             inputs,
             variables,
@@ -1230,17 +1235,8 @@ impl Study {
         match &self.rows {
             Rows::Stored(s) => Ok(Cow::Borrowed(&s[range.start * n6..range.end * n6])),
             Rows::OnDemand { model, parameters } => {
-                let mut s = vec![0.0; range.len() * n6];
-                let points = &self.points;
-                evaluate_into(
-                    &**model,
-                    parameters,
-                    points,
-                    range.clone(),
-                    &mut Vec::new(),
-                    &mut s,
-                )?;
-                check_moments(&self.inputs, &self.variables, points, range, &s)?;
+                let checked = (&self.inputs, &self.variables[..]);
+                let s = evaluate(&**model, parameters, checked, &self.points, range)?;
                 Ok(Cow::Owned(s))
             }
         }
@@ -2187,21 +2183,29 @@ fn targets(spec: &StudySpec) -> Result<Vec<Target>, ReliabilityError> {
     Ok(targets)
 }
 
-/// The `6 × N` sensitivity matrices of `points` (checked against the
-/// model's variables), flat, through the model's batch entry point (a
+/// The `6 × N` sensitivity matrices of the points `range` (checked against
+/// the model's variables), flat, through the model's batch entry point (a
 /// compiled model's tape over blocks of points, a `machine!` type's batched
-/// kernels; the values of `sensitivity` point by point, to rounding).
+/// kernels; the values of `sensitivity` point by point, to rounding), each
+/// point refused by [`check_moments`] when a value or a moment is not
+/// finite.
 fn evaluate<M: ErrorModel + ?Sized>(
     model: &M,
     parameters: &[f64],
+    (inputs, variables): (&Inputs, &[String]),
     points: &Points,
     range: Range<usize>,
 ) -> Result<Vec<f64>, ReliabilityError> {
     let mut flat = vec![0.0; range.len() * 6 * model.errors().len()];
-    evaluate_into(model, parameters, points, range, &mut Vec::new(), &mut flat)?;
-    if !scan(&flat).0 {
-        return Err(ReliabilityError::NonFinite("the model's sensitivities"));
-    }
+    evaluate_into(
+        model,
+        parameters,
+        points,
+        range.clone(),
+        &mut Vec::new(),
+        &mut flat,
+    )?;
+    check_moments(inputs, variables, points, range, &flat)?;
     Ok(flat)
 }
 

@@ -133,6 +133,14 @@ pub struct Run {
 }
 
 impl Run {
+    /// The sample points of direction `d`: per sample its angle (degrees)
+    /// and its measured radius `R + Δr` (mm).
+    pub fn points(&self, d: Direction) -> Vec<(f64, f64)> {
+        (self.samples(d).iter())
+            .map(|s| (s.angle, self.radius + s.deviation))
+            .collect()
+    }
+
     /// The samples of direction `d`.
     pub fn samples(&self, d: Direction) -> &[Sample] {
         match d {
@@ -633,9 +641,7 @@ fn radii_about(points: &[(f64, f64)], centre: [f64; 2]) -> Vec<f64> {
 /// and its radial deviation from the nominal radius about that centre (mm,
 /// what `F_max` and `F_min` bound), in file order.
 pub fn trace(run: &Run, d: Direction, centre: [f64; 2]) -> Vec<(f64, f64)> {
-    let points: Vec<(f64, f64)> = (run.samples(d).iter())
-        .map(|s| (s.angle, run.radius + s.deviation))
-        .collect();
+    let points = run.points(d);
     let radii = radii_about(&points, centre);
     (points.iter().zip(radii))
         .map(|(&(deg, _), r)| (deg, r - run.radius))
@@ -714,18 +720,13 @@ pub fn evaluate(test: &CircularTest) -> Vec<RunResult> {
 
 /// Evaluates one run (its directions covering `arc` degrees).
 pub fn evaluate_run(run: &Run, arc: f64) -> RunResult {
-    let points = |d: Direction| -> Vec<(f64, f64)> {
-        (run.samples(d).iter())
-            .map(|s| (s.angle, run.radius + s.deviation))
-            .collect()
-    };
-    let one = |d: Direction| {
-        let p = points(d);
+    let (ccw, cw) = (run.points(Direction::Ccw), run.points(Direction::Cw));
+    let one = |p: &[(f64, f64)]| {
         if p.is_empty() {
             return None;
         }
-        let (centre, rho) = least_squares_circle(&p);
-        let radii = radii_about(&p, centre);
+        let (centre, rho) = least_squares_circle(p);
+        let radii = radii_about(p, centre);
         let (lo, hi) = range(&radii);
         Some(DirectionResult {
             g: hi - lo,
@@ -737,12 +738,11 @@ pub fn evaluate_run(run: &Run, arc: f64) -> RunResult {
         })
     };
     let directions = Directions {
-        ccw: one(Direction::Ccw),
-        cw: one(Direction::Cw),
+        ccw: one(&ccw),
+        cw: one(&cw),
     };
     let (mut g_b, mut h, mut centre_both) = (None, None, None);
     if directions.ccw.is_some() && directions.cw.is_some() {
-        let (ccw, cw) = (points(Direction::Ccw), points(Direction::Cw));
         let both: Vec<(f64, f64)> = ccw.iter().chain(&cw).copied().collect();
         let (centre, _) = least_squares_circle(&both);
         let (lo, hi) = range(&radii_about(&both, centre));
