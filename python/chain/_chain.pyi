@@ -182,6 +182,8 @@ def circular_json(
     feed: Optional[float] = None,
     plane: Optional[str] = None,
     arc: Optional[float] = None,
+    pitch: Sequence[Tuple[str, float]] = (),
+    window: Optional[float] = None,
 ) -> str: ...
 
 

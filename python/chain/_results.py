@@ -14,6 +14,15 @@ import json
 from typing import Any, Dict, Iterator, List, Optional
 
 
+def _frame(rows: List[Dict[str, Any]]) -> Any:
+    """``rows`` as a pandas DataFrame (pandas must be installed)."""
+    try:
+        import pandas
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError("to_dataframe() needs pandas: pip install pandas") from e
+    return pandas.DataFrame(rows)
+
+
 class Result:
     """A result document of one ``chain`` command (``command`` names it)."""
 
@@ -57,11 +66,7 @@ class Result:
 
     def to_dataframe(self) -> Any:
         """The result's rows as a pandas DataFrame (pandas must be installed)."""
-        try:
-            import pandas
-        except ImportError as e:  # pragma: no cover - depends on the environment
-            raise ImportError("to_dataframe() needs pandas: pip install pandas") from e
-        return pandas.DataFrame(self._rows())
+        return _frame(self._rows())
 
 
 class Derivation(Result):
@@ -327,10 +332,32 @@ class CircularResult(Result):
     ``arc``, ``runs`` (per run: ``run``, ``plane``, ``radius``, ``feed``,
     ``directions`` with ``ccw`` and ``cw`` each ``G``, ``F_max``, ``F_min``,
     ``centre``, ``radius_offset``, ``samples``; ``G_b``, ``H``,
-    ``centre_both``). Rows of ``to_dataframe()``: one per run and direction.
+    ``centre_both``), ``diagnosis`` (per error ``error``, ``plane``,
+    ``axes``, ``run``, ``value``, ``unit``, ``uncertainty``, ``sign``,
+    ``share``, ``shares``), ``fit`` (per plane). Rows of ``to_dataframe()``:
+    one per run and direction; of ``diagnosis_frame()``: one per error.
     """
 
     command = "circular"
+
+    def diagnosis_frame(self) -> Any:
+        """The diagnosis as a pandas DataFrame: one row per error (its axes
+        joined by ``-``)."""
+        rows = []
+        for e in self._document["diagnosis"]:
+            rows.append(
+                {
+                    "error": e["error"],
+                    "plane": e["plane"],
+                    "axes": "-".join(e["axes"]),
+                    "run": e["run"],
+                    "value": e["value"],
+                    "unit": e["unit"],
+                    "uncertainty": e["uncertainty"],
+                    "share": e["share"],
+                }
+            )
+        return _frame(rows)
 
     def _rows(self) -> List[Dict[str, Any]]:
         rows = []

@@ -11,9 +11,10 @@ use pyo3::prelude::*;
 use crate::{load_error, source, to_json, value_error};
 
 /// `chain circular` of the file at `path`, or of `text` named `file`, with
-/// the CLI's `--radius`, `--feed`, `--plane` and `--arc`: its JSON.
+/// the CLI's `--radius`, `--feed`, `--plane`, `--arc`, `--pitch` (pairs of
+/// axis and mm) and `--window`: its JSON.
 #[pyfunction]
-#[pyo3(signature = (path, text, file, radius=None, feed=None, plane=None, arc=None))]
+#[pyo3(signature = (path, text, file, radius=None, feed=None, plane=None, arc=None, pitch=Vec::new(), window=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn circular_json(
     py: Python<'_>,
@@ -24,11 +25,15 @@ pub(crate) fn circular_json(
     feed: Option<f64>,
     plane: Option<&str>,
     arc: Option<f64>,
+    pitch: Vec<(String, f64)>,
+    window: Option<f64>,
 ) -> PyResult<String> {
     let options = ops::options(radius, feed, plane, arc).map_err(|e| value_error(e.with_help()))?;
+    let diagnosis =
+        ops::diagnosis_options(&pitch, window).map_err(|e| value_error(e.with_help()))?;
     let source = source(path, text, file)?;
     let test = py
         .allow_threads(|| read_circular(source, &options))
         .map_err(|e| load_error(py, e.diagnostics()))?;
-    to_json(&ops::run(&test))
+    to_json(&ops::run(&test, &diagnosis))
 }

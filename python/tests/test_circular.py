@@ -62,3 +62,27 @@ def test_refusals_are_the_cli_s(cli_error, tmp_path):
     assert "--arc 400: must be in [45, 360] degrees" in flat(cli_error("circular", path, "--radius", 100, "--arc", 400))
     with pytest.raises(ValueError):
         chain.circular(path, text="angle\n", radius=100)
+
+
+def test_the_diagnosis_is_the_cli_s(cli, cli_error, tmp_path):
+    """The ellipse 3 µm · sin 2θ in both directions is squareness 2·3 µm / 100 mm = 60 µrad
+    (docs/circular.md, "Squareness S"); --pitch and --window as the CLI's."""
+    path = _runs(tmp_path)
+    r = chain.circular(path, radius=100, feed=1000, pitch={"x": 10.0}, window=3)
+    want = cli("circular", path, "--radius", 100, "--feed", 1000, "--pitch", "x=10", "--window", 3)
+    assert r.to_dict() == want
+    square = [e for e in r.diagnosis if e["error"] == "squareness"]
+    assert len(square) == 1 and abs(square[0]["value"] - 60.0) < 0.05, square
+    assert square[0]["unit"] == "urad" and square[0]["axes"] == ["x", "y"]
+    assert r.fit[0]["window"] == 3
+    assert any(e["error"] == "cyclic_error" and e["axes"] == ["x"] for e in r.diagnosis)
+    frame = r.diagnosis_frame()
+    assert list(frame["error"]) == [e["error"] for e in want["diagnosis"]]
+    assert list(frame["value"]) == [e["value"] for e in want["diagnosis"]]
+    with pytest.raises(ValueError) as e:
+        chain.circular(path, radius=100, pitch={"w": 5})
+    assert "--pitch w=5: the axis must be x, y or z" in str(e.value)
+    assert "--pitch w=5: the axis must be x, y or z" in flat(cli_error("circular", path, "--radius", 100, "--pitch", "w=5"))
+    with pytest.raises(ValueError) as e:
+        chain.circular(path, radius=100, window=50)
+    assert "--window 50: must be more than 0 and less than 45 degrees" in str(e.value)

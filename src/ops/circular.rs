@@ -4,6 +4,7 @@
 
 use serde::Serialize;
 
+use chain_core::measured::circular::diagnosis::{self, Diagnosed, DiagnosisOptions, PlaneFit};
 use chain_core::measured::circular::{self, CircularTest, Plane, RunOptions, RunResult};
 
 use super::worded::{diagnostic, Worded};
@@ -22,6 +23,13 @@ pub struct Circular {
     pub arc: f64,
     /// Each run evaluated, in the file's order.
     pub runs: Vec<RunResult>,
+    /// Every error diagnosed (`docs/circular.md`, "The fit"), plane by
+    /// plane: its value, unit, uncertainty, sign convention and share of G.
+    pub diagnosis: Vec<Diagnosed>,
+    /// Each plane's fit: the samples, what was not fitted and why, what the
+    /// runs separate only weakly, each run's centres, radius offset and
+    /// residual.
+    pub fit: Vec<PlaneFit>,
 }
 
 /// Why the options of `chain circular` are refused.
@@ -40,6 +48,16 @@ pub enum CircularOpsError {
     /// A `--plane` other than `xy`, `yz`, `zx`.
     #[error("--plane {0}: expected xy, yz or zx")]
     Plane(String),
+    /// A `--pitch` naming no axis, or one twice, or not a positive length.
+    #[error("--pitch {axis}={pitch}: {rule}")]
+    Pitch {
+        /// The axis as given.
+        axis: String,
+        /// The pitch as given.
+        pitch: f64,
+        /// What it must be.
+        rule: &'static str,
+    },
 }
 
 impl Worded for CircularOpsError {
@@ -48,7 +66,7 @@ impl Worded for CircularOpsError {
     }
 
     fn own_help(&self) -> Option<String> {
-        Some("--radius R (mm) and --feed F (mm/min) apply to runs whose file gives none; --arc DEG (at most 360) the arc every direction covers".to_string())
+        Some("--radius R (mm) and --feed F (mm/min) apply to runs whose file gives none; --arc DEG (at most 360) the arc every direction covers; --pitch AXIS=MM the pitch of an axis's cyclic error (x, y or z, once each); --window DEG the spike window after each reversal (more than 0, less than 45)".to_string())
     }
 }
 
@@ -92,13 +110,58 @@ pub fn options(
     })
 }
 
-/// Runs `chain circular` on a read run file.
-pub fn run(test: &CircularTest) -> Circular {
+/// The options of the diagnosis, checked: per machine axis (`x`, `y`,
+/// `z`, once each) the pitch (mm) of its cyclic error, and the spike window
+/// (degrees, default [`diagnosis::SPIKE_WINDOW`]).
+pub fn diagnosis_options(
+    pitch: &[(String, f64)],
+    window: Option<f64>,
+) -> Result<DiagnosisOptions, CircularOpsError> {
+    let mut options = DiagnosisOptions::default();
+    for (axis, p) in pitch {
+        let refuse = |rule| CircularOpsError::Pitch {
+            axis: axis.clone(),
+            pitch: *p,
+            rule,
+        };
+        let i = match axis.to_ascii_lowercase().as_str() {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            _ => return Err(refuse("the axis must be x, y or z")),
+        };
+        if !(p.is_finite() && *p > 0.0) {
+            return Err(refuse("the pitch must be a positive length (mm)"));
+        }
+        if options.pitch[i].replace(*p).is_some() {
+            return Err(refuse("the axis is given twice"));
+        }
+    }
+    if let Some(w) = window {
+        if !(w.is_finite() && w > 0.0 && w < 45.0) {
+            return Err(CircularOpsError::Option {
+                option: "window",
+                value: w,
+                rule: "must be more than 0 and less than 45 degrees",
+            });
+        }
+        options.window = w;
+    }
+    Ok(options)
+}
+
+/// Runs `chain circular` on a read run file: the evaluation and the
+/// diagnosis.
+pub fn run(test: &CircularTest, options: &DiagnosisOptions) -> Circular {
+    let runs = circular::evaluate(test);
+    let diagnosis = diagnosis::diagnose(test, &runs, options);
     Circular {
         file: test.file.clone(),
         unit: "mm",
         centre: "least_squares",
         arc: test.arc,
-        runs: circular::evaluate(test),
+        runs,
+        diagnosis: diagnosis.entries,
+        fit: diagnosis.planes,
     }
 }

@@ -1,6 +1,7 @@
 //! The polar plots of `chain circular --plot`: per run, both directions'
 //! traces about their least-squares centres, the deviation from the
-//! nominal radius magnified on a ring, as ballbar software draws them.
+//! nominal radius magnified on a ring, as ballbar software draws them, and
+//! the diagnosis (the errors explaining most of the run's G) in the legend.
 
 use chain_core::measured::circular::{trace, CircularTest, Direction, DirectionResult};
 
@@ -9,6 +10,12 @@ use crate::plot::{self, Figures, Legend, RGBColor, Series, XyChart};
 
 /// Image size (pixels): square, so the circle is round.
 const SIZE: (u32, u32) = (820, 820);
+
+/// The diagnosed errors a plot's legend names at most, by share of G.
+const LEGEND_ERRORS: usize = 8;
+
+/// The least share of G an error named in the legend explains.
+const LEGEND_SHARE: f64 = 0.02;
 
 /// The scale of the rings: the least of 1, 2, 5 × 10ⁿ µm at or above
 /// `span` (the largest |deviation|).
@@ -118,6 +125,36 @@ pub fn charts(test: &CircularTest, doc: &Circular) -> Figures {
                 )
                 .color(plot::color(k))
                 .width(2),
+            );
+        }
+        // The diagnosis in the legend: the errors of the run's plane and
+        // of the run, by the share of this run's G they explain.
+        let mut named: Vec<(f64, String)> = (doc.diagnosis.iter())
+            .filter(|e| e.term.plane == run.plane)
+            .filter(|e| e.term.run.as_ref().is_none_or(|r| *r == run.id))
+            .filter(|e| e.within_noise != Some(true))
+            .filter_map(|e| {
+                let share = e.shares.iter().find(|s| s.run == run.id)?.share;
+                (share >= LEGEND_SHARE).then(|| {
+                    let error = e.term.label().replace(&format!(" (run {})", run.id), "");
+                    (
+                        share,
+                        format!(
+                            "{error} {:.3} {} ({:.0}% of G)",
+                            e.value,
+                            e.unit.replace("urad", "µrad").replace("um", "µm"),
+                            100.0 * share
+                        ),
+                    )
+                })
+            })
+            .collect();
+        named.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for (_, label) in named.into_iter().take(LEGEND_ERRORS) {
+            chart = chart.series(
+                Series::line(label, Vec::new())
+                    .color(RGBColor(255, 255, 255))
+                    .width(1),
             );
         }
         // Distinct stems for identifiers that read alike as file names.

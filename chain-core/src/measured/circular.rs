@@ -15,6 +15,8 @@
 
 use serde::Serialize;
 
+pub mod diagnosis;
+
 use crate::diagnostic::Diagnostics;
 #[cfg(feature = "csv")]
 use crate::diagnostic::{CircularProblem, Problem};

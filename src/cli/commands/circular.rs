@@ -41,6 +41,15 @@ pub struct CircularArgs {
     /// circle, 360).
     #[arg(long, value_name = "DEG")]
     pub arc: Option<f64>,
+    /// The pitch (mm) of an axis's cyclic error, as AXIS=MM (e.g. x=10, a
+    /// ballscrew's lead): that axis's cyclic error is diagnosed. Repeat
+    /// for each axis.
+    #[arg(long, value_name = "AXIS=MM", value_parser = pitch)]
+    pub pitch: Vec<(String, f64)>,
+    /// The window after each reversal, in degrees, that the diagnosis's
+    /// fit leaves out and reads the reversal spike from (default 4).
+    #[arg(long, value_name = "DEG")]
+    pub window: Option<f64>,
     /// Output format.
     #[arg(long, value_enum, default_value = "table")]
     pub format: CircularFormat,
@@ -51,11 +60,23 @@ pub struct CircularArgs {
     pub plot: Option<PathBuf>,
 }
 
+/// `AXIS=MM` of `--pitch`, split (what the pair must be is the library's
+/// rule: [`ops::diagnosis_options`]).
+fn pitch(text: &str) -> Result<(String, f64), String> {
+    let (axis, mm) = text
+        .split_once('=')
+        .ok_or_else(|| format!("{text}: expected AXIS=MM, e.g. x=10"))?;
+    let mm = (mm.trim().parse::<f64>())
+        .map_err(|_| format!("{text}: the pitch {mm:?} is not a number (mm)"))?;
+    Ok((axis.trim().to_string(), mm))
+}
+
 /// Runs `chain circular` ([`chain::ops::circular`]).
 pub fn exec(args: CircularArgs) -> miette::Result<()> {
     let options = ops::options(args.radius, args.feed, args.plane.as_deref(), args.arc)?;
+    let diagnosis = ops::diagnosis_options(&args.pitch, args.window)?;
     let test = source::read_circular(Source::Path(&args.runs), &options)?;
-    let done = ops::run(&test);
+    let done = ops::run(&test, &diagnosis);
     if let Some(dir) = &args.plot {
         for f in plot::write(dir, &chain::plot::circular::charts(&test, &done))? {
             eprintln!("wrote {}", f.display());

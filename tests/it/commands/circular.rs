@@ -242,6 +242,36 @@ fn every_refusal_is_located() {
         &["--radius=-1"],
         &["--radius -1", "positive"],
     );
+    check(
+        "opt4.csv",
+        &no_radius,
+        &["--radius", "100", "--pitch", "w=5"],
+        &["--pitch w=5", "x, y or z"],
+    );
+    check(
+        "opt5.csv",
+        &no_radius,
+        &["--radius", "100", "--pitch", "x=5", "--pitch", "X=6"],
+        &["--pitch X=6", "given twice"],
+    );
+    check(
+        "opt6.csv",
+        &no_radius,
+        &["--radius", "100", "--pitch", "x=0"],
+        &["--pitch x=0", "positive length"],
+    );
+    check(
+        "opt7.csv",
+        &no_radius,
+        &["--radius", "100", "--pitch", "x10"],
+        &["--pitch", "expected AXIS=MM"],
+    );
+    check(
+        "opt8.csv",
+        &no_radius,
+        &["--radius", "100", "--window", "45"],
+        &["--window 45", "less than 45"],
+    );
 }
 
 /// The example runs (examples/circular/generate.py: a time-domain
@@ -305,6 +335,91 @@ fn the_example_runs_read_their_stated_set_up() {
     }
 }
 
+/// The diagnosis of the example reads the generator's stated machine
+/// (`examples/circular/runs.csv`'s `# derived` lines, from
+/// `examples/circular/generate.py`): per plane squareness, scale mismatch,
+/// each axis's backlash, servo mismatch and the gain term, each within
+/// three of its standard errors plus an allowance for what the first-order
+/// model leaves (docs/circular.md, "Checked against simulation": the
+/// backlash step's delay and ramp 1 %, the servo's higher orders 1 %), and
+/// each run's radius offset within 0.1 µm.
+#[test]
+fn the_example_diagnosis_reads_the_generator_s_machine() {
+    let file = common::example_file("circular/runs.csv");
+    let text = std::fs::read_to_string(&file).unwrap();
+    let doc = ok_json(&["circular", file.to_str().unwrap(), "--format", "json"]);
+    let diagnosis = doc["diagnosis"].as_array().unwrap();
+    for plane in ["xy", "yz", "zx"] {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(&format!("# derived {plane}:")))
+            .unwrap();
+        let stated = |key: &str| -> f64 {
+            let part = (line.split(", "))
+                .find(|p| {
+                    p.trim_start_matches(&format!("# derived {plane}: "))
+                        .starts_with(&format!("{key}="))
+                })
+                .unwrap_or_else(|| panic!("{key} in {line}"));
+            let value = part.rsplit('=').next().unwrap();
+            value.split_whitespace().next().unwrap().parse().unwrap()
+        };
+        let axes = match plane {
+            "xy" => ["x", "y"],
+            "yz" => ["y", "z"],
+            _ => ["z", "x"],
+        };
+        let got = |error: &str, axes: &[&str]| -> (f64, f64, &'static str) {
+            let e = (diagnosis.iter())
+                .find(|e| {
+                    e["plane"] == plane
+                        && e["error"] == error
+                        && e["axes"] == serde_json::json!(axes)
+                })
+                .unwrap_or_else(|| panic!("{plane} {error} {axes:?}"));
+            let unit = match e["unit"].as_str().unwrap() {
+                "urad" => "urad",
+                "ppm" => "ppm",
+                "um" => "um",
+                "ms" => "ms",
+                _ => "ms^2",
+            };
+            assert!(num(&e["share"]) >= 0.0);
+            (num(&e["value"]), num(&e["uncertainty"]), unit)
+        };
+        for (error, key, axes, allowance) in [
+            ("squareness", "S", &axes[..], 0.1),
+            ("scale_mismatch", "de", &axes[..], 0.1),
+            ("backlash", "B_a", &axes[..1], 0.02),
+            ("backlash", "B_b", &axes[1..], 0.02),
+            ("servo_mismatch", "dt", &axes[..], 0.01),
+            ("gain_mismatch", "q", &axes[..], 0.02),
+        ] {
+            let (value, se, unit) = got(error, axes);
+            let truth = stated(key);
+            // Relative allowances for backlash, servo and gain; absolute
+            // (µrad, ppm) for the geometry.
+            let allowance = if matches!(unit, "urad" | "ppm") {
+                allowance
+            } else {
+                allowance * truth.abs()
+            };
+            assert!(
+                (value - truth).abs() <= 3.0 * se + allowance,
+                "{plane} {error} {axes:?}: {value} ± {se} {unit}, stated {truth}"
+            );
+        }
+    }
+    // Two feeds and both directions: everything separated, only the
+    // cyclic errors (no pitch given) not fitted.
+    for fit in doc["fit"].as_array().unwrap() {
+        for n in fit["not_fitted"].as_array().unwrap() {
+            assert_eq!(n["reason"], "no_pitch", "{n}");
+        }
+        assert_eq!(fit["correlated"], serde_json::json!([]), "{fit}");
+    }
+}
+
 /// `--plot DIR`: one polar plot per run, PNG and SVG, both directions with
 /// their G and F in the legend, G(b) and H in the title, the rings' scale.
 #[test]
@@ -335,6 +450,27 @@ fn the_polar_plots_are_one_per_run() {
         ] {
             assert!(svg.contains(&label), "{id}: `{label}`");
         }
+        // The diagnosis in the legend: the run's plane's servo mismatch
+        // (most of G in these runs) with its value and share of this run's G.
+        let servo = (doc["diagnosis"].as_array().unwrap().iter())
+            .find(|e| e["error"] == "servo_mismatch" && e["plane"] == run["plane"])
+            .unwrap();
+        let share = (servo["shares"].as_array().unwrap().iter())
+            .find(|s| s["run"] == id)
+            .unwrap();
+        let label = format!(
+            "servo mismatch {} {:.3} ms ({:.0}% of G)",
+            servo["axes"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|a| a.as_str().unwrap())
+                .collect::<Vec<_>>()
+                .join("-"),
+            num(&servo["value"]),
+            100.0 * num(&share["share"])
+        );
+        assert!(svg.contains(&label), "{id}: `{label}`");
         let png = std::fs::read(dir.join(format!("circular_{id}.png"))).unwrap();
         assert!(
             png.starts_with(b"\x89PNG") && png.len() > 20_000,
