@@ -135,6 +135,13 @@ def identify_json(
     holdout: Optional[float] = None,
     seed: Optional[int] = None,
     temperatures: Sequence[Tuple[str, float]] = (),
+    circular: Optional[Tuple[Optional[str], Optional[str], str]] = None,
+    centre: Optional[Sequence[Tuple[str, float]]] = None,
+    axes: bool = False,
+    radius: Optional[float] = None,
+    feed: Optional[float] = None,
+    plane: Optional[str] = None,
+    arc: Optional[float] = None,
 ) -> Tuple[str, str]: ...
 def plan_json(
     model: Model,

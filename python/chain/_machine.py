@@ -572,6 +572,13 @@ class Machine:
         spheres: Optional[Union[str, "os.PathLike[str]", Mapping[str, Any]]] = None,
         setup: Optional[str] = None,
         temperature: Optional[Mapping[str, float]] = None,
+        circular: Optional[Union[str, "os.PathLike[str]", Mapping[str, Any]]] = None,
+        centre: Optional[Mapping[str, float]] = None,
+        axes: bool = False,
+        radius: Optional[float] = None,
+        feed: Optional[float] = None,
+        plane: Optional[str] = None,
+        arc: Optional[float] = None,
     ) -> "IdentifyResult":
         """The error parameters from measurements, ``chain identify --measurements M --format json``.
 
@@ -607,6 +614,15 @@ class Machine:
         identified with the geometric ones; ``temperature``
         (``--temperature``, ``{sensor: °C}``) is the state of the records
         whose file has no column for a sensor (docs/thermal.md).
+        ``circular`` (``--circular``), instead of ``measurements``: a
+        circular-test file (a ballbar's runs, as ``chain.circular`` reads
+        them: path, text or columns): each sample a measurement along the
+        nominal ball-to-ball direction, each run's table-ball offset and bar
+        length estimated beside the errors (``setups``); placed by
+        ``centre`` (``--centre``, ``{variable: value}``, rotary in degrees:
+        the circle's centre) or ``axes=True`` (``--axes``: each sample's pose
+        in the file's columns named after the machine's variables);
+        ``radius``, ``feed``, ``plane``, ``arc`` as ``chain.circular``'s.
         """
         from ._results import IdentifyResult
 
@@ -619,7 +635,14 @@ class Machine:
         text_columns = ("sphere",) if spheres is not None else ()
         records = None if measurements is None else file_input(measurements, "measurements", name)
         probings = None if spheres is None else file_input(spheres, "spheres", name if name != "<measurements>" else "<spheres>", ("sphere",))
+        runs = None if circular is None else file_input(circular, "circular", name if name != "<measurements>" else "<runs>", ("direction", "run", "plane"))
+        if circular is not None:
+            text_columns = ("direction", "run", "plane")
         held_out = None if validate is None else file_input(validate, "validate", validate_name, text_columns)
+        if centre is not None and not isinstance(centre, Mapping):
+            raise ValueError(f"centre must be a mapping {{variable: value}}, not {type(centre).__name__}")
+        if plane is not None and not isinstance(plane, str):
+            raise ValueError(f"plane must be 'xy', 'yz' or 'zx', not {plane!r}")
         doc, values_text = _chain.identify_json(
             self._model,
             records,
@@ -635,6 +658,13 @@ class Machine:
             None if holdout is None else float(holdout),
             None if seed is None else int(seed),
             _temperatures(temperature),
+            runs,
+            None if centre is None else [(str(k), _optional_float(v, f"centre[{k!r}]")) for k, v in centre.items()],
+            bool(axes),
+            _optional_float(radius, "radius"),
+            _optional_float(feed, "feed"),
+            plane,
+            _optional_float(arc, "arc"),
         )
         if values_out is not None:
             with open(os.fspath(values_out), "w", encoding="utf-8") as f:

@@ -9,7 +9,7 @@
 //! (`MachineError` with file, line, column, key) where the library locates
 //! it, a `ValueError` otherwise.
 
-use chain::ops::identify::{IdentifyOpsError, IdentifyRequest};
+use chain::ops::identify::{CircleRequest, IdentifyOpsError, IdentifyRequest};
 use chain::ops::plan::{self, PlanRequest};
 use chain::ops::Worded;
 use chain_core::measured::{Layout, Measurements, MeasurementsError, SetupKind};
@@ -61,12 +61,14 @@ pub(crate) fn read_values(
 }
 
 /// `chain identify --format json` (and the values file `--values-out`
-/// writes): the measurement CSV `measurements` or the sphere-probing CSV
-/// `spheres` (each a path, or text and its name), `setup` (`--setup`,
+/// writes): the measurement CSV `measurements`, the sphere-probing CSV
+/// `spheres` or the circular-test file `circular` (each a path, or text
+/// and its name; the latter placed by `centre` or `axes` and read with
+/// `radius`, `feed`, `plane`, `arc`), `setup` (`--setup`,
 /// `"ball"`); the held-out records of `--validate`, if any, from
 /// `validate`, read as the fitted ones are.
 #[pyfunction]
-#[pyo3(signature = (model, measurements, spheres, setup, params, prior, validate=None, rank_tol=None, fix=None, estimate=None, iterate=false, holdout=None, seed=None, temperatures=Vec::new()))]
+#[pyo3(signature = (model, measurements, spheres, setup, params, prior, validate=None, rank_tol=None, fix=None, estimate=None, iterate=false, holdout=None, seed=None, temperatures=Vec::new(), circular=None, centre=None, axes=false, radius=None, feed=None, plane=None, arc=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_json(
     py: Python<'_>,
@@ -84,6 +86,13 @@ pub(crate) fn identify_json(
     holdout: Option<f64>,
     seed: Option<u64>,
     temperatures: Vec<(String, f64)>,
+    circular: Option<FileInput>,
+    centre: Option<Vec<(String, f64)>>,
+    axes: bool,
+    radius: Option<f64>,
+    feed: Option<f64>,
+    plane: Option<&str>,
+    arc: Option<f64>,
 ) -> PyResult<(String, String)> {
     let request = IdentifyRequest {
         measurements: measurements.as_ref().map(FileInput::source).transpose()?,
@@ -99,6 +108,15 @@ pub(crate) fn identify_json(
         seed,
         iterate,
         temperatures: &temperatures,
+        circular: circular.as_ref().map(FileInput::source).transpose()?,
+        circle: CircleRequest {
+            centre: centre.as_deref(),
+            axes,
+            radius,
+            feed,
+            plane,
+            arc,
+        },
     };
     let checked = request.check().map_err(|e| value_error(e.with_help()))?;
     let m = &model.machine;

@@ -2,6 +2,7 @@
 its columns), and refuses what the CLI refuses with its words."""
 
 import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -86,3 +87,26 @@ def test_the_diagnosis_is_the_cli_s(cli, cli_error, tmp_path):
     with pytest.raises(ValueError) as e:
         chain.circular(path, radius=100, window=50)
     assert "--window 50: must be more than 0 and less than 45 degrees" in str(e.value)
+
+
+def test_identify_circular_is_the_cli_s(cli, cli_error):
+    """Machine.identify(circular=...) gives `chain identify --circular` (each sample along the
+    ball-to-ball direction, each run's table ball and bar length estimated), and refuses what the
+    CLI refuses with its words."""
+    root = pathlib.Path(__file__).resolve().parents[2]
+    machine = root / "examples" / "machines" / "vmc3.yaml"
+    runs = root / "examples" / "circular" / "runs.csv"
+    m = chain.Machine.load(machine)
+    want = cli("identify", machine, "--circular", runs, "--centre", "x=400,y=250,z=250")
+    got = m.identify(circular=runs, centre={"x": 400, "y": 250, "z": 250}).to_dict()
+    assert got == want
+    assert [s["kind"] for s in want["setups"]] == ["circle"] * 6
+    assert want["setups"][0]["unknowns"] == ["circle xy_f1000.x", "circle xy_f1000.y", "circle xy_f1000.length"]
+    with pytest.raises(ValueError) as e:
+        m.identify(circular=runs)
+    words = "--circular: give the circle's centre (--centre NAME=VALUE,...) or each sample's pose"
+    assert flat(str(e.value)).startswith(words)
+    assert words in flat(cli_error("identify", machine, "--circular", runs))
+    with pytest.raises(ValueError) as e:
+        m.identify(circular=runs, centre={"w": 1})
+    assert "--centre: the circle's centre names `w`" in str(e.value)

@@ -25,6 +25,25 @@ impl ParamArgs {
     }
 }
 
+/// How a circular-test file's runs are read where the file gives no column
+/// (`chain circular`, `chain identify --circular`).
+#[derive(Debug, clap::Args)]
+pub struct RunFileArgs {
+    /// The nominal radius (mm) of runs whose file gives none.
+    #[arg(long, value_name = "R")]
+    pub radius: Option<f64>,
+    /// The feed (mm/min) of runs whose file gives none.
+    #[arg(long, value_name = "F")]
+    pub feed: Option<f64>,
+    /// The plane of runs whose file gives none: xy (default), yz or zx.
+    #[arg(long, value_name = "PLANE")]
+    pub plane: Option<String>,
+    /// The arc every direction covers, in degrees (default the whole
+    /// circle, 360).
+    #[arg(long, value_name = "DEG")]
+    pub arc: Option<f64>,
+}
+
 /// `--temperature NAME=VALUE,...`: the thermal state at which a machine with
 /// `sensors` is evaluated (docs/thermal.md).
 #[derive(Debug, clap::Args)]

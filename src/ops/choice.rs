@@ -245,6 +245,7 @@ impl Choice for SetupKind {
                 "An R-test: the ball's three set-up offsets on the table are unknowns of the fit (reported, not written into values)"
             }
             SetupKind::Sphere => "A sphere probed on the table (a sphere file)",
+            SetupKind::Circle => "A circular test's run (a circular-test file)",
         }
     }
 }

@@ -15,6 +15,10 @@
 
 pub mod document;
 
+#[cfg(feature = "records")]
+use chain_core::measured::circular::records::{centre_pose, CirclePose};
+#[cfg(feature = "records")]
+use chain_core::measured::circular::RunOptions;
 use chain_core::measured::SetupKind;
 use chain_core::measured::{
     DesignError, HoldoutError, Identification, IdentifyError, IdentifyOptions, MeasurementsError,
@@ -74,6 +78,46 @@ pub struct IdentifyRequest<'a> {
     /// `--temperature NAME=VALUE`: the thermal state of the records whose
     /// file has no column for a sensor (docs/thermal.md).
     pub temperatures: &'a [(String, f64)],
+    /// `--circular`: a circular-test file (spec `circular.md`, "Into
+    /// identification"): each sample a record along the nominal
+    /// ball-to-ball direction, each run's table-ball offset and bar length
+    /// estimated beside the errors (this, `measurements` or `spheres`).
+    pub circular: Option<Source<'a>>,
+    /// Where the circular test's samples are and how its runs are read.
+    pub circle: CircleRequest<'a>,
+}
+
+/// The options of a circular test read for identification.
+#[cfg(feature = "records")]
+#[derive(Debug, Clone, Copy, Default)]
+pub struct CircleRequest<'a> {
+    /// `--centre NAME=VALUE,...`: the circle's centre as the machine's
+    /// variables (rotary ones in degrees, every other at 0).
+    pub centre: Option<&'a [(String, f64)]>,
+    /// `--axes`: each sample's pose in the run file's columns named after
+    /// the machine's variables.
+    pub axes: bool,
+    /// `--radius` (mm) of runs whose file gives none.
+    pub radius: Option<f64>,
+    /// `--feed` (mm/min) of runs whose file gives none.
+    pub feed: Option<f64>,
+    /// `--plane` of runs whose file gives none.
+    pub plane: Option<&'a str>,
+    /// `--arc` (degrees) every direction covers.
+    pub arc: Option<f64>,
+}
+
+#[cfg(feature = "records")]
+impl CircleRequest<'_> {
+    /// Whether any of its options is given.
+    fn given(&self) -> bool {
+        self.centre.is_some()
+            || self.axes
+            || self.radius.is_some()
+            || self.feed.is_some()
+            || self.plane.is_some()
+            || self.arc.is_some()
+    }
 }
 
 /// An [`IdentifyRequest`] whose options are checked: what
@@ -99,6 +143,9 @@ enum Records<'a> {
     Measurements(Source<'a>, Option<SetupKind>),
     /// A sphere-probing CSV.
     Spheres(Source<'a>),
+    /// A circular-test file, its runs read with the options, its samples
+    /// placed by the centre (`Some`) or the file's pose columns.
+    Circular(Source<'a>, RunOptions, Option<&'a [(String, f64)]>),
 }
 
 /// The document of `chain identify` (JSON: [`IdentifyDocument`]) with the
@@ -122,15 +169,34 @@ impl Serialize for IdentifyRun {
 /// Why `chain identify` cannot run, in the options' words.
 #[derive(Debug, thiserror::Error)]
 pub enum IdentifyOpsError {
-    /// Neither `--measurements` nor `--spheres`, or both.
-    #[error("--measurements: give the measurement CSV (--measurements M.csv) or a sphere-probing CSV (--spheres S.csv), {}", if *.both { "not both" } else { "one of them" })]
+    /// None of `--measurements`, `--spheres`, `--circular`, or more than
+    /// one.
+    #[error("--measurements: give the measurement CSV (--measurements M.csv) or a sphere-probing CSV (--spheres S.csv) or a circular test (--circular RUNS.csv), {}", if *.both { "one of them, not both" } else { "one of them" })]
     Records {
-        /// Both were given.
+        /// More than one was given.
         both: bool,
     },
     /// `--setup` with `--spheres`.
     #[error("--setup: the spheres of --spheres are already set-ups whose positions are estimated; --setup ball is for the records of --measurements")]
     SetupWithSpheres,
+    /// `--setup` with `--circular`.
+    #[error("--setup: the runs of --circular are already set-ups (each run's table-ball offset and bar length are estimated); --setup ball is for the records of --measurements")]
+    SetupWithCircular,
+    /// `--circular` without `--centre` or `--axes`, or with both.
+    #[error("--circular: give the circle's centre (--centre NAME=VALUE,...) or each sample's pose in the run file's columns (--axes), {}", if *.both { "not both" } else { "one of them" })]
+    CircleAt {
+        /// Both were given.
+        both: bool,
+    },
+    /// A circular test's option without `--circular`.
+    #[error("--centre, --axes, --radius, --feed, --plane and --arc read a circular test: give --circular RUNS.csv")]
+    CircleWithout,
+    /// A circular test's run option refused.
+    #[error(transparent)]
+    Circular(#[from] super::circular::CircularOpsError),
+    /// `--centre` naming no variable, one twice, or a non-finite value.
+    #[error("--centre: {0}")]
+    Centre(#[from] chain_core::measured::circular::records::CentreError),
     /// A held-out record on a set-up the fit does not have.
     #[error("{file}: line {line}: {kind} `{name}` is not among the fitted file's, so its position is not known; hold out probings of the fitted spheres")]
     UnknownSetup {
@@ -229,9 +295,13 @@ impl Worded for IdentifyOpsError {
     fn own_code(&self) -> Option<&'static str> {
         match self {
             IdentifyOpsError::FixWithEstimate => Some("chain::identify::subset"),
-            IdentifyOpsError::Records { .. } | IdentifyOpsError::SetupWithSpheres => {
-                Some("chain::identify::records")
-            }
+            IdentifyOpsError::Records { .. }
+            | IdentifyOpsError::SetupWithSpheres
+            | IdentifyOpsError::SetupWithCircular => Some("chain::identify::records"),
+            IdentifyOpsError::CircleAt { .. }
+            | IdentifyOpsError::CircleWithout
+            | IdentifyOpsError::Centre(_) => Some("chain::identify::circular"),
+            IdentifyOpsError::Circular(e) => e.own_code(),
             IdentifyOpsError::UnknownSetup { .. } => Some("chain::identify::setup"),
             IdentifyOpsError::SeedWithoutHoldout | IdentifyOpsError::HoldoutWithValidate => {
                 Some("chain::identify::holdout")
@@ -243,9 +313,17 @@ impl Worded for IdentifyOpsError {
     fn own_help(&self) -> Option<String> {
         let help = match self {
             IdentifyOpsError::FixWithEstimate => SUBSET_HELP,
-            IdentifyOpsError::Records { .. } | IdentifyOpsError::SetupWithSpheres => {
-                "measurements along the tool point or a direction go in --measurements (with --setup ball for an R-test); sphere probings (rotary axes in degrees) in --spheres"
+            IdentifyOpsError::Records { .. }
+            | IdentifyOpsError::SetupWithSpheres
+            | IdentifyOpsError::SetupWithCircular => {
+                "measurements along the tool point or a direction go in --measurements (with --setup ball for an R-test); sphere probings (rotary axes in degrees) in --spheres; a ballbar's circular test in --circular"
             }
+            IdentifyOpsError::CircleAt { .. }
+            | IdentifyOpsError::CircleWithout
+            | IdentifyOpsError::Centre(_) => {
+                "--circular RUNS.csv --centre x=400,y=250,z=200 places each run's circle about that pose, moving the variables named after the plane's axes; --axes reads each sample's pose from the run file's columns named after the machine's variables (rotary ones in degrees)"
+            }
+            IdentifyOpsError::Circular(e) => return e.own_help(),
             IdentifyOpsError::UnknownSetup { .. } => {
                 "--validate takes probings of the spheres of the fitted file at other positions"
             }
@@ -339,11 +417,36 @@ impl<'a> IdentifyRequest<'a> {
         if holdout.is_some() && self.validate.is_some() {
             return Err(IdentifyOpsError::HoldoutWithValidate);
         }
-        let records = match (self.measurements, self.spheres) {
-            (Some(m), None) => Records::Measurements(m, self.setup),
-            (None, Some(s)) if self.setup.is_none() => Records::Spheres(s),
-            (None, Some(_)) => return Err(IdentifyOpsError::SetupWithSpheres),
-            (m, _) => return Err(IdentifyOpsError::Records { both: m.is_some() }),
+        if self.circular.is_none() && self.circle.given() {
+            return Err(IdentifyOpsError::CircleWithout);
+        }
+        let records = match (self.measurements, self.spheres, self.circular) {
+            (Some(m), None, None) => Records::Measurements(m, self.setup),
+            (None, Some(s), None) if self.setup.is_none() => Records::Spheres(s),
+            (None, Some(_), None) => return Err(IdentifyOpsError::SetupWithSpheres),
+            (None, None, Some(_)) if self.setup.is_some() => {
+                return Err(IdentifyOpsError::SetupWithCircular)
+            }
+            (None, None, Some(c)) => {
+                let circle = &self.circle;
+                let options =
+                    super::circular::options(circle.radius, circle.feed, circle.plane, circle.arc)?;
+                match (circle.centre, circle.axes) {
+                    (Some(centre), false) => Records::Circular(c, options, Some(centre)),
+                    (None, true) => Records::Circular(c, options, None),
+                    (centre, _) => {
+                        return Err(IdentifyOpsError::CircleAt {
+                            both: centre.is_some(),
+                        })
+                    }
+                }
+            }
+            (m, s, c) => {
+                let given = [m.is_some(), s.is_some(), c.is_some()];
+                return Err(IdentifyOpsError::Records {
+                    both: given.into_iter().filter(|g| *g).count() > 1,
+                });
+            }
         };
         Ok(CheckedIdentify {
             records,
@@ -436,15 +539,26 @@ impl CheckedIdentify<'_> {
                     Layout::Measurements,
                 )?;
                 match setup {
-                    Some(kind) => read.on_setup(Setup {
-                        name: kind.name().to_string(),
-                        kind,
-                    }),
+                    Some(kind) => read.on_setup(Setup::new(kind.name(), kind)),
                     None => read,
                 }
             }
             Records::Spheres(source) => {
                 super::source::read_spheres(validate.unwrap_or(source), machine, params)?
+            }
+            Records::Circular(source, options, centre) => {
+                let centre = centre.map(|c| centre_pose(machine, c)).transpose()?;
+                let pose = match &centre {
+                    Some(q) => CirclePose::Centre(q),
+                    None => CirclePose::Columns,
+                };
+                super::source::read_circular_records(
+                    validate.unwrap_or(source),
+                    machine,
+                    &overrides,
+                    &options,
+                    pose,
+                )?
             }
         };
         // A sphere file has no sensor column: its records are at the state.

@@ -162,6 +162,23 @@ pub fn read_circular(
     }
 }
 
+/// A circular-test file as identification records of `machine`
+/// ([`Measurements::read_circular`]).
+pub fn read_circular_records(
+    source: Source<'_>,
+    machine: &Machine,
+    overrides: &[(String, f64)],
+    options: &chain_core::measured::circular::RunOptions,
+    pose: chain_core::measured::circular::records::CirclePose<'_>,
+) -> Result<Measurements, MeasurementsError> {
+    match source {
+        Source::Path(path) => Measurements::read_circular(path, machine, overrides, options, pose),
+        Source::Bytes { name, bytes } => {
+            Measurements::circular_from_bytes(bytes, name, machine, overrides, options, pose)
+        }
+    }
+}
+
 /// The swing-angle measurements of `chain compensate`.
 pub fn read_swing(source: Source<'_>) -> Result<compensate::Measurements, CompensateError> {
     match source {

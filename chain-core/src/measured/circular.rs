@@ -16,6 +16,7 @@
 use serde::Serialize;
 
 pub mod diagnosis;
+pub mod records;
 
 use crate::diagnostic::Diagnostics;
 #[cfg(feature = "csv")]

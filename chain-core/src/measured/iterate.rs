@@ -135,13 +135,18 @@ pub fn exact_rows(
         } else {
             (chain.deviation(&rec.q, &rec.p, at_state), None)
         };
-        // A set-up's position s: the deviation less s, in the machine's
-        // frame (`docs/five-axis.md`).
-        let setup = rec.setup.map(|g| (g, chain.nominal(&rec.q, &rec.p)));
-        if let Some((g, nominal)) = &setup {
-            let s = nominal.in_frame([setups[3 * g], setups[3 * g + 1], setups[3 * g + 2]]);
-            for (d, s) in dev.iter_mut().zip(s) {
-                *d -= s;
+        // A set-up's unknowns: their columns weighted by them added to
+        // the deviation ([`super::Setup::columns`]: a position s is −s in
+        // the machine's frame, `docs/five-axis.md`).
+        let setup = (rec.setup).map(|g| {
+            let nominal = chain.nominal(&rec.q, &rec.p);
+            (g, design.setups[g].columns(&nominal, &rec.observed))
+        });
+        if let Some((g, columns)) = &setup {
+            for (l, col) in columns.iter().enumerate() {
+                for (d, c) in dev.iter_mut().zip(col) {
+                    *d += setups[3 * g + l] * c;
+                }
             }
         }
         let observed = &rec.observed;
@@ -152,11 +157,9 @@ pub fn exact_rows(
                 for k in 0..ne {
                     out[(i + c, k)] = observed.row(c, [j[(0, k)], j[(1, k)], j[(2, k)]]);
                 }
-                if let Some((g, nominal)) = &setup {
-                    for l in 0..3 {
-                        let mut unit = [0.0; 3];
-                        unit[l] = -1.0;
-                        out[(i + c, ne + 3 * g + l)] = observed.row(c, nominal.in_frame(unit));
+                if let Some((g, columns)) = &setup {
+                    for (l, col) in columns.iter().enumerate() {
+                        out[(i + c, ne + 3 * g + l)] = observed.row(c, *col);
                     }
                 }
             }

@@ -229,38 +229,99 @@ pub enum SetupKind {
     /// The ball of an R-test (five-axis spec, `--setup ball`): its
     /// set-up offset on the table is the unknown.
     Ball,
+    /// A circular test's run (spec `circular.md`, "Into identification"):
+    /// its table ball's offset in the circle's plane and the bar's length
+    /// offset are the unknowns.
+    Circle,
 }
 
 impl SetupKind {
-    /// The kind in words (`sphere`, `ball`).
+    /// The kind in words (`sphere`, `ball`, `circle`).
     pub fn name(self) -> &'static str {
         match self {
             SetupKind::Sphere => "sphere",
             SetupKind::Ball => "ball",
+            SetupKind::Circle => "circle",
         }
     }
 }
 
 /// An instrument set-up whose position on the workpiece (table) is not
-/// known: three unknowns of the fit beside the machine's errors, entering
-/// each of its records' tool-point rows with `−I` (in the machine file's
-/// frame), reported but never written into values.
+/// known: three unknowns of the fit beside the machine's errors, reported
+/// but never written into values. A sphere's or a ball's are its position,
+/// entering each of its records' tool-point rows with `−I` (in the machine
+/// file's frame); a circle's are its table ball's offset along the plane's
+/// two axes (with `−I`) and the bar's length offset (`+1` on the record's
+/// distance).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Setup {
-    /// Its identifier (a sphere file's `sphere` column; `ball`).
+    /// Its identifier (a sphere file's `sphere` column; `ball`; a circular
+    /// test's run).
     pub name: String,
     /// What it is.
     pub kind: SetupKind,
+    /// A circle's plane.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plane: Option<super::circular::Plane>,
 }
 
 impl Setup {
-    /// The names of its three unknowns: `sphere 1.x`, `ball.y`, …
+    /// A sphere's or a ball's set-up named `name`.
+    pub fn new(name: impl Into<String>, kind: SetupKind) -> Setup {
+        Setup {
+            name: name.into(),
+            kind,
+            plane: None,
+        }
+    }
+
+    /// What its three unknowns are: `x`, `y`, `z`; a circle's the plane's
+    /// two axes and `length`.
+    pub fn coordinates(&self) -> [&'static str; 3] {
+        match self.plane {
+            Some(plane) => {
+                let [a, b] = plane.axes().map(|k| ["x", "y", "z"][k]);
+                [a, b, "length"]
+            }
+            None => ["x", "y", "z"],
+        }
+    }
+
+    /// The names of its three unknowns: `sphere 1.x`, `ball.y`,
+    /// `circle xy_f1000.length`, …
     pub fn unknowns(&self) -> [String; 3] {
         let stem = match self.kind {
             SetupKind::Sphere => format!("sphere {}", self.name),
             SetupKind::Ball => self.name.clone(),
+            SetupKind::Circle => format!("circle {}", self.name),
         };
-        ["x", "y", "z"].map(|c| format!("{stem}.{c}"))
+        self.coordinates().map(|c| format!("{stem}.{c}"))
+    }
+
+    /// Its three unknowns' columns at a record measuring `observed` at
+    /// `nominal`: vectors in the machine file's frame whose
+    /// [`Observed::row`] is the record's design entry, and whose sum
+    /// weighted by the unknowns is what they add to the record's
+    /// deviation. A position's is `−(unit l)` of the workpiece frame; a
+    /// circle's length is the record's own direction (its distance grows
+    /// by the length: `uᵀu = 1`).
+    pub fn columns(&self, nominal: &super::exact::Nominal, observed: &Observed) -> [[f64; 3]; 3] {
+        let minus = |l: usize| {
+            let mut unit = [0.0; 3];
+            unit[l] = -1.0;
+            nominal.in_frame(unit)
+        };
+        match self.plane {
+            Some(plane) => {
+                let [a, b] = plane.axes();
+                let along = match observed {
+                    Observed::Direction { u } => *u,
+                    Observed::Point => [0.0; 3],
+                };
+                [minus(a), minus(b), along]
+            }
+            None => [minus(0), minus(1), minus(2)],
+        }
     }
 }
 
@@ -1122,13 +1183,10 @@ impl Design {
                 }
             }
             if let Some(g) = r.setup {
-                // The set-up's position s enters as −s in the workpiece
-                // frame: column l is −(unit l) in the machine's frame.
+                // The set-up's unknowns' columns ([`Setup::columns`]).
                 let nominal = chain.nominal(&r.q, &r.p);
-                for l in 0..3 {
-                    let mut unit = [0.0; 3];
-                    unit[l] = -1.0;
-                    let col = nominal.in_frame(unit);
+                let columns = setups[g].columns(&nominal, &r.observed);
+                for (l, col) in columns.into_iter().enumerate() {
                     for c in 0..k {
                         out[c * width + n + 3 * g + l] = r.observed.row(c, col);
                     }

@@ -42,7 +42,7 @@ use super::measurements::{SetupKind, MAX_MEASUREMENT_BYTES, STD_COLUMN};
 #[cfg(feature = "csv")]
 use crate::diagnostic::{closest, Diagnostics, MeasurementsProblem as P, Problem};
 #[cfg(feature = "csv")]
-use crate::model::{JointKind, Machine, Origin};
+use crate::model::{Machine, Origin};
 
 /// The column of a probing's sphere identifier.
 pub const SPHERE_COLUMN: &str = "sphere";
@@ -111,10 +111,7 @@ impl Measurements {
                 let g = match setups.iter().position(|s| s.name == id) {
                     Some(g) => g,
                     None => {
-                        setups.push(Setup {
-                            name: id,
-                            kind: SetupKind::Sphere,
-                        });
+                        setups.push(Setup::new(id, SetupKind::Sphere));
                         counts.push(0);
                         setups.len() - 1
                     }
@@ -198,15 +195,7 @@ impl SphereColumns {
                 problems.push((origin.clone(), problem.into()));
             }
         }
-        let rotary: Vec<bool> = (0..m.variables.len())
-            .map(|k| {
-                m.bodies.iter().any(|b| {
-                    b.joint
-                        .as_ref()
-                        .is_some_and(|j| j.variable == k && j.kind == JointKind::Rotary)
-                })
-            })
-            .collect();
+        let rotary = super::circular::records::rotary_variables(m);
         let missing: Vec<String> = (m.variables.iter())
             .filter(|v| find(&v.name).is_none())
             .map(|v| v.name.clone())

@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use chain::ops::circular as ops;
 use chain::ops::source::{self, Source};
 
+use crate::cli::args::RunFileArgs;
 use crate::cli::{plot, report};
 
 /// Output formats of `chain circular`.
@@ -28,19 +29,8 @@ pub struct CircularArgs {
     /// `deviation` (mm; `deviation(um)` for µm), and optionally `run`,
     /// `radius`, `feed`, `plane`.
     pub runs: PathBuf,
-    /// The nominal radius (mm) of runs whose file gives none.
-    #[arg(long, value_name = "R")]
-    pub radius: Option<f64>,
-    /// The feed (mm/min) of runs whose file gives none.
-    #[arg(long, value_name = "F")]
-    pub feed: Option<f64>,
-    /// The plane of runs whose file gives none: xy (default), yz or zx.
-    #[arg(long, value_name = "PLANE")]
-    pub plane: Option<String>,
-    /// The arc every direction covers, in degrees (default the whole
-    /// circle, 360).
-    #[arg(long, value_name = "DEG")]
-    pub arc: Option<f64>,
+    #[command(flatten)]
+    pub run: RunFileArgs,
     /// The pitch (mm) of an axis's cyclic error, as AXIS=MM (e.g. x=10, a
     /// ballscrew's lead): that axis's cyclic error is diagnosed. Repeat
     /// for each axis.
@@ -73,7 +63,8 @@ fn pitch(text: &str) -> Result<(String, f64), String> {
 
 /// Runs `chain circular` ([`chain::ops::circular`]).
 pub fn exec(args: CircularArgs) -> miette::Result<()> {
-    let options = ops::options(args.radius, args.feed, args.plane.as_deref(), args.arc)?;
+    let r = &args.run;
+    let options = ops::options(r.radius, r.feed, r.plane.as_deref(), r.arc)?;
     let diagnosis = ops::diagnosis_options(&args.pitch, args.window)?;
     let test = source::read_circular(Source::Path(&args.runs), &options)?;
     let done = ops::run(&test, &diagnosis);

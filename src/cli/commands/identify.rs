@@ -1,4 +1,6 @@
-//! `chain identify FILE (--measurements M.csv [--setup ball] | --spheres S.csv)
+//! `chain identify FILE (--measurements M.csv [--setup ball] | --spheres S.csv
+//! | --circular RUNS.csv (--centre NAME=VALUE,... | --axes) [--radius R] [--feed F]
+//! [--plane P] [--arc DEG])
 //! [--prior] [--validate M2.csv]
 //! [--holdout FRACTION [--seed S]] [--rank-tol TOL]
 //! [--fix NAME,... | --estimate NAME,...] [--iterate]
@@ -13,11 +15,11 @@
 
 use std::path::PathBuf;
 
-use chain::ops::identify::IdentifyRequest;
+use chain::ops::identify::{CircleRequest, IdentifyRequest};
 use chain::ops::source::Source;
 use chain_core::measured::SetupKind;
 
-use crate::cli::args::{ParamArgs, ThermalArgs};
+use crate::cli::args::{ParamArgs, RunFileArgs, ThermalArgs};
 use crate::cli::loaded::Loaded;
 use crate::cli::report;
 
@@ -48,6 +50,25 @@ pub struct IdentifyArgs {
     /// on the table is estimated beside the errors.
     #[arg(long, value_name = "S.csv")]
     pub spheres: Option<PathBuf>,
+    /// A circular-test file (a ballbar's runs, `chain circular`'s) instead
+    /// of measurements: each sample a measurement along the nominal
+    /// ball-to-ball direction, each run's table-ball offset and bar length
+    /// estimated beside the errors; with --centre or --axes.
+    #[arg(long, value_name = "RUNS.csv")]
+    pub circular: Option<PathBuf>,
+    /// The circle's centre as the machine's variables, NAME=VALUE
+    /// (comma-separated; rotary ones in degrees, every other at 0): a
+    /// sample at angle θ moves the variables named after the plane's axes
+    /// by R cos θ, R sin θ.
+    #[arg(long, value_name = "NAME=VALUE", value_delimiter = ',', value_parser = crate::cli::args::parse_param)]
+    pub centre: Option<Vec<(String, f64)>>,
+    /// Read each sample's pose of --circular from the run file's columns
+    /// named after the machine's variables (rotary ones in degrees): any
+    /// path, e.g. a rotary axis interpolating with a linear one.
+    #[arg(long)]
+    pub axes: bool,
+    #[command(flatten)]
+    pub run: RunFileArgs,
     /// `ball`: an R-test: the measurement records are taken against one
     /// ball whose three set-up offsets on the table are estimated beside
     /// the errors.
@@ -118,6 +139,15 @@ pub fn exec(args: IdentifyArgs) -> miette::Result<()> {
         seed: args.seed,
         iterate: args.iterate,
         temperatures: &args.thermal.temperatures,
+        circular: args.circular.as_deref().map(Source::Path),
+        circle: CircleRequest {
+            centre: args.centre.as_deref(),
+            axes: args.axes,
+            radius: args.run.radius,
+            feed: args.run.feed,
+            plane: args.run.plane.as_deref(),
+            arc: args.run.arc,
+        },
     };
     let checked = request.check()?;
     let loaded = Loaded::new(&args.file)?;

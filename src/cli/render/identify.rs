@@ -69,15 +69,7 @@ fn table(d: &IdentifyDocument) -> String {
         }
     );
     // The set-ups' unknowns are listed with their set-up below.
-    let setup_unknowns: Vec<String> = (d.setups.iter())
-        .flat_map(|u| {
-            chain_core::measured::Setup {
-                name: u.name.clone(),
-                kind: u.kind,
-            }
-            .unknowns()
-        })
-        .collect();
+    let setup_unknowns: Vec<String> = (d.setups.iter()).flat_map(|u| u.unknowns.clone()).collect();
     let machine_error = |name: &String| !setup_unknowns.contains(name);
     let width = d
         .estimates
@@ -135,7 +127,7 @@ fn table(d: &IdentifyDocument) -> String {
 set-ups estimated beside the errors (workpiece frame, mm; not written into values):"
         );
         for u in &d.setups {
-            let coords: Vec<String> = (["x", "y", "z"].iter().enumerate())
+            let coords: Vec<String> = (u.coordinates.iter().enumerate())
                 .map(|(l, c)| {
                     let std = u.std[l].map_or("—".to_string(), num);
                     format!("{c} = {} ± {std}", num(u.position[l]))
@@ -144,6 +136,7 @@ set-ups estimated beside the errors (workpiece frame, mm; not written into value
             let label = match u.kind {
                 chain_core::measured::SetupKind::Sphere => format!("sphere {}", u.name),
                 chain_core::measured::SetupKind::Ball => u.name.clone(),
+                chain_core::measured::SetupKind::Circle => format!("circle {}", u.name),
             };
             let _ = writeln!(s, "  {label}: {}", coords.join(", "));
         }

@@ -117,11 +117,20 @@ pub struct IdentifyDocument {
 pub struct SetupDoc {
     /// Its identifier.
     pub name: String,
-    /// `sphere` or `ball`.
+    /// `sphere`, `ball` or `circle`.
     pub kind: SetupKind,
+    /// A circle's plane.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plane: Option<chain_core::measured::circular::Plane>,
+    /// What its three unknowns are (`x`, `y`, `z`; a circle's plane's two
+    /// axes and `length`).
+    pub coordinates: [&'static str; 3],
+    /// Their names among the estimates.
+    pub unknowns: [String; 3],
     /// Its position `[x, y, z]` from the reported solution (`--iterate`'s
     /// exact fit when given, else the least-squares subset, else the
-    /// posterior).
+    /// posterior); a circle's offsets along the plane's two axes and the
+    /// bar's length offset.
     pub position: [f64; 3],
     /// The std of each coordinate (null where it cannot be estimated).
     pub std: [Option<f64>; 3],
@@ -594,6 +603,9 @@ fn setup_docs(design: &Design, r: &Identification, iteration: Option<&Iteration>
             SetupDoc {
                 name: setup.name.clone(),
                 kind: setup.kind,
+                plane: setup.plane,
+                coordinates: setup.coordinates(),
+                unknowns: setup.unknowns(),
                 position: std::array::from_fn(|l| at(l).value),
                 std: std::array::from_fn(|l| at(l).std),
             }

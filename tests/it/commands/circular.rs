@@ -479,3 +479,255 @@ fn the_polar_plots_are_one_per_run() {
         );
     }
 }
+
+/// A serial X-Y-Z machine with a scale error per axis (`E<i><i>_1`, ppm
+/// as a slope) and the three squareness errors: EC0Y (about z, after X:
+/// the Y travel is (−EC0Y, 1, 0)), EA0Z and EB0Z (after Y: the Z travel is
+/// (EB0Z, −EA0Z, 1)), right-hand rotations.
+const BALLBAR_XYZ: &str = "machine: ballbar_xyz
+bodies:
+  bed: {}
+  x_slide:
+    parent: bed
+    joint: {type: prismatic, axis: +x, variable: x}
+    errors: {dx: {name: EXX, powers: [1]}}
+    squareness: {ez: EC0Y}
+  y_slide:
+    parent: x_slide
+    joint: {type: prismatic, axis: +y, variable: y}
+    errors: {dy: {name: EYY, powers: [1]}}
+    squareness: {ex: EA0Z, ey: EB0Z}
+  z_slide:
+    parent: y_slide
+    joint: {type: prismatic, axis: +z, variable: z}
+    errors: {dz: {name: EZZ, powers: [1]}}
+  tool: {parent: z_slide}
+workpiece: bed
+tool: tool
+tool_point: [0, 0, 0]
+frame: workpiece
+";
+
+/// The simulated truth: scales (1), squareness (rad), and per plane the
+/// table ball's offset along a, b and the bar's length offset (mm).
+const SCALE: [f64; 3] = [10e-6, -5e-6, 0.0];
+const SQUARE: [(&str, f64); 3] = [("EC0Y", 20e-6), ("EA0Z", -15e-6), ("EB0Z", 10e-6)];
+const SETUP: [(&str, [f64; 3]); 3] = [
+    ("xy", [0.003, -0.002, 0.0015]),
+    ("yz", [-0.001, 0.004, -0.001]),
+    ("zx", [0.002, 0.001, 0.002]),
+];
+
+/// The ballbar runs of that machine about the centre (200, 150, 100), R =
+/// 100 mm, xy, yz and zx, both directions, a sample a degree: the exact
+/// distance between the tool ball (each axis's travel scaled and tilted as
+/// the machine's errors say, to first order in the errors) and the table
+/// ball (at the centre plus its offset), less R, plus the bar's offset.
+/// With `axes`, each sample's pose in columns `x`, `y`, `z`.
+fn ballbar_runs(axes: bool) -> String {
+    let [ex, ey, ez] = SCALE;
+    let (c, a, b) = (SQUARE[0].1, SQUARE[1].1, SQUARE[2].1);
+    let tool = |q: [f64; 3]| {
+        let [x, y, z] = q;
+        [
+            x * (1.0 + ex) - c * y + b * z,
+            y * (1.0 + ey) - a * z,
+            z * (1.0 + ez),
+        ]
+    };
+    let centre = [200.0, 150.0, 100.0];
+    let mut s = String::from(if axes {
+        "run,radius,plane,angle,direction,deviation(um),x,y,z\n"
+    } else {
+        "run,radius,plane,angle,direction,deviation(um)\n"
+    });
+    for (plane, [sa, sb, length]) in SETUP {
+        let (ia, ib) = match plane {
+            "xy" => (0, 1),
+            "yz" => (1, 2),
+            _ => (2, 0),
+        };
+        for (d, name) in [(1i32, "ccw"), (-1, "cw")] {
+            for k in 0..360 {
+                let deg = (d * k).rem_euclid(360);
+                let t = f64::from(deg).to_radians();
+                let mut q = centre;
+                q[ia] += 100.0 * t.cos();
+                q[ib] += 100.0 * t.sin();
+                let p = tool(q);
+                let mut ball = centre;
+                ball[ia] += sa;
+                ball[ib] += sb;
+                let dist = ((0..3).map(|i| (p[i] - ball[i]).powi(2)).sum::<f64>()).sqrt();
+                let dev = (dist - 100.0 + length) * 1e3;
+                s.push_str(&format!("{plane},100,{plane},{deg},{name},{dev:.7}"));
+                if axes {
+                    s.push_str(&format!(",{},{},{}", q[0], q[1], q[2]));
+                }
+                s.push('\n');
+            }
+        }
+    }
+    s
+}
+
+/// `chain identify --circular`: the runs of three planes recover the
+/// machine's three squareness errors and (with z's scale fixed, as a laser
+/// would give it: the bar's length takes each run's mean scale) the scale
+/// errors of x and y, and each run's table-ball offset and bar length; the
+/// same from the poses in the file's columns (`--axes`).
+#[test]
+fn identify_reads_a_circular_test() {
+    let dir = common::cli::scratch("circular-identify");
+    let machine = common::cli::write(&dir, "ballbar_xyz.yaml", BALLBAR_XYZ);
+    let machine = machine.to_str().unwrap();
+    let runs = common::cli::write(&dir, "runs.csv", &ballbar_runs(false));
+    let posed = common::cli::write(&dir, "posed.csv", &ballbar_runs(true));
+    let by_centre = ok_json(&[
+        "identify",
+        machine,
+        "--circular",
+        runs.to_str().unwrap(),
+        "--centre",
+        "x=200,y=150,z=100",
+        "--fix",
+        "EZZ_1",
+        "--format",
+        "json",
+    ]);
+    let by_axes = ok_json(&[
+        "identify",
+        machine,
+        "--circular",
+        posed.to_str().unwrap(),
+        "--axes",
+        "--fix",
+        "EZZ_1",
+        "--format",
+        "json",
+    ]);
+    // The exact kinematics fitted from there (`--iterate`): the circle's
+    // length column is the record's own direction there too.
+    let iterated = ok_json(&[
+        "identify",
+        machine,
+        "--circular",
+        runs.to_str().unwrap(),
+        "--centre",
+        "x=200,y=150,z=100",
+        "--fix",
+        "EZZ_1",
+        "--iterate",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(iterated["iteration"]["converged"], true, "{iterated}");
+    for doc in [&by_centre, &by_axes, &iterated] {
+        let estimate = |name: &str| -> f64 {
+            let e = if doc["iteration"].is_object() {
+                &doc["iteration"]["estimates"]
+            } else {
+                &doc["subset"]["estimates"]
+            };
+            let v = e.get(name).map(|v| &v["value"]).unwrap_or(&Value::Null);
+            v.as_f64()
+                .or_else(|| doc["estimates"][name]["value"].as_f64())
+                .unwrap_or_else(|| panic!("{name}: {doc}"))
+        };
+        // First order in the errors (products of 1e-5 over 100 mm: 1e-8 mm).
+        for (name, truth) in [("EXX_1", SCALE[0]), ("EYY_1", SCALE[1])]
+            .into_iter()
+            .chain(SQUARE)
+        {
+            let got = estimate(name);
+            assert!((got - truth).abs() < 1e-8, "{name}: {got} against {truth}");
+        }
+        let setups = doc["setups"].as_array().unwrap();
+        assert_eq!(setups.len(), 3);
+        for (plane, truth) in SETUP {
+            let s = setups.iter().find(|s| s["name"] == plane).unwrap();
+            assert_eq!(s["kind"], "circle");
+            assert_eq!(s["unknowns"][2], format!("circle {plane}.length"));
+            // 1 nm: the linearisation about the nominal ball-to-ball
+            // direction leaves terms of the offsets times the errors.
+            for k in 0..3 {
+                let got = num(&s["position"][k]);
+                assert!(
+                    (got - truth[k]).abs() < 1e-6,
+                    "{plane} {k}: {got} against {}",
+                    truth[k]
+                );
+            }
+        }
+    }
+}
+
+/// Every refusal of `--circular` and its options, named.
+#[test]
+fn identify_circular_refusals_are_named() {
+    let dir = common::cli::scratch("circular-identify-refusals");
+    let machine = common::cli::write(&dir, "ballbar_xyz.yaml", BALLBAR_XYZ);
+    let machine = machine.to_str().unwrap();
+    let runs = common::cli::write(&dir, "runs.csv", &ballbar_runs(false));
+    let runs = runs.to_str().unwrap();
+    let check = |args: &[&str], words: &[&str]| {
+        let mut all = vec!["identify", machine];
+        all.extend_from_slice(args);
+        let err = unwrapped(&fails(&all));
+        for w in words {
+            assert!(err.contains(w), "{args:?}: `{w}` not in {err}");
+        }
+    };
+    check(
+        &["--circular", runs],
+        &["--circular", "--centre", "--axes", "one of them"],
+    );
+    check(
+        &["--circular", runs, "--centre", "x=1", "--axes"],
+        &["--circular", "not both"],
+    );
+    check(&["--centre", "x=1"], &["give --circular RUNS.csv"]);
+    check(
+        &["--circular", runs, "--centre", "w=1"],
+        &["--centre", "`w`", "not a variable of machine `ballbar_xyz`"],
+    );
+    check(
+        &["--circular", runs, "--centre", "x=1", "--setup", "ball"],
+        &["--setup", "already set-ups"],
+    );
+    check(
+        &[
+            "--circular",
+            runs,
+            "--measurements",
+            runs,
+            "--centre",
+            "x=1",
+        ],
+        &["one of them, not both"],
+    );
+    // The run file's poses without the columns, and off the circle.
+    check(
+        &["--circular", runs, "--axes"],
+        &["runs.csv:1", "no column for the axis variables `x`, `y`"],
+    );
+    let wrong = ballbar_runs(true).replace(",100,xy,", ",90,xy,");
+    let wrong = common::cli::write(&dir, "wrong.csv", &wrong);
+    check(
+        &["--circular", wrong.to_str().unwrap(), "--axes"],
+        &["wrong.csv:2", "run xy", "not the run's radius 90 mm"],
+    );
+    // A run file refused as `chain circular` refuses it.
+    let bad = common::cli::write(&dir, "bad.csv", "angle,direction,deviation\n0,up,0\n");
+    check(
+        &[
+            "--circular",
+            bad.to_str().unwrap(),
+            "--centre",
+            "x=0",
+            "--radius",
+            "100",
+        ],
+        &["bad.csv:2", "`up` is not a direction"],
+    );
+}

@@ -630,6 +630,33 @@ pub enum CircularProblem {
         /// The widest gap allowed (degrees).
         allowed: f64,
     },
+    /// A plane's axis with no prismatic variable of the machine named
+    /// after it (a circle placed by its centre).
+    NoAxis {
+        /// The run.
+        run: String,
+        /// `x`, `y` or `z`.
+        axis: &'static str,
+        /// The machine.
+        machine: String,
+        /// Its variables.
+        variables: Vec<String>,
+    },
+    /// A sample whose pose puts the nominal tool point off the run's
+    /// nominal circle.
+    OffCircle {
+        /// The run.
+        run: String,
+        /// The distance from the circle's centre (mm).
+        distance: f64,
+        /// The run's radius (mm).
+        radius: f64,
+    },
+    /// A run whose poses do not draw a circle (all on one line or point).
+    NoCircle {
+        /// The run.
+        run: String,
+    },
 }
 
 impl CircularProblem {
@@ -689,6 +716,37 @@ impl CircularProblem {
                     "run {run}, {direction}: {count} distinct angle(s); a circle needs at least {} around its arc",
                     crate::measured::circular::MIN_SAMPLES
                 ),
+            ),
+            CircularProblem::NoAxis {
+                run,
+                axis,
+                machine,
+                variables,
+            } => D::new(
+                "chain::circular::no_axis",
+                "plane",
+                format!(
+                    "run {run}: machine `{machine}` has no linear variable named `{axis}` to draw the circle with (its variables: {})",
+                    quoted(variables.iter().map(String::as_str))
+                ),
+            )
+            .help("a circle placed by its centre moves the machine's variables named after the plane's axes; for other axes give each sample's pose in columns named after the machine's variables".to_string()),
+            CircularProblem::OffCircle {
+                run,
+                distance,
+                radius,
+            } => D::new(
+                "chain::circular::off_circle",
+                "pose",
+                format!(
+                    "run {run}: at this sample's pose the machine's nominal tool point is {distance} mm from the circle's centre, not the run's radius {radius} mm"
+                ),
+            )
+            .help("the poses and the radius describe one circle: check the radius, the pose columns' units (rotary axes in degrees) and the centre".to_string()),
+            CircularProblem::NoCircle { run } => D::new(
+                "chain::circular::no_circle",
+                "pose",
+                format!("run {run}: its poses put the nominal tool point on one line, not a circle"),
             ),
             CircularProblem::TooLarge { deviation, radius } => D::new(
                 "chain::circular::too_large",
