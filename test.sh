@@ -18,7 +18,7 @@ if [ ! -x "$VENV/bin/python" ]; then
   "$PY" -m venv "$VENV"
 fi
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
-"$VENV/bin/python" -m pip install --quiet "maturin>=1.5,<2" numpy pytest sympy pandas
+"$VENV/bin/python" -m pip install --quiet "maturin>=1.5,<2" numpy pytest sympy pandas html5lib
 # The wheel is built in the workspace's target/ and `ci` profile (reused
 # between runs): the dependencies it shares with the Rust tests (same
 # versions, features and profile) are compiled once for both. (`pip install

@@ -28,3 +28,5 @@ pub mod compensate;
 pub mod ops;
 #[cfg(feature = "plot")]
 pub mod plot;
+#[cfg(feature = "report")]
+pub mod report;

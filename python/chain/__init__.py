@@ -19,11 +19,12 @@ from ._results import IdentifyResult, MapResult, PlanResult
 from ._results import Derivation, ReliabilityResult, Result, SobolResult
 from ._results import AllocationResult, GeometricSensitivityResult, SensitivityResult
 from ._results import CompensateResult, ExportResult, InverseResult, MotionResult, PathResult, PositioningResult
-from ._results import CircularResult, ThermalResult
+from ._results import CircularResult, ReportResult, ThermalResult
 from ._positioning import positioning
 from ._circular import circular
 from ._thermal import thermal
 from ._compensate import compensate
+from ._report import report
 
 __all__ = [
     "AllocationResult",
@@ -43,6 +44,7 @@ __all__ = [
     "MachineError",
     "Nominal",
     "ReliabilityResult",
+    "ReportResult",
     "Result",
     "SensitivityResult",
     "SobolResult",
@@ -51,6 +53,7 @@ __all__ = [
     "positioning",
     "thermal",
     "circular",
+    "report",
 ]
 
 __version__ = "0.1.0"

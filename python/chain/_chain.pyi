@@ -194,6 +194,11 @@ def circular_json(
 ) -> str: ...
 
 
+# -- the calibration report (python/src/report.rs) -------------------------------
+
+def report_html(path: str) -> Tuple[str, str]: ...
+
+
 # -- thermal drift tests (python/src/thermal.rs) ---------------------------------
 
 def thermal_json(

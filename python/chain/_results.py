@@ -492,3 +492,37 @@ class CompensateResult(Result):
 
     def _rows(self) -> List[Dict[str, Any]]:
         return [dict(p) for p in self._document["points"]]
+
+
+class ReportResult(Result):
+    """``chain report``: the calibration report's page and its documents.
+
+    ``html``: the page (``str(result)`` too). Attributes (``to_dict()``, the
+    CLI's ``--format json``): ``file``, ``cover``, ``chain_version``,
+    ``machine``, ``inputs`` (each ``role``, ``path``, ``bytes``,
+    ``sha256``), ``positioning`` (per axis ``axis``, ``document``,
+    ``verdicts``), ``map``, ``identify``, ``export``, ``circular`` (each a
+    command's document, or ``None``). Rows of ``to_dataframe()``: one per
+    ISO 230-2 verdict.
+    """
+
+    command = "report"
+
+    def __init__(self, document: Dict[str, Any], html: str = "") -> None:
+        super().__init__(document)
+        self.__dict__["html"] = html
+
+    @classmethod
+    def _from_json(cls, text: str, html: str = "") -> "ReportResult":  # type: ignore[override]
+        return cls(json.loads(text), html)
+
+    def __str__(self) -> str:
+        return self.__dict__["html"]
+
+    def _rows(self) -> List[Dict[str, Any]]:
+        rows = []
+        for a in self._document["positioning"]:
+            for v in a["verdicts"]:
+                rows.append({"axis": a["axis"], **v})
+        return rows
+

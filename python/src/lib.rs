@@ -24,6 +24,7 @@ mod measured;
 mod motion;
 mod path;
 mod positioning;
+mod report;
 mod thermal;
 use std::mem::MaybeUninit;
 
@@ -593,6 +594,7 @@ fn _chain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(positioning::positioning_json, m)?)?;
     m.add_function(wrap_pyfunction!(thermal::thermal_json, m)?)?;
     m.add_function(wrap_pyfunction!(circular::circular_json, m)?)?;
+    m.add_function(wrap_pyfunction!(report::report_html, m)?)?;
     m.add_function(wrap_pyfunction!(inverse::inverse_json, m)?)?;
     m.add_function(wrap_pyfunction!(path::path_json, m)?)?;
     m.add_function(wrap_pyfunction!(export::export_json, m)?)?;

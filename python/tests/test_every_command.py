@@ -62,6 +62,7 @@ CASES = [
     ("positioning", lambda: chain.positioning(EX / "positioning/x_axis_runs.csv"),
      [EX / "positioning/x_axis_runs.csv"]),
     ("circular", lambda: chain.circular(EX / "circular/runs.csv"), [EX / "circular/runs.csv"]),
+    ("report", lambda: chain.report(EX / "calibration/vmc3.yaml"), [EX / "calibration/vmc3.yaml"]),
 ]
 
 
@@ -80,6 +81,12 @@ def _bad_machine(tmp_path):
         "  s: {parent: bed, joint: {type: prismatic, axis: +x, variable: x}, bogus: 1}\n"
         "workpiece: bed\ntool: s\n"
     )
+    return path
+
+
+def _bad_calibration(tmp_path):
+    path = tmp_path / "calibration.yaml"
+    path.write_text(f"machine: {VMC3}\ncustomr: X\n")
     return path
 
 
@@ -133,6 +140,8 @@ BAD = [
      "the coverage factor k must be a finite number > 0, not 0"),
     ("circular", lambda t: chain.circular(EX / "circular/runs.csv", arc=0.0),
      lambda t: [EX / "circular/runs.csv", "--arc", "0"], ValueError, "--arc 0: must be in [45, 360] degrees"),
+    ("report", lambda t: chain.report(_bad_calibration(t)), lambda t: [_bad_calibration(t)], chain.MachineError,
+     "unknown key `customr`"),
 ]
 
 

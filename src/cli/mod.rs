@@ -63,6 +63,8 @@ enum Command {
     Thermal(thermal::ThermalArgs),
     /// ISO 230-4 circular test (ballbar): per run and direction the circular deviation G, the radial deviations F_max and F_min about the least-squares centre, and with both directions G(b) and the hysteresis H.
     Circular(circular::CircularArgs),
+    /// The calibration report a lab hands over: one self-contained HTML page (positioning per axis against tolerances, the volumetric map before and after compensation, the identification and its held-out prediction, the controller's files, a circular test, the inputs' checksums) from a calibration file.
+    Report(commands::report::ReportArgs),
     /// Motion conversion ("Precision Machining Technology of Jewelry on CNC Machine Tool", 2022): CNC axis motions reproducing a cradle-type generator's roll, and their Maclaurin series.
     Motion(motion::MotionArgs),
 }
@@ -86,5 +88,6 @@ pub fn run(cli: Cli) -> miette::Result<()> {
         Command::Positioning(args) => positioning::exec(args),
         Command::Thermal(args) => thermal::exec(args),
         Command::Circular(args) => circular::exec(args),
+        Command::Report(args) => commands::report::exec(args),
     }
 }

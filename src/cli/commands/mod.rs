@@ -14,6 +14,7 @@ pub mod path;
 pub mod plan;
 pub mod positioning;
 pub mod reliability;
+pub mod report;
 pub mod sensitivity;
 pub mod sobol;
 pub mod thermal;

@@ -12,6 +12,7 @@ pub(crate) mod path;
 pub(crate) mod plan;
 pub(crate) mod positioning;
 pub(crate) mod reliability;
+pub(crate) mod report;
 pub(crate) mod sensitivity;
 pub(crate) mod sobol;
 pub(crate) mod thermal;

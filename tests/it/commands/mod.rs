@@ -43,6 +43,7 @@ mod positioning;
 mod positioning_values;
 mod posterior_reliability;
 mod reliability_cli;
+mod report;
 mod samplers_cli;
 mod sobol;
 mod sorm_cli;
