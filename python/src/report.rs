@@ -23,6 +23,7 @@ pub(crate) fn report_html(py: Python<'_>, path: &str) -> PyResult<(String, Strin
         ReportError::Runs(e) => load_error(py, &e.0),
         ReportError::Values(e) => load_error(py, e.diagnostics()),
         ReportError::CircularFile(e) => load_error(py, e.diagnostics()),
+        ReportError::DriftFile(e) => load_error(py, &e.0),
         e => value_error(e.to_string()),
     })?;
     Ok((report::html(&done), to_json(&done)?))

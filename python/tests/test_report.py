@@ -49,7 +49,8 @@ def test_the_page_is_well_formed_self_contained_and_its_documents():
     # raises.
     tree = html5lib.HTMLParser(strict=True, namespaceHTMLElements=False).parse(page)
     ids = [s.get("id") for s in tree.iter() if s.tag in ("section", "header")]
-    assert ids == ["cover", "summary", "positioning-x", "map", "identify", "export", "circular", "reproduce"]
+    assert ids == ["cover", "summary", "positioning-x", "map", "identify", "export", "circular", "thermal",
+                   "reproduce"]
     doc = chain.report(CALIBRATION).to_dict()
     checked = 0
     for element in tree.iter():
@@ -138,7 +139,7 @@ def test_a_real_browser_prints_the_page_and_draws_every_chart(tmp_path):
     data = pdf.read_bytes()
     pages = len(re.findall(rb"/Type\s*/Page(?![s\w])", data))
     sections = page.read_text().count('class="page"')
-    assert sections == 7
+    assert sections == 8
     assert sections + 1 <= pages <= 60, pages
     boxes = {tuple(round(float(v)) for v in m) for m in re.findall(rb"/MediaBox\s*\[\s*0 0 ([\d.]+) ([\d.]+)\s*\]", data)}
     assert boxes == {(595, 842)}, boxes  # A4 in points

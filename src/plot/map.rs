@@ -560,7 +560,6 @@ where
         Rectangle::new([(0.0, y0), (1.0, y1)], colour(0.5 * (y0 + y1)).filled())
     }))
     .map_err(err)?;
-    root.present().map_err(err)?;
     Ok(())
 }
 

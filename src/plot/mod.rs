@@ -198,11 +198,15 @@ impl Chart {
     where
         DB::ErrorType: 'static,
     {
+        // Presented once, when the whole chart is drawn: the SVG backend
+        // closes its document there (a panel presenting its own area would
+        // close it after the first panel, the others drawn after `</svg>`).
+        let whole = root.clone();
         match self {
-            Chart::Xy(c) => c.draw(root, c.ranges().map_err(|e| e.to_string())?),
-            Chart::Bar(c) => c.draw(root),
-            Chart::Heat(c) => c.draw(root),
-            Chart::Cells(c) => c.draw(root),
+            Chart::Xy(c) => c.draw(root, c.ranges().map_err(|e| e.to_string())?)?,
+            Chart::Bar(c) => c.draw(root)?,
+            Chart::Heat(c) => c.draw(root)?,
+            Chart::Cells(c) => c.draw(root)?,
             Chart::Stack(cs) => {
                 // Each panel its own height, top to bottom.
                 let mut rest = root;
@@ -211,9 +215,9 @@ impl Chart {
                     c.draw(top, c.ranges().map_err(|e| e.to_string())?)?;
                     rest = below;
                 }
-                Ok(())
             }
         }
+        whole.present().map_err(|e| e.to_string())
     }
 
     /// The chart as an SVG document, in memory.
@@ -680,7 +684,6 @@ impl XyChart {
                 .draw()
                 .map_err(err)?;
         }
-        root.present().map_err(err)?;
         Ok(())
     }
 }
@@ -828,7 +831,31 @@ impl BarChart {
                 }))
                 .map_err(|e| err(&e))?;
         }
-        root.present().map_err(|e| err(&e))?;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A stacked chart is one SVG document: its panels inside the one
+    /// `<svg>`, closed once at the end (a panel presenting its own area
+    /// closed the document after the first panel).
+    #[test]
+    fn a_stack_is_one_svg_document() {
+        let panel = |title: &str| {
+            XyChart::new(title, "t", "v").series(Series::line("a", vec![(0.0, 1.0), (1.0, 2.0)]))
+        };
+        let chart = Chart::Stack(vec![panel("top"), panel("bottom")]);
+        let svg = chart.svg().unwrap();
+        assert_eq!(svg.matches("<svg").count(), 1);
+        assert_eq!(svg.matches("</svg>").count(), 1);
+        assert!(
+            svg.trim_end().ends_with("</svg>"),
+            "{}",
+            &svg[svg.len() - 200..]
+        );
+        assert!(svg.contains(">\ntop\n<") && svg.contains(">\nbottom\n<"));
     }
 }

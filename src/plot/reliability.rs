@@ -212,6 +212,5 @@ where
             })
         }))
         .map_err(err)?;
-    root.present().map_err(err)?;
     Ok(())
 }

@@ -95,6 +95,21 @@ pub struct CircularPart {
     pub plane: Option<String>,
 }
 
+/// An ISO 230-3 thermal drift test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ThermalPart {
+    /// The drift file.
+    pub runs: PathBuf,
+    /// Fit the thermal model of each channel (default true).
+    pub fit: bool,
+    /// The fraction of the test's duration held out of the fit.
+    pub holdout: Option<f64>,
+    /// Consider lag responses to the loads.
+    pub lag: bool,
+    /// The most temperature sensors per channel.
+    pub sensors: Option<usize>,
+}
+
 /// A calibration file, read and checked.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Calibration {
@@ -116,6 +131,8 @@ pub struct Calibration {
     pub export: Option<ExportController>,
     /// A circular test.
     pub circular: Option<CircularPart>,
+    /// A thermal drift test.
+    pub thermal: Option<ThermalPart>,
     /// Every file named, with its role, in the file's order.
     pub inputs: Vec<(String, PathBuf)>,
 }
@@ -229,11 +246,13 @@ const TOP: &[&str] = &[
     "identify",
     "export",
     "circular",
+    "thermal",
 ];
 const AXIS: &[&str] = &["axis", "runs", "rotary", "k", "tolerances"];
 const IDENTIFY: &[&str] = &["machine", "measurements", "holdout", "seed", "validate"];
 const EXPORT: &[&str] = &["controller"];
 const CIRCULAR: &[&str] = &["runs", "radius", "feed", "plane"];
+const THERMAL: &[&str] = &["runs", "fit", "holdout", "lag", "sensors"];
 
 /// The reader: the file's folder and the problems found.
 struct Reader<'a> {
@@ -601,6 +620,62 @@ impl Calibration {
                 plane,
             })
         });
+        let thermal = get("thermal").and_then(|node| {
+            let entries = r.mapping(node, "thermal", "`thermal`", THERMAL)?;
+            let field = |k: &str| entries.iter().find(|(n, _)| *n == k).map(|(_, v)| *v);
+            let runs = match field("runs") {
+                Some(f) => r.file(f, "thermal.runs"),
+                None => {
+                    let problem = CalibrationProblem::MissingKey {
+                        key: "runs",
+                        at: "`thermal`".into(),
+                    };
+                    r.refuse(node, "thermal", problem);
+                    None
+                }
+            };
+            let fit = field("fit")
+                .and_then(|v| r.boolean(v, "thermal.fit"))
+                .unwrap_or(true);
+            let lag = field("lag")
+                .and_then(|v| r.boolean(v, "thermal.lag"))
+                .unwrap_or(false);
+            let holdout = field("holdout").and_then(|h| {
+                let v = r.number(h, "thermal.holdout")?;
+                if v > 0.0 && v < 1.0 {
+                    Some(v)
+                } else {
+                    let rule = "a fraction in (0, 1)";
+                    r.refuse(
+                        h,
+                        "thermal.holdout",
+                        CalibrationProblem::Range { value: v, rule },
+                    );
+                    None
+                }
+            });
+            let sensors = field("sensors").and_then(|s| {
+                let v = r.number(s, "thermal.sensors")?;
+                if v >= 1.0 && v == v.trunc() && v <= 64.0 {
+                    Some(v as usize)
+                } else {
+                    let rule = "a whole number from 1 to 64";
+                    r.refuse(
+                        s,
+                        "thermal.sensors",
+                        CalibrationProblem::Range { value: v, rule },
+                    );
+                    None
+                }
+            });
+            Some(ThermalPart {
+                runs: runs?,
+                fit,
+                holdout,
+                lag,
+                sensors,
+            })
+        });
         if !r.problems.is_empty() {
             return Err(fail(r.problems));
         }
@@ -614,6 +689,7 @@ impl Calibration {
             identify,
             export,
             circular,
+            thermal,
             inputs: r.inputs,
         })
     }

@@ -82,6 +82,7 @@ pub fn html(report: &Report) -> String {
     identify(&mut o, report);
     export(&mut o, report);
     circular(&mut o, report);
+    thermal(&mut o, report);
     reproduce(&mut o, report);
     o.push_str("</body>\n</html>\n");
     o
@@ -430,6 +431,44 @@ fn circular(o: &mut String, r: &Report) {
     }
     o.push_str("</table>\n");
     for svg in &c.charts {
+        o.push_str(&figure(svg));
+    }
+    o.push_str("</section>\n");
+}
+
+fn thermal(o: &mut String, r: &Report) {
+    let Some(t) = &r.thermal else { return };
+    let d = &t.document.document;
+    let _ = writeln!(
+        o,
+        "<section class=\"page\" id=\"thermal\">\n<h2>Thermal drift (ISO 230-3)</h2>\n<p>Drift file <code>{}</code>: {} samples over {:.0} s.</p>\n<table>\n<tr><th>channel</th><th>unit</th><th>range</th><th>largest drift</th><th>fit RMS</th><th>held-out RMS before</th><th>held-out RMS after</th></tr>",
+        esc(&d.file),
+        d.samples,
+        d.duration
+    );
+    for (i, c) in d.channels.iter().enumerate() {
+        let key = format!("thermal.document.channels.{i}");
+        let fit = c.fit.as_ref().map_or("<td>—</td>".to_string(), |f| {
+            cell(&format!("{key}.fit.rms"), f.rms, 1.0, 3)
+        });
+        let (before, after) = match &c.holdout {
+            Some(h) => (
+                cell(&format!("{key}.holdout.rms_before"), h.rms_before, 1.0, 3),
+                cell(&format!("{key}.holdout.rms_after"), h.rms_after, 1.0, 3),
+            ),
+            None => ("<td>—</td>".to_string(), "<td>—</td>".to_string()),
+        };
+        let _ = writeln!(
+            o,
+            "<tr><td>{}</td><td>{}</td>{}{}{fit}{before}{after}</tr>",
+            esc(&c.name),
+            esc(&c.unit),
+            cell(&format!("{key}.range"), c.range, 1.0, 3),
+            cell(&format!("{key}.max_drift"), c.max_drift, 1.0, 3),
+        );
+    }
+    o.push_str("</table>\n");
+    for svg in &t.charts {
         o.push_str(&figure(svg));
     }
     o.push_str("</section>\n");

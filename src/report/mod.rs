@@ -4,7 +4,7 @@
 //! [`crate::ops`] as the CLI would (positioning per axis, the map of the
 //! values before and after the controller's compensation, the
 //! identification with its held-out prediction, the export, a circular
-//! test) into one typed, serialisable [`Report`]; [`html`] renders it (the
+//! test, a thermal drift test) into one typed, serialisable [`Report`]; [`html`] renders it (the
 //! one place the page is written), its charts the commands' own `--plot`
 //! charts as inline SVG.
 
@@ -27,7 +27,10 @@ use crate::ops::map::{CompensationRequest, MapDocument, MapOpsError, MapRequest}
 use crate::ops::positioning::{PositioningError, PositioningRequest};
 use crate::ops::resolve::AxisPoints;
 use crate::ops::source::{self, Source};
+use crate::ops::thermal::{Thermal, ThermalOpsError, ThermalRequest};
 use crate::plot::{Figures, PlotError};
+use chain_core::measured::thermal::{DriftFileError, Roles};
+use chain_core::measured::thermal_fit::{FitOptions, Split, DEFAULT_SENSORS};
 
 pub use calibration::{Calibration, CalibrationError, Cover};
 pub use html::html;
@@ -129,6 +132,8 @@ pub struct Report {
     pub export: Option<ExportSection>,
     /// The circular test.
     pub circular: Option<Charted<Circular>>,
+    /// The thermal drift test.
+    pub thermal: Option<Charted<Thermal>>,
 }
 
 /// Why the report could not be made: the calibration file's problem, or
@@ -176,6 +181,14 @@ pub enum ReportError {
     #[error(transparent)]
     #[cfg_attr(feature = "cli", diagnostic(transparent))]
     CircularFile(#[from] chain_core::measured::circular::CircularFileError),
+    /// The thermal drift test's file.
+    #[error(transparent)]
+    #[cfg_attr(feature = "cli", diagnostic(transparent))]
+    DriftFile(#[from] DriftFileError),
+    /// The thermal drift test's evaluation or fit.
+    #[error(transparent)]
+    #[cfg_attr(feature = "cli", diagnostic(transparent))]
+    Thermal(Box<ThermalOpsError>),
     /// A chart.
     #[error(transparent)]
     #[cfg_attr(feature = "cli", diagnostic(transparent))]
@@ -211,6 +224,12 @@ impl From<IdentifyOpsError> for ReportError {
 impl From<PositioningError> for ReportError {
     fn from(e: PositioningError) -> ReportError {
         ReportError::Positioning(Box::new(e))
+    }
+}
+
+impl From<ThermalOpsError> for ReportError {
+    fn from(e: ThermalOpsError) -> ReportError {
+        ReportError::Thermal(Box::new(e))
     }
 }
 
@@ -366,6 +385,27 @@ pub fn run(cal: &Calibration, calibration_file: &Path) -> Result<Report, ReportE
         None => None,
     };
 
+    let thermal = match &cal.thermal {
+        Some(part) => {
+            let test = source::read_drift(Source::Path(&part.runs), &Roles::default())?;
+            let split = part.holdout.map_or(Split::None, Split::Holdout);
+            let fit = part.fit.then(|| FitOptions {
+                sensors: part.sensors.unwrap_or(DEFAULT_SENSORS),
+                lag: part.lag,
+                split,
+            });
+            let document = crate::ops::thermal::run(&ThermalRequest {
+                test: &test,
+                pairs: &[],
+                fit,
+                into_machine: None,
+            })?;
+            let charts = svgs(&crate::plot::thermal::charts(&test, &document))?;
+            Some(Charted { document, charts })
+        }
+        None => None,
+    };
+
     Ok(Report {
         file: cal.file.clone(),
         cover: cal.cover.clone(),
@@ -377,6 +417,7 @@ pub fn run(cal: &Calibration, calibration_file: &Path) -> Result<Report, ReportE
         identify,
         export,
         circular,
+        thermal,
     })
 }
 

@@ -67,6 +67,7 @@ fn the_example_report_is_its_documents() {
         "identify",
         "export",
         "circular",
+        "thermal",
         "reproduce",
     ] {
         let at = html[from..]
@@ -134,6 +135,17 @@ fn the_example_report_is_its_documents() {
         doc["map"]["document"]["compensated"]["summary"],
         map["compensated"]["summary"]
     );
+    let thermal = ok_json(&[
+        "thermal",
+        &ex("thermal/spindle_drift.csv"),
+        "--fit",
+        "--holdout",
+        "0.25",
+        "--lag",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(doc["thermal"]["document"]["channels"], thermal["channels"]);
     // The controller's files: the committed example export, byte for byte
     // (its checksums those of examples/export/linuxcnc).
     for f in doc["export"]["files"].as_array().unwrap() {
