@@ -501,8 +501,8 @@ class ReportResult(Result):
     CLI's ``--format json``): ``file``, ``cover``, ``chain_version``,
     ``machine``, ``inputs`` (each ``role``, ``path``, ``bytes``,
     ``sha256``), ``positioning`` (per axis ``axis``, ``document``,
-    ``verdicts``), ``map``, ``identify``, ``export``, ``circular`` (each a
-    command's document, or ``None``). Rows of ``to_dataframe()``: one per
+    ``verdicts``), ``map``, ``identify``, ``export``, ``circular``,
+    ``thermal`` (each a command's document, or ``None``). Rows of ``to_dataframe()``: one per
     ISO 230-2 verdict.
     """
 

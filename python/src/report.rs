@@ -3,6 +3,8 @@
 //! the CLI's message: located problems of the calibration file or of a file
 //! it names as `MachineError`, the others as `ValueError`.
 
+use chain::ops::identify::IdentifyOpsError;
+use chain::ops::Worded;
 use chain::report::{self, Calibration, ReportError};
 use pyo3::prelude::*;
 
@@ -24,6 +26,14 @@ pub(crate) fn report_html(py: Python<'_>, path: &str) -> PyResult<(String, Strin
         ReportError::Values(e) => load_error(py, e.diagnostics()),
         ReportError::CircularFile(e) => load_error(py, e.diagnostics()),
         ReportError::DriftFile(e) => load_error(py, &e.0),
+        ReportError::Identify(e) => match *e {
+            IdentifyOpsError::Measurements(m) => load_error(py, m.diagnostics()),
+            e => value_error(e.with_help()),
+        },
+        ReportError::Map(e) => value_error(e.with_help()),
+        ReportError::Export(e) => value_error(e.with_help()),
+        ReportError::Circular(e) => value_error(e.with_help()),
+        ReportError::Thermal(e) => value_error(e.with_help()),
         e => value_error(e.to_string()),
     })?;
     Ok((report::html(&done), to_json(&done)?))

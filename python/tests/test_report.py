@@ -3,8 +3,10 @@ well-formed HTML (html5lib, strict), self-contained, every number it shows the J
 real browser (Debian's Chromium, headless), it prints on A4 with a page per section and draws
 every chart."""
 
+import hashlib
 import json
 import os
+import pathlib
 import re
 import shutil
 import struct
@@ -41,6 +43,21 @@ def test_report_is_the_cli_s(cli, tmp_path):
     frame = r.to_dataframe()
     assert list(frame["figure"]) == ["A", "E", "R", "M", "B"]
     assert all(frame["pass"] == (frame["value"].abs() <= frame["tolerance"]))
+
+
+def test_the_controller_files_are_the_committed_export():
+    """The LinuxCNC files the report lists are examples/export/linuxcnc's, by SHA-256 (Python's
+    hashlib, independent of the report's)."""
+    doc = chain.report(CALIBRATION).to_dict()
+    files = doc["export"]["files"]
+    committed = sorted(p.name for p in (ROOT / "examples" / "export" / "linuxcnc").iterdir())
+    assert sorted(f["path"] for f in files) == committed
+    for f in files:
+        data = (ROOT / "examples" / "export" / "linuxcnc" / f["path"]).read_bytes()
+        assert f["sha256"] == hashlib.sha256(data).hexdigest(), f["path"]
+        assert f["bytes"] == len(data)
+    for f in doc["inputs"]:
+        assert f["sha256"] == hashlib.sha256(pathlib.Path(f["path"]).read_bytes()).hexdigest(), f["path"]
 
 
 def test_the_page_is_well_formed_self_contained_and_its_documents():

@@ -123,3 +123,12 @@ pub fn quantity_label(q: Quantity) -> &'static str {
         Quantity::Component(c) => c.name(),
     }
 }
+
+/// The decimals that show an uncertainty `u` to two significant digits,
+/// and its value to the same place (3 without one; at most 6): how the
+/// circular test's diagnosis is printed in the table and on the report's
+/// page.
+pub fn places(u: Option<f64>) -> usize {
+    u.filter(|u| *u > 0.0 && u.is_finite())
+        .map_or(3, |u| (1 - u.log10().floor() as i32).clamp(0, 6) as usize)
+}

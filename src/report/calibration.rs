@@ -8,7 +8,9 @@
 use std::path::{Path, PathBuf};
 
 use chain_core::diagnostic::{closest, Describe, Description, Diagnostics, Problem};
+use chain_core::measured::circular::Plane;
 use chain_core::measured::positioning::Coverage;
+use chain_core::measured::Holdout;
 use chain_core::model::Origin;
 use chain_core::yaml::{self, Node};
 use serde::Serialize;
@@ -19,11 +21,17 @@ use crate::ops::export::ExportController;
 /// The largest calibration file read.
 pub const MAX_CALIBRATION_BYTES: usize = 1 << 20;
 
-/// The ISO 230-2 figures a tolerance may be given for (spec
-/// `positioning.md`, "Output").
-pub const FIGURES: [&str; 12] = [
-    "A", "A_up", "A_down", "E", "E_up", "E_down", "M", "R", "R_up", "R_down", "B", "B_mean",
-];
+/// The ISO 230-2 figures a tolerance may be given for: the names of
+/// [`super::FIGURES`].
+const FIGURE_NAMES: [&str; 12] = {
+    let mut names = [""; 12];
+    let mut i = 0;
+    while i < 12 {
+        names[i] = super::FIGURES[i].0;
+        i += 1;
+    }
+    names
+};
 
 /// The cover of the report: who, what, with what, when, at what
 /// temperatures (free text, as the calibration file gives it).
@@ -171,6 +179,14 @@ enum CalibrationProblem {
     ExportWithoutValues,
     /// An axis named twice.
     AxisTwice { axis: String },
+    /// A value the library refuses, in its words.
+    Refused { message: String },
+    /// Two keys that do not go together.
+    Conflict {
+        key: &'static str,
+        with: &'static str,
+        why: &'static str,
+    },
 }
 
 impl Describe for CalibrationProblem {
@@ -220,6 +236,14 @@ impl Describe for CalibrationProblem {
                 "chain::report::export_without_values",
                 "export",
                 "the export writes a values file's errors for a controller: give `values` too",
+            ),
+            P::Refused { message } => {
+                Description::new("chain::report::refused", "value", message.clone())
+            }
+            P::Conflict { key, with, why } => Description::new(
+                "chain::report::conflict",
+                "here",
+                format!("`{key}` with `{with}`: {why}"),
             ),
             P::AxisTwice { axis } => Description::new(
                 "chain::report::axis_twice",
@@ -529,34 +553,48 @@ impl Calibration {
                     None
                 }
             };
-            let holdout = field("holdout").and_then(|h| {
-                let v = r.number(h, "identify.holdout")?;
-                if v > 0.0 && v < 1.0 {
-                    Some(v)
-                } else {
-                    let rule = "a fraction in (0, 1)";
-                    r.refuse(
-                        h,
-                        "identify.holdout",
-                        CalibrationProblem::Range { value: v, rule },
-                    );
-                    None
-                }
-            });
             let seed = field("seed").and_then(|s| {
                 let v = r.number(s, "identify.seed")?;
                 if v >= 0.0 && v == v.trunc() && v < 1.8e19 {
                     Some(v as u64)
                 } else {
                     let rule = "a whole number, 0 or more";
-                    r.refuse(
-                        s,
-                        "identify.seed",
-                        CalibrationProblem::Range { value: v, rule },
-                    );
+                    r.refuse(s, "identify.seed", CalibrationProblem::Range { value: v, rule });
                     None
                 }
             });
+            // The holdout's own rule (`Holdout::check`), located here.
+            let holdout = field("holdout").and_then(|h| {
+                let fraction = r.number(h, "identify.holdout")?;
+                let split = Holdout {
+                    fraction,
+                    seed: seed.unwrap_or(Holdout::DEFAULT_SEED),
+                };
+                match split.check() {
+                    Ok(()) => Some(fraction),
+                    Err(e) => {
+                        let message = e.to_string();
+                        r.refuse(h, "identify.holdout", CalibrationProblem::Refused { message });
+                        None
+                    }
+                }
+            });
+            if let (Some(s), None) = (field("seed"), field("holdout")) {
+                let problem = CalibrationProblem::Conflict {
+                    key: "seed",
+                    with: "no holdout",
+                    why: "the seed chooses the records the holdout holds out: give `holdout` too",
+                };
+                r.refuse(s, "identify.seed", problem);
+            }
+            if let (Some(h), Some(_)) = (field("holdout"), field("validate")) {
+                let problem = CalibrationProblem::Conflict {
+                    key: "holdout",
+                    with: "validate",
+                    why: "one holds records of the measurements out, the other reads them from a file: give one",
+                };
+                r.refuse(h, "identify.holdout", problem);
+            }
             let validate = field("validate").and_then(|v| r.file(v, "identify.validate"));
             let machine = field("machine").and_then(|v| r.file(v, "identify.machine"));
             Some(IdentifyPart {
@@ -612,7 +650,23 @@ impl Calibration {
             };
             let radius = field("radius").and_then(|v| r.positive(v, "circular.radius"));
             let feed = field("feed").and_then(|v| r.positive(v, "circular.feed"));
-            let plane = field("plane").and_then(|v| r.text(v, "circular.plane"));
+            let plane = field("plane").and_then(|v| {
+                let text = r.text(v, "circular.plane")?;
+                if Plane::parse(&text).is_some() {
+                    Some(text)
+                } else {
+                    let found = v.describe();
+                    r.refuse(
+                        v,
+                        "circular.plane",
+                        CalibrationProblem::WrongType {
+                            expected: "a plane: xy, yz or zx",
+                            found,
+                        },
+                    );
+                    None
+                }
+            });
             Some(CircularPart {
                 runs: runs?,
                 radius,
@@ -656,10 +710,10 @@ impl Calibration {
             });
             let sensors = field("sensors").and_then(|s| {
                 let v = r.number(s, "thermal.sensors")?;
-                if v >= 1.0 && v == v.trunc() && v <= 64.0 {
+                if v >= 1.0 && v == v.trunc() && v < 1e9 {
                     Some(v as usize)
                 } else {
-                    let rule = "a whole number from 1 to 64";
+                    let rule = "a whole number, 1 or more";
                     r.refuse(
                         s,
                         "thermal.sensors",
@@ -733,7 +787,7 @@ fn axis_runs(r: &mut Reader<'_>, node: &Node, key: &str) -> Option<AxisRuns> {
     let mut tolerances = Vec::new();
     if let Some(t) = field("tolerances") {
         let tkey = join(key, "tolerances");
-        if let Some(entries) = r.mapping(t, &tkey, &format!("`{tkey}`"), &FIGURES) {
+        if let Some(entries) = r.mapping(t, &tkey, &format!("`{tkey}`"), &FIGURE_NAMES) {
             for (name, v) in entries {
                 if let Some(x) = r.positive(v, &join(&tkey, name)) {
                     tolerances.push((name.to_string(), x));

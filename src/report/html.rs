@@ -204,8 +204,8 @@ fn positioning(o: &mut String, index: usize, a: &AxisSection) {
         d.k
     );
     o.push_str("<table>\n<tr><th>figure</th><th>value</th><th>unit</th></tr>\n");
-    for figure in super::calibration::FIGURES {
-        let value = super::figure_value(d, figure);
+    for (figure, value) in super::FIGURES {
+        let value = value(&d.axis);
         let _ = writeln!(
             o,
             "<tr><td>{figure}</td>{}<td>{unit}</td></tr>",
@@ -419,12 +419,13 @@ fn circular(o: &mut String, r: &Report) {
         if e.within_noise == Some(true) {
             continue;
         }
+        let places = crate::ops::views::places(e.uncertainty);
         let _ = writeln!(
             o,
             "<tr><td>{}</td>{}<td class=\"num\">{}</td><td>{}</td><td class=\"num\">{:.0}%</td></tr>",
             esc(&e.term.label()),
-            cell(&format!("circular.document.diagnosis.{i}.value"), e.value, 1.0, 3),
-            e.uncertainty.map_or("—".to_string(), |u| format!("{u:.3}")),
+            cell(&format!("circular.document.diagnosis.{i}.value"), e.value, 1.0, places),
+            e.uncertainty.map_or("—".to_string(), |u| format!("{u:.places$}")),
             e.unit,
             100.0 * e.share
         );

@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use chain_core::diagnostic::Diagnostics;
 use chain_core::measured::circular::diagnosis::DiagnosisOptions;
-use chain_core::measured::positioning::{PositioningDocument, Runs, RunsFileError};
+use chain_core::measured::positioning::{AxisStats, PositioningDocument, Runs, RunsFileError};
 use chain_core::values::ValuesError;
 
 use crate::ops::circular::{Circular, CircularOpsError};
@@ -270,14 +270,14 @@ pub fn run(cal: &Calibration, calibration_file: &Path) -> Result<Report, ReportE
         })?;
         let document = done.document;
         let verdicts = (axis.tolerances.iter())
-            .map(|(figure, tolerance)| {
-                let value = figure_value(&document, figure);
-                Verdict {
+            .filter_map(|(figure, tolerance)| {
+                let value = figure_value(&document, figure)?;
+                Some(Verdict {
                     figure: figure.clone(),
                     value,
                     tolerance: *tolerance,
                     pass: value.abs() <= *tolerance,
-                }
+                })
             })
             .collect();
         let charts = svgs(&crate::plot::positioning::charts(&document))?;
@@ -421,22 +421,31 @@ pub fn run(cal: &Calibration, calibration_file: &Path) -> Result<Report, ReportE
     })
 }
 
-/// The axis's value of an ISO 230-2 figure ([`calibration::FIGURES`]).
-pub fn figure_value(doc: &PositioningDocument, figure: &str) -> f64 {
-    let a = &doc.axis;
-    match figure {
-        "A" => a.A,
-        "A_up" => a.A_up,
-        "A_down" => a.A_down,
-        "E" => a.E,
-        "E_up" => a.E_up,
-        "E_down" => a.E_down,
-        "M" => a.M,
-        "R" => a.R,
-        "R_up" => a.R_up,
-        "R_down" => a.R_down,
-        "B" => a.B,
-        "B_mean" => a.B_mean,
-        _ => f64::NAN,
-    }
+/// How an ISO 230-2 figure is read from an axis's statistics.
+pub type Figure = fn(&AxisStats) -> f64;
+
+/// The ISO 230-2 figures of an axis (spec `positioning.md`, "Output"): name
+/// and value, the one table the tolerances, the verdicts and the page read.
+pub const FIGURES: [(&str, Figure); 12] = [
+    ("A", |a| a.A),
+    ("A_up", |a| a.A_up),
+    ("A_down", |a| a.A_down),
+    ("E", |a| a.E),
+    ("E_up", |a| a.E_up),
+    ("E_down", |a| a.E_down),
+    ("M", |a| a.M),
+    ("R", |a| a.R),
+    ("R_up", |a| a.R_up),
+    ("R_down", |a| a.R_down),
+    ("B", |a| a.B),
+    ("B_mean", |a| a.B_mean),
+];
+
+/// The axis's value of the ISO 230-2 figure `figure` (one of
+/// [`FIGURES`]; the calibration file refuses any other).
+fn figure_value(doc: &PositioningDocument, figure: &str) -> Option<f64> {
+    FIGURES
+        .iter()
+        .find(|(name, _)| *name == figure)
+        .map(|(_, value)| value(&doc.axis))
 }

@@ -89,7 +89,7 @@ fn diagnosis(doc: &Circular, out: &mut String) {
             fit.excluded,
             fit.window,
             fit.unknowns,
-            um(fit.rms)
+            fit.rms.map_or("- (no degree of freedom left)".to_string(), um)
         );
         let _ = writeln!(
             out,
@@ -97,12 +97,7 @@ fn diagnosis(doc: &Circular, out: &mut String) {
             "error", "value", "± 1σ", "unit", "share"
         );
         for e in doc.diagnosis.iter().filter(|e| e.term.plane == plane) {
-            // Two significant digits of the uncertainty, the value to its
-            // last one.
-            let places = e
-                .uncertainty
-                .filter(|u| *u > 0.0)
-                .map_or(3, |u| (1 - u.log10().floor() as i32).clamp(0, 6) as usize);
+            let places = chain::ops::views::places(e.uncertainty);
             let se = e
                 .uncertainty
                 .map_or("-".to_string(), |u| format!("{u:.places$}"));

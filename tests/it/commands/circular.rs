@@ -384,7 +384,6 @@ fn the_example_diagnosis_reads_the_generator_s_machine() {
                 "ms" => "ms",
                 _ => "ms^2",
             };
-            assert!(num(&e["share"]) >= 0.0);
             (num(&e["value"]), num(&e["uncertainty"]), unit)
         };
         for (error, key, axes, allowance) in [
@@ -409,6 +408,17 @@ fn the_example_diagnosis_reads_the_generator_s_machine() {
                 "{plane} {error} {axes:?}: {value} ± {se} {unit}, stated {truth}"
             );
         }
+        // The servo mismatch explains most of every run's G (the lag
+        // difference at 1000 and 3000 mm/min), squareness a part of it:
+        // shares are of G, between 0 and 1.
+        let share = |error: &str| -> f64 {
+            let e = (diagnosis.iter())
+                .find(|e| e["plane"] == plane && e["error"] == error)
+                .unwrap();
+            num(&e["share"])
+        };
+        assert!(share("servo_mismatch") > 0.5 && share("servo_mismatch") <= 1.0);
+        assert!(share("squareness") > 0.02 && share("squareness") < 0.5);
     }
     // Two feeds and both directions: everything separated, only the
     // cyclic errors (no pitch given) not fitted.
@@ -670,7 +680,7 @@ fn identify_circular_refusals_are_named() {
     let machine = machine.to_str().unwrap();
     let runs = common::cli::write(&dir, "runs.csv", &ballbar_runs(false));
     let runs = runs.to_str().unwrap();
-    let check = |args: &[&str], words: &[&str]| {
+    let check_on = |machine: &str, args: &[&str], words: &[&str]| {
         let mut all = vec!["identify", machine];
         all.extend_from_slice(args);
         let err = unwrapped(&fails(&all));
@@ -678,6 +688,7 @@ fn identify_circular_refusals_are_named() {
             assert!(err.contains(w), "{args:?}: `{w}` not in {err}");
         }
     };
+    let check = |args: &[&str], words: &[&str]| check_on(machine, args, words);
     check(
         &["--circular", runs],
         &["--circular", "--centre", "--axes", "one of them"],
@@ -716,6 +727,56 @@ fn identify_circular_refusals_are_named() {
     check(
         &["--circular", wrong.to_str().unwrap(), "--axes"],
         &["wrong.csv:2", "run xy", "not the run's radius 90 mm"],
+    );
+    check(
+        &["--circular", runs, "--centre", "x=1,x=2"],
+        &["--centre", "gives `x` twice"],
+    );
+    check(
+        &["--circular", runs, "--centre", "x=NaN"],
+        &["--centre", "not a finite number"],
+    );
+    // Poses on one line, and a circle out of the run's plane.
+    let line: String = ballbar_runs(true)
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 0 || !l.starts_with("xy,") {
+                return format!("{l}\n");
+            }
+            let mut cells: Vec<String> = l.split(',').map(str::to_string).collect();
+            cells[7] = "150".into(); // y fixed: the poses on a line
+            format!("{}\n", cells.join(","))
+        })
+        .collect();
+    let line = common::cli::write(&dir, "line.csv", &line);
+    check(
+        &["--circular", line.to_str().unwrap(), "--axes"],
+        &["line.csv:2", "run xy", "on one line"],
+    );
+    let tilted = ballbar_runs(true).replace(",xy,", ",yz,").replacen(
+        "run,radius,yz,",
+        "run,radius,plane,",
+        1,
+    );
+    let tilted = common::cli::write(&dir, "tilted.csv", &tilted);
+    check(
+        &["--circular", tilted.to_str().unwrap(), "--axes"],
+        &["tilted.csv:2", "tilted 90.00° from the run's plane yz"],
+    );
+    // A machine without a linear variable named after a plane's axis.
+    let uvw = common::cli::write(
+        &dir,
+        "uvw.yaml",
+        &BALLBAR_XYZ.replace("variable: x", "variable: u"),
+    );
+    check_on(
+        uvw.to_str().unwrap(),
+        &["--circular", runs, "--centre", "u=0"],
+        &[
+            "runs.csv:2",
+            "machine `ballbar_xyz` has no linear variable named `x`",
+        ],
     );
     // A run file refused as `chain circular` refuses it.
     let bad = common::cli::write(&dir, "bad.csv", "angle,direction,deviation\n0,up,0\n");

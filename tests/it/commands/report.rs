@@ -146,8 +146,8 @@ fn the_example_report_is_its_documents() {
         "json",
     ]);
     assert_eq!(doc["thermal"]["document"]["channels"], thermal["channels"]);
-    // The controller's files: the committed example export, byte for byte
-    // (its checksums those of examples/export/linuxcnc).
+    // The controller's files: the committed example export's, by size
+    // (python/tests/test_report.py compares their SHA-256).
     for f in doc["export"]["files"].as_array().unwrap() {
         let name = f["path"].as_str().unwrap();
         let bytes =
@@ -249,6 +249,31 @@ fn calibration_refusals_are_located() {
             r = ex("positioning/x_axis_runs.csv")
         ),
         &["twice.yaml:4", "axis `x` has positioning runs twice"],
+    );
+    let runs = ex("positioning/x_axis_runs.csv");
+    let measurements = ex("measurements/interferometer.csv");
+    check(
+        "plane.yaml",
+        &format!(
+            "machine: {machine}\ncircular: {{runs: {}, plane: xz}}\n",
+            ex("circular/runs.csv")
+        ),
+        &["plane.yaml:2", "expected a plane: xy, yz or zx, found `xz`"],
+    );
+    check(
+        "seed.yaml",
+        &format!("machine: {machine}\nidentify: {{measurements: {measurements}, seed: 3}}\n"),
+        &["seed.yaml:2", "give `holdout` too"],
+    );
+    check(
+        "validate.yaml",
+        &format!("machine: {machine}\nidentify: {{measurements: {measurements}, holdout: 0.2, validate: {measurements}}}\n"),
+        &["validate.yaml:2", "`holdout` with `validate`"],
+    );
+    check(
+        "k.yaml",
+        &format!("machine: {machine}\npositioning:\n  - {{axis: x, runs: {runs}, k: 0}}\n"),
+        &["k.yaml:3", "must be positive"],
     );
     // A refusal inside a named file is that file's, located there.
     let bad_runs = write(

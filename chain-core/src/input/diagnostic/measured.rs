@@ -657,6 +657,15 @@ pub enum CircularProblem {
         /// The run.
         run: String,
     },
+    /// A run whose poses draw a circle out of the run's plane.
+    PlaneTilted {
+        /// The run.
+        run: String,
+        /// Its plane.
+        plane: &'static str,
+        /// The tilt (degrees).
+        tilt: f64,
+    },
 }
 
 impl CircularProblem {
@@ -743,6 +752,15 @@ impl CircularProblem {
                 ),
             )
             .help("the poses and the radius describe one circle: check the radius, the pose columns' units (rotary axes in degrees) and the centre".to_string()),
+            CircularProblem::PlaneTilted { run, plane, tilt } => D::new(
+                "chain::circular::plane_tilted",
+                "pose",
+                format!(
+                    "run {run}: its poses draw a circle whose plane is tilted {tilt:.2}° from the run's plane {plane} (at most {}°)",
+                    crate::measured::circular::records::MAX_TILT
+                ),
+            )
+            .help("the run's `plane` names the plane its circle lies in (the table ball's offsets are taken along its axes)".to_string()),
             CircularProblem::NoCircle { run } => D::new(
                 "chain::circular::no_circle",
                 "pose",

@@ -66,7 +66,8 @@ pub enum Error {
     Backlash,
     /// `Δt = τ_a − τ_b` (ms): a lags more than b.
     ServoMismatch,
-    /// `v·Δt/2` of one run without a feed (µm).
+    /// `v·Δt` of one run without a feed (µm): the servo mismatch's
+    /// amplitude there (its column `d·sin 2θ/2`).
     ServoAmplitude,
     /// `q = τ_a² − τ_b²` (ms²): the servo's second-order `cos 2θ` term.
     GainMismatch,
@@ -99,7 +100,7 @@ impl Error {
             Error::ScaleMismatch => "+: a over-travels more than b (eps_a - eps_b; eps + = over-travel)",
             Error::Backlash => "+: lost motion (the trace steps outward after the axis reverses); - over-compensated",
             Error::ServoMismatch => "+: a lags its command more than b (tau_a - tau_b, tau = 1/Kv)",
-            Error::ServoAmplitude => "+: as servo mismatch, v*dt/2 of this run (no feed given)",
+            Error::ServoAmplitude => "+: as servo mismatch, v*dt of this run (no feed given)",
             Error::GainMismatch => "tau_a^2 - tau_b^2",
             Error::StraightnessBow => "a: + = a's path bulges towards +b at mid-travel; b: + = towards +a (less the other axis's positioning bow)",
             Error::CyclicError => "amplitude, >= 0 (the phase holds the circle's position on the axis)",
@@ -192,8 +193,9 @@ pub struct Diagnosed {
     /// [`Error::unit`].
     pub unit: &'static str,
     /// Its standard error (the least-squares one, the residuals taken as
-    /// independent: a lower bound for a smooth residual), when the fit has
-    /// more samples than unknowns.
+    /// independent: a lower bound for a smooth residual; for a reversal
+    /// spike, one sample's: the residual's standard deviation), when the
+    /// fit has more samples than unknowns.
     pub uncertainty: Option<f64>,
     /// [`Error::sign`].
     pub sign: &'static str,
@@ -310,8 +312,8 @@ pub struct PlaneFit {
     /// The unknowns fitted.
     pub unknowns: usize,
     /// The RMS of the residual (mm), with `samples − unknowns` degrees of
-    /// freedom.
-    pub rms: f64,
+    /// freedom (`None` when none is left).
+    pub rms: Option<f64>,
     /// Each run's centre, radius offset and residual.
     pub runs: Vec<RunFit>,
     /// What was not fitted, and why.
@@ -1006,7 +1008,7 @@ fn diagnose_plane(
         excluded: all.len() - n,
         window: options.window,
         unknowns: p,
-        rms: sigma.unwrap_or(0.0),
+        rms: sigma,
         runs: run_fits,
         not_fitted,
         correlated,
@@ -1458,7 +1460,8 @@ mod tests {
         check(&d, Error::StraightnessBow, Some("x"), -2.0, 0.03);
         check(&d, Error::StraightnessBow, Some("y"), 1.0, 0.03);
         // The residual is the noise.
-        assert!(d.planes[0].rms < 1.5 * NOISE, "{}", d.planes[0].rms);
+        let rms = d.planes[0].rms.unwrap();
+        assert!(rms < 1.5 * NOISE, "{rms}");
         assert!(d.planes[0]
             .not_fitted
             .iter()

@@ -60,6 +60,11 @@ pub(crate) fn rotary_variables(m: &Machine) -> Vec<bool> {
 /// different circles (a wrong radius, radians for degrees).
 pub const ON_CIRCLE: f64 = 1e-3;
 
+/// How far (degrees) the plane of a run's nominal tool points may tilt from
+/// the run's plane: its table ball's offsets are taken along that plane's
+/// axes.
+pub const MAX_TILT: f64 = 1.0;
+
 /// Where a circular test's samples are on the machine.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum CirclePose<'a> {
@@ -236,6 +241,9 @@ impl Measurements {
                 Ok((origin, q, p))
             })
             .map_err(fail)?;
+        // The run file's rows by line: the same text read by the same CSV
+        // reader as `CircularTest::parse` read it, one record a line, so
+        // every sample's line is here.
         let at: HashMap<usize, usize> = (rows.iter().enumerate())
             .map(|(i, r)| (r.0.line, i))
             .collect();
@@ -296,7 +304,22 @@ impl Measurements {
             let c0 = match pose {
                 CirclePose::Centre(centre) => chain.nominal(centre, &poses[0].1).point,
                 CirclePose::Columns => match circle_centre(&points) {
-                    Some(c) => c,
+                    Some((c, normal)) => {
+                        // The set-up's offsets are along the run's plane's
+                        // axes: the circle must lie in that plane.
+                        let [a, b] = run.plane.axes();
+                        let k = 3 - a - b;
+                        let tilt = normal[k].abs().clamp(0.0, 1.0).acos().to_degrees();
+                        if tilt > MAX_TILT {
+                            let problem = CircularProblem::PlaneTilted {
+                                run: run.id.clone(),
+                                plane: run.plane.name(),
+                                tilt,
+                            };
+                            return Err(fail(vec![(first, problem.into())]));
+                        }
+                        c
+                    }
                     None => {
                         let problem = CircularProblem::NoCircle {
                             run: run.id.clone(),
@@ -349,10 +372,10 @@ impl Measurements {
 }
 
 #[cfg(feature = "csv")]
-/// The centre of the circle through `points`: their least-squares plane
-/// through their centroid, then in it the algebraic (Kåsa) circle;
-/// `None` for points on one line.
-fn circle_centre(points: &[[f64; 3]]) -> Option<[f64; 3]> {
+/// The centre of the circle through `points` and the normal of its plane:
+/// their least-squares plane through their centroid, then in it the
+/// algebraic (Kåsa) circle; `None` for points on one line.
+fn circle_centre(points: &[[f64; 3]]) -> Option<([f64; 3], [f64; 3])> {
     use nalgebra::{Matrix3, Vector3};
     let n = points.len() as f64;
     let m: Vector3<f64> = points
@@ -386,5 +409,6 @@ fn circle_centre(points: &[[f64; 3]]) -> Option<[f64; 3]> {
     }
     let s = a.lu().solve(&b)?;
     let c = m - e1 * (s[0] / 2.0) - e2 * (s[1] / 2.0);
-    Some([c[0], c[1], c[2]])
+    let n = e1.cross(&e2);
+    Some(([c[0], c[1], c[2]], [n[0], n[1], n[2]]))
 }
