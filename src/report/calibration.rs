@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 use chain_core::diagnostic::{closest, Describe, Description, Diagnostics, Problem};
 use chain_core::measured::circular::Plane;
 use chain_core::measured::positioning::Coverage;
+use chain_core::measured::positioning_temperature::Temperatures;
 use chain_core::measured::Holdout;
 use chain_core::model::Origin;
 use chain_core::yaml::{self, Node};
@@ -70,6 +71,9 @@ pub struct AxisRuns {
     /// The tolerances of the figures given (figure, tolerance in the
     /// deviations' unit).
     pub tolerances: Vec<(String, f64)>,
+    /// The correction of a linear axis's runs to 20 °C
+    /// (`docs/positioning.md`, "At 20 °C").
+    pub temperature: Option<Temperatures>,
 }
 
 /// The identification's records and how their prediction is checked.
@@ -272,7 +276,15 @@ const TOP: &[&str] = &[
     "circular",
     "thermal",
 ];
-const AXIS: &[&str] = &["axis", "runs", "rotary", "k", "tolerances"];
+const AXIS: &[&str] = &["axis", "runs", "rotary", "k", "tolerances", "temperature"];
+const TEMPERATURE: &[&str] = &[
+    "axis",
+    "expansion",
+    "instrument",
+    "instrument_expansion",
+    "temperature_uncertainty",
+    "expansion_uncertainty",
+];
 const IDENTIFY: &[&str] = &["machine", "measurements", "holdout", "seed", "validate"];
 const EXPORT: &[&str] = &["controller"];
 const CIRCULAR: &[&str] = &["runs", "radius", "feed", "plane"];
@@ -320,19 +332,48 @@ impl Reader<'_> {
         Some(out)
     }
 
+    /// `node` is not of the kind `expected`.
+    fn wrong(&mut self, node: &Node, key: &str, expected: &'static str) {
+        let found = node.describe();
+        self.refuse(node, key, CalibrationProblem::WrongType { expected, found });
+    }
+
+    /// A required entry of a mapping (`at`: the mapping in words), refused
+    /// at the mapping's node when missing.
+    fn required<'n>(
+        &mut self,
+        value: Option<&'n Node>,
+        mapping: &Node,
+        key: &str,
+        name: &'static str,
+        at: &str,
+    ) -> Option<&'n Node> {
+        if value.is_none() {
+            let problem = CalibrationProblem::MissingKey {
+                key: name,
+                at: at.to_string(),
+            };
+            self.refuse(mapping, key, problem);
+        }
+        value
+    }
+
+    /// A whole number at least `least`.
+    fn whole(&mut self, node: &Node, key: &str, least: f64, rule: &'static str) -> Option<u64> {
+        let v = self.number(node, key)?;
+        if v >= least && v == v.trunc() && v < 1.8e19 {
+            Some(v as u64)
+        } else {
+            self.refuse(node, key, CalibrationProblem::Range { value: v, rule });
+            None
+        }
+    }
+
     fn text(&mut self, node: &Node, key: &str) -> Option<String> {
         match node.as_scalar() {
             Some(s) if !s.is_null() => Some(s.text.clone()),
             _ => {
-                let found = node.describe();
-                self.refuse(
-                    node,
-                    key,
-                    CalibrationProblem::WrongType {
-                        expected: "text",
-                        found,
-                    },
-                );
+                self.wrong(node, key, "text");
                 None
             }
         }
@@ -343,15 +384,7 @@ impl Reader<'_> {
         match value {
             Some(v) if v.is_finite() => Some(v),
             _ => {
-                let found = node.describe();
-                self.refuse(
-                    node,
-                    key,
-                    CalibrationProblem::WrongType {
-                        expected: "a finite number",
-                        found,
-                    },
-                );
+                self.wrong(node, key, "a finite number");
                 None
             }
         }
@@ -373,15 +406,7 @@ impl Reader<'_> {
             Some("true") => Some(true),
             Some("false") => Some(false),
             _ => {
-                let found = node.describe();
-                self.refuse(
-                    node,
-                    key,
-                    CalibrationProblem::WrongType {
-                        expected: "true or false",
-                        found,
-                    },
-                );
+                self.wrong(node, key, "true or false");
                 None
             }
         }
@@ -497,17 +522,9 @@ impl Calibration {
         if let Some(t) = get("temperatures") {
             cover.temperatures = r.named_numbers(t, "temperatures");
         }
-        let machine = match get("machine") {
-            Some(m) => r.file(m, "machine"),
-            None => {
-                let problem = CalibrationProblem::MissingKey {
-                    key: "machine",
-                    at: "the calibration file".into(),
-                };
-                r.refuse(&root, "", problem);
-                None
-            }
-        };
+        let machine = r
+            .required(get("machine"), &root, "", "machine", "the calibration file")
+            .and_then(|m| r.file(m, "machine"));
         let params = get("params").map_or_else(Vec::new, |p| r.named_numbers(p, "params"));
         let mut positioning: Vec<AxisRuns> = Vec::new();
         if let Some(list) = get("positioning") {
@@ -525,44 +542,18 @@ impl Calibration {
                         }
                     }
                 }
-                None => {
-                    let found = list.describe();
-                    r.refuse(
-                        list,
-                        "positioning",
-                        CalibrationProblem::WrongType {
-                            expected: "a list of axes",
-                            found,
-                        },
-                    );
-                }
+                None => r.wrong(list, "positioning", "a list of axes"),
             }
         }
         let values = get("values").and_then(|v| r.file(v, "values"));
         let identify = get("identify").and_then(|node| {
             let entries = r.mapping(node, "identify", "`identify`", IDENTIFY)?;
             let field = |k: &str| entries.iter().find(|(n, _)| *n == k).map(|(_, v)| *v);
-            let measurements = match field("measurements") {
-                Some(m) => r.file(m, "identify.measurements"),
-                None => {
-                    let problem = CalibrationProblem::MissingKey {
-                        key: "measurements",
-                        at: "`identify`".into(),
-                    };
-                    r.refuse(node, "identify", problem);
-                    None
-                }
-            };
-            let seed = field("seed").and_then(|s| {
-                let v = r.number(s, "identify.seed")?;
-                if v >= 0.0 && v == v.trunc() && v < 1.8e19 {
-                    Some(v as u64)
-                } else {
-                    let rule = "a whole number, 0 or more";
-                    r.refuse(s, "identify.seed", CalibrationProblem::Range { value: v, rule });
-                    None
-                }
-            });
+            let measurements = r
+                .required(field("measurements"), node, "identify", "measurements", "`identify`")
+                .and_then(|f| r.file(f, "identify.measurements"));
+            let seed = field("seed")
+                .and_then(|s| r.whole(s, "identify.seed", 0.0, "a whole number, 0 or more"));
             // The holdout's own rule (`Holdout::check`), located here.
             let holdout = field("holdout").and_then(|h| {
                 let fraction = r.number(h, "identify.holdout")?;
@@ -607,14 +598,11 @@ impl Calibration {
         });
         let export = get("export").and_then(|node| {
             let entries = r.mapping(node, "export", "`export`", EXPORT)?;
-            let Some((_, c)) = entries.iter().find(|(n, _)| *n == "controller") else {
-                let problem = CalibrationProblem::MissingKey {
-                    key: "controller",
-                    at: "`export`".into(),
-                };
-                r.refuse(node, "export", problem);
-                return None;
-            };
+            let field = entries
+                .iter()
+                .find(|(n, _)| *n == "controller")
+                .map(|(_, v)| *v);
+            let c = r.required(field, node, "export", "controller", "`export`")?;
             let name = r.text(c, "export.controller")?;
             match ExportController::parse(&name) {
                 Ok(controller) => {
@@ -637,17 +625,9 @@ impl Calibration {
         let circular = get("circular").and_then(|node| {
             let entries = r.mapping(node, "circular", "`circular`", CIRCULAR)?;
             let field = |k: &str| entries.iter().find(|(n, _)| *n == k).map(|(_, v)| *v);
-            let runs = match field("runs") {
-                Some(f) => r.file(f, "circular.runs"),
-                None => {
-                    let problem = CalibrationProblem::MissingKey {
-                        key: "runs",
-                        at: "`circular`".into(),
-                    };
-                    r.refuse(node, "circular", problem);
-                    None
-                }
-            };
+            let runs = r
+                .required(field("runs"), node, "circular", "runs", "`circular`")
+                .and_then(|f| r.file(f, "circular.runs"));
             let radius = field("radius").and_then(|v| r.positive(v, "circular.radius"));
             let feed = field("feed").and_then(|v| r.positive(v, "circular.feed"));
             let plane = field("plane").and_then(|v| {
@@ -655,15 +635,7 @@ impl Calibration {
                 if Plane::parse(&text).is_some() {
                     Some(text)
                 } else {
-                    let found = v.describe();
-                    r.refuse(
-                        v,
-                        "circular.plane",
-                        CalibrationProblem::WrongType {
-                            expected: "a plane: xy, yz or zx",
-                            found,
-                        },
-                    );
+                    r.wrong(v, "circular.plane", "a plane: xy, yz or zx");
                     None
                 }
             });
@@ -677,17 +649,9 @@ impl Calibration {
         let thermal = get("thermal").and_then(|node| {
             let entries = r.mapping(node, "thermal", "`thermal`", THERMAL)?;
             let field = |k: &str| entries.iter().find(|(n, _)| *n == k).map(|(_, v)| *v);
-            let runs = match field("runs") {
-                Some(f) => r.file(f, "thermal.runs"),
-                None => {
-                    let problem = CalibrationProblem::MissingKey {
-                        key: "runs",
-                        at: "`thermal`".into(),
-                    };
-                    r.refuse(node, "thermal", problem);
-                    None
-                }
-            };
+            let runs = r
+                .required(field("runs"), node, "thermal", "runs", "`thermal`")
+                .and_then(|f| r.file(f, "thermal.runs"));
             let fit = field("fit")
                 .and_then(|v| r.boolean(v, "thermal.fit"))
                 .unwrap_or(true);
@@ -753,27 +717,13 @@ impl Calibration {
 fn axis_runs(r: &mut Reader<'_>, node: &Node, key: &str) -> Option<AxisRuns> {
     let entries = r.mapping(node, key, &format!("`{key}`"), AXIS)?;
     let field = |k: &str| entries.iter().find(|(n, _)| *n == k).map(|(_, v)| *v);
-    let missing = |r: &mut Reader, k: &'static str| {
-        let problem = CalibrationProblem::MissingKey {
-            key: k,
-            at: format!("`{key}`"),
-        };
-        r.refuse(node, key, problem);
-    };
-    let axis = match field("axis") {
-        Some(a) => r.text(a, &join(key, "axis")),
-        None => {
-            missing(r, "axis");
-            None
-        }
-    };
-    let runs = match field("runs") {
-        Some(f) => r.file(f, &join(key, "runs")),
-        None => {
-            missing(r, "runs");
-            None
-        }
-    };
+    let at = format!("`{key}`");
+    let axis = r
+        .required(field("axis"), node, key, "axis", &at)
+        .and_then(|a| r.text(a, &join(key, "axis")));
+    let runs = r
+        .required(field("runs"), node, key, "runs", &at)
+        .and_then(|f| r.file(f, &join(key, "runs")));
     let rotary = field("rotary")
         .and_then(|v| r.boolean(v, &join(key, "rotary")))
         .unwrap_or(false);
@@ -795,11 +745,53 @@ fn axis_runs(r: &mut Reader<'_>, node: &Node, key: &str) -> Option<AxisRuns> {
             }
         }
     }
+    let temperature = match field("temperature") {
+        Some(t) => {
+            let tkey = join(key, "temperature");
+            let entries = r.mapping(t, &tkey, &format!("`{tkey}`"), TEMPERATURE)?;
+            let value = |r: &mut Reader, name: &'static str| {
+                let v = entries.iter().find(|(n, _)| *n == name).map(|(_, v)| *v)?;
+                r.number(v, &join(&tkey, name))
+            };
+            let at = format!("`{tkey}`");
+            let axis_t = r
+                .required(
+                    entries.iter().find(|(n, _)| *n == "axis").map(|(_, v)| *v),
+                    t,
+                    &tkey,
+                    "axis",
+                    &at,
+                )
+                .and_then(|v| r.number(v, &join(&tkey, "axis")));
+            let expansion = r
+                .required(
+                    entries
+                        .iter()
+                        .find(|(n, _)| *n == "expansion")
+                        .map(|(_, v)| *v),
+                    t,
+                    &tkey,
+                    "expansion",
+                    &at,
+                )
+                .and_then(|v| r.number(v, &join(&tkey, "expansion")));
+            Some(crate::ops::positioning::temperatures(
+                axis_t?,
+                expansion?,
+                value(r, "instrument"),
+                value(r, "instrument_expansion"),
+                value(r, "temperature_uncertainty"),
+                value(r, "expansion_uncertainty"),
+            ))
+        }
+        None => None,
+    };
     Some(AxisRuns {
         axis: axis?,
         runs: runs?,
         rotary,
         k: k?,
         tolerances,
+        temperature,
     })
 }

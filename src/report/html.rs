@@ -203,6 +203,9 @@ fn positioning(o: &mut String, index: usize, a: &AxisSection) {
         d.runs,
         d.k
     );
+    if d.temperature.is_some() {
+        o.push_str("<p>The deviations are corrected to 20 °C (ISO 230-2 and ISO 1; docs/positioning.md, \"At 20 °C\"), with the calibration file's temperatures.</p>\n");
+    }
     o.push_str("<table>\n<tr><th>figure</th><th>value</th><th>unit</th></tr>\n");
     for (figure, value) in super::FIGURES {
         let value = value(&d.axis);

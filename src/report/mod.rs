@@ -266,7 +266,7 @@ pub fn run(cal: &Calibration, calibration_file: &Path) -> Result<Report, ReportE
             runs: &runs,
             k: axis.k,
             values_out: None,
-            temperatures: None,
+            temperatures: axis.temperature,
         })?;
         let document = done.document;
         let verdicts = (axis.tolerances.iter())

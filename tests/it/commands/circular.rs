@@ -593,44 +593,18 @@ fn identify_reads_a_circular_test() {
     let machine = machine.to_str().unwrap();
     let runs = common::cli::write(&dir, "runs.csv", &ballbar_runs(false));
     let posed = common::cli::write(&dir, "posed.csv", &ballbar_runs(true));
-    let by_centre = ok_json(&[
-        "identify",
-        machine,
-        "--circular",
-        runs.to_str().unwrap(),
-        "--centre",
-        "x=200,y=150,z=100",
-        "--fix",
-        "EZZ_1",
-        "--format",
-        "json",
-    ]);
-    let by_axes = ok_json(&[
-        "identify",
-        machine,
-        "--circular",
-        posed.to_str().unwrap(),
-        "--axes",
-        "--fix",
-        "EZZ_1",
-        "--format",
-        "json",
-    ]);
-    // The exact kinematics fitted from there (`--iterate`): the circle's
-    // length column is the record's own direction there too.
-    let iterated = ok_json(&[
-        "identify",
-        machine,
-        "--circular",
-        runs.to_str().unwrap(),
-        "--centre",
-        "x=200,y=150,z=100",
-        "--fix",
-        "EZZ_1",
-        "--iterate",
-        "--format",
-        "json",
-    ]);
+    // The runs placed by their centre, by the file's pose columns, and the
+    // exact kinematics fitted from there (`--iterate`: the circle's length
+    // column is the record's own direction there too).
+    let identify = |args: &[&str]| {
+        let head = ["identify", machine, "--circular"];
+        let tail = ["--fix", "EZZ_1", "--format", "json"];
+        ok_json(&[&head[..], args, &tail[..]].concat())
+    };
+    let (runs, posed) = (runs.to_str().unwrap(), posed.to_str().unwrap());
+    let by_centre = identify(&[runs, "--centre", "x=200,y=150,z=100"]);
+    let by_axes = identify(&[posed, "--axes"]);
+    let iterated = identify(&[runs, "--centre", "x=200,y=150,z=100", "--iterate"]);
     assert_eq!(iterated["iteration"]["converged"], true, "{iterated}");
     for doc in [&by_centre, &by_axes, &iterated] {
         let estimate = |name: &str| -> f64 {

@@ -169,6 +169,56 @@ fn the_example_report_is_its_documents() {
     assert_eq!(first["sha256"].as_str().unwrap().len(), 64);
 }
 
+/// A positioning axis corrected to 20 °C (`temperature`) is `chain
+/// positioning --axis-temperature ... --axis-expansion ...`'s document.
+#[test]
+fn a_positioning_axis_at_20_c_is_the_command_s() {
+    let dir = scratch("report-temperature");
+    let ex = |p: &str| common::example_file(p).to_str().unwrap().to_string();
+    let runs = ex("positioning/x_axis_runs.csv");
+    let cal = write(
+        &dir,
+        "warm.yaml",
+        &format!(
+            "machine: {}\npositioning:\n  - axis: x\n    runs: {runs}\n    temperature: {{axis: 23.5, expansion: 11.5, instrument: 20.4}}\n",
+            ex("machines/vmc3.yaml")
+        ),
+    );
+    let doc = ok_json(&["report", cal.to_str().unwrap(), "--format", "json"]);
+    let alone = ok_json(&[
+        "positioning",
+        &runs,
+        "--axis-temperature",
+        "23.5",
+        "--axis-expansion",
+        "11.5",
+        "--instrument-temperature",
+        "20.4",
+        "--format",
+        "json",
+    ]);
+    let got = &doc["positioning"][0]["document"];
+    assert_eq!(got["axis"], alone["axis"]);
+    assert_eq!(got["temperature"], alone["temperature"]);
+    assert!(got["temperature"].is_object());
+    let html = ok_stdout(&["report", cal.to_str().unwrap()]);
+    assert!(html.contains("corrected to 20 °C"));
+    // A missing expansion coefficient, located.
+    let bad = write(
+        &dir,
+        "cold.yaml",
+        &format!(
+            "machine: {}\npositioning:\n  - axis: x\n    runs: {runs}\n    temperature: {{axis: 23.5}}\n",
+            ex("machines/vmc3.yaml")
+        ),
+    );
+    let err = unwrapped(&fails(&["report", bad.to_str().unwrap()]));
+    assert!(
+        err.contains("cold.yaml:5") && err.contains("has no `expansion`"),
+        "{err}"
+    );
+}
+
 #[test]
 fn calibration_refusals_are_located() {
     let dir = scratch("report-refusals");
