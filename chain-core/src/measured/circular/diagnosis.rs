@@ -513,15 +513,7 @@ impl Basis {
     /// its coefficients on them.
     fn add(&mut self, col: &[f64]) -> Result<(), Vec<f64>> {
         let norm = dot(col, col).sqrt();
-        let mut rest = col.to_vec();
-        let mut coef = vec![0.0; self.q.len()];
-        for _ in 0..2 {
-            for (k, qk) in self.q.iter().enumerate() {
-                let p = dot(qk, &rest);
-                coef[k] += p;
-                rest.iter_mut().zip(qk).for_each(|(x, q)| *x -= p * q);
-            }
-        }
+        let (mut rest, mut coef) = self.project(col);
         let left = dot(&rest, &rest).sqrt();
         if norm == 0.0 || left <= COLLINEAR * norm {
             return Err(self.back(&coef));
@@ -531,6 +523,22 @@ impl Basis {
         self.q.push(rest);
         self.r.push(coef);
         Ok(())
+    }
+
+    /// `col` less its projection on the columns so far (modified
+    /// Gram-Schmidt, twice), and its coefficients on their orthonormal
+    /// basis.
+    fn project(&self, col: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let mut rest = col.to_vec();
+        let mut coef = vec![0.0; self.q.len()];
+        for _ in 0..2 {
+            for (k, qk) in self.q.iter().enumerate() {
+                let p = dot(qk, &rest);
+                coef[k] += p;
+                rest.iter_mut().zip(qk).for_each(|(x, q)| *x -= p * q);
+            }
+        }
+        (rest, coef)
     }
 
     /// `R⁻¹ y`.
@@ -751,10 +759,19 @@ fn diagnose_plane(
                 .unwrap_or(0.0)
         })
         .collect();
+    // Per run its samples and the basis that centres a term there, formed
+    // once for every term's share.
+    let centrings: Vec<(Vec<&Obs>, Basis)> = (0..pr.runs.len())
+        .map(|run| {
+            let obs: Vec<&Obs> = all.iter().filter(|o| o.run == run).collect();
+            let basis = centring(&obs);
+            (obs, basis)
+        })
+        .collect();
     let share_of = |run: usize, term: &dyn Fn(&Obs) -> f64| -> f64 {
-        let obs: Vec<&Obs> = all.iter().filter(|o| o.run == run).collect();
+        let (obs, basis) = &centrings[run];
         let t: Vec<f64> = obs.iter().map(|o| term(o)).collect();
-        let centred = centred(&obs, &t);
+        let (centred, _) = basis.project(&t);
         let (lo, hi) = centred
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
@@ -1048,42 +1065,32 @@ fn entry(term: Term, value: f64, uncertainty: Option<f64>, shares: Vec<RunShare>
     }
 }
 
-/// `t` less its least-squares projection on the run's centre (per
-/// direction) and radius columns: the term as it appears in the centred
-/// trace.
-fn centred(obs: &[&Obs], t: &[f64]) -> Vec<f64> {
+/// The basis of a run's centre (per direction) and radius columns at its
+/// samples `obs`: a term less its projection on it ([`Basis::project`]) is
+/// the term as it appears in the centred trace.
+fn centring(obs: &[&Obs]) -> Basis {
     let mut basis = Basis {
         q: Vec::new(),
         r: Vec::new(),
     };
-    let mut cols = vec![obs.iter().map(|_| 1.0).collect::<Vec<f64>>()];
+    let _ = basis.add(&obs.iter().map(|_| 1.0).collect::<Vec<f64>>());
     for dir in [Direction::Ccw, Direction::Cw] {
         for side in 0..2 {
-            cols.push(
-                obs.iter()
-                    .map(|o| {
-                        if o.dir == dir {
-                            let (s, c) = o.theta.sin_cos();
-                            [c, s][side]
-                        } else {
-                            0.0
-                        }
-                    })
-                    .collect(),
-            );
+            let col: Vec<f64> = (obs.iter())
+                .map(|o| {
+                    let (s, c) = o.theta.sin_cos();
+                    if o.dir == dir {
+                        [c, s][side]
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            // A direction not measured gives a zero column, not added.
+            let _ = basis.add(&col);
         }
     }
-    for c in &cols {
-        let _ = basis.add(c);
-    }
-    let mut rest = t.to_vec();
-    for _ in 0..2 {
-        for q in &basis.q {
-            let p = dot(q, &rest);
-            rest.iter_mut().zip(q).for_each(|(x, q)| *x -= p * q);
-        }
-    }
-    rest
+    basis
 }
 
 #[cfg(test)]

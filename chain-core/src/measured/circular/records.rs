@@ -298,9 +298,9 @@ impl Measurements {
                         .collect()
                 }
             };
-            let points: Vec<[f64; 3]> = (poses.iter())
-                .map(|(q, p)| chain.nominal(q, p).point)
-                .collect();
+            // Each sample's nominal tool point and frame, once.
+            let nominals: Vec<_> = (poses.iter()).map(|(q, p)| chain.nominal(q, p)).collect();
+            let points: Vec<[f64; 3]> = nominals.iter().map(|n| n.point).collect();
             let c0 = match pose {
                 CirclePose::Centre(centre) => chain.nominal(centre, &poses[0].1).point,
                 CirclePose::Columns => match circle_centre(&points) {
@@ -328,7 +328,8 @@ impl Measurements {
                     }
                 },
             };
-            for ((s, (q, p)), point) in samples.iter().zip(poses).zip(&points) {
+            for ((s, (q, p)), nominal) in samples.iter().zip(poses).zip(&nominals) {
+                let point = &nominal.point;
                 let v: [f64; 3] = std::array::from_fn(|i| point[i] - c0[i]);
                 let distance = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
                 let on = (distance - run.radius).abs() <= ON_CIRCLE * run.radius;
@@ -344,7 +345,6 @@ impl Measurements {
                     }
                     continue;
                 }
-                let nominal = chain.nominal(&q, &p);
                 let u = nominal.in_frame(v.map(|x| x / distance));
                 records.push(Measurement {
                     line: s.line,
